@@ -1,0 +1,156 @@
+"""The `jaxslosh` command (SPEC section 2). Exit status: 0 done, 2 bad input, 3 numerical failure."""
+from __future__ import annotations
+
+import argparse
+import json
+import os
+import sys
+import time
+
+EXIT_OK, EXIT_INPUT, EXIT_NUMERICAL = 0, 2, 3
+
+
+class InputError(Exception):
+    """Bad command-line input: one line on stderr, exit status 2."""
+
+
+class _Parser(argparse.ArgumentParser):
+    def error(self, message):  # one line, no usage block
+        raise InputError(f"{self.prog}: {message}")
+
+
+def _parser():
+    p = _Parser(prog="jaxslosh", description="Floating vessels carrying sloshing liquid (Gonzalez & Park 2013).")
+    sub = p.add_subparsers(dest="command", required=True, parser_class=_Parser)
+    r = sub.add_parser("run", help="simulate a scene, write the result file")
+    r.add_argument("scene")
+    r.add_argument("-o", "--output", help="result file (default: the scene's name with .h5, here)")
+    r.add_argument("--duration", type=float, help="override simulation.duration (s)")
+    r.add_argument("--dt", type=float, help="override simulation.dt (s)")
+    r.add_argument("--no-progress", action="store_true", help="no progress bar")
+    r.add_argument("--no-fields", action="store_true", help="do not store the liquid displacement fields")
+    c = sub.add_parser("check", help="validate a scene; list what it will simulate")
+    c.add_argument("scene")
+    pl = sub.add_parser("plot", help="time histories of a result: roll, pitch, heave and every probe")
+    pl.add_argument("result")
+    pl.add_argument("-o", "--output", help="figure file (default: the result's name with .png)")
+    m = sub.add_parser("modes", help="natural frequencies of a tank's liquid with the vessel held fixed")
+    m.add_argument("scene")
+    g = m.add_mutually_exclusive_group()
+    g.add_argument("--tank")
+    g.add_argument("--structure")
+    m.add_argument("-n", type=int, default=10, help="number of modes (default 10)")
+    m.add_argument("--json", action="store_true", help="print one JSON object")
+    return p
+
+
+def _enable_x64():
+    import jax
+    jax.config.update("jax_enable_x64", True)
+
+
+def _load(path):
+    from .scene import load_scene
+    scene = load_scene(path)
+    for w in scene.warnings:
+        print(f"warning: {w}", file=sys.stderr)
+    return scene
+
+
+def _positive(name, value):
+    if value is not None and not (value > 0):
+        raise InputError(f"--{name}: must be positive, got {value}")
+
+
+def cmd_run(a):
+    _positive("duration", a.duration)
+    _positive("dt", a.dt)
+    scene = _load(a.scene)
+    dt = a.dt if a.dt is not None else scene.simulation.dt
+    duration = a.duration if a.duration is not None else scene.simulation.duration
+    if dt > duration:
+        raise InputError(f"--dt: {dt} s is longer than the duration {duration} s")
+    out = a.output or os.path.splitext(os.path.basename(a.scene))[0] + ".h5"
+    d = os.path.dirname(os.path.abspath(out))
+    if not os.path.isdir(d):
+        raise InputError(f"-o: the folder {d} does not exist")
+    _enable_x64()
+    from .run import run_to_file
+    t0 = time.perf_counter()
+    status, steps, wall = run_to_file(scene, out, duration=a.duration, dt=a.dt,
+                                      progress=not a.no_progress, save_fields=False if a.no_fields else None)
+    total = time.perf_counter() - t0
+    if status != "ok":
+        print(f"jaxslosh: numerical failure at {status}; {steps} steps kept in {out}", file=sys.stderr)
+        return EXIT_NUMERICAL
+    print(f"done: {steps} steps to t = {steps * dt:.6g} s in {total:.2f} s wall, compilation included "
+          f"({wall:.2f} s after the first chunk) -> {out}")
+    return EXIT_OK
+
+
+def cmd_check(a):
+    scene = _load(a.scene)
+    from .scene import describe
+    print(describe(scene))
+    from .effects import effects_summary
+    print(effects_summary(scene))
+    return EXIT_OK
+
+
+def cmd_plot(a):
+    if not os.path.exists(a.result):
+        raise InputError(f"{a.result}: no such file")
+    out = a.output or os.path.splitext(a.result)[0] + ".png"
+    from .plot import plot_result
+    from .result import load_result
+    try:
+        r = load_result(a.result)
+    except (OSError, ValueError) as e:
+        raise InputError(f"{a.result}: not a readable jaxslosh result ({e})")
+    plot_result(r, out)
+    print(f"wrote {out}")
+    return EXIT_OK
+
+
+def cmd_modes(a):
+    if a.n < 1:
+        raise InputError(f"-n: must be at least 1, got {a.n}")
+    scene = _load(a.scene)
+    if a.structure is not None:
+        raise InputError("--structure: flexible structures are not supported yet")
+    _enable_x64()
+    from .analysis import sloshing_modes
+    tank = a.tank
+    if tank is None:
+        if not scene.tanks:
+            raise InputError(f"{a.scene}: the scene has no tanks")
+        tank = scene.tanks[0].name
+    modes = sloshing_modes(scene, tank=tank, n=a.n)
+    if a.json:
+        print(json.dumps({"tank": tank, "omega": [float(w) for w in modes.omega], "kind": list(modes.kind),
+                          "free_surface_share": [float(s) for s in modes.free_surface_share]}))
+    else:
+        print(f"liquid modes of tank {tank!r} (vessel held fixed):")
+        print(f"{'#':>3} {'omega rad/s':>12} {'f Hz':>10} {'period s':>10} {'surface share':>14}  kind")
+        import math
+        for i, (w, k, s) in enumerate(zip(modes.omega, modes.kind, modes.free_surface_share)):
+            f = w / (2 * math.pi)
+            print(f"{i + 1:>3} {w:12.5f} {f:10.5f} {1 / f if f > 0 else float('inf'):10.4f} {s:14.3f}  {k}")
+    return EXIT_OK
+
+
+def main(argv=None) -> int:
+    from .scene_types import SceneError
+    try:
+        a = _parser().parse_args(argv)
+        return {"run": cmd_run, "check": cmd_check, "plot": cmd_plot, "modes": cmd_modes}[a.command](a)
+    except (InputError, SceneError) as e:
+        print(f"error: {e}", file=sys.stderr)
+        return EXIT_INPUT
+    except KeyboardInterrupt:
+        print("interrupted", file=sys.stderr)
+        return 130
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())

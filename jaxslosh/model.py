@@ -1,0 +1,207 @@
+"""The assembled model: a rigid vessel (floating frame at its COG) carrying liquid in rigid tanks.
+
+Static model, dynamic state (STYLE.md habit 3): `System` holds everything that is constant in the
+body frame (the vessel's mass and inertia, hydrostatic coefficients, the liquid's mass and
+stiffness matrices on its free dofs); `Config`/`Vel` are the dynamic unknowns.
+
+Generalised coordinates: X0 (inertial position of the vessel COG), q (Euler parameters), d (liquid
+displacement relative to the tank, on the dofs the slip walls leave free). Generalised velocities:
+V0 = dX0/dt (inertial), omega (body frame), d_dot. Particle kinematics are eq. (1)-(4) of the paper
+with d kept in the rotational terms, so the system is Lagrangian with kinetic energy
+
+    T = 1/2 m_v |V0|^2 + 1/2 omega.I_v omega + 1/2 sum_ij Ms_ij v_i.v_j,
+    v_i = A^T V0 + d_dot_i + omega x (r_i + d_i)                     (body components)
+
+and potential energy V = V_h(X0, q) + 1/2 d^T K d - g_b(q).(sum_i m_i d_i), where g_b = A^T g is
+gravity turning with the body (eq. 32) and V_h the hydrostatic restoring of eqs. (33)-(36). GM_T and
+GM_L are for the frozen liquid (PHYSICS.md item 9), so only the liquid's displacement d adds a
+gravity moment. The residual below is the virtual work of inertia minus applied forces (eq. 26),
+written once as a pure function; tangents come from JAX.
+"""
+from __future__ import annotations
+
+from typing import NamedTuple, Optional
+
+import equinox as eqx
+import jax
+import jax.numpy as jnp
+import numpy as np
+
+from .kinematics import G_matrix, quat_exp, quat_multiply, rotation_matrix, skew
+
+# eq. (36): q^T A_phi q = 2 (q0 q1 + q2 q3) = sin(roll) cos(pitch), q^T A_theta q = 2 (q0 q2 - q1 q3)
+A_PHI = np.array([[0, 1, 0, 0], [1, 0, 0, 0], [0, 0, 0, 1], [0, 0, 1, 0]], dtype=float)
+A_THETA = np.array([[0, 0, 1, 0], [0, 0, 0, -1], [1, 0, 0, 0], [0, -1, 0, 0]], dtype=float)
+
+
+class Config(NamedTuple):
+    X0: jax.Array      # (3,) inertial position of the vessel COG
+    q: jax.Array       # (4,) Euler parameters, scalar first
+    d: jax.Array       # (nf,) liquid displacement on free dofs, tank frame
+
+
+class Hydro(eqx.Module):
+    """Linear hydrostatic restoring about the initial equilibrium (eqs. 33-36)."""
+    rho_w: jax.Array
+    gravity: jax.Array
+    waterplane_area: jax.Array
+    displaced_volume: jax.Array
+    gm_t: jax.Array
+    gm_l: jax.Array
+    moment_form: str = eqx.field(static=True, default="paper")
+
+    def force(self, X0):
+        """Eq. (35) in the inertial frame: F_z = -rho g A_w (Z0 - Z0^0), equilibrium at Z0^0 = 0."""
+        return jnp.array([0.0, 0.0, -self.rho_w * self.gravity * self.waterplane_area * X0[2]])
+
+    def moment_paper(self, q):
+        """Eq. (36), body frame."""
+        k = self.rho_w * self.gravity * self.displaced_volume
+        return -k * jnp.array([self.gm_t * (q @ A_PHI @ q), self.gm_l * (q @ A_THETA @ q), 0.0])
+
+    def potential(self, X0, q):
+        """Restoring energy. The moment part, k_T g_y^2 + k_L g_x^2 over (1 + g_z) with g = A^T e_z,
+        is 1/2 (k_T roll^2 + k_L pitch^2) to second order, exact for pure roll and pure pitch, and
+        its gradient is eq. (36) exactly when GM_T = GM_L (eq. (36) is not conservative otherwise)."""
+        k = self.rho_w * self.gravity * self.displaced_volume
+        g = rotation_matrix(q)[2]
+        heave = 0.5 * self.rho_w * self.gravity * self.waterplane_area * X0[2] ** 2
+        return heave + k * (self.gm_t * g[1] ** 2 + self.gm_l * g[0] ** 2) / (1.0 + g[2])
+
+    def moment(self, q):
+        if self.moment_form == "paper":
+            return self.moment_paper(q)
+        # conservative: minus the derivative of the potential along body-frame rotations
+        return -jax.grad(lambda th: self.potential(jnp.zeros(3), quat_multiply(q, quat_exp(th))))(jnp.zeros(3))
+
+
+class Liquid(eqx.Module):
+    """All tank liquid of the vessel, as one block (tanks stacked block-diagonally)."""
+    r: jax.Array          # (N, 3) node positions in the vessel frame (COG origin)
+    Ms: jax.Array         # (N, N) scalar mass matrix (3N mass = kron(Ms, I3))
+    K: jax.Array          # (nf, nf) stiffness on the free dofs
+    free: jax.Array       # (nf,) indices of the free dofs in the node-major 3N vector
+    n_nodes: int = eqx.field(static=True)
+
+    def full(self, d):
+        """(nf,) free-dof vector -> (N, 3) nodal field, zero on the wall-normal dofs."""
+        return jnp.zeros(3 * self.n_nodes, d.dtype).at[self.free].set(d).reshape(self.n_nodes, 3)
+
+    def free_part(self, F):
+        return F.reshape(-1)[self.free]
+
+    @property
+    def m_nodes(self):
+        return self.Ms.sum(axis=1)
+
+
+class System(eqx.Module):
+    mass: jax.Array                 # vessel mass (no liquid)
+    inertia: jax.Array              # (3, 3) about the vessel COG, body axes
+    gravity: jax.Array              # m/s^2, along -Z
+    hydro: Optional[Hydro]
+    liquid: Optional[Liquid]
+
+    @property
+    def nf(self) -> int:
+        return 0 if self.liquid is None else int(self.liquid.free.shape[0])
+
+    @property
+    def n(self) -> int:
+        return 6 + self.nf
+
+    def total_mass(self):
+        m = self.mass
+        if self.liquid is not None:
+            m = m + self.liquid.Ms.sum()
+        return m
+
+    # ---------------------------------------------------------------- equations of motion
+    def residual(self, c: Config, V0, omega, d_dot, acc):
+        """Virtual work of inertia minus applied forces (eq. 26) for the unknown accelerations
+        acc = (dV0/dt (3, inertial), d omega/dt (3, body), d2 d/dt2 (nf)). Rows: translation
+        (inertial, N), rotation (body, N m), liquid free dofs (N)."""
+        A = rotation_matrix(c.q)
+        a0, alpha = acc[:3], acc[3:6]
+        g_vec = jnp.array([0.0, 0.0, -self.gravity])
+        g_b = A.T @ g_vec
+        r_t = self.mass * a0
+        r_r = self.inertia @ alpha + jnp.cross(omega, self.inertia @ omega)
+        parts = []
+        if self.liquid is not None:
+            L = self.liquid
+            D, Dv, Da = L.full(c.d), L.full(d_dot), L.full(acc[6:])
+            x = L.r + D
+            a = (A.T @ a0 + Da + jnp.cross(alpha, x) + 2.0 * jnp.cross(omega, Dv)
+                 + jnp.cross(omega, jnp.cross(omega, x)))             # eq. (4), body components
+            F = L.Ms @ a                                             # inertia forces on nodes
+            r_t = r_t + A @ F.sum(axis=0)
+            r_r = r_r + jnp.cross(x, F).sum(axis=0)
+            mD = L.m_nodes @ D                                       # first moment of d
+            r_d = L.free_part(F - L.m_nodes[:, None] * g_b) + L.K @ c.d
+            parts.append(r_d)
+            if self.hydro is not None:
+                r_r = r_r - jnp.cross(mD, g_b)
+            else:
+                r_r = r_r - jnp.cross(L.m_nodes @ L.r + mD, g_b)
+        if self.hydro is not None:
+            r_t = r_t - self.hydro.force(c.X0)
+            r_r = r_r - self.hydro.moment(c.q)
+        else:
+            r_t = r_t - self.total_mass() * g_vec
+        return jnp.concatenate([r_t, r_r, *parts])
+
+    # ---------------------------------------------------------------- energies
+    def kinetic_energy(self, c: Config, V0, omega, d_dot):
+        T = 0.5 * self.mass * V0 @ V0 + 0.5 * omega @ self.inertia @ omega
+        if self.liquid is not None:
+            L = self.liquid
+            A = rotation_matrix(c.q)
+            v = A.T @ V0 + L.full(d_dot) + jnp.cross(omega, L.r + L.full(c.d))
+            T = T + 0.5 * jnp.sum(v * (L.Ms @ v))
+        return T
+
+    def potential_energy(self, c: Config):
+        V = jnp.zeros(())
+        A = rotation_matrix(c.q)
+        g_b = A.T @ jnp.array([0.0, 0.0, -self.gravity])
+        if self.hydro is not None:
+            V = V + self.hydro.potential(c.X0, c.q)
+        else:
+            V = V + self.total_mass() * self.gravity * c.X0[2]
+        if self.liquid is not None:
+            L = self.liquid
+            V = V + 0.5 * c.d @ (L.K @ c.d) - g_b @ (L.m_nodes @ L.full(c.d))
+            if self.hydro is None:
+                V = V - g_b @ (L.m_nodes @ L.r)
+        return V
+
+    # ---------------------------------------------------------------- scales
+    def scales(self):
+        """Characteristic mass (kg or kg m^2) of each unknown, to scale residual rows to O(1)."""
+        m = self.total_mass()
+        I = jnp.diag(self.inertia)
+        if self.liquid is not None:
+            L = self.liquid
+            x = L.r
+            I = I + jnp.array([
+                L.m_nodes @ (x[:, 1] ** 2 + x[:, 2] ** 2),
+                L.m_nodes @ (x[:, 0] ** 2 + x[:, 2] ** 2),
+                L.m_nodes @ (x[:, 0] ** 2 + x[:, 1] ** 2)])
+        s = [jnp.full(3, m), I]
+        if self.liquid is not None:
+            s.append(jnp.repeat(self.liquid.m_nodes, 3)[self.liquid.free])
+        return jnp.concatenate(s)
+
+
+def advance_config(c: Config, delta) -> Config:
+    """Apply an increment (dX0, Theta, dd): rotations on the group, q_{n+1} = q_n exp(Theta)."""
+    return Config(c.X0 + delta[:3], quat_multiply(c.q, quat_exp(delta[3:6])), c.d + delta[6:])
+
+
+def omega_from_qdot(q, q_dot):
+    """omega = 2 G(q) q_dot (body frame)."""
+    return 2.0 * G_matrix(q) @ q_dot
+
+
+__all__ = ["Config", "Hydro", "Liquid", "System", "advance_config", "omega_from_qdot", "skew"]

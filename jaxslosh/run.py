@@ -1,0 +1,271 @@
+"""The time loop: one jit-compiled `lax.scan` over saved frames (each frame `save_every` steps).
+
+`simulate` runs the whole scan in one call (differentiable: `params` may hold tracers);
+`run_to_file` runs the same compiled chunk repeatedly and appends each chunk to the result file,
+with a progress bar, so long runs show progress and a killed run leaves a readable file.
+A step that fails (Newton not converged, non-finite values) freezes the state; the host finds the
+first failure, keeps every frame before it and reports the step, the time and the residual.
+"""
+from __future__ import annotations
+
+import math
+import sys
+import time as _time
+from typing import NamedTuple, Optional
+
+import equinox as eqx
+import jax
+import jax.numpy as jnp
+import numpy as np
+
+from .build import Built, build
+from .integrator import Solver, State, initial_state, make_scheme, make_solver, step
+from .kinematics import rotation_matrix, rpy_from_quat
+from .result import (Energy, ProbeHistory, Result, ResultWriter, SolverHistory, TankField, VesselHistory,
+                     truncated)
+from .scene_types import Scene
+
+
+class NumericalFailure(RuntimeError):
+    """A step that did not converge or produced non-finite values (exit status 3 on the CLI)."""
+
+    def __init__(self, message: str, result: Optional[Result] = None):
+        super().__init__(message)
+        self.result = result
+
+
+class Carry(NamedTuple):
+    s: State
+    k: jax.Array          # steps done
+    failed: jax.Array     # a step has failed: the state is frozen since
+    fail_step: jax.Array
+    fail_err: jax.Array
+    fail_it: jax.Array
+
+
+class Frame(NamedTuple):
+    t: jax.Array
+    X0: jax.Array
+    q: jax.Array
+    omega: jax.Array
+    probes: jax.Array
+    ke: jax.Array
+    pe: jax.Array
+    iterations: jax.Array
+    residual: jax.Array
+    D: jax.Array          # liquid nodal displacement (N, 3), empty without liquid
+    failed: jax.Array
+
+
+class Setup(NamedTuple):
+    built: Built
+    solver: Solver
+    n_steps: int
+    save_every: int
+
+
+def prepare(scene: Scene, params=None, duration=None, dt=None) -> Setup:
+    sim = scene.simulation
+    h = float(dt if dt is not None else sim.dt)
+    T = float(duration if duration is not None else sim.duration)
+    b = build(scene, params)
+    scheme = make_scheme(sim.scheme, sim.alpha, sim.rho_inf)
+    solver = make_solver(b.system, h, scheme, sim.tolerance, sim.max_iterations)
+    n_steps = int(round(T / h))
+    return Setup(b, solver, n_steps, max(1, int(sim.save_every)))
+
+
+def _frame(b: Built, s: State, it, err, failed) -> Frame:
+    sysm = b.system
+    V0, om, dd = s.v[:3], s.v[3:6], s.v[6:]
+    A = rotation_matrix(s.c.q)
+    if sysm.liquid is not None:
+        D = sysm.liquid.full(s.c.d)
+    else:
+        D = jnp.zeros((0, 3))
+    pr = b.probes
+    local = pr.points + (pr.weights @ D if sysm.liquid is not None else 0.0)
+    probes = s.c.X0[None, :] + local @ A.T
+    return Frame(s.t, s.c.X0, s.c.q, om, probes, sysm.kinetic_energy(s.c, V0, om, dd),
+                 sysm.potential_energy(s.c), it, err, D, failed)
+
+
+def _select(pred, a, b):
+    return jax.tree_util.tree_map(lambda x, y: jnp.where(pred, x, y), a, b)
+
+
+@eqx.filter_jit
+def start(b: Built, solver: Solver):
+    s0, info = initial_state(b.system, solver, b.c0, b.v0)
+    failed = ~info.ok
+    carry = Carry(s0, jnp.array(0), failed, jnp.where(failed, 0, -1), info.residual, info.iterations)
+    return carry, _frame(b, s0, info.iterations, info.residual, failed)
+
+
+@eqx.filter_jit
+def advance(b: Built, solver: Solver, carry: Carry, n_frames: int, save_every: int):
+    """n_frames frames of save_every steps each: one scan of scans, no Python loop in traced code."""
+
+    def one_step(c: Carry, _):
+        s_new, info = step(b.system, solver, c.s)
+        bad = ~info.ok & ~c.failed
+        keep = c.failed | ~info.ok
+        s = _select(keep, c.s, s_new)
+        c2 = Carry(s, c.k + jnp.where(keep, 0, 1), c.failed | ~info.ok,
+                   jnp.where(bad, c.k + 1, c.fail_step), jnp.where(bad, info.residual, c.fail_err),
+                   jnp.where(bad, info.iterations, c.fail_it))
+        return c2, (info.iterations, info.residual)
+
+    def one_frame(c: Carry, _):
+        c, (its, errs) = jax.lax.scan(one_step, c, None, length=save_every)
+        return c, _frame(b, c.s, its.max(), errs.max(), c.failed)
+
+    return jax.lax.scan(one_frame, carry, None, length=n_frames)
+
+
+def _concat_frames(frames):
+    return jax.tree_util.tree_map(lambda *xs: jnp.concatenate(xs), *frames)
+
+
+def _to_result(b: Built, fr: Frame, scene_text: str, status: str, steps_done: int) -> Result:
+    probes = {}
+    for i, name in enumerate(b.probes.names):
+        pos = fr.probes[:, i, :]
+        probes[name] = ProbeHistory(pos, pos - pos[0])
+    tanks = {}
+    for t in b.tanks:
+        N = t.nodes.shape[0]
+        tanks[t.name] = TankField(t.nodes, t.elements, fr.D[:, t.node_offset:t.node_offset + N, :])
+    return Result(time=fr.t, vessel=VesselHistory(fr.X0, fr.q, fr.omega, rpy_from_quat(fr.q)), probes=probes,
+                  energy=Energy(fr.ke, fr.pe), solver=SolverHistory(fr.iterations, fr.residual), tanks=tanks,
+                  status=status, steps_done=steps_done, scene_text=scene_text)
+
+
+def _failure_message(carry: Carry, h: float, tol: float, max_iter: int) -> str:
+    k = int(carry.fail_step)
+    err = float(carry.fail_err)
+    if k == 0:
+        return f"the initial accelerations could not be solved (scaled residual {err:.3g})"
+    t = k * h
+    if not math.isfinite(err):
+        return f"step {k} (t = {t:.6g} s): non-finite values (NaN or Inf) in the solution"
+    return (f"step {k} (t = {t:.6g} s): Newton did not converge in {int(carry.fail_it)} iterations "
+            f"(scaled residual {err:.3g}, tolerance {tol:.3g})")
+
+
+def simulate(scene: Scene, params: Optional[dict] = None, *, duration: Optional[float] = None,
+             dt: Optional[float] = None, throw: bool = False) -> Result:
+    """Run a scene; the result holds every `save_every`-th step, t = 0 included.
+
+    `params` maps dotted scene keys to replacement values, which may be JAX tracers:
+    `jax.grad` of any scalar function of the result works with respect to them.
+    A numerical failure truncates the result to the frames before it and sets `status`
+    (or raises NumericalFailure when `throw=True`); under tracing the status cannot be read.
+    """
+    setup = prepare(scene, params, duration, dt)
+    b, solver = setup.built, setup.solver
+    n_frames = setup.n_steps // setup.save_every
+    carry, f0 = start(b, solver)
+    carry, frames = advance(b, solver, carry, n_frames, setup.save_every)
+    fr = _concat_frames([jax.tree_util.tree_map(lambda x: x[None], f0), frames])
+    traced = isinstance(carry.failed, jax.core.Tracer)
+    if traced:
+        return _to_result(b, fr, scene.text, "ok", setup.n_steps)
+    if bool(carry.failed):
+        msg = _failure_message(carry, solver.h, solver.tol, solver.max_iter)
+        n_ok = int(np.sum(~np.asarray(fr.failed)))
+        res = _to_result(b, fr, scene.text, msg, int(carry.k))
+        res = truncated(res, n_ok)
+        if throw:
+            raise NumericalFailure(msg, res)
+        return res
+    return _to_result(b, fr, scene.text, "ok", int(carry.k))
+
+
+class Progress:
+    """A progress bar on stderr (no dependency; quiet when stderr is not a terminal unless forced)."""
+
+    def __init__(self, total: int, enabled: bool = True, width: int = 30):
+        self.total, self.enabled, self.width = max(1, total), enabled, width
+        self.t0 = _time.perf_counter()
+        self.last = -1.0
+
+    def update(self, done: int, extra: str = ""):
+        if not self.enabled:
+            return
+        now = _time.perf_counter()
+        if now - self.last < 0.2 and done < self.total:
+            return
+        self.last = now
+        frac = min(1.0, done / self.total)
+        bar = "#" * int(frac * self.width) + "-" * (self.width - int(frac * self.width))
+        el = now - self.t0
+        eta = el / frac - el if frac > 0 else 0.0
+        sys.stderr.write(f"\r[{bar}] {100 * frac:5.1f}% step {done}/{self.total} {el:6.1f}s elapsed, {eta:6.1f}s left {extra}")
+        sys.stderr.flush()
+
+    def close(self):
+        if self.enabled:
+            sys.stderr.write("\n")
+            sys.stderr.flush()
+
+
+def run_to_file(scene: Scene, out: str, *, duration=None, dt=None, progress: bool = True,
+                save_fields: Optional[bool] = None):
+    """The CLI's run: chunks of the compiled loop appended to `out` as they finish.
+    Returns (status, steps done, wall seconds of the loop after the first chunk compiled)."""
+    setup = prepare(scene, None, duration, dt)
+    b, solver = setup.built, setup.solver
+    se = setup.save_every
+    n_frames = setup.n_steps // se
+    N = 0 if b.system.liquid is None else b.system.liquid.n_nodes
+    if save_fields is None:
+        save_fields = N * 3 * 8 * (n_frames + 1) < 200e6
+    chunk_frames = scene.simulation.chunk or max(1, min(n_frames, max(1, 500 // se)))
+    writer = ResultWriter(out, scene.text, b.probes.names, b.tanks if save_fields else ())
+    status, steps_done = "ok", 0
+    bar = Progress(setup.n_steps, enabled=progress)
+    t_loop = None
+    try:
+        carry, f0 = start(b, solver)
+        first = jax.tree_util.tree_map(lambda x: np.asarray(x)[None], f0)
+        p0 = first.probes[0]
+        pending, done_frames = first, 0
+        while True:
+            ok = ~np.asarray(pending.failed)
+            n_ok = int(ok.sum()) if ok.all() else int(np.argmin(ok))
+            writer.append(_file_frames(b, pending, p0, n_ok, save_fields), min(int(carry.k), setup.n_steps))
+            if bool(carry.failed) or done_frames >= n_frames:
+                break
+            carry, fr = advance(b, solver, carry, chunk_frames, se)
+            fr = jax.device_get(fr)
+            if t_loop is None:
+                t_loop = _time.perf_counter()
+            take = min(chunk_frames, n_frames - done_frames)
+            pending = jax.tree_util.tree_map(lambda x: x[:take], fr)
+            done_frames += take
+            bar.update(min(int(carry.k), setup.n_steps))
+        if bool(carry.failed):
+            status = _failure_message(carry, solver.h, solver.tol, solver.max_iter)
+        steps_done = min(int(carry.k), setup.n_steps)
+    finally:
+        bar.close()
+        writer.close(status, steps_done)
+    wall = (_time.perf_counter() - t_loop) if t_loop is not None else 0.0
+    return status, steps_done, wall
+
+
+def _file_frames(b: Built, fr: Frame, p0, n: int, save_fields: bool) -> dict:
+    """Frames (first n rows) as {dataset: array} for the result file."""
+    q = np.asarray(fr.q[:n])
+    d = {"time": fr.t[:n], "vessel/position": fr.X0[:n], "vessel/quaternion": q,
+         "vessel/angular_velocity": fr.omega[:n], "vessel/roll_pitch_yaw": np.asarray(rpy_from_quat(q)).reshape(-1, 3),
+         "energy/kinetic": fr.ke[:n], "energy/potential": fr.pe[:n], "solver/iterations": fr.iterations[:n],
+         "solver/residual": fr.residual[:n]}
+    for i, name in enumerate(b.probes.names):
+        d[f"probes/{name}/position"] = fr.probes[:n, i]
+        d[f"probes/{name}/displacement"] = fr.probes[:n, i] - p0[i]
+    if save_fields:
+        for t in b.tanks:
+            d[f"tanks/{t.name}/displacement"] = fr.D[:n, t.node_offset:t.node_offset + t.nodes.shape[0]]
+    return {k: np.asarray(v) for k, v in d.items()}

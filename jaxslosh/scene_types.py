@@ -1,0 +1,156 @@
+"""The validated, immutable scene: plain frozen dataclasses of Python numbers and tuples.
+
+A scene is what `load_scene` returns (see `scene.py` for the loader and its validation rules,
+SPEC.md section 1 for the file format). Everything here is static model data: nothing is traced.
+Values that `simulate(scene, params=...)` may override are looked up by their dotted TOML path
+(`vessel.hydrostatics.gm_t`, `tanks.tank.fill_depth` or `tanks[0].fill_depth`) in `Scene.values()`.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from typing import Optional
+
+
+Vec3 = tuple[float, float, float]
+Mat3 = tuple[Vec3, Vec3, Vec3]
+
+
+class SceneError(ValueError):
+    """Bad input: `key` is the dotted path of the offending value, the message names it."""
+
+    def __init__(self, key: str, message: str):
+        self.key = key
+        super().__init__(f"{key}: {message}" if key else message)
+
+
+@dataclass(frozen=True)
+class Environment:
+    gravity: float = 9.81            # m/s^2, >= 0 (0: no gravity, e.g. a torque-free body)
+    water_density: float = 1025.0    # kg/m^3, > 0
+
+
+@dataclass(frozen=True)
+class Simulation:
+    duration: float                  # s, > 0
+    dt: float                        # s, > 0, <= duration
+    scheme: str = "hht"              # "newmark" | "hht" | "generalized-alpha"
+    alpha: float = 0.0               # HHT: 0 <= alpha <= 1/3
+    rho_inf: float = 1.0             # generalized-alpha: 0 <= rho_inf <= 1
+    save_every: int = 1              # >= 1
+    tolerance: float = 1e-10         # Newton: residual over mass, an acceleration error (m/s^2, rad/s^2)
+    max_iterations: int = 25         # Newton iterations per step before the step counts as failed
+    chunk: int = 0                   # steps per jitted chunk written to the result (0: automatic)
+
+    @property
+    def n_steps(self) -> int:
+        return int(round(self.duration / self.dt))
+
+
+@dataclass(frozen=True)
+class Hydrostatics:
+    waterplane_area: float           # A_w, m^2, > 0
+    displaced_volume: float          # m^3, > 0
+    gm_t: float                      # m (<= 0 legal, warned)
+    gm_l: float                      # m (<= 0 legal, warned)
+    moment: str = "paper"            # "paper": eq. (36) literally | "conservative": gradient of a potential
+
+
+@dataclass(frozen=True)
+class Initial:
+    position: Vec3 = (0.0, 0.0, 0.0)          # m, inertial offset of the COG from equilibrium
+    velocity: Vec3 = (0.0, 0.0, 0.0)          # m/s, inertial
+    angular_velocity: Vec3 = (0.0, 0.0, 0.0)  # rad/s, body frame
+    roll_pitch_yaw: Vec3 = (0.0, 0.0, 0.0)    # rad, initial attitude (Z-Y-X: yaw, then pitch, then roll)
+
+
+@dataclass(frozen=True)
+class Vessel:
+    mass: float                      # kg, > 0 (everything except tank liquid)
+    inertia: Mat3                    # kg m^2 about the COG, body axes, symmetric positive definite
+    hydrostatics: Optional[Hydrostatics] = None   # None: no buoyancy (free body)
+    initial: Initial = field(default_factory=Initial)
+
+
+@dataclass(frozen=True)
+class Material:
+    young: float                     # Pa, > 0
+    poisson: float                   # -1 < nu < 0.5
+    density: float                   # kg/m^3, > 0
+
+
+@dataclass(frozen=True)
+class Fluid:
+    density: float = 1000.0          # kg/m^3, > 0
+    sound_speed: float = 1500.0      # m/s, > 0
+    element: str = "stabilized"      # liquid element form, see liquid.py (ELEMENT_FORMS)
+
+
+@dataclass(frozen=True)
+class Walls:
+    thickness: float                 # m, > 0
+    material: Material
+    mesh: Optional[tuple[int, int, int]] = None
+
+
+@dataclass(frozen=True)
+class Tank:
+    name: str
+    origin: Vec3                     # inner min corner in the vessel frame, m
+    size: Vec3                       # inner length, breadth, height, m, each > 0
+    fill_depth: float                # m, 0 < fill_depth <= size[2]
+    mesh: tuple[int, int, int]       # liquid hexahedra along x, y, z, each >= 1
+    walls: str = "rigid"             # "rigid" | "elastic"
+    fluid: Fluid = field(default_factory=Fluid)
+    wall_spec: Optional[Walls] = None   # the [tanks.walls] table when walls = "elastic"
+
+    @property
+    def liquid_volume(self) -> float:
+        return self.size[0] * self.size[1] * self.fill_depth
+
+    @property
+    def liquid_mass(self) -> float:
+        return self.fluid.density * self.liquid_volume
+
+
+@dataclass(frozen=True)
+class Structure:
+    name: str
+    origin: Vec3
+    size: Vec3
+    mesh: tuple[int, int, int]
+    attach: str                      # "x-" | "x+" | "y-" | "y+" | "z-" | "z+"
+    material: Material
+
+
+@dataclass(frozen=True)
+class Probe:
+    name: str
+    point: Vec3                      # local coordinates from the owner's origin, m
+    tank: Optional[str] = None       # exactly one of tank / structure is set
+    structure: Optional[str] = None
+
+
+@dataclass(frozen=True)
+class Scene:
+    title: str
+    environment: Environment
+    simulation: Simulation
+    vessel: Vessel
+    tanks: tuple[Tank, ...] = ()
+    structures: tuple[Structure, ...] = ()
+    probes: tuple[Probe, ...] = ()
+    text: str = ""                   # the TOML source, stored in result files
+    path: str = ""
+    warnings: tuple[str, ...] = ()   # physically doubtful but legal choices, said once at load
+
+    def tank(self, name: str) -> Tank:
+        for t in self.tanks:
+            if t.name == name:
+                return t
+        raise SceneError("tank", f"no tank named {name!r} (tanks: {', '.join(t.name for t in self.tanks) or 'none'})")
+
+    def structure(self, name: str) -> Structure:
+        for s in self.structures:
+            if s.name == name:
+                return s
+        raise SceneError("structure", f"no structure named {name!r}")
