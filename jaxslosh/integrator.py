@@ -136,7 +136,8 @@ def _newton(R, x0, Cinv, scale, tol, max_iter):
     x, r, it, err, stalled = jax.lax.while_loop(cond, body, (x0, r0, jnp.array(0), err_of(r0), jnp.array(False)))
     # Converged: below the tolerance, or stalled at round-off within a factor 100 of it.
     ok = jnp.isfinite(err) & ((err <= tol) | (stalled & (err <= 100.0 * tol)))
-    return x, (it, err, ok)
+    # aux leaves are floats: custom_root's JVP rule cannot carry integer or boolean aux tangents
+    return x, (it.astype(float), err, ok.astype(float))
 
 
 def _dense_tangent_solve(g, y):
@@ -145,8 +146,10 @@ def _dense_tangent_solve(g, y):
 
 def solve_root(R, x0, Cinv, scale, tol, max_iter):
     """Root of R near x0; differentiable by the implicit function theorem (lax.custom_root)."""
-    return jax.lax.custom_root(
+    x, (it, err, ok) = jax.lax.custom_root(
         R, x0, lambda f, x: _newton(f, x, Cinv, scale, tol, max_iter), _dense_tangent_solve, has_aux=True)
+    it, err, ok = jax.lax.stop_gradient((it, err, ok))
+    return x, (it.astype(jnp.int32), err, ok > 0.5)
 
 
 def _split(v):
