@@ -13,7 +13,7 @@ import jax.numpy as jnp
 import numpy as np
 
 from .kinematics import quat_from_rpy
-from .model import Config, Hydro, Liquid, System
+from .model import Config, Forced, Hydro, Liquid, System
 from .scene_types import Scene, SceneError
 
 # Scene values that simulate(params=...) may replace by traced values (the vessel is rebuilt per
@@ -82,8 +82,15 @@ def build(scene: Scene, params: Optional[dict] = None) -> Built:
             gm_l=jnp.asarray(P("vessel.hydrostatics.gm_l", h.gm_l), dtype=float),
             moment_form=h.moment)
     liquid, tanks, d0 = _build_liquid(scene)
+    forced = None
+    if ves.forced is not None:
+        f = ves.forced
+        dofs = ("surge", "sway", "heave", "roll", "pitch", "yaw")
+        forced = Forced(dof=dofs.index(f.dof), amplitude=jnp.asarray(f.amplitude, dtype=float),
+                        frequency=jnp.asarray(f.frequency, dtype=float), ramp=float(f.ramp))
     system = System(mass=jnp.asarray(P("vessel.mass", ves.mass), dtype=float),
-                    inertia=_inertia(P("vessel.inertia", ves.inertia)), gravity=g, hydro=hydro, liquid=liquid)
+                    inertia=_inertia(P("vessel.inertia", ves.inertia)), gravity=g, hydro=hydro, liquid=liquid,
+                    forced=forced)
     ini = ves.initial
     q0 = quat_from_rpy(jnp.asarray(P("vessel.initial.roll_pitch_yaw", ini.roll_pitch_yaw), dtype=float))
     nf = system.nf
@@ -94,6 +101,9 @@ def build(scene: Scene, params: Optional[dict] = None) -> Built:
     v0 = jnp.concatenate([jnp.asarray(P("vessel.initial.velocity", ini.velocity), dtype=float),
                           jnp.asarray(P("vessel.initial.angular_velocity", ini.angular_velocity), dtype=float),
                           jnp.zeros(nf)])
+    if forced is not None:   # the prescribed motion sets the rigid state at t = 0
+        c0 = Config(jnp.zeros(3), jnp.array([1.0, 0.0, 0.0, 0.0]), c0.d)
+        v0 = v0.at[:6].set(forced.rates(jnp.zeros(())))
     probes = _build_probes(scene, tanks, liquid)
     return Built(system, c0, v0, probes, tanks)
 

@@ -162,7 +162,7 @@ def initial_state(system: System, solver: Solver, c0: Config, v0) -> tuple[State
 
     def R(acc):
         V0, om, dd = _split(v0)
-        return system.residual(c0, V0, om, dd, acc)
+        return system.residual(c0, V0, om, dd, acc, jnp.zeros(()))
 
     acc0, (it, err, ok) = solve_root(R, jnp.zeros_like(v0), solver.Cinv_mass, scale, solver.tol, solver.max_iter)
     return State(c0, v0, acc0, acc0, jnp.zeros(())), StepInfo(it, err, ok)
@@ -184,7 +184,7 @@ def step(system: System, solver: Solver, s: State) -> tuple[State, StepInfo]:
     def R(delta):
         c, v, acc, _ = unpack(delta)
         V0, om, dd = _split(v)
-        return system.residual(c, V0, om, dd, acc)
+        return system.residual(c, V0, om, dd, acc, s.t + h)
 
     x0 = base + h * h * beta * s.a
     delta, (it, err, ok) = solve_root(R, x0, solver.Cinv_step, scale, solver.tol, solver.max_iter)

@@ -75,6 +75,35 @@ class Hydro(eqx.Module):
         return -jax.grad(lambda th: self.potential(jnp.zeros(3), quat_multiply(q, quat_exp(th))))(jnp.zeros(3))
 
 
+class Forced(eqx.Module):
+    """Prescribed harmonic motion of one rigid dof (the others held at zero): the rigid rows of the
+    residual prescribe the accelerations, scaled by the rigid masses like the free rows."""
+    dof: int = eqx.field(static=True)      # 0-2 surge, sway, heave; 3-5 roll, pitch, yaw
+    amplitude: jax.Array
+    frequency: jax.Array
+    ramp: float = eqx.field(static=True, default=0.0)
+
+    def value(self, t):
+        x = self.amplitude * jnp.sin(self.frequency * t)
+        if self.ramp > 0:
+            x = x * jnp.where(t < self.ramp, 0.5 * (1.0 - jnp.cos(jnp.pi * t / self.ramp)), 1.0)
+        return x
+
+    def rates(self, t):
+        """Prescribed (dX0/dt, omega) at time t."""
+        v = jax.jvp(self.value, (t,), (jnp.ones_like(t),))[1]
+        return jnp.zeros(6).at[self.dof].set(v)
+
+    def accelerations(self, t):
+        a = jax.jvp(lambda tt: jax.jvp(self.value, (tt,), (jnp.ones_like(tt),))[1], (t,), (jnp.ones_like(t),))[1]
+        return jnp.zeros(6).at[self.dof].set(a)
+
+    def rigid_rows(self, acc, t, scale):
+        """The prescribed accelerations (a single-axis rotation has omega_dot = theta_ddot e);
+        positions and velocities follow by the scheme from the prescribed initial rates."""
+        return scale * (acc[:6] - self.accelerations(t))
+
+
 class Liquid(eqx.Module):
     """All tank liquid of the vessel, as one block (tanks stacked block-diagonally)."""
     r: jax.Array          # (N, 3) node positions in the vessel frame (COG origin)
@@ -101,6 +130,7 @@ class System(eqx.Module):
     gravity: jax.Array              # m/s^2, along -Z
     hydro: Optional[Hydro]
     liquid: Optional[Liquid]
+    forced: Optional[Forced] = None
 
     @property
     def nf(self) -> int:
@@ -117,7 +147,7 @@ class System(eqx.Module):
         return m
 
     # ---------------------------------------------------------------- equations of motion
-    def residual(self, c: Config, V0, omega, d_dot, acc):
+    def residual(self, c: Config, V0, omega, d_dot, acc, t=0.0):
         """Virtual work of inertia minus applied forces (eq. 26) for the unknown accelerations
         acc = (dV0/dt (3, inertial), d omega/dt (3, body), d2 d/dt2 (nf)). Rows: translation
         (inertial, N), rotation (body, N m), liquid free dofs (N)."""
@@ -149,7 +179,10 @@ class System(eqx.Module):
             r_r = r_r - self.hydro.moment(c.q)
         else:
             r_t = r_t - self.total_mass() * g_vec
-        return jnp.concatenate([r_t, r_r, *parts])
+        rigid = jnp.concatenate([r_t, r_r])
+        if self.forced is not None:
+            rigid = self.forced.rigid_rows(acc, t, self.scales()[:6])
+        return jnp.concatenate([rigid, *parts])
 
     # ---------------------------------------------------------------- energies
     def kinetic_energy(self, c: Config, V0, omega, d_dot):

@@ -29,7 +29,7 @@ try:
 except ModuleNotFoundError:  # Python 3.10
     import tomli as tomllib  # type: ignore[no-redef]
 
-from .scene_types import (Environment, Fluid, Hydrostatics, Initial, Material, Probe, Scene, SceneError,
+from .scene_types import (Environment, Forced, Fluid, Hydrostatics, Initial, Material, Probe, Scene, SceneError,
                           Simulation, Structure, Tank, Vessel, Walls)
 
 __all__ = ["ELEMENT_FORMS", "SCHEMES", "WALLS", "FACES", "MOMENTS", "PROBE_TOLERANCE",
@@ -39,7 +39,8 @@ ELEMENT_FORMS = ("stabilized", "paper")          # [tanks.fluid] element: liquid
 SCHEMES = ("newmark", "hht", "generalized-alpha")
 WALLS = ("rigid", "elastic")
 FACES = ("x-", "x+", "y-", "y+", "z-", "z+")
-MOMENTS = ("paper", "conservative")              # [vessel.hydrostatics] moment
+MOMENTS = ("paper", "conservative")
+FORCED_DOFS = ("surge", "sway", "heave", "roll", "pitch", "yaw")   # [vessel.forced] dof
 PROBE_TOLERANCE = 1e-9                           # m: how far outside its owner a probe may lie
 MASS_BALANCE_TOLERANCE = 0.01                    # relative mismatch of weight and buoyancy that warns
 HHT_ALPHA_MAX = 1.0 / 3.0
@@ -212,6 +213,7 @@ def _vessel(table, environment: Environment, warnings: list[str]) -> Vessel:
         "inertia": ("inertia", None),
         "hydrostatics": ("table", None),
         "initial": ("table", None),
+        "forced": ("table", None),
     }, required=("mass", "inertia"))
     inertia = v["inertia"]
     _inertia_warnings(inertia, warnings)
@@ -225,7 +227,16 @@ def _vessel(table, environment: Environment, warnings: list[str]) -> Vessel:
         "angular_velocity": ("vec3", None),
         "roll_pitch_yaw": ("vec3", None),
     }))
-    return Vessel(mass=v["mass"], inertia=inertia, hydrostatics=hydrostatics, initial=initial)
+    forced = None
+    if "forced" in table:
+        f = _read(table["forced"], "vessel.forced", {
+            "dof": ("str", _one_of(FORCED_DOFS)),
+            "amplitude": ("float", None),
+            "frequency": ("float", _positive),
+            "ramp": ("float", _non_negative),
+        }, required=("dof", "amplitude", "frequency"))
+        forced = Forced(**f)
+    return Vessel(mass=v["mass"], inertia=inertia, hydrostatics=hydrostatics, initial=initial, forced=forced)
 
 
 def _hydrostatics(table, warnings: list[str]) -> Hydrostatics:

@@ -64,11 +64,22 @@ class Initial:
 
 
 @dataclass(frozen=True)
+class Forced:
+    """Prescribed harmonic motion of the vessel (tank tests): one rigid dof follows
+    amplitude * sin(frequency * t), faded in over `ramp` seconds; the other five are held at zero."""
+    dof: str                         # "surge" | "sway" | "heave" | "roll" | "pitch" | "yaw"
+    amplitude: float                 # m or rad
+    frequency: float                 # rad/s, > 0
+    ramp: float = 0.0                # s, >= 0: the amplitude grows as (1 - cos(pi t / ramp)) / 2
+
+
+@dataclass(frozen=True)
 class Vessel:
     mass: float                      # kg, > 0 (everything except tank liquid)
     inertia: Mat3                    # kg m^2 about the COG, body axes, symmetric positive definite
     hydrostatics: Optional[Hydrostatics] = None   # None: no buoyancy (free body)
     initial: Initial = field(default_factory=Initial)
+    forced: Optional[Forced] = None  # prescribed motion instead of free motion
 
 
 @dataclass(frozen=True)
