@@ -34,6 +34,8 @@ def _parser():
     pl = sub.add_parser("plot", help="time histories of a result: roll, pitch, heave and every probe")
     pl.add_argument("result")
     pl.add_argument("-o", "--output", help="figure file (default: the result's name with .png)")
+    pl.add_argument("--surface", metavar="FIG", help="also draw the deformed free surface at a few instants to FIG")
+    pl.add_argument("--scale", type=float, default=1.0, help="magnify liquid displacements in --surface (default 1)")
     m = sub.add_parser("modes", help="natural frequencies of a tank's liquid with the vessel held fixed")
     m.add_argument("scene")
     g = m.add_mutually_exclusive_group()
@@ -109,6 +111,12 @@ def cmd_plot(a):
         raise InputError(f"{a.result}: not a readable jaxslosh result ({e})")
     plot_result(r, out)
     print(f"wrote {out}")
+    if a.surface:
+        from .plot import plot_free_surface
+        if not r.tanks:
+            raise InputError(f"--surface: {a.result} holds no liquid fields")
+        plot_free_surface(r, a.surface, scale=a.scale)
+        print(f"wrote {a.surface}")
     return EXIT_OK
 
 
