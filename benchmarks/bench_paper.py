@@ -14,14 +14,14 @@ import jax
 jax.config.update("jax_enable_x64", True)
 
 import jaxslosh as js  # noqa: E402
-from jaxslosh.run import advance, prepare, start  # noqa: E402
+from jaxslosh.run import _core, advance, prepare, start  # noqa: E402
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 
 
 def time_scene(scene, steps):
     setup = prepare(scene, duration=steps * scene.simulation.dt)
-    b, solver = setup.built, setup.solver
+    b, solver = _core(setup.built), setup.solver
     t0 = time.perf_counter()
     carry, f0 = start(b, solver)
     jax.block_until_ready(f0)

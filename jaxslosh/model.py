@@ -48,7 +48,7 @@ class Hydro(eqx.Module):
     displaced_volume: jax.Array
     gm_t: jax.Array
     gm_l: jax.Array
-    moment_form: str = eqx.field(static=True, default="paper")
+    moment_form: str = eqx.field(static=True, default="conservative")
 
     def force(self, X0):
         """Eq. (35) in the inertial frame: F_z = -rho g A_w (Z0 - Z0^0), equilibrium at Z0^0 = 0."""

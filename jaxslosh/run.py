@@ -90,6 +90,11 @@ def _frame(b: Built, s: State, it, err, failed) -> Frame:
                  sysm.potential_energy(s.c), it, err, D, failed)
 
 
+def _core(b: Built) -> Built:
+    """What the compiled loop needs: the host-side tank blocks (NumPy meshes) stay out of it."""
+    return b._replace(tanks=())
+
+
 def _select(pred, a, b):
     return jax.tree_util.tree_map(lambda x, y: jnp.where(pred, x, y), a, b)
 
@@ -165,8 +170,8 @@ def simulate(scene: Scene, params: Optional[dict] = None, *, duration: Optional[
     setup = prepare(scene, params, duration, dt)
     b, solver = setup.built, setup.solver
     n_frames = setup.n_steps // setup.save_every
-    carry, f0 = start(b, solver)
-    carry, frames = advance(b, solver, carry, n_frames, setup.save_every)
+    carry, f0 = start(_core(b), solver)
+    carry, frames = advance(_core(b), solver, carry, n_frames, setup.save_every)
     fr = _concat_frames([jax.tree_util.tree_map(lambda x: x[None], f0), frames])
     traced = isinstance(carry.failed, jax.core.Tracer)
     if traced:
@@ -227,7 +232,7 @@ def run_to_file(scene: Scene, out: str, *, duration=None, dt=None, progress: boo
     bar = Progress(setup.n_steps, enabled=progress)
     t_loop = None
     try:
-        carry, f0 = start(b, solver)
+        carry, f0 = start(_core(b), solver)
         first = jax.tree_util.tree_map(lambda x: np.asarray(x)[None], f0)
         p0 = first.probes[0]
         pending, done_frames = first, 0
@@ -237,7 +242,7 @@ def run_to_file(scene: Scene, out: str, *, duration=None, dt=None, progress: boo
             writer.append(_file_frames(b, pending, p0, n_ok, save_fields), min(int(carry.k), setup.n_steps))
             if bool(carry.failed) or done_frames >= n_frames:
                 break
-            carry, fr = advance(b, solver, carry, chunk_frames, se)
+            carry, fr = advance(_core(b), solver, carry, chunk_frames, se)
             fr = jax.device_get(fr)
             if t_loop is None:
                 t_loop = _time.perf_counter()

@@ -52,7 +52,7 @@ class Hydrostatics:
     displaced_volume: float          # m^3, > 0
     gm_t: float                      # m (<= 0 legal, warned)
     gm_l: float                      # m (<= 0 legal, warned)
-    moment: str = "paper"            # "paper": eq. (36) literally | "conservative": gradient of a potential
+    moment: str = "conservative"     # "conservative": gradient of a restoring potential | "paper": eq. (36) literally
 
 
 @dataclass(frozen=True)

@@ -134,7 +134,7 @@ def test_spec_example_loads():
     assert s.simulation.tolerance == 1e-10 and s.simulation.max_iterations == 25 and s.simulation.chunk == 0
     assert s.vessel.mass == 3.25e5
     assert s.vessel.inertia == ((4.9e6, 0.0, 0.0), (0.0, 1.45e7, 0.0), (0.0, 0.0, 1.6e7))
-    assert s.vessel.hydrostatics.gm_t == 1.67 and s.vessel.hydrostatics.moment == "paper"
+    assert s.vessel.hydrostatics.gm_t == 1.67 and s.vessel.hydrostatics.moment == "conservative"
     assert s.vessel.initial.angular_velocity == (0.1, 0.05, 0.0) and s.vessel.initial.position == (0, 0, 0)
     (t,) = s.tanks
     assert t.name == "tank" and t.size == (5.0, 5.0, 4.0) and t.mesh == (5, 5, 5) and t.walls == "rigid"
