@@ -105,7 +105,8 @@ class FitResult:
     loss_history: the loss (SSR / n of the weighted residuals) at the start and after every
     iteration. iterations: iterations done (Jacobian evaluations for Gauss-Newton, optimiser
     updates for the optax methods). evaluations: simulations run (line search and rejected
-    trial steps included). channels: the weight of every channel used.
+    trial steps included). channels: the weight of every channel used. wall_time: seconds in
+    all; compile_time: of which tracing and compiling; solve_time: the iterations alone.
     """
     values: dict
     standard_errors: dict
@@ -119,6 +120,8 @@ class FitResult:
     channels: dict = dataclasses.field(default_factory=dict)
     start: dict = dataclasses.field(default_factory=dict)
     wall_time: float = 0.0
+    compile_time: float = 0.0
+    solve_time: float = 0.0
     correlation: Optional[list] = None
 
     @property
@@ -291,6 +294,33 @@ def channels_of(r: Result, names=None) -> dict:
     return ch
 
 
+def add_noise(r: Result, noise: dict, seed: int = 0, keep_probes: bool = True) -> Result:
+    """A synthetic measurement: `r` with independent Gaussian noise of standard deviation
+    noise[channel] added to the channels `identify` reads ("roll", "pitch", "heave",
+    "probes.<name>"); other datasets (quaternion, probe positions, ...) are left as they are.
+    keep_probes=False drops the probes (a record of the vessel's motion alone)."""
+    rng = np.random.default_rng(seed)
+    names = set(channels_of(r))
+    for k in noise:
+        if k not in names:
+            raise SceneError(f"noise.{k}", f"no such channel (channels: {', '.join(sorted(names))})")
+    n = len(np.asarray(r.time))
+    draw = lambda k: noise.get(k, 0.0) * rng.standard_normal(n)  # noqa: E731
+    rpy = np.array(r.vessel.roll_pitch_yaw, dtype=float)
+    rpy[:, 0] += draw("roll")
+    rpy[:, 1] += draw("pitch")
+    pos = np.array(r.vessel.position, dtype=float)
+    pos[:, 2] += draw("heave")
+    probes = {}
+    if keep_probes:
+        for name, p in r.probes.items():
+            d = np.array(p.displacement, dtype=float)
+            d[:, 2] += draw(f"probes.{name}")
+            probes[name] = dataclasses.replace(p, displacement=d)
+    vessel = dataclasses.replace(r.vessel, roll_pitch_yaw=rpy, position=pos)
+    return dataclasses.replace(r, vessel=vessel, probes=probes)
+
+
 class _Problem:
     """The residual r(theta) of one identification, compiled once."""
 
@@ -341,10 +371,17 @@ class _Problem:
         self.offsets = np.concatenate([[0], np.cumsum(sizes)]).astype(int)
         self.theta0 = np.concatenate([p.theta_of(p.start) for p in params])
         self.tol = float(sim.tolerance)
-        self._resid = jax.jit(self._residual_ok)
-        self._rj = jax.jit(self._residual_jac)
-        self._vg = None
+        self._resid = self._rj = self._vg = None
         self.evaluations = 0
+        self.compile_time = 0.0
+
+    def compiled(self, fn, *args):
+        """`fn` jit-compiled for arguments like `args` (ahead of time, so that the compilation is
+        timed apart from the iterations; each is traced and compiled once)."""
+        t0 = _time.perf_counter()
+        c = jax.jit(fn).lower(*args).compile()
+        self.compile_time += _time.perf_counter() - t0
+        return c
 
     # the model -------------------------------------------------------------------------------
     def physical(self, theta):
@@ -385,11 +422,15 @@ class _Problem:
     # evaluations counted, results on the host -------------------------------------------------
     def residual(self, theta):
         self.evaluations += 1
+        if self._resid is None:
+            self._resid = self.compiled(self._residual_ok, jnp.asarray(self.theta0))
         res, ok = self._resid(jnp.asarray(theta))
         return np.asarray(res), bool(ok)
 
     def residual_jacobian(self, theta):
         self.evaluations += 1
+        if self._rj is None:
+            self._rj = self.compiled(self._residual_jac, jnp.asarray(self.theta0))
         res, J, ok = self._rj(jnp.asarray(theta))
         return np.asarray(res), np.asarray(J), bool(ok)
 
@@ -471,7 +512,6 @@ def _optax_loop(pb: _Problem, theta, method, max_iter, callback, history, learni
     if method == "adam":
         opt = optax.adam(learning_rate if learning_rate is not None else 0.02)
 
-        @jax.jit
         def update(th, state):
             value, grad = pb._vg(th)
             upd, state = opt.update(grad, state, th)
@@ -485,7 +525,6 @@ def _optax_loop(pb: _Problem, theta, method, max_iter, callback, history, learni
                           optax.scale_by_zoom_linesearch(max_linesearch_steps=20))
         vg = optax.value_and_grad_from_state(pb._loss)
 
-        @jax.jit
         def update(th, state):
             value, grad = vg(th, state=state)
             upd, state = opt.update(grad, state, th, value=value, grad=grad, value_fn=pb._loss)
@@ -493,6 +532,7 @@ def _optax_loop(pb: _Problem, theta, method, max_iter, callback, history, learni
             return optax.apply_updates(th, upd), state, value, n_ls
 
     state = opt.init(theta)
+    update = pb.compiled(update, theta, state)
     it, converged, message, flat = 0, False, f"stopped after max_iter = {max_iter} iterations", 0
     final_known = False          # whether history[-1] is the loss at the returned theta
     while it < max_iter:
@@ -549,12 +589,14 @@ def identify(scene: Scene, measured, fit: Sequence[str], *, weights: Optional[di
     params = _make_params(scene, keys, x0, bounds)
     pb = _Problem(scene, measured, params, weights)
     history: list = []
+    t_solve = _time.perf_counter()
     if method == "gauss-newton":
         theta, it, converged, message = _gauss_newton(pb, pb.theta0.copy(), int(max_iter), callback, history)
         final_known = True
     else:
         theta, it, converged, message, final_known = _optax_loop(pb, pb.theta0.copy(), method, int(max_iter),
                                                                  callback, history, learning_rate)
+    solve_time = _time.perf_counter() - t_solve - pb.compile_time
     # standard errors from the Gauss-Newton covariance, in the physical parameters
     res, J, ok = pb.residual_jacobian(theta)
     p_dim = J.shape[1]
@@ -581,7 +623,8 @@ def identify(scene: Scene, measured, fit: Sequence[str], *, weights: Optional[di
     return FitResult(values=pb.values(theta), standard_errors=se, loss_history=[float(x) for x in history],
                      iterations=int(it), converged=bool(converged), method=method, message=message,
                      evaluations=pb.evaluations, n_residuals=pb.n, channels=dict(pb.weights), start=start,
-                     wall_time=_time.perf_counter() - t0, correlation=corr)
+                     wall_time=_time.perf_counter() - t0, compile_time=pb.compile_time, solve_time=solve_time,
+                     correlation=corr)
 
 
 # --------------------------------------------------------------------------------------------

@@ -22,7 +22,7 @@ enters, are re-linearised with JAX in each iteration (a Schur complement on the 
 """
 from __future__ import annotations
 
-from typing import NamedTuple
+from typing import NamedTuple, Optional
 
 import equinox as eqx
 import jax
@@ -75,6 +75,11 @@ class Solver(eqx.Module):
     scheme: Scheme = eqx.field(static=True)
     tol: float = eqx.field(static=True)
     max_iter: int = eqx.field(static=True)
+    substeps: int = eqx.field(static=True, default=0)   # retry a failed step as this many sub-steps
+    Cinv_sub: Optional[jax.Array] = None                # liquid block inverse for the sub-step
+
+    def sub_solver(self) -> "Solver":
+        return Solver(self.Cinv_sub, self.Cinv_mass, self.h / self.substeps, self.scheme, self.tol, self.max_iter)
 
     @property
     def c_a(self):
@@ -82,21 +87,26 @@ class Solver(eqx.Module):
         return (1.0 - s.alpha_m) / ((1.0 - s.alpha_f) * s.beta * self.h ** 2)
 
 
-def make_solver(system: System, h: float, scheme: Scheme, tol: float, max_iter: int) -> Solver:
+def make_solver(system: System, h: float, scheme: Scheme, tol: float, max_iter: int, substeps: int = 0) -> Solver:
     """Factor the constant liquid blocks once (NumPy, float64)."""
     nf = system.nf
+    substeps = int(substeps) if substeps and substeps > 1 else 0
     if nf == 0:
         z = jnp.zeros((0, 0))
-        return Solver(z, z, jnp.asarray(h, dtype=float), scheme, tol, max_iter)
+        return Solver(z, z, jnp.asarray(h, dtype=float), scheme, tol, max_iter, substeps, z if substeps else None)
     L = system.liquid
     Ms = np.asarray(L.Ms)
     free = np.asarray(L.free)
     M_ff = np.kron(Ms, np.eye(3))[np.ix_(free, free)]
     K_ff = np.asarray(L.K)
-    c_a = (1.0 - scheme.alpha_m) / ((1.0 - scheme.alpha_f) * scheme.beta * h ** 2)
-    Cs = c_a * M_ff + K_ff
-    return Solver(jnp.asarray(np.linalg.inv(0.5 * (Cs + Cs.T))), jnp.asarray(np.linalg.inv(M_ff)),
-                  jnp.asarray(h, dtype=float), scheme, tol, max_iter)
+
+    def step_block_inverse(hh):
+        c_a = (1.0 - scheme.alpha_m) / ((1.0 - scheme.alpha_f) * scheme.beta * hh ** 2)
+        Cs = c_a * M_ff + K_ff
+        return jnp.asarray(np.linalg.inv(0.5 * (Cs + Cs.T)))
+
+    return Solver(step_block_inverse(h), jnp.asarray(np.linalg.inv(M_ff)), jnp.asarray(h, dtype=float), scheme, tol,
+                  max_iter, substeps, step_block_inverse(h / substeps) if substeps else None)
 
 
 def _preconditioner(A, like, Cinv):
@@ -225,3 +235,24 @@ def step(system: System, solver: Solver, s: State) -> tuple[State, StepInfo]:
     c, v, acc, a = unpack(delta)
     ok = ok & jnp.all(jnp.isfinite(delta))
     return State(c, v, acc, a, s.t + h), StepInfo(it, err, ok)
+
+
+def step_or_retry(system: System, solver: Solver, s: State) -> tuple[State, StepInfo]:
+    """One step; when it fails and `solver.substeps` > 1, the step is redone as that many sub-steps
+    (the iterations of every attempt are counted)."""
+    s1, info = step(system, solver, s)
+    if not solver.substeps:
+        return s1, info
+    sub = solver.sub_solver()
+
+    def retry(_):
+        def one(carry, _):
+            st, it, err, ok = carry
+            st2, inf = step(system, sub, st)
+            return (st2, it + inf.iterations, jnp.maximum(err, inf.residual), ok & inf.ok), None
+
+        init = (s, info.iterations, jnp.zeros_like(info.residual), jnp.array(True))
+        (st, it, err, ok), _ = jax.lax.scan(one, init, None, length=solver.substeps)
+        return st, StepInfo(it, err, ok)
+
+    return jax.lax.cond(info.ok, lambda _: (s1, info), retry, None)

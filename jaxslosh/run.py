@@ -19,7 +19,7 @@ import jax.numpy as jnp
 import numpy as np
 
 from .build import Built, build
-from .integrator import Solver, State, initial_state, make_scheme, make_solver, step
+from .integrator import Solver, State, initial_state, make_scheme, make_solver, step_or_retry
 from .kinematics import rotation_matrix, rpy_from_quat
 from .result import (Energy, ProbeHistory, Result, ResultWriter, SolverHistory, TankField, VesselHistory,
                      truncated)
@@ -70,7 +70,7 @@ def prepare(scene: Scene, params=None, duration=None, dt=None) -> Setup:
     T = float(duration if duration is not None else sim.duration)
     b = build(scene, params)
     scheme = make_scheme(sim.scheme, sim.alpha, sim.rho_inf)
-    solver = make_solver(b.system, h, scheme, sim.tolerance, sim.max_iterations)
+    solver = make_solver(b.system, h, scheme, sim.tolerance, sim.max_iterations, sim.substeps)
     n_steps = int(round(T / h))
     return Setup(b, solver, n_steps, max(1, int(sim.save_every)))
 
@@ -112,7 +112,7 @@ def advance(b: Built, solver: Solver, carry: Carry, n_frames: int, save_every: i
     """n_frames frames of save_every steps each: one scan of scans, no Python loop in traced code."""
 
     def one_step(c: Carry, _):
-        s_new, info = step(b.system, solver, c.s)
+        s_new, info = step_or_retry(b.system, solver, c.s)
         bad = ~info.ok & ~c.failed
         keep = c.failed | ~info.ok
         s = _select(keep, c.s, s_new)

@@ -181,6 +181,7 @@ def _simulation(table, warnings: list[str]) -> Simulation:
         "tolerance": ("float", _positive),
         "max_iterations": ("int", _at_least(1)),
         "chunk": ("int", _non_negative),
+        "substeps": ("int", _non_negative),
     }, required=("duration", "dt"))
     sim = Simulation(**v)
     if sim.dt > sim.duration:

@@ -40,6 +40,7 @@ class Simulation:
     tolerance: float = 1e-10         # Newton: residual over mass, an acceleration error (m/s^2, rad/s^2)
     max_iterations: int = 25         # Newton iterations per step before the step counts as failed
     chunk: int = 0                   # steps per jitted chunk written to the result (0: automatic)
+    substeps: int = 0                # > 1: a step whose Newton iteration fails is retried as this many sub-steps
 
     @property
     def n_steps(self) -> int:

@@ -157,3 +157,17 @@ def test_file_of_a_killed_run_is_readable(tmp_path):
         assert 0 < n < 200001
         assert int(f.attrs["steps_done"]) >= n - 1
         assert np.all(np.isfinite(f["vessel/position"][:n]))
+
+
+def test_failing_steps_retried_as_substeps_get_further():
+    import jaxslosh as js
+    text = GOOD.replace("gm_t = 1.5", "gm_t = -1.5").replace(
+        "alpha = 0.01", "alpha = 0.01\nmax_iterations = 1\ntolerance = 1e-8").replace("duration = 1.0", "duration = 30.0")
+    plain = js.simulate(js.load_scene(text))
+    retried = js.simulate(js.load_scene(text.replace("tolerance = 1e-8", "tolerance = 1e-8\nsubsteps = 4")))
+    assert "did not converge" in plain.status and plain.steps_done > 10
+    assert retried.steps_done > plain.steps_done
+    # up to the first failure both runs are the same run
+    n = plain.steps_done + 1
+    np.testing.assert_allclose(np.asarray(retried.vessel.quaternion[:n]), np.asarray(plain.vessel.quaternion[:n]),
+                               atol=1e-14)
