@@ -71,8 +71,9 @@ def build(scene: Scene, params: Optional[dict] = None) -> Built:
     P = lambda k, d: _params_get(params, k, d)  # noqa: E731
     env, ves = scene.environment, scene.vessel
     g = jnp.asarray(P("environment.gravity", env.gravity), dtype=float)
+    eff = scene.effects
     hydro = None
-    if ves.hydrostatics is not None:
+    if ves.hydrostatics is not None and eff.buoyancy:
         h = ves.hydrostatics
         hydro = Hydro(
             rho_w=jnp.asarray(P("environment.water_density", env.water_density), dtype=float), gravity=g,
@@ -81,18 +82,25 @@ def build(scene: Scene, params: Optional[dict] = None) -> Built:
             gm_t=jnp.asarray(P("vessel.hydrostatics.gm_t", h.gm_t), dtype=float),
             gm_l=jnp.asarray(P("vessel.hydrostatics.gm_l", h.gm_l), dtype=float),
             moment_form=h.moment)
-    liquid, tanks, d0 = _build_liquid(scene)
+    liquid, tanks, d0 = _build_liquid(scene) if eff.liquid else (None, (), None)
     forced = None
     if ves.forced is not None:
         f = ves.forced
         dofs = ("surge", "sway", "heave", "roll", "pitch", "yaw")
         forced = Forced(dof=dofs.index(f.dof), amplitude=jnp.asarray(f.amplitude, dtype=float),
                         frequency=jnp.asarray(f.frequency, dtype=float), ramp=float(f.ramp))
-    system = System(mass=jnp.asarray(P("vessel.mass", ves.mass), dtype=float),
-                    inertia=_inertia(P("vessel.inertia", ves.inertia)), gravity=g, hydro=hydro, liquid=liquid,
-                    forced=forced)
     ini = ves.initial
     q0 = quat_from_rpy(jnp.asarray(P("vessel.initial.roll_pitch_yaw", ini.roll_pitch_yaw), dtype=float))
+    if forced is not None:
+        q0 = jnp.array([1.0, 0.0, 0.0, 0.0])
+    g_fixed = None
+    if liquid is not None and not eff.gravity_turning:
+        from .kinematics import rotation_matrix
+        g_fixed = rotation_matrix(q0).T @ jnp.array([0.0, 0.0, -g])
+    system = System(mass=jnp.asarray(P("vessel.mass", ves.mass), dtype=float),
+                    inertia=_inertia(P("vessel.inertia", ves.inertia)), gravity=g, hydro=hydro, liquid=liquid,
+                    forced=forced, g_fixed=g_fixed, balanced=ves.hydrostatics is not None,
+                    coriolis=eff.coriolis, centrifugal=eff.centrifugal)
     nf = system.nf
     d_init = jnp.zeros(nf)
     if liquid is not None:
@@ -102,7 +110,7 @@ def build(scene: Scene, params: Optional[dict] = None) -> Built:
                           jnp.asarray(P("vessel.initial.angular_velocity", ini.angular_velocity), dtype=float),
                           jnp.zeros(nf)])
     if forced is not None:   # the prescribed motion sets the rigid state at t = 0
-        c0 = Config(jnp.zeros(3), jnp.array([1.0, 0.0, 0.0, 0.0]), c0.d)
+        c0 = Config(jnp.zeros(3), q0, c0.d)
         v0 = v0.at[:6].set(forced.rates(jnp.zeros(())))
     probes = _build_probes(scene, tanks, liquid)
     return Built(system, c0, v0, probes, tanks)

@@ -1,30 +1,44 @@
-"""Which physical effects a scene simulates: only those it calls for (the model is assembled from
-the scene, so an effect the scene lacks is never traced)."""
+"""Which physical effects a scene simulates: only those it calls for. The model is assembled from
+the scene (build.py), so an effect the scene lacks, or switches off in `[effects]`, is never traced."""
 from __future__ import annotations
 
-from .scene_types import Scene
+from .scene_types import EFFECTS, Scene
 
 
 def scene_effects(scene: Scene) -> list[tuple[str, str]]:
-    """(effect, why) for every effect the scene's model contains."""
+    """(effect, what it is) for every effect the scene's model contains."""
+    e = scene.effects
     eff = [("rigid-body inertia", "vessel: 6 unknowns, rotations on the group (|q| = 1 exactly)")]
-    if scene.vessel.hydrostatics is not None:
+    if scene.vessel.forced is not None:
+        f = scene.vessel.forced
+        eff.append(("prescribed motion", f"{f.dof} = {f.amplitude:g} sin({f.frequency:g} t), other rigid dofs held"))
+    if scene.vessel.hydrostatics is not None and e.buoyancy:
         eff.append(("buoyancy", "restoring force and moments of eqs. (33)-(36), "
                                 f"moment form {scene.vessel.hydrostatics.moment!r}"))
-    elif scene.environment.gravity > 0:
+    elif scene.vessel.hydrostatics is None and scene.environment.gravity > 0:
         eff.append(("gravity", "no hydrostatics table: the vessel falls freely"))
-    for t in scene.tanks:
-        eff.append((f"liquid in tank {t.name!r}", f"{t.mesh[0]}x{t.mesh[1]}x{t.mesh[2]} hexahedra, "
-                    f"{t.liquid_mass:.6g} kg, element {t.fluid.element!r}, {t.walls} walls (slip)"))
-    if scene.tanks:
-        eff.append(("centrifugal and Coriolis terms", "liquid moving in the rotating vessel frame (eq. 19)"))
-        if scene.environment.gravity > 0:
+    liquid = bool(scene.tanks) and e.liquid
+    if liquid:
+        for t in scene.tanks:
+            eff.append((f"liquid in tank {t.name!r}", f"{t.mesh[0]}x{t.mesh[1]}x{t.mesh[2]} hexahedra, "
+                        f"{t.liquid_mass:.6g} kg, element {t.fluid.element!r}, {t.walls} walls (slip)"))
+        if e.coriolis:
+            eff.append(("Coriolis", "2 omega x d_dot on the liquid (eq. 19)"))
+        if e.centrifugal:
+            eff.append(("centrifugal", "omega x (omega x r) on the liquid (eq. 19)"))
+        if scene.environment.gravity > 0 and e.gravity_turning:
             eff.append(("gravity turning with the body", "load of eq. (32) on the liquid"))
     return eff
 
 
+def switched_off(scene: Scene) -> list[str]:
+    return [k for k in EFFECTS if not getattr(scene.effects, k)]
+
+
 def count_unknowns(scene: Scene) -> int:
     n = 6
+    if not scene.effects.liquid:
+        return n
     for t in scene.tanks:
         nx, ny, nz = t.mesh
         nodes = (nx + 1) * (ny + 1) * (nz + 1)
@@ -36,5 +50,8 @@ def count_unknowns(scene: Scene) -> int:
 def effects_summary(scene: Scene) -> str:
     lines = ["effects simulated:"]
     lines += [f"  - {name}: {why}" for name, why in scene_effects(scene)]
+    off = switched_off(scene)
+    if off:
+        lines.append("switched off in [effects]: " + ", ".join(off))
     lines.append(f"unknowns per step: {count_unknowns(scene)}")
     return "\n".join(lines)

@@ -131,6 +131,10 @@ class System(eqx.Module):
     hydro: Optional[Hydro]
     liquid: Optional[Liquid]
     forced: Optional[Forced] = None
+    g_fixed: Optional[jax.Array] = None   # body-frame gravity on the liquid when it does not turn (effect off)
+    balanced: bool = eqx.field(static=True, default=True)      # weight balanced by static buoyancy
+    coriolis: bool = eqx.field(static=True, default=True)
+    centrifugal: bool = eqx.field(static=True, default=True)
 
     @property
     def nf(self) -> int:
@@ -154,7 +158,7 @@ class System(eqx.Module):
         A = rotation_matrix(c.q)
         a0, alpha = acc[:3], acc[3:6]
         g_vec = jnp.array([0.0, 0.0, -self.gravity])
-        g_b = A.T @ g_vec
+        g_b = A.T @ g_vec if self.g_fixed is None else self.g_fixed
         r_t = self.mass * a0
         r_r = self.inertia @ alpha + jnp.cross(omega, self.inertia @ omega)
         parts = []
@@ -162,22 +166,25 @@ class System(eqx.Module):
             L = self.liquid
             D, Dv, Da = L.full(c.d), L.full(d_dot), L.full(acc[6:])
             x = L.r + D
-            a = (A.T @ a0 + Da + jnp.cross(alpha, x) + 2.0 * jnp.cross(omega, Dv)
-                 + jnp.cross(omega, jnp.cross(omega, x)))             # eq. (4), body components
+            a = A.T @ a0 + Da + jnp.cross(alpha, x)                     # eq. (4), body components
+            if self.coriolis:
+                a = a + 2.0 * jnp.cross(omega, Dv)
+            if self.centrifugal:
+                a = a + jnp.cross(omega, jnp.cross(omega, x))
             F = L.Ms @ a                                             # inertia forces on nodes
             r_t = r_t + A @ F.sum(axis=0)
             r_r = r_r + jnp.cross(x, F).sum(axis=0)
             mD = L.m_nodes @ D                                       # first moment of d
             r_d = L.free_part(F - L.m_nodes[:, None] * g_b) + L.K @ c.d
             parts.append(r_d)
-            if self.hydro is not None:
+            if self.balanced:
                 r_r = r_r - jnp.cross(mD, g_b)
             else:
                 r_r = r_r - jnp.cross(L.m_nodes @ L.r + mD, g_b)
         if self.hydro is not None:
             r_t = r_t - self.hydro.force(c.X0)
             r_r = r_r - self.hydro.moment(c.q)
-        else:
+        if not self.balanced:
             r_t = r_t - self.total_mass() * g_vec
         rigid = jnp.concatenate([r_t, r_r])
         if self.forced is not None:
@@ -197,15 +204,15 @@ class System(eqx.Module):
     def potential_energy(self, c: Config):
         V = jnp.zeros(())
         A = rotation_matrix(c.q)
-        g_b = A.T @ jnp.array([0.0, 0.0, -self.gravity])
+        g_b = A.T @ jnp.array([0.0, 0.0, -self.gravity]) if self.g_fixed is None else self.g_fixed
         if self.hydro is not None:
             V = V + self.hydro.potential(c.X0, c.q)
-        else:
+        if not self.balanced:
             V = V + self.total_mass() * self.gravity * c.X0[2]
         if self.liquid is not None:
             L = self.liquid
             V = V + 0.5 * c.d @ (L.K @ c.d) - g_b @ (L.m_nodes @ L.full(c.d))
-            if self.hydro is None:
+            if not self.balanced:
                 V = V - g_b @ (L.m_nodes @ L.r)
         return V
 

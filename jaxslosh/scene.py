@@ -29,7 +29,7 @@ try:
 except ModuleNotFoundError:  # Python 3.10
     import tomli as tomllib  # type: ignore[no-redef]
 
-from .scene_types import (Environment, Forced, Fluid, Hydrostatics, Initial, Material, Probe, Scene, SceneError,
+from .scene_types import (EFFECTS, Effects, Environment, Forced, Fluid, Hydrostatics, Initial, Material, Probe, Scene, SceneError,
                           Simulation, Structure, Tank, Vessel, Walls)
 
 __all__ = ["ELEMENT_FORMS", "SCHEMES", "WALLS", "FACES", "MOMENTS", "PROBE_TOLERANCE",
@@ -95,6 +95,7 @@ def parse_scene(mapping: Mapping[str, Any], text: str = "", path: str = "") -> S
         "tanks": ("tables", None),
         "structures": ("tables", None),
         "probes": ("tables", None),
+        "effects": ("table", None),
     }, required=("simulation", "vessel"))
     warnings: list[str] = []
     title = top.get("title", Path(path).stem if path else "")
@@ -110,8 +111,10 @@ def parse_scene(mapping: Mapping[str, Any], text: str = "", path: str = "") -> S
     for i, probe in enumerate(probes):
         _place_probe(probe, f"probes[{i}]", tanks, structures)
     _mass_balance(vessel, tanks, environment, warnings)
+    effects = Effects(**_read(mapping.get("effects", {}), "effects", {k: ("bool", None) for k in EFFECTS}))
     return Scene(title=title, environment=environment, simulation=simulation, vessel=vessel, tanks=tanks,
-                 structures=structures, probes=probes, text=text, path=path, warnings=tuple(warnings))
+                 structures=structures, probes=probes, effects=effects, text=text, path=path,
+                 warnings=tuple(warnings))
 
 
 # --------------------------------------------------------------------------------------------
@@ -448,6 +451,12 @@ def _int(name: str, x) -> int:
     return x
 
 
+def _bool(name: str, x) -> bool:
+    if not isinstance(x, bool):
+        raise SceneError(name, f"must be true or false, got {_toml_type(x)} {_show(x)}")
+    return x
+
+
 def _str(name: str, x) -> str:
     if not isinstance(x, str):
         raise SceneError(name, f"must be a string, got {_toml_type(x)} {_show(x)}")
@@ -509,7 +518,7 @@ def _str_or_table(name: str, x):
     return x
 
 
-_CONVERT = {"float": _float, "int": _int, "str": _str, "vec3": _vec3, "mesh": _mesh, "inertia": _inertia,
+_CONVERT = {"bool": _bool, "float": _float, "int": _int, "str": _str, "vec3": _vec3, "mesh": _mesh, "inertia": _inertia,
             "table": _table, "tables": _tables, "str_or_table": _str_or_table}
 
 

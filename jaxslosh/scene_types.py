@@ -142,6 +142,21 @@ class Probe:
     structure: Optional[str] = None
 
 
+EFFECTS = ("buoyancy", "liquid", "coriolis", "centrifugal", "gravity_turning")
+
+
+@dataclass(frozen=True)
+class Effects:
+    """Switches of the `[effects]` table. An effect is simulated when the scene has what it needs
+    (a hydrostatics table, tanks, ...) and its switch is on; the model never traces an effect that
+    is off, so switching one off measures what it contributes."""
+    buoyancy: bool = True            # restoring force and moments, eqs. (33)-(36)
+    liquid: bool = True              # the tank liquid (off: the tanks are empty and carry nothing)
+    coriolis: bool = True            # 2 omega x d_dot on the liquid (eq. 19)
+    centrifugal: bool = True         # omega x (omega x r) on the liquid (eq. 19)
+    gravity_turning: bool = True     # gravity turning with the body as a load on the liquid (eq. 32)
+
+
 @dataclass(frozen=True)
 class Scene:
     title: str
@@ -151,6 +166,7 @@ class Scene:
     tanks: tuple[Tank, ...] = ()
     structures: tuple[Structure, ...] = ()
     probes: tuple[Probe, ...] = ()
+    effects: Effects = field(default_factory=Effects)
     text: str = ""                   # the TOML source, stored in result files
     path: str = ""
     warnings: tuple[str, ...] = ()   # physically doubtful but legal choices, said once at load

@@ -197,7 +197,9 @@ def test_probe_on_boundaries_within_tolerance():
 
 BAD = {
     # unknown keys, at every level
-    "top-level unknown": ([("effects", {"buoyancy": True})], "effects"),
+    "top-level unknown": ([("effectz", {"buoyancy": True})], "effectz"),
+    "effects unknown": ([("effects", {"sloshing": True})], "effects.sloshing"),
+    "effects not a bool": ([("effects", {"buoyancy": 1})], "effects.buoyancy"),
     "environment unknown": ([("environment.gravty", 9.81)], "environment.gravty"),
     "simulation unknown": ([("simulation.dtt", 0.01)], "simulation.dtt"),
     "vessel unknown": ([("vessel.masss", 1.0)], "vessel.masss"),
