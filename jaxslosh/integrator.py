@@ -109,50 +109,63 @@ def make_solver(system: System, h: float, scheme: Scheme, tol: float, max_iter: 
                   max_iter, substeps, step_block_inverse(h / substeps) if substeps else None)
 
 
-def _preconditioner(A, like, Cinv):
-    """P^-1 for a linear map A with the Newton matrix's structure: the rigid rows and columns exact
-    (6 products with A and 6 with its transpose), the liquid block replaced by the constant C
-    (inverse Cinv); a Schur complement on the 6 rigid unknowns. Exact when there is no liquid."""
+def _precond_data(A, like, Cinv):
+    """The factors of P^-1 for a linear map A with the Newton matrix's structure: the rigid rows and
+    columns exact (6 products with A, 6 with its transpose), the liquid block replaced by the
+    constant C (inverse Cinv); a Schur complement on the 6 rigid unknowns. Exact without liquid."""
     n = like.shape[0]
     E6 = jnp.eye(n, 6, dtype=like.dtype)
     cols = jax.vmap(A, in_axes=1, out_axes=1)(E6)                   # [A_yy; A_zy]
     if n == 6:
-        inv = jnp.linalg.inv(cols)
-        return lambda r: inv @ r
+        return (jnp.linalg.inv(cols),)
     AT = jax.linear_transpose(A, like)
     Ayz = jax.vmap(lambda e: AT(e)[0])(E6.T)[:, 6:]                  # (6, nf)
     Wz = Cinv @ cols[6:]
-    S_inv = jnp.linalg.inv(cols[:6] - Ayz @ Wz)
+    return jnp.linalg.inv(cols[:6] - Ayz @ Wz), Ayz, Wz
 
-    def P_inv(r):
-        wz = Cinv @ r[6:]
-        xy = S_inv @ (r[:6] - Ayz @ wz)
-        return jnp.concatenate([xy, wz - Wz @ xy])
 
-    return P_inv
+def _precond_apply(data, Cinv, r):
+    if len(data) == 1:
+        return data[0] @ r
+    S_inv, Ayz, Wz = data
+    wz = Cinv @ r[6:]
+    xy = S_inv @ (r[:6] - Ayz @ wz)
+    return jnp.concatenate([xy, wz - Wz @ xy])
+
+
+def _preconditioner(A, like, Cinv):
+    data = _precond_data(A, like, Cinv)
+    return lambda r: _precond_apply(data, Cinv, r)
 
 
 def _newton(R, x0, Cinv, scale, tol, max_iter):
-    """Newton iterations on R(x) = 0 (x: 6 rigid unknowns, then the liquid's), with the structured
-    approximate inverse of the Jacobian: quadratic in the rigid part, linear (fast) in the liquid."""
+    """Quasi-Newton iterations on R(x) = 0 (x: 6 rigid unknowns, then the liquid's) with the
+    structured approximate inverse of the Jacobian, formed at the start of the step and formed
+    again only when the residual stops falling fast (a rotation that changed a lot)."""
 
     def err_of(r):
         return jnp.max(jnp.abs(r / scale))
 
+    def refresh(x):
+        _, jvp = jax.linearize(R, x)
+        return _precond_data(jvp, x, Cinv)
+
     def body(carry):
-        x, _, it, err_prev, _ = carry
-        r, jvp = jax.linearize(R, x)
-        x = x + _preconditioner(jvp, x, Cinv)(-r)
+        x, r, it, err_prev, _, data = carry
+        x = x + _precond_apply(data, Cinv, -r)
         r = R(x)
         err = err_of(r)
-        return x, r, it + 1, err, err > 0.5 * err_prev
+        slow = err > 0.1 * err_prev
+        data = jax.lax.cond(slow & (err > tol), refresh, lambda _: data, x)
+        return x, r, it + 1, err, err > 0.5 * err_prev, data
 
     def cond(carry):
-        _, _, it, err, stalled = carry
+        _, _, it, err, stalled, _ = carry
         return (err > tol) & (it < max_iter) & jnp.isfinite(err) & ~stalled
 
     r0 = R(x0)
-    x, r, it, err, stalled = jax.lax.while_loop(cond, body, (x0, r0, jnp.array(0), err_of(r0), jnp.array(False)))
+    init = (x0, r0, jnp.array(0), err_of(r0), jnp.array(False), refresh(x0))
+    x, r, it, err, stalled, _ = jax.lax.while_loop(cond, body, init)
     # Converged: below the tolerance, or stalled at round-off within a factor 100 of it.
     ok = jnp.isfinite(err) & ((err <= tol) | (stalled & (err <= 100.0 * tol)))
     # aux leaves are floats: custom_root's JVP rule cannot carry integer or boolean aux tangents
