@@ -99,7 +99,7 @@ def build(scene: Scene, params: Optional[dict] = None) -> Built:
         g_fixed = rotation_matrix(q0).T @ jnp.array([0.0, 0.0, -g])
     system = System(mass=jnp.asarray(P("vessel.mass", ves.mass), dtype=float),
                     inertia=_inertia(P("vessel.inertia", ves.inertia)), gravity=g, hydro=hydro, liquid=liquid,
-                    forced=forced, g_fixed=g_fixed, balanced=ves.hydrostatics is not None,
+                    forced=forced, g_fixed=g_fixed, q_ref=q0, balanced=ves.hydrostatics is not None,
                     coriolis=eff.coriolis, centrifugal=eff.centrifugal)
     nf = system.nf
     d_init = jnp.zeros(nf)
@@ -125,7 +125,8 @@ def _build_liquid(scene: Scene):
             raise SceneError(f"tanks[{i}].walls", "elastic tank walls are not supported yet (use \"rigid\")")
     from .liquid import build_liquid  # the liquid module is only imported by scenes that have liquid
 
-    blocks, rs, Ms_list, K_list, free_list = [], [], [], [], []
+    blocks, rs, Ms_list, K_list, free_list, Kdt_list, Ktt = [], [], [], [], [], [], np.zeros((3, 3))
+    coupled = False
     offset = 0
     g = scene.environment.gravity
     for t in rigid:
@@ -136,12 +137,19 @@ def _build_liquid(scene: Scene):
         Ms_list.append(np.asarray(m.mass))
         free = np.flatnonzero(np.asarray(m.free))
         K_list.append(np.asarray(m.stiffness)[np.ix_(free, free)])
+        if getattr(m, "rotation_coupling", None) is not None:
+            coupled = True
+            Kdt_list.append(np.asarray(m.rotation_coupling)[free])
+            Ktt = Ktt + np.asarray(m.rotation_stiffness)
+        else:
+            Kdt_list.append(np.zeros((free.size, 3)))
         free_list.append(free + 3 * offset)
         offset += N
     from scipy.linalg import block_diag
     liquid = Liquid(r=jnp.asarray(np.concatenate(rs)), Ms=jnp.asarray(block_diag(*Ms_list)),
                     K=jnp.asarray(block_diag(*K_list)), free=jnp.asarray(np.concatenate(free_list)),
-                    n_nodes=offset)
+                    n_nodes=offset, Kdt=jnp.asarray(np.concatenate(Kdt_list)) if coupled else None,
+                    Ktt=jnp.asarray(Ktt) if coupled else None)
     return liquid, tuple(blocks), None
 
 

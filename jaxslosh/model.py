@@ -111,6 +111,8 @@ class Liquid(eqx.Module):
     K: jax.Array          # (nf, nf) stiffness on the free dofs
     free: jax.Array       # (nf,) indices of the free dofs in the node-major 3N vector
     n_nodes: int = eqx.field(static=True)
+    Kdt: Optional[jax.Array] = None   # (nf, 3) d-theta block of the absolute-rotation penalty
+    Ktt: Optional[jax.Array] = None   # (3, 3) theta-theta block
 
     def full(self, d):
         """(nf,) free-dof vector -> (N, 3) nodal field, zero on the wall-normal dofs."""
@@ -132,6 +134,7 @@ class System(eqx.Module):
     liquid: Optional[Liquid]
     forced: Optional[Forced] = None
     g_fixed: Optional[jax.Array] = None   # body-frame gravity on the liquid when it does not turn (effect off)
+    q_ref: Optional[jax.Array] = None     # attitude at which the liquid's absolute rotation is zero (t = 0)
     balanced: bool = eqx.field(static=True, default=True)      # weight balanced by static buoyancy
     coriolis: bool = eqx.field(static=True, default=True)
     centrifugal: bool = eqx.field(static=True, default=True)
@@ -176,6 +179,10 @@ class System(eqx.Module):
             r_r = r_r + jnp.cross(x, F).sum(axis=0)
             mD = L.m_nodes @ D                                       # first moment of d
             r_d = L.free_part(F - L.m_nodes[:, None] * g_b) + L.K @ c.d
+            if L.Kdt is not None:   # the penalty on the absolute rotation curl d + 2 theta (PHYSICS.md item 5)
+                th, J = self.liquid_rotation(c.q, with_jacobian=True)
+                r_d = r_d + L.Kdt @ th
+                r_r = r_r + J.T @ (L.Kdt.T @ c.d + L.Ktt @ th)
             parts.append(r_d)
             if self.balanced:
                 r_r = r_r - jnp.cross(mD, g_b)
@@ -190,6 +197,22 @@ class System(eqx.Module):
         if self.forced is not None:
             rigid = self.forced.rigid_rows(acc, t, self.scales()[:6])
         return jnp.concatenate([rigid, *parts])
+
+    def liquid_rotation(self, q, with_jacobian=False):
+        """theta = 2 vec(q_ref^-1 q): the small rotation of the body since the reference attitude
+        (body frame); with its derivative along body-frame rotation increments, d theta / d eps."""
+        dq = quat_multiply(jnp.concatenate([self.q_ref[:1], -self.q_ref[1:]]), q)
+        sgn = jnp.where(dq[0] < 0, -1.0, 1.0)
+        th = 2.0 * sgn * dq[1:]
+        if not with_jacobian:
+            return th
+        return th, sgn * (dq[0] * jnp.eye(3) + skew(dq[1:]))
+
+    def _penalty(self, d, q):
+        """The theta-dependent part of the rotation-penalty energy: d^T K_dt theta + 1/2 theta^T K_tt theta."""
+        L = self.liquid
+        th = self.liquid_rotation(q)
+        return d @ (L.Kdt @ th) + 0.5 * th @ (L.Ktt @ th)
 
     # ---------------------------------------------------------------- energies
     def kinetic_energy(self, c: Config, V0, omega, d_dot):
@@ -212,6 +235,8 @@ class System(eqx.Module):
         if self.liquid is not None:
             L = self.liquid
             V = V + 0.5 * c.d @ (L.K @ c.d) - g_b @ (L.m_nodes @ L.full(c.d))
+            if L.Kdt is not None:
+                V = V + self._penalty(c.d, c.q)
             if not self.balanced:
                 V = V - g_b @ (L.m_nodes @ L.r)
         return V
