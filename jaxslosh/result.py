@@ -44,8 +44,8 @@ class SolverHistory(eqx.Module):
 
 
 class TankField(eqx.Module):
-    nodes: np.ndarray = eqx.field(static=True)
-    elements: np.ndarray = eqx.field(static=True)
+    nodes: np.ndarray            # (m, 3) tank-local
+    elements: np.ndarray         # (e, 8)
     displacement: jax.Array      # (k, m, 3) tank frame, deformational
 
 
