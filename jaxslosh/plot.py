@@ -58,6 +58,7 @@ def plot_free_surface(r, out: str, times=None, scale: float = 1.0) -> None:
         times = np.linspace(t_all[0], t_all[-1], 4)
     idx = [int(np.argmin(np.abs(t_all - tt))) for tt in times]
     fig = plt.figure(figsize=(4.2 * len(idx), 4.2))
+    span = max(float(np.max(sz)) for sz in sizes.values()) * 0.75
     for j, i in enumerate(idx):
         ax = fig.add_subplot(1, len(idx), j + 1, projection="3d")
         A = np.asarray(rotation_matrix(np.asarray(r.vessel.quaternion[i])))
@@ -78,7 +79,11 @@ def plot_free_surface(r, out: str, times=None, scale: float = 1.0) -> None:
                         seg = X0 + corners[[a_, b_]] @ A.T
                         ax.plot(seg[:, 0], seg[:, 1], seg[:, 2], color="0.3", lw=0.8)
         ax.set_title(f"t = {t_all[i]:.2f} s", fontsize=9)
-        ax.set_box_aspect((1, 1, 0.8))
+        c = np.asarray(r.vessel.position[i])
+        ax.set_xlim(c[0] - span, c[0] + span)
+        ax.set_ylim(c[1] - span, c[1] + span)
+        ax.set_zlim(c[2] - span, c[2] + span)
+        ax.set_box_aspect((1, 1, 1))
         ax.set_xlabel("X")
         ax.set_ylabel("Y")
         ax.set_zlabel("Z")
