@@ -43,6 +43,8 @@ def _parser():
     g.add_argument("--structure")
     m.add_argument("-n", type=int, default=10, help="number of modes (default 10)")
     m.add_argument("--json", action="store_true", help="print one JSON object")
+    from .identify import add_identify_parser
+    add_identify_parser(sub)
     return p
 
 
@@ -151,7 +153,9 @@ def main(argv=None) -> int:
     from .scene_types import SceneError
     try:
         a = _parser().parse_args(argv)
-        return {"run": cmd_run, "check": cmd_check, "plot": cmd_plot, "modes": cmd_modes}[a.command](a)
+        from .identify import cmd_identify
+        return {"run": cmd_run, "check": cmd_check, "plot": cmd_plot, "modes": cmd_modes,
+                "identify": cmd_identify}[a.command](a)
     except (InputError, SceneError) as e:
         print(f"error: {e}", file=sys.stderr)
         return EXIT_INPUT

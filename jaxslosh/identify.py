@@ -42,23 +42,33 @@ Methods (`method=`)
         1e-10, the largest step below 1e-8 in theta (a relative change of 1e-8 for a log
         parameter), or the gradient is orthogonal to the residual to 1e-8
         (|J^T r|_i / (|J_i| |r|) < 1e-8 for every i).
-    "lbfgs": optax.lbfgs with its zoom line search on the loss, gradient by reverse mode.
+    "lbfgs": optax's L-BFGS direction, capped at a norm of 0.25 in theta, then its zoom line
+        search, on the loss; gradients by reverse mode.
     "adam": optax.adam (learning rate `learning_rate`, default 0.02 in theta) on the loss.
     Both optax methods stop when the loss changed by less than 1e-10 relative over 5 consecutive
     iterations or the largest step in theta fell below 1e-8.
 
-    Measured on the roll-decay problem of `notebooks/identify_metacentric_heights.ipynb`
-    (scenes/vessel_only.toml, 10 s record, dt 0.01, noise 1e-4 rad on roll and pitch, GM_T and GM_L
-    started 30 % off, 2 CPU cores, compilation excluded):
-        method          iterations   simulations  final loss (SSR/n)   GM_T, GM_L error   wall
-        gauss-newton        7            8           1.6337e-06            < 0.02 %       0.21 s
-        lbfgs              19           29           1.6337e-06            < 0.02 %       0.85 s
-        adam (lr 0.02)   >500          500           1.69e-06              0.4 %, 0.1 %   11 s
-    Gauss-Newton is the default: it needs the fewest simulations, reaches the noise floor to all
-    digits, and its J gives the standard errors for free. Adam with a fixed learning rate creeps
-    towards the minimum and is kept only for comparison (and for many parameters with cheap
-    gradients); L-BFGS is the choice when there are many parameters (reverse mode, one gradient
-    per evaluation whatever their number).
+    Measured on the roll-decay problem of `notebooks/identify_metacentric_heights.ipynb` with
+    scenes/vessel_only.toml (10 s record at dt 0.01, noise 1e-4 rad on roll and pitch, seed 2013,
+    GM_T started 30 % high and GM_L 30 % low) on 2 CPU cores shared with other jobs (three runs;
+    where they differ the range is given). "simulations" counts every evaluation of the model, the
+    final one for the standard errors included; "solve" excludes compilation, which happens once
+    per problem structure (its time depends on the machine's load and on what the process traced
+    before):
+        method          iterations  to 1 %  simulations  final loss    solve          compile
+        gauss-newton         6         4          7      1.71141e-05   0.37-0.41 s    12-23 s
+        lbfgs               23         3         26      1.71141e-05   1.5-2.1 s      28-39 s
+        adam (lr 0.02)     288        38        289      1.71141e-05   14-35 s         7-12 s
+    ("to 1 %": the first iteration after which both GMs are within 1 % of the truth.)
+    All three end at the same minimum (GM_T within 0.0004 %, GM_L within 0.004 % of the truth).
+    Gauss-Newton is the default: the fewest simulations and the least wall time (forward mode: r
+    and the Jacobian of 2 parameters cost 0.05 s, a reverse-mode gradient 0.05-0.12 s), and its J
+    gives the standard errors. On the paper's ship with its tank (scenes/paper_ship_tank.toml,
+    the same record) it also takes 6 iterations (7 simulations): GM_T within 0.0002 %, GM_L within
+    0.004 %. Adam with a fixed learning rate creeps to the minimum; L-BFGS is the one to use with
+    many parameters (one reverse-mode gradient per evaluation whatever their number). Plain
+    optax.lbfgs (no cap on the first step) went to a wrong valley on this problem (GM_L 43 m
+    instead of 14.2 m, loss 0.63), hence the cap.
 
 Standard errors
     From the Gauss-Newton covariance at the optimum in the physical parameters:
@@ -67,8 +77,12 @@ Standard errors
     weighting; with the default weights (1 / std of the signal) and unequal noise levels across
     channels they are only indicative.
 
-All model evaluations inside one `identify` call go through one jit-compiled function of the
-parameter vector theta: the simulation is traced and compiled once per call, not per iteration.
+All model evaluations go through one jit-compiled function of the parameter vector theta and the
+data (r and J together for Gauss-Newton; the whole optimiser update, line search included, for the
+optax methods): the simulation is traced and compiled once, before the first iteration, never per
+iteration. The compiled functions are kept for a few problem structures (scene, fitted keys and
+their transforms, channels, number of samples), so a repeated fit of the same structure (another
+record, start or weights) compiles nothing.
 """
 from __future__ import annotations
 
@@ -96,6 +110,10 @@ POSITIVE = ("environment.gravity", "environment.water_density", "vessel.mass", "
 _FTOL, _XTOL, _GTOL = 1e-10, 1e-8, 1e-8
 _LBFGS_MAX_STEP = 0.25
 
+# compiled residual / Jacobian / optimiser-update functions, by problem structure (see _Problem.compiled)
+_COMPILED: dict = {}
+_COMPILED_MAX = 6
+
 
 @dataclasses.dataclass
 class FitResult:
@@ -103,8 +121,8 @@ class FitResult:
 
     values / standard_errors: key -> float (a list of floats for a vector key).
     loss_history: the loss (SSR / n of the weighted residuals) at the start and after every
-    iteration. iterations: iterations done (Jacobian evaluations for Gauss-Newton, optimiser
-    updates for the optax methods). evaluations: simulations run (line search and rejected
+    iteration. iterations: iterations done (accepted steps for Gauss-Newton, optimiser updates
+    for the optax methods). evaluations: simulations run (line search and rejected
     trial steps included). channels: the weight of every channel used. wall_time: seconds in
     all; compile_time: of which tracing and compiling; solve_time: the iterations alone.
     """
@@ -264,9 +282,8 @@ def _make_params(scene: Scene, keys, x0, bounds) -> list:
         if not np.all(np.isfinite(start)):
             raise SceneError(f"x0.{key}", "the start must be finite")
         if (lo is not None and np.any(start <= lo)) or (hi is not None and np.any(start >= hi)):
-            raise SceneError(key, f"the start {start.tolist()} is not strictly inside the bounds ({lo}, {hi})"
-                                  + ("; fitting a value that must stay positive" if key in POSITIVE and key not in bounds
-                                     else ""))
+            why = "; the value must stay positive" if key in POSITIVE and key not in bounds else ""
+            raise SceneError(key, f"the start {start.tolist()} is not strictly inside the bounds ({lo}, {hi}){why}")
         out.append(_Param(key, base, start, lo, hi))
     return out
 
@@ -365,23 +382,42 @@ class _Problem:
         if not self.active:
             raise SceneError("measured", "no channel to fit: every measured channel is constant or has weight 0 "
                                          f"(channels: {', '.join(names) or 'none'})")
-        self.meas = {k: meas[k] for k in self.active}
+        # the data, an argument of the compiled functions (so that they serve any record of this shape)
+        self.data = (jnp.asarray(t), jnp.asarray(np.stack([meas[k] for k in self.active])),
+                     jnp.asarray([self.weights[k] for k in self.active]))
         self.n = t.size * len(self.active)
         sizes = [p.size for p in params]
         self.offsets = np.concatenate([[0], np.cumsum(sizes)]).astype(int)
         self.theta0 = np.concatenate([p.theta_of(p.start) for p in params])
         self.tol = float(sim.tolerance)
-        self._resid = self._rj = self._vg = None
+        self._rj = None
         self.evaluations = 0
         self.compile_time = 0.0
+        self.key = (dataclasses.replace(scene, path="", warnings=()),
+                    tuple((p.key, p.lo, p.hi, tuple(p.scale.tolist()) if p.lo is None and p.hi is None else None,
+                           p.base.tobytes(), p.size, p.scalar)
+                          for p in params),
+                    self.duration, bool(self.direct), tuple(self.active), t.size)
 
-    def compiled(self, fn, *args):
-        """`fn` jit-compiled for arguments like `args` (ahead of time, so that the compilation is
-        timed apart from the iterations; each is traced and compiled once)."""
-        t0 = _time.perf_counter()
-        c = jax.jit(fn).lower(*args).compile()
-        self.compile_time += _time.perf_counter() - t0
-        return c
+    def compiled(self, name, fn, *args):
+        """`fn` jit-compiled ahead of time for arguments like `args`, so that compiling is timed apart
+        from the iterations. Kept (a few, least recently used out) under `name` and the problem's
+        structure: the scene, the fitted keys and their transforms, the channels and the number of
+        samples; a later identify of the same structure (another record, start, weights) reuses it."""
+        key = (name, self.key)
+        try:
+            hit = _COMPILED.pop(key, None)
+        except TypeError:                       # an unhashable scene: no reuse
+            key, hit = None, None
+        if hit is None:
+            t0 = _time.perf_counter()
+            hit = jax.jit(fn).lower(*args).compile()
+            self.compile_time += _time.perf_counter() - t0
+        if key is not None:
+            _COMPILED[key] = hit
+            while len(_COMPILED) > _COMPILED_MAX:
+                _COMPILED.pop(next(iter(_COMPILED)))
+        return hit
 
     # the model -------------------------------------------------------------------------------
     def physical(self, theta):
@@ -392,46 +428,44 @@ class _Problem:
 
     def simulate(self, theta):
         from .run import simulate
-        return simulate(self.scene, params=self.sim_params(theta), duration=self.duration)
+        # traced under jit: what does not depend on theta (the host-side assembly of the liquid
+        # matrices, in NumPy) is evaluated while tracing, as it would be outside jit
+        with jax.ensure_compile_time_eval():
+            return simulate(self.scene, params=self.sim_params(theta), duration=self.duration)
 
-    def model_channels(self, r: Result) -> dict:
+    def model_channels(self, r: Result, t_measured) -> dict:
         ch = channels_of(r, self.active)
         if self.direct:
             return {k: v[:self.t_measured.size] for k, v in ch.items()}
-        t = jnp.asarray(self.t_measured)
-        return {k: jnp.interp(t, r.time, v) for k, v in ch.items()}
+        return {k: jnp.interp(t_measured, r.time, v) for k, v in ch.items()}
 
-    def _residual_ok(self, theta):
+    # traced: functions of theta and the data (t_measured, measured (channels, n), weights (channels,))
+    def _residual_ok(self, theta, data):
+        t_measured, meas, w = data
         r = self.simulate(theta)
-        ch = self.model_channels(r)
-        res = jnp.concatenate([self.weights[k] * (ch[k] - self.meas[k]) for k in self.active])
+        ch = self.model_channels(r, t_measured)
+        model = jnp.stack([ch[k] for k in self.active])
+        res = (w[:, None] * (model - meas)).reshape(-1)
         ok = jnp.all(jnp.isfinite(res)) & (jnp.max(r.solver.residual) <= 100.0 * self.tol)
         return res, ok
 
-    def _residual_jac(self, theta):
+    def _residual_jac(self, theta, data):
         def f(th):
-            res, ok = self._residual_ok(th)
+            res, ok = self._residual_ok(th, data)
             return res, (res, ok)
         J, (res, ok) = jax.jacfwd(f, has_aux=True)(theta)
         return res, J, ok
 
-    def _loss(self, theta):
-        res, ok = self._residual_ok(theta)
+    def _loss(self, theta, data):
+        res, ok = self._residual_ok(theta, data)
         return jnp.where(ok, jnp.mean(res ** 2), jnp.inf)
 
     # evaluations counted, results on the host -------------------------------------------------
-    def residual(self, theta):
-        self.evaluations += 1
-        if self._resid is None:
-            self._resid = self.compiled(self._residual_ok, jnp.asarray(self.theta0))
-        res, ok = self._resid(jnp.asarray(theta))
-        return np.asarray(res), bool(ok)
-
     def residual_jacobian(self, theta):
         self.evaluations += 1
         if self._rj is None:
-            self._rj = self.compiled(self._residual_jac, jnp.asarray(self.theta0))
-        res, J, ok = self._rj(jnp.asarray(theta))
+            self._rj = self.compiled("jacobian", self._residual_jac, jnp.asarray(self.theta0), self.data)
+        res, J, ok = self._rj(jnp.asarray(theta), self.data)
         return np.asarray(res), np.asarray(J), bool(ok)
 
     def values(self, theta) -> dict:
@@ -452,8 +486,9 @@ class _Problem:
 
 def _gauss_newton(pb: _Problem, theta, max_iter, callback, history):
     res, J, ok = pb.residual_jacobian(theta)
+    last = (res, J, ok)
     if not ok:
-        return theta, 0, False, "the simulation at the start failed (Newton did not converge or non-finite values)"
+        return theta, 0, False, "the simulation at the start failed (Newton not converged or non-finite values)", last
     ssr = float(res @ res)
     history.append(ssr / pb.n)
     lam = 1e-3
@@ -466,7 +501,7 @@ def _gauss_newton(pb: _Problem, theta, max_iter, callback, history):
         if np.all(np.abs(g) <= _GTOL * np.maximum(colnorm, 1e-300) * math.sqrt(ssr)) or ssr == 0.0:
             converged, message = True, "gradient orthogonal to the residual"
             break
-        accepted = False
+        accepted, any_ok = False, False
         for _ in range(12):
             try:
                 step = np.linalg.solve(A + lam * np.diag(d), -g)
@@ -476,19 +511,21 @@ def _gauss_newton(pb: _Problem, theta, max_iter, callback, history):
             t_new = theta + step
             r_new, J_new, ok_new = pb.residual_jacobian(t_new)
             ssr_new = float(r_new @ r_new) if ok_new else math.inf
+            any_ok = any_ok or ok_new
             if ssr_new < ssr:
                 accepted = True
                 break
             lam *= 10.0
-        it += 1
         if not accepted:
-            # no damping lowers the SSR: a minimum to round-off
-            converged = True
-            message = "no step lowers the loss (a minimum to round-off)"
-            history.append(ssr / pb.n)
+            if any_ok:      # no damping lowers the SSR: a minimum to round-off
+                converged, message = True, "no step lowers the loss (a minimum to round-off)"
+            else:
+                message = "every trial step failed to simulate (Newton did not converge or non-finite values)"
             break
+        it += 1
         rel = (ssr - ssr_new) / ssr
         theta, res, J, ssr = t_new, r_new, J_new, ssr_new
+        last = (res, J, True)
         lam = max(lam / 10.0, 1e-12)
         history.append(ssr / pb.n)
         if callback is not None and callback(it, pb.values(theta), ssr / pb.n):
@@ -500,20 +537,19 @@ def _gauss_newton(pb: _Problem, theta, max_iter, callback, history):
         if np.max(np.abs(step)) < _XTOL:
             converged, message = True, f"step {np.max(np.abs(step)):.2g} < {_XTOL:g}"
             break
-    return theta, it, converged, message
+    return theta, it, converged, message, last
 
 
 def _optax_loop(pb: _Problem, theta, method, max_iter, callback, history, learning_rate):
     import optax
 
-    if pb._vg is None:
-        pb._vg = jax.value_and_grad(pb._loss)
     theta = jnp.asarray(theta)
     if method == "adam":
-        opt = optax.adam(learning_rate if learning_rate is not None else 0.02)
+        lr = learning_rate if learning_rate is not None else 0.02
+        opt = optax.adam(lr)
 
-        def update(th, state):
-            value, grad = pb._vg(th)
+        def update(th, state, data):
+            value, grad = jax.value_and_grad(pb._loss)(th, data)
             upd, state = opt.update(grad, state, th)
             return optax.apply_updates(th, upd), state, value, 1
     else:
@@ -523,20 +559,21 @@ def _optax_loop(pb: _Problem, theta, method, max_iter, callback, history, learni
         opt = optax.chain(optax.scale_by_lbfgs(), optax.clip_by_global_norm(_LBFGS_MAX_STEP),
                           optax.scale(-1.0) if learning_rate is None else optax.scale_by_learning_rate(learning_rate),
                           optax.scale_by_zoom_linesearch(max_linesearch_steps=20))
-        vg = optax.value_and_grad_from_state(pb._loss)
+        lr = learning_rate
 
-        def update(th, state):
-            value, grad = vg(th, state=state)
-            upd, state = opt.update(grad, state, th, value=value, grad=grad, value_fn=pb._loss)
+        def update(th, state, data):
+            loss = lambda x: pb._loss(x, data)  # noqa: E731
+            value, grad = optax.value_and_grad_from_state(loss)(th, state=state)
+            upd, state = opt.update(grad, state, th, value=value, grad=grad, value_fn=loss)
             n_ls = optax.tree_utils.tree_get(state, "info").num_linesearch_steps
             return optax.apply_updates(th, upd), state, value, n_ls
 
     state = opt.init(theta)
-    update = pb.compiled(update, theta, state)
+    update = pb.compiled((method, lr), update, theta, state, pb.data)
     it, converged, message, flat = 0, False, f"stopped after max_iter = {max_iter} iterations", 0
     final_known = False          # whether history[-1] is the loss at the returned theta
     while it < max_iter:
-        t_new, state, value, n_eval = update(theta, state)
+        t_new, state, value, n_eval = update(theta, state, pb.data)
         value = float(value)      # the loss at theta (before this update)
         pb.evaluations += int(n_eval) if method == "lbfgs" else 1
         history.append(value)
@@ -591,14 +628,14 @@ def identify(scene: Scene, measured, fit: Sequence[str], *, weights: Optional[di
     history: list = []
     t_solve = _time.perf_counter()
     if method == "gauss-newton":
-        theta, it, converged, message = _gauss_newton(pb, pb.theta0.copy(), int(max_iter), callback, history)
+        theta, it, converged, message, last = _gauss_newton(pb, pb.theta0.copy(), int(max_iter), callback, history)
         final_known = True
     else:
         theta, it, converged, message, final_known = _optax_loop(pb, pb.theta0.copy(), method, int(max_iter),
                                                                  callback, history, learning_rate)
     solve_time = _time.perf_counter() - t_solve - pb.compile_time
     # standard errors from the Gauss-Newton covariance, in the physical parameters
-    res, J, ok = pb.residual_jacobian(theta)
+    res, J, ok = last if method == "gauss-newton" else pb.residual_jacobian(theta)
     p_dim = J.shape[1]
     se_vec = np.full(p_dim, np.nan)
     corr = None
@@ -642,7 +679,6 @@ def plot_fit(scene: Scene, measured, fit_result: FitResult, out_png: Optional[st
     meas = {k: np.asarray(v) for k, v in channels_of(measured).items()}
     names = [k for k, w in fit_result.channels.items() if w > 0] or [
         k for k in ("roll", "pitch", "heave") if np.std(meas[k]) > 0]
-    keys = list(fit_result.values)
     params_of = lambda vals: {k: _param_for(scene, k, v) for k, v in vals.items()}  # noqa: E731
     fitted = simulate(scene, params=params_of(fit_result.values), duration=max(T, scene.simulation.dt))
     ch_fit = {k: np.asarray(v) for k, v in channels_of(fitted).items()}
@@ -662,11 +698,11 @@ def plot_fit(scene: Scene, measured, fit_result: FitResult, out_png: Optional[st
     units = {"roll": ("deg", np.degrees), "pitch": ("deg", np.degrees), "heave": ("m", lambda x: x)}
     for ax, k in zip(axes[:, 0], names):
         unit, conv = units.get(k, ("m", lambda x: x))
-        ax.plot(t_m, conv(meas[k]), ".", ms=2.5, color="0.45", label="measured")
+        ax.plot(t_m, conv(meas[k]), ".", ms=3, color="k", alpha=0.35, label="measured")
         if ch_start is not None and k in ch_start:
             ax.plot(np.asarray(r0.time), conv(ch_start[k]), "--", lw=0.9, color="C1", label="start")
         if k in ch_fit:
-            ax.plot(t_f, conv(ch_fit[k]), "-", lw=1.2, color="C0", label="fitted")
+            ax.plot(t_f, conv(ch_fit[k]), "-", lw=1.0, color="C0", label="fitted")
         ax.set_ylabel(f"{k} ({unit})")
         ax.legend(loc="upper right", fontsize=8)
     axes[-1, 0].set_xlabel("time (s)")
@@ -675,7 +711,6 @@ def plot_fit(scene: Scene, measured, fit_result: FitResult, out_png: Optional[st
     fig.tight_layout()
     if out_png is not None:
         fig.savefig(out_png, dpi=110)
-    del keys
     return fig
 
 
@@ -702,8 +737,10 @@ def add_identify_parser(subparsers):
     p.add_argument("scene")
     p.add_argument("--data", required=True, metavar="MEASURED.h5", help="the measured result file")
     p.add_argument("--fit", required=True, metavar="KEY[,KEY...]",
-                   help="dotted scene keys to fit, comma-separated, e.g. vessel.hydrostatics.gm_t,vessel.hydrostatics.gm_l")
-    p.add_argument("-o", "--output", metavar="FIT.json", help="the fit as JSON (default: the scene's name with _fit.json, here)")
+                   help="dotted scene keys to fit, comma-separated, e.g. "
+                        "vessel.hydrostatics.gm_t,vessel.hydrostatics.gm_l")
+    p.add_argument("-o", "--output", metavar="FIT.json",
+                   help="the fit as JSON (default: the scene's name with _fit.json, here)")
     p.add_argument("--method", default="gauss-newton", choices=METHODS, help="optimiser (default gauss-newton)")
     p.add_argument("--max-iter", type=int, default=50, dest="max_iter", help="iterations at most (default 50)")
     p.add_argument("--start", metavar="KEY=VALUE[,...]", help="start values (default: the scene's values)")
@@ -769,7 +806,9 @@ def cmd_identify(a) -> int:
     try:
         fr = identify(scene, measured, keys, method=method, max_iter=max_iter, x0=x0 or None)
     except SceneError as e:
-        raise InputError(str(e).replace("\n", " "))
+        msg = str(e).replace("\n", " ")
+        flag = "--start" if ("the start" in msg or "given in x0" in msg) else "--data" if e.key == "measured" else None
+        raise InputError(f"{flag}: {msg}" if flag else msg)
     if not fr.loss_history or not math.isfinite(fr.loss_history[0]):
         print(f"jaxslosh identify: numerical failure: {fr.message}", file=sys.stderr)
         return EXIT_NUMERICAL
