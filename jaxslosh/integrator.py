@@ -140,8 +140,8 @@ def _preconditioner(A, like, Cinv):
 
 def _newton(R, x0, Cinv, scale, tol, max_iter):
     """Quasi-Newton iterations on R(x) = 0 (x: 6 rigid unknowns, then the liquid's) with the
-    structured approximate inverse of the Jacobian, formed at the start of the step and formed
-    again only when the residual stops falling fast (a rotation that changed a lot)."""
+    structured approximate inverse of the Jacobian, formed at the first iteration of the step and
+    formed again only when the residual stops falling fast (a rotation that changed a lot)."""
 
     def err_of(r):
         return jnp.max(jnp.abs(r / scale))
@@ -151,21 +151,21 @@ def _newton(R, x0, Cinv, scale, tol, max_iter):
         return _precond_data(jvp, x, Cinv)
 
     def body(carry):
-        x, r, it, err_prev, _, data = carry
+        x, r, it, err_prev, _, need, data = carry
+        data = jax.lax.cond(need, refresh, lambda _: data, x)
         x = x + _precond_apply(data, Cinv, -r)
         r = R(x)
         err = err_of(r)
-        slow = err > 0.1 * err_prev
-        data = jax.lax.cond(slow & (err > tol), refresh, lambda _: data, x)
-        return x, r, it + 1, err, err > 0.5 * err_prev, data
+        return x, r, it + 1, err, err > 0.5 * err_prev, err > 0.1 * err_prev, data
 
     def cond(carry):
-        _, _, it, err, stalled, _ = carry
+        _, _, it, err, stalled, _, _ = carry
         return (err > tol) & (it < max_iter) & jnp.isfinite(err) & ~stalled
 
     r0 = R(x0)
-    init = (x0, r0, jnp.array(0), err_of(r0), jnp.array(False), refresh(x0))
-    x, r, it, err, stalled, _ = jax.lax.while_loop(cond, body, init)
+    data0 = jax.tree_util.tree_map(jnp.zeros_like, jax.eval_shape(refresh, x0))
+    init = (x0, r0, jnp.array(0), err_of(r0), jnp.array(False), jnp.array(True), data0)
+    x, r, it, err, stalled, _, _ = jax.lax.while_loop(cond, body, init)
     # Converged: below the tolerance, or stalled at round-off within a factor 100 of it.
     ok = jnp.isfinite(err) & ((err <= tol) | (stalled & (err <= 100.0 * tol)))
     # aux leaves are floats: custom_root's JVP rule cannot carry integer or boolean aux tangents

@@ -71,8 +71,14 @@ class Hydro(eqx.Module):
     def moment(self, q):
         if self.moment_form == "paper":
             return self.moment_paper(q)
-        # conservative: minus the derivative of the potential along body-frame rotations
-        return -jax.grad(lambda th: self.potential(jnp.zeros(3), quat_multiply(q, quat_exp(th))))(jnp.zeros(3))
+        # conservative: minus the derivative of the potential along body-frame rotations. With
+        # g = A^T e_z, a body rotation d theta changes g by g x d theta, so M = g x dV/dg.
+        k = self.rho_w * self.gravity * self.displaced_volume
+        g = rotation_matrix(q)[2]
+        D = 1.0 + g[2]
+        N = self.gm_t * g[1] ** 2 + self.gm_l * g[0] ** 2
+        dV_dg = k * jnp.array([2.0 * self.gm_l * g[0] / D, 2.0 * self.gm_t * g[1] / D, -N / D ** 2])
+        return jnp.cross(g, dV_dg)
 
 
 class Forced(eqx.Module):
