@@ -12,7 +12,7 @@ __version__ = "0.1.0"
 from .scene import load_scene  # noqa: E402
 from .scene_types import Scene, SceneError  # noqa: E402
 from .result import Result, load_result, save_result  # noqa: E402
-from .run import NumericalFailure, simulate  # noqa: E402
+from .run import NumericalFailure, simulate, simulate_batch  # noqa: E402
 from .identify import identify  # noqa: E402
 
 
@@ -23,4 +23,4 @@ def sloshing_modes(scene, tank=None, n=10):
 
 
 __all__ = ["Scene", "SceneError", "Result", "NumericalFailure", "load_scene", "simulate", "save_result",
-           "load_result", "sloshing_modes", "identify", "__version__"]
+           "load_result", "sloshing_modes", "identify", "simulate_batch", "__version__"]

@@ -45,6 +45,8 @@ def _parser():
     m.add_argument("--json", action="store_true", help="print one JSON object")
     from .identify import add_identify_parser
     add_identify_parser(sub)
+    from .sweep import add_sweep_parser
+    add_sweep_parser(sub)
     return p
 
 
@@ -154,8 +156,9 @@ def main(argv=None) -> int:
     try:
         a = _parser().parse_args(argv)
         from .identify import cmd_identify
+        from .sweep import cmd_sweep
         return {"run": cmd_run, "check": cmd_check, "plot": cmd_plot, "modes": cmd_modes,
-                "identify": cmd_identify}[a.command](a)
+                "identify": cmd_identify, "sweep": cmd_sweep}[a.command](a)
     except (InputError, SceneError) as e:
         print(f"error: {e}", file=sys.stderr)
         return EXIT_INPUT

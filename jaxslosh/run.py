@@ -274,3 +274,56 @@ def _file_frames(b: Built, fr: Frame, p0, n: int, save_fields: bool) -> dict:
         for t in b.tanks:
             d[f"tanks/{t.name}/displacement"] = fr.D[:n, t.node_offset:t.node_offset + t.nodes.shape[0]]
     return {k: np.asarray(v) for k, v in d.items()}
+
+
+def simulate_batch(scene: Scene, params: dict, *, duration: Optional[float] = None,
+                   dt: Optional[float] = None) -> tuple[Result, list]:
+    """Run a batch of parameter sets in one compiled, vmapped loop.
+
+    `params` maps dotted scene keys to arrays of equal leading length B (one value per run).
+    Returns (result, statuses): the result's arrays carry a leading batch axis, statuses is one
+    string per run ("ok" or why it stopped; a failed run keeps its last good state after that).
+    With several devices the batch is sharded over them (jax.sharding), B divisible by their count.
+    """
+    keys = list(params)
+    vals = [jnp.asarray(params[k], dtype=float) for k in keys]
+    if not vals:
+        raise ValueError("simulate_batch needs at least one parameter array")
+    B = int(vals[0].shape[0])
+    if any(int(v.shape[0]) != B for v in vals):
+        raise ValueError("every parameter array must have the same leading length")
+    devices = jax.devices()
+    if len(devices) > 1 and B % len(devices) == 0:
+        from jax.sharding import Mesh, NamedSharding, PartitionSpec
+        mesh = Mesh(np.array(devices), ("batch",))
+        vals = [jax.device_put(v, NamedSharding(mesh, PartitionSpec("batch", *([None] * (v.ndim - 1)))))
+                for v in vals]
+    setup0 = prepare(scene, None, duration, dt)
+    n_frames = setup0.n_steps // setup0.save_every
+
+    def one(*v):
+        with jax.ensure_compile_time_eval():     # the liquid's matrices are built on the host, once
+            setup = prepare(scene, dict(zip(keys, v)), duration, dt)
+        b = _core(setup.built)
+        carry, f0 = start(b, setup.solver)
+        carry, frames = advance(b, setup.solver, carry, n_frames, setup.save_every)
+        fr = _concat_frames([jax.tree_util.tree_map(lambda x: x[None], f0), frames])
+        return carry, fr
+
+    carry, fr = jax.jit(jax.vmap(one))(*vals)
+    statuses = []
+    h = setup0.solver.h
+    for i in range(B):
+        ci = jax.tree_util.tree_map(lambda x: x[i], carry)
+        statuses.append(_failure_message(ci, h, setup0.solver.tol, setup0.solver.max_iter)
+                        if bool(ci.failed) else "ok")
+    b0 = setup0.built
+    probes = {}
+    for i, name in enumerate(b0.probes.names):
+        pos = fr.probes[:, :, i, :]
+        probes[name] = ProbeHistory(pos, pos - pos[:, :1])
+    res = Result(time=fr.t, vessel=VesselHistory(fr.X0, fr.q, fr.omega, rpy_from_quat(fr.q)), probes=probes,
+                 energy=Energy(fr.ke, fr.pe), solver=SolverHistory(fr.iterations, fr.residual), tanks={},
+                 status="ok" if all(s == "ok" for s in statuses) else "some runs failed",
+                 steps_done=setup0.n_steps, scene_text=scene.text)
+    return res, statuses
