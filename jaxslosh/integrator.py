@@ -88,24 +88,35 @@ class Solver(eqx.Module):
 
 
 def make_solver(system: System, h: float, scheme: Scheme, tol: float, max_iter: int, substeps: int = 0) -> Solver:
-    """Factor the constant liquid blocks once (NumPy, float64)."""
+    """Factor the constant liquid blocks once (float64): NumPy for concrete matrices, JAX when the
+    liquid was built from traced values (under jit).
+
+    The inverses only precondition the Newton iterations and the tangent solves, whose solutions do
+    not depend on them (`lax.custom_root` drops their tangents), so they are formed from
+    `stop_gradient` values: under `jax.grad` outside jit the matrices are then concrete again."""
     nf = system.nf
     substeps = int(substeps) if substeps and substeps > 1 else 0
     if nf == 0:
         z = jnp.zeros((0, 0))
         return Solver(z, z, jnp.asarray(h, dtype=float), scheme, tol, max_iter, substeps, z if substeps else None)
     L = system.liquid
-    Ms = np.asarray(L.Ms)
+    Ms, K_ff = jax.lax.stop_gradient(L.Ms), jax.lax.stop_gradient(L.K)
     free = np.asarray(L.free)
-    M_ff = np.kron(Ms, np.eye(3))[np.ix_(free, free)]
-    K_ff = np.asarray(L.K)
+    traced = isinstance(Ms, jax.core.Tracer) or isinstance(K_ff, jax.core.Tracer)
+    xp = jnp if traced else np
+    if not traced:
+        Ms, K_ff = np.asarray(Ms), np.asarray(K_ff)
+    M_ff = xp.kron(Ms, xp.eye(3))[np.ix_(free, free)]
+
+    def inverse(A):
+        return jnp.linalg.inv(A) if traced else jnp.asarray(np.linalg.inv(A))
 
     def step_block_inverse(hh):
         c_a = (1.0 - scheme.alpha_m) / ((1.0 - scheme.alpha_f) * scheme.beta * hh ** 2)
         Cs = c_a * M_ff + K_ff
-        return jnp.asarray(np.linalg.inv(0.5 * (Cs + Cs.T)))
+        return inverse(0.5 * (Cs + Cs.T))
 
-    return Solver(step_block_inverse(h), jnp.asarray(np.linalg.inv(M_ff)), jnp.asarray(h, dtype=float), scheme, tol,
+    return Solver(step_block_inverse(h), inverse(M_ff), jnp.asarray(h, dtype=float), scheme, tol,
                   max_iter, substeps, step_block_inverse(h / substeps) if substeps else None)
 
 
@@ -225,11 +236,11 @@ def initial_state(system: System, solver: Solver, c0: Config, v0) -> tuple[State
     return State(c0, v0, acc0, acc0, jnp.zeros(())), StepInfo(it, err, ok)
 
 
-def step(system: System, solver: Solver, s: State) -> tuple[State, StepInfo]:
-    """One implicit step t_n -> t_{n+1}; the unknown is the increment Delta = (dX0, Theta, dd)."""
+def step_equations(system: System, solver: Solver, s: State):
+    """The equations of one step t_n -> t_{n+1} in the increment Delta = (dX0, Theta, dd):
+    returns (R, unpack, x0): the residual R(Delta), the map Delta -> (config, v, acc, a) of the
+    scheme, and the predictor (a_{n+1} = a_n)."""
     h, (am, af, beta, gamma) = solver.h, solver.scheme
-    scale = system.scales()            # residual rows / scale: accelerations (m/s^2, rad/s^2)
-
     base = h * s.v + h * h * (0.5 - beta) * s.a
 
     def unpack(delta):
@@ -243,11 +254,17 @@ def step(system: System, solver: Solver, s: State) -> tuple[State, StepInfo]:
         V0, om, dd = _split(v)
         return system.residual(c, V0, om, dd, acc, s.t + h)
 
-    x0 = base + h * h * beta * s.a
+    return R, unpack, base + h * h * beta * s.a
+
+
+def step(system: System, solver: Solver, s: State) -> tuple[State, StepInfo]:
+    """One implicit step t_n -> t_{n+1}; the unknown is the increment Delta = (dX0, Theta, dd)."""
+    scale = system.scales()            # residual rows / scale: accelerations (m/s^2, rad/s^2)
+    R, unpack, x0 = step_equations(system, solver, s)
     delta, (it, err, ok) = solve_root(R, x0, solver.Cinv_step, scale, solver.tol, solver.max_iter)
     c, v, acc, a = unpack(delta)
     ok = ok & jnp.all(jnp.isfinite(delta))
-    return State(c, v, acc, a, s.t + h), StepInfo(it, err, ok)
+    return State(c, v, acc, a, s.t + solver.h), StepInfo(it, err, ok)
 
 
 def step_or_retry(system: System, solver: Solver, s: State) -> tuple[State, StepInfo]:
