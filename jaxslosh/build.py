@@ -16,15 +16,35 @@ from .kinematics import quat_from_rpy
 from .model import Config, Forced, Hydro, Liquid, System
 from .scene_types import Scene, SceneError
 
+class _Keys(tuple):
+    """The traceable keys; `<name>` in an entry stands for the name of any tank of the scene
+    (`tanks.<name>.fill_depth` holds `tanks.tank.fill_depth`)."""
+
+    def __contains__(self, key) -> bool:
+        if not isinstance(key, str):
+            return False
+        for pattern in self:
+            if "<name>" not in pattern:
+                if key == pattern:
+                    return True
+                continue
+            head, tail = pattern.split("<name>")
+            if key.startswith(head) and key.endswith(tail) and len(key) > len(head) + len(tail):
+                if not any(ch in key[len(head):len(key) - len(tail)] for ch in ".[]/"):
+                    return True
+        return False
+
+
 # Scene values that simulate(params=...) may replace by traced values (the vessel is rebuilt per
-# call; liquid matrices are assembled in NumPy, so their parameters are not traceable yet).
-TRACEABLE = (
+# call; the liquid matrices are assembled from traced fill depth, density, sound speed and gravity).
+TANK_TRACEABLE = ("fill_depth", "fluid.density", "fluid.sound_speed")
+TRACEABLE = _Keys((
     "environment.gravity", "environment.water_density", "vessel.mass", "vessel.inertia",
     "vessel.hydrostatics.waterplane_area", "vessel.hydrostatics.displaced_volume",
     "vessel.hydrostatics.gm_t", "vessel.hydrostatics.gm_l",
     "vessel.initial.position", "vessel.initial.velocity", "vessel.initial.angular_velocity",
     "vessel.initial.roll_pitch_yaw",
-)
+) + tuple(f"tanks.<name>.{k}" for k in TANK_TRACEABLE))
 
 
 class TankBlock(NamedTuple):
@@ -66,7 +86,7 @@ def check_params(params) -> None:
 
 
 def build(scene: Scene, params: Optional[dict] = None) -> Built:
-    params = dict(params or {})
+    params = _canonical_params(scene, dict(params or {}))
     check_params(params)
     P = lambda k, d: _params_get(params, k, d)  # noqa: E731
     env, ves = scene.environment, scene.vessel
@@ -82,7 +102,7 @@ def build(scene: Scene, params: Optional[dict] = None) -> Built:
             gm_t=jnp.asarray(P("vessel.hydrostatics.gm_t", h.gm_t), dtype=float),
             gm_l=jnp.asarray(P("vessel.hydrostatics.gm_l", h.gm_l), dtype=float),
             moment_form=h.moment)
-    liquid, tanks, d0 = _build_liquid(scene) if eff.liquid else (None, (), None)
+    liquid, tanks, d0 = _build_liquid(scene, params, g) if eff.liquid else (None, (), None)
     forced = None
     if ves.forced is not None:
         f = ves.forced
@@ -116,7 +136,16 @@ def build(scene: Scene, params: Optional[dict] = None) -> Built:
     return Built(system, c0, v0, probes, tanks)
 
 
-def _build_liquid(scene: Scene):
+def _build_liquid(scene: Scene, params: Optional[dict] = None, gravity=None):
+    """The stacked liquid block of all tanks. `params` (canonical keys) may replace each tank's
+    fill depth, density and sound speed, and `gravity` the scene's, by traced values: then the
+    matrices are JAX values (the integer mesh, the free dofs and the probes' host-side geometry
+    stay NumPy).
+
+    The host-side tank blocks (`TankBlock.nodes`, used for the probes' interpolation weights and the
+    result's undeformed mesh) are the mesh at the scene's fill depth, whatever the params say: a
+    probe keeps its place relative to the mesh (one at the scene's fill depth stays on the free
+    surface), so its weights do not depend on a traced fill depth."""
     rigid = [t for t in scene.tanks]
     if not rigid:
         return None, (), None
@@ -125,32 +154,66 @@ def _build_liquid(scene: Scene):
             raise SceneError(f"tanks[{i}].walls", "elastic tank walls are not supported yet (use \"rigid\")")
     from .liquid import build_liquid  # the liquid module is only imported by scenes that have liquid
 
-    blocks, rs, Ms_list, K_list, free_list, Kdt_list, Ktt = [], [], [], [], [], [], np.zeros((3, 3))
+    params = params or {}
+    g = scene.environment.gravity if gravity is None else gravity
+    models = []
+    for t in rigid:
+        P = lambda k, d: params.get(f"tanks.{t.name}.{k}", d)  # noqa: E731
+        models.append(build_liquid(t.size, P("fill_depth", t.fill_depth), t.mesh, P("fluid.density", t.fluid.density),
+                                   P("fluid.sound_speed", t.fluid.sound_speed), g, element=t.fluid.element))
+    traced = any(m.traced for m in models)
+    xp = jnp if traced else np
+
+    blocks, rs, Ms_list, K_list, free_list, Kdt_list, Ktt = [], [], [], [], [], [], xp.zeros((3, 3))
     coupled = False
     offset = 0
-    g = scene.environment.gravity
-    for t in rigid:
-        m = build_liquid(t.size, t.fill_depth, t.mesh, t.fluid.density, t.fluid.sound_speed, g, element=t.fluid.element)
+    for t, m in zip(rigid, models):
         N = m.nodes.shape[0]
-        blocks.append(TankBlock(t.name, offset, np.asarray(m.nodes), np.asarray(m.elements), m))
-        rs.append(np.asarray(m.nodes) + np.asarray(t.origin)[None, :])
-        Ms_list.append(np.asarray(m.mass))
+        host_nodes = np.asarray(m.nodes) if not m.traced and m.depth == t.fill_depth else None
+        if host_nodes is None:      # the mesh at the scene's fill depth (see above)
+            nx, ny, nz = m.mesh
+            X, Y, Z = np.meshgrid(np.linspace(0, t.size[0], nx + 1), np.linspace(0, t.size[1], ny + 1),
+                                  np.linspace(0, t.fill_depth, nz + 1), indexing="ij")
+            host_nodes = np.stack([X.ravel(), Y.ravel(), Z.ravel()], axis=1)
+        blocks.append(TankBlock(t.name, offset, host_nodes, np.asarray(m.elements), m))
+        rs.append(xp.asarray(m.nodes) + xp.asarray(t.origin)[None, :])
+        Ms_list.append(xp.asarray(m.mass))
         free = np.flatnonzero(np.asarray(m.free))
-        K_list.append(np.asarray(m.stiffness)[np.ix_(free, free)])
+        K_list.append(xp.asarray(m.stiffness)[np.ix_(free, free)])
         if getattr(m, "rotation_coupling", None) is not None:
             coupled = True
-            Kdt_list.append(np.asarray(m.rotation_coupling)[free])
-            Ktt = Ktt + np.asarray(m.rotation_stiffness)
+            Kdt_list.append(xp.asarray(m.rotation_coupling)[free])
+            Ktt = Ktt + xp.asarray(m.rotation_stiffness)
         else:
-            Kdt_list.append(np.zeros((free.size, 3)))
+            Kdt_list.append(xp.zeros((free.size, 3)))
         free_list.append(free + 3 * offset)
         offset += N
-    from scipy.linalg import block_diag
-    liquid = Liquid(r=jnp.asarray(np.concatenate(rs)), Ms=jnp.asarray(block_diag(*Ms_list)),
+    if traced:
+        from jax.scipy.linalg import block_diag
+    else:
+        from scipy.linalg import block_diag
+    liquid = Liquid(r=jnp.asarray(xp.concatenate(rs)), Ms=jnp.asarray(block_diag(*Ms_list)),
                     K=jnp.asarray(block_diag(*K_list)), free=jnp.asarray(np.concatenate(free_list)),
-                    n_nodes=offset, Kdt=jnp.asarray(np.concatenate(Kdt_list)) if coupled else None,
+                    n_nodes=offset, Kdt=jnp.asarray(xp.concatenate(Kdt_list)) if coupled else None,
                     Ktt=jnp.asarray(Ktt) if coupled else None)
     return liquid, tuple(blocks), None
+
+
+def _canonical_params(scene: Scene, params) -> dict:
+    """Keys in their name form (`tanks[0].fill_depth` -> `tanks.tank.fill_depth`); a value given
+    under both spellings is an error, and a tank key must name a tank of the scene."""
+    from .scene import canonical_key
+    out, given = {}, {}
+    for k, v in params.items():
+        c = canonical_key(scene, k) if isinstance(k, str) else k
+        if c in out:
+            raise SceneError(k, f"names the same value as {given[c]}; give it once")
+        out[c], given[c] = v, k
+        if isinstance(c, str) and c.startswith("tanks.") and c in TRACEABLE:
+            if not any(c.startswith(f"tanks.{t.name}.") for t in scene.tanks):
+                raise SceneError(k, "names no tank of this scene (tanks: "
+                                    + (", ".join(t.name for t in scene.tanks) or "none") + ")")
+    return out
 
 
 def _hydrostatic_start(system: System, q0):

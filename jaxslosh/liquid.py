@@ -71,13 +71,24 @@ mass (the frozen inertia R^T M R) are low by 2 beta (h_e/L)^2 (z^2: -3.6 %, x^2:
 
 Limits: a direction meshed with a single element carries no sloshing along it (its one-element
 curl constraint holds the surface flat that way: a static tilt along it is not followed at all);
-use >= 2 elements along every direction in which the surface should move. The model is built in
-NumPy, so ``fill_depth``, ``density``, ... are not traceable parameters.
+use >= 2 elements along every direction in which the surface should move.
+
+Traceability: ``fill_depth``, ``density``, ``sound_speed`` and ``gravity`` may be JAX tracers (so
+that ``jax.grad`` of a simulation works with respect to them). Everything that depends only on the
+integer mesh -- connectivity, the ``free`` mask, the surface nodes, the rotation-penalty pairs and
+the scatter indices of the assembly -- is NumPy and cached per mesh; the node coordinates, the
+element matrices (the same JAX Hessians) and their assembly are JAX when traced (a jitted
+scatter-add into dense matrices); with concrete values the same assembly code runs on NumPy and
+SciPy (nothing to compile per mesh). With concrete values the model holds NumPy arrays and the
+sparse ``parts``; with traced ones it holds JAX arrays and ``parts`` is empty (modes are never
+traced).
+The tank's length and breadth and the mesh counts are static.
 """
 from __future__ import annotations
 
+import functools
 from dataclasses import dataclass, field
-from typing import Optional
+from typing import NamedTuple, Optional
 
 import numpy as np
 import scipy.sparse as sp
@@ -104,6 +115,11 @@ _GAUSS8 = np.array([[sx, sy, sz] for sx in (-_G, _G) for sy in (-_G, _G) for sz 
 _FACE_HOURGLASS = np.array([1.0, -1.0, 1.0, -1.0])
 
 
+def _is_traced(x) -> bool:
+    import jax
+    return isinstance(x, jax.core.Tracer)
+
+
 @dataclass(frozen=True, eq=False)
 class LiquidModel:
     """Static finite-element model of the liquid in one rigid rectangular tank (tank frame).
@@ -119,7 +135,10 @@ class LiquidModel:
     on the relative rotation, as written).
     ``parts`` holds sparse (3N, 3N) energy measures used to classify modes: "free_surface" (the
     gravity energy of the free surface), "acoustic" (compression), "rotation" (the rotation
-    penalty, or for "paper" the p0 |curl|^2 part of eq. 31).
+    penalty, or for "paper" the p0 |curl|^2 part of eq. 31). It is empty when the model was built
+    from traced values (``traced``): then ``nodes``, ``mass``, ``stiffness``, the rotation blocks,
+    ``density``, ``sound_speed``, ``gravity`` and ``depth`` are JAX values; ``free``, ``surface``
+    and ``elements`` are always NumPy.
     """
 
     nodes: np.ndarray
@@ -138,17 +157,24 @@ class LiquidModel:
     rotation_coupling: Optional[np.ndarray] = None
     rotation_stiffness: Optional[np.ndarray] = None
     parts: dict = field(default_factory=dict)
+    traced: bool = False
 
     @property
     def n_nodes(self) -> int:
         return int(self.nodes.shape[0])
 
-    def mass3(self) -> np.ndarray:
+    def mass3(self):
         """The (3N, 3N) mass matrix kron(mass, I3)."""
+        if self.traced:
+            import jax.numpy as jnp
+            return jnp.kron(self.mass, jnp.eye(3))
         return np.kron(self.mass, np.eye(3))
 
-    def body_force(self, g_body) -> np.ndarray:
+    def body_force(self, g_body):
         """Nodal force (3N,) of a uniform body acceleration field g_body (3,), m/s^2: kron(M, I3) tile(g)."""
+        if self.traced or _is_traced(g_body):
+            import jax.numpy as jnp
+            return (self.mass @ jnp.tile(jnp.asarray(g_body, dtype=float), (self.n_nodes, 1))).reshape(-1)
         g_body = np.asarray(g_body, dtype=float)
         return (self.mass @ np.tile(g_body, (self.n_nodes, 1))).reshape(-1)
 
@@ -163,92 +189,197 @@ def build_liquid(size, fill_depth, mesh, density, sound_speed, gravity, element=
     """Build the liquid model of a rigid tank of inner size (a, b, H) filled to ``fill_depth``.
 
     ``mesh`` = (nx, ny, nz) hexahedra over the liquid region; ``element`` one of ``ELEMENT_FORMS``.
+    ``fill_depth``, ``density``, ``sound_speed`` and ``gravity`` may be JAX tracers (float64).
     """
+    import jax
+    import jax.numpy as jnp
+
     if element not in ELEMENT_FORMS:
         raise ValueError(f"element form {element!r} unknown; choose one of {ELEMENT_FORMS}")
     a, b = float(size[0]), float(size[1])
-    h = float(fill_depth)
     nx, ny, nz = (int(m) for m in mesh)
-    if min(a, b, h) <= 0 or min(nx, ny, nz) < 1:
-        raise ValueError("tank size, fill depth and mesh counts must be positive")
-    rho, c, g = float(density), float(sound_speed), float(gravity)
-
-    nodes, elements = _box_mesh(a, b, h, nx, ny, nz)
-    n = len(nodes)
-    xe = nodes[elements]                                   # (E, 8, 3)
-    faces = elements.reshape(nx, ny, nz, 8)[:, :, -1, 4:8].reshape(-1, 4)
-    xf = nodes[faces][:, :, :2]                            # (F, 4, 2)
-    dofs = (3 * elements[:, :, None] + np.arange(3)).reshape(len(elements), 24)
-
-    el = _element_matrices(xe, xf, rho, c, g, h, element)
-
-    mass = _assemble(el["mass"], elements, n)
-    acoustic = _assemble(el["acoustic"], dofs, 3 * n)                     # eq. (30)
-    fs_dofs = 3 * faces + 2
-    free_surface = _assemble(el["free_surface"], fs_dofs, 3 * n)
-    if element == "paper":
-        # eq. (31) literally; free_surface and rotation_dd are only measures for classifying modes
-        stiffness = acoustic + _assemble(el["prestress"], dofs, 3 * n)
-        rotation_dd = _assemble(el["rotation_dd"], dofs, 3 * n)
-        coupling, theta_theta = None, None     # its p0 |curl|^2 stays on the relative rotation
+    traced = any(_is_traced(v) for v in (fill_depth, density, sound_speed, gravity))
+    if traced:
+        if min(a, b) <= 0 or min(nx, ny, nz) < 1:
+            raise ValueError("tank size, fill depth and mesh counts must be positive")
+        h, rho, c, g = (jnp.asarray(v, dtype=jnp.float64) for v in (fill_depth, density, sound_speed, gravity))
     else:
-        kappa = ROTATION_PENALTY * rho * g * max(a, b, h)
-        rotation_dd, coupling, theta_theta = _rotation_penalty(el["axial_curl"], el["volume"], dofs, kappa,
-                                                               (nx, ny, nz), 3 * n)
-        volume_coupling = _assemble(el["coupling"], dofs, 3 * n)
-        hourglass = _assemble(el["surface_hourglass"], fs_dofs, 3 * n)
-        bending = SURFACE_BENDING * rho * g * _surface_bending(nx, ny, nz, a / nx, b / ny)
-        stiffness = acoustic + free_surface + volume_coupling + rotation_dd + hourglass + bending
-    stiffness = 0.5 * (stiffness + stiffness.T)
+        h = float(fill_depth)
+        if min(a, b, h) <= 0 or min(nx, ny, nz) < 1:
+            raise ValueError("tank size, fill depth and mesh counts must be positive")
+        rho, c, g = float(density), float(sound_speed), float(gravity)
 
-    free = np.ones((n, 3), dtype=bool)
-    tol = 1e-9 * max(a, b, h)
-    free[np.abs(nodes[:, 0]) < tol, 0] = False
-    free[np.abs(nodes[:, 0] - a) < tol, 0] = False
-    free[np.abs(nodes[:, 1]) < tol, 1] = False
-    free[np.abs(nodes[:, 1] - b) < tol, 1] = False
-    free[np.abs(nodes[:, 2]) < tol, 2] = False
-    surface = np.flatnonzero(np.abs(nodes[:, 2] - h) < tol)
+    topo = _topology(nx, ny, nz, element)
+    with jax.enable_x64(True):
+        xs, ys = np.linspace(0, a, nx + 1), np.linspace(0, b, ny + 1)
+        if traced:
+            zs = h * jnp.asarray(np.arange(nz + 1) / nz)
+            gi, gj, gk = topo.grid.T
+            nodes = jnp.stack([jnp.asarray(xs[gi]), jnp.asarray(ys[gj]), zs[gk]], axis=1)
+        else:
+            zs = np.linspace(0, h, nz + 1)
+            X, Y, Z = np.meshgrid(xs, ys, zs, indexing="ij")
+            nodes = np.stack([X.ravel(), Y.ravel(), Z.ravel()], axis=1)
+        xe = nodes[topo.elements]                              # (E, 8, 3)
+        xf = nodes[topo.faces][:, :, :2]                       # (F, 4, 2)
+        el = _element_matrices(xe, xf, rho, c, g, h, element, with_parts=not traced)
+        kappa = ROTATION_PENALTY * rho * g * (jnp.maximum(max(a, b), h) if traced else max(a, b, h))
+        bending = SURFACE_BENDING * rho * g * (a / nx) * (b / ny)
+        out = topo.assemble(el, kappa, bending, traced)
+        mass, stiffness = out["mass"], out["stiffness"]
+        coupling, theta_theta = out.get("coupling"), out.get("theta_theta")
 
-    parts = {
-        "free_surface": sp.csr_matrix(free_surface),
-        "acoustic": sp.csr_matrix(acoustic),
-        "rotation": sp.csr_matrix(rotation_dd),
-    }
+    parts = {}
+    if not traced:
+        parts = topo.parts(el, out)
     return LiquidModel(
-        nodes=nodes, elements=elements, mass=mass, stiffness=stiffness, free=free.reshape(-1),
-        surface=surface, density=rho, sound_speed=c, gravity=g, size=tuple(float(s) for s in size),
+        nodes=nodes, elements=topo.elements, mass=mass, stiffness=stiffness, free=topo.free.reshape(-1).copy(),
+        surface=topo.surface.copy(), density=rho, sound_speed=c, gravity=g, size=tuple(float(s) for s in size),
         depth=h, element=element, mesh=(nx, ny, nz), rotation_coupling=coupling,
-        rotation_stiffness=theta_theta, parts=parts,
+        rotation_stiffness=theta_theta, parts=parts, traced=traced,
     )
 
 
 # ----------------------------------------------------------------------------------------------
-# mesh and assembly (NumPy)
+# topology (NumPy, cached per mesh) and assembly (SciPy for concrete values, a jitted JAX scatter-add for traced)
 
-def _box_mesh(a, b, h, nx, ny, nz):
-    xs, ys, zs = np.linspace(0, a, nx + 1), np.linspace(0, b, ny + 1), np.linspace(0, h, nz + 1)
-    X, Y, Z = np.meshgrid(xs, ys, zs, indexing="ij")
-    nodes = np.stack([X.ravel(), Y.ravel(), Z.ravel()], axis=1)
+class _Topology(NamedTuple):
+    grid: np.ndarray          # (N, 3) integer (i, j, k) of every node
+    elements: np.ndarray      # (E, 8)
+    faces: np.ndarray         # (F, 4) top faces
+    free: np.ndarray          # (N, 3) bool
+    surface: np.ndarray       # surface node indices
+    assemble: object          # (el, kappa, bending, traced) -> dense matrices; see _topology
+    parts: object             # (el, out) -> sparse energy measures (concrete values only)
+
+
+def _box_elements(nx, ny, nz):
     i, j, k = np.meshgrid(np.arange(nx), np.arange(ny), np.arange(nz), indexing="ij")
     corner = ((_XI + 1) / 2).astype(int)                   # (8, 3) offsets of the hex8 nodes
     ii = i.reshape(-1, 1) + corner[:, 0]
     jj = j.reshape(-1, 1) + corner[:, 1]
     kk = k.reshape(-1, 1) + corner[:, 2]
-    elements = (ii * (ny + 1) + jj) * (nz + 1) + kk
-    return nodes, elements
+    return (ii * (ny + 1) + jj) * (nz + 1) + kk
 
 
-def _assemble(blocks, dofs, size):
-    out = np.zeros((size, size))
-    rows = np.repeat(dofs, dofs.shape[1], axis=1).reshape(-1)
-    cols = np.tile(dofs, (1, dofs.shape[1])).reshape(-1)
-    np.add.at(out, (rows, cols), np.asarray(blocks).reshape(-1))
-    return out
+def _block_index(dofs):
+    """(rows, cols) of the entries of the (k, k) blocks on the dof rows (B, k), block-major."""
+    k = dofs.shape[1]
+    return np.repeat(dofs, k, axis=1).reshape(-1), np.tile(dofs, (1, k)).reshape(-1)
 
 
-def _rotation_penalty(curl_rows, volume, dofs, kappa, mesh, size):
-    """Blocks of 1/2 kappa int |P curl d + 2 theta|^2 (P: the axial projection, two points per component).
+def _coo(vals, rows, cols, shape):
+    return sp.coo_matrix((np.asarray(vals).reshape(-1), (rows, cols)), shape=shape).tocsr()
+
+
+def _scatter(xp, shape, rows, cols, vals):
+    """Dense matrix of the summed COO entries: SciPy for NumPy values, a JAX scatter-add otherwise."""
+    if xp is np:
+        return sp.coo_matrix((vals, (rows, cols)), shape=shape).toarray()
+    import jax.numpy as jnp
+    return jnp.zeros(shape, dtype=vals.dtype).at[rows, cols].add(vals)
+
+
+@functools.lru_cache(maxsize=64)
+def _topology(nx, ny, nz, form) -> _Topology:
+    """What depends only on the integer mesh (NumPy), and the assembly from element matrices.
+
+    The assembly is written once for an array namespace: NumPy + SciPy when the element matrices
+    are concrete (nothing to compile per mesh), JAX (jitted, scatter-add) when they are traced."""
+    import jax
+    import jax.numpy as jnp
+
+    gi, gj, gk = np.meshgrid(np.arange(nx + 1), np.arange(ny + 1), np.arange(nz + 1), indexing="ij")
+    grid = np.stack([gi.ravel(), gj.ravel(), gk.ravel()], axis=1)
+    n = len(grid)
+    size = 3 * n
+    elements = _box_elements(nx, ny, nz)
+    E = len(elements)
+    faces = elements.reshape(nx, ny, nz, 8)[:, :, -1, 4:8].reshape(-1, 4)
+    dofs = (3 * elements[:, :, None] + np.arange(3)).reshape(E, 24)
+    fs_dofs = 3 * faces + 2
+    free = np.ones((n, 3), dtype=bool)                     # slip walls: no normal displacement
+    free[(grid[:, 0] == 0) | (grid[:, 0] == nx), 0] = False
+    free[(grid[:, 1] == 0) | (grid[:, 1] == ny), 1] = False
+    free[grid[:, 2] == 0, 2] = False
+    surface = np.flatnonzero(grid[:, 2] == nz)
+
+    r24, c24 = _block_index(dofs)
+    r4, c4 = _block_index(fs_dofs)
+    rm, cm = _block_index(elements)
+
+    if form == "paper":
+        def assemble_xp(xp, el, kappa, bending):
+            K = _scatter(xp, (size, size), r24, c24, (el["acoustic"] + el["prestress"]).reshape(-1))
+            M = _scatter(xp, (n, n), rm, cm, el["mass"].reshape(-1))
+            return {"mass": M, "stiffness": 0.5 * (K + K.T)}
+
+        def parts(el, out):
+            return {"free_surface": _coo(el["free_surface"], r4, c4, (size, size)),
+                    "acoustic": _coo(el["acoustic"], r24, c24, (size, size)),
+                    "rotation": _coo(np.asarray(el["rotation"])[:, :24, :24], r24, c24, (size, size))}
+    else:
+        # stabilized: the rotation penalty's rows, the wall pairs and the surface bending pattern
+        keep, pairs = _rotation_pairs(nx, ny, nz)
+        keep_f = keep.astype(float)
+        comp = np.repeat(np.arange(3), 2)                    # curl component of each of the six rows
+        pe0, pe1, pk = (np.array([p[i] for p in pairs], dtype=int) for i in range(3))
+        prow = 2 * pk[:, None] + np.arange(2)[None, :]       # (P, 2) curl rows of each pair
+        pdofs = np.concatenate([dofs[pe0], dofs[pe1]], axis=1) if pairs else np.zeros((0, 48), dtype=int)
+        pr, pc = _block_index(np.repeat(pdofs, 2, axis=0))   # two rows (s = 0, 1) per pair
+        Br, Bc, Bv = _surface_bending_pattern(nx, ny, nz)
+        Cr = np.repeat(dofs[:, None, :], 6, axis=1).reshape(-1)     # (E, 6, 24) -> d dof
+        Cc = np.broadcast_to(comp[None, :, None], (E, 6, 24)).reshape(-1)
+        rows_all = np.concatenate([r24, r4, pr, Br])
+        cols_all = np.concatenate([c24, c4, pc, Bc])
+        T_rows = keep_f @ (comp[:, None] == np.arange(3)[None, :])    # (E, 3) kept rows per component
+
+        def rotation_blocks(xp, el, kappa):
+            w = 0.5 * kappa * el["volume"]                    # weight of each of the six rows
+            ck = el["axial_curl"] * keep_f[:, :, None]         # (E, 6, 24)
+            blocks = xp.einsum("e,epa,epb->eab", w, ck, ck)
+            if pairs:
+                c0 = el["axial_curl"][pe0[:, None], prow]      # (P, 2, 24)
+                c1 = el["axial_curl"][pe1[:, None], prow]
+                r = xp.concatenate([c0, -c1], axis=2)          # (P, 2, 48): c0 - c1 on the pair's dofs
+                pblocks = 0.5 * w[pe0][:, None, None, None] * r[..., :, None] * r[..., None, :]
+            else:
+                pblocks = xp.zeros((0, 2, 48, 48))
+            return w, ck, blocks, pblocks
+
+        def assemble_xp(xp, el, kappa, bending):
+            w, ck, rblocks, pblocks = rotation_blocks(xp, el, kappa)
+            vals = xp.concatenate([
+                (el["acoustic"] + el["coupling"] + rblocks).reshape(-1),
+                (el["free_surface"] + el["surface_hourglass"]).reshape(-1),
+                pblocks.reshape(-1),
+                bending * Bv])
+            K = _scatter(xp, (size, size), rows_all, cols_all, vals)
+            C = _scatter(xp, (size, 3), Cr, Cc, (2.0 * w[:, None, None] * ck).reshape(-1))
+            T = xp.diag(4.0 * (w @ T_rows))
+            M = _scatter(xp, (n, n), rm, cm, el["mass"].reshape(-1))
+            return {"mass": M, "stiffness": 0.5 * (K + K.T), "coupling": C, "theta_theta": T,
+                    "rotation_blocks": rblocks, "pair_blocks": pblocks}
+
+        def parts(el, out):
+            rot = _coo(np.concatenate([out["rotation_blocks"].reshape(-1), out["pair_blocks"].reshape(-1)]),
+                       np.concatenate([r24, pr]), np.concatenate([c24, pc]), (size, size))
+            return {"free_surface": _coo(el["free_surface"], r4, c4, (size, size)),
+                    "acoustic": _coo(el["acoustic"], r24, c24, (size, size)),
+                    "rotation": rot}
+
+    traced_assemble = jax.jit(lambda el, kappa, bending: assemble_xp(jnp, el, kappa, bending))
+
+    def assemble(el, kappa=None, bending=None, traced=False):
+        if traced:
+            return traced_assemble(el, kappa, bending)
+        return assemble_xp(np, el, kappa, bending)
+
+    return _Topology(grid, elements, faces, free, surface, assemble, parts)
+
+
+def _rotation_pairs(nx, ny, nz):
+    """The rows of 1/2 kappa int |P curl d + 2 theta|^2 (P: the axial projection, two points per component).
 
     Each element gives six rows (component k of curl d at xi_k = -+1/sqrt(3)) of weight kappa V/2.
     One exception, for a direction with an odd number n > 1 of elements: in the top layer, the
@@ -257,13 +388,11 @@ def _rotation_penalty(curl_rows, volume, dofs, kappa, mesh, size):
     slopes vanishes, which a uniform slope (a tilt) violates when n is odd; the static tilt then
     shows an O(1/n^2) zig-zag of the nodal free surface. Replacing, in each such row, the two
     constraints of the elements at the walls by their difference removes exactly this
-    incompatibility (the pair's sum component) and, for odd n, leaves no zero-energy mode.
-    Returns (K_dd (size, size), K_dtheta (size, 3), K_thetatheta (3, 3)).
+    incompatibility (the pair's sum component) and, for odd n, leaves no zero-energy mode; the
+    difference carries weight kappa V/4 (energy 1/2 (w/2) (c0 - c1)^2) and no theta.
+    Returns (keep (E, 6) bool: the rows penalised on their own, pairs [(e0, e1, k)]).
     """
-    nx, ny, nz = mesh
-    E = len(volume)
-    comp = np.repeat(np.arange(3), 2)                      # curl component of each of the six rows
-    w = np.repeat(0.5 * kappa * volume[:, None], 6, axis=1)
+    E = nx * ny * nz
     paired = np.zeros((E, 6), dtype=bool)
     idx = np.arange(E).reshape(nx, ny, nz)
     pairs = []
@@ -275,32 +404,12 @@ def _rotation_penalty(curl_rows, volume, dofs, kappa, mesh, size):
             pairs.append((idx[i, 0, -1], idx[i, -1, -1], 0))
     for e0, e1, k in pairs:
         paired[e0, 2 * k:2 * k + 2] = paired[e1, 2 * k:2 * k + 2] = True
-
-    K = np.zeros((size, size))
-    C = np.zeros((size, 3))
-    T = np.zeros((3, 3))
-    keep = ~paired
-    rows = curl_rows * np.sqrt(w)[:, :, None] * keep[:, :, None]          # (E, 6, 24)
-    blocks = np.einsum("epa,epb->eab", rows, rows)
-    np.add.at(K, (np.repeat(dofs, 24, axis=1).reshape(-1), np.tile(dofs, (1, 24)).reshape(-1)), blocks.reshape(-1))
-    theta_rows = 2.0 * np.sqrt(w) * keep                                  # coefficient of theta[comp]
-    for k in range(3):
-        sel = comp == k
-        np.add.at(C[:, k], dofs.reshape(-1), np.einsum("epa,ep->ea", rows[:, sel], theta_rows[:, sel]).reshape(-1))
-        T[k, k] = np.sum(theta_rows[:, sel] ** 2)
-    for e0, e1, k in pairs:
-        for s in range(2):
-            p = 2 * k + s
-            r = np.zeros(size)
-            np.add.at(r, dofs[e0], curl_rows[e0, p])
-            np.add.at(r, dofs[e1], -curl_rows[e1, p])
-            on = np.flatnonzero(r)
-            K[np.ix_(on, on)] += 0.5 * w[e0, p] * np.outer(r[on], r[on])     # energy 1/2 (w/2) (c0 - c1)^2
-    return K, C, T
+    return ~paired, pairs
 
 
-def _surface_bending(nx, ny, nz, hx, hy):
-    """sum over surface nodes of A (second difference of u_z)^2 along x and along y, as a (3N,3N) matrix.
+def _surface_bending_pattern(nx, ny, nz):
+    """sum over surface nodes of (A / (hx hy)) (second difference of u_z)^2 along x and along y, as
+    COO (rows, cols, values) of a (3N, 3N) matrix; times hx hy it is the bending measure.
 
     Only interior stencils are used, so the term vanishes on every linear surface field.
     """
@@ -317,7 +426,7 @@ def _surface_bending(nx, ny, nz, hx, hy):
             rows += [r] * 3
             cols += [dof(i - 1, j), dof(i, j), dof(i + 1, j)]
             vals += [1.0, -2.0, 1.0]
-            weights.append(wj * hx * hy)
+            weights.append(wj)
             r += 1
     for i in range(nx + 1):
         wi = 0.5 if i in (0, nx) else 1.0
@@ -325,12 +434,14 @@ def _surface_bending(nx, ny, nz, hx, hy):
             rows += [r] * 3
             cols += [dof(i, j - 1), dof(i, j), dof(i, j + 1)]
             vals += [1.0, -2.0, 1.0]
-            weights.append(wi * hx * hy)
+            weights.append(wi)
             r += 1
     if r == 0:
-        return np.zeros((3 * n, 3 * n))
+        z = np.zeros(0, dtype=int)
+        return z, z, np.zeros(0)
     D = sp.csr_matrix((vals, (rows, cols)), shape=(r, 3 * n))
-    return (D.T @ sp.diags(weights) @ D).toarray()
+    B = (D.T @ sp.diags(weights) @ D).tocoo()
+    return B.row.astype(int), B.col.astype(int), B.data
 
 
 # ----------------------------------------------------------------------------------------------
@@ -339,28 +450,45 @@ def _surface_bending(nx, ny, nz, hx, hy):
 _CHUNK = 128          # elements per jitted batch: fixed shapes, so each kernel compiles once per process
 
 
-def _element_matrices(xe, xf, rho, c, g, h, form):
-    """Element matrices of every term, as NumPy arrays (Hessians of the energies below)."""
+def _element_matrices(xe, xf, rho, c, g, h, form, with_parts=True):
+    """Element matrices of every term (Hessians of the energies below): NumPy arrays for concrete
+    values, JAX arrays when any input is traced.
+
+    ``xe``/``xf`` NumPy or JAX; ``rho, c, g, h`` floats or tracers. Without ``with_parts`` the
+    kernels needed only for the mode-classification measures ("paper": the consistent free surface
+    and the p0 |curl|^2 part) are skipped."""
     import jax
     import jax.numpy as jnp
 
     with jax.enable_x64(True):
         xi_h, xi_z = (_G, _G) if form == "paper" else (MASS_XI_HORIZONTAL, MASS_XI_VERTICAL)
-        prm = jnp.array([rho, c, g, h, 0.0, xi_h, xi_z], dtype=jnp.float64)
+        if any(_is_traced(v) for v in (rho, c, g, h)):
+            prm = jnp.stack([jnp.asarray(v, dtype=jnp.float64) for v in (rho, c, g, h, 0.0, xi_h, xi_z)])
+        else:
+            prm = jnp.array([rho, c, g, h, 0.0, xi_h, xi_z], dtype=jnp.float64)
+        traced_x = _is_traced(xe) or _is_traced(prm)
         kern = _kernels(form)
         out = {}
         for name, (fn, on_faces) in kern.items():
+            if not with_parts and form == "paper" and name in ("free_surface", "rotation"):
+                continue
             x = xf if on_faces else xe
-            blocks = []
-            for i in range(0, len(x), _CHUNK):
-                chunk = x[i:i + _CHUNK]
-                pad = _CHUNK - len(chunk)
-                if pad:
-                    chunk = np.concatenate([chunk, np.repeat(chunk[:1], pad, axis=0)])
-                blocks.append(np.asarray(fn(prm, jnp.asarray(chunk, dtype=jnp.float64)))[:_CHUNK - pad])
-            out[name] = np.concatenate(blocks)
-    if "rotation" in out:
-        out["rotation_dd"] = out.pop("rotation")[:, :24, :24]
+            n = len(x)
+            if not traced_x:          # concrete: chunks cut and joined in NumPy (no eager JAX op to compile)
+                blocks = []
+                for i in range(0, n, _CHUNK):
+                    chunk = x[i:i + _CHUNK]
+                    pad = _CHUNK - len(chunk)
+                    if pad:
+                        chunk = np.concatenate([chunk, np.repeat(chunk[:1], pad, axis=0)])
+                    blocks.append(np.asarray(fn(prm, jnp.asarray(chunk, dtype=jnp.float64)))[:_CHUNK - pad])
+                out[name] = np.concatenate(blocks)
+            else:                     # traced: the same fixed-shape chunks, cut by dynamic slices
+                x = jnp.asarray(x, dtype=jnp.float64)
+                pad = -n % _CHUNK
+                xpad = jnp.concatenate([x, jnp.repeat(x[:1], pad, axis=0)]) if pad else x
+                blocks = [fn(prm, jax.lax.dynamic_slice_in_dim(xpad, i, _CHUNK)) for i in range(0, n, _CHUNK)]
+                out[name] = (blocks[0] if len(blocks) == 1 else jnp.concatenate(blocks))[:n]
     return out
 
 
@@ -374,13 +502,14 @@ def _kernels(form):
     import jax
     import jax.numpy as jnp
 
-    XI = jnp.asarray(_XI)
-    XI2 = jnp.asarray(_XI[:4, :2])
-    gauss = jnp.asarray(_GAUSS8)
-    gauss4 = jnp.asarray(_GAUSS8[::2, :2])
-    corners = jnp.asarray(_XI)
-    axial = jnp.asarray([[s if k == j else 0.0 for j in range(3)] for k in range(3) for s in (-_G, _G)])
-    axial_comp = jnp.asarray([0, 0, 1, 1, 2, 2])
+    with jax.ensure_compile_time_eval(), jax.enable_x64(True):   # concrete constants even if first built under a trace
+        XI = jnp.asarray(_XI)
+        XI2 = jnp.asarray(_XI[:4, :2])
+        gauss = jnp.asarray(_GAUSS8)
+        gauss4 = jnp.asarray(_GAUSS8[::2, :2])
+        corners = jnp.asarray(_XI)
+        axial = jnp.asarray([[s if k == j else 0.0 for j in range(3)] for k in range(3) for s in (-_G, _G)])
+        axial_comp = jnp.asarray([0, 0, 1, 1, 2, 2])
 
     def at(x, xi):
         """Shape values (8,), physical gradients (8, 3) and det J of the hex at reference point xi."""
