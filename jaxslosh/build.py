@@ -60,6 +60,16 @@ class Probes(NamedTuple):
     names: tuple
     points: jnp.ndarray    # (P, 3) undeformed positions in the vessel frame
     weights: jnp.ndarray   # (P, N) interpolation of the liquid displacement (zero rows: the probe follows the tank)
+    on_structures: tuple = ()   # StructureProbes per structure that has probes
+
+
+class StructureProbes(NamedTuple):
+    """Probes on structure `index`: rows `rows` of the probe table, points `r` in its frame (from its
+    COG) and trilinear weights `W` (k, N_s) over its nodes."""
+    index: int
+    rows: np.ndarray
+    r: jnp.ndarray
+    W: jnp.ndarray
 
 
 class Built(NamedTuple):
@@ -68,6 +78,8 @@ class Built(NamedTuple):
     v0: jnp.ndarray
     probes: Probes
     tanks: tuple
+    alg0: Optional[jnp.ndarray] = None    # interface frame positions (and zero multipliers) at t = 0
+    structures: tuple = ()               # host-side StructureBlock per structure (result fields)
 
 
 def _inertia(value):
@@ -117,10 +129,11 @@ def build(scene: Scene, params: Optional[dict] = None) -> Built:
     if liquid is not None and not eff.gravity_turning:
         from .kinematics import rotation_matrix
         g_fixed = rotation_matrix(q0).T @ jnp.array([0.0, 0.0, -g])
+    flex, blocks = _build_flex(scene) if scene.structures else (None, ())
     system = System(mass=jnp.asarray(P("vessel.mass", ves.mass), dtype=float),
                     inertia=_inertia(P("vessel.inertia", ves.inertia)), gravity=g, hydro=hydro, liquid=liquid,
                     forced=forced, g_fixed=g_fixed, q_ref=q0, balanced=ves.hydrostatics is not None,
-                    coriolis=eff.coriolis, centrifugal=eff.centrifugal)
+                    coriolis=eff.coriolis, centrifugal=eff.centrifugal, flex=flex)
     nf = system.nf
     d_init = jnp.zeros(nf)
     if liquid is not None:
@@ -132,8 +145,11 @@ def build(scene: Scene, params: Optional[dict] = None) -> Built:
     if forced is not None:   # the prescribed motion sets the rigid state at t = 0
         c0 = Config(jnp.zeros(3), q0, c0.d)
         v0 = v0.at[:6].set(forced.rates(jnp.zeros(())))
-    probes = _build_probes(scene, tanks, liquid)
-    return Built(system, c0, v0, probes, tanks)
+    alg0 = None
+    if flex is not None:
+        c0, v0, alg0 = _flex_start(system, c0, v0)
+    probes = _build_probes(scene, tanks, liquid, blocks)
+    return Built(system, c0, v0, probes, tanks, alg0, blocks)
 
 
 def _build_liquid(scene: Scene, params: Optional[dict] = None, gravity=None):
@@ -199,6 +215,70 @@ def _build_liquid(scene: Scene, params: Optional[dict] = None, gravity=None):
     return liquid, tuple(blocks), None
 
 
+class StructureBlock(NamedTuple):
+    """Host-side data of one structure: its model (structure.StructureModel) and where its modal
+    coordinates sit in the stacked eta."""
+    name: str
+    index: int
+    eta_offset: int
+    model: object
+
+
+def _build_flex(scene: Scene):
+    """Each structure in its own floating frame (origin at its COG), tied at its `attach` face to an
+    interface frame that the vessel is tied to as well (localized multipliers on both sides)."""
+    from .multibody import Body, Flex, Interface, Side
+    from .structure import build_structure, face_nodes
+    bodies, interfaces, blocks, models = [], [], [], {}
+    offset = 0
+    for i, st in enumerate(scene.structures):
+        mat = st.material
+        m = build_structure(st.size, st.mesh, mat.young, mat.poisson, mat.density)
+        models[st.name] = (i, m, np.asarray(st.origin, dtype=float))
+        bodies.append(Body(r=jnp.asarray(m.r), Ms=jnp.asarray(m.mass), Phi=jnp.asarray(m.Phi),
+                           omega2=jnp.asarray(m.omega ** 2), mass=jnp.asarray(m.total_mass),
+                           c0=jnp.asarray(models[st.name][2] + m.cog)))
+        blocks.append(StructureBlock(st.name, i, offset, m))
+        offset += m.Phi.shape[1]
+    for i, st in enumerate(scene.structures):
+        _, m, origin = models[st.name]
+        nodes = face_nodes(m.nodes, m.size, st.attach)
+        points = origin[None, :] + m.nodes[nodes]           # vessel frame, from the vessel's COG
+        if st.attach_to is None:                             # tied to the vessel
+            other = Side(-1, jnp.asarray(nodes), jnp.asarray(points))
+            m_ref = m.total_mass
+        else:                                                # tied to another structure's coincident nodes
+            j, mo, oo = models[st.attach_to]
+            theirs = oo[None, :] + mo.nodes
+            match = np.argmin(np.linalg.norm(points[:, None, :] - theirs[None, :, :], axis=2), axis=1)
+            other = Side(j, jnp.asarray(match), jnp.asarray(points))
+            m_ref = min(m.total_mass, mo.total_mass)
+        L_ref = float(max(max(st.size), np.abs(points).max()))
+        interfaces.append(Interface(sides=(other, Side(i, jnp.asarray(nodes), jnp.asarray(points))),
+                                    m_ref=jnp.asarray(m_ref), L_ref=L_ref))
+    return Flex(bodies=tuple(bodies), interfaces=tuple(interfaces)), tuple(blocks)
+
+
+def _flex_start(system: System, c0: Config, v0):
+    """Structures at rest relative to the vessel, undeformed: frames aligned with the vessel's, at
+    their centres of gravity, moving with it; interface frames on the vessel's attachment points."""
+    from .kinematics import rotation_matrix
+    from .multibody import layout
+    flex = system.flex
+    L = layout(system)
+    A = rotation_matrix(c0.q)
+    V, om = v0[:3], v0[3:6]
+    Xs = jnp.stack([c0.X0 + A @ b.c0 for b in flex.bodies])
+    qs = jnp.tile(c0.q, (L.S, 1))
+    c = c0._replace(Xs=Xs, qs=qs, eta=jnp.zeros(L.m))
+    rig = jnp.concatenate([jnp.concatenate([V + A @ jnp.cross(om, b.c0), om]) for b in flex.bodies])
+    v = jnp.concatenate([v0[:6], rig, v0[6:], jnp.zeros(L.m)])
+    alg = []
+    for itf in flex.interfaces:
+        alg += [(c0.X0[None, :] + itf.sides[0].points @ A.T).reshape(-1), jnp.zeros(3 * itf.n * len(itf.sides))]
+    return c, v, jnp.concatenate(alg)
+
+
 def _canonical_params(scene: Scene, params) -> dict:
     """Keys in their name form (`tanks[0].fill_depth` -> `tanks.tank.fill_depth`); a value given
     under both spellings is an error, and a tank key must name a tank of the scene."""
@@ -226,10 +306,11 @@ def _hydrostatic_start(system: System, q0):
     return jnp.linalg.solve(L.K, F)
 
 
-def _build_probes(scene: Scene, tanks, liquid) -> Probes:
+def _build_probes(scene: Scene, tanks, liquid, structures=()) -> Probes:
     names, pts, W = [], [], []
     N = 0 if liquid is None else liquid.n_nodes
     by_name = {b.name: b for b in tanks}
+    on_struct = {}
     for i, p in enumerate(scene.probes):
         w = np.zeros(N)
         if p.tank is not None:
@@ -240,10 +321,34 @@ def _build_probes(scene: Scene, tanks, liquid) -> Probes:
                 local = probe_weights(np.asarray(p.point), t.size, t.fill_depth, b.nodes, b.elements)
                 w[b.node_offset:b.node_offset + b.nodes.shape[0]] = local
         else:
-            raise SceneError(f"probes[{i}].structure", "probes on structures need flexible structures, not supported yet")
+            st = scene.structure(p.structure)
+            pts.append(np.asarray(st.origin) + np.asarray(p.point))
+            blk = next(b for b in structures if b.name == st.name)
+            on_struct.setdefault(blk.index, []).append((i, np.asarray(p.point) - blk.model.cog,
+                                                        block_weights(np.asarray(p.point), blk.model.nodes,
+                                                                      blk.model.elements)))
         names.append(p.name)
         W.append(w)
-    return Probes(tuple(names), jnp.asarray(np.array(pts).reshape(-1, 3)), jnp.asarray(np.array(W, dtype=float).reshape(len(W), N)))
+    sp = tuple(StructureProbes(k, np.array([e[0] for e in v]), jnp.asarray(np.array([e[1] for e in v])),
+                               jnp.asarray(np.array([e[2] for e in v]))) for k, v in sorted(on_struct.items()))
+    return Probes(tuple(names), jnp.asarray(np.array(pts).reshape(-1, 3)),
+                  jnp.asarray(np.array(W, dtype=float).reshape(len(W), N)), sp)
+
+
+def block_weights(point, nodes, elements, tol=1e-9):
+    """Trilinear weights (N,) of a point of a meshed block (any point inside or on it)."""
+    scale = np.ptp(nodes, axis=0).max()
+    w = np.zeros(nodes.shape[0])
+    for el in elements:
+        X = nodes[el]
+        lo, hi = X.min(axis=0), X.max(axis=0)
+        if np.all(point >= lo - tol * scale) and np.all(point <= hi + tol * scale):
+            xi = np.clip((point - lo) / (hi - lo), 0.0, 1.0)
+            for k, node in enumerate(el):
+                corner = (X[k] - lo) / (hi - lo)
+                w[node] = np.prod(np.where(corner > 0.5, xi, 1.0 - xi))
+            return w
+    return w
 
 
 def probe_weights(point, size, depth, nodes, elements, eps=1e-9):

@@ -29,6 +29,7 @@ import jax
 import jax.numpy as jnp
 import numpy as np
 
+from .kinematics import rotation_matrix
 from .model import Config, System, advance_config
 
 
@@ -59,6 +60,7 @@ class State(NamedTuple):
     acc: jax.Array    # (n,) accelerations satisfying the equations of motion
     a: jax.Array      # (n,) generalized-alpha pseudo-accelerations
     t: jax.Array
+    alg: Optional[jax.Array] = None   # interface frame positions and multipliers (multibody.py), if any
 
 
 class StepInfo(NamedTuple):
@@ -77,9 +79,11 @@ class Solver(eqx.Module):
     max_iter: int = eqx.field(static=True)
     substeps: int = eqx.field(static=True, default=0)   # retry a failed step as this many sub-steps
     Cinv_sub: Optional[jax.Array] = None                # liquid block inverse for the sub-step
+    ns: int = eqx.field(static=True, default=6)         # unknowns of the exact (Schur) block: rigid + algebraic
 
     def sub_solver(self) -> "Solver":
-        return Solver(self.Cinv_sub, self.Cinv_mass, self.h / self.substeps, self.scheme, self.tol, self.max_iter)
+        return Solver(self.Cinv_sub, self.Cinv_mass, self.h / self.substeps, self.scheme, self.tol, self.max_iter,
+                      ns=self.ns)
 
     @property
     def c_a(self):
@@ -96,6 +100,8 @@ def make_solver(system: System, h: float, scheme: Scheme, tol: float, max_iter: 
     `stop_gradient` values: under `jax.grad` outside jit the matrices are then concrete again."""
     nf = system.nf
     substeps = int(substeps) if substeps and substeps > 1 else 0
+    if getattr(system, "flex", None) is not None:
+        return _flex_solver(system, h, scheme, tol, max_iter, substeps)
     if nf == 0:
         z = jnp.zeros((0, 0))
         return Solver(z, z, jnp.asarray(h, dtype=float), scheme, tol, max_iter, substeps, z if substeps else None)
@@ -120,54 +126,100 @@ def make_solver(system: System, h: float, scheme: Scheme, tol: float, max_iter: 
                   max_iter, substeps, step_block_inverse(h / substeps) if substeps else None)
 
 
-def _precond_data(A, like, Cinv):
-    """The factors of P^-1 for a linear map A with the Newton matrix's structure: the rigid rows and
-    columns exact (6 products with A, 6 with its transpose), the liquid block replaced by the
-    constant C (inverse Cinv); a Schur complement on the 6 rigid unknowns. Exact without liquid."""
+def _flex_solver(system: System, h, scheme: Scheme, tol, max_iter, substeps) -> Solver:
+    """With flexible structures: the liquid block inverses as without them, and the structures'
+    modal block, which is diagonal (Phi^T M Phi = I, Phi^T K Phi = omega^2): 1 / (c_a + omega^2)."""
+    import dataclasses
+
+    from .multibody import layout
+    base = make_solver(dataclasses.replace(system, flex=None), h, scheme, tol, max_iter, substeps)
+    w2 = jax.lax.stop_gradient(jnp.concatenate([b.omega2 for b in system.flex.bodies]))
+
+    def with_modal(Cl, d):
+        nf, m = Cl.shape[0], d.shape[0]
+        return jnp.zeros((nf + m, nf + m)).at[:nf, :nf].set(Cl).at[nf:, nf:].set(jnp.diag(d))
+
+    def c_a(hh):
+        return (1.0 - scheme.alpha_m) / ((1.0 - scheme.alpha_f) * scheme.beta * hh ** 2)
+
+    sub = with_modal(base.Cinv_sub, 1.0 / (c_a(h / substeps) + w2)) if substeps else None
+    return Solver(with_modal(base.Cinv_step, 1.0 / (c_a(h) + w2)), with_modal(base.Cinv_mass, jnp.ones_like(w2)),
+                  jnp.asarray(h, dtype=float), scheme, tol, max_iter, substeps, sub, ns=layout(system).n_small)
+
+
+def _precond_data_split(A, Ac, like, Cinv, nr, ns):
+    """As _precond_data, when unknowns nr..ns (interface frames and multipliers) enter the residual
+    only through a cheap part Ac of A (the constraints), whose rows nr..ns are all of A's there: their
+    columns and rows are taken from Ac, and the expensive A is applied only nr times each way."""
     n = like.shape[0]
-    E6 = jnp.eye(n, 6, dtype=like.dtype)
+    I = jnp.eye(n, ns, dtype=like.dtype)
+    cols = jnp.concatenate([jax.vmap(A, in_axes=1, out_axes=1)(I[:, :nr]),
+                            jax.vmap(Ac, in_axes=1, out_axes=1)(I[:, nr:])], axis=1)
+    AT = jax.linear_transpose(A, like)
+    AcT = jax.linear_transpose(Ac, like)
+    rows = jnp.concatenate([jax.vmap(lambda e: AT(e)[0])(I[:, :nr].T), jax.vmap(lambda e: AcT(e)[0])(I[:, nr:].T)])
+    Ayz = rows[:, ns:]
+    Wz = Cinv @ cols[ns:]
+    return jnp.linalg.inv(cols[:ns] - Ayz @ Wz), Ayz, Wz
+
+
+def _precond_data(A, like, Cinv, ns=6):
+    """The factors of P^-1 for a linear map A with the Newton matrix's structure: the first ns rows
+    and columns exact (ns products with A, ns with its transpose: the rigid unknowns, and the
+    interface frames and multipliers when there are flexible structures), the rest (liquid and
+    elastic modal coordinates) replaced by the constant C (inverse Cinv); a Schur complement on the
+    ns unknowns. Exact without liquid and structures."""
+    n = like.shape[0]
+    E6 = jnp.eye(n, ns, dtype=like.dtype)
     cols = jax.vmap(A, in_axes=1, out_axes=1)(E6)                   # [A_yy; A_zy]
-    if n == 6:
+    if n == ns:
         return (jnp.linalg.inv(cols),)
     AT = jax.linear_transpose(A, like)
-    Ayz = jax.vmap(lambda e: AT(e)[0])(E6.T)[:, 6:]                  # (6, nf)
-    Wz = Cinv @ cols[6:]
-    return jnp.linalg.inv(cols[:6] - Ayz @ Wz), Ayz, Wz
+    Ayz = jax.vmap(lambda e: AT(e)[0])(E6.T)[:, ns:]                 # (ns, nz)
+    Wz = Cinv @ cols[ns:]
+    return jnp.linalg.inv(cols[:ns] - Ayz @ Wz), Ayz, Wz
 
 
-def _precond_apply(data, Cinv, r):
+def _precond_apply(data, Cinv, r, ns=6):
     if len(data) == 1:
         return data[0] @ r
     S_inv, Ayz, Wz = data
-    wz = Cinv @ r[6:]
-    xy = S_inv @ (r[:6] - Ayz @ wz)
+    wz = Cinv @ r[ns:]
+    xy = S_inv @ (r[:ns] - Ayz @ wz)
     return jnp.concatenate([xy, wz - Wz @ xy])
 
 
-def _preconditioner(A, like, Cinv):
-    data = _precond_data(A, like, Cinv)
-    return lambda r: _precond_apply(data, Cinv, r)
+def _preconditioner(A, like, Cinv, ns=6):
+    data = _precond_data(A, like, Cinv, ns)
+    return lambda r: _precond_apply(data, Cinv, r, ns)
 
 
-def _newton(R, x0, Cinv, scale, tol, max_iter):
-    """Quasi-Newton iterations on R(x) = 0 (x: 6 rigid unknowns, then the liquid's) with the
-    structured approximate inverse of the Jacobian, formed at the first iteration of the step and
-    formed again only when the residual stops falling fast (a rotation that changed a lot)."""
+def _newton(R, x0, Cinv, scale, tol, max_iter, ns=6, split=None):
+    """Quasi-Newton iterations on R(x) = 0 (x: ns rigid and algebraic unknowns, then the liquid's and
+    the structures' modal ones) with the structured approximate inverse of the Jacobian, formed at
+    the first iteration of the step and formed again only when the residual stops falling fast (a
+    rotation that changed a lot)."""
 
     def err_of(r):
         return jnp.max(jnp.abs(r / scale))
 
     def refresh(x):
         _, jvp = jax.linearize(R, x)
-        return _precond_data(jvp, x, Cinv)
+        if split is not None:
+            Rc, nr = split
+            _, jvp_c = jax.linearize(Rc, x)
+            return _precond_data_split(jvp, jvp_c, x, Cinv, nr, ns)
+        return _precond_data(jvp, x, Cinv, ns)
 
     def body(carry):
         x, r, it, err_prev, _, need, data = carry
         data = jax.lax.cond(need, refresh, lambda _: data, x)
-        x = x + _precond_apply(data, Cinv, -r)
+        x = x + _precond_apply(data, Cinv, -r, ns)
         r = R(x)
         err = err_of(r)
-        return x, r, it + 1, err, err > 0.5 * err_prev, err > 0.1 * err_prev, data
+        # stalled: no progress although the linearisation was fresh (round-off, or a true failure);
+        # slow progress with an older one asks for a fresh one
+        return x, r, it + 1, err, (err > 0.5 * err_prev) & need, err > 0.1 * err_prev, data
 
     def cond(carry):
         _, _, it, err, stalled, _, _ = carry
@@ -183,10 +235,10 @@ def _newton(R, x0, Cinv, scale, tol, max_iter):
     return x, (it.astype(float), err, ok.astype(float))
 
 
-def _structured_linear_solve(A, b, Cinv, rtol=1e-13, max_sweeps=30):
+def _structured_linear_solve(A, b, Cinv, rtol=1e-13, max_sweeps=30, ns=6):
     """Solve A x = b to full precision: the structured preconditioner, then Richardson sweeps.
     The same code solves the transposed system (pass A^T), which reverse mode needs."""
-    P_inv = _preconditioner(A, b, Cinv)
+    P_inv = _preconditioner(A, b, Cinv, ns)
     bnorm = jnp.max(jnp.abs(b)) + 1e-300
 
     def cond(c):
@@ -203,29 +255,44 @@ def _structured_linear_solve(A, b, Cinv, rtol=1e-13, max_sweeps=30):
     return x
 
 
-def _tangent_solver(Cinv):
+def _tangent_solver(Cinv, ns=6):
     def tangent_solve(g, y):
         return jax.lax.custom_linear_solve(
-            g, y, solve=lambda A, b: _structured_linear_solve(A, b, Cinv),
-            transpose_solve=lambda AT, b: _structured_linear_solve(AT, b, Cinv))
+            g, y, solve=lambda A, b: _structured_linear_solve(A, b, Cinv, ns=ns),
+            transpose_solve=lambda AT, b: _structured_linear_solve(AT, b, Cinv, ns=ns))
     return tangent_solve
 
 
-def solve_root(R, x0, Cinv, scale, tol, max_iter):
+def solve_root(R, x0, Cinv, scale, tol, max_iter, ns=6, split=None):
     """Root of R near x0; differentiable by the implicit function theorem (lax.custom_root), the
     tangent systems solved with the same structure as the Newton iterations."""
     x, (it, err, ok) = jax.lax.custom_root(
-        R, x0, lambda f, x: _newton(f, x, Cinv, scale, tol, max_iter), _tangent_solver(Cinv), has_aux=True)
+        R, x0, lambda f, x: _newton(f, x, Cinv, scale, tol, max_iter, ns, split), _tangent_solver(Cinv, ns),
+        has_aux=True)
     it, err, ok = jax.lax.stop_gradient((it, err, ok))
     return x, (it.astype(jnp.int32), err, ok > 0.5)
+
+
+def _advance(system, c, delta):
+    if _has_flex(system):
+        from .multibody import advance
+        return advance(system, c, delta)
+    return advance_config(c, delta)
 
 
 def _split(v):
     return v[:3], v[3:6], v[6:]
 
 
-def initial_state(system: System, solver: Solver, c0: Config, v0) -> tuple[State, StepInfo]:
-    """Accelerations consistent with the initial configuration and velocities."""
+def _has_flex(system) -> bool:
+    return getattr(system, "flex", None) is not None
+
+
+def initial_state(system: System, solver: Solver, c0: Config, v0, alg0=None) -> tuple[State, StepInfo]:
+    """Accelerations consistent with the initial configuration and velocities (with structures:
+    and the multipliers, from the constraints differentiated twice in time)."""
+    if _has_flex(system):
+        return _flex_initial_state(system, solver, c0, v0, alg0)
     scale = system.scales()
 
     def R(acc):
@@ -247,7 +314,8 @@ def step_equations(system: System, solver: Solver, s: State):
         a_new = (delta - base) / (beta * h * h)
         v_new = s.v + h * ((1.0 - gamma) * s.a + gamma * a_new)
         acc_new = ((1.0 - am) * a_new + am * s.a - af * s.acc) / (1.0 - af)
-        return advance_config(s.c, delta), v_new, acc_new, a_new
+        c_new = _advance(system, s.c, delta)
+        return c_new, v_new, acc_new, a_new
 
     def R(delta):
         c, v, acc, _ = unpack(delta)
@@ -257,8 +325,96 @@ def step_equations(system: System, solver: Solver, s: State):
     return R, unpack, base + h * h * beta * s.a
 
 
+def static_structures(system, solver: Solver, c0: Config, v0, alg0):
+    """The structures in static equilibrium under gravity, the vessel and the liquid held where they
+    are (the counterpart of the liquid's hydrostatic start, PHYSICS.md item 6: a mast that starts
+    undeformed would ring with its own weight). Returns the configuration, velocities in which every
+    structure moves rigidly with the vessel, and the frames and multipliers of the equilibrium."""
+    from . import multibody as mb
+    L = mb.layout(system)
+    r, nf = L.n_rigid, L.nf
+    held = jnp.zeros(L.n_dyn, dtype=bool).at[:6].set(True).at[r:r + nf].set(True)
+    held_x = L.to_x(held, jnp.zeros(L.n_alg, dtype=bool))
+    f = 1.0 / (solver.scheme.beta * solver.h ** 2)
+    gsc, alg_sc = mb.alg_scales(system, f, lambda itf: jnp.maximum(1.0 / f, 1e-13 * itf.L_ref / solver.tol))
+    scale = L.to_x(mb.scales(system), alg_sc)
+    z = jnp.zeros(L.n_dyn)
+    w2 = jax.lax.stop_gradient(jnp.concatenate([b.omega2 for b in system.flex.bodies]))
+    Cinv = jnp.zeros((nf + L.m, nf + L.m)).at[:nf, :nf].set(jnp.eye(nf)).at[nf:, nf:].set(jnp.diag(1.0 / w2))
+
+    def Rm(x):
+        dyn, _ = L.from_x(x)
+        rows = L.to_x(mb.inertia_rows(system, mb.advance(system, c0, dyn), z, z, jnp.zeros(())), jnp.zeros(L.n_alg))
+        return jnp.where(held_x, x * scale, rows)
+
+    def Rc(x):
+        dyn, alg = L.from_x(x)
+        c = mb.advance(system, c0, dyn)
+        return jnp.where(held_x, 0.0, mb.constraint_rows(system, c, alg, mb.constraint(system, c, alg), gsc))
+
+    x, (it, err, ok) = solve_root(lambda x: Rm(x) + Rc(x), L.to_x(z, alg0), Cinv, scale, solver.tol,
+                                  solver.max_iter, L.n_small, split=(Rc, L.n_rigid))
+    dyn, alg = L.from_x(x)
+    c = mb.advance(system, c0, dyn)
+    # every structure moves rigidly with the vessel: V_s = V + (A omega) x (X_s - X0), omega_s = A_s^T A omega
+    ves, _, d_v, _ = L.split(v0)
+    w = rotation_matrix(c.q) @ ves[3:]
+    rig = jnp.concatenate([jnp.concatenate([ves[:3] + jnp.cross(w, c.Xs[k] - c.X0), rotation_matrix(c.qs[k]).T @ w])
+                           for k in range(L.S)])
+    v = jnp.concatenate([ves, rig, d_v, jnp.zeros(L.m)])
+    return c, v, alg, StepInfo(it, err, ok)
+
+
+def _flex_initial_state(system, solver: Solver, c0: Config, v0, alg0):
+    from . import multibody as mb
+    L = mb.layout(system)
+    c0, v0, alg0, info0 = static_structures(system, solver, c0, v0, alg0)
+    gsc, alg_sc = mb.alg_scales(system, 1.0, lambda itf: 1.0)       # rows m_ref d2g/dt2: forces
+    scale = L.to_x(mb.scales(system), alg_sc)
+    Rm, Rc = mb.initial_residuals(system, c0, v0, alg0, jnp.zeros(()), gsc)
+    x, (it, err, ok) = solve_root(lambda x: Rm(x) + Rc(x), jnp.zeros(L.n), solver.Cinv_mass, scale, solver.tol,
+                                  solver.max_iter, L.n_small, split=(Rc, L.n_rigid))
+    acc0, alg_a = L.from_x(x)
+    alg = jnp.where(mb._position_mask(system.flex), alg0, alg_a)
+    info = StepInfo(it + info0.iterations, jnp.maximum(err, info0.residual), ok & info0.ok)
+    return State(c0, v0, acc0, acc0, jnp.zeros(()), alg), info
+
+
+def _flex_step(system, solver: Solver, s: State) -> tuple[State, StepInfo]:
+    """The step with structures: unknowns [Delta_y, (X_f, lambda), Delta_z]; the constraint rows
+    are g(q_{n+1}) m_ref / (beta h^2) (forces), converged when g / (beta h^2) is below the tolerance
+    like the acceleration errors of the other rows, or |g| below 1e-13 of the interface's size
+    (round-off), whichever is larger."""
+    from . import multibody as mb
+    L = mb.layout(system)
+    h, beta = solver.h, solver.scheme.beta
+    f = 1.0 / (beta * h * h)
+    gsc, alg_sc = mb.alg_scales(system, f, lambda itf: jnp.maximum(1.0 / f, 1e-13 * itf.L_ref / solver.tol))
+    scale = L.to_x(mb.scales(system), alg_sc)
+    _, unpack, pred = step_equations(system, solver, s)
+
+    def Rm(x):
+        dyn, _ = L.from_x(x)
+        c, v, acc, _ = unpack(dyn)
+        return L.to_x(mb.inertia_rows(system, c, v, acc, s.t + h), jnp.zeros(L.n_alg))
+
+    def Rc(x):
+        dyn, alg = L.from_x(x)
+        c = unpack(dyn)[0]
+        return mb.constraint_rows(system, c, alg, mb.constraint(system, c, alg), gsc)
+
+    x, (it, err, ok) = solve_root(lambda x: Rm(x) + Rc(x), L.to_x(pred, s.alg), solver.Cinv_step, scale, solver.tol,
+                                  solver.max_iter, L.n_small, split=(Rc, L.n_rigid))
+    dyn, alg = L.from_x(x)
+    c, v, acc, a = unpack(dyn)
+    ok = ok & jnp.all(jnp.isfinite(x))
+    return State(c, v, acc, a, s.t + h, alg), StepInfo(it, err, ok)
+
+
 def step(system: System, solver: Solver, s: State) -> tuple[State, StepInfo]:
     """One implicit step t_n -> t_{n+1}; the unknown is the increment Delta = (dX0, Theta, dd)."""
+    if _has_flex(system):
+        return _flex_step(system, solver, s)
     scale = system.scales()            # residual rows / scale: accelerations (m/s^2, rad/s^2)
     R, unpack, x0 = step_equations(system, solver, s)
     delta, (it, err, ok) = solve_root(R, x0, solver.Cinv_step, scale, solver.tol, solver.max_iter)

@@ -38,6 +38,9 @@ class Config(NamedTuple):
     X0: jax.Array      # (3,) inertial position of the vessel COG
     q: jax.Array       # (4,) Euler parameters, scalar first
     d: jax.Array       # (nf,) liquid displacement on free dofs, tank frame
+    Xs: Optional[jax.Array] = None    # (S, 3) origins of the structures' floating frames (their COG), inertial
+    qs: Optional[jax.Array] = None    # (S, 4) their Euler parameters
+    eta: Optional[jax.Array] = None   # (m,) their elastic modal coordinates, stacked (multibody.py)
 
 
 class Hydro(eqx.Module):
@@ -144,6 +147,7 @@ class System(eqx.Module):
     balanced: bool = eqx.field(static=True, default=True)      # weight balanced by static buoyancy
     coriolis: bool = eqx.field(static=True, default=True)
     centrifugal: bool = eqx.field(static=True, default=True)
+    flex: Optional[object] = None         # flexible structures and their interfaces (multibody.Flex)
 
     @property
     def nf(self) -> int:

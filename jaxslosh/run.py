@@ -77,7 +77,13 @@ def prepare(scene: Scene, params=None, duration=None, dt=None) -> Setup:
 
 def _frame(b: Built, s: State, it, err, failed) -> Frame:
     sysm = b.system
-    V0, om, dd = s.v[:3], s.v[3:6], s.v[6:]
+    flex = getattr(sysm, "flex", None)
+    V0, om = s.v[:3], s.v[3:6]
+    if flex is None:
+        dd = s.v[6:]
+    else:
+        from .multibody import layout
+        dd = layout(sysm).split(s.v)[2]
     A = rotation_matrix(s.c.q)
     if sysm.liquid is not None:
         D = sysm.liquid.full(s.c.d)
@@ -86,13 +92,23 @@ def _frame(b: Built, s: State, it, err, failed) -> Frame:
     pr = b.probes
     local = pr.points + (pr.weights @ D if sysm.liquid is not None else 0.0)
     probes = s.c.X0[None, :] + local @ A.T
-    return Frame(s.t, s.c.X0, s.c.q, om, probes, sysm.kinetic_energy(s.c, V0, om, dd),
-                 sysm.potential_energy(s.c), it, err, D, failed)
+    ke = sysm.kinetic_energy(s.c, V0, om, dd)
+    pe = sysm.potential_energy(s.c)
+    if flex is not None:
+        from .multibody import structure_kinetic, structure_potential, _etas
+        ke = ke + structure_kinetic(sysm, s.c, s.v)
+        pe = pe + structure_potential(sysm, s.c)
+        etas = _etas(flex, s.c.eta)
+        for sp in pr.on_structures:
+            body = flex.bodies[sp.index]
+            x = sp.r + sp.W @ body.u(etas[sp.index])
+            probes = probes.at[sp.rows].set(s.c.Xs[sp.index][None, :] + x @ rotation_matrix(s.c.qs[sp.index]).T)
+    return Frame(s.t, s.c.X0, s.c.q, om, probes, ke, pe, it, err, D, failed)
 
 
 def _core(b: Built) -> Built:
     """What the compiled loop needs: the host-side tank blocks (NumPy meshes) stay out of it."""
-    return b._replace(tanks=())
+    return b._replace(tanks=(), structures=())
 
 
 def _select(pred, a, b):
@@ -101,7 +117,7 @@ def _select(pred, a, b):
 
 @eqx.filter_jit
 def start(b: Built, solver: Solver):
-    s0, info = initial_state(b.system, solver, b.c0, b.v0)
+    s0, info = initial_state(b.system, solver, b.c0, b.v0, b.alg0)
     failed = ~info.ok
     carry = Carry(s0, jnp.array(0), failed, jnp.where(failed, 0, -1), info.residual, info.iterations)
     return carry, _frame(b, s0, info.iterations, info.residual, failed)

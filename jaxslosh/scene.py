@@ -107,6 +107,7 @@ def parse_scene(mapping: Mapping[str, Any], text: str = "", path: str = "") -> S
     probes = tuple(_probe(p, f"probes[{i}]") for i, p in enumerate(mapping.get("probes", [])))
     _unique_names(tanks, "tanks", "tank")
     _unique_names(structures, "structures", "structure")
+    _attachments(structures)
     _unique_names(probes, "probes", "probe")
     for i, probe in enumerate(probes):
         _place_probe(probe, f"probes[{i}]", tanks, structures)
@@ -329,9 +330,36 @@ def _structure(table, where: str) -> Structure:
         "size": ("vec3", _sizes),
         "mesh": ("mesh", _counts),
         "attach": ("str", _one_of(FACES)),
+        "attach_to": ("str", None),
         "material": ("table", None),
     }, required=("name", "origin", "size", "mesh", "attach", "material"))
     return Structure(material=_material(table["material"], f"{where}.material"), **v)
+
+
+def _attachments(structures) -> None:
+    """A structure tied to another (`attach_to`) needs its attachment face's nodes to coincide with
+    nodes of the other's mesh (the interface frame's nodes are shared), and may not tie to itself."""
+    from .structure import box_mesh, face_nodes
+    by_name = {s.name: s for s in structures}
+    for i, s in enumerate(structures):
+        if s.attach_to is None:
+            continue
+        key = f"structures[{i}].attach_to"
+        if s.attach_to == s.name:
+            raise SceneError(key, f"structure {s.name!r} cannot be attached to itself")
+        if s.attach_to not in by_name:
+            raise SceneError(key, f"names no structure ({', '.join(repr(n) for n in by_name if n != s.name) or 'none'}); "
+                                  "leave it out to attach to the vessel")
+        o = by_name[s.attach_to]
+        mine, _ = box_mesh(s.size, s.mesh)
+        mine = mine[face_nodes(mine, s.size, s.attach)] + np.asarray(s.origin)
+        theirs, _ = box_mesh(o.size, o.mesh)
+        theirs = theirs + np.asarray(o.origin)
+        tol = 1e-6 * max(max(s.size), max(o.size))
+        dist = np.min(np.linalg.norm(mine[:, None, :] - theirs[None, :, :], axis=2), axis=1)
+        if dist.max() > tol:
+            raise SceneError(key, f"the {s.attach} face of {s.name!r} does not lie on nodes of {o.name!r} "
+                                  f"(a node is {dist.max():.3g} m from the nearest): the meshes must match there")
 
 
 def _probe(table, where: str) -> Probe:

@@ -132,6 +132,7 @@ class Structure:
     mesh: tuple[int, int, int]
     attach: str                      # "x-" | "x+" | "y-" | "y+" | "z-" | "z+"
     material: Material
+    attach_to: Optional[str] = None  # another structure's name: tie the face to it instead of the vessel
 
 
 @dataclass(frozen=True)
