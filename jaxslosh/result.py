@@ -41,6 +41,7 @@ class Energy(eqx.Module):
 class SolverHistory(eqx.Module):
     iterations: jax.Array
     residual: jax.Array
+    constraint: Optional[jax.Array] = None   # max |g| of the interface constraints per step, m (0 without structures)
 
 
 class TankField(eqx.Module):
@@ -84,7 +85,7 @@ class ResultWriter:
         self.tank_names = []
         spec = {"time": (), "vessel/position": (3,), "vessel/quaternion": (4,), "vessel/angular_velocity": (3,),
                 "vessel/roll_pitch_yaw": (3,), "energy/kinetic": (), "energy/potential": (),
-                "solver/iterations": (), "solver/residual": ()}
+                "solver/iterations": (), "solver/residual": (), "solver/constraint": ()}
         for p in self.probe_names:
             spec[f"probes/{p}/position"] = (3,)
             spec[f"probes/{p}/displacement"] = (3,)
@@ -122,7 +123,8 @@ def result_frames(r: Result) -> dict:
     d = {"time": r.time, "vessel/position": r.vessel.position, "vessel/quaternion": r.vessel.quaternion,
          "vessel/angular_velocity": r.vessel.angular_velocity, "vessel/roll_pitch_yaw": r.vessel.roll_pitch_yaw,
          "energy/kinetic": r.energy.kinetic, "energy/potential": r.energy.potential,
-         "solver/iterations": r.solver.iterations, "solver/residual": r.solver.residual}
+         "solver/iterations": r.solver.iterations, "solver/residual": r.solver.residual,
+         "solver/constraint": (r.solver.constraint if r.solver.constraint is not None else np.zeros_like(r.time))}
     for name, p in r.probes.items():
         d[f"probes/{name}/position"] = p.position
         d[f"probes/{name}/displacement"] = p.displacement
@@ -165,7 +167,8 @@ def load_result(path: str) -> Result:
             vessel=VesselHistory(g("vessel/position"), g("vessel/quaternion"), g("vessel/angular_velocity"),
                                  g("vessel/roll_pitch_yaw")),
             probes=probes, energy=Energy(g("energy/kinetic"), g("energy/potential")),
-            solver=SolverHistory(g("solver/iterations"), g("solver/residual")), tanks=tanks,
+            solver=SolverHistory(g("solver/iterations"), g("solver/residual"),
+                                 g("solver/constraint") if "solver/constraint" in f else None), tanks=tanks,
             status=_attr_str(a.get("status", "ok")), steps_done=int(a.get("steps_done", 0)),
             scene_text=_attr_str(a.get("scene", "")))
 

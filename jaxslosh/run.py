@@ -55,6 +55,7 @@ class Frame(NamedTuple):
     residual: jax.Array
     D: jax.Array          # liquid nodal displacement (N, 3), empty without liquid
     failed: jax.Array
+    gmax: jax.Array       # max |g| of the interface constraints (m), 0 without structures
 
 
 class Setup(NamedTuple):
@@ -94,7 +95,10 @@ def _frame(b: Built, s: State, it, err, failed) -> Frame:
     probes = s.c.X0[None, :] + local @ A.T
     ke = sysm.kinetic_energy(s.c, V0, om, dd)
     pe = sysm.potential_energy(s.c)
+    gmax = jnp.zeros(())
     if flex is not None:
+        from .multibody import constraint
+        gmax = jnp.max(jnp.abs(constraint(sysm, s.c, s.alg)))
         from .multibody import structure_kinetic, structure_potential, _etas
         ke = ke + structure_kinetic(sysm, s.c, s.v)
         pe = pe + structure_potential(sysm, s.c)
@@ -103,7 +107,7 @@ def _frame(b: Built, s: State, it, err, failed) -> Frame:
             body = flex.bodies[sp.index]
             x = sp.r + sp.W @ body.u(etas[sp.index])
             probes = probes.at[sp.rows].set(s.c.Xs[sp.index][None, :] + x @ rotation_matrix(s.c.qs[sp.index]).T)
-    return Frame(s.t, s.c.X0, s.c.q, om, probes, ke, pe, it, err, D, failed)
+    return Frame(s.t, s.c.X0, s.c.q, om, probes, ke, pe, it, err, D, failed, gmax)
 
 
 def _core(b: Built) -> Built:
@@ -158,7 +162,7 @@ def _to_result(b: Built, fr: Frame, scene_text: str, status: str, steps_done: in
         N = t.nodes.shape[0]
         tanks[t.name] = TankField(t.nodes, t.elements, fr.D[:, t.node_offset:t.node_offset + N, :])
     return Result(time=fr.t, vessel=VesselHistory(fr.X0, fr.q, fr.omega, rpy_from_quat(fr.q)), probes=probes,
-                  energy=Energy(fr.ke, fr.pe), solver=SolverHistory(fr.iterations, fr.residual), tanks=tanks,
+                  energy=Energy(fr.ke, fr.pe), solver=SolverHistory(fr.iterations, fr.residual, fr.gmax), tanks=tanks,
                   status=status, steps_done=steps_done, scene_text=scene_text)
 
 
@@ -282,7 +286,7 @@ def _file_frames(b: Built, fr: Frame, p0, n: int, save_fields: bool) -> dict:
     d = {"time": fr.t[:n], "vessel/position": fr.X0[:n], "vessel/quaternion": q,
          "vessel/angular_velocity": fr.omega[:n], "vessel/roll_pitch_yaw": np.asarray(rpy_from_quat(q)).reshape(-1, 3),
          "energy/kinetic": fr.ke[:n], "energy/potential": fr.pe[:n], "solver/iterations": fr.iterations[:n],
-         "solver/residual": fr.residual[:n]}
+         "solver/residual": fr.residual[:n], "solver/constraint": fr.gmax[:n]}
     for i, name in enumerate(b.probes.names):
         d[f"probes/{name}/position"] = fr.probes[:n, i]
         d[f"probes/{name}/displacement"] = fr.probes[:n, i] - p0[i]
@@ -339,7 +343,7 @@ def simulate_batch(scene: Scene, params: dict, *, duration: Optional[float] = No
         pos = fr.probes[:, :, i, :]
         probes[name] = ProbeHistory(pos, pos - pos[:, :1])
     res = Result(time=fr.t, vessel=VesselHistory(fr.X0, fr.q, fr.omega, rpy_from_quat(fr.q)), probes=probes,
-                 energy=Energy(fr.ke, fr.pe), solver=SolverHistory(fr.iterations, fr.residual), tanks={},
+                 energy=Energy(fr.ke, fr.pe), solver=SolverHistory(fr.iterations, fr.residual, fr.gmax), tanks={},
                  status="ok" if all(s == "ok" for s in statuses) else "some runs failed",
                  steps_done=setup0.n_steps, scene_text=scene.text)
     return res, statuses
