@@ -163,6 +163,9 @@ def _build_liquid(scene: Scene, params: Optional[dict] = None, gravity=None):
                                    P("fluid.sound_speed", t.fluid.sound_speed), g, element=t.fluid.element))
     traced = any(m.traced for m in models)
     xp = jnp if traced else np
+    reduced = [t.reduction is not None for t in rigid]
+    if any(reduced):
+        return _reduced_liquid(scene, rigid, models, reduced, g)
 
     blocks, rs, Ms_list, K_list, free_list, Kdt_list, Ktt = [], [], [], [], [], [], xp.zeros((3, 3))
     coupled = False
@@ -199,6 +202,43 @@ def _build_liquid(scene: Scene, params: Optional[dict] = None, gravity=None):
     return liquid, tuple(blocks), None
 
 
+def _host_block(t, m, offset) -> TankBlock:
+    """The tank's block for probes and result fields, with the mesh at the scene's fill depth."""
+    nx, ny, nz = m.mesh
+    X, Y, Z = np.meshgrid(np.linspace(0, t.size[0], nx + 1), np.linspace(0, t.size[1], ny + 1),
+                          np.linspace(0, t.fill_depth, nz + 1), indexing="ij")
+    return TankBlock(t.name, offset, np.stack([X.ravel(), Y.ravel(), Z.ravel()], axis=1), np.asarray(m.elements), m)
+
+
+def _reduced_liquid(scene: Scene, tanks, models, reduced, g):
+    """Every tank's liquid on its modal basis (reduction.py); the bases come from the scene's values."""
+    from .liquid import build_liquid
+    from .reduction import reduce_liquid
+    for i, (t, r) in enumerate(zip(tanks, reduced)):
+        if not r:
+            raise SceneError(f"tanks[{i}].reduction", "reduce every tank or none: another tank has a "
+                                                       "[tanks.reduction] table and this one has not")
+    concrete = []
+    for t, m in zip(tanks, models):
+        if m.traced or _is_traced(g):
+            m = build_liquid(t.size, t.fill_depth, t.mesh, t.fluid.density, t.fluid.sound_speed,
+                             scene.environment.gravity, element=t.fluid.element)
+        concrete.append(m)
+    offsets, blocks, offset = [], [], 0
+    for t, m in zip(tanks, models):
+        offsets.append(offset)
+        blocks.append(_host_block(t, m, offset))
+        offset += m.n_nodes
+    liquid = reduce_liquid(models, concrete, [t.origin for t in tanks], offsets,
+                           [(t.reduction.modes, t.reduction.static_correction) for t in tanks])
+    return liquid, tuple(blocks), None
+
+
+def _is_traced(x) -> bool:
+    import jax
+    return isinstance(x, jax.core.Tracer)
+
+
 def _canonical_params(scene: Scene, params) -> dict:
     """Keys in their name form (`tanks[0].fill_depth` -> `tanks.tank.fill_depth`); a value given
     under both spellings is an error, and a tank key must name a tank of the scene."""
@@ -220,8 +260,11 @@ def _hydrostatic_start(system: System, q0):
     """Discrete hydrostatic equilibrium K d0 = F_g under the initial gravity direction (PHYSICS.md
     item 6), so that the stiff acoustic modes are not excited by the start."""
     from .kinematics import rotation_matrix
+    from .reduction import is_reduced
     L = system.liquid
     g_b = rotation_matrix(q0).T @ jnp.array([0.0, 0.0, -system.gravity])
+    if is_reduced(L):
+        return L.static_start(g_b)
     F = L.free_part(L.m_nodes[:, None] * g_b[None, :])
     return jnp.linalg.solve(L.K, F)
 

@@ -22,7 +22,7 @@ enters, are re-linearised with JAX in each iteration (a Schur complement on the 
 """
 from __future__ import annotations
 
-from typing import NamedTuple, Optional
+from typing import Any, NamedTuple, Optional
 
 import equinox as eqx
 import jax
@@ -30,6 +30,7 @@ import jax.numpy as jnp
 import numpy as np
 
 from .model import Config, System, advance_config
+from .reduction import is_reduced
 
 
 class Scheme(NamedTuple):
@@ -59,6 +60,7 @@ class State(NamedTuple):
     acc: jax.Array    # (n,) accelerations satisfying the equations of motion
     a: jax.Array      # (n,) generalized-alpha pseudo-accelerations
     t: jax.Array
+    pre: Any = None   # the Newton preconditioner carried to the next step (Solver.reuse), else None
 
 
 class StepInfo(NamedTuple):
@@ -77,9 +79,20 @@ class Solver(eqx.Module):
     max_iter: int = eqx.field(static=True)
     substeps: int = eqx.field(static=True, default=0)   # retry a failed step as this many sub-steps
     Cinv_sub: Optional[jax.Array] = None                # liquid block inverse for the sub-step
+    # Speed (none changes what a converged step is):
+    # the round-off floor of the scaled residual per metre of liquid displacement, eps max_i
+    # sum_j |K_ij| / scale_i: a tolerance below eps |K| |d| cannot be met, so the iterations stop there
+    noise: Any = 0.0
+    # carry the preconditioner from step to step, formed again only when convergence slows (single
+    # runs); False: formed once at the start of every step
+    reuse: bool = eqx.field(static=True, default=False)
+    # refresh the preconditioner inside the iterations when convergence slows (a lax.cond); False
+    # for vmapped batches, where a cond computes both branches
+    adaptive: bool = eqx.field(static=True, default=True)
 
     def sub_solver(self) -> "Solver":
-        return Solver(self.Cinv_sub, self.Cinv_mass, self.h / self.substeps, self.scheme, self.tol, self.max_iter)
+        return Solver(self.Cinv_sub, self.Cinv_mass, self.h / self.substeps, self.scheme, self.tol, self.max_iter,
+                      noise=self.noise, adaptive=self.adaptive)
 
     @property
     def c_a(self):
@@ -87,7 +100,8 @@ class Solver(eqx.Module):
         return (1.0 - s.alpha_m) / ((1.0 - s.alpha_f) * s.beta * self.h ** 2)
 
 
-def make_solver(system: System, h: float, scheme: Scheme, tol: float, max_iter: int, substeps: int = 0) -> Solver:
+def make_solver(system: System, h: float, scheme: Scheme, tol: float, max_iter: int, substeps: int = 0,
+                reuse: bool = False, adaptive: bool = True) -> Solver:
     """Factor the constant liquid blocks once (float64): NumPy for concrete matrices, JAX when the
     liquid was built from traced values (under jit).
 
@@ -98,15 +112,22 @@ def make_solver(system: System, h: float, scheme: Scheme, tol: float, max_iter: 
     substeps = int(substeps) if substeps and substeps > 1 else 0
     if nf == 0:
         z = jnp.zeros((0, 0))
-        return Solver(z, z, jnp.asarray(h, dtype=float), scheme, tol, max_iter, substeps, z if substeps else None)
+        return Solver(z, z, jnp.asarray(h, dtype=float), scheme, tol, max_iter, substeps, z if substeps else None,
+                      reuse=reuse, adaptive=adaptive)
     L = system.liquid
-    Ms, K_ff = jax.lax.stop_gradient(L.Ms), jax.lax.stop_gradient(L.K)
-    free = np.asarray(L.free)
-    traced = isinstance(Ms, jax.core.Tracer) or isinstance(K_ff, jax.core.Tracer)
-    xp = jnp if traced else np
-    if not traced:
-        Ms, K_ff = np.asarray(Ms), np.asarray(K_ff)
-    M_ff = xp.kron(Ms, xp.eye(3))[np.ix_(free, free)]
+    if is_reduced(L):        # modal liquid (reduction.py): small dense blocks
+        M_ff, K_ff = jax.lax.stop_gradient(L.Mr), jax.lax.stop_gradient(L.Kr)
+        traced = isinstance(M_ff, jax.core.Tracer) or isinstance(K_ff, jax.core.Tracer)
+        if not traced:
+            M_ff, K_ff = np.asarray(M_ff), np.asarray(K_ff)
+    else:
+        Ms, K_ff = jax.lax.stop_gradient(L.Ms), jax.lax.stop_gradient(L.K)
+        free = np.asarray(L.free)
+        traced = isinstance(Ms, jax.core.Tracer) or isinstance(K_ff, jax.core.Tracer)
+        xp = jnp if traced else np
+        if not traced:
+            Ms, K_ff = np.asarray(Ms), np.asarray(K_ff)
+        M_ff = xp.kron(Ms, xp.eye(3))[np.ix_(free, free)]
 
     def inverse(A):
         return jnp.linalg.inv(A) if traced else jnp.asarray(np.linalg.inv(A))
@@ -116,8 +137,11 @@ def make_solver(system: System, h: float, scheme: Scheme, tol: float, max_iter: 
         Cs = c_a * M_ff + K_ff
         return inverse(0.5 * (Cs + Cs.T))
 
+    scale = jax.lax.stop_gradient(system.scales()[6:])
+    noise = jnp.finfo(jnp.float64).eps * jnp.max(jnp.sum(jnp.abs(jnp.asarray(K_ff)), axis=1) / scale)
     return Solver(step_block_inverse(h), inverse(M_ff), jnp.asarray(h, dtype=float), scheme, tol,
-                  max_iter, substeps, step_block_inverse(h / substeps) if substeps else None)
+                  max_iter, substeps, step_block_inverse(h / substeps) if substeps else None,
+                  noise=noise, reuse=reuse, adaptive=adaptive)
 
 
 def _precond_data(A, like, Cinv):
@@ -149,10 +173,22 @@ def _preconditioner(A, like, Cinv):
     return lambda r: _precond_apply(data, Cinv, r)
 
 
-def _newton(R, x0, Cinv, scale, tol, max_iter):
+#: a carried preconditioner is formed again when an iteration reduces the residual by less than this
+#: factor (a fresh one converges 1e-3 to 1e-4 per iteration on the paper example)
+SLOW = 0.01
+
+
+def _newton(R, x0, Cinv, scale, tol, max_iter, pre=None, floor=0.0, adaptive=True):
     """Quasi-Newton iterations on R(x) = 0 (x: 6 rigid unknowns, then the liquid's) with the
     structured approximate inverse of the Jacobian, formed at the first iteration of the step and
-    formed again only when the residual stops falling fast (a rotation that changed a lot)."""
+    formed again only when the residual stops falling fast (a rotation that changed a lot).
+
+    `pre` = (data, valid): a preconditioner carried from the previous step, used while it keeps the
+    convergence fast (and formed afresh when not valid); the one used last is returned with the
+    aux. `floor`: the round-off floor of the scaled residual; the iterations stop below
+    max(tol, floor). `adaptive=False`: formed once before the iterations, never inside (vmapped
+    batches, where a lax.cond computes both branches)."""
+    tol = jnp.maximum(tol, floor)
 
     def err_of(r):
         return jnp.max(jnp.abs(r / scale))
@@ -163,24 +199,37 @@ def _newton(R, x0, Cinv, scale, tol, max_iter):
 
     def body(carry):
         x, r, it, err_prev, _, need, data = carry
-        data = jax.lax.cond(need, refresh, lambda _: data, x)
+        if adaptive:
+            data = jax.lax.cond(need, refresh, lambda _: data, x)
         x = x + _precond_apply(data, Cinv, -r)
         r = R(x)
         err = err_of(r)
-        return x, r, it + 1, err, err > 0.5 * err_prev, err > 0.1 * err_prev, data
+        fresh = need | (not adaptive)
+        # a stale preconditioner that slows down is formed again; a fresh one that cannot is a stall
+        slow = err > jnp.where(fresh, 0.1, SLOW) * err_prev
+        return x, r, it + 1, err, fresh & (err > 0.5 * err_prev), slow, data
 
     def cond(carry):
         _, _, it, err, stalled, _, _ = carry
         return (err > tol) & (it < max_iter) & jnp.isfinite(err) & ~stalled
 
     r0 = R(x0)
-    data0 = jax.tree_util.tree_map(jnp.zeros_like, jax.eval_shape(refresh, x0))
-    init = (x0, r0, jnp.array(0), err_of(r0), jnp.array(False), jnp.array(True), data0)
-    x, r, it, err, stalled, _, _ = jax.lax.while_loop(cond, body, init)
+    if not adaptive:
+        data0, need0 = refresh(x0), jnp.array(False)
+    elif pre is not None:
+        data0, need0 = pre[0], ~(pre[1] > 0.5)
+    else:
+        data0 = jax.tree_util.tree_map(jnp.zeros_like, jax.eval_shape(refresh, x0))
+        need0 = jnp.array(True)
+    init = (x0, r0, jnp.array(0), err_of(r0), jnp.array(False), need0, data0)
+    x, r, it, err, stalled, _, data = jax.lax.while_loop(cond, body, init)
     # Converged: below the tolerance, or stalled at round-off within a factor 100 of it.
     ok = jnp.isfinite(err) & ((err <= tol) | (stalled & (err <= 100.0 * tol)))
     # aux leaves are floats: custom_root's JVP rule cannot carry integer or boolean aux tangents
-    return x, (it.astype(float), err, ok.astype(float))
+    aux = (it.astype(float), err, ok.astype(float))
+    if pre is not None:
+        aux = aux + ((data, jnp.ones(())),)
+    return x, aux
 
 
 def _structured_linear_solve(A, b, Cinv, rtol=1e-13, max_sweeps=30):
@@ -220,6 +269,25 @@ def solve_root(R, x0, Cinv, scale, tol, max_iter):
     return x, (it.astype(jnp.int32), err, ok > 0.5)
 
 
+def solve_root_carried(R, x0, Cinv, scale, tol, max_iter, pre=None, floor=0.0, adaptive=True):
+    """`solve_root` with a preconditioner carried in and out (`pre`, see `_newton`; None: formed
+    here and not returned), a round-off floor and the batch mode. Returns x, (it, err, ok), pre."""
+    out = jax.lax.custom_root(
+        R, x0, lambda f, x: _newton(f, x, Cinv, scale, tol, max_iter, pre, floor, adaptive),
+        _tangent_solver(Cinv), has_aux=True)
+    x, aux = out
+    it, err, ok = jax.lax.stop_gradient(aux[:3])
+    new_pre = jax.lax.stop_gradient(aux[3]) if pre is not None else None
+    return x, (it.astype(jnp.int32), err, ok > 0.5), new_pre
+
+
+def empty_pre(system: System):
+    """A carried preconditioner of the right shapes, marked not valid (formed at the first step)."""
+    n, nf = 6 + system.nf, system.nf
+    data = (jnp.zeros((6, 6)),) if nf == 0 else (jnp.zeros((6, 6)), jnp.zeros((6, nf)), jnp.zeros((nf, 6)))
+    return data, jnp.zeros(())
+
+
 def _split(v):
     return v[:3], v[3:6], v[6:]
 
@@ -233,7 +301,8 @@ def initial_state(system: System, solver: Solver, c0: Config, v0) -> tuple[State
         return system.residual(c0, V0, om, dd, acc, jnp.zeros(()))
 
     acc0, (it, err, ok) = solve_root(R, jnp.zeros_like(v0), solver.Cinv_mass, scale, solver.tol, solver.max_iter)
-    return State(c0, v0, acc0, acc0, jnp.zeros(())), StepInfo(it, err, ok)
+    pre = empty_pre(system) if solver.reuse else None
+    return State(c0, v0, acc0, acc0, jnp.zeros(()), pre), StepInfo(it, err, ok)
 
 
 def step_equations(system: System, solver: Solver, s: State):
@@ -261,10 +330,13 @@ def step(system: System, solver: Solver, s: State) -> tuple[State, StepInfo]:
     """One implicit step t_n -> t_{n+1}; the unknown is the increment Delta = (dX0, Theta, dd)."""
     scale = system.scales()            # residual rows / scale: accelerations (m/s^2, rad/s^2)
     R, unpack, x0 = step_equations(system, solver, s)
-    delta, (it, err, ok) = solve_root(R, x0, solver.Cinv_step, scale, solver.tol, solver.max_iter)
+    floor = solver.noise * jnp.max(jnp.abs(s.c.d), initial=0.0)
+    pre = s.pre if solver.reuse else None
+    delta, (it, err, ok), pre_new = solve_root_carried(R, x0, solver.Cinv_step, scale, solver.tol, solver.max_iter,
+                                                       pre, floor, solver.adaptive)
     c, v, acc, a = unpack(delta)
     ok = ok & jnp.all(jnp.isfinite(delta))
-    return State(c, v, acc, a, s.t + solver.h), StepInfo(it, err, ok)
+    return State(c, v, acc, a, s.t + solver.h, pre_new if solver.reuse else s.pre), StepInfo(it, err, ok)
 
 
 def step_or_retry(system: System, solver: Solver, s: State) -> tuple[State, StepInfo]:

@@ -64,13 +64,17 @@ class Setup(NamedTuple):
     save_every: int
 
 
-def prepare(scene: Scene, params=None, duration=None, dt=None) -> Setup:
+def prepare(scene: Scene, params=None, duration=None, dt=None, batch: bool = False) -> Setup:
+    """The static model, the solver and the step count. `batch`: the solver for vmapped runs (the
+    preconditioner formed once per step, no lax.cond in the iterations); otherwise it is carried
+    from step to step and formed again only when convergence slows."""
     sim = scene.simulation
     h = float(dt if dt is not None else sim.dt)
     T = float(duration if duration is not None else sim.duration)
     b = build(scene, params)
     scheme = make_scheme(sim.scheme, sim.alpha, sim.rho_inf)
-    solver = make_solver(b.system, h, scheme, sim.tolerance, sim.max_iterations, sim.substeps)
+    solver = make_solver(b.system, h, scheme, sim.tolerance, sim.max_iterations, sim.substeps,
+                         reuse=not batch, adaptive=not batch)
     n_steps = int(round(T / h))
     return Setup(b, solver, n_steps, max(1, int(sim.save_every)))
 
@@ -303,7 +307,7 @@ def simulate_batch(scene: Scene, params: dict, *, duration: Optional[float] = No
 
     def one(*v):
         with jax.ensure_compile_time_eval():     # the liquid's matrices are built on the host, once
-            setup = prepare(scene, dict(zip(keys, v)), duration, dt)
+            setup = prepare(scene, dict(zip(keys, v)), duration, dt, batch=True)
         b = _core(setup.built)
         carry, f0 = start(b, setup.solver)
         carry, frames = advance(b, setup.solver, carry, n_frames, setup.save_every)
