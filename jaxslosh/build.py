@@ -11,6 +11,7 @@ from typing import NamedTuple, Optional
 
 import jax.numpy as jnp
 import numpy as np
+import scipy.sparse as sp
 
 from .kinematics import quat_from_rpy
 from .model import Config, Forced, Hydro, Liquid, System
@@ -156,11 +157,18 @@ def _build_liquid(scene: Scene, params: Optional[dict] = None, gravity=None):
 
     params = params or {}
     g = scene.environment.gravity if gravity is None else gravity
+    from .sparse import wants_sparse
+    sparse = wants_sparse(scene)
     models = []
-    for t in rigid:
+    for i, t in enumerate(rigid):
         P = lambda k, d: params.get(f"tanks.{t.name}.{k}", d)  # noqa: E731
         models.append(build_liquid(t.size, P("fill_depth", t.fill_depth), t.mesh, P("fluid.density", t.fluid.density),
-                                   P("fluid.sound_speed", t.fluid.sound_speed), g, element=t.fluid.element))
+                                   P("fluid.sound_speed", t.fluid.sound_speed), g, element=t.fluid.element,
+                                   sparse=sparse))
+        if sparse and models[-1].traced:
+            raise SceneError(f"tanks[{i}]", "a traced tank value (fill depth, density, sound speed or gravity in "
+                                            "params or a sweep) needs the dense liquid matrices; this mesh uses the "
+                                            "sparse solver: set simulation.linear_solver = \"dense\" if they fit")
     traced = any(m.traced for m in models)
     xp = jnp if traced else np
     reduced = [t.reduction is not None for t in rigid]
@@ -180,9 +188,13 @@ def _build_liquid(scene: Scene, params: Optional[dict] = None, gravity=None):
             host_nodes = np.stack([X.ravel(), Y.ravel(), Z.ravel()], axis=1)
         blocks.append(TankBlock(t.name, offset, host_nodes, np.asarray(m.elements), m))
         rs.append(xp.asarray(m.nodes) + xp.asarray(t.origin)[None, :])
-        Ms_list.append(xp.asarray(m.mass))
         free = np.flatnonzero(np.asarray(m.free))
-        K_list.append(xp.asarray(m.stiffness)[np.ix_(free, free)])
+        if sparse:
+            Ms_list.append(m.mass)
+            K_list.append(m.stiffness.tocsr()[free][:, free])
+        else:
+            Ms_list.append(xp.asarray(m.mass))
+            K_list.append(xp.asarray(m.stiffness)[np.ix_(free, free)])
         if getattr(m, "rotation_coupling", None) is not None:
             coupled = True
             Kdt_list.append(xp.asarray(m.rotation_coupling)[free])
@@ -191,6 +203,13 @@ def _build_liquid(scene: Scene, params: Optional[dict] = None, gravity=None):
             Kdt_list.append(xp.zeros((free.size, 3)))
         free_list.append(free + 3 * offset)
         offset += N
+    if sparse:
+        from .sparse import host_sparse
+        Kdt = jnp.asarray(np.concatenate(Kdt_list)) if coupled else None
+        liquid = Liquid(r=jnp.asarray(np.concatenate(rs)), Ms=host_sparse(sp.block_diag(Ms_list)),
+                        K=host_sparse(sp.block_diag(K_list)), free=jnp.asarray(np.concatenate(free_list)),
+                        n_nodes=offset, Kdt=Kdt, Ktt=jnp.asarray(Ktt) if coupled else None)
+        return liquid, tuple(blocks), None
     if traced:
         from jax.scipy.linalg import block_diag
     else:
@@ -265,6 +284,9 @@ def _hydrostatic_start(system: System, q0):
     g_b = rotation_matrix(q0).T @ jnp.array([0.0, 0.0, -system.gravity])
     if is_reduced(L):
         return L.static_start(g_b)
+    from .sparse import hydrostatic_start, is_sparse
+    if is_sparse(L):
+        return hydrostatic_start(L, g_b)
     F = L.free_part(L.m_nodes[:, None] * g_b[None, :])
     return jnp.linalg.solve(L.K, F)
 

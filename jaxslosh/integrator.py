@@ -115,6 +115,15 @@ def make_solver(system: System, h: float, scheme: Scheme, tol: float, max_iter: 
         return Solver(z, z, jnp.asarray(h, dtype=float), scheme, tol, max_iter, substeps, z if substeps else None,
                       reuse=reuse, adaptive=adaptive)
     L = system.liquid
+    from .sparse import is_sparse
+    if is_sparse(L):         # large mesh (sparse.py): host-side sparse LU factors
+        from .sparse import sparse_solver_blocks
+        c_a = lambda hh: (1.0 - scheme.alpha_m) / ((1.0 - scheme.alpha_f) * scheme.beta * hh ** 2)  # noqa: E731
+        step_inv, mass_inv, sub_inv, K = sparse_solver_blocks(L, c_a(h), c_a(h / substeps) if substeps else None)
+        scale = np.asarray(jax.lax.stop_gradient(system.scales()[6:]))
+        noise = np.finfo(np.float64).eps * np.max(np.asarray(abs(K).sum(axis=1)).reshape(-1) / scale)
+        return Solver(step_inv, mass_inv, jnp.asarray(h, dtype=float), scheme, tol, max_iter, substeps, sub_inv,
+                      noise=noise, reuse=reuse, adaptive=adaptive)
     if is_reduced(L):        # modal liquid (reduction.py): small dense blocks
         M_ff, K_ff = jax.lax.stop_gradient(L.Mr), jax.lax.stop_gradient(L.Kr)
         traced = isinstance(M_ff, jax.core.Tracer) or isinstance(K_ff, jax.core.Tracer)

@@ -280,6 +280,39 @@ def _file_frames(b: Built, fr: Frame, p0, n: int, save_fields: bool) -> dict:
     return {k: np.asarray(v) for k, v in d.items()}
 
 
+_BATCH_FNS: dict = {}
+
+
+def _batch_fn(scene: Scene, keys: tuple, duration, dt):
+    """The jitted, vmapped run of a batch, kept per scene, keys and times: a second batch of the
+    same structure does not compile again."""
+    cache_key = (scene, keys, duration, dt)
+    try:
+        hit = _BATCH_FNS.get(cache_key)
+    except TypeError:                 # an unhashable scene: no reuse
+        cache_key, hit = None, None
+    if hit is not None:
+        return hit
+    setup0 = prepare(scene, None, duration, dt)
+    n_frames = setup0.n_steps // setup0.save_every
+
+    def one(*v):
+        with jax.ensure_compile_time_eval():     # the liquid's matrices are built on the host, once
+            setup = prepare(scene, dict(zip(keys, v)), duration, dt, batch=True)
+        b = _core(setup.built)
+        carry, f0 = start(b, setup.solver)
+        carry, frames = advance(b, setup.solver, carry, n_frames, setup.save_every)
+        fr = _concat_frames([jax.tree_util.tree_map(lambda x: x[None], f0), frames])
+        return carry, fr
+
+    fn = jax.jit(jax.vmap(one))
+    if cache_key is not None:
+        _BATCH_FNS[cache_key] = fn
+        while len(_BATCH_FNS) > 8:
+            _BATCH_FNS.pop(next(iter(_BATCH_FNS)))
+    return fn
+
+
 def simulate_batch(scene: Scene, params: dict, *, duration: Optional[float] = None,
                    dt: Optional[float] = None) -> tuple[Result, list]:
     """Run a batch of parameter sets in one compiled, vmapped loop.
@@ -303,18 +336,7 @@ def simulate_batch(scene: Scene, params: dict, *, duration: Optional[float] = No
         vals = [jax.device_put(v, NamedSharding(mesh, PartitionSpec("batch", *([None] * (v.ndim - 1)))))
                 for v in vals]
     setup0 = prepare(scene, None, duration, dt)
-    n_frames = setup0.n_steps // setup0.save_every
-
-    def one(*v):
-        with jax.ensure_compile_time_eval():     # the liquid's matrices are built on the host, once
-            setup = prepare(scene, dict(zip(keys, v)), duration, dt, batch=True)
-        b = _core(setup.built)
-        carry, f0 = start(b, setup.solver)
-        carry, frames = advance(b, setup.solver, carry, n_frames, setup.save_every)
-        fr = _concat_frames([jax.tree_util.tree_map(lambda x: x[None], f0), frames])
-        return carry, fr
-
-    carry, fr = jax.jit(jax.vmap(one))(*vals)
+    carry, fr = _batch_fn(scene, tuple(keys), duration, dt)(*vals)
     statuses = []
     h = setup0.solver.h
     for i in range(B):
