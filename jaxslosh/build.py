@@ -11,6 +11,7 @@ from typing import NamedTuple, Optional
 
 import jax.numpy as jnp
 import numpy as np
+import scipy.sparse as sp
 
 from .kinematics import quat_from_rpy
 from .model import Config, Forced, Hydro, Liquid, System
@@ -172,13 +173,23 @@ def _build_liquid(scene: Scene, params: Optional[dict] = None, gravity=None):
 
     params = params or {}
     g = scene.environment.gravity if gravity is None else gravity
+    from .sparse import wants_sparse
+    sparse = wants_sparse(scene)
     models = []
-    for t in rigid:
+    for i, t in enumerate(rigid):
         P = lambda k, d: params.get(f"tanks.{t.name}.{k}", d)  # noqa: E731
         models.append(build_liquid(t.size, P("fill_depth", t.fill_depth), t.mesh, P("fluid.density", t.fluid.density),
-                                   P("fluid.sound_speed", t.fluid.sound_speed), g, element=t.fluid.element))
+                                   P("fluid.sound_speed", t.fluid.sound_speed), g, element=t.fluid.element,
+                                   sparse=sparse))
+        if sparse and models[-1].traced:
+            raise SceneError(f"tanks[{i}]", "a traced tank value (fill depth, density, sound speed or gravity in "
+                                            "params or a sweep) needs the dense liquid matrices; this mesh uses the "
+                                            "sparse solver: set simulation.linear_solver = \"dense\" if they fit")
     traced = any(m.traced for m in models)
     xp = jnp if traced else np
+    reduced = [t.reduction is not None for t in rigid]
+    if any(reduced):
+        return _reduced_liquid(scene, rigid, models, reduced, g)
 
     blocks, rs, Ms_list, K_list, free_list, Kdt_list, Ktt = [], [], [], [], [], [], xp.zeros((3, 3))
     coupled = False
@@ -193,9 +204,13 @@ def _build_liquid(scene: Scene, params: Optional[dict] = None, gravity=None):
             host_nodes = np.stack([X.ravel(), Y.ravel(), Z.ravel()], axis=1)
         blocks.append(TankBlock(t.name, offset, host_nodes, np.asarray(m.elements), m))
         rs.append(xp.asarray(m.nodes) + xp.asarray(t.origin)[None, :])
-        Ms_list.append(xp.asarray(m.mass))
         free = np.flatnonzero(np.asarray(m.free))
-        K_list.append(xp.asarray(m.stiffness)[np.ix_(free, free)])
+        if sparse:
+            Ms_list.append(m.mass)
+            K_list.append(m.stiffness.tocsr()[free][:, free])
+        else:
+            Ms_list.append(xp.asarray(m.mass))
+            K_list.append(xp.asarray(m.stiffness)[np.ix_(free, free)])
         if getattr(m, "rotation_coupling", None) is not None:
             coupled = True
             Kdt_list.append(xp.asarray(m.rotation_coupling)[free])
@@ -204,6 +219,13 @@ def _build_liquid(scene: Scene, params: Optional[dict] = None, gravity=None):
             Kdt_list.append(xp.zeros((free.size, 3)))
         free_list.append(free + 3 * offset)
         offset += N
+    if sparse:
+        from .sparse import host_sparse
+        Kdt = jnp.asarray(np.concatenate(Kdt_list)) if coupled else None
+        liquid = Liquid(r=jnp.asarray(np.concatenate(rs)), Ms=host_sparse(sp.block_diag(Ms_list)),
+                        K=host_sparse(sp.block_diag(K_list)), free=jnp.asarray(np.concatenate(free_list)),
+                        n_nodes=offset, Kdt=Kdt, Ktt=jnp.asarray(Ktt) if coupled else None)
+        return liquid, tuple(blocks), None
     if traced:
         from jax.scipy.linalg import block_diag
     else:
@@ -279,6 +301,43 @@ def _flex_start(system: System, c0: Config, v0):
     return c, v, jnp.concatenate(alg)
 
 
+def _host_block(t, m, offset) -> TankBlock:
+    """The tank's block for probes and result fields, with the mesh at the scene's fill depth."""
+    nx, ny, nz = m.mesh
+    X, Y, Z = np.meshgrid(np.linspace(0, t.size[0], nx + 1), np.linspace(0, t.size[1], ny + 1),
+                          np.linspace(0, t.fill_depth, nz + 1), indexing="ij")
+    return TankBlock(t.name, offset, np.stack([X.ravel(), Y.ravel(), Z.ravel()], axis=1), np.asarray(m.elements), m)
+
+
+def _reduced_liquid(scene: Scene, tanks, models, reduced, g):
+    """Every tank's liquid on its modal basis (reduction.py); the bases come from the scene's values."""
+    from .liquid import build_liquid
+    from .reduction import reduce_liquid
+    for i, (t, r) in enumerate(zip(tanks, reduced)):
+        if not r:
+            raise SceneError(f"tanks[{i}].reduction", "reduce every tank or none: another tank has a "
+                                                       "[tanks.reduction] table and this one has not")
+    concrete = []
+    for t, m in zip(tanks, models):
+        if m.traced or _is_traced(g):
+            m = build_liquid(t.size, t.fill_depth, t.mesh, t.fluid.density, t.fluid.sound_speed,
+                             scene.environment.gravity, element=t.fluid.element)
+        concrete.append(m)
+    offsets, blocks, offset = [], [], 0
+    for t, m in zip(tanks, models):
+        offsets.append(offset)
+        blocks.append(_host_block(t, m, offset))
+        offset += m.n_nodes
+    liquid = reduce_liquid(models, concrete, [t.origin for t in tanks], offsets,
+                           [(t.reduction.modes, t.reduction.static_correction) for t in tanks])
+    return liquid, tuple(blocks), None
+
+
+def _is_traced(x) -> bool:
+    import jax
+    return isinstance(x, jax.core.Tracer)
+
+
 def _canonical_params(scene: Scene, params) -> dict:
     """Keys in their name form (`tanks[0].fill_depth` -> `tanks.tank.fill_depth`); a value given
     under both spellings is an error, and a tank key must name a tank of the scene."""
@@ -300,8 +359,14 @@ def _hydrostatic_start(system: System, q0):
     """Discrete hydrostatic equilibrium K d0 = F_g under the initial gravity direction (PHYSICS.md
     item 6), so that the stiff acoustic modes are not excited by the start."""
     from .kinematics import rotation_matrix
+    from .reduction import is_reduced
     L = system.liquid
     g_b = rotation_matrix(q0).T @ jnp.array([0.0, 0.0, -system.gravity])
+    if is_reduced(L):
+        return L.static_start(g_b)
+    from .sparse import hydrostatic_start, is_sparse
+    if is_sparse(L):
+        return hydrostatic_start(L, g_b)
     F = L.free_part(L.m_nodes[:, None] * g_b[None, :])
     return jnp.linalg.solve(L.K, F)
 

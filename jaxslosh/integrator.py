@@ -22,7 +22,7 @@ enters, are re-linearised with JAX in each iteration (a Schur complement on the 
 """
 from __future__ import annotations
 
-from typing import NamedTuple, Optional
+from typing import Any, NamedTuple, Optional
 
 import equinox as eqx
 import jax
@@ -31,6 +31,7 @@ import numpy as np
 
 from .kinematics import rotation_matrix
 from .model import Config, System, advance_config
+from .reduction import is_reduced
 
 
 class Scheme(NamedTuple):
@@ -60,6 +61,7 @@ class State(NamedTuple):
     acc: jax.Array    # (n,) accelerations satisfying the equations of motion
     a: jax.Array      # (n,) generalized-alpha pseudo-accelerations
     t: jax.Array
+    pre: Any = None   # the Newton preconditioner carried to the next step (Solver.reuse), else None
     alg: Optional[jax.Array] = None   # interface frame positions and multipliers (multibody.py), if any
 
 
@@ -79,11 +81,23 @@ class Solver(eqx.Module):
     max_iter: int = eqx.field(static=True)
     substeps: int = eqx.field(static=True, default=0)   # retry a failed step as this many sub-steps
     Cinv_sub: Optional[jax.Array] = None                # liquid block inverse for the sub-step
-    ns: int = eqx.field(static=True, default=6)         # unknowns of the exact (Schur) block: rigid + algebraic
+    # Speed (none changes what a converged step is):
+    # the round-off floor of the scaled residual per metre of liquid displacement, eps max_i
+    # sum_j |K_ij| / scale_i: a tolerance below eps |K| |d| cannot be met, so the iterations stop there
+    noise: Any = 0.0
+    # carry the preconditioner from step to step, formed again only when convergence slows (single
+    # runs); False: formed once at the start of every step
+    reuse: bool = eqx.field(static=True, default=False)
+    # refresh the preconditioner inside the iterations when convergence slows (a lax.cond); False
+    # for vmapped batches, where a cond computes both branches
+    adaptive: bool = eqx.field(static=True, default=True)
+    # unknowns of the exact (Schur) block: the 6 rigid ones, and with flexible structures their rigid
+    # unknowns and the interface frames and multipliers (multibody.Layout.n_small)
+    ns: int = eqx.field(static=True, default=6)
 
     def sub_solver(self) -> "Solver":
         return Solver(self.Cinv_sub, self.Cinv_mass, self.h / self.substeps, self.scheme, self.tol, self.max_iter,
-                      ns=self.ns)
+                      noise=self.noise, adaptive=self.adaptive, ns=self.ns)
 
     @property
     def c_a(self):
@@ -91,7 +105,8 @@ class Solver(eqx.Module):
         return (1.0 - s.alpha_m) / ((1.0 - s.alpha_f) * s.beta * self.h ** 2)
 
 
-def make_solver(system: System, h: float, scheme: Scheme, tol: float, max_iter: int, substeps: int = 0) -> Solver:
+def make_solver(system: System, h: float, scheme: Scheme, tol: float, max_iter: int, substeps: int = 0,
+                reuse: bool = False, adaptive: bool = True) -> Solver:
     """Factor the constant liquid blocks once (float64): NumPy for concrete matrices, JAX when the
     liquid was built from traced values (under jit).
 
@@ -101,18 +116,34 @@ def make_solver(system: System, h: float, scheme: Scheme, tol: float, max_iter: 
     nf = system.nf
     substeps = int(substeps) if substeps and substeps > 1 else 0
     if getattr(system, "flex", None) is not None:
-        return _flex_solver(system, h, scheme, tol, max_iter, substeps)
+        return _flex_solver(system, h, scheme, tol, max_iter, substeps, reuse, adaptive)
     if nf == 0:
         z = jnp.zeros((0, 0))
-        return Solver(z, z, jnp.asarray(h, dtype=float), scheme, tol, max_iter, substeps, z if substeps else None)
+        return Solver(z, z, jnp.asarray(h, dtype=float), scheme, tol, max_iter, substeps, z if substeps else None,
+                      reuse=reuse, adaptive=adaptive)
     L = system.liquid
-    Ms, K_ff = jax.lax.stop_gradient(L.Ms), jax.lax.stop_gradient(L.K)
-    free = np.asarray(L.free)
-    traced = isinstance(Ms, jax.core.Tracer) or isinstance(K_ff, jax.core.Tracer)
-    xp = jnp if traced else np
-    if not traced:
-        Ms, K_ff = np.asarray(Ms), np.asarray(K_ff)
-    M_ff = xp.kron(Ms, xp.eye(3))[np.ix_(free, free)]
+    from .sparse import is_sparse
+    if is_sparse(L):         # large mesh (sparse.py): host-side sparse LU factors
+        from .sparse import sparse_solver_blocks
+        c_a = lambda hh: (1.0 - scheme.alpha_m) / ((1.0 - scheme.alpha_f) * scheme.beta * hh ** 2)  # noqa: E731
+        step_inv, mass_inv, sub_inv, K = sparse_solver_blocks(L, c_a(h), c_a(h / substeps) if substeps else None)
+        scale = np.asarray(jax.lax.stop_gradient(system.scales()[6:]))
+        noise = np.finfo(np.float64).eps * np.max(np.asarray(abs(K).sum(axis=1)).reshape(-1) / scale)
+        return Solver(step_inv, mass_inv, jnp.asarray(h, dtype=float), scheme, tol, max_iter, substeps, sub_inv,
+                      noise=noise, reuse=reuse, adaptive=adaptive)
+    if is_reduced(L):        # modal liquid (reduction.py): small dense blocks
+        M_ff, K_ff = jax.lax.stop_gradient(L.Mr), jax.lax.stop_gradient(L.Kr)
+        traced = isinstance(M_ff, jax.core.Tracer) or isinstance(K_ff, jax.core.Tracer)
+        if not traced:
+            M_ff, K_ff = np.asarray(M_ff), np.asarray(K_ff)
+    else:
+        Ms, K_ff = jax.lax.stop_gradient(L.Ms), jax.lax.stop_gradient(L.K)
+        free = np.asarray(L.free)
+        traced = isinstance(Ms, jax.core.Tracer) or isinstance(K_ff, jax.core.Tracer)
+        xp = jnp if traced else np
+        if not traced:
+            Ms, K_ff = np.asarray(Ms), np.asarray(K_ff)
+        M_ff = xp.kron(Ms, xp.eye(3))[np.ix_(free, free)]
 
     def inverse(A):
         return jnp.linalg.inv(A) if traced else jnp.asarray(np.linalg.inv(A))
@@ -122,29 +153,46 @@ def make_solver(system: System, h: float, scheme: Scheme, tol: float, max_iter: 
         Cs = c_a * M_ff + K_ff
         return inverse(0.5 * (Cs + Cs.T))
 
+    scale = jax.lax.stop_gradient(system.scales()[6:])
+    noise = jnp.finfo(jnp.float64).eps * jnp.max(jnp.sum(jnp.abs(jnp.asarray(K_ff)), axis=1) / scale)
     return Solver(step_block_inverse(h), inverse(M_ff), jnp.asarray(h, dtype=float), scheme, tol,
-                  max_iter, substeps, step_block_inverse(h / substeps) if substeps else None)
+                  max_iter, substeps, step_block_inverse(h / substeps) if substeps else None,
+                  noise=noise, reuse=reuse, adaptive=adaptive)
 
 
-def _flex_solver(system: System, h, scheme: Scheme, tol, max_iter, substeps) -> Solver:
+class BlockInverse(eqx.Module):
+    """The constant-block inverse with flexible structures: the liquid's (a dense matrix, or the
+    sparse factors of sparse.py) and the structures' modal block, which is diagonal."""
+    liquid: Any           # (nf, nf)
+    modal: jax.Array      # (m,)
+
+    @property
+    def shape(self):
+        n = self.liquid.shape[0] + self.modal.shape[0]
+        return (n, n)
+
+    def __matmul__(self, x):
+        nf = self.liquid.shape[0]
+        bottom = self.modal[:, None] * x[nf:] if x.ndim == 2 else self.modal * x[nf:]
+        return jnp.concatenate([self.liquid @ x[:nf], bottom])
+
+
+def _flex_solver(system: System, h, scheme: Scheme, tol, max_iter, substeps, reuse, adaptive) -> Solver:
     """With flexible structures: the liquid block inverses as without them, and the structures'
     modal block, which is diagonal (Phi^T M Phi = I, Phi^T K Phi = omega^2): 1 / (c_a + omega^2)."""
     import dataclasses
 
     from .multibody import layout
-    base = make_solver(dataclasses.replace(system, flex=None), h, scheme, tol, max_iter, substeps)
+    base = make_solver(dataclasses.replace(system, flex=None), h, scheme, tol, max_iter, substeps, reuse, adaptive)
     w2 = jax.lax.stop_gradient(jnp.concatenate([b.omega2 for b in system.flex.bodies]))
-
-    def with_modal(Cl, d):
-        nf, m = Cl.shape[0], d.shape[0]
-        return jnp.zeros((nf + m, nf + m)).at[:nf, :nf].set(Cl).at[nf:, nf:].set(jnp.diag(d))
 
     def c_a(hh):
         return (1.0 - scheme.alpha_m) / ((1.0 - scheme.alpha_f) * scheme.beta * hh ** 2)
 
-    sub = with_modal(base.Cinv_sub, 1.0 / (c_a(h / substeps) + w2)) if substeps else None
-    return Solver(with_modal(base.Cinv_step, 1.0 / (c_a(h) + w2)), with_modal(base.Cinv_mass, jnp.ones_like(w2)),
-                  jnp.asarray(h, dtype=float), scheme, tol, max_iter, substeps, sub, ns=layout(system).n_small)
+    sub = BlockInverse(base.Cinv_sub, 1.0 / (c_a(h / substeps) + w2)) if substeps else None
+    return Solver(BlockInverse(base.Cinv_step, 1.0 / (c_a(h) + w2)), BlockInverse(base.Cinv_mass, jnp.ones_like(w2)),
+                  jnp.asarray(h, dtype=float), scheme, tol, max_iter, substeps, sub, noise=base.noise, reuse=reuse,
+                  adaptive=adaptive, ns=layout(system).n_small)
 
 
 def _precond_data_split(A, Ac, like, Cinv, nr, ns):
@@ -194,11 +242,24 @@ def _preconditioner(A, like, Cinv, ns=6):
     return lambda r: _precond_apply(data, Cinv, r, ns)
 
 
-def _newton(R, x0, Cinv, scale, tol, max_iter, ns=6, split=None):
+#: a carried preconditioner is formed again when an iteration reduces the residual by less than this
+#: factor (a fresh one converges 1e-3 to 1e-4 per iteration on the paper example)
+SLOW = 0.01
+
+
+def _newton(R, x0, Cinv, scale, tol, max_iter, pre=None, floor=0.0, adaptive=True, ns=6, split=None):
     """Quasi-Newton iterations on R(x) = 0 (x: ns rigid and algebraic unknowns, then the liquid's and
-    the structures' modal ones) with the structured approximate inverse of the Jacobian, formed at
-    the first iteration of the step and formed again only when the residual stops falling fast (a
-    rotation that changed a lot)."""
+    the structures' modal ones) with the
+    structured approximate inverse of the Jacobian, formed at the first iteration of the step and
+    formed again only when the residual stops falling fast (a rotation that changed a lot).
+
+    `pre` = (data, valid): a preconditioner carried from the previous step, used while it keeps the
+    convergence fast (and formed afresh when not valid); the one used last is returned with the
+    aux. `floor`: the round-off floor of the scaled residual; the iterations stop below
+    max(tol, floor). `adaptive=False`: formed once before the iterations, never inside (vmapped
+    batches, where a lax.cond computes both branches). `split` = (Rc, nr): unknowns nr..ns enter R
+    only through the cheap part Rc (see _precond_data_split)."""
+    tol = jnp.maximum(tol, floor)
 
     def err_of(r):
         return jnp.max(jnp.abs(r / scale))
@@ -213,26 +274,37 @@ def _newton(R, x0, Cinv, scale, tol, max_iter, ns=6, split=None):
 
     def body(carry):
         x, r, it, err_prev, _, need, data = carry
-        data = jax.lax.cond(need, refresh, lambda _: data, x)
+        if adaptive:
+            data = jax.lax.cond(need, refresh, lambda _: data, x)
         x = x + _precond_apply(data, Cinv, -r, ns)
         r = R(x)
         err = err_of(r)
-        # stalled: no progress although the linearisation was fresh (round-off, or a true failure);
-        # slow progress with an older one asks for a fresh one
-        return x, r, it + 1, err, (err > 0.5 * err_prev) & need, err > 0.1 * err_prev, data
+        fresh = need | (not adaptive)
+        # a stale preconditioner that slows down is formed again; a fresh one that cannot is a stall
+        slow = err > jnp.where(fresh, 0.1, SLOW) * err_prev
+        return x, r, it + 1, err, fresh & (err > 0.5 * err_prev), slow, data
 
     def cond(carry):
         _, _, it, err, stalled, _, _ = carry
         return (err > tol) & (it < max_iter) & jnp.isfinite(err) & ~stalled
 
     r0 = R(x0)
-    data0 = jax.tree_util.tree_map(jnp.zeros_like, jax.eval_shape(refresh, x0))
-    init = (x0, r0, jnp.array(0), err_of(r0), jnp.array(False), jnp.array(True), data0)
-    x, r, it, err, stalled, _, _ = jax.lax.while_loop(cond, body, init)
+    if not adaptive:
+        data0, need0 = refresh(x0), jnp.array(False)
+    elif pre is not None:
+        data0, need0 = pre[0], ~(pre[1] > 0.5)
+    else:
+        data0 = jax.tree_util.tree_map(jnp.zeros_like, jax.eval_shape(refresh, x0))
+        need0 = jnp.array(True)
+    init = (x0, r0, jnp.array(0), err_of(r0), jnp.array(False), need0, data0)
+    x, r, it, err, stalled, _, data = jax.lax.while_loop(cond, body, init)
     # Converged: below the tolerance, or stalled at round-off within a factor 100 of it.
     ok = jnp.isfinite(err) & ((err <= tol) | (stalled & (err <= 100.0 * tol)))
     # aux leaves are floats: custom_root's JVP rule cannot carry integer or boolean aux tangents
-    return x, (it.astype(float), err, ok.astype(float))
+    aux = (it.astype(float), err, ok.astype(float))
+    if pre is not None:
+        aux = aux + ((data, jnp.ones(())),)
+    return x, aux
 
 
 def _structured_linear_solve(A, b, Cinv, rtol=1e-13, max_sweeps=30, ns=6):
@@ -267,10 +339,33 @@ def solve_root(R, x0, Cinv, scale, tol, max_iter, ns=6, split=None):
     """Root of R near x0; differentiable by the implicit function theorem (lax.custom_root), the
     tangent systems solved with the same structure as the Newton iterations."""
     x, (it, err, ok) = jax.lax.custom_root(
-        R, x0, lambda f, x: _newton(f, x, Cinv, scale, tol, max_iter, ns, split), _tangent_solver(Cinv, ns),
-        has_aux=True)
+        R, x0, lambda f, x: _newton(f, x, Cinv, scale, tol, max_iter, ns=ns, split=split),
+        _tangent_solver(Cinv, ns), has_aux=True)
     it, err, ok = jax.lax.stop_gradient((it, err, ok))
     return x, (it.astype(jnp.int32), err, ok > 0.5)
+
+
+def solve_root_carried(R, x0, Cinv, scale, tol, max_iter, pre=None, floor=0.0, adaptive=True, ns=6, split=None):
+    """`solve_root` with a preconditioner carried in and out (`pre`, see `_newton`; None: formed
+    here and not returned), a round-off floor and the batch mode. Returns x, (it, err, ok), pre."""
+    out = jax.lax.custom_root(
+        R, x0, lambda f, x: _newton(f, x, Cinv, scale, tol, max_iter, pre, floor, adaptive, ns, split),
+        _tangent_solver(Cinv, ns), has_aux=True)
+    x, aux = out
+    it, err, ok = jax.lax.stop_gradient(aux[:3])
+    new_pre = jax.lax.stop_gradient(aux[3]) if pre is not None else None
+    return x, (it.astype(jnp.int32), err, ok > 0.5), new_pre
+
+
+def empty_pre(system: System):
+    """A carried preconditioner of the right shapes, marked not valid (formed at the first step)."""
+    ns, nz = 6, system.nf
+    if _has_flex(system):
+        from .multibody import layout
+        L = layout(system)
+        ns, nz = L.n_small, L.nf + L.m
+    data = (jnp.zeros((ns, ns)),) if nz == 0 else (jnp.zeros((ns, ns)), jnp.zeros((ns, nz)), jnp.zeros((nz, ns)))
+    return data, jnp.zeros(())
 
 
 def _advance(system, c, delta):
@@ -280,17 +375,18 @@ def _advance(system, c, delta):
     return advance_config(c, delta)
 
 
-def _split(v):
-    return v[:3], v[3:6], v[6:]
-
-
 def _has_flex(system) -> bool:
     return getattr(system, "flex", None) is not None
 
 
+def _split(v):
+    return v[:3], v[3:6], v[6:]
+
+
 def initial_state(system: System, solver: Solver, c0: Config, v0, alg0=None) -> tuple[State, StepInfo]:
     """Accelerations consistent with the initial configuration and velocities (with structures:
-    and the multipliers, from the constraints differentiated twice in time)."""
+    their static equilibrium first, then the accelerations and multipliers from the constraints
+    differentiated twice in time)."""
     if _has_flex(system):
         return _flex_initial_state(system, solver, c0, v0, alg0)
     scale = system.scales()
@@ -300,7 +396,8 @@ def initial_state(system: System, solver: Solver, c0: Config, v0, alg0=None) -> 
         return system.residual(c0, V0, om, dd, acc, jnp.zeros(()))
 
     acc0, (it, err, ok) = solve_root(R, jnp.zeros_like(v0), solver.Cinv_mass, scale, solver.tol, solver.max_iter)
-    return State(c0, v0, acc0, acc0, jnp.zeros(())), StepInfo(it, err, ok)
+    pre = empty_pre(system) if solver.reuse else None
+    return State(c0, v0, acc0, acc0, jnp.zeros(()), pre), StepInfo(it, err, ok)
 
 
 def step_equations(system: System, solver: Solver, s: State):
@@ -314,8 +411,7 @@ def step_equations(system: System, solver: Solver, s: State):
         a_new = (delta - base) / (beta * h * h)
         v_new = s.v + h * ((1.0 - gamma) * s.a + gamma * a_new)
         acc_new = ((1.0 - am) * a_new + am * s.a - af * s.acc) / (1.0 - af)
-        c_new = _advance(system, s.c, delta)
-        return c_new, v_new, acc_new, a_new
+        return _advance(system, s.c, delta), v_new, acc_new, a_new
 
     def R(delta):
         c, v, acc, _ = unpack(delta)
@@ -377,7 +473,8 @@ def _flex_initial_state(system, solver: Solver, c0: Config, v0, alg0):
     acc0, alg_a = L.from_x(x)
     alg = jnp.where(mb._position_mask(system.flex), alg0, alg_a)
     info = StepInfo(it + info0.iterations, jnp.maximum(err, info0.residual), ok & info0.ok)
-    return State(c0, v0, acc0, acc0, jnp.zeros(()), alg), info
+    pre = empty_pre(system) if solver.reuse else None
+    return State(c0, v0, acc0, acc0, jnp.zeros(()), pre, alg), info
 
 
 def _flex_step(system, solver: Solver, s: State) -> tuple[State, StepInfo]:
@@ -403,12 +500,15 @@ def _flex_step(system, solver: Solver, s: State) -> tuple[State, StepInfo]:
         c = unpack(dyn)[0]
         return mb.constraint_rows(system, c, alg, mb.constraint(system, c, alg), gsc)
 
-    x, (it, err, ok) = solve_root(lambda x: Rm(x) + Rc(x), L.to_x(pred, s.alg), solver.Cinv_step, scale, solver.tol,
-                                  solver.max_iter, L.n_small, split=(Rc, L.n_rigid))
+    floor = solver.noise * jnp.max(jnp.abs(s.c.d), initial=0.0)
+    pre = s.pre if solver.reuse else None
+    x, (it, err, ok), pre_new = solve_root_carried(lambda x: Rm(x) + Rc(x), L.to_x(pred, s.alg), solver.Cinv_step,
+                                                   scale, solver.tol, solver.max_iter, pre, floor, solver.adaptive,
+                                                   L.n_small, (Rc, L.n_rigid))
     dyn, alg = L.from_x(x)
     c, v, acc, a = unpack(dyn)
     ok = ok & jnp.all(jnp.isfinite(x))
-    return State(c, v, acc, a, s.t + h, alg), StepInfo(it, err, ok)
+    return State(c, v, acc, a, s.t + h, pre_new if solver.reuse else s.pre, alg), StepInfo(it, err, ok)
 
 
 def step(system: System, solver: Solver, s: State) -> tuple[State, StepInfo]:
@@ -417,10 +517,13 @@ def step(system: System, solver: Solver, s: State) -> tuple[State, StepInfo]:
         return _flex_step(system, solver, s)
     scale = system.scales()            # residual rows / scale: accelerations (m/s^2, rad/s^2)
     R, unpack, x0 = step_equations(system, solver, s)
-    delta, (it, err, ok) = solve_root(R, x0, solver.Cinv_step, scale, solver.tol, solver.max_iter)
+    floor = solver.noise * jnp.max(jnp.abs(s.c.d), initial=0.0)
+    pre = s.pre if solver.reuse else None
+    delta, (it, err, ok), pre_new = solve_root_carried(R, x0, solver.Cinv_step, scale, solver.tol, solver.max_iter,
+                                                       pre, floor, solver.adaptive)
     c, v, acc, a = unpack(delta)
     ok = ok & jnp.all(jnp.isfinite(delta))
-    return State(c, v, acc, a, s.t + solver.h), StepInfo(it, err, ok)
+    return State(c, v, acc, a, s.t + solver.h, pre_new if solver.reuse else s.pre), StepInfo(it, err, ok)
 
 
 def step_or_retry(system: System, solver: Solver, s: State) -> tuple[State, StepInfo]:

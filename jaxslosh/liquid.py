@@ -185,11 +185,14 @@ class LiquidModel:
         return self.elements[top][:, 4:8]
 
 
-def build_liquid(size, fill_depth, mesh, density, sound_speed, gravity, element="stabilized") -> LiquidModel:
+def build_liquid(size, fill_depth, mesh, density, sound_speed, gravity, element="stabilized",
+                 sparse=False) -> LiquidModel:
     """Build the liquid model of a rigid tank of inner size (a, b, H) filled to ``fill_depth``.
 
     ``mesh`` = (nx, ny, nz) hexahedra over the liquid region; ``element`` one of ``ELEMENT_FORMS``.
     ``fill_depth``, ``density``, ``sound_speed`` and ``gravity`` may be JAX tracers (float64).
+    ``sparse=True`` (concrete values only): ``mass`` and ``stiffness`` are SciPy CSR matrices, for
+    meshes whose dense matrices would not fit (see sparse.py).
     """
     import jax
     import jax.numpy as jnp
@@ -225,9 +228,11 @@ def build_liquid(size, fill_depth, mesh, density, sound_speed, gravity, element=
         el = _element_matrices(xe, xf, rho, c, g, h, element, with_parts=not traced)
         kappa = ROTATION_PENALTY * rho * g * (jnp.maximum(max(a, b), h) if traced else max(a, b, h))
         bending = SURFACE_BENDING * rho * g * (a / nx) * (b / ny)
-        out = topo.assemble(el, kappa, bending, traced)
+        out = topo.assemble(el, kappa, bending, traced, sparse=sparse and not traced)
         mass, stiffness = out["mass"], out["stiffness"]
         coupling, theta_theta = out.get("coupling"), out.get("theta_theta")
+        if sp.issparse(coupling):
+            coupling = np.asarray(coupling.todense())
 
     parts = {}
     if not traced:
@@ -272,8 +277,21 @@ def _coo(vals, rows, cols, shape):
     return sp.coo_matrix((np.asarray(vals).reshape(-1), (rows, cols)), shape=shape).tocsr()
 
 
+class _SparseNumPy:
+    """NumPy, except that `_scatter` assembles SciPy CSR matrices (large meshes, `sparse=True`)."""
+
+    def __getattr__(self, name):
+        return getattr(np, name)
+
+
+_SPARSE_NP = _SparseNumPy()
+
+
 def _scatter(xp, shape, rows, cols, vals):
-    """Dense matrix of the summed COO entries: SciPy for NumPy values, a JAX scatter-add otherwise."""
+    """Dense matrix of the summed COO entries: SciPy for NumPy values, a JAX scatter-add otherwise
+    (a SciPy CSR matrix under `_SPARSE_NP`)."""
+    if xp is _SPARSE_NP:
+        return sp.coo_matrix((vals, (rows, cols)), shape=shape).tocsr()
     if xp is np:
         return sp.coo_matrix((vals, (rows, cols)), shape=shape).toarray()
     import jax.numpy as jnp
@@ -370,10 +388,10 @@ def _topology(nx, ny, nz, form) -> _Topology:
 
     traced_assemble = jax.jit(lambda el, kappa, bending: assemble_xp(jnp, el, kappa, bending))
 
-    def assemble(el, kappa=None, bending=None, traced=False):
+    def assemble(el, kappa=None, bending=None, traced=False, sparse=False):
         if traced:
             return traced_assemble(el, kappa, bending)
-        return assemble_xp(np, el, kappa, bending)
+        return assemble_xp(_SPARSE_NP if sparse else np, el, kappa, bending)
 
     return _Topology(grid, elements, faces, free, surface, assemble, parts)
 

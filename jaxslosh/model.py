@@ -28,6 +28,7 @@ import jax.numpy as jnp
 import numpy as np
 
 from .kinematics import G_matrix, quat_exp, quat_multiply, rotation_matrix, skew
+from .reduction import is_reduced
 
 # eq. (36): q^T A_phi q = 2 (q0 q1 + q2 q3) = sin(roll) cos(pitch), q^T A_theta q = 2 (q0 q2 - q1 q3)
 A_PHI = np.array([[0, 1, 0, 0], [1, 0, 0, 0], [0, 0, 0, 1], [0, 0, 1, 0]], dtype=float)
@@ -151,6 +152,8 @@ class System(eqx.Module):
 
     @property
     def nf(self) -> int:
+        if is_reduced(self.liquid):
+            return self.liquid.nf
         return 0 if self.liquid is None else int(self.liquid.free.shape[0])
 
     @property
@@ -159,7 +162,9 @@ class System(eqx.Module):
 
     def total_mass(self):
         m = self.mass
-        if self.liquid is not None:
+        if is_reduced(self.liquid):
+            m = m + self.liquid.mass
+        elif self.liquid is not None:
             m = m + self.liquid.Ms.sum()
         return m
 
@@ -175,7 +180,11 @@ class System(eqx.Module):
         r_t = self.mass * a0
         r_r = self.inertia @ alpha + jnp.cross(omega, self.inertia @ omega)
         parts = []
-        if self.liquid is not None:
+        if is_reduced(self.liquid):    # modal liquid: the same rows from its inertia invariants (reduction.py)
+            f_t, f_r, r_d = self.liquid.rows(self, c, omega, d_dot, acc, A, g_b)
+            r_t, r_r = r_t + f_t, r_r + f_r
+            parts.append(r_d)
+        elif self.liquid is not None:
             L = self.liquid
             D, Dv, Da = L.full(c.d), L.full(d_dot), L.full(acc[6:])
             x = L.r + D
@@ -227,6 +236,8 @@ class System(eqx.Module):
     # ---------------------------------------------------------------- energies
     def kinetic_energy(self, c: Config, V0, omega, d_dot):
         T = 0.5 * self.mass * V0 @ V0 + 0.5 * omega @ self.inertia @ omega
+        if is_reduced(self.liquid):
+            return T + self.liquid.kinetic_energy(rotation_matrix(c.q), V0, omega, c.d, d_dot)
         if self.liquid is not None:
             L = self.liquid
             A = rotation_matrix(c.q)
@@ -242,6 +253,8 @@ class System(eqx.Module):
             V = V + self.hydro.potential(c.X0, c.q)
         if not self.balanced:
             V = V + self.total_mass() * self.gravity * c.X0[2]
+        if is_reduced(self.liquid):
+            return V + self.liquid.potential_energy(self, c.q, c.d, g_b)
         if self.liquid is not None:
             L = self.liquid
             V = V + 0.5 * c.d @ (L.K @ c.d) - g_b @ (L.m_nodes @ L.full(c.d))
@@ -264,7 +277,9 @@ class System(eqx.Module):
                 L.m_nodes @ (x[:, 0] ** 2 + x[:, 2] ** 2),
                 L.m_nodes @ (x[:, 0] ** 2 + x[:, 1] ** 2)])
         s = [jnp.full(3, m), I]
-        if self.liquid is not None:
+        if is_reduced(self.liquid):
+            s.append(self.liquid.row_scale)
+        elif self.liquid is not None:
             s.append(jnp.repeat(self.liquid.m_nodes, 3)[self.liquid.free])
         return jnp.concatenate(s)
 

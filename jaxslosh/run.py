@@ -65,13 +65,17 @@ class Setup(NamedTuple):
     save_every: int
 
 
-def prepare(scene: Scene, params=None, duration=None, dt=None) -> Setup:
+def prepare(scene: Scene, params=None, duration=None, dt=None, batch: bool = False) -> Setup:
+    """The static model, the solver and the step count. `batch`: the solver for vmapped runs (the
+    preconditioner formed once per step, no lax.cond in the iterations); otherwise it is carried
+    from step to step and formed again only when convergence slows."""
     sim = scene.simulation
     h = float(dt if dt is not None else sim.dt)
     T = float(duration if duration is not None else sim.duration)
     b = build(scene, params)
     scheme = make_scheme(sim.scheme, sim.alpha, sim.rho_inf)
-    solver = make_solver(b.system, h, scheme, sim.tolerance, sim.max_iterations, sim.substeps)
+    solver = make_solver(b.system, h, scheme, sim.tolerance, sim.max_iterations, sim.substeps,
+                         reuse=not batch, adaptive=not batch)
     n_steps = int(round(T / h))
     return Setup(b, solver, n_steps, max(1, int(sim.save_every)))
 
@@ -296,6 +300,39 @@ def _file_frames(b: Built, fr: Frame, p0, n: int, save_fields: bool) -> dict:
     return {k: np.asarray(v) for k, v in d.items()}
 
 
+_BATCH_FNS: dict = {}
+
+
+def _batch_fn(scene: Scene, keys: tuple, duration, dt):
+    """The jitted, vmapped run of a batch, kept per scene, keys and times: a second batch of the
+    same structure does not compile again."""
+    cache_key = (scene, keys, duration, dt)
+    try:
+        hit = _BATCH_FNS.get(cache_key)
+    except TypeError:                 # an unhashable scene: no reuse
+        cache_key, hit = None, None
+    if hit is not None:
+        return hit
+    setup0 = prepare(scene, None, duration, dt)
+    n_frames = setup0.n_steps // setup0.save_every
+
+    def one(*v):
+        with jax.ensure_compile_time_eval():     # the liquid's matrices are built on the host, once
+            setup = prepare(scene, dict(zip(keys, v)), duration, dt, batch=True)
+        b = _core(setup.built)
+        carry, f0 = start(b, setup.solver)
+        carry, frames = advance(b, setup.solver, carry, n_frames, setup.save_every)
+        fr = _concat_frames([jax.tree_util.tree_map(lambda x: x[None], f0), frames])
+        return carry, fr
+
+    fn = jax.jit(jax.vmap(one))
+    if cache_key is not None:
+        _BATCH_FNS[cache_key] = fn
+        while len(_BATCH_FNS) > 8:
+            _BATCH_FNS.pop(next(iter(_BATCH_FNS)))
+    return fn
+
+
 def simulate_batch(scene: Scene, params: dict, *, duration: Optional[float] = None,
                    dt: Optional[float] = None) -> tuple[Result, list]:
     """Run a batch of parameter sets in one compiled, vmapped loop.
@@ -319,18 +356,7 @@ def simulate_batch(scene: Scene, params: dict, *, duration: Optional[float] = No
         vals = [jax.device_put(v, NamedSharding(mesh, PartitionSpec("batch", *([None] * (v.ndim - 1)))))
                 for v in vals]
     setup0 = prepare(scene, None, duration, dt)
-    n_frames = setup0.n_steps // setup0.save_every
-
-    def one(*v):
-        with jax.ensure_compile_time_eval():     # the liquid's matrices are built on the host, once
-            setup = prepare(scene, dict(zip(keys, v)), duration, dt)
-        b = _core(setup.built)
-        carry, f0 = start(b, setup.solver)
-        carry, frames = advance(b, setup.solver, carry, n_frames, setup.save_every)
-        fr = _concat_frames([jax.tree_util.tree_map(lambda x: x[None], f0), frames])
-        return carry, fr
-
-    carry, fr = jax.jit(jax.vmap(one))(*vals)
+    carry, fr = _batch_fn(scene, tuple(keys), duration, dt)(*vals)
     statuses = []
     h = setup0.solver.h
     for i in range(B):

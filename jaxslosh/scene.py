@@ -29,7 +29,7 @@ try:
 except ModuleNotFoundError:  # Python 3.10
     import tomli as tomllib  # type: ignore[no-redef]
 
-from .scene_types import (EFFECTS, Effects, Environment, Forced, Fluid, Hydrostatics, Initial, Material, Probe, Scene, SceneError,
+from .scene_types import (EFFECTS, Effects, Environment, Forced, Fluid, Hydrostatics, Initial, Material, Probe, Reduction, Scene, SceneError,
                           Simulation, Structure, Tank, Vessel, Walls)
 
 __all__ = ["ELEMENT_FORMS", "SCHEMES", "WALLS", "FACES", "MOMENTS", "PROBE_TOLERANCE",
@@ -37,6 +37,7 @@ __all__ = ["ELEMENT_FORMS", "SCHEMES", "WALLS", "FACES", "MOMENTS", "PROBE_TOLER
 
 ELEMENT_FORMS = ("stabilized", "paper")          # [tanks.fluid] element: liquid element forms (liquid.py)
 SCHEMES = ("newmark", "hht", "generalized-alpha")
+LINEAR_SOLVERS = ("auto", "dense", "sparse")      # [simulation] linear_solver (sparse.py)
 WALLS = ("rigid", "elastic")
 FACES = ("x-", "x+", "y-", "y+", "z-", "z+")
 MOMENTS = ("paper", "conservative")
@@ -186,6 +187,7 @@ def _simulation(table, warnings: list[str]) -> Simulation:
         "max_iterations": ("int", _at_least(1)),
         "chunk": ("int", _non_negative),
         "substeps": ("int", _non_negative),
+        "linear_solver": ("str", _one_of(LINEAR_SOLVERS)),
     }, required=("duration", "dt"))
     sim = Simulation(**v)
     if sim.dt > sim.duration:
@@ -284,6 +286,7 @@ def _tank(table, where: str) -> Tank:
         "mesh": ("mesh", _counts),
         "walls": ("str_or_table", None),
         "fluid": ("table", None),
+        "reduction": ("table", None),
     }, required=("name", "origin", "size", "fill_depth", "mesh"))
     # SPEC writes `walls = "elastic"` and a `[tanks.walls]` table, but TOML cannot hold both under
     # one key: `walls` is either the string "rigid" or the table, which makes the walls elastic.
@@ -309,8 +312,14 @@ def _tank(table, where: str) -> Tank:
         "sound_speed": ("float", _positive),
         "element": ("str", _one_of(ELEMENT_FORMS)),
     }))
+    reduction = None
+    if "reduction" in table:
+        reduction = Reduction(**_read(table["reduction"], f"{where}.reduction", {
+            "modes": ("int", _at_least(1)),
+            "static_correction": ("bool", None),
+        }, required=("modes",)))
     return Tank(name=v["name"], origin=v["origin"], size=v["size"], fill_depth=depth, mesh=v["mesh"],
-                walls=walls, fluid=fluid, wall_spec=wall_spec)
+                walls=walls, fluid=fluid, wall_spec=wall_spec, reduction=reduction)
 
 
 def _walls(table, where: str) -> Walls:

@@ -41,6 +41,7 @@ class Simulation:
     max_iterations: int = 25         # Newton iterations per step before the step counts as failed
     chunk: int = 0                   # steps per jitted chunk written to the result (0: automatic)
     substeps: int = 0                # > 1: a step whose Newton iteration fails is retried as this many sub-steps
+    linear_solver: str = "auto"      # liquid block: "dense" inverse | "sparse" factor (sparse.py) | "auto" by size
 
     @property
     def n_steps(self) -> int:
@@ -98,6 +99,14 @@ class Fluid:
 
 
 @dataclass(frozen=True)
+class Reduction:
+    """`[tanks.reduction]`: the liquid on its first `modes` natural modes plus a static correction
+    (reduction.py), instead of every finite-element unknown."""
+    modes: int                       # >= 1 natural modes (a degenerate pair is never split)
+    static_correction: bool = True   # add the quasi-static response to the rigid body's loads
+
+
+@dataclass(frozen=True)
 class Walls:
     thickness: float                 # m, > 0
     material: Material
@@ -114,6 +123,7 @@ class Tank:
     walls: str = "rigid"             # "rigid" | "elastic"
     fluid: Fluid = field(default_factory=Fluid)
     wall_spec: Optional[Walls] = None   # the [tanks.walls] table when walls = "elastic"
+    reduction: Optional[Reduction] = None   # None: full order
 
     @property
     def liquid_volume(self) -> float:

@@ -25,3 +25,15 @@ def test_quickstart_notebook_runs():
     assert not [o for o in outs if o.get("output_type") == "error"]
     text = "".join(o.get("text", "") for o in outs)
     assert "ok" in text and "sloshing" in text and "d(peak roll)/d(GM_T)" in text
+
+
+def test_accuracy_vs_cost_notebook_runs():
+    """Draws the committed map (docs/accuracy_cost.csv): no simulation, only the CSV."""
+    nb = nbformat.read(ROOT / "notebooks" / "accuracy_vs_cost.ipynb", as_version=4)
+    assert all(not c.get("outputs") for c in nb.cells if c.cell_type == "code")
+    nbclient.NotebookClient(nb, timeout=300, kernel_name="python3",
+                            resources={"metadata": {"path": str(ROOT / "notebooks")}}).execute()
+    outs = [o for c in nb.cells if c.cell_type == "code" for o in c.get("outputs", [])]
+    assert not [o for o in outs if o.get("output_type") == "error"]
+    text = "".join(o.get("text", "") for o in outs)
+    assert "Pareto front (probe B)" in text and "machine" in text

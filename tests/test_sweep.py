@@ -15,8 +15,10 @@ def test_batch_equals_single_runs():
     assert statuses == ["ok"] * 3 and batch.vessel.quaternion.shape == (3, 301, 4)
     for i, g in enumerate(gm):
         single = js.simulate(scene, params={"vessel.hydrostatics.gm_t": g})
+        # the batch forms its Newton preconditioner every step, a single run carries it from step to
+        # step: both converge to the Newton tolerance (1e-10 m/s^2), not bitwise to each other
         np.testing.assert_allclose(np.asarray(batch.vessel.quaternion[i]), np.asarray(single.vessel.quaternion),
-                                   atol=1e-13)
+                                   atol=1e-11)
     # a larger GM_T rolls less
     roll = np.abs(np.asarray(batch.vessel.roll_pitch_yaw)[:, :, 0]).max(axis=1)
     assert roll[0] > roll[1] > roll[2]

@@ -1,0 +1,174 @@
+"""The accuracy-cost map (issue item 3(d)): error against wall time over meshes, steps and modal
+reductions of the paper example, a CSV table and a Pareto plot.
+
+    python benchmarks/accuracy_cost.py [--duration 5] [-o docs/accuracy_cost]
+
+Every setting runs the paper scene for `duration` seconds. Errors:
+  * first sloshing frequency: the mesh's first natural frequency of the liquid (tank held fixed),
+    with the step's period error (trapezoidal rule: omega_h = (2/h) atan(omega h / 2)), against the
+    closed form g k tanh(k h) = 2.4261 rad/s of the 5 x 5 x 3 m tank (modes keep the mesh's value);
+  * probe B: the largest difference of its vertical displacement from the reference run's over the
+    run, over the reference's peak. Reference: mesh 20 x 20 x 12, full order, dt = 0.0025 s (or
+    --ref-dt).
+Wall time: seconds of computing per simulated second, after compilation (a second run of the
+compiled loop), on this machine (named in the CSV and the plot).
+"""
+import argparse
+import csv
+import os
+import platform
+import sys
+import time
+
+import jax
+
+jax.config.update("jax_enable_x64", True)
+
+import numpy as np  # noqa: E402
+
+import jaxslosh as js  # noqa: E402
+from jaxslosh.liquid import build_liquid  # noqa: E402
+from jaxslosh.modes import analytic_sloshing_omegas  # noqa: E402
+from jaxslosh.reduction import tank_basis  # noqa: E402
+from jaxslosh.run import _core, advance, prepare, start  # noqa: E402
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from bench_paper import paper_variant  # noqa: E402
+
+ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+
+
+def machine() -> str:
+    name = platform.processor() or platform.machine()
+    try:
+        for line in open("/proc/cpuinfo"):
+            if line.startswith("model name"):
+                name = line.split(":", 1)[1].strip()
+                break
+    except OSError:
+        pass
+    return f"{os.cpu_count()} cores, {name}"
+
+
+def run(text, duration):
+    """(time, probe B z-displacement, wall seconds per simulated second, unknowns, steps/s)."""
+    scene = js.load_scene(text)
+    setup = prepare(scene, duration=duration)
+    b, solver = _core(setup.built), setup.solver
+    carry, f0 = start(b, solver)
+    c1, fr = advance(b, solver, carry, setup.n_steps, 1)        # compile and run
+    jax.block_until_ready(fr)
+    t0 = time.perf_counter()
+    jax.block_until_ready(advance(b, solver, carry, setup.n_steps, 1))
+    wall = time.perf_counter() - t0
+    assert not bool(c1.failed), "a run failed"
+    i = b.probes.names.index("B")
+    z = np.concatenate([[float(f0.probes[i, 2])], np.asarray(fr.probes[:, i, 2])])
+    t = np.concatenate([[0.0], np.asarray(fr.t)])
+    return t, z - z[0], wall / duration, b.system.n, setup.n_steps / wall
+
+
+def first_omega(mesh, scene):
+    t = scene.tanks[0]
+    sparse = (mesh[0] + 1) * (mesh[1] + 1) * (mesh[2] + 1) > 2000
+    model = build_liquid(t.size, t.fill_depth, mesh, t.fluid.density, t.fluid.sound_speed,
+                         scene.environment.gravity, sparse=sparse)
+    return float(tank_basis(model, t.origin, 1, static_correction=False).omega[0])
+
+
+def settings(quick):
+    meshes = [(3, 3, 2), (5, 5, 5), (10, 10, 6), (20, 20, 12)]
+    dts = [0.04, 0.02, 0.005, 0.0025]
+    modes = [2, 8, 20, 40]
+    if quick:
+        meshes, dts, modes = [(3, 3, 2), (5, 5, 5), (10, 10, 6)], [0.04, 0.02], [2, 20]
+    out = [("mesh", m, 0.01, 0) for m in meshes]
+    out += [("step", (5, 5, 5), dt, 0) for dt in dts]
+    out += [("modes", (20, 20, 12) if not quick else (10, 10, 6), 0.01, n) for n in modes]
+    return out
+
+
+def main():
+    ap = argparse.ArgumentParser()
+    ap.add_argument("--duration", type=float, default=5.0)
+    ap.add_argument("--ref-dt", type=float, default=0.0025)
+    ap.add_argument("--quick", action="store_true", help="a few coarse settings and a 10x10x6 reference")
+    ap.add_argument("-o", "--output", default=os.path.join(ROOT, "docs", "accuracy_cost"))
+    a = ap.parse_args()
+    paper = open(os.path.join(ROOT, "scenes", "paper_ship_tank.toml")).read()
+    scene = js.load_scene(paper)
+    t = scene.tanks[0]
+    exact = float(analytic_sloshing_omegas(t.size[0], t.size[1], t.fill_depth, scene.environment.gravity, 1)[0])
+    ref_mesh = (10, 10, 6) if a.quick else (20, 20, 12)
+    print(f"reference: mesh {ref_mesh}, dt = {a.ref_dt} s, {a.duration} s ...", flush=True)
+    t_ref, z_ref, _, _, _ = run(paper_variant(paper, mesh=ref_mesh, dt=a.ref_dt), a.duration)
+    peak = np.abs(z_ref).max()
+    omegas = {}
+    rows = []
+    print(f"{'family':6} {'mesh':>10} {'dt':>7} {'modes':>5} {'unknowns':>8} {'steps/s':>9} {'wall/sim s':>10} "
+          f"{'omega1 err':>10} {'B err':>9}", flush=True)
+    for family, mesh, dt, modes in settings(a.quick):
+        text = paper_variant(paper, mesh=mesh, modes=modes or None, dt=dt)
+        tt, z, wall, n, sps = run(text, a.duration)
+        if mesh not in omegas:
+            omegas[mesh] = first_omega(mesh, scene)
+        w = omegas[mesh]
+        w_h = 2.0 / dt * np.arctan(w * dt / 2.0)
+        w_err = w_h / exact - 1.0
+        b_err = np.abs(np.interp(t_ref, tt, z) - z_ref).max() / peak
+        row = dict(family=family, mesh="x".join(map(str, mesh)), dt=dt, modes=modes, unknowns=n,
+                   steps_per_s=round(sps, 1), wall_per_sim_s=wall, omega1=w_h, omega1_err=w_err, B_err=b_err)
+        rows.append(row)
+        print(f"{family:6} {row['mesh']:>10} {dt:7.4f} {modes:5d} {n:8d} {sps:9.0f} {wall:10.4f} {w_err:+10.4%} "
+              f"{b_err:9.4%}", flush=True)
+    host = machine()
+    with open(a.output + ".csv", "w", newline="") as f:
+        f.write(f"# jaxslosh accuracy-cost map, paper example, {a.duration} s; reference mesh "
+                f"{'x'.join(map(str, ref_mesh))} dt {a.ref_dt}; machine: {host}; jax {jax.__version__}\n")
+        w = csv.DictWriter(f, fieldnames=list(rows[0]))
+        w.writeheader()
+        w.writerows(rows)
+    plot(rows, a.output + ".png", host)
+    print(f"wrote {a.output}.csv and {a.output}.png")
+
+
+def pareto(points):
+    """Indices of the points no other point beats in both cost and error."""
+    order = sorted(range(len(points)), key=lambda i: points[i])
+    front, best = [], np.inf
+    for i in order:
+        if points[i][1] < best:
+            front.append(i)
+            best = points[i][1]
+    return front
+
+
+def plot(rows, path, host):
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    fig, axes = plt.subplots(1, 2, figsize=(12, 4.8))
+    style = {"mesh": ("o", "C0"), "step": ("s", "C1"), "modes": ("^", "C2")}
+    for ax, key, label in ((axes[0], "B_err", "probe B error (max over the run / peak)"),
+                           (axes[1], "omega1_err", "first sloshing frequency error |relative|")):
+        pts = [(r["wall_per_sim_s"], max(abs(r[key]), 1e-7)) for r in rows]
+        for fam, (mk, col) in style.items():
+            sel = [i for i, r in enumerate(rows) if r["family"] == fam]
+            ax.loglog([pts[i][0] for i in sel], [pts[i][1] for i in sel], mk, color=col, label=fam)
+            for i in sel:
+                r = rows[i]
+                tag = r["mesh"] if fam == "mesh" else (f"dt {r['dt']:g}" if fam == "step" else f"{r['modes']} modes")
+                ax.annotate(tag, pts[i], fontsize=7, xytext=(3, 3), textcoords="offset points")
+        front = pareto(pts)
+        ax.loglog([pts[i][0] for i in front], [pts[i][1] for i in front], "k--", lw=0.8, label="Pareto front")
+        ax.set_xlabel("wall seconds per simulated second (after compilation)")
+        ax.set_ylabel(label)
+        ax.grid(True, which="both", alpha=0.3)
+        ax.legend(fontsize=8)
+    fig.suptitle(f"jaxslosh accuracy-cost map, paper example ({host})", fontsize=10)
+    fig.tight_layout()
+    fig.savefig(path, dpi=110)
+
+
+if __name__ == "__main__":
+    main()
