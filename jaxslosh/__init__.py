@@ -22,5 +22,11 @@ def sloshing_modes(scene, tank=None, n=10):
     return _sm(scene, tank=tank, n=n)
 
 
-__all__ = ["Scene", "SceneError", "Result", "NumericalFailure", "load_scene", "simulate", "save_result",
+def structure_modes(scene, structure, n=10):
+    """Natural modes of a flexible structure held at its attachment (see analysis.py)."""
+    from .analysis import structure_modes as _sm
+    return _sm(scene, structure, n=n)
+
+
+__all__ = ["structure_modes", "Scene", "SceneError", "Result", "NumericalFailure", "load_scene", "simulate", "save_result",
            "load_result", "sloshing_modes", "identify", "simulate_batch", "__version__"]

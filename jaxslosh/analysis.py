@@ -11,7 +11,21 @@ def sloshing_modes(scene: Scene, tank=None, n: int = 10):
     t = scene.tank(tank) if tank is not None else scene.tanks[0]
     model = build_liquid(t.size, t.fill_depth, t.mesh, t.fluid.density, t.fluid.sound_speed,
                          scene.environment.gravity, element=t.fluid.element)
+    if t.wall_spec is not None:       # the liquid and its elastic walls together (kinds add "wall")
+        from .tankwalls import build_tank_with_walls, tank_modes
+        return tank_modes(build_tank_with_walls(t, model), n=n)
     return liquid_modes(model, n=n)
+
+
+def structure_modes(scene: Scene, structure: str, n: int = 10):
+    """The first n modes of a flexible structure held at its attachment face (the vessel, or the
+    structure it is attached to, held fixed): `StructureModes(omega, kind, shares, shapes)`; each mode
+    named by the pattern of its cross-sections that holds most of its kinetic energy (bending along
+    an axis, torsion, axial, other)."""
+    from .structure import build_structure, clamped_modes, face_nodes
+    st = scene.structure(structure)
+    m = build_structure(st.size, st.mesh, st.material.young, st.material.poisson, st.material.density)
+    return clamped_modes(m, face_nodes(m.nodes, m.size, st.attach), n=n)
 
 
 def effective_roll_inertia(size, mesh, element="stabilized", density=1000.0, sound_speed=1500.0, gravity=9.81,

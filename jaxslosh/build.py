@@ -166,9 +166,6 @@ def _build_liquid(scene: Scene, params: Optional[dict] = None, gravity=None):
     rigid = [t for t in scene.tanks]
     if not rigid:
         return None, (), None
-    for i, t in enumerate(rigid):
-        if t.walls != "rigid":
-            raise SceneError(f"tanks[{i}].walls", "elastic tank walls are not supported yet (use \"rigid\")")
     from .liquid import build_liquid  # the liquid module is only imported by scenes that have liquid
 
     params = params or {}
@@ -188,6 +185,14 @@ def _build_liquid(scene: Scene, params: Optional[dict] = None, gravity=None):
     traced = any(m.traced for m in models)
     xp = jnp if traced else np
     reduced = [t.reduction is not None for t in rigid]
+    elastic = [t.wall_spec is not None for t in rigid]
+    if any(elastic):
+        for i, t in enumerate(rigid):
+            if reduced[i] or sparse or models[i].traced:
+                raise SceneError(f"tanks[{i}].walls", "elastic walls need the full-order dense liquid with the "
+                                                      "scene's own values (no [tanks.reduction], no sparse solver, "
+                                                      "no traced tank values)")
+        return _liquid_with_walls(rigid, models)
     if any(reduced):
         return _reduced_liquid(scene, rigid, models, reduced, g)
 
@@ -234,6 +239,51 @@ def _build_liquid(scene: Scene, params: Optional[dict] = None, gravity=None):
                     K=jnp.asarray(block_diag(*K_list)), free=jnp.asarray(np.concatenate(free_list)),
                     n_nodes=offset, Kdt=jnp.asarray(xp.concatenate(Kdt_list)) if coupled else None,
                     Ktt=jnp.asarray(Ktt) if coupled else None)
+    return liquid, tuple(blocks), None
+
+
+def _liquid_with_walls(tanks, models):
+    """The stacked liquid block when some tank has elastic walls (tankwalls.py): every tank's nodes
+    (liquid, then its walls'), the map from nodal dofs to unknowns, and the matrices on the unknowns."""
+    from scipy.linalg import block_diag
+
+    from .tankwalls import build_tank_with_walls
+    blocks, rs, Ms_list, K_list, maps, reps, Kdt_list = [], [], [], [], [], [], []
+    coupled = False
+    Ktt = np.zeros((3, 3))
+    node_off, free_off = 0, 0
+    for t, m in zip(tanks, models):
+        Nl = m.n_nodes
+        blocks.append(TankBlock(t.name, node_off, np.asarray(m.nodes), np.asarray(m.elements), m))
+        if t.wall_spec is not None:
+            tw = build_tank_with_walls(t, m)
+            nodes, Ms, K, dmap, rep, C = tw.nodes, tw.mass, tw.stiffness, tw.dof_map, tw.rep, tw.rotation_coupling
+        else:
+            free = np.asarray(m.free).reshape(-1)
+            dmap = np.where(free, np.cumsum(free) - 1, -1)
+            rep = np.flatnonzero(free)
+            nodes, Ms = np.asarray(m.nodes), np.asarray(m.mass)
+            K = np.asarray(m.stiffness)[np.ix_(rep, rep)]
+            C = None if m.rotation_coupling is None else np.asarray(m.rotation_coupling)[rep]
+        rs.append(nodes + np.asarray(t.origin)[None, :])
+        Ms_list.append(Ms)
+        K_list.append(K)
+        maps.append(np.where(dmap >= 0, dmap + free_off, -1))
+        reps.append(rep + 3 * node_off)
+        if C is not None:
+            coupled = True
+            Kdt_list.append(C)
+            Ktt = Ktt + np.asarray(m.rotation_stiffness)
+        else:
+            Kdt_list.append(np.zeros((rep.size, 3)))
+        node_off += nodes.shape[0]
+        free_off += rep.size
+    dof_map = np.concatenate(maps)
+    dof_map = np.where(dof_map >= 0, dof_map, free_off)          # the zero slot after the unknowns
+    liquid = Liquid(r=jnp.asarray(np.concatenate(rs)), Ms=jnp.asarray(block_diag(*Ms_list)),
+                    K=jnp.asarray(block_diag(*K_list)), free=jnp.asarray(np.concatenate(reps)), n_nodes=node_off,
+                    Kdt=jnp.asarray(np.concatenate(Kdt_list)) if coupled else None,
+                    Ktt=jnp.asarray(Ktt) if coupled else None, dof_map=jnp.asarray(dof_map))
     return liquid, tuple(blocks), None
 
 

@@ -36,7 +36,8 @@ def _parser():
     pl.add_argument("-o", "--output", help="figure file (default: the result's name with .png)")
     pl.add_argument("--surface", metavar="FIG", help="also draw the deformed free surface at a few instants to FIG")
     pl.add_argument("--scale", type=float, default=1.0, help="magnify liquid displacements in --surface (default 1)")
-    m = sub.add_parser("modes", help="natural frequencies of a tank's liquid with the vessel held fixed")
+    m = sub.add_parser("modes", help="natural frequencies of a tank's liquid, or of a flexible structure, with the "
+                                     "vessel held fixed")
     m.add_argument("scene")
     g = m.add_mutually_exclusive_group()
     g.add_argument("--tank")
@@ -128,9 +129,9 @@ def cmd_modes(a):
     if a.n < 1:
         raise InputError(f"-n: must be at least 1, got {a.n}")
     scene = _load(a.scene)
-    if a.structure is not None:
-        raise InputError("--structure: flexible structures are not supported yet")
     _enable_x64()
+    if a.structure is not None:
+        return _structure_modes(scene, a)
     from .analysis import sloshing_modes
     tank = a.tank
     if tank is None:
@@ -148,6 +149,25 @@ def cmd_modes(a):
         for i, (w, k, s) in enumerate(zip(modes.omega, modes.kind, modes.free_surface_share)):
             f = w / (2 * math.pi)
             print(f"{i + 1:>3} {w:12.5f} {f:10.5f} {1 / f if f > 0 else float('inf'):10.4f} {s:14.3f}  {k}")
+    return EXIT_OK
+
+
+def _structure_modes(scene, a):
+    from .analysis import structure_modes
+    names = [s.name for s in scene.structures]
+    if a.structure not in names:
+        raise InputError(f"--structure: no structure named {a.structure!r} (structures: {', '.join(names) or 'none'})")
+    modes = structure_modes(scene, a.structure, n=a.n)
+    if a.json:
+        print(json.dumps({"structure": a.structure, "omega": [float(w) for w in modes.omega], "kind": list(modes.kind),
+                          "shares": {k: [float(x) for x in v] for k, v in modes.shares.items()}}))
+        return EXIT_OK
+    import math
+    print(f"modes of structure {a.structure!r} (held at its attachment, vessel fixed):")
+    print(f"{'#':>3} {'omega rad/s':>12} {'f Hz':>10} {'period s':>10} {'share':>6}  kind")
+    for i, (w, k) in enumerate(zip(modes.omega, modes.kind)):
+        f = w / (2 * math.pi)
+        print(f"{i + 1:>3} {w:12.5f} {f:10.5f} {1 / f if f > 0 else float('inf'):10.4f} {modes.shares[k][i]:6.3f}  {k}")
     return EXIT_OK
 
 

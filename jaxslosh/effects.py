@@ -22,29 +22,65 @@ def scene_effects(scene: Scene) -> list[tuple[str, str]]:
         for t in scene.tanks:
             eff.append((f"liquid in tank {t.name!r}", f"{t.mesh[0]}x{t.mesh[1]}x{t.mesh[2]} hexahedra, "
                         f"{t.liquid_mass:.6g} kg, element {t.fluid.element!r}, {t.walls} walls (slip)"))
+            if t.wall_spec is not None:
+                eff.append((f"elastic walls of tank {t.name!r}",
+                            f"{t.wall_spec.thickness:g} m thick, {t.wall_mass:.6g} kg of elastic hexahedra built into "
+                            "the hull (the vessel's frame), the liquid tied to them in the normal direction only"))
         if e.coriolis:
             eff.append(("Coriolis", "2 omega x d_dot on the liquid (eq. 19)"))
         if e.centrifugal:
             eff.append(("centrifugal", "omega x (omega x r) on the liquid (eq. 19)"))
         if scene.environment.gravity > 0 and e.gravity_turning:
             eff.append(("gravity turning with the body", "load of eq. (32) on the liquid"))
+    for s in scene.structures:
+        nx, ny, nz = s.mesh
+        to = f"structure {s.attach_to!r}" if s.attach_to else "the vessel"
+        eff.append((f"flexible structure {s.name!r}",
+                    f"{nx}x{ny}x{nz} elastic hexahedra (incompatible modes), its own floating frame (6 unknowns) "
+                    f"and {_structure_modes(s)} elastic modes; its {s.attach} face tied to {to} through an "
+                    f"interface frame and localized multipliers ({_interface_unknowns(s)} unknowns)"))
     return eff
+
+
+def _face_nodes(s) -> int:
+    nx, ny, nz = s.mesh
+    axis = "xyz".index(s.attach[0])
+    return [(ny + 1) * (nz + 1), (nx + 1) * (nz + 1), (nx + 1) * (ny + 1)][axis]
+
+
+def _structure_modes(s) -> int:
+    nx, ny, nz = s.mesh
+    return 3 * (nx + 1) * (ny + 1) * (nz + 1) - 6
+
+
+def _interface_unknowns(s) -> int:
+    return 9 * _face_nodes(s)          # frame positions and the multipliers of its two sides
 
 
 def switched_off(scene: Scene) -> list[str]:
     return [k for k in EFFECTS if not getattr(scene.effects, k)]
 
 
-def count_unknowns(scene: Scene) -> int:
-    n = 6
-    if not scene.effects.liquid:
-        return n
+def liquid_unknowns(scene: Scene) -> int:
+    """Unknowns of the full-order liquid block: every tank's free liquid dofs, and its elastic walls'."""
+    n = 0
     for t in scene.tanks:
         nx, ny, nz = t.mesh
         nodes = (nx + 1) * (ny + 1) * (nz + 1)
         fixed = 2 * (ny + 1) * (nz + 1) + 2 * (nx + 1) * (nz + 1) + (nx + 1) * (ny + 1)
         n += 3 * nodes - fixed
+        if t.wall_spec is not None:       # the walls' free nodes (the liquid's normal dofs share theirs)
+            from .structure import wall_mesh
+            _, _, _, held = wall_mesh(t.size, t.fill_depth, t.mesh, t.wall_spec.thickness, t.wall_spec.mesh)
+            n += 3 * int((~held).sum())
     return n
+
+
+def count_unknowns(scene: Scene) -> int:
+    n = 6 + sum(6 + _structure_modes(s) + _interface_unknowns(s) for s in scene.structures)
+    if not scene.effects.liquid:
+        return n
+    return n + liquid_unknowns(scene)
 
 
 def effects_summary(scene: Scene) -> str:

@@ -144,6 +144,12 @@ def make_solver(system: System, h: float, scheme: Scheme, tol: float, max_iter: 
         if not traced:
             Ms, K_ff = np.asarray(Ms), np.asarray(K_ff)
         M_ff = xp.kron(Ms, xp.eye(3))[np.ix_(free, free)]
+        if getattr(L, "dof_map", None) is not None:     # elastic tank walls: T^T kron(Ms, I3) T
+            dmap = np.asarray(L.dof_map)
+            T = np.zeros((dmap.size, free.size + 1))
+            T[np.arange(dmap.size), dmap] = 1.0
+            T = T[:, :-1]
+            M_ff = T.T @ np.kron(np.asarray(Ms), np.eye(3)) @ T
 
     def inverse(A):
         return jnp.linalg.inv(A) if traced else jnp.asarray(np.linalg.inv(A))

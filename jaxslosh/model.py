@@ -123,12 +123,22 @@ class Liquid(eqx.Module):
     n_nodes: int = eqx.field(static=True)
     Kdt: Optional[jax.Array] = None   # (nf, 3) d-theta block of the absolute-rotation penalty
     Ktt: Optional[jax.Array] = None   # (3, 3) theta-theta block
+    # elastic tank walls (tankwalls.py): (3N,) the unknown of each nodal dof (nf: held at zero); a
+    # liquid's wall-normal dof shares the wall's unknown. None: `free` lists the free dofs
+    dof_map: Optional[jax.Array] = None
 
     def full(self, d):
-        """(nf,) free-dof vector -> (N, 3) nodal field, zero on the wall-normal dofs."""
+        """(nf,) free-dof vector -> (N, 3) nodal field, zero on the wall-normal dofs (with elastic
+        walls: equal to the wall's there, through `dof_map`)."""
+        if self.dof_map is not None:
+            return jnp.concatenate([d, jnp.zeros(1, d.dtype)])[self.dof_map].reshape(self.n_nodes, 3)
         return jnp.zeros(3 * self.n_nodes, d.dtype).at[self.free].set(d).reshape(self.n_nodes, 3)
 
     def free_part(self, F):
+        """The transpose of `full`: nodal forces -> generalized forces on the free dofs."""
+        if self.dof_map is not None:
+            nf = self.free.shape[0]
+            return jax.ops.segment_sum(F.reshape(-1), self.dof_map, nf + 1)[:nf]
         return F.reshape(-1)[self.free]
 
     @property
@@ -280,7 +290,7 @@ class System(eqx.Module):
         if is_reduced(self.liquid):
             s.append(self.liquid.row_scale)
         elif self.liquid is not None:
-            s.append(jnp.repeat(self.liquid.m_nodes, 3)[self.liquid.free])
+            s.append(self.liquid.free_part(jnp.repeat(self.liquid.m_nodes, 3)))
         return jnp.concatenate(s)
 
 

@@ -112,7 +112,7 @@ def parse_scene(mapping: Mapping[str, Any], text: str = "", path: str = "") -> S
     _unique_names(probes, "probes", "probe")
     for i, probe in enumerate(probes):
         _place_probe(probe, f"probes[{i}]", tanks, structures)
-    _mass_balance(vessel, tanks, environment, warnings)
+    _mass_balance(vessel, tanks, environment, warnings, structures)
     effects = Effects(**_read(mapping.get("effects", {}), "effects", {k: ("bool", None) for k in EFFECTS}))
     return Scene(title=title, environment=environment, simulation=simulation, vessel=vessel, tanks=tanks,
                  structures=structures, probes=probes, effects=effects, text=text, path=path,
@@ -415,18 +415,21 @@ def _place_probe(probe: Probe, where: str, tanks, structures) -> None:
                 f"on no wall of tank {owner_name!r}: no material point is there to follow"))
 
 
-def _mass_balance(vessel: Vessel, tanks, environment: Environment, warnings: list[str]) -> None:
+def _mass_balance(vessel: Vessel, tanks, environment: Environment, warnings: list[str], structures=()) -> None:
     h = vessel.hydrostatics
     if h is None or environment.gravity == 0:
         return
     liquid = sum(t.liquid_mass for t in tanks)
-    total = vessel.mass + liquid
+    parts = sum(s.material.density * s.size[0] * s.size[1] * s.size[2] for s in structures) \
+        + sum(t.wall_mass for t in tanks)
+    total = vessel.mass + liquid + parts
     buoyant = environment.water_density * h.displaced_volume
     if abs(total - buoyant) > MASS_BALANCE_TOLERANCE * buoyant:
         imbalance = (total - buoyant) * environment.gravity
+        extra = f" + structures and elastic walls {parts:.6g} kg" if parts else ""
         warnings.append(
             f"vessel.hydrostatics.displaced_volume: the total mass {total:.6g} kg (vessel {vessel.mass:.6g} kg + "
-            f"tank liquid {liquid:.6g} kg) differs from water_density * displaced_volume = {buoyant:.6g} kg by "
+            f"tank liquid {liquid:.6g} kg{extra}) differs from water_density * displaced_volume = {buoyant:.6g} kg by "
             f"{100 * (total - buoyant) / buoyant:+.2f} %; the hydrostatic restoring forces are taken about the "
             f"initial position as if it were the equilibrium; the static imbalance of {abs(imbalance):.4g} N "
             f"({'weight' if imbalance > 0 else 'buoyancy'} in excess) is ignored")

@@ -133,6 +133,16 @@ class Tank:
     def liquid_mass(self) -> float:
         return self.fluid.density * self.liquid_volume
 
+    @property
+    def wall_mass(self) -> float:
+        """Mass of elastic walls (an open box one wall thick around the inner size); 0 for rigid ones,
+        whose mass is the vessel's."""
+        if self.wall_spec is None:
+            return 0.0
+        a, b, H = self.size
+        t = self.wall_spec.thickness
+        return self.wall_spec.material.density * ((a + 2 * t) * (b + 2 * t) * (H + t) - a * b * H)
+
 
 @dataclass(frozen=True)
 class Structure:

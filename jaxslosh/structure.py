@@ -311,3 +311,107 @@ def euler_bernoulli_free_free(length, EI, rhoA, n=3) -> np.ndarray:
     roots = [brentq(lambda x: np.cos(x) * np.cosh(x) - 1.0, (k + 1.5) * np.pi - 0.5, (k + 1.5) * np.pi + 0.5)
              for k in range(n)]
     return np.array([(b / length) ** 2 * np.sqrt(EI / rhoA) for b in roots])
+
+
+# ------------------------------------------------------------------------------------------------
+# elastic tank walls: an open box shell of hexahedra around the liquid
+
+
+@dataclass(frozen=True, eq=False)
+class WallModel:
+    """The walls of an elastic tank: an open box (bottom and four sides, no lid) of hexahedra one
+    element thick, around the cavity [0, a] x [0, b] x [0, H] (tank-local coordinates). The node
+    planes inside the cavity's span include the liquid mesh's, so that every liquid node on a wetted
+    wall coincides with a wall node (`wetted`)."""
+    nodes: np.ndarray          # (Nw, 3) tank-local
+    elements: np.ndarray       # (Ew, 8)
+    mass: np.ndarray           # (Nw, Nw) scalar
+    stiffness: np.ndarray      # (3Nw, 3Nw)
+    held: np.ndarray           # (Nw,) bool: the attachment face, tied to the hull
+    total_mass: float
+
+
+def _planes(inner, t):
+    return np.concatenate([[-t], inner, [inner[-1] + t]])
+
+
+def wall_planes(size, fill_depth, liquid_mesh, thickness, wall_mesh=None):
+    """(xs, ys, zs) node planes of the wall shell: the liquid mesh's planes (refined by the integer
+    factors that `wall_mesh` implies along x and y), in z the liquid's planes up to the fill depth
+    and planes of the same spacing above it up to the tank height, plus the outer planes at -t (and
+    a + t, b + t). Raises ValueError when `wall_mesh` does not nest the liquid mesh."""
+    a, b, H = (float(s) for s in size)
+    nx, ny, nz = liquid_mesh
+    h = float(fill_depth)
+    if wall_mesh is None:
+        mx, my = nx, ny
+        dz = h / nz
+        above = int(np.ceil((H - h) / dz - 1e-9)) if H > h * (1 + 1e-12) else 0
+        zs = np.concatenate([np.linspace(0.0, h, nz + 1), np.linspace(h, H, above + 1)[1:]]) if above else \
+            np.linspace(0.0, h, nz + 1)
+    else:
+        mx, my, mz = (int(m) for m in wall_mesh)
+        if mx % nx or my % ny:
+            raise ValueError(f"the wall mesh's counts along x and y ({mx}, {my}) must be multiples of the "
+                             f"liquid mesh's ({nx}, {ny})")
+        zs = np.linspace(0.0, H, mz + 1)
+        liquid_z = np.linspace(0.0, h, nz + 1)
+        if np.min(np.abs(zs[None, :] - liquid_z[:, None]), axis=1).max() > 1e-9 * H:
+            raise ValueError(f"the wall mesh's {mz} layers over the height {H:g} m put no node plane at some of the "
+                             f"liquid's {nz} layers up to {h:g} m")
+    xs = np.linspace(0.0, a, mx + 1)
+    ys = np.linspace(0.0, b, my + 1)
+    t = float(thickness)
+    return _planes(xs, t), _planes(ys, t), np.concatenate([[-t], zs])
+
+
+def wall_mesh(size, fill_depth, liquid_mesh, thickness, wall_mesh=None, attach="z-"):
+    """(nodes, elements, element sizes, held) of the open box shell (see WallModel), no assembly."""
+    xs, ys, zs = wall_planes(size, fill_depth, liquid_mesh, thickness, wall_mesh)
+    a, b, H = (float(s) for s in size)
+    X, Y, Z = np.meshgrid(xs, ys, zs, indexing="ij")
+    grid_nodes = np.stack([X.ravel(), Y.ravel(), Z.ravel()], axis=1)
+    nX, nY, nZ = len(xs) - 1, len(ys) - 1, len(zs) - 1
+    i, j, k = np.meshgrid(np.arange(nX), np.arange(nY), np.arange(nZ), indexing="ij")
+    i, j, k = i.ravel(), j.ravel(), k.ravel()
+    cx, cy, cz = (xs[i] + xs[i + 1]) / 2, (ys[j] + ys[j + 1]) / 2, (zs[k] + zs[k + 1]) / 2
+    solid = ~((cx > 0) & (cx < a) & (cy > 0) & (cy < b) & (cz > 0))        # the cavity and the open top
+    i, j, k = i[solid], j[solid], k[solid]
+    corner = ((_XI + 1) / 2).astype(int)
+    elements = (((i[:, None] + corner[:, 0]) * (nY + 1) + j[:, None] + corner[:, 1]) * (nZ + 1)
+                + k[:, None] + corner[:, 2])
+    used = np.unique(elements)
+    renum = -np.ones(len(grid_nodes), dtype=int)
+    renum[used] = np.arange(len(used))
+    nodes, elements = grid_nodes[used], renum[elements]
+    hs = np.stack([xs[i + 1] - xs[i], ys[j + 1] - ys[j], zs[k + 1] - zs[k]], axis=1)
+    axis = "xyz".index(attach[0])
+    target = (xs, ys, zs)[axis][0 if attach[1] == "-" else -1]
+    held = np.abs(nodes[:, axis] - target) <= 1e-9 * max(a, b, H)
+    return nodes, elements, hs, held
+
+
+def build_walls(size, fill_depth, liquid_mesh, thickness, young, poisson, density, wall_mesh=None,
+                attach="z-") -> WallModel:
+    nodes, elements, hs, held = globals()["wall_mesh"](size, fill_depth, liquid_mesh, thickness, wall_mesh, attach)
+    K, Ms = assemble_cells(nodes, elements, hs, young, poisson, density)
+    return WallModel(nodes=nodes, elements=elements, mass=Ms, stiffness=K, held=held, total_mass=float(Ms.sum()))
+
+
+def assemble_cells(nodes, elements, sizes, young, poisson, density):
+    """Dense (3N, 3N) stiffness and (N, N) scalar mass of box hexahedra of the given sizes (E, 3)."""
+    import scipy.sparse as sp
+    N, E = nodes.shape[0], elements.shape[0]
+    keys, inv = np.unique(np.round(sizes, 12), axis=0, return_inverse=True)
+    inv = inv.reshape(-1)
+    Ke = np.zeros((E, 24, 24))
+    Me = np.zeros((E, 8, 8))
+    for u, hk in enumerate(keys):
+        K1, M1 = box_element(*(float(x) for x in hk), float(young), float(poisson), float(density))
+        Ke[inv == u], Me[inv == u] = K1, M1
+    dofs = (3 * elements[:, :, None] + np.arange(3)).reshape(E, 24)
+    K = sp.coo_matrix((Ke.reshape(-1), (np.repeat(dofs, 24, axis=1).reshape(-1), np.tile(dofs, (1, 24)).reshape(-1))),
+                      shape=(3 * N, 3 * N)).toarray()
+    Ms = sp.coo_matrix((Me.reshape(-1), (np.repeat(elements, 8, axis=1).reshape(-1), np.tile(elements, (1, 8)).reshape(-1))),
+                       shape=(N, N)).toarray()
+    return 0.5 * (K + K.T), Ms
