@@ -9,6 +9,7 @@ from __future__ import annotations
 
 from typing import NamedTuple, Optional
 
+import jax
 import jax.numpy as jnp
 import numpy as np
 import scipy.sparse as sp
@@ -115,13 +116,15 @@ def build(scene: Scene, params: Optional[dict] = None) -> Built:
             gm_t=jnp.asarray(P("vessel.hydrostatics.gm_t", h.gm_t), dtype=float),
             gm_l=jnp.asarray(P("vessel.hydrostatics.gm_l", h.gm_l), dtype=float),
             moment_form=h.moment)
-    liquid, tanks, d0 = _build_liquid(scene, params, g) if eff.liquid else (None, (), None)
+    liquid, tanks, extra = _build_liquid(scene, params, g, include_liquid=eff.liquid)
+    vstructs, carried = extra if extra else ((), [])
     forced = None
     if ves.forced is not None:
         f = ves.forced
         dofs = ("surge", "sway", "heave", "roll", "pitch", "yaw")
         forced = Forced(dof=dofs.index(f.dof), amplitude=jnp.asarray(f.amplitude, dtype=float),
-                        frequency=jnp.asarray(f.frequency, dtype=float), ramp=float(f.ramp))
+                        frequency=jnp.asarray(f.frequency, dtype=float), ramp=float(f.ramp), profile=f.profile,
+                        rate=float(f.rate), duration=float(f.duration) if f.duration else 1.0)
     ini = ves.initial
     q0 = quat_from_rpy(jnp.asarray(P("vessel.initial.roll_pitch_yaw", ini.roll_pitch_yaw), dtype=float))
     if forced is not None:
@@ -130,9 +133,15 @@ def build(scene: Scene, params: Optional[dict] = None) -> Built:
     if liquid is not None and not eff.gravity_turning:
         from .kinematics import rotation_matrix
         g_fixed = rotation_matrix(q0).T @ jnp.array([0.0, 0.0, -g])
-    flex, blocks = _build_flex(scene) if scene.structures else (None, ())
-    system = System(mass=jnp.asarray(P("vessel.mass", ves.mass), dtype=float),
-                    inertia=_inertia(P("vessel.inertia", ves.inertia)), gravity=g, hydro=hydro, liquid=liquid,
+    own = [s for s in scene.structures if s.frame == "own"]
+    flex, blocks = _build_flex(scene) if own else (None, ())
+    mass, inertia = jnp.asarray(P("vessel.mass", ves.mass), dtype=float), _inertia(P("vessel.inertia", ves.inertia))
+    hull_S = None
+    carried = carried + [_rigid_part(b.model.mass, b.model.nodes + np.asarray(scene.structure(b.name).origin))
+                         for b in blocks]
+    if carried:       # the ship's mass and inertia include these parts: the hull is the rest (SPEC)
+        mass, inertia, hull_S = _hull(mass, inertia, carried)
+    system = System(mass=mass, inertia=inertia, gravity=g, hydro=hydro, liquid=liquid, hull_S=hull_S,
                     forced=forced, g_fixed=g_fixed, q_ref=q0, balanced=ves.hydrostatics is not None,
                     coriolis=eff.coriolis, centrifugal=eff.centrifugal, flex=flex)
     nf = system.nf
@@ -149,11 +158,11 @@ def build(scene: Scene, params: Optional[dict] = None) -> Built:
     alg0 = None
     if flex is not None:
         c0, v0, alg0 = _flex_start(system, c0, v0)
-    probes = _build_probes(scene, tanks, liquid, blocks)
+    probes = _build_probes(scene, tanks, liquid, blocks, vstructs or ())
     return Built(system, c0, v0, probes, tanks, alg0, blocks)
 
 
-def _build_liquid(scene: Scene, params: Optional[dict] = None, gravity=None):
+def _build_liquid(scene: Scene, params: Optional[dict] = None, gravity=None, include_liquid=True):
     """The stacked liquid block of all tanks. `params` (canonical keys) may replace each tank's
     fill depth, density and sound speed, and `gravity` the scene's, by traced values: then the
     matrices are JAX values (the integer mesh, the free dofs and the probes' host-side geometry
@@ -163,8 +172,9 @@ def _build_liquid(scene: Scene, params: Optional[dict] = None, gravity=None):
     result's undeformed mesh) are the mesh at the scene's fill depth, whatever the params say: a
     probe keeps its place relative to the mesh (one at the scene's fill depth stays on the free
     surface), so its weights do not depend on a traced fill depth."""
-    rigid = [t for t in scene.tanks]
-    if not rigid:
+    rigid = [t for t in scene.tanks] if include_liquid else []
+    in_vessel_frame = [s for s in scene.structures if s.frame == "vessel"]
+    if not rigid and not in_vessel_frame:
         return None, (), None
     from .liquid import build_liquid  # the liquid module is only imported by scenes that have liquid
 
@@ -186,13 +196,14 @@ def _build_liquid(scene: Scene, params: Optional[dict] = None, gravity=None):
     xp = jnp if traced else np
     reduced = [t.reduction is not None for t in rigid]
     elastic = [t.wall_spec is not None for t in rigid]
-    if any(elastic):
+    if any(elastic) or in_vessel_frame:
         for i, t in enumerate(rigid):
             if reduced[i] or sparse or models[i].traced:
-                raise SceneError(f"tanks[{i}].walls", "elastic walls need the full-order dense liquid with the "
-                                                      "scene's own values (no [tanks.reduction], no sparse solver, "
-                                                      "no traced tank values)")
-        return _liquid_with_walls(rigid, models)
+                raise SceneError(f"tanks[{i}].walls" if elastic[i] else f"tanks[{i}]",
+                                 "elastic walls, and structures in the vessel's frame, need the full-order dense "
+                                 "liquid with the scene's own values (no [tanks.reduction], no sparse solver, no "
+                                 "traced tank values)")
+        return _liquid_with_walls(rigid, models, in_vessel_frame)
     if any(reduced):
         return _reduced_liquid(scene, rigid, models, reduced, g)
 
@@ -242,22 +253,26 @@ def _build_liquid(scene: Scene, params: Optional[dict] = None, gravity=None):
     return liquid, tuple(blocks), None
 
 
-def _liquid_with_walls(tanks, models):
-    """The stacked liquid block when some tank has elastic walls (tankwalls.py): every tank's nodes
-    (liquid, then its walls'), the map from nodal dofs to unknowns, and the matrices on the unknowns."""
+def _liquid_with_walls(tanks, models, structures=()):
+    """The stacked deformable block of the vessel's frame when some tank has elastic walls
+    (tankwalls.py) or some structure has frame = "vessel": every tank's nodes (liquid, then its
+    walls'), then those structures' nodes; the map from nodal dofs to unknowns (held ones map to the
+    zero slot); the matrices on the unknowns; and the structures' centrifugal stiffness."""
     from scipy.linalg import block_diag
 
+    from .structure import assemble, box_element, box_mesh, centrifugal_stiffness, face_nodes
     from .tankwalls import build_tank_with_walls
-    blocks, rs, Ms_list, K_list, maps, reps, Kdt_list = [], [], [], [], [], [], []
+    blocks, rs, Ms_list, K_list, maps, reps, Kdt_list, Kg_parts = [], [], [], [], [], [], [], []
+    carried_idx = []      # (block index, first carried node): elastic walls and vessel-frame structures
     coupled = False
     Ktt = np.zeros((3, 3))
     node_off, free_off = 0, 0
     for t, m in zip(tanks, models):
-        Nl = m.n_nodes
         blocks.append(TankBlock(t.name, node_off, np.asarray(m.nodes), np.asarray(m.elements), m))
         if t.wall_spec is not None:
             tw = build_tank_with_walls(t, m)
             nodes, Ms, K, dmap, rep, C = tw.nodes, tw.mass, tw.stiffness, tw.dof_map, tw.rep, tw.rotation_coupling
+            carried_idx.append((len(rs), m.n_nodes))
         else:
             free = np.asarray(m.free).reshape(-1)
             dmap = np.where(free, np.cumsum(free) - 1, -1)
@@ -278,13 +293,85 @@ def _liquid_with_walls(tanks, models):
             Kdt_list.append(np.zeros((rep.size, 3)))
         node_off += nodes.shape[0]
         free_off += rep.size
+    vstructs = []
+    for st in structures:
+        mat = st.material
+        nodes, elements = box_mesh(st.size, st.mesh)
+        hs = tuple(a / n for a, n in zip(st.size, st.mesh))
+        Ke, Mse = box_element(*hs, mat.young, mat.poisson, mat.density)
+        Kfull, Ms = assemble(nodes, elements, Ke, Mse)
+        held = np.zeros(nodes.shape[0], dtype=bool)
+        held[face_nodes(nodes, st.size, st.attach)] = True
+        fr = ~np.repeat(held, 3)
+        dmap = np.where(fr, np.cumsum(fr) - 1, -1)
+        rep = np.flatnonzero(fr)
+        if st.stiffening == "centrifugal":     # spin about axes through the vessel's COG
+            sizes = np.tile(np.asarray(hs), (elements.shape[0], 1))
+            Kg = centrifugal_stiffness(nodes, elements, sizes, Kfull, Ms, held, mat.young, mat.poisson,
+                                       axis_point=-np.asarray(st.origin, dtype=float))
+            Kg_parts.append((free_off, [k[np.ix_(rep, rep)] for k in Kg]))
+        vstructs.append(VesselFrameStructure(st.name, node_off, nodes, elements))
+        carried_idx.append((len(rs), 0))
+        rs.append(nodes + np.asarray(st.origin)[None, :])
+        Ms_list.append(Ms)
+        K_list.append(Kfull[np.ix_(rep, rep)])
+        maps.append(np.where(dmap >= 0, dmap + free_off, -1))
+        reps.append(rep + 3 * node_off)
+        Kdt_list.append(np.zeros((rep.size, 3)))
+        node_off += nodes.shape[0]
+        free_off += rep.size
     dof_map = np.concatenate(maps)
     dof_map = np.where(dof_map >= 0, dof_map, free_off)          # the zero slot after the unknowns
+    Kg = None
+    if Kg_parts:
+        Kg = np.zeros((6, free_off, free_off))
+        for off, parts in Kg_parts:
+            n = parts[0].shape[0]
+            for k in range(6):
+                Kg[k, off:off + n, off:off + n] = parts[k]
     liquid = Liquid(r=jnp.asarray(np.concatenate(rs)), Ms=jnp.asarray(block_diag(*Ms_list)),
                     K=jnp.asarray(block_diag(*K_list)), free=jnp.asarray(np.concatenate(reps)), n_nodes=node_off,
                     Kdt=jnp.asarray(np.concatenate(Kdt_list)) if coupled else None,
-                    Ktt=jnp.asarray(Ktt) if coupled else None, dof_map=jnp.asarray(dof_map))
-    return liquid, tuple(blocks), None
+                    Ktt=jnp.asarray(Ktt) if coupled else None, dof_map=jnp.asarray(dof_map),
+                    Kg=None if Kg is None else jnp.asarray(Kg))
+    carried = [_rigid_part(Ms_list[k], rs[k][n0:], n0) for k, n0 in carried_idx]
+    return liquid, tuple(blocks), (tuple(vstructs), carried)
+
+
+def _hull(mass, inertia, parts):
+    """The hull's own mass, inertia about the origin and first moment: the ship's (mass, inertia
+    about its COG at the origin) less the parts that carry their own (structures, elastic walls)."""
+    m = sum(p[0] for p in parts)
+    S = sum(p[1] for p in parts)
+    I = sum(p[2] for p in parts)
+    if not isinstance(mass, jax.core.Tracer):
+        if float(mass) <= m:
+            raise SceneError("vessel.mass", f"{float(mass):.6g} kg is the whole ship without its liquid, structures "
+                                            f"and elastic walls included, but those alone weigh {m:.6g} kg")
+        if np.min(np.linalg.eigvalsh(np.asarray(inertia) - I)) <= 0:
+            raise SceneError("vessel.inertia", "is the whole ship's about its COG, structures and elastic walls "
+                                               "included, but it is smaller than theirs alone (the hull's would not "
+                                               f"be positive definite; theirs: {np.round(np.diag(I), 1).tolist()} kg m^2)")
+    return mass - m, inertia - jnp.asarray(I), -jnp.asarray(S)
+
+
+def _rigid_part(Ms, r, n0=0):
+    """(mass, first moment, inertia about the origin) of the nodes n0... of a block with scalar mass Ms
+    (consistent: the inertia a rigid motion of the nodes has in the dynamics)."""
+    Ms = np.asarray(Ms)[n0:, n0:]
+    r = np.asarray(r)
+    mn = Ms.sum(axis=1)
+    G = r.T @ Ms @ r                                                 # sum_ij Ms_ij r_i r_j^T
+    return float(mn.sum()), mn @ r, np.trace(G) * np.eye(3) - G
+
+
+class VesselFrameStructure(NamedTuple):
+    """A structure with frame = "vessel" inside the vessel-frame block: its nodes (block-local from
+    its min corner) start at `node_offset`."""
+    name: str
+    node_offset: int
+    nodes: np.ndarray
+    elements: np.ndarray
 
 
 class StructureBlock(NamedTuple):
@@ -303,16 +390,26 @@ def _build_flex(scene: Scene):
     from .structure import build_structure, face_nodes
     bodies, interfaces, blocks, models = [], [], [], {}
     offset = 0
-    for i, st in enumerate(scene.structures):
+    own = [st for st in scene.structures if st.frame == "own"]
+    for i, st in enumerate(own):
         mat = st.material
         m = build_structure(st.size, st.mesh, mat.young, mat.poisson, mat.density)
         models[st.name] = (i, m, np.asarray(st.origin, dtype=float))
+        Kg = None
+        if st.stiffening == "centrifugal":   # spin about axes through the vessel's COG, modal form
+            from .structure import centrifugal_stiffness
+            held = np.zeros(m.n_nodes, dtype=bool)
+            held[face_nodes(m.nodes, m.size, st.attach)] = True
+            sizes = np.tile(np.asarray([a / n for a, n in zip(m.size, m.mesh)]), (m.elements.shape[0], 1))
+            Kg = jnp.asarray(np.stack([m.Phi.T @ k @ m.Phi for k in centrifugal_stiffness(
+                m.nodes, m.elements, sizes, m.stiffness, m.mass, held, mat.young, mat.poisson,
+                axis_point=-np.asarray(st.origin, dtype=float))]))
         bodies.append(Body(r=jnp.asarray(m.r), Ms=jnp.asarray(m.mass), Phi=jnp.asarray(m.Phi),
                            omega2=jnp.asarray(m.omega ** 2), mass=jnp.asarray(m.total_mass),
-                           c0=jnp.asarray(models[st.name][2] + m.cog)))
+                           c0=jnp.asarray(models[st.name][2] + m.cog), Kg=Kg))
         blocks.append(StructureBlock(st.name, i, offset, m))
         offset += m.Phi.shape[1]
-    for i, st in enumerate(scene.structures):
+    for i, st in enumerate(own):
         _, m, origin = models[st.name]
         nodes = face_nodes(m.nodes, m.size, st.attach)
         points = origin[None, :] + m.nodes[nodes]           # vessel frame, from the vessel's COG
@@ -421,7 +518,7 @@ def _hydrostatic_start(system: System, q0):
     return jnp.linalg.solve(L.K, F)
 
 
-def _build_probes(scene: Scene, tanks, liquid, structures=()) -> Probes:
+def _build_probes(scene: Scene, tanks, liquid, structures=(), vstructs=()) -> Probes:
     names, pts, W = [], [], []
     N = 0 if liquid is None else liquid.n_nodes
     by_name = {b.name: b for b in tanks}
@@ -435,6 +532,12 @@ def _build_probes(scene: Scene, tanks, liquid, structures=()) -> Probes:
             if b is not None:
                 local = probe_weights(np.asarray(p.point), t.size, t.fill_depth, b.nodes, b.elements)
                 w[b.node_offset:b.node_offset + b.nodes.shape[0]] = local
+        elif scene.structure(p.structure).frame == "vessel":     # in the vessel-frame block, like a liquid point
+            st = scene.structure(p.structure)
+            pts.append(np.asarray(st.origin) + np.asarray(p.point))
+            vb = next(b for b in vstructs if b.name == st.name)
+            w[vb.node_offset:vb.node_offset + vb.nodes.shape[0]] = block_weights(np.asarray(p.point), vb.nodes,
+                                                                                 vb.elements)
         else:
             st = scene.structure(p.structure)
             pts.append(np.asarray(st.origin) + np.asarray(p.point))

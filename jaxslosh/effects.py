@@ -11,7 +11,11 @@ def scene_effects(scene: Scene) -> list[tuple[str, str]]:
     eff = [("rigid-body inertia", "vessel: 6 unknowns, rotations on the group (|q| = 1 exactly)")]
     if scene.vessel.forced is not None:
         f = scene.vessel.forced
-        eff.append(("prescribed motion", f"{f.dof} = {f.amplitude:g} sin({f.frequency:g} t), other rigid dofs held"))
+        if f.profile == "spin-up":
+            eff.append(("prescribed motion", f"{f.dof} rate spun up to {f.rate:g} rad/s over {f.duration:g} s, "
+                                             "other rigid dofs held"))
+        else:
+            eff.append(("prescribed motion", f"{f.dof} = {f.amplitude:g} sin({f.frequency:g} t), other rigid dofs held"))
     if scene.vessel.hydrostatics is not None and e.buoyancy:
         eff.append(("buoyancy", "restoring force and moments of eqs. (33)-(36), "
                                 f"moment form {scene.vessel.hydrostatics.moment!r}"))
@@ -35,11 +39,26 @@ def scene_effects(scene: Scene) -> list[tuple[str, str]]:
     for s in scene.structures:
         nx, ny, nz = s.mesh
         to = f"structure {s.attach_to!r}" if s.attach_to else "the vessel"
-        eff.append((f"flexible structure {s.name!r}",
-                    f"{nx}x{ny}x{nz} elastic hexahedra (incompatible modes), its own floating frame (6 unknowns) "
-                    f"and {_structure_modes(s)} elastic modes; its {s.attach} face tied to {to} through an "
-                    f"interface frame and localized multipliers ({_interface_unknowns(s)} unknowns)"))
+        if s.frame == "vessel":
+            eff.append((f"flexible structure {s.name!r}",
+                        f"{nx}x{ny}x{nz} elastic hexahedra (incompatible modes) deforming in the vessel's frame, its "
+                        f"{s.attach} face held on the vessel ({_unknowns(s)} unknowns)"))
+        else:
+            eff.append((f"flexible structure {s.name!r}",
+                        f"{nx}x{ny}x{nz} elastic hexahedra (incompatible modes), its own floating frame (6 unknowns) "
+                        f"and {_structure_modes(s)} elastic modes; its {s.attach} face tied to {to} through an "
+                        f"interface frame and localized multipliers ({_interface_unknowns(s)} unknowns)"))
+        if s.stiffening == "centrifugal":
+            eff.append((f"centrifugal stiffening of {s.name!r}", "geometric stiffness of the stress of its spin"))
     return eff
+
+
+def _unknowns(s) -> int:
+    """Unknowns a structure adds (frame = "vessel": its nodes' dofs less the held face's)."""
+    if s.frame == "vessel":
+        nx, ny, nz = s.mesh
+        return 3 * ((nx + 1) * (ny + 1) * (nz + 1) - _face_nodes(s))
+    return 6 + _structure_modes(s) + _interface_unknowns(s)
 
 
 def _face_nodes(s) -> int:
@@ -77,7 +96,7 @@ def liquid_unknowns(scene: Scene) -> int:
 
 
 def count_unknowns(scene: Scene) -> int:
-    n = 6 + sum(6 + _structure_modes(s) + _interface_unknowns(s) for s in scene.structures)
+    n = 6 + sum(_unknowns(s) for s in scene.structures)
     if not scene.effects.liquid:
         return n
     return n + liquid_unknowns(scene)

@@ -92,8 +92,16 @@ class Forced(eqx.Module):
     amplitude: jax.Array
     frequency: jax.Array
     ramp: float = eqx.field(static=True, default=0.0)
+    profile: str = eqx.field(static=True, default="harmonic")
+    rate: float = eqx.field(static=True, default=0.0)      # spin-up: final rate, rad/s
+    duration: float = eqx.field(static=True, default=1.0)  # spin-up: its time, s
 
     def value(self, t):
+        if self.profile == "spin-up":
+            T, W = self.duration, self.rate
+            c = T / (2.0 * jnp.pi)
+            up = W / T * (0.5 * t * t + c * c * (jnp.cos(t / c) - 1.0))
+            return jnp.where(t < T, up, W * (0.5 * T) + W * (t - T))
         x = self.amplitude * jnp.sin(self.frequency * t)
         if self.ramp > 0:
             x = x * jnp.where(t < self.ramp, 0.5 * (1.0 - jnp.cos(jnp.pi * t / self.ramp)), 1.0)
@@ -126,6 +134,9 @@ class Liquid(eqx.Module):
     # elastic tank walls (tankwalls.py): (3N,) the unknown of each nodal dof (nf: held at zero); a
     # liquid's wall-normal dof shares the wall's unknown. None: `free` lists the free dofs
     dof_map: Optional[jax.Array] = None
+    # structures in the vessel's frame with centrifugal stiffening: (6, nf, nf) per component of
+    # omega omega^T (structure.centrifugal_stiffness), None without
+    Kg: Optional[jax.Array] = None
 
     def full(self, d):
         """(nf,) free-dof vector -> (N, 3) nodal field, zero on the wall-normal dofs (with elastic
@@ -159,6 +170,11 @@ class System(eqx.Module):
     coriolis: bool = eqx.field(static=True, default=True)
     centrifugal: bool = eqx.field(static=True, default=True)
     flex: Optional[object] = None         # flexible structures and their interfaces (multibody.Flex)
+    # first moment (kg m, body frame) of the hull's own mass about the frame origin. The scene's
+    # vessel mass and inertia are the whole ship's but the liquid (SPEC), about its COG; flexible
+    # structures and elastic tank walls carry their own mass, so the hull is the ship less them,
+    # and its COG is off the origin by hull_S / mass. None: at the origin
+    hull_S: Optional[jax.Array] = None
 
     @property
     def nf(self) -> int:
@@ -189,6 +205,12 @@ class System(eqx.Module):
         g_b = A.T @ g_vec if self.g_fixed is None else self.g_fixed
         r_t = self.mass * a0
         r_r = self.inertia @ alpha + jnp.cross(omega, self.inertia @ omega)
+        if self.hull_S is not None:    # a reference point off the hull's COG (eq. 14 with r_G)
+            S = self.hull_S
+            r_t = r_t + A @ (jnp.cross(alpha, S) + jnp.cross(omega, jnp.cross(omega, S)))
+            r_r = r_r + jnp.cross(S, A.T @ a0)
+            if not self.balanced:
+                r_r = r_r - jnp.cross(S, g_b)
         parts = []
         if is_reduced(self.liquid):    # modal liquid: the same rows from its inertia invariants (reduction.py)
             f_t, f_r, r_d = self.liquid.rows(self, c, omega, d_dot, acc, A, g_b)
@@ -208,6 +230,9 @@ class System(eqx.Module):
             r_r = r_r + jnp.cross(x, F).sum(axis=0)
             mD = L.m_nodes @ D                                       # first moment of d
             r_d = L.free_part(F - L.m_nodes[:, None] * g_b) + L.K @ c.d
+            if L.Kg is not None:    # a spin-dependent stiffness: the prestress follows the current spin
+                from .structure import spin_tensor_components
+                r_d = r_d + jnp.einsum("k,kij,j->i", jnp.stack(spin_tensor_components(omega)), L.Kg, c.d)
             if L.Kdt is not None:   # the penalty on the absolute rotation curl d + 2 theta (PHYSICS.md item 5)
                 th, J = self.liquid_rotation(c.q, with_jacobian=True)
                 r_d = r_d + L.Kdt @ th
@@ -246,6 +271,8 @@ class System(eqx.Module):
     # ---------------------------------------------------------------- energies
     def kinetic_energy(self, c: Config, V0, omega, d_dot):
         T = 0.5 * self.mass * V0 @ V0 + 0.5 * omega @ self.inertia @ omega
+        if self.hull_S is not None:
+            T = T + V0 @ (rotation_matrix(c.q) @ jnp.cross(omega, self.hull_S))
         if is_reduced(self.liquid):
             return T + self.liquid.kinetic_energy(rotation_matrix(c.q), V0, omega, c.d, d_dot)
         if self.liquid is not None:
@@ -263,6 +290,8 @@ class System(eqx.Module):
             V = V + self.hydro.potential(c.X0, c.q)
         if not self.balanced:
             V = V + self.total_mass() * self.gravity * c.X0[2]
+            if self.hull_S is not None:
+                V = V - g_b @ self.hull_S
         if is_reduced(self.liquid):
             return V + self.liquid.potential_energy(self, c.q, c.d, g_b)
         if self.liquid is not None:

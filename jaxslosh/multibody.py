@@ -31,7 +31,7 @@ would carry it. Without hydrostatics, gravity acts in full.
 """
 from __future__ import annotations
 
-from typing import NamedTuple
+from typing import NamedTuple, Optional
 
 import equinox as eqx
 import jax
@@ -39,6 +39,7 @@ import jax.numpy as jnp
 
 from .kinematics import quat_exp, quat_multiply, rotation_matrix
 from .model import Config
+from .structure import spin_tensor_components
 
 
 class Body(eqx.Module):
@@ -49,6 +50,7 @@ class Body(eqx.Module):
     omega2: jax.Array     # (m,) their squared angular frequencies
     mass: jax.Array       # total mass
     c0: jax.Array         # (3,) its centre of gravity in the vessel frame at rest
+    Kg: Optional[jax.Array] = None   # (6, m, m) centrifugal stiffness per component of omega omega^T
 
     @property
     def n_modes(self) -> int:
@@ -285,7 +287,10 @@ def inertia_rows(system, c: Config, v, acc, t):
             + jnp.cross(om, jnp.cross(om, x))                       # eq. (4), body components
         F = b.Ms @ a                                                # inertia forces on the nodes
         rigid_s.append(jnp.concatenate([A_s @ F.sum(axis=0), jnp.cross(x, F).sum(axis=0)]))
-        modal.append(b.Phi.T @ F.reshape(-1))
+        r_eta = b.Phi.T @ F.reshape(-1)
+        if b.Kg is not None:                                        # centrifugal stiffening (structure.py)
+            r_eta = r_eta + jnp.einsum("k,kij,j->i", jnp.stack(spin_tensor_components(om)), b.Kg, eta)
+        modal.append(r_eta)
     dyn = jnp.concatenate([core[:6], jnp.concatenate(rigid_s), core[6:], jnp.concatenate(modal)])
     grad_V = _potential_forces(system, c)
     if system.forced is not None:            # the vessel's rows prescribe its motion

@@ -238,10 +238,26 @@ def _vessel(table, environment: Environment, warnings: list[str]) -> Vessel:
     if "forced" in table:
         f = _read(table["forced"], "vessel.forced", {
             "dof": ("str", _one_of(FORCED_DOFS)),
+            "profile": ("str", _one_of(("harmonic", "spin-up"))),
             "amplitude": ("float", None),
             "frequency": ("float", _positive),
             "ramp": ("float", _non_negative),
-        }, required=("dof", "amplitude", "frequency"))
+            "rate": ("float", None),
+            "duration": ("float", _positive),
+        }, required=("dof",))
+        profile = f.get("profile", "harmonic")
+        need = ("amplitude", "frequency") if profile == "harmonic" else ("rate", "duration")
+        for k in need:
+            if k not in f:
+                raise SceneError(f"vessel.forced.{k}", f"is required for the {profile} profile")
+        other = ("rate", "duration") if profile == "harmonic" else ("amplitude", "frequency", "ramp")
+        for k in other:
+            if k in f:
+                raise SceneError(f"vessel.forced.{k}", f"does not belong to the {profile} profile "
+                                                       f"(it takes {', '.join(need)})")
+        if profile == "spin-up" and f["dof"] not in ("roll", "pitch", "yaw"):
+            raise SceneError("vessel.forced.dof", f"the spin-up profile turns a rotation (roll, pitch or yaw), "
+                                                  f"not {f['dof']!r}")
         forced = Forced(**f)
     return Vessel(mass=v["mass"], inertia=inertia, hydrostatics=hydrostatics, initial=initial, forced=forced)
 
@@ -340,6 +356,8 @@ def _structure(table, where: str) -> Structure:
         "mesh": ("mesh", _counts),
         "attach": ("str", _one_of(FACES)),
         "attach_to": ("str", None),
+        "frame": ("str", _one_of(("own", "vessel"))),
+        "stiffening": ("str", _one_of(("none", "centrifugal"))),
         "material": ("table", None),
     }, required=("name", "origin", "size", "mesh", "attach", "material"))
     return Structure(material=_material(table["material"], f"{where}.material"), **v)
@@ -354,6 +372,11 @@ def _attachments(structures) -> None:
         if s.attach_to is None:
             continue
         key = f"structures[{i}].attach_to"
+        if s.frame == "vessel":
+            raise SceneError(key, 'a structure in the vessel\'s frame (frame = "vessel") is held at its face on the '
+                                  'vessel; attach_to needs frame = "own"')
+        if s.attach_to in by_name and by_name[s.attach_to].frame == "vessel":
+            raise SceneError(key, f"{s.attach_to!r} has frame = \"vessel\": attach to a structure with its own frame")
         if s.attach_to == s.name:
             raise SceneError(key, f"structure {s.name!r} cannot be attached to itself")
         if s.attach_to not in by_name:
@@ -420,16 +443,13 @@ def _mass_balance(vessel: Vessel, tanks, environment: Environment, warnings: lis
     if h is None or environment.gravity == 0:
         return
     liquid = sum(t.liquid_mass for t in tanks)
-    parts = sum(s.material.density * s.size[0] * s.size[1] * s.size[2] for s in structures) \
-        + sum(t.wall_mass for t in tanks)
-    total = vessel.mass + liquid + parts
+    total = vessel.mass + liquid        # vessel.mass: the whole ship without its liquid (structures included)
     buoyant = environment.water_density * h.displaced_volume
     if abs(total - buoyant) > MASS_BALANCE_TOLERANCE * buoyant:
         imbalance = (total - buoyant) * environment.gravity
-        extra = f" + structures and elastic walls {parts:.6g} kg" if parts else ""
         warnings.append(
             f"vessel.hydrostatics.displaced_volume: the total mass {total:.6g} kg (vessel {vessel.mass:.6g} kg + "
-            f"tank liquid {liquid:.6g} kg{extra}) differs from water_density * displaced_volume = {buoyant:.6g} kg by "
+            f"tank liquid {liquid:.6g} kg) differs from water_density * displaced_volume = {buoyant:.6g} kg by "
             f"{100 * (total - buoyant) / buoyant:+.2f} %; the hydrostatic restoring forces are taken about the "
             f"initial position as if it were the equilibrium; the static imbalance of {abs(imbalance):.4g} N "
             f"({'weight' if imbalance > 0 else 'buoyancy'} in excess) is ignored")

@@ -67,12 +67,19 @@ class Initial:
 
 @dataclass(frozen=True)
 class Forced:
-    """Prescribed harmonic motion of the vessel (tank tests): one rigid dof follows
-    amplitude * sin(frequency * t), faded in over `ramp` seconds; the other five are held at zero."""
+    """Prescribed motion of the vessel (tank tests, rotating hubs): one rigid dof follows a profile,
+    the other five are held at zero.
+    "harmonic": amplitude * sin(frequency * t), faded in over `ramp` seconds;
+    "spin-up" (a rotation dof): the rate grows smoothly from 0 to `rate` over `duration` seconds,
+    omega(t) = rate / duration (t - duration / (2 pi) sin(2 pi t / duration)), then stays (the
+    Kane-Ryan-Banerjee profile)."""
     dof: str                         # "surge" | "sway" | "heave" | "roll" | "pitch" | "yaw"
-    amplitude: float                 # m or rad
-    frequency: float                 # rad/s, > 0
+    amplitude: float = 0.0           # m or rad (harmonic)
+    frequency: float = 1.0           # rad/s, > 0 (harmonic)
     ramp: float = 0.0                # s, >= 0: the amplitude grows as (1 - cos(pi t / ramp)) / 2
+    profile: str = "harmonic"        # "harmonic" | "spin-up"
+    rate: float = 0.0                # rad/s (spin-up: final rate)
+    duration: float = 0.0            # s, > 0 (spin-up time)
 
 
 @dataclass(frozen=True)
@@ -153,6 +160,9 @@ class Structure:
     attach: str                      # "x-" | "x+" | "y-" | "y+" | "z-" | "z+"
     material: Material
     attach_to: Optional[str] = None  # another structure's name: tie the face to it instead of the vessel
+    frame: str = "own"               # "own": its own floating frame, tied by multipliers; "vessel": deformation
+                                     # measured in the vessel's frame, the attachment face held (no multipliers)
+    stiffening: str = "none"         # "centrifugal": the geometric stiffness of the stress its spin causes
 
 
 @dataclass(frozen=True)

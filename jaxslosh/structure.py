@@ -415,3 +415,62 @@ def assemble_cells(nodes, elements, sizes, young, poisson, density):
     Ms = sp.coo_matrix((Me.reshape(-1), (np.repeat(elements, 8, axis=1).reshape(-1), np.tile(elements, (1, 8)).reshape(-1))),
                        shape=(N, N)).toarray()
     return 0.5 * (K + K.T), Ms
+
+
+# ------------------------------------------------------------------------------------------------
+# centrifugal (geometric) stiffening
+
+
+def spin_tensor_components(omega):
+    """The six components (xx, yy, zz, yz, xz, xy) of W = omega omega^T, in the order of
+    `centrifugal_stiffness`'s matrices (jax or numpy)."""
+    w = omega
+    return [w[0] * w[0], w[1] * w[1], w[2] * w[2], w[1] * w[2], w[0] * w[2], w[0] * w[1]]
+
+
+def centrifugal_stiffness(nodes, elements, sizes, stiffness, mass, held, young, poisson, axis_point):
+    """The initial-stress (geometric) stiffness of the stress that spinning causes, per component of
+    W = omega omega^T: six (3N, 3N) matrices K_k such that K_G(omega) = sum_k W_k K_k.
+
+    For each component the structure, held at `held`, carries the quasi-static centrifugal load
+    f = M (tr(E_k) I - E_k)(r - axis_point) (for W = omega omega^T the acceleration
+    |omega|^2 r - omega (omega . r) of points turning about the axis through `axis_point`); its
+    stress sigma (from the compatible part of the displacement, at the 2x2x2 Gauss points) gives
+    K_G[a i, b j] = delta_ij int dN_a/dx_k sigma_kl dN_b/dx_l dV. A beam pulled by its spin is stiffer
+    in bending: the stiffening that a linear floating frame lacks (Kane, Ryan & Banerjee 1987)."""
+    import scipy.sparse as sp
+    N, E = nodes.shape[0], elements.shape[0]
+    C = elasticity_matrix(young, poisson)
+    free = np.flatnonzero(~np.repeat(np.asarray(held, dtype=bool), 3))
+    M3 = np.kron(mass, np.eye(3))
+    Kff = stiffness[np.ix_(free, free)]
+    r = nodes - np.asarray(axis_point, dtype=float)[None, :]
+    basis = [np.diag([1.0, 0, 0]), np.diag([0, 1.0, 0]), np.diag([0, 0, 1.0])]
+    for i, j in ((1, 2), (0, 2), (0, 1)):
+        e = np.zeros((3, 3))
+        e[i, j] = e[j, i] = 1.0
+        basis.append(e)
+    half = sizes / 2.0                                                   # (E, 3)
+    dNdxi = np.stack([_XI * np.prod(1 + _XI * xi, axis=1, keepdims=True) / (1 + _XI * xi) / 8.0
+                      for xi in _GAUSS8])                                # (G, 8, 3)
+    dNdx = dNdxi[None, :, :, :] / half[:, None, None, :]                 # (E, G, 8, 3)
+    vol = np.prod(half, axis=1)                                          # detJ, weights 1
+    rows = np.repeat(elements, 8, axis=1).reshape(-1)
+    cols = np.tile(elements, (1, 8)).reshape(-1)
+    out = []
+    for Ek in basis:
+        acc = r @ (np.trace(Ek) * np.eye(3) - Ek).T                     # (N, 3)
+        f = (M3 @ acc.reshape(-1))[free]
+        u = np.zeros(3 * N)
+        u[free] = np.linalg.solve(Kff, f)
+        ue = u.reshape(N, 3)[elements]                                   # (E, 8, 3)
+        grad = np.einsum("eai,egaj->egij", ue, dNdx)                     # du_i/dx_j
+        eps = np.stack([grad[..., 0, 0], grad[..., 1, 1], grad[..., 2, 2], grad[..., 1, 2] + grad[..., 2, 1],
+                        grad[..., 0, 2] + grad[..., 2, 0], grad[..., 0, 1] + grad[..., 1, 0]], axis=-1)
+        s = eps @ C.T                                                    # (E, G, 6)
+        sig = np.stack([np.stack([s[..., 0], s[..., 5], s[..., 4]], -1), np.stack([s[..., 5], s[..., 1], s[..., 3]], -1),
+                        np.stack([s[..., 4], s[..., 3], s[..., 2]], -1)], -2)   # (E, G, 3, 3)
+        ke = np.einsum("egak,egkl,egbl,e->eab", dNdx, sig, dNdx, vol)     # (E, 8, 8) scalar
+        Ks = sp.coo_matrix((ke.reshape(-1), (rows, cols)), shape=(N, N)).toarray()
+        out.append(np.kron(0.5 * (Ks + Ks.T), np.eye(3)))
+    return out
