@@ -28,7 +28,32 @@ def scene_effects(scene: Scene) -> list[tuple[str, str]]:
             eff.append(("centrifugal", "omega x (omega x r) on the liquid (eq. 19)"))
         if scene.environment.gravity > 0 and e.gravity_turning:
             eff.append(("gravity turning with the body", "load of eq. (32) on the liquid"))
+    eff += _wave_effects(scene)
     return eff
+
+
+def _wave_effects(scene: Scene) -> list[tuple[str, str]]:
+    """Waves and hull hydrodynamics (waves.py, hydrodynamics.py), as build.py assembles them."""
+    e, w, ves = scene.effects, scene.waves, scene.vessel
+    out = []
+    if w is not None and e.waves:
+        from .hydrodynamics import excitation_source
+        src = excitation_source(scene)
+        src = ("Froude-Krylov on the box hull" if src == "froude-krylov" else
+               "Capytaine (Froude-Krylov + diffraction)" if ves.hydrodynamics.capytaine else "excitation tables")
+        sea = (f"regular, amplitude {w.amplitude:g} m, {w.omega:.4g} rad/s" if w.type == "regular" else
+               f"JONSWAP Hs {w.hs:g} m, Tp {w.tp:g} s, gamma {w.gamma:g}, {w.components} components, seed {w.seed}")
+        out.append(("waves", f"{sea}, heading {w.heading:.4g} rad; forces from {src}"
+                             + (f", faded in over {w.ramp:g} s" if w.ramp > 0 else "")))
+    hd = ves.hydrodynamics
+    if hd is not None and e.radiation:
+        if hd.capytaine or hd.added_mass is not None:
+            where = "Capytaine" if hd.capytaine else f"tables at {len(hd.frequencies)} frequencies"
+            out.append(("radiation", f"added mass at infinite frequency and the memory of the Cummins equation "
+                                     f"(state-space fit), from {where}"))
+        if hd.viscous_damping is not None:
+            out.append(("viscous damping", "linear, [vessel.hydrodynamics] viscous_damping"))
+    return out
 
 
 def switched_off(scene: Scene) -> list[str]:

@@ -59,6 +59,7 @@ class State(NamedTuple):
     acc: jax.Array    # (n,) accelerations satisfying the equations of motion
     a: jax.Array      # (n,) generalized-alpha pseudo-accelerations
     t: jax.Array
+    z: Optional[jax.Array] = None   # radiation memory states (hydrodynamics.Memory), None without them
 
 
 class StepInfo(NamedTuple):
@@ -228,12 +229,31 @@ def initial_state(system: System, solver: Solver, c0: Config, v0) -> tuple[State
     """Accelerations consistent with the initial configuration and velocities."""
     scale = system.scales()
 
+    memory = _memory(system)
+    z0 = None if memory is None else memory.init()
+    mu0 = None if memory is None else memory.force(z0)
+
     def R(acc):
         V0, om, dd = _split(v0)
-        return system.residual(c0, V0, om, dd, acc, jnp.zeros(()))
+        return system.residual(c0, V0, om, dd, acc, jnp.zeros(()), mu0)
 
     acc0, (it, err, ok) = solve_root(R, jnp.zeros_like(v0), solver.Cinv_mass, scale, solver.tol, solver.max_iter)
-    return State(c0, v0, acc0, acc0, jnp.zeros(())), StepInfo(it, err, ok)
+    return State(c0, v0, acc0, acc0, jnp.zeros(()), z0), StepInfo(it, err, ok)
+
+
+def _memory(system: System):
+    """The radiation memory of the system's hydrodynamics, or None (hydrodynamics.py)."""
+    sea = getattr(system, "sea", None)
+    return None if sea is None else sea.memory
+
+
+def memory_next(system: System, solver: Solver, s: State, v_new):
+    """Radiation states at t_{n+1}: exact for a rigid velocity linear over the step, so they are a
+    linear function of the step's unknown new velocity (None without radiation)."""
+    memory = _memory(system)
+    if memory is None:
+        return None
+    return memory.advance(s.z, s.v[:6], v_new[:6], memory.coefficients(solver.h))
 
 
 def step_equations(system: System, solver: Solver, s: State):
@@ -249,10 +269,14 @@ def step_equations(system: System, solver: Solver, s: State):
         acc_new = ((1.0 - am) * a_new + am * s.a - af * s.acc) / (1.0 - af)
         return advance_config(s.c, delta), v_new, acc_new, a_new
 
+    memory = _memory(system)
+    coef = None if memory is None else memory.coefficients(h)
+
     def R(delta):
         c, v, acc, _ = unpack(delta)
         V0, om, dd = _split(v)
-        return system.residual(c, V0, om, dd, acc, s.t + h)
+        mu = None if memory is None else memory.force(memory.advance(s.z, s.v[:6], v[:6], coef))
+        return system.residual(c, V0, om, dd, acc, s.t + h, mu)
 
     return R, unpack, base + h * h * beta * s.a
 
@@ -264,7 +288,7 @@ def step(system: System, solver: Solver, s: State) -> tuple[State, StepInfo]:
     delta, (it, err, ok) = solve_root(R, x0, solver.Cinv_step, scale, solver.tol, solver.max_iter)
     c, v, acc, a = unpack(delta)
     ok = ok & jnp.all(jnp.isfinite(delta))
-    return State(c, v, acc, a, s.t + solver.h), StepInfo(it, err, ok)
+    return State(c, v, acc, a, s.t + solver.h, memory_next(system, solver, s, v)), StepInfo(it, err, ok)
 
 
 def step_or_retry(system: System, solver: Solver, s: State) -> tuple[State, StepInfo]:

@@ -144,6 +144,7 @@ class System(eqx.Module):
     balanced: bool = eqx.field(static=True, default=True)      # weight balanced by static buoyancy
     coriolis: bool = eqx.field(static=True, default=True)
     centrifugal: bool = eqx.field(static=True, default=True)
+    sea: Optional[eqx.Module] = None      # waves and hull hydrodynamics (hydrodynamics.Seakeeping)
 
     @property
     def nf(self) -> int:
@@ -160,10 +161,11 @@ class System(eqx.Module):
         return m
 
     # ---------------------------------------------------------------- equations of motion
-    def residual(self, c: Config, V0, omega, d_dot, acc, t=0.0):
+    def residual(self, c: Config, V0, omega, d_dot, acc, t=0.0, mu=None):
         """Virtual work of inertia minus applied forces (eq. 26) for the unknown accelerations
         acc = (dV0/dt (3, inertial), d omega/dt (3, body), d2 d/dt2 (nf)). Rows: translation
-        (inertial, N), rotation (body, N m), liquid free dofs (N)."""
+        (inertial, N), rotation (body, N m), liquid free dofs (N). `mu` (6,): the radiation memory
+        force at t (hydrodynamics.py), from the integrator's radiation states."""
         A = rotation_matrix(c.q)
         a0, alpha = acc[:3], acc[3:6]
         g_vec = jnp.array([0.0, 0.0, -self.gravity])
@@ -200,6 +202,8 @@ class System(eqx.Module):
         if not self.balanced:
             r_t = r_t - self.total_mass() * g_vec
         rigid = jnp.concatenate([r_t, r_r])
+        if self.sea is not None:   # waves and hull hydrodynamics: excitation, added mass, memory (hydrodynamics.py)
+            rigid = rigid + self.sea.rigid_rows(acc[:6], jnp.concatenate([V0, omega]), t, mu)
         if self.forced is not None:
             rigid = self.forced.rigid_rows(acc, t, self.scales()[:6])
         return jnp.concatenate([rigid, *parts])
@@ -228,6 +232,8 @@ class System(eqx.Module):
             A = rotation_matrix(c.q)
             v = A.T @ V0 + L.full(d_dot) + jnp.cross(omega, L.r + L.full(c.d))
             T = T + 0.5 * jnp.sum(v * (L.Ms @ v))
+        if self.sea is not None:   # the added mass at infinite frequency moves with the hull
+            T = T + self.sea.kinetic_energy(jnp.concatenate([V0, omega]))
         return T
 
     def potential_energy(self, c: Config):
@@ -260,6 +266,9 @@ class System(eqx.Module):
                 L.m_nodes @ (x[:, 0] ** 2 + x[:, 2] ** 2),
                 L.m_nodes @ (x[:, 0] ** 2 + x[:, 1] ** 2)])
         s = [jnp.full(3, m), I]
+        if self.sea is not None:   # added mass at infinite frequency (hydrodynamics.py)
+            a = self.sea.added_mass_diagonal()
+            s = [s[0] + a[:3], s[1] + a[3:]]
         if self.liquid is not None:
             s.append(jnp.repeat(self.liquid.m_nodes, 3)[self.liquid.free])
         return jnp.concatenate(s)
