@@ -611,7 +611,7 @@ def excitation_source(scene) -> Optional[str]:
     """"table" or "froude-krylov": where the wave forces of a scene come from (None without waves)."""
     if scene.waves is None:
         return None
-    hd, hull = scene.vessel.hydrodynamics, scene.vessel.hull
+    hd = scene.vessel.hydrodynamics
     tables = hd is not None and (hd.capytaine or hd.excitation_amplitude is not None)
     if hd is not None and hd.excitation != "auto":
         return hd.excitation

@@ -2,7 +2,6 @@
 equation against the frequency domain, Capytaine's hydrostatics, scene validation, effects,
 gradients and batches through runs in waves."""
 import math
-import re
 import sys
 from pathlib import Path
 
@@ -14,7 +13,7 @@ import pytest
 import jaxslosh as js
 from jaxslosh.build import build
 from jaxslosh.cli import main
-from jaxslosh.hydrodynamics import (fit_radiation, linear_response, radiation_fit, restoring_matrix,
+from jaxslosh.hydrodynamics import (linear_response, radiation_fit, restoring_matrix,
                                     rigid_mass_matrix, scene_tables)
 from jaxslosh.integrator import initial_state, make_scheme, make_solver, step
 from jaxslosh.waves import box_hydrostatics, components, elevation, froude_krylov_box, jonswap, wavenumber
@@ -373,11 +372,6 @@ def test_box_hull_gives_the_closed_form_hydrostatics():
     assert (h.waterplane_area, h.displaced_volume) == (ref["waterplane_area"], ref["displaced_volume"])
     assert h.gm_t == pytest.approx(T / 2 + B * B / (12 * T) - KG) and h.gm_l == pytest.approx(ref["gm_l"])
     assert not scene.warnings
-
-
-def _shapes(system, h=0.05):
-    b_solver = make_solver(system, h, make_scheme("newmark"), 1e-10, 25)
-    return b_solver
 
 
 def test_effects_switch_waves_and_radiation_off_and_check_lists_them(tmp_path, capsys):
