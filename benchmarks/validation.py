@@ -106,6 +106,41 @@ def inertia():
             f"default {I_eff / I_fr:.4f}; relative-rotation penalty {I_rel / I_fr:.4f}; paper form {I_pap / I_fr:.4f}")
 
 
+def waves():
+    """The rows of tests/test_waves.py: the regular-wave RAO and the Cummins memory, Capytaine's box."""
+    import test_waves as tw
+    from jaxslosh.hydrodynamics import capytaine_hydrostatics
+    from jaxslosh.scene_types import Hull
+    w, Bv = 0.9, [0.0, 0.0, 0.0, 8.0e5, 0.0, 0.0]
+    scene = tw.box_scene(tw.regular(w), duration=180.0, extra_hydro=f'viscous_damping = {Bv}\nexcitation = "froude-krylov"\n')
+    r = js.simulate(scene)
+    t = np.asarray(r.time)
+    k = t > 100.0
+    roll = tw._harmonic(t[k], np.asarray(r.vessel.roll_pitch_yaw)[k, 0], w)
+    X = tw.froude_krylov_box(w, np.pi / 2, tw.L, tw.B, tw.T, tw.KG, tw.RHO, tw.G)[0]
+    ref = 0.2 * tw._reference(scene, w, X, viscous=np.diag(Bv)[None])[3]
+    row("regular beam wave 0.2 m, 0.9 rad/s, box 20 x 10 x 2 m, Froude-Krylov", "linear RAO (6 dof, Capytaine A(w), B(w))",
+        f"roll {abs(roll):.5f} rad vs {abs(ref):.5f} rad ({100 * (abs(roll) / abs(ref) - 1):+.2f} %)")
+    M0, Bv = 5.0e4, [0.0, 0.0, 0.0, 6.0e5, 0.0, 0.0]
+    exc = (f"headings = [1.5707963267948966]\nviscous_damping = {Bv}\n"
+           f"excitation_amplitude = {[[0, 0, 0, M0, 0, 0]] * 20}\nexcitation_phase = {[[0.0] * 6] * 20}\n")
+    errs = []
+    for w in (0.7, 0.9, 1.1, 1.3, 1.5):
+        scene = tw.box_scene(tw.regular(w, amplitude=1.0), duration=240.0, extra_hydro=exc, excitation=False)
+        r = js.simulate(scene)
+        t = np.asarray(r.time)
+        k = t > 140.0
+        roll = tw._harmonic(t[k], np.asarray(r.vessel.roll_pitch_yaw)[k, 0], w)
+        ref = tw._reference(scene, w, np.array([0, 0, 0, M0, 0, 0], dtype=complex), viscous=np.diag(Bv)[None])[3]
+        errs.append(f"{100 * (abs(roll) / abs(ref) - 1):+.2f}")
+    row("Cummins memory, harmonic roll moment at 0.7, 0.9, 1.1, 1.3, 1.5 rad/s", "frequency domain with A(w), B(w)",
+        "amplitude errors " + ", ".join(errs) + " %")
+    hs = capytaine_hydrostatics(Hull(length=20.0, beam=10.0, draft=2.0, kg=2.5))
+    closed = {"displaced_volume": 400.0, "waterplane_area": 200.0, "bm_t": 100 / 24, "bm_l": 400 / 24}
+    row("Capytaine hydrostatics, box 20 x 10 x 2 m", "V, A_w, BM_T = B^2/12T, BM_L = L^2/12T",
+        "errors " + ", ".join(f"{100 * (hs[k] / v - 1):+.3f}" for k, v in closed.items()) + " %")
+
+
 def main():
     t0 = time.perf_counter()
     print("| check | reference | measured |")
@@ -115,6 +150,7 @@ def main():
     sloshing()
     free_surface_moment()
     inertia()
+    waves()
     print(f"\n({time.perf_counter() - t0:.0f} s; jax {jax.__version__}, {os.cpu_count()} cpu)")
 
 

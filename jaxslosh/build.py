@@ -46,7 +46,7 @@ TRACEABLE = _Keys((
     "vessel.hydrostatics.gm_t", "vessel.hydrostatics.gm_l",
     "vessel.initial.position", "vessel.initial.velocity", "vessel.initial.angular_velocity",
     "vessel.initial.roll_pitch_yaw",
-) + tuple(f"tanks.<name>.{k}" for k in TANK_TRACEABLE))
+) + tuple(f"tanks.<name>.{k}" for k in TANK_TRACEABLE) + ("waves.amplitude", "waves.hs"))
 
 
 class TankBlock(NamedTuple):
@@ -133,6 +133,10 @@ def build(scene: Scene, params: Optional[dict] = None) -> Built:
     if liquid is not None and not eff.gravity_turning:
         from .kinematics import rotation_matrix
         g_fixed = rotation_matrix(q0).T @ jnp.array([0.0, 0.0, -g])
+    sea = None
+    if scene.waves is not None or ves.hydrodynamics is not None:   # waves and hull hydrodynamics
+        from .hydrodynamics import build_seakeeping
+        sea = build_seakeeping(scene, params)
     own = [s for s in scene.structures if s.frame == "own"]
     flex, blocks = _build_flex(scene) if own else (None, ())
     mass, inertia = jnp.asarray(P("vessel.mass", ves.mass), dtype=float), _inertia(P("vessel.inertia", ves.inertia))
@@ -143,7 +147,7 @@ def build(scene: Scene, params: Optional[dict] = None) -> Built:
         mass, inertia, hull_S = _hull(mass, inertia, carried)
     system = System(mass=mass, inertia=inertia, gravity=g, hydro=hydro, liquid=liquid, hull_S=hull_S,
                     forced=forced, g_fixed=g_fixed, q_ref=q0, balanced=ves.hydrostatics is not None,
-                    coriolis=eff.coriolis, centrifugal=eff.centrifugal, flex=flex)
+                    coriolis=eff.coriolis, centrifugal=eff.centrifugal, flex=flex, sea=sea)
     nf = system.nf
     d_init = jnp.zeros(nf)
     if liquid is not None:

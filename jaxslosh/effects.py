@@ -50,6 +50,7 @@ def scene_effects(scene: Scene) -> list[tuple[str, str]]:
                         f"interface frame and localized multipliers ({_interface_unknowns(s)} unknowns)"))
         if s.stiffening == "centrifugal":
             eff.append((f"centrifugal stiffening of {s.name!r}", "geometric stiffness of the stress of its spin"))
+    eff += _wave_effects(scene)
     return eff
 
 
@@ -74,6 +75,30 @@ def _structure_modes(s) -> int:
 
 def _interface_unknowns(s) -> int:
     return 9 * _face_nodes(s)          # frame positions and the multipliers of its two sides
+
+
+def _wave_effects(scene: Scene) -> list[tuple[str, str]]:
+    """Waves and hull hydrodynamics (waves.py, hydrodynamics.py), as build.py assembles them."""
+    e, w, ves = scene.effects, scene.waves, scene.vessel
+    out = []
+    if w is not None and e.waves:
+        from .hydrodynamics import excitation_source
+        src = excitation_source(scene)
+        src = ("Froude-Krylov on the box hull" if src == "froude-krylov" else
+               "Capytaine (Froude-Krylov + diffraction)" if ves.hydrodynamics.capytaine else "excitation tables")
+        sea = (f"regular, amplitude {w.amplitude:g} m, {w.omega:.4g} rad/s" if w.type == "regular" else
+               f"JONSWAP Hs {w.hs:g} m, Tp {w.tp:g} s, gamma {w.gamma:g}, {w.components} components, seed {w.seed}")
+        out.append(("waves", f"{sea}, heading {w.heading:.4g} rad; forces from {src}"
+                             + (f", faded in over {w.ramp:g} s" if w.ramp > 0 else "")))
+    hd = ves.hydrodynamics
+    if hd is not None and e.radiation:
+        if hd.capytaine or hd.added_mass is not None:
+            where = "Capytaine" if hd.capytaine else f"tables at {len(hd.frequencies)} frequencies"
+            out.append(("radiation", f"added mass at infinite frequency and the memory of the Cummins equation "
+                                     f"(state-space fit), from {where}"))
+        if hd.viscous_damping is not None:
+            out.append(("viscous damping", "linear, [vessel.hydrodynamics] viscous_damping"))
+    return out
 
 
 def switched_off(scene: Scene) -> list[str]:

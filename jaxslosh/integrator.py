@@ -63,6 +63,7 @@ class State(NamedTuple):
     t: jax.Array
     pre: Any = None   # the Newton preconditioner carried to the next step (Solver.reuse), else None
     alg: Optional[jax.Array] = None   # interface frame positions and multipliers (multibody.py), if any
+    z: Optional[jax.Array] = None   # radiation memory states (hydrodynamics.Memory), None without them
 
 
 class StepInfo(NamedTuple):
@@ -397,13 +398,32 @@ def initial_state(system: System, solver: Solver, c0: Config, v0, alg0=None) -> 
         return _flex_initial_state(system, solver, c0, v0, alg0)
     scale = system.scales()
 
+    memory = _memory(system)
+    z0 = None if memory is None else memory.init()
+    mu0 = None if memory is None else memory.force(z0)
+
     def R(acc):
         V0, om, dd = _split(v0)
-        return system.residual(c0, V0, om, dd, acc, jnp.zeros(()))
+        return system.residual(c0, V0, om, dd, acc, jnp.zeros(()), mu0)
 
     acc0, (it, err, ok) = solve_root(R, jnp.zeros_like(v0), solver.Cinv_mass, scale, solver.tol, solver.max_iter)
     pre = empty_pre(system) if solver.reuse else None
-    return State(c0, v0, acc0, acc0, jnp.zeros(()), pre), StepInfo(it, err, ok)
+    return State(c0, v0, acc0, acc0, jnp.zeros(()), pre=pre, z=z0), StepInfo(it, err, ok)
+
+
+def _memory(system: System):
+    """The radiation memory of the system's hydrodynamics, or None (hydrodynamics.py)."""
+    sea = getattr(system, "sea", None)
+    return None if sea is None else sea.memory
+
+
+def memory_next(system: System, solver: Solver, s: State, v_new):
+    """Radiation states at t_{n+1}: exact for a rigid velocity linear over the step, so they are a
+    linear function of the step's unknown new velocity (None without radiation)."""
+    memory = _memory(system)
+    if memory is None:
+        return None
+    return memory.advance(s.z, s.v[:6], v_new[:6], memory.coefficients(solver.h))
 
 
 def step_equations(system: System, solver: Solver, s: State):
@@ -419,10 +439,14 @@ def step_equations(system: System, solver: Solver, s: State):
         acc_new = ((1.0 - am) * a_new + am * s.a - af * s.acc) / (1.0 - af)
         return _advance(system, s.c, delta), v_new, acc_new, a_new
 
+    memory = _memory(system)
+    coef = None if memory is None else memory.coefficients(h)
+
     def R(delta):
         c, v, acc, _ = unpack(delta)
         V0, om, dd = _split(v)
-        return system.residual(c, V0, om, dd, acc, s.t + h)
+        mu = None if memory is None else memory.force(memory.advance(s.z, s.v[:6], v[:6], coef))
+        return system.residual(c, V0, om, dd, acc, s.t + h, mu)
 
     return R, unpack, base + h * h * beta * s.a
 
@@ -473,14 +497,16 @@ def _flex_initial_state(system, solver: Solver, c0: Config, v0, alg0):
     c0, v0, alg0, info0 = static_structures(system, solver, c0, v0, alg0)
     gsc, alg_sc = mb.alg_scales(system, 1.0, lambda itf: 1.0)       # rows m_ref d2g/dt2: forces
     scale = L.to_x(mb.scales(system), alg_sc)
-    Rm, Rc = mb.initial_residuals(system, c0, v0, alg0, jnp.zeros(()), gsc)
+    memory = _memory(system)
+    z0 = None if memory is None else memory.init()
+    Rm, Rc = mb.initial_residuals(system, c0, v0, alg0, jnp.zeros(()), gsc, None if memory is None else memory.force(z0))
     x, (it, err, ok) = solve_root(lambda x: Rm(x) + Rc(x), jnp.zeros(L.n), solver.Cinv_mass, scale, solver.tol,
                                   solver.max_iter, L.n_small, split=(Rc, L.n_rigid))
     acc0, alg_a = L.from_x(x)
     alg = jnp.where(mb._position_mask(system.flex), alg0, alg_a)
     info = StepInfo(it + info0.iterations, jnp.maximum(err, info0.residual), ok & info0.ok)
     pre = empty_pre(system) if solver.reuse else None
-    return State(c0, v0, acc0, acc0, jnp.zeros(()), pre, alg), info
+    return State(c0, v0, acc0, acc0, jnp.zeros(()), pre, alg, z0), info
 
 
 def _flex_step(system, solver: Solver, s: State) -> tuple[State, StepInfo]:
@@ -496,10 +522,14 @@ def _flex_step(system, solver: Solver, s: State) -> tuple[State, StepInfo]:
     scale = L.to_x(mb.scales(system), alg_sc)
     _, unpack, pred = step_equations(system, solver, s)
 
+    memory = _memory(system)
+    coef = None if memory is None else memory.coefficients(h)
+
     def Rm(x):
         dyn, _ = L.from_x(x)
         c, v, acc, _ = unpack(dyn)
-        return L.to_x(mb.inertia_rows(system, c, v, acc, s.t + h), jnp.zeros(L.n_alg))
+        mu = None if memory is None else memory.force(memory.advance(s.z, s.v[:6], v[:6], coef))
+        return L.to_x(mb.inertia_rows(system, c, v, acc, s.t + h, mu), jnp.zeros(L.n_alg))
 
     def Rc(x):
         dyn, alg = L.from_x(x)
@@ -514,7 +544,8 @@ def _flex_step(system, solver: Solver, s: State) -> tuple[State, StepInfo]:
     dyn, alg = L.from_x(x)
     c, v, acc, a = unpack(dyn)
     ok = ok & jnp.all(jnp.isfinite(x))
-    return State(c, v, acc, a, s.t + h, pre_new if solver.reuse else s.pre, alg), StepInfo(it, err, ok)
+    return (State(c, v, acc, a, s.t + h, pre_new if solver.reuse else s.pre, alg, memory_next(system, solver, s, v)),
+            StepInfo(it, err, ok))
 
 
 def step(system: System, solver: Solver, s: State) -> tuple[State, StepInfo]:
@@ -529,7 +560,8 @@ def step(system: System, solver: Solver, s: State) -> tuple[State, StepInfo]:
                                                        pre, floor, solver.adaptive)
     c, v, acc, a = unpack(delta)
     ok = ok & jnp.all(jnp.isfinite(delta))
-    return State(c, v, acc, a, s.t + solver.h, pre_new if solver.reuse else s.pre), StepInfo(it, err, ok)
+    return (State(c, v, acc, a, s.t + solver.h, pre=pre_new if solver.reuse else s.pre,
+                  z=memory_next(system, solver, s, v)), StepInfo(it, err, ok))
 
 
 def step_or_retry(system: System, solver: Solver, s: State) -> tuple[State, StepInfo]:

@@ -175,6 +175,7 @@ class System(eqx.Module):
     # structures and elastic tank walls carry their own mass, so the hull is the ship less them,
     # and its COG is off the origin by hull_S / mass. None: at the origin
     hull_S: Optional[jax.Array] = None
+    sea: Optional[eqx.Module] = None      # waves and hull hydrodynamics (hydrodynamics.Seakeeping)
 
     @property
     def nf(self) -> int:
@@ -195,10 +196,11 @@ class System(eqx.Module):
         return m
 
     # ---------------------------------------------------------------- equations of motion
-    def residual(self, c: Config, V0, omega, d_dot, acc, t=0.0):
+    def residual(self, c: Config, V0, omega, d_dot, acc, t=0.0, mu=None):
         """Virtual work of inertia minus applied forces (eq. 26) for the unknown accelerations
         acc = (dV0/dt (3, inertial), d omega/dt (3, body), d2 d/dt2 (nf)). Rows: translation
-        (inertial, N), rotation (body, N m), liquid free dofs (N)."""
+        (inertial, N), rotation (body, N m), liquid free dofs (N). `mu` (6,): the radiation memory
+        force at t (hydrodynamics.py), from the integrator's radiation states."""
         A = rotation_matrix(c.q)
         a0, alpha = acc[:3], acc[3:6]
         g_vec = jnp.array([0.0, 0.0, -self.gravity])
@@ -248,6 +250,8 @@ class System(eqx.Module):
         if not self.balanced:
             r_t = r_t - self.total_mass() * g_vec
         rigid = jnp.concatenate([r_t, r_r])
+        if self.sea is not None:   # waves and hull hydrodynamics: excitation, added mass, memory (hydrodynamics.py)
+            rigid = rigid + self.sea.rigid_rows(acc[:6], jnp.concatenate([V0, omega]), t, mu)
         if self.forced is not None:
             rigid = self.forced.rigid_rows(acc, t, self.scales()[:6])
         return jnp.concatenate([rigid, *parts])
@@ -280,6 +284,8 @@ class System(eqx.Module):
             A = rotation_matrix(c.q)
             v = A.T @ V0 + L.full(d_dot) + jnp.cross(omega, L.r + L.full(c.d))
             T = T + 0.5 * jnp.sum(v * (L.Ms @ v))
+        if self.sea is not None:   # the added mass at infinite frequency moves with the hull
+            T = T + self.sea.kinetic_energy(jnp.concatenate([V0, omega]))
         return T
 
     def potential_energy(self, c: Config):
@@ -316,6 +322,9 @@ class System(eqx.Module):
                 L.m_nodes @ (x[:, 0] ** 2 + x[:, 2] ** 2),
                 L.m_nodes @ (x[:, 0] ** 2 + x[:, 1] ** 2)])
         s = [jnp.full(3, m), I]
+        if self.sea is not None:   # added mass at infinite frequency (hydrodynamics.py)
+            a = self.sea.added_mass_diagonal()
+            s = [s[0] + a[:3], s[1] + a[3:]]
         if is_reduced(self.liquid):
             s.append(self.liquid.row_scale)
         elif self.liquid is not None:

@@ -269,13 +269,13 @@ def structure_potential(system, c: Config):
     return V
 
 
-def inertia_rows(system, c: Config, v, acc, t):
+def inertia_rows(system, c: Config, v, acc, t, mu=None):
     """Dyn rows without the multipliers: the vessel-and-liquid residual of model.py, each structure's
     rigid and elastic inertia rows, and the forces of the structures' potential (elastic, gravity)."""
     L = layout(system)
     ves_v, st_v, d_v, e_v = L.split(v)
     ves_a, st_a, d_a, e_a = L.split(acc)
-    core = system.residual(c, ves_v[:3], ves_v[3:], d_v, jnp.concatenate([ves_a, d_a]), t)
+    core = system.residual(c, ves_v[:3], ves_v[3:], d_v, jnp.concatenate([ves_a, d_a]), t, mu)
     flex = system.flex
     rigid_s, modal = [], []
     for s, (b, eta, eta_d, eta_dd) in enumerate(zip(flex.bodies, _etas(flex, c.eta), _etas(flex, e_v),
@@ -367,7 +367,7 @@ def frame_velocities(system, c: Config, v):
     return jnp.concatenate(out)
 
 
-def initial_residuals(system, c: Config, v, alg0, t, mscale):
+def initial_residuals(system, c: Config, v, alg0, t, mscale, mu=None):
     """The initial accelerations as (R_main, R_c) of x = [acc_y, (frame accelerations, multipliers),
     acc_z]; the constraint rows are d^2 g / dt^2 = 0 times `mscale` (per interface)."""
     L = layout(system)
@@ -376,7 +376,7 @@ def initial_residuals(system, c: Config, v, alg0, t, mscale):
 
     def R_main(x):
         acc, _ = L.from_x(x)
-        return L.to_x(inertia_rows(system, c, v, acc, t), jnp.zeros(L.n_alg))
+        return L.to_x(inertia_rows(system, c, v, acc, t, mu), jnp.zeros(L.n_alg))
 
     def R_c(x):
         acc, alg_a = L.from_x(x)

@@ -97,6 +97,7 @@ def parse_scene(mapping: Mapping[str, Any], text: str = "", path: str = "") -> S
         "structures": ("tables", None),
         "probes": ("tables", None),
         "effects": ("table", None),
+        "waves": ("table", None),
     }, required=("simulation", "vessel"))
     warnings: list[str] = []
     title = top.get("title", Path(path).stem if path else "")
@@ -114,9 +115,19 @@ def parse_scene(mapping: Mapping[str, Any], text: str = "", path: str = "") -> S
         _place_probe(probe, f"probes[{i}]", tanks, structures)
     _mass_balance(vessel, tanks, environment, warnings, structures)
     effects = Effects(**_read(mapping.get("effects", {}), "effects", {k: ("bool", None) for k in EFFECTS}))
-    return Scene(title=title, environment=environment, simulation=simulation, vessel=vessel, tanks=tanks,
-                 structures=structures, probes=probes, effects=effects, text=text, path=path,
-                 warnings=tuple(warnings))
+    waves = None
+    if "waves" in mapping:   # incident waves (scene_waves.py)
+        from .scene_waves import read_waves
+        waves = read_waves(mapping["waves"], warnings)
+    scene = Scene(title=title, environment=environment, simulation=simulation, vessel=vessel, tanks=tanks,
+                  structures=structures, probes=probes, effects=effects, text=text, path=path,
+                  warnings=tuple(warnings), waves=waves)
+    if waves is not None or vessel.hull is not None or vessel.hydrodynamics is not None:
+        import dataclasses
+        from .scene_waves import check_waves
+        scene = check_waves(scene, path, warnings)
+        scene = dataclasses.replace(scene, warnings=tuple(warnings))
+    return scene
 
 
 # --------------------------------------------------------------------------------------------
@@ -221,10 +232,19 @@ def _vessel(table, environment: Environment, warnings: list[str]) -> Vessel:
         "hydrostatics": ("table", None),
         "initial": ("table", None),
         "forced": ("table", None),
+        "hull": ("table", None),
+        "hydrodynamics": ("table", None),
     }, required=("mass", "inertia"))
     inertia = v["inertia"]
     _inertia_warnings(inertia, warnings)
     hydrostatics = _hydrostatics(table["hydrostatics"], warnings) if "hydrostatics" in table else None
+    hull = hydrodynamics = None
+    if "hull" in table or "hydrodynamics" in table:   # hull and its hydrodynamics (scene_waves.py)
+        from .scene_waves import hull_hydrostatics, read_hull, read_hydrodynamics
+        hull = read_hull(table["hull"]) if "hull" in table else None
+        if hull is not None:
+            hydrostatics = hull_hydrostatics(hull, hydrostatics, warnings)
+        hydrodynamics = read_hydrodynamics(table["hydrodynamics"], hull) if "hydrodynamics" in table else None
     if hydrostatics is None and environment.gravity > 0:
         warnings.append(f"vessel: no [vessel.hydrostatics] table, so nothing holds the vessel up: it falls "
                         f"freely under gravity {_show(environment.gravity)} m/s^2")
@@ -259,7 +279,8 @@ def _vessel(table, environment: Environment, warnings: list[str]) -> Vessel:
             raise SceneError("vessel.forced.dof", f"the spin-up profile turns a rotation (roll, pitch or yaw), "
                                                   f"not {f['dof']!r}")
         forced = Forced(**f)
-    return Vessel(mass=v["mass"], inertia=inertia, hydrostatics=hydrostatics, initial=initial, forced=forced)
+    return Vessel(mass=v["mass"], inertia=inertia, hydrostatics=hydrostatics, initial=initial, forced=forced,
+                  hull=hull, hydrodynamics=hydrodynamics)
 
 
 def _hydrostatics(table, warnings: list[str]) -> Hydrostatics:
@@ -578,8 +599,25 @@ def _str_or_table(name: str, x):
     return x
 
 
+def _numbers(name: str, x):
+    """A number or a rectangular nested list of numbers (the tables of [vessel.hydrodynamics]), as floats."""
+    def conv(e, path):
+        if isinstance(e, list):
+            return [conv(c, f"{path}[{i}]") for i, c in enumerate(e)]
+        return _float(path, e)
+    if not (_is_number(x) or isinstance(x, list)):
+        raise SceneError(name, f"must be a number or an array of numbers, got {_toml_type(x)} {_show(x)}")
+    out = conv(x, name)
+    if isinstance(out, list):
+        try:
+            np.asarray(out, dtype=float)
+        except ValueError:
+            raise SceneError(name, "must be a rectangular array (every row of the same length)") from None
+    return out
+
+
 _CONVERT = {"bool": _bool, "float": _float, "int": _int, "str": _str, "vec3": _vec3, "mesh": _mesh, "inertia": _inertia,
-            "table": _table, "tables": _tables, "str_or_table": _str_or_table}
+            "table": _table, "tables": _tables, "str_or_table": _str_or_table, "numbers": _numbers}
 
 
 def _is_number(x) -> bool:
@@ -644,6 +682,8 @@ def scene_values(scene: Scene) -> dict[str, Any]:
             v[f"vessel.hydrostatics.{key}"] = getattr(ves.hydrostatics, key)
     for key in ("position", "velocity", "angular_velocity", "roll_pitch_yaw"):
         v[f"vessel.initial.{key}"] = getattr(ves.initial, key)
+    if scene.waves is not None:   # the wave forces are linear in these (waves.py)
+        v["waves.amplitude" if scene.waves.type == "regular" else "waves.hs"] = scene.waves.height
 
     def material(prefix: str, m: Material) -> dict[str, float]:
         return {f"{prefix}.young": m.young, f"{prefix}.poisson": m.poisson, f"{prefix}.density": m.density}

@@ -89,6 +89,8 @@ class Vessel:
     hydrostatics: Optional[Hydrostatics] = None   # None: no buoyancy (free body)
     initial: Initial = field(default_factory=Initial)
     forced: Optional[Forced] = None  # prescribed motion instead of free motion
+    hull: Optional["Hull"] = None    # hull geometry: Froude-Krylov forces, Capytaine (waves, hydrodynamics.py)
+    hydrodynamics: Optional["Hydrodynamics"] = None   # added mass, radiation damping, excitation tables
 
 
 @dataclass(frozen=True)
@@ -173,7 +175,65 @@ class Probe:
     structure: Optional[str] = None
 
 
-EFFECTS = ("buoyancy", "liquid", "coriolis", "centrifugal", "gravity_turning")
+# ---- waves and hull hydrodynamics (waves.py, hydrodynamics.py)
+
+
+@dataclass(frozen=True)
+class Waves:
+    """The `[waves]` table: a regular wave or a JONSWAP sea (waves.py has the conventions)."""
+    type: str                        # "regular" | "jonswap"
+    heading: float = 0.0             # rad, the direction the waves travel to, from +X towards +Y
+    amplitude: float = 0.0           # m (regular)
+    omega: float = 0.0               # rad/s (regular; the scene gives `period` or `frequency`)
+    phase: float = 0.0               # rad (regular): eta = amplitude cos(omega t + phase) at the origin
+    hs: float = 0.0                  # m, significant wave height (jonswap)
+    tp: float = 0.0                  # s, peak period (jonswap)
+    gamma: float = 3.3               # peak enhancement (jonswap), >= 1
+    seed: int = 0                    # random phases and frequencies (jonswap)
+    components: int = 100            # regular components (jonswap), >= 1
+    omega_range: tuple[float, float] = (0.0, 0.0)   # rad/s (jonswap; default 0.5 to 3 times the peak frequency)
+    ramp: float = 0.0                # s, the forces fade in as (1 - cos(pi t / ramp)) / 2
+    depth: Optional[float] = None    # m, water depth (None: deep water)
+
+    @property
+    def height(self) -> float:
+        """The value the forces are proportional to: the amplitude (regular) or Hs (jonswap)."""
+        return self.amplitude if self.type == "regular" else self.hs
+
+
+@dataclass(frozen=True)
+class Hull:
+    """The `[vessel.hull]` table: a box (length x beam x draft, centred on the COG in plan, the COG
+    `kg` above the keel) or a mesh file (Capytaine only; waterline at z = 0, COG at `cog`)."""
+    type: str = "box"                # "box" | "mesh"
+    length: float = 0.0
+    beam: float = 0.0
+    draft: float = 0.0
+    kg: float = 0.0                  # m, COG above the keel (box)
+    file: str = ""                   # mesh file (type = "mesh"), relative to the scene's folder
+    cog: tuple[float, float, float] = (0.0, 0.0, 0.0)   # the COG in the mesh's coordinates (type = "mesh")
+
+
+@dataclass(frozen=True)
+class Hydrodynamics:
+    """The `[vessel.hydrodynamics]` table: frequency-domain coefficients about the COG, or
+    `capytaine = true` to compute them from the hull. Arrays are nested tuples as written."""
+    frequencies: tuple = ()          # rad/s, ascending
+    added_mass: Optional[tuple] = None            # (n, 6) diagonal or (n, 6, 6)
+    damping: Optional[tuple] = None               # radiation damping, same shapes
+    added_mass_infinite: Optional[tuple] = None   # (6,) or (6, 6); fitted when absent
+    headings: Optional[tuple] = None              # rad, the excitation tables' headings
+    excitation_amplitude: Optional[tuple] = None  # (n, headings, 6) or (n, 6): N/m, N m/m
+    excitation_phase: Optional[tuple] = None      # same shape, rad
+    viscous_damping: Optional[tuple] = None       # (6,) or (6, 6) linear damping added to the radiation
+    capytaine: bool = False          # compute added mass, damping, A_inf and excitation with Capytaine
+    panel_size: Optional[float] = None            # m, Capytaine's panels (default from the hull)
+    memory_order: int = 0            # complex pole pairs per column of the memory fit (0: automatic)
+    excitation: str = "auto"         # "auto" | "table" | "froude-krylov"
+    base_dir: str = ""               # the scene's folder (a mesh file is relative to it)
+
+
+EFFECTS = ("buoyancy", "liquid", "coriolis", "centrifugal", "gravity_turning", "waves", "radiation")
 
 
 @dataclass(frozen=True)
@@ -186,6 +246,8 @@ class Effects:
     coriolis: bool = True            # 2 omega x d_dot on the liquid (eq. 19)
     centrifugal: bool = True         # omega x (omega x r) on the liquid (eq. 19)
     gravity_turning: bool = True     # gravity turning with the body as a load on the liquid (eq. 32)
+    waves: bool = True               # first-order wave excitation from the [waves] table
+    radiation: bool = True           # added mass, radiation damping and memory from [vessel.hydrodynamics]
 
 
 @dataclass(frozen=True)
@@ -201,6 +263,7 @@ class Scene:
     text: str = ""                   # the TOML source, stored in result files
     path: str = ""
     warnings: tuple[str, ...] = ()   # physically doubtful but legal choices, said once at load
+    waves: Optional["Waves"] = None  # the [waves] table: incident regular waves or a JONSWAP sea
 
     def tank(self, name: str) -> Tank:
         for t in self.tanks:

@@ -37,3 +37,22 @@ def test_accuracy_vs_cost_notebook_runs():
     assert not [o for o in outs if o.get("output_type") == "error"]
     text = "".join(o.get("text", "") for o in outs)
     assert "Pareto front (probe B)" in text and "machine" in text
+
+
+def test_waves_notebook_runs():
+    nb = nbformat.read(ROOT / "notebooks" / "waves.ipynb", as_version=4)
+    assert all(not c.get("outputs") for c in nb.cells if c.cell_type == "code")
+    old = os.environ.get("JAXSLOSH_NOTEBOOK_SMALL")
+    os.environ["JAXSLOSH_NOTEBOOK_SMALL"] = "1"
+    try:
+        nbclient.NotebookClient(nb, timeout=900, kernel_name="python3",
+                                resources={"metadata": {"path": str(ROOT / "notebooks")}}).execute()
+    finally:
+        if old is None:
+            os.environ.pop("JAXSLOSH_NOTEBOOK_SMALL")
+        else:
+            os.environ["JAXSLOSH_NOTEBOOK_SMALL"] = old
+    outs = [o for c in nb.cells if c.cell_type == "code" for o in c.get("outputs", [])]
+    assert not [o for o in outs if o.get("output_type") == "error"]
+    text = "".join(o.get("text", "") for o in outs)
+    assert "with liquid: ok | frozen: ok" in text and "roll std" in text and "ok" in text
