@@ -1,6 +1,6 @@
 """What a step costs, and how that compares with simpler ways of doing the same work, in one run.
 
-    python benchmarks/bench_speed.py [--steps 200] [--batch 64]
+    python benchmarks/bench_speed.py [--steps 200] [--batch 64] [--tables newton,gradient,batch,memory]
 
 Prints four tables (no assertion; tests never time anything):
   1. the structured quasi-Newton step against a naive Newton (global jax.jacfwd of the residual and a
@@ -138,14 +138,20 @@ def main():
     ap.add_argument("--steps", type=int, default=200)
     ap.add_argument("--batch", type=int, default=64)
     ap.add_argument("--memory-steps", type=int, default=2000)
+    ap.add_argument("--tables", default="newton,gradient,batch,memory", help="comma-separated subset to run")
     a = ap.parse_args()
+    tables = set(a.tables.split(","))
     scenes = [("vessel alone", js.load_scene(os.path.join(ROOT, "scenes", "vessel_only.toml"))),
               ("paper example 5x5x5", js.load_scene(os.path.join(ROOT, "scenes", "paper_ship_tank.toml")))]
     print(f"jax {jax.__version__} on {jax.devices()[0].platform}, {os.cpu_count()} cpu")
-    newton_table(scenes, a.steps)
-    gradient_table(scenes, a.steps)
-    batch_table(scenes, a.steps, a.batch)
-    memory_table(a.memory_steps)
+    if "newton" in tables:
+        newton_table(scenes, a.steps)
+    if "gradient" in tables:
+        gradient_table(scenes, a.steps)
+    if "batch" in tables:
+        batch_table(scenes, a.steps, a.batch)
+    if "memory" in tables:
+        memory_table(a.memory_steps)
 
 
 if __name__ == "__main__":
