@@ -37,3 +37,31 @@ def test_sweep_command_writes_the_grid(tmp_path, capsys):
         np.testing.assert_allclose(f["sweep/vessel.hydrostatics.gm_l"][:], [10, 20, 30, 10, 20, 30])
     assert main(["sweep", str(p), "--param", "vessel.bogus=1,2"]) == 2
     assert "vessel.bogus" in capsys.readouterr().err
+
+
+def test_batch_is_sharded_over_several_devices_with_the_same_numbers(tmp_path):
+    """Two host devices (XLA's forced device count, in a fresh process): the batch is split over
+    both, and each run equals the same batch on one device."""
+    import os
+    import subprocess
+    import sys
+    code = r"""
+import jax
+jax.config.update("jax_enable_x64", True)
+import numpy as np, jaxslosh as js
+from helpers import vessel_scene
+assert len(jax.devices()) == 2
+scene = vessel_scene(duration=1.0, omega=(0.03, 0.01, 0.0))
+res, st = js.simulate_batch(scene, {"vessel.hydrostatics.gm_t": np.array([1.0, 1.5, 2.0, 2.5])})
+q = res.vessel.quaternion
+print(len(q.sharding.device_set), st == ["ok"] * 4)
+np.save(%r, np.asarray(q))
+""" % str(tmp_path / "q.npy")
+    env = dict(os.environ, XLA_FLAGS="--xla_force_host_platform_device_count=2", JAX_PLATFORMS="cpu",
+               PYTHONPATH=os.path.dirname(os.path.abspath(__file__)))
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, env=env, timeout=600)
+    assert out.returncode == 0, out.stderr[-2000:]
+    assert out.stdout.split()[-2:] == ["2", "True"]
+    one, _ = js.simulate_batch(vessel_scene(duration=1.0, omega=(0.03, 0.01, 0.0)),
+                               {"vessel.hydrostatics.gm_t": np.array([1.0, 1.5, 2.0, 2.5])})
+    np.testing.assert_allclose(np.load(tmp_path / "q.npy"), np.asarray(one.vessel.quaternion), atol=1e-13)
