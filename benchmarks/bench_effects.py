@@ -27,6 +27,7 @@ jax.config.update("jax_enable_x64", True)
 import jaxslosh as js  # noqa: E402
 from jaxslosh.effects import count_unknowns, scene_effects  # noqa: E402
 from jaxslosh.run import _core, advance, prepare, start  # noqa: E402
+from jaxslosh.scene import tomllib  # noqa: E402  (tomli before Python 3.11)
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 REFERENCE = "paper, all effects"
@@ -54,7 +55,7 @@ def load_variant(filename, off):
     path = os.path.join(ROOT, "scenes", filename)
     text = open(path).read()
     if off:
-        if "[effects]" in text:
+        if "effects" in tomllib.loads(text):
             raise ValueError(f"{filename} has its own [effects] table: cannot append one")
         text += "\n[effects]\n" + "".join(f"{k} = false\n" for k in off)
     return js.load_scene(text)
