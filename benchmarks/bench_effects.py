@@ -1,6 +1,6 @@
 """Compile time and step cost per set of effects: what each `[effects]` switch costs, in one run.
 
-    python benchmarks/bench_effects.py [--steps 1000] [--repeat 3] [--quick]
+    python benchmarks/bench_effects.py [--steps 500] [--repeat 5] [--quick]
 
 Issue 8 ("a scene simulates only the effects it calls for"): the vessel alone, the paper example
 with every effect and with Coriolis, centrifugal, gravity turning (each, then all three) or the
@@ -104,12 +104,12 @@ class Row:
 
 def main():
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("--steps", type=int, help="steps per timed call (default 1000, 200 with --quick)")
-    ap.add_argument("--repeat", type=int, help="timed calls per row; the best is shown (default 3, 2 with --quick)")
+    ap.add_argument("--steps", type=int, help="steps per timed call (default 500, 200 with --quick)")
+    ap.add_argument("--repeat", type=int, help="timed calls per row; the best is shown (default 5, 2 with --quick)")
     ap.add_argument("--quick", action="store_true", help="five rows, fewer steps")
     a = ap.parse_args()
-    steps = a.steps or (200 if a.quick else 1000)
-    repeat = a.repeat or (2 if a.quick else 3)
+    steps = a.steps or (200 if a.quick else 500)
+    repeat = a.repeat or (2 if a.quick else 5)
     if steps < 1 or repeat < 1:
         ap.error("--steps and --repeat must be at least 1")
     rows = [r for r in ROWS if r[3] or not a.quick]
@@ -134,7 +134,8 @@ def main():
         print(f"| {row.label} (`{row.filename}`) | {effects_column(row.scene)} | {count_unknowns(row.scene)} | "
               f"{row.build:.2f} | {row.compile:.2f} | {row.us:.1f}{flag} | {row.iters:.2f} | {ratio} |")
     print()
-    print(f"total {time.perf_counter() - t_all:.0f} s; compile s = start + first advance less its run time; "
+    load = f"; load average {os.getloadavg()[1]:.1f} over the last 5 min" if hasattr(os, "getloadavg") else ""
+    print(f"total {time.perf_counter() - t_all:.0f} s{load}; compile s = start + first advance less its run time; "
           f"ratio = us/step over the row {REFERENCE!r}")
 
 
