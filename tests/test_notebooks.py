@@ -11,6 +11,8 @@ ROOT = Path(__file__).resolve().parents[1]
 def test_quickstart_notebook_runs():
     nb = nbformat.read(ROOT / "notebooks" / "quickstart.ipynb", as_version=4)
     assert all(not c.get("outputs") for c in nb.cells if c.cell_type == "code")
+    gif = ROOT / "notebooks" / "surface.gif"
+    gif.unlink(missing_ok=True)
     old = os.environ.get("JAXSLOSH_NOTEBOOK_SMALL")
     os.environ["JAXSLOSH_NOTEBOOK_SMALL"] = "1"
     try:
@@ -25,6 +27,11 @@ def test_quickstart_notebook_runs():
     assert not [o for o in outs if o.get("output_type") == "error"]
     text = "".join(o.get("text", "") for o in outs)
     assert "ok" in text and "sloshing" in text and "d(peak roll)/d(GM_T)" in text
+    # the free-surface animation: 2 s saved every step, every 50th frame shown
+    assert "5 frames written to surface.gif" in text
+    from PIL import Image
+    with Image.open(gif) as im:
+        assert im.format == "GIF" and im.n_frames == 5
 
 
 def test_accuracy_vs_cost_notebook_runs():
