@@ -43,3 +43,35 @@ def zero_crossing_period(t, x):
     tc = t[i] - x[i] * (t[i + 1] - t[i]) / (x[i + 1] - x[i])
     assert len(tc) >= 3, "too few oscillations to measure a period"
     return (tc[-1] - tc[0]) / (len(tc) - 1)
+
+
+def run_notebook(name: str, env: dict | None = None, timeout: int = 900) -> list:
+    """Execute notebooks/NAME (saved without outputs) in its folder with the environment variables
+    `env` set for the run; no cell may raise. Returns the outputs of its code cells."""
+    import os
+    from pathlib import Path
+
+    import nbclient
+    import nbformat
+    folder = Path(__file__).resolve().parents[1] / "notebooks"
+    nb = nbformat.read(folder / name, as_version=4)
+    assert all(not c.get("outputs") for c in nb.cells if c.cell_type == "code"), "commit it with outputs cleared"
+    env = env or {}
+    old = {k: os.environ.get(k) for k in env}
+    os.environ.update(env)
+    try:
+        nbclient.NotebookClient(nb, timeout=timeout, kernel_name="python3",
+                                resources={"metadata": {"path": str(folder)}}).execute()
+    finally:
+        for k, v in old.items():
+            if v is None:
+                os.environ.pop(k, None)
+            else:
+                os.environ[k] = v
+    outputs = [o for c in nb.cells if c.cell_type == "code" for o in c.get("outputs", [])]
+    assert not [o for o in outputs if o.get("output_type") == "error"]
+    return outputs
+
+
+def printed(outputs: list) -> str:
+    return "".join(o.get("text", "") for o in outputs)

@@ -1,6 +1,5 @@
 """Parameter identification (SPEC sections 2 and 4: `jaxslosh identify`, `js.identify`)."""
 import json
-import os
 from pathlib import Path
 
 import jax
@@ -11,7 +10,7 @@ import pytest
 import jaxslosh as js
 from jaxslosh.identify import FitResult, add_noise, identify
 
-from helpers import vessel_scene
+from helpers import run_notebook, vessel_scene
 
 ROOT = Path(__file__).resolve().parents[1]
 GM = ["vessel.hydrostatics.gm_t", "vessel.hydrostatics.gm_l"]
@@ -162,24 +161,7 @@ def test_cli_identify_bad_data(tmp_path, capsys):
 
 
 def _execute_notebook(env):
-    import nbclient
-    import nbformat
-    path = ROOT / "notebooks" / "identify_metacentric_heights.ipynb"
-    nb = nbformat.read(path, as_version=4)
-    assert all(not c.get("outputs") for c in nb.cells if c.cell_type == "code"), "commit it with outputs cleared"
-    old = {k: os.environ.get(k) for k in env}
-    os.environ.update(env)
-    try:
-        nbclient.NotebookClient(nb, timeout=1200, kernel_name="python3",
-                                resources={"metadata": {"path": str(ROOT / "notebooks")}}).execute()
-    finally:
-        for k, v in old.items():
-            if v is None:
-                os.environ.pop(k, None)
-            else:
-                os.environ[k] = v
-    outputs = [o for c in nb.cells if c.cell_type == "code" for o in c.get("outputs", [])]
-    assert not [o for o in outputs if o.get("output_type") == "error"]
+    outputs = run_notebook("identify_metacentric_heights.ipynb", env, timeout=1200)
     assert sum("image/png" in o.get("data", {}) for o in outputs) >= 2     # the loss curve and the fit
     text = "".join(o.get("text", "") for o in outputs)
     assert "converged=True" in text
