@@ -439,7 +439,7 @@ def centrifugal_stiffness(nodes, elements, sizes, stiffness, mass, held, young, 
     K_G[a i, b j] = delta_ij int dN_a/dx_k sigma_kl dN_b/dx_l dV. A beam pulled by its spin is stiffer
     in bending: the stiffening that a linear floating frame lacks (Kane, Ryan & Banerjee 1987)."""
     import scipy.sparse as sp
-    N, E = nodes.shape[0], elements.shape[0]
+    N = nodes.shape[0]
     C = elasticity_matrix(young, poisson)
     free = np.flatnonzero(~np.repeat(np.asarray(held, dtype=bool), 3))
     M3 = np.kron(mass, np.eye(3))

@@ -1,5 +1,4 @@
 """The `jaxslosh` command: exit statuses, one-line errors, result files (SPEC sections 2-3)."""
-import os
 import subprocess
 import sys
 

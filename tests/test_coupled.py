@@ -1,5 +1,4 @@
 """Vessel + liquid in a rigid tank: rest, heave, static heel, forced sway against potential theory."""
-import jax.numpy as jnp
 import numpy as np
 import pytest
 

@@ -1,6 +1,5 @@
 """A scene simulates only the effects it calls for: nothing else is traced, switches are exact."""
 import jax
-import jax.numpy as jnp
 import numpy as np
 
 import jaxslosh as js

@@ -3,7 +3,6 @@ import functools
 import os
 
 import numpy as np
-import pytest
 import scipy.linalg as sl
 
 import jaxslosh as js

@@ -6,12 +6,10 @@ import functools
 import jax
 import jax.numpy as jnp
 import numpy as np
-import pytest
 
 import jaxslosh as js
 from jaxslosh import multibody as mb
 from jaxslosh.build import build
-from jaxslosh.kinematics import quat_exp, quat_multiply
 
 from helpers import zero_crossing_period
 

@@ -9,7 +9,6 @@ frequency (3.80 rad/s) the beam diverges. The geometric stiffness of the spin's 
 coefficients, and the spin-up stays bounded.
 """
 import numpy as np
-import pytest
 import scipy.linalg as sl
 
 import jaxslosh as js
