@@ -28,9 +28,10 @@ frame body built from OUR matrices (`exudyn_paper`):
     (`--only ffrf`) is the same object with ALL 468 modes, a complete basis of the free dofs, so the
     same model as the nodal one. ObjectFFRF on the nodal coordinates (`--nodal`: the held
     coordinates by one CoordinateVectorConstraint, as Exudyn's own Tisserand constraint is written)
-    did not run here: its Newton iterations diverged from the first step (with the constraint or
-    with a penalty instead, dense or sparse solver, with or without loads, step down to 4e-5 s) and
-    each Jacobian update took seconds;
+    did not run here: its Newton iterations diverged from the first step (the held coordinates by
+    the constraint or by a 1e12 N/m penalty, sparse or dense solver, the step cut down to 4e-5 s)
+    and each Jacobian update took seconds; without the loads, or with a 1e4 times softer stiffness,
+    no step finished within a minute;
   * gravity: the liquid's weight at its current centre of mass (a LoadForceVector of m g on a
     MarkerSuperElementPosition over all liquid nodes weighted by nodal mass, which is exactly m_i g on
     every node, deformation included) less the same weight at the undeformed centre of mass fixed in
