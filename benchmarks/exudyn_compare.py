@@ -94,9 +94,9 @@ def exudyn_barge(scene, duration, dt):
     mbs.CreateRigidBodySpringDamper(itemNumbers=[ground, body], stiffness=k, damping=np.zeros((6, 6)),
                                     useIntrinsicFormulation=False)
     s_pos = mbs.AddSensor(SensorBody(bodyNumber=body, outputVariableType=exu.OutputVariableType.Position,
-                                     storeInternal=True))
+                                     storeInternal=True, writeToFile=False))
     s_rot = mbs.AddSensor(SensorBody(bodyNumber=body, outputVariableType=exu.OutputVariableType.Rotation,
-                                     storeInternal=True))
+                                     storeInternal=True, writeToFile=False))
     mbs.Assemble()
     st = exu.SimulationSettings()
     n = int(round(duration / dt))
@@ -300,9 +300,9 @@ def exudyn_paper(scene, L, kind, basis, q0, duration, dt, probe_w, probe_p):
     mbs.CreateRigidBodySpringDamper(itemNumbers=[ground, nRef], stiffness=k, damping=np.zeros((6, 6)),
                                     useIntrinsicFormulation=False)
     OV = exu.OutputVariableType
-    s_pos = mbs.AddSensor(SensorNode(nodeNumber=nRef, outputVariableType=OV.Position, storeInternal=True))
-    s_rot = mbs.AddSensor(SensorNode(nodeNumber=nRef, outputVariableType=OV.RotationMatrix, storeInternal=True))
-    s_flex = [mbs.AddSensor(SensorNode(nodeNumber=n, outputVariableType=OV.Coordinates, storeInternal=True))
+    s_pos = mbs.AddSensor(SensorNode(nodeNumber=nRef, outputVariableType=OV.Position, storeInternal=True, writeToFile=False))
+    s_rot = mbs.AddSensor(SensorNode(nodeNumber=nRef, outputVariableType=OV.RotationMatrix, storeInternal=True, writeToFile=False))
+    s_flex = [mbs.AddSensor(SensorNode(nodeNumber=n, outputVariableType=OV.Coordinates, storeInternal=True, writeToFile=False))
               for n in flex_sensors]
     mbs.Assemble()
     st = exu.SimulationSettings()
