@@ -131,6 +131,10 @@ def start(b: Built, solver: Solver):
     return carry, _frame(b, s0, info.iterations, info.residual, failed)
 
 
+#: runs of at least this many steps are checkpointed in blocks (see advance)
+REMAT_MIN_STEPS = 5000
+
+
 @eqx.filter_jit
 def advance(b: Built, solver: Solver, carry: Carry, n_frames: int, save_every: int):
     """n_frames frames of save_every steps each: one scan of scans, no Python loop in traced code."""
@@ -149,7 +153,24 @@ def advance(b: Built, solver: Solver, carry: Carry, n_frames: int, save_every: i
         c, (its, errs) = jax.lax.scan(one_step, c, None, length=save_every)
         return c, _frame(b, c.s, its.max(), errs.max(), c.failed)
 
-    return jax.lax.scan(one_frame, carry, None, length=n_frames)
+    def frames(c, n):
+        return jax.lax.scan(one_frame, c, None, length=n)
+
+    # Reverse mode through long runs: blocks of K ~ sqrt(n) frames are checkpointed (jax.checkpoint
+    # keeps only the block boundaries and recomputes a block's steps when its gradient is taken), so
+    # a gradient's memory stops growing with the steps. Measured on the paper example (peak RSS of
+    # one gradient): 1.22 / 1.60 / 2.37 GB at 1,000 / 4,000 / 10,000 steps without, 1.76 / 1.67 /
+    # 1.45 GB with (a larger compiled program); so only runs of REMAT_MIN_STEPS or more take it.
+    K = int(math.isqrt(n_frames))
+    if n_frames * save_every < REMAT_MIN_STEPS or K < 4:
+        return frames(carry, n_frames)
+    nb, rem = divmod(n_frames, K)
+    carry, fr = jax.lax.scan(jax.checkpoint(lambda c, _: frames(c, K)), carry, None, length=nb)
+    fr = jax.tree_util.tree_map(lambda x: x.reshape((nb * K,) + x.shape[2:]), fr)
+    if rem:
+        carry, tail = frames(carry, rem)
+        fr = _concat_frames([fr, tail])
+    return carry, fr
 
 
 def _concat_frames(frames):

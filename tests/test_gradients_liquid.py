@@ -218,3 +218,27 @@ def test_gradient_of_a_trajectory_loss_wrt_tank_parameters_matches_central_diffe
         errors[key] = abs(g[i] - fds[1]) / abs(fds[1])
     print("gradient vs central differences, relative:", {k: f"{v:.1e}" for k, v in errors.items()})
     assert all(v <= 1e-5 for v in errors.values()), errors
+
+
+@pytest.mark.parametrize("steps", [100, 103])
+def test_checkpointed_long_runs_give_the_same_frames_and_gradient(monkeypatch, steps):
+    """Runs of run.REMAT_MIN_STEPS steps or more are checkpointed in blocks of ~sqrt(n) frames (a
+    remainder run after them): the frames and the gradient equal the plain scan's."""
+    import jaxslosh.run as run_mod
+    from helpers import vessel_scene
+    scene = vessel_scene(duration=steps * 0.01, omega=(0.03, 0.01, 0.0))
+
+    def loss(gm):
+        r = js.simulate(scene, params={"vessel.hydrostatics.gm_t": gm})
+        return jnp.sum(r.vessel.roll_pitch_yaw[:, 0] ** 2), r.vessel.quaternion
+
+    (l0, q0), g0 = jax.value_and_grad(loss, has_aux=True)(1.5)
+    monkeypatch.setattr(run_mod, "REMAT_MIN_STEPS", 50)
+    calls, checkpoint = [], jax.checkpoint
+    monkeypatch.setattr(run_mod.jax, "checkpoint", lambda f, *a, **k: calls.append(1) or checkpoint(f, *a, **k))
+    jax.clear_caches()        # the compiled loop of the first run would be taken again
+    (l1, q1), g1 = jax.value_and_grad(loss, has_aux=True)(1.5)
+    assert calls              # the checkpointed form ran
+    assert q1.shape == q0.shape == (steps + 1, 4)
+    np.testing.assert_allclose(np.asarray(q1), np.asarray(q0), rtol=0, atol=1e-14)
+    assert abs(float(g1) / float(g0) - 1.0) < 1e-10 and float(g0) != 0.0
