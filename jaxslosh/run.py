@@ -161,7 +161,7 @@ def advance(b: Built, solver: Solver, carry: Carry, n_frames: int, save_every: i
     # a gradient's memory stops growing with the steps. Measured on the paper example (peak RSS of
     # one gradient): 1.22 / 1.60 / 2.37 GB at 1,000 / 4,000 / 10,000 steps without, 1.76 / 1.67 /
     # 1.45 GB with (a larger compiled program); so only runs of REMAT_MIN_STEPS or more take it.
-    K = int(math.isqrt(n_frames))
+    K = _block_size(n_frames)
     if n_frames * save_every < REMAT_MIN_STEPS or K < 4:
         return frames(carry, n_frames)
     nb, rem = divmod(n_frames, K)
@@ -171,6 +171,16 @@ def advance(b: Built, solver: Solver, carry: Carry, n_frames: int, save_every: i
         carry, tail = frames(carry, rem)
         fr = _concat_frames([fr, tail])
     return carry, fr
+
+
+def _block_size(n: int) -> int:
+    """Frames per checkpointed block: a divisor of n near sqrt(n) where there is one (no remainder
+    scan, so the step is compiled once), else sqrt(n)."""
+    r = math.isqrt(n)
+    for k in sorted(range(max(1, r // 2), 2 * r + 1), key=lambda k: abs(k - r)):
+        if n % k == 0:
+            return k
+    return r
 
 
 def _concat_frames(frames):
