@@ -78,6 +78,20 @@ from jaxslosh.run import _core, advance, prepare, start  # noqa: E402
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 
 
+def _settings(exu, scene, duration, dt):
+    """Exudyn's settings for our run: n steps of dt, generalized-alpha with the spectral radius of
+    our HHT alpha, (1 - alpha) / (1 + alpha); sensors stored in memory, no files."""
+    st = exu.SimulationSettings()
+    n = int(round(duration / dt))
+    st.timeIntegration.numberOfSteps = n
+    st.timeIntegration.endTime = n * dt
+    st.timeIntegration.verboseMode = 0
+    st.timeIntegration.generalizedAlpha.spectralRadius = (1 - scene.simulation.alpha) / (1 + scene.simulation.alpha)
+    st.solution.file.write = False
+    st.solution.sensors.writePeriod = dt
+    return st, n
+
+
 def exudyn_barge(scene, duration, dt):
     import exudyn as exu
     from exudyn.utilities import RigidBodyInertia, SensorBody
@@ -98,14 +112,7 @@ def exudyn_barge(scene, duration, dt):
     s_rot = mbs.AddSensor(SensorBody(bodyNumber=body, outputVariableType=exu.OutputVariableType.Rotation,
                                      storeInternal=True, writeToFile=False))
     mbs.Assemble()
-    st = exu.SimulationSettings()
-    n = int(round(duration / dt))
-    st.timeIntegration.numberOfSteps = n
-    st.timeIntegration.endTime = n * dt
-    st.timeIntegration.verboseMode = 0
-    st.timeIntegration.generalizedAlpha.spectralRadius = (1 - scene.simulation.alpha) / (1 + scene.simulation.alpha)
-    st.solution.file.write = False
-    st.solution.sensors.writePeriod = dt
+    st, n = _settings(exu, scene, duration, dt)
     t0 = time.perf_counter()
     mbs.SolveDynamic(st)
     wall = time.perf_counter() - t0
@@ -305,17 +312,10 @@ def exudyn_paper(scene, L, kind, basis, q0, duration, dt, probe_w, probe_p):
     s_flex = [mbs.AddSensor(SensorNode(nodeNumber=n, outputVariableType=OV.Coordinates, storeInternal=True, writeToFile=False))
               for n in flex_sensors]
     mbs.Assemble()
-    st = exu.SimulationSettings()
-    n = int(round(duration / dt))
-    st.timeIntegration.numberOfSteps = n
-    st.timeIntegration.endTime = n * dt
-    st.timeIntegration.verboseMode = 0
-    st.timeIntegration.generalizedAlpha.spectralRadius = (1 - scene.simulation.alpha) / (1 + scene.simulation.alpha)
+    st, n = _settings(exu, scene, duration, dt)
     st.timeIntegration.newton.useModifiedNewton = True     # as Exudyn's FFRF examples; same answer, fewer Jacobians
     if kind == "ffrf":
         st.linearSolverType = exu.LinearSolverType.EigenSparse
-    st.solution.file.write = False
-    st.solution.sensors.writePeriod = dt
     t0 = time.perf_counter()
     try:
         mbs.SolveDynamic(st)
