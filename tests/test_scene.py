@@ -136,10 +136,10 @@ def test_spec_example_loads():
     assert s.vessel.inertia == ((4.9e6, 0.0, 0.0), (0.0, 1.45e7, 0.0), (0.0, 0.0, 1.6e7))
     assert s.vessel.hydrostatics.gm_t == 1.67 and s.vessel.hydrostatics.moment == "conservative"
     assert s.vessel.initial.angular_velocity == (0.1, 0.05, 0.0) and s.vessel.initial.position == (0, 0, 0)
-    (t,) = s.tanks
-    assert t.name == "tank" and t.size == (5.0, 5.0, 4.0) and t.mesh == (5, 5, 5) and t.walls == "rigid"
-    assert t.fluid.element == ELEMENT_FORMS[0] == "stabilized"
-    assert math.isclose(t.liquid_mass, 75_000.0)
+    (tank,) = s.tanks
+    assert tank.name == "tank" and tank.size == (5.0, 5.0, 4.0) and tank.mesh == (5, 5, 5) and tank.walls == "rigid"
+    assert tank.fluid.element == ELEMENT_FORMS[0] == "stabilized"
+    assert math.isclose(tank.liquid_mass, 75_000.0)
     assert [p.name for p in s.probes] == ["A", "B", "tip"]          # file order
     assert s.probes[2].structure == "mast" and s.probes[2].tank is None
     assert s.structures[0].material.young == 2.1e11 and s.structures[0].attach == "z-"
@@ -172,9 +172,9 @@ def test_extra_keys_and_forms():
     assert s.vessel.hydrostatics.moment == "conservative" and s.vessel.initial.position == (0.0, 0.0, 1.0)
     assert s.tanks[0].fluid.element == "paper" and isinstance(s.vessel.mass, float)
     assert s.vessel.inertia[0][2] == s.vessel.inertia[2][0] == -1e5
-    t = s.tanks[0]
-    assert t.walls == "elastic" and t.wall_spec.thickness == 0.02 and t.wall_spec.mesh == (5, 5, 4)
-    assert t.wall_spec.material.poisson == 0.3
+    tank = s.tanks[0]
+    assert tank.walls == "elastic" and tank.wall_spec.thickness == 0.02 and tank.wall_spec.mesh == (5, 5, 4)
+    assert tank.wall_spec.material.poisson == 0.3
     assert s.warnings == ()                                       # 335 t + 75 t = 410 t: balanced
 
 
