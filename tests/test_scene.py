@@ -143,7 +143,7 @@ def test_spec_example_loads():
     assert [p.name for p in s.probes] == ["A", "B", "tip"]          # file order
     assert s.probes[2].structure == "mast" and s.probes[2].tank is None
     assert s.structures[0].material.young == 2.1e11 and s.structures[0].attach == "z-"
-    assert s.tank("tank") is t and s.structure("mast") is s.structures[0]
+    assert s.tank("tank") is tank and s.structure("mast") is s.structures[0]
     # 325 t + 75 t of liquid against 1025 * 400 = 410 t: 2.4 % off, warned, not an error
     assert len(s.warnings) == 1 and "static imbalance" in s.warnings[0]
 
