@@ -22,6 +22,7 @@ enters, are re-linearised with JAX in each iteration (a Schur complement on the 
 """
 from __future__ import annotations
 
+import dataclasses
 from typing import Any, NamedTuple, Optional
 
 import equinox as eqx
@@ -64,6 +65,7 @@ class State(NamedTuple):
     pre: Any = None   # the Newton preconditioner carried to the next step (Solver.reuse), else None
     alg: Optional[jax.Array] = None   # interface frame positions and multipliers (multibody.py), if any
     z: Optional[jax.Array] = None   # radiation memory states (hydrodynamics.Memory), None without them
+    e0: Optional[jax.Array] = None  # the initial total energy, held by the energy projection (Solver.project)
 
 
 class StepInfo(NamedTuple):
@@ -95,10 +97,13 @@ class Solver(eqx.Module):
     # unknowns of the exact (Schur) block: the 6 rigid ones, and with flexible structures their rigid
     # unknowns and the interface frames and multipliers (multibody.Layout.n_small)
     ns: int = eqx.field(static=True, default=6)
+    # after each step, scale the velocities so that the total energy is the initial one (the
+    # `simulation.energy_projection` key: trapezoidal rule, conservative scenes only; see project_energy)
+    project: bool = eqx.field(static=True, default=False)
 
     def sub_solver(self) -> "Solver":
         return Solver(self.Cinv_sub, self.Cinv_mass, self.h / self.substeps, self.scheme, self.tol, self.max_iter,
-                      noise=self.noise, adaptive=self.adaptive, ns=self.ns)
+                      noise=self.noise, adaptive=self.adaptive, ns=self.ns, project=self.project)
 
     @property
     def c_a(self):
@@ -107,13 +112,20 @@ class Solver(eqx.Module):
 
 
 def make_solver(system: System, h: float, scheme: Scheme, tol: float, max_iter: int, substeps: int = 0,
-                reuse: bool = False, adaptive: bool = True) -> Solver:
+                reuse: bool = False, adaptive: bool = True, project: bool = False) -> Solver:
     """Factor the constant liquid blocks once (float64): NumPy for concrete matrices, JAX when the
     liquid was built from traced values (under jit).
 
     The inverses only precondition the Newton iterations and the tangent solves, whose solutions do
     not depend on them (`lax.custom_root` drops their tangents), so they are formed from
-    `stop_gradient` values: under `jax.grad` outside jit the matrices are then concrete again."""
+    `stop_gradient` values: under `jax.grad` outside jit the matrices are then concrete again.
+
+    `project`: the energy projection after each step (project_energy; not with flexible structures)."""
+    if project:
+        if _has_flex(system):
+            raise ValueError("the energy projection is not available with flexible structures")
+        return dataclasses.replace(make_solver(system, h, scheme, tol, max_iter, substeps, reuse, adaptive),
+                                   project=True)
     nf = system.nf
     substeps = int(substeps) if substeps and substeps > 1 else 0
     if getattr(system, "flex", None) is not None:
@@ -187,8 +199,6 @@ class BlockInverse(eqx.Module):
 def _flex_solver(system: System, h, scheme: Scheme, tol, max_iter, substeps, reuse, adaptive) -> Solver:
     """With flexible structures: the liquid block inverses as without them, and the structures'
     modal block, which is diagonal (Phi^T M Phi = I, Phi^T K Phi = omega^2): 1 / (c_a + omega^2)."""
-    import dataclasses
-
     from .multibody import layout
     base = make_solver(dataclasses.replace(system, flex=None), h, scheme, tol, max_iter, substeps, reuse, adaptive)
     w2 = jax.lax.stop_gradient(jnp.concatenate([b.omega2 for b in system.flex.bodies]))
@@ -408,7 +418,29 @@ def initial_state(system: System, solver: Solver, c0: Config, v0, alg0=None) -> 
 
     acc0, (it, err, ok) = solve_root(R, jnp.zeros_like(v0), solver.Cinv_mass, scale, solver.tol, solver.max_iter)
     pre = empty_pre(system) if solver.reuse else None
-    return State(c0, v0, acc0, acc0, jnp.zeros(()), pre=pre, z=z0), StepInfo(it, err, ok)
+    e0 = total_energy(system, c0, v0) if solver.project else None
+    return State(c0, v0, acc0, acc0, jnp.zeros(()), pre=pre, z=z0, e0=e0), StepInfo(it, err, ok)
+
+
+def total_energy(system: System, c: Config, v):
+    V0, om, dd = _split(v)
+    return system.kinetic_energy(c, V0, om, dd) + system.potential_energy(c)
+
+
+def project_energy(system: System, c: Config, v, e0):
+    """Scale the velocities so that T(c, s v) + V(c) = e0 (the standard projection onto the energy
+    surface, Hairer, Lubich & Wanner, Geometric Numerical Integration, sec. IV.4, along the velocity).
+
+    The kinetic energy is a quadratic form in the velocities at fixed configuration, so the scale is
+    s = sqrt((e0 - V) / T) in closed form; it leaves the configuration, |q| = 1 and every homogeneous
+    linear velocity constraint as they are. After a trapezoidal step s - 1 is of the order of the
+    step's local energy error (dt^3), so the scheme stays second order. Where there is no kinetic
+    energy to scale (T = 0) or the potential is above e0, the velocities are left as they are."""
+    V0, om, dd = _split(v)
+    T = system.kinetic_energy(c, V0, om, dd)
+    room = e0 - system.potential_energy(c)
+    ok = (T > 0.0) & (room > 0.0)
+    return v * jnp.sqrt(jnp.where(ok, room / jnp.where(ok, T, 1.0), 1.0))
 
 
 def _memory(system: System):
@@ -560,8 +592,11 @@ def step(system: System, solver: Solver, s: State) -> tuple[State, StepInfo]:
                                                        pre, floor, solver.adaptive)
     c, v, acc, a = unpack(delta)
     ok = ok & jnp.all(jnp.isfinite(delta))
-    return (State(c, v, acc, a, s.t + solver.h, pre=pre_new if solver.reuse else s.pre,
-                  z=memory_next(system, solver, s, v)), StepInfo(it, err, ok))
+    z = memory_next(system, solver, s, v)
+    if solver.project:
+        v = project_energy(system, c, v, s.e0)
+    return (State(c, v, acc, a, s.t + solver.h, pre=pre_new if solver.reuse else s.pre, z=z, e0=s.e0),
+            StepInfo(it, err, ok))
 
 
 def step_or_retry(system: System, solver: Solver, s: State) -> tuple[State, StepInfo]:

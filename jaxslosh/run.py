@@ -75,7 +75,7 @@ def prepare(scene: Scene, params=None, duration=None, dt=None, batch: bool = Fal
     b = build(scene, params)
     scheme = make_scheme(sim.scheme, sim.alpha, sim.rho_inf)
     solver = make_solver(b.system, h, scheme, sim.tolerance, sim.max_iterations, sim.substeps,
-                         reuse=not batch, adaptive=not batch)
+                         reuse=not batch, adaptive=not batch, project=sim.energy_projection)
     n_steps = int(round(T / h))
     return Setup(b, solver, n_steps, max(1, int(sim.save_every)))
 

@@ -127,7 +127,30 @@ def parse_scene(mapping: Mapping[str, Any], text: str = "", path: str = "") -> S
         from .scene_waves import check_waves
         scene = check_waves(scene, path, warnings)
         scene = dataclasses.replace(scene, warnings=tuple(warnings))
+    if simulation.energy_projection:
+        _conservative(scene)
     return scene
+
+
+def _conservative(scene: Scene) -> None:
+    """`simulation.energy_projection` holds the total energy at its initial value: only right when
+    nothing in the scene adds or removes energy and the equations are those of that energy."""
+    v, e = scene.vessel, scene.effects
+    why = []
+    if v.forced is not None:
+        why.append("[vessel.forced] prescribes motion (it does work)")
+    if scene.waves is not None or v.hydrodynamics is not None or v.hull is not None:
+        why.append("waves and hull hydrodynamics add and radiate energy")
+    if scene.structures:
+        why.append("flexible structures are not covered by the projection")
+    if v.hydrostatics is not None and v.hydrostatics.moment != "conservative":
+        why.append('vessel.hydrostatics.moment = "paper" is not the gradient of a potential')
+    off = [k for k in ("coriolis", "centrifugal", "gravity_turning") if not getattr(e, k)]
+    if off:
+        why.append(f"effects {', '.join(off)} off: the equations are no longer those of the total energy")
+    if why:
+        raise SceneError("simulation.energy_projection",
+                         "needs a conservative scene (the total energy must stay constant), but " + "; ".join(why))
 
 
 # --------------------------------------------------------------------------------------------
@@ -199,6 +222,7 @@ def _simulation(table, warnings: list[str]) -> Simulation:
         "chunk": ("int", _non_negative),
         "substeps": ("int", _non_negative),
         "linear_solver": ("str", _one_of(LINEAR_SOLVERS)),
+        "energy_projection": ("bool", None),
     }, required=("duration", "dt"))
     sim = Simulation(**v)
     if sim.dt > sim.duration:
@@ -208,6 +232,10 @@ def _simulation(table, warnings: list[str]) -> Simulation:
             f'{_show(sim.alpha)} with scheme = "newmark": newmark is the trapezoidal rule (gamma = 1/2, '
             f"beta = 1/4), and with alpha != 0 those coefficients amplify the response instead of damping it; "
             f'use scheme = "hht" (gamma = 1/2 + alpha, beta = (1 + alpha)^2 / 4) or remove alpha'))
+    if sim.energy_projection and sim.scheme != "newmark":
+        raise SceneError("simulation.energy_projection", (
+            f'needs scheme = "newmark" (the trapezoidal rule), got "{sim.scheme}": it holds the total energy at '
+            f"its initial value, which contradicts the numerical damping of {sim.scheme}"))
     if not 0.0 <= sim.alpha <= HHT_ALPHA_MAX + 1e-12:
         raise SceneError("simulation.alpha", f"must lie in [0, 1/3], got {_show(sim.alpha)}")
     if not 0.0 <= sim.rho_inf <= 1.0:
@@ -764,7 +792,7 @@ def describe(scene: Scene) -> str:
         lines.append("probes: " + ", ".join(
             f"{p.name} ({'tank' if p.tank else 'structure'} {p.tank or p.structure!r} at "
             f"[{', '.join(f'{x:g}' for x in p.point)}])" for p in scene.probes))
-    damping = {"newmark": "", "hht": f", alpha {sim.alpha:g}", "generalized-alpha": f", rho_inf {sim.rho_inf:g}"}
+    damping = {"newmark": ", energy projection" if sim.energy_projection else "", "hht": f", alpha {sim.alpha:g}", "generalized-alpha": f", rho_inf {sim.rho_inf:g}"}
     lines.append(f"simulation: {sim.n_steps} steps of {sim.dt:g} s to t = {sim.n_steps * sim.dt:g} s, "
                  f"scheme {sim.scheme}{damping[sim.scheme]}, saving every {sim.save_every} step(s)")
     return "\n".join(lines)

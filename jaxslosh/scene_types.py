@@ -42,6 +42,7 @@ class Simulation:
     chunk: int = 0                   # steps per jitted chunk written to the result (0: automatic)
     substeps: int = 0                # > 1: a step whose Newton iteration fails is retried as this many sub-steps
     linear_solver: str = "auto"      # liquid block: "dense" inverse | "sparse" factor (sparse.py) | "auto" by size
+    energy_projection: bool = False  # trapezoidal rule only: scale the velocities after each step to the initial energy
 
     @property
     def n_steps(self) -> int:

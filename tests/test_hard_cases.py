@@ -30,11 +30,11 @@ MESH = (3, 3, 2)            # coarse version of the paper's 5 x 5 x 5 liquid mes
 ALPHA_STIFF = 0.05          # HHT alpha of the stiffness runs
 
 
-def paper_scene(scheme="hht", alpha=0.01, dt=0.01, steps=N_STEPS, mesh=MESH):
+def paper_scene(scheme="hht", alpha=0.01, dt=0.01, steps=N_STEPS, mesh=MESH, extra=""):
     text = open(os.path.join(ROOT, "scenes", "paper_ship_tank.toml")).read()
     for old, new in (("mesh = [5, 5, 5]", f"mesh = {list(mesh)}"), ("duration = 20.0", f"duration = {steps * dt!r}"),
                      ("dt = 0.01", f"dt = {dt!r}"),
-                     ('scheme = "hht"\nalpha = 0.01', f'scheme = "{scheme}"\nalpha = {alpha!r}')):
+                     ('scheme = "hht"\nalpha = 0.01', f'scheme = "{scheme}"\nalpha = {alpha!r}{extra}')):
         assert old in text
         text = text.replace(old, new, 1)
     return js.load_scene(text)
@@ -108,6 +108,36 @@ def test_paper_example_with_the_trapezoidal_rule_conserves_energy_to_second_orde
     full = np.max(np.abs(energy(r1) / energy(r1)[0] - 1))
     assert full < 5e-6, full
     assert 3.0 < errs[0] / errs[1] < 5.0, errs
+
+
+def test_energy_projection_holds_the_energy_and_leaves_the_motion_to_the_trapezoidal_rule():
+    """`simulation.energy_projection`: after each trapezoidal step the velocities are scaled back to
+    the initial energy. The energy then holds to round-off (measured 2.7e-15; the plain rule: 1.7e-6),
+    and the motion
+    moves from the plain rule's by far less than the plain rule's own step error, its distance from
+    the run at half the step (measured 2.8e-8 against 8.9e-5 rad/s): the projection only removes
+    the O(dt^2) energy error."""
+    r1, r2 = paper_run("newmark", 0.0, 0.01), paper_run("newmark", 0.0, 0.005)
+    rp = js.simulate(paper_scene("newmark", 0.0, 0.01, extra="\nenergy_projection = true"))
+    assert rp.status == "ok", rp.status
+    rel = np.abs(energy(rp) / energy(rp)[0] - 1)
+    assert np.max(rel) < 1e-12, np.max(rel)
+    assert quaternion_drift(rp) < 1e-12
+    t = np.asarray(r1.time)
+    span = t <= 10.0 + 1e-9                                      # the span the half-step run covers
+    w1, wp = (np.asarray(r.vessel.angular_velocity)[span] for r in (r1, rp))
+    w2 = np.asarray(r2.vessel.angular_velocity)[::2][:len(w1)]
+    step_error, moved = np.max(np.abs(w1 - w2)), np.max(np.abs(wp - w1))
+    assert moved < 0.01 * step_error, (moved, step_error)
+
+
+@pytest.mark.parametrize("extra, why", [("\n[vessel.forced]\ndof = \"roll\"\namplitude = 0.05\nfrequency = 1.0", "forced"),
+                                        ("\n[effects]\ncoriolis = false", "coriolis")])
+def test_energy_projection_is_refused_where_energy_is_not_conserved(extra, why):
+    text = paper_scene("newmark", 0.0).text.replace('alpha = 0.0', 'alpha = 0.0\nenergy_projection = true', 1) + extra
+    with pytest.raises(js.SceneError) as info:
+        js.load_scene(text)
+    assert info.value.key == "simulation.energy_projection" and why in str(info.value), str(info.value)
 
 
 # ------------------------------------------------------------------------------------------------
