@@ -26,12 +26,17 @@ frame body built from OUR matrices (`exudyn_paper`):
     liquid with the walls held (jaxslosh.reduction, mass-normalised, zero on those dofs; 8 modes
     become 9 because the degenerate (1,0)/(0,1) pair is not split). The full-order body
     (`--only ffrf`) is the same object with ALL 468 modes, a complete basis of the free dofs, so the
-    same model as the nodal one. ObjectFFRF on the nodal coordinates (`--nodal`: the held
-    coordinates by one CoordinateVectorConstraint, as Exudyn's own Tisserand constraint is written)
-    did not run here: its Newton iterations diverged from the first step (the held coordinates by
-    the constraint or by a 1e12 N/m penalty, sparse or dense solver, the step cut down to 4e-5 s)
-    and each Jacobian update took seconds; without the loads, or with a 1e4 times softer stiffness,
-    no step finished within a minute;
+    same model as the nodal one. ObjectFFRF on the nodal coordinates (`--nodal`): the held
+    coordinates each by one CoordinateConstraint to ground (a MarkerNodeCoordinate per held
+    coordinate). Held instead by one CoordinateVectorConstraint on a MarkerObjectODE2Coordinates of
+    the whole body (as Exudyn's own Tisserand constraint is written), the run did not get through
+    one step: Exudyn differentiates the constraint forces C_q^T lambda numerically, column by
+    column, and each column rebuilt that constraint's dense (held x 7 + 3n) Jacobian (gdb: the
+    time was in CObjectConnectorCoordinateVector::ComputeJacobianAE under
+    NumericalConstraintJacobianDerivative, already for the initial accelerations; no step within
+    10 minutes, Exudyn 1.13.6). With the scalar constraints Newton converges in 2-3 iterations a
+    step (modified Newton, EigenSparse; EXUdense is 2x slower, full Newton 40x slower) and the
+    nodal body gives the modal all-modes body's response to round-off;
   * gravity: the liquid's weight at its current centre of mass (a LoadForceVector of m g on a
     MarkerSuperElementPosition over all liquid nodes weighted by nodal mass, which is exactly m_i g on
     every node, deformation included) less the same weight at the undeformed centre of mass fixed in
@@ -284,13 +289,16 @@ def exudyn_paper(scene, L, kind, basis, q0, duration, dt, probe_w, probe_p):
         Mmc.SetWithSparseMatrix(M3, useDenseMatrix=False)
         body = mbs.AddObject(eii.ObjectFFRF(nodeNumbers=[nRef] + nlist, massMatrixFF=Mmc, stiffnessMatrixFF=Kmc,
                                             visualization=eii.VObjectFFRF(show=False)))
-        fixed = np.setdiff1d(np.arange(n3), free)
-        X1 = np.zeros((fixed.size, 7 + n3))
-        X1[np.arange(fixed.size), 7 + fixed] = 1.0
+        # the held coordinates (wall normals, ship points): one CoordinateConstraint to ground each.
+        # NOT one CoordinateVectorConstraint on a MarkerObjectODE2Coordinates of the body: its
+        # Jacobian is a dense (held x 7+3n) matrix that Exudyn differentiates numerically, column by
+        # column, for the derivative of C_q^T lambda (initial accelerations and every Jacobian
+        # update); here that did not finish one step in 10 minutes
         nG = mbs.AddNode(eii.NodePointGround(referenceCoordinates=[0, 0, 0], visualization=eii.VNodePointGround(show=False)))
-        mbs.AddObject(eii.CoordinateVectorConstraint(markerNumbers=[
-            mbs.AddMarker(eii.MarkerNodeCoordinates(nodeNumber=nG)),
-            mbs.AddMarker(eii.MarkerObjectODE2Coordinates(objectNumber=body))], scalingMarker1=X1, offset=np.zeros(fixed.size)))
+        mG = mbs.AddMarker(eii.MarkerNodeCoordinate(nodeNumber=nG, coordinate=0))
+        for j in np.setdiff1d(np.arange(n3), free):
+            mj = mbs.AddMarker(eii.MarkerNodeCoordinate(nodeNumber=nlist[j // 3], coordinate=int(j % 3)))
+            mbs.AddObject(eii.CoordinateConstraint(markerNumbers=[mG, mj], visualization=eii.VCoordinateConstraint(show=False)))
         flex_sensors = [nlist[i] for i in np.flatnonzero(probe_w)]
     mCom = mbs.AddMarker(eii.MarkerSuperElementPosition(bodyNumber=body, meshNodeNumbers=list(range(N)),
                                                         weightingFactors=list(m_nodes / m_l)))
@@ -418,6 +426,11 @@ def paper_compare(a, which):
             refs.append(same.replace(", relative", " + static corr."))
         for ref in dict.fromkeys(refs):
             row(name, r, ref)
+    nodal = ex.get("exudyn ObjectFFRF (nodal)", ({"failed": True},))[0]
+    cms = [k for k in ex if k.startswith("exudyn CMS all")]
+    if not nodal.get("failed") and cms and not ex[cms[0]][0].get("failed"):
+        d = differences(nodal, ex[cms[0]][0])         # the same model in Exudyn, nodal against modal
+        print("exudyn ObjectFFRF (nodal)              " + f"{cms[0]:30} " + " ".join(f"{x:9.2e}" for x in d))
     row("ours full, relative penalty", runs["ours full, relative penalty"], "ours full")
     for m in a.modes if which in ("all", "ffrf-reduced") else ():
         row(f"ours {m} modes + static corr.", runs[f"ours {m} modes + static corr."], "ours full")
@@ -433,7 +446,7 @@ def main():
     ap.add_argument("--full-duration", type=float, default=0.5,
                     help="simulated time of Exudyn's full-order bodies (s; about 1 s of wall time per step here)")
     ap.add_argument("--nodal", action="store_true",
-                    help="also try ObjectFFRF on the nodal coordinates (its Newton diverged here, see the docstring)")
+                    help="also ObjectFFRF on the nodal coordinates (the held ones by scalar CoordinateConstraints, see the docstring)")
     a = ap.parse_args()
     try:
         import exudyn  # noqa: F401
