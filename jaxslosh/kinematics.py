@@ -12,6 +12,17 @@ from __future__ import annotations
 import jax.numpy as jnp
 
 
+def mv3(A, x):
+    """A @ x for A (k, 3) as three scaled columns: elementwise, so XLA fuses it with its neighbours
+    (a dot is a separate kernel launch, and the small-step loops are launch-bound)."""
+    return A[..., 0] * x[0] + A[..., 1] * x[1] + A[..., 2] * x[2]
+
+
+def tv3(A, x):
+    """A.T @ x for A (3, k), as mv3."""
+    return A[0] * x[0] + A[1] * x[1] + A[2] * x[2]
+
+
 def skew(v):
     """The cross-product matrix: skew(a) @ b = a x b (the paper's tilde)."""
     return jnp.array([[0.0, -v[2], v[1]], [v[2], 0.0, -v[0]], [-v[1], v[0], 0.0]])

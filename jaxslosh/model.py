@@ -27,7 +27,7 @@ import jax
 import jax.numpy as jnp
 import numpy as np
 
-from .kinematics import G_matrix, quat_exp, quat_multiply, rotation_matrix, skew
+from .kinematics import G_matrix, mv3, quat_exp, quat_multiply, rotation_matrix, skew, tv3
 from .reduction import is_reduced
 
 # eq. (36): q^T A_phi q = 2 (q0 q1 + q2 q3) = sin(roll) cos(pitch), q^T A_theta q = 2 (q0 q2 - q1 q3)
@@ -204,13 +204,13 @@ class System(eqx.Module):
         A = rotation_matrix(c.q)
         a0, alpha = acc[:3], acc[3:6]
         g_vec = jnp.array([0.0, 0.0, -self.gravity])
-        g_b = A.T @ g_vec if self.g_fixed is None else self.g_fixed
+        g_b = tv3(A, g_vec) if self.g_fixed is None else self.g_fixed
         r_t = self.mass * a0
-        r_r = self.inertia @ alpha + jnp.cross(omega, self.inertia @ omega)
+        r_r = mv3(self.inertia, alpha) + jnp.cross(omega, mv3(self.inertia, omega))
         if self.hull_S is not None:    # a reference point off the hull's COG (eq. 14 with r_G)
             S = self.hull_S
-            r_t = r_t + A @ (jnp.cross(alpha, S) + jnp.cross(omega, jnp.cross(omega, S)))
-            r_r = r_r + jnp.cross(S, A.T @ a0)
+            r_t = r_t + mv3(A, jnp.cross(alpha, S) + jnp.cross(omega, jnp.cross(omega, S)))
+            r_r = r_r + jnp.cross(S, tv3(A, a0))
             if not self.balanced:
                 r_r = r_r - jnp.cross(S, g_b)
         parts = []
@@ -222,13 +222,13 @@ class System(eqx.Module):
             L = self.liquid
             D, Dv, Da = L.full(c.d), L.full(d_dot), L.full(acc[6:])
             x = L.r + D
-            a = A.T @ a0 + Da + jnp.cross(alpha, x)                     # eq. (4), body components
+            a = tv3(A, a0) + Da + jnp.cross(alpha, x)                     # eq. (4), body components
             if self.coriolis:
                 a = a + 2.0 * jnp.cross(omega, Dv)
             if self.centrifugal:
                 a = a + jnp.cross(omega, jnp.cross(omega, x))
             F = L.Ms @ a                                             # inertia forces on nodes
-            r_t = r_t + A @ F.sum(axis=0)
+            r_t = r_t + mv3(A, F.sum(axis=0))
             r_r = r_r + jnp.cross(x, F).sum(axis=0)
             mD = L.m_nodes @ D                                       # first moment of d
             r_d = L.free_part(F - L.m_nodes[:, None] * g_b) + L.K @ c.d
@@ -237,8 +237,8 @@ class System(eqx.Module):
                 r_d = r_d + jnp.einsum("k,kij,j->i", jnp.stack(spin_tensor_components(omega)), L.Kg, c.d)
             if L.Kdt is not None:   # the penalty on the absolute rotation curl d + 2 theta (PHYSICS.md item 5)
                 th, J = self.liquid_rotation(c.q, with_jacobian=True)
-                r_d = r_d + L.Kdt @ th
-                r_r = r_r + J.T @ (L.Kdt.T @ c.d + L.Ktt @ th)
+                r_d = r_d + mv3(L.Kdt, th)
+                r_r = r_r + tv3(J, L.Kdt.T @ c.d + mv3(L.Ktt, th))
             parts.append(r_d)
             if self.balanced:
                 r_r = r_r - jnp.cross(mD, g_b)

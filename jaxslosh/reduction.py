@@ -49,7 +49,7 @@ import numpy as np
 import scipy.linalg as sl
 import scipy.sparse as sp
 
-from .kinematics import skew
+from .kinematics import mv3, skew, tv3
 
 #: relative gap under which two natural frequencies count as one degenerate cluster
 DEGENERATE_GAP = 1e-6
@@ -236,7 +236,7 @@ class ReducedLiquid(eqx.Module):
         (inertial), rigid rotation rows (body), modal rows), as the full model's at d = V eta."""
         eta, eta_dd = c.d, acc[6:]
         a0, alpha = acc[:3], acc[3:6]
-        b = A.T @ a0
+        b = tv3(A, a0)
         W = self._W(eta)
         J = self.second_moment(eta, W)
         Sx = self.S0 + self.U1.T @ eta
@@ -244,31 +244,31 @@ class ReducedLiquid(eqx.Module):
         s = self.mass * b + self.U1.T @ eta_dd + jnp.cross(alpha, Sx)
         # rotation: sum_ij Ms_ij x_i x a_j
         Txa = jnp.einsum("l,lab->ab", eta_dd, W)
-        f_r = jnp.cross(Sx, b) + _axial(Txa) + jnp.trace(J) * alpha - J @ alpha
+        f_r = jnp.cross(Sx, b) + _axial(Txa) + jnp.trace(J) * alpha - mv3(J, alpha)
         # modal rows: sum_ij Ms_ij U_k,i . a_j
-        r_d = self.U1 @ b + self.Mr @ eta_dd + jnp.einsum("a,ka->k", alpha, _axial(W))
+        r_d = mv3(self.U1, b) + self.Mr @ eta_dd + mv3(_axial(W), alpha)
         if system.coriolis:
             v1 = self.U1.T @ eta_dot
             s = s + 2.0 * jnp.cross(omega, v1)
             Txv = jnp.einsum("l,lab->ab", eta_dot, W)
-            f_r = f_r + 2.0 * (jnp.trace(Txv) * omega - Txv.T @ omega)
+            f_r = f_r + 2.0 * (jnp.trace(Txv) * omega - tv3(Txv, omega))
             Tvu = jnp.einsum("l,lkab->kab", eta_dot, self.Q2)            # T(v, U_k)
-            r_d = r_d + 2.0 * jnp.einsum("a,ka->k", omega, _axial(Tvu))
+            r_d = r_d + 2.0 * mv3(_axial(Tvu), omega)
         if system.centrifugal:
             s = s + jnp.cross(omega, jnp.cross(omega, Sx))
-            f_r = f_r + jnp.cross(J @ omega, omega)
+            f_r = f_r + jnp.cross(mv3(J, omega), omega)
             r_d = r_d + jnp.einsum("a,kba,b->k", omega, W, omega) - (omega @ omega) * jnp.trace(W, axis1=1, axis2=2)
-        r_d = r_d - self.U1 @ g_b + self.Kr @ eta
+        r_d = r_d - mv3(self.U1, g_b) + self.Kr @ eta
         if self.Kdt is not None:
             th, Jth = system.liquid_rotation(c.q, with_jacobian=True)
-            r_d = r_d + self.Kdt @ th
-            f_r = f_r + Jth.T @ (self.Kdt.T @ eta + self.Ktt @ th)
+            r_d = r_d + mv3(self.Kdt, th)
+            f_r = f_r + tv3(Jth, self.Kdt.T @ eta + mv3(self.Ktt, th))
         mD = self.U1.T @ eta
         if system.balanced:
             f_r = f_r - jnp.cross(mD, g_b)
         else:
             f_r = f_r - jnp.cross(self.S0 + mD, g_b)
-        return A @ s, f_r, r_d
+        return mv3(A, s), f_r, r_d
 
     def kinetic_energy(self, A, V0, omega, eta, eta_dot):
         c = A.T @ V0
