@@ -72,10 +72,14 @@ def prepare(scene: Scene, params=None, duration=None, dt=None, batch: bool = Fal
     sim = scene.simulation
     h = float(dt if dt is not None else sim.dt)
     T = float(duration if duration is not None else sim.duration)
-    b = build(scene, params)
-    scheme = make_scheme(sim.scheme, sim.alpha, sim.rho_inf)
-    solver = make_solver(b.system, h, scheme, sim.tolerance, sim.max_iterations, sim.substeps,
-                         reuse=not batch, adaptive=not batch, project=sim.energy_projection)
+    # Under an outer jax.jit (a user's jitted loss) every jnp operation is staged, even on
+    # constants; the build relies on the scene's own values being concrete (NumPy meshes, host
+    # factors), so what does not depend on traced `params` is evaluated now, as outside jit.
+    with jax.ensure_compile_time_eval():
+        b = build(scene, params)
+        scheme = make_scheme(sim.scheme, sim.alpha, sim.rho_inf)
+        solver = make_solver(b.system, h, scheme, sim.tolerance, sim.max_iterations, sim.substeps,
+                             reuse=not batch, adaptive=not batch, project=sim.energy_projection)
     n_steps = int(round(T / h))
     return Setup(b, solver, n_steps, max(1, int(sim.save_every)))
 

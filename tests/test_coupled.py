@@ -205,3 +205,25 @@ def test_forced_roll_surface_amplitude_matches_the_linear_modal_solution(ratio):
     expected = abs(d[3 * node + 2]) * th0
     print(f"steady amplitude {amp:.6g} m, linear theory {expected:.6g} m, ratio {amp / expected:.4f}")
     assert abs(amp / expected - 1) < 0.05, (amp, expected)
+
+
+def test_simulate_works_inside_a_users_jax_jit():
+    """`jax.jit(jax.value_and_grad(loss))` of a loss through js.simulate(params=...), as an optax
+    loop would write it: the scene's own values stay concrete while it is built (a jnp operation
+    on constants is otherwise staged under jit), and the gradient agrees with central differences
+    of the same compiled function's values."""
+    import jax
+    import jax.numpy as jnp
+    scene = ship_with_tank(mesh=(2, 2, 2), duration=0.5, omega=(0.1, 0.05, 0.0))
+
+    @jax.jit
+    @jax.value_and_grad
+    def loss(gm):
+        r = js.simulate(scene, params={"vessel.hydrostatics.gm_t": gm})
+        return jnp.sum(r.vessel.roll_pitch_yaw[:, 0] ** 2) + jnp.sum(r.probes["B"].displacement[:, 2] ** 2)
+
+    v, g = loss(1.67)
+    eps = 1e-5
+    fd = (float(loss(1.67 + eps)[0]) - float(loss(1.67 - eps)[0])) / (2 * eps)
+    assert np.isfinite(float(v)) and float(v) > 0.0
+    assert abs(float(g) - fd) <= 1e-5 * abs(fd), (float(g), fd)
