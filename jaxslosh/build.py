@@ -16,6 +16,7 @@ import scipy.sparse as sp
 
 from .kinematics import quat_from_rpy
 from .model import Config, Forced, Hydro, Liquid, System
+from .reduction import is_reduced
 from .scene_types import Scene, SceneError
 
 class _Keys(tuple):
@@ -63,6 +64,7 @@ class Probes(NamedTuple):
     points: jnp.ndarray    # (P, 3) undeformed positions in the vessel frame
     weights: jnp.ndarray   # (P, N) interpolation of the liquid displacement (zero rows: the probe follows the tank)
     on_structures: tuple = ()   # StructureProbes per structure that has probes
+    modal: Optional[jnp.ndarray] = None   # (P, m, 3) weights @ basis, with a reduced liquid: probes from eta
 
 
 class StructureProbes(NamedTuple):
@@ -163,6 +165,8 @@ def build(scene: Scene, params: Optional[dict] = None) -> Built:
     if flex is not None:
         c0, v0, alg0 = _flex_start(system, c0, v0)
     probes = _build_probes(scene, tanks, liquid, blocks, vstructs or ())
+    if is_reduced(liquid):     # the frames keep eta; probes through the basis (run._frame)
+        probes = probes._replace(modal=jnp.einsum("pn,knc->pkc", probes.weights, liquid.U))
     return Built(system, c0, v0, probes, tanks, alg0, blocks)
 
 

@@ -53,7 +53,7 @@ class Frame(NamedTuple):
     pe: jax.Array
     iterations: jax.Array
     residual: jax.Array
-    D: jax.Array          # liquid nodal displacement (N, 3), empty without liquid
+    D: jax.Array          # liquid nodal displacement (N, 3), empty without liquid; a reduced liquid's eta (m,)
     failed: jax.Array
     gmax: jax.Array       # max |g| of the interface constraints (m), 0 without structures
 
@@ -94,12 +94,16 @@ def _frame(b: Built, s: State, it, err, failed) -> Frame:
         from .multibody import layout
         dd = layout(sysm).split(s.v)[2]
     A = rotation_matrix(s.c.q)
-    if sysm.liquid is not None:
+    pr = b.probes
+    if pr.modal is not None:       # reduced liquid: the frame keeps eta, mapped to nodes after the run
+        D = s.c.d
+        local = pr.points + jnp.einsum("pkc,k->pc", pr.modal, D)
+    elif sysm.liquid is not None:
         D = sysm.liquid.full(s.c.d)
+        local = pr.points + pr.weights @ D
     else:
         D = jnp.zeros((0, 3))
-    pr = b.probes
-    local = pr.points + (pr.weights @ D if sysm.liquid is not None else 0.0)
+        local = pr.points
     probes = s.c.X0[None, :] + local @ A.T
     ke = sysm.kinetic_energy(s.c, V0, om, dd)
     pe = sysm.potential_energy(s.c)
@@ -191,15 +195,24 @@ def _concat_frames(frames):
     return jax.tree_util.tree_map(lambda *xs: jnp.concatenate(xs), *frames)
 
 
+def _nodal(b: Built, D):
+    """Frames' liquid displacement as nodal fields (..., N, 3): a reduced liquid's frames hold its
+    modal coordinates (storing the nodal field every step cost more than the step itself)."""
+    if b.probes.modal is not None:
+        return jnp.einsum("...k,knc->...nc", D, b.system.liquid.U)
+    return D
+
+
 def _to_result(b: Built, fr: Frame, scene_text: str, status: str, steps_done: int) -> Result:
     probes = {}
     for i, name in enumerate(b.probes.names):
         pos = fr.probes[:, i, :]
         probes[name] = ProbeHistory(pos, pos - pos[0])
     tanks = {}
+    D = _nodal(b, fr.D) if b.tanks else fr.D
     for t in b.tanks:
         N = t.nodes.shape[0]
-        tanks[t.name] = TankField(t.nodes, t.elements, fr.D[:, t.node_offset:t.node_offset + N, :])
+        tanks[t.name] = TankField(t.nodes, t.elements, D[:, t.node_offset:t.node_offset + N, :])
     return Result(time=fr.t, vessel=VesselHistory(fr.X0, fr.q, fr.omega, rpy_from_quat(fr.q)), probes=probes,
                   energy=Energy(fr.ke, fr.pe), solver=SolverHistory(fr.iterations, fr.residual, fr.gmax), tanks=tanks,
                   status=status, steps_done=steps_done, scene_text=scene_text)
@@ -330,8 +343,9 @@ def _file_frames(b: Built, fr: Frame, p0, n: int, save_fields: bool) -> dict:
         d[f"probes/{name}/position"] = fr.probes[:n, i]
         d[f"probes/{name}/displacement"] = fr.probes[:n, i] - p0[i]
     if save_fields:
+        D = _nodal(b, fr.D[:n])
         for t in b.tanks:
-            d[f"tanks/{t.name}/displacement"] = fr.D[:n, t.node_offset:t.node_offset + t.nodes.shape[0]]
+            d[f"tanks/{t.name}/displacement"] = D[:, t.node_offset:t.node_offset + t.nodes.shape[0]]
     return {k: np.asarray(v) for k, v in d.items()}
 
 
