@@ -112,20 +112,13 @@ class Solver(eqx.Module):
 
 
 def make_solver(system: System, h: float, scheme: Scheme, tol: float, max_iter: int, substeps: int = 0,
-                reuse: bool = False, adaptive: bool = True, project: bool = False) -> Solver:
+                reuse: bool = False, adaptive: bool = True) -> Solver:
     """Factor the constant liquid blocks once (float64): NumPy for concrete matrices, JAX when the
     liquid was built from traced values (under jit).
 
     The inverses only precondition the Newton iterations and the tangent solves, whose solutions do
     not depend on them (`lax.custom_root` drops their tangents), so they are formed from
-    `stop_gradient` values: under `jax.grad` outside jit the matrices are then concrete again.
-
-    `project`: the energy projection after each step (project_energy; not with flexible structures)."""
-    if project:
-        if _has_flex(system):
-            raise ValueError("the energy projection is not available with flexible structures")
-        return dataclasses.replace(make_solver(system, h, scheme, tol, max_iter, substeps, reuse, adaptive),
-                                   project=True)
+    `stop_gradient` values: under `jax.grad` outside jit the matrices are then concrete again."""
     nf = system.nf
     substeps = int(substeps) if substeps and substeps > 1 else 0
     if getattr(system, "flex", None) is not None:

@@ -8,6 +8,8 @@ first failure, keeps every frame before it and reports the step, the time and th
 """
 from __future__ import annotations
 
+import dataclasses
+
 import math
 import sys
 import time as _time
@@ -79,7 +81,9 @@ def prepare(scene: Scene, params=None, duration=None, dt=None, batch: bool = Fal
         b = build(scene, params)
         scheme = make_scheme(sim.scheme, sim.alpha, sim.rho_inf)
         solver = make_solver(b.system, h, scheme, sim.tolerance, sim.max_iterations, sim.substeps,
-                             reuse=not batch, adaptive=not batch, project=sim.energy_projection)
+                             reuse=not batch, adaptive=not batch)
+    if sim.energy_projection:     # the scene check allows it only where it holds (scene._conservative)
+        solver = dataclasses.replace(solver, project=True)
     n_steps = int(round(T / h))
     return Setup(b, solver, n_steps, max(1, int(sim.save_every)))
 
@@ -209,7 +213,7 @@ def _to_result(b: Built, fr: Frame, scene_text: str, status: str, steps_done: in
         pos = fr.probes[:, i, :]
         probes[name] = ProbeHistory(pos, pos - pos[0])
     tanks = {}
-    D = _nodal(b, fr.D) if b.tanks else fr.D
+    D = _nodal(b, fr.D)
     for t in b.tanks:
         N = t.nodes.shape[0]
         tanks[t.name] = TankField(t.nodes, t.elements, D[:, t.node_offset:t.node_offset + N, :])

@@ -137,7 +137,8 @@ def test_spec_example_loads():
     assert s.vessel.hydrostatics.gm_t == 1.67 and s.vessel.hydrostatics.moment == "conservative"
     assert s.vessel.initial.angular_velocity == (0.1, 0.05, 0.0) and s.vessel.initial.position == (0, 0, 0)
     (tank,) = s.tanks
-    assert tank.name == "tank" and tank.size == (5.0, 5.0, 4.0) and tank.mesh == (5, 5, 5) and tank.walls == "rigid"
+    kind = tank.walls            # the scene key `walls` (rigid or elastic tank sides)
+    assert tank.name == "tank" and tank.size == (5.0, 5.0, 4.0) and tank.mesh == (5, 5, 5) and kind == "rigid"
     assert tank.fluid.element == ELEMENT_FORMS[0] == "stabilized"
     assert math.isclose(tank.liquid_mass, 75_000.0)
     assert [p.name for p in s.probes] == ["A", "B", "tip"]          # file order
@@ -173,8 +174,9 @@ def test_extra_keys_and_forms():
     assert s.tanks[0].fluid.element == "paper" and isinstance(s.vessel.mass, float)
     assert s.vessel.inertia[0][2] == s.vessel.inertia[2][0] == -1e5
     tank = s.tanks[0]
-    assert tank.walls == "elastic" and tank.wall_spec.thickness == 0.02 and tank.wall_spec.mesh == (5, 5, 4)
-    assert tank.wall_spec.material.poisson == 0.3
+    kind, sides = tank.walls, tank.wall_spec    # the scene's `walls` table: elastic tank sides
+    assert kind == "elastic" and sides.thickness == 0.02 and sides.mesh == (5, 5, 4)
+    assert sides.material.poisson == 0.3
     assert s.warnings == ()                                       # 335 t + 75 t = 410 t: balanced
 
 
