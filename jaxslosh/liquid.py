@@ -245,6 +245,14 @@ def build_liquid(size, fill_depth, mesh, density, sound_speed, gravity, element=
     )
 
 
+def surface_bending_scale(model: LiquidModel) -> float:
+    """The factor of `_surface_bending_pattern` in the stiffness (0 for the paper's form)."""
+    if model.element == "paper":
+        return 0.0
+    nx, ny, _ = model.mesh
+    return float(SURFACE_BENDING * model.density * model.gravity * (model.size[0] / nx) * (model.size[1] / ny))
+
+
 # ----------------------------------------------------------------------------------------------
 # topology (NumPy, cached per mesh) and assembly (SciPy for concrete values, a jitted JAX scatter-add for traced)
 

@@ -137,6 +137,9 @@ class Liquid(eqx.Module):
     # structures in the vessel's frame with centrifugal stiffening: (6, nf, nf) per component of
     # omega omega^T (structure.centrifugal_stiffness), None without
     Kg: Optional[jax.Array] = None
+    # large meshes (sparse.py): each tank's box grid ((nx, ny, nz, surface bending scale, element
+    # form), ...) in the stacking order, for the fast-diagonalization inverse (boxsolve.py)
+    grids: Optional[tuple] = eqx.field(static=True, default=None)
 
     def full(self, d):
         """(nf,) free-dof vector -> (N, 3) nodal field, zero on the wall-normal dofs (with elastic

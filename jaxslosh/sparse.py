@@ -90,6 +90,7 @@ class HostSparse(eqx.Module):
     bcoo: object
     rowsum: jax.Array
     handle: _Handle = eqx.field(static=True)
+    grid: object = None        # box tanks: the same matrix as a stencil (boxsolve.py), used instead
 
     @property
     def shape(self):
@@ -100,19 +101,24 @@ class HostSparse(eqx.Module):
         return self.handle.obj
 
     def __matmul__(self, x):
-        return self.bcoo @ x
+        return (self.bcoo if self.grid is None else self.grid) @ x
 
     def sum(self, axis=None):
         return self.rowsum.sum() if axis is None else self.rowsum
 
 
-def host_sparse(A) -> HostSparse:
+def host_sparse(A, layout=None) -> HostSparse:
+    """`layout`: the rows' places on box grids (see boxsolve.stencil), for the stencil product."""
     from jax.experimental.sparse import BCOO
     A = sp.csr_matrix(A)
     A = (0.5 * (A + A.T)).tocsr()
     A.sort_indices()
-    return HostSparse(BCOO.from_scipy_sparse(A), jnp.asarray(np.asarray(A.sum(axis=1)).reshape(-1)),
-                      _handle("matrix", A, lambda M: M))
+    grid = None
+    if layout is not None:
+        from .boxsolve import stencil
+        grid = stencil(A, layout)
+    return HostSparse(BCOO.from_scipy_sparse(A) if grid is None else None,
+                      jnp.asarray(np.asarray(A.sum(axis=1)).reshape(-1)), _handle("matrix", A, lambda M: M), grid)
 
 
 class HostInverse(eqx.Module):
@@ -151,9 +157,20 @@ def free_blocks(liquid):
 def sparse_solver_blocks(liquid, c_a_step, c_a_sub=None):
     """(Cinv_step, Cinv_mass, Cinv_sub or None, noise factor) for `integrator.make_solver`."""
     M, K = free_blocks(liquid)
-    step = host_inverse(c_a_step * M + K)
-    sub = host_inverse(c_a_sub * M + K) if c_a_sub is not None else None
-    return step, host_inverse(M), sub, K
+
+    def inverse(A, with_bending=True):
+        box = None
+        if liquid.grids is not None:      # box tanks: fast diagonalization (boxsolve.py), else LU
+            key = _content_key("box", sp.csr_matrix(A), (liquid.grids, with_bending))
+            if key not in _REGISTRY:
+                from .boxsolve import box_inverse
+                _REGISTRY[key] = box_inverse(A, liquid.grids, with_bending)
+            box = _REGISTRY[key]
+        return box if box is not None else host_inverse(A)
+
+    step = inverse(c_a_step * M + K)
+    sub = inverse(c_a_sub * M + K) if c_a_sub is not None else None
+    return step, inverse(M, with_bending=False), sub, K
 
 
 def hydrostatic_start(liquid, g_b):
