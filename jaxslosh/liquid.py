@@ -501,6 +501,10 @@ def _element_matrices(xe, xf, rho, c, g, h, form, with_parts=True):
             x = xf if on_faces else xe
             n = len(x)
             if not traced_x:          # concrete: chunks cut and joined in NumPy (no eager JAX op to compile)
+                # every energy is invariant under horizontal shifts (p0 depends on z only), so each
+                # distinct element shape and height is computed once (a uniform grid: one per layer)
+                x, expand = _distinct(np.asarray(x, dtype=np.float64), horizontal_only=not on_faces)
+                n = len(x)
                 blocks = []
                 for i in range(0, n, _CHUNK):
                     chunk = x[i:i + _CHUNK]
@@ -508,7 +512,7 @@ def _element_matrices(xe, xf, rho, c, g, h, form, with_parts=True):
                     if pad:
                         chunk = np.concatenate([chunk, np.repeat(chunk[:1], pad, axis=0)])
                     blocks.append(np.asarray(fn(prm, jnp.asarray(chunk, dtype=jnp.float64)))[:_CHUNK - pad])
-                out[name] = np.concatenate(blocks)
+                out[name] = np.concatenate(blocks)[expand]
             else:                     # traced: the same fixed-shape chunks, cut by dynamic slices
                 x = jnp.asarray(x, dtype=jnp.float64)
                 pad = -n % _CHUNK
@@ -516,6 +520,18 @@ def _element_matrices(xe, xf, rho, c, g, h, form, with_parts=True):
                 blocks = [fn(prm, jax.lax.dynamic_slice_in_dim(xpad, i, _CHUNK)) for i in range(0, n, _CHUNK)]
                 out[name] = (blocks[0] if len(blocks) == 1 else jnp.concatenate(blocks))[:n]
     return out
+
+
+def _distinct(x, horizontal_only):
+    """(the distinct elements of x (n, k, dim) up to a shift of their first corner, index of each
+    element's representative): horizontal shifts for volume elements, any shift for surface faces."""
+    rel = x.copy()
+    dims = slice(0, 2) if horizontal_only else slice(None)
+    rel[:, :, dims] -= x[:, :1, dims]
+    scale = max(float(np.abs(x).max()), 1e-300)
+    key = np.round(rel.reshape(len(x), -1) / scale, 11)
+    _, first, inverse = np.unique(key, axis=0, return_index=True, return_inverse=True)
+    return x[first], inverse.reshape(-1)
 
 
 _KERNEL_CACHE: dict = {}

@@ -178,11 +178,15 @@ def hydrostatic_start(liquid, g_b):
     from scipy.sparse.linalg import splu
     f = np.asarray(liquid.free)
     m = np.asarray(liquid.Ms.rowsum)
-    lu = splu(liquid.K.matrix.tocsc())
     F = np.zeros((3 * m.size, 3))
     for c in range(3):
         F[c::3, c] = m
-    D = lu.solve(F[f])
+    K = liquid.K.matrix
+    box = None
+    if liquid.grids is not None:          # box tanks: K itself diagonalizes (boxsolve.py)
+        from .boxsolve import box_inverse, solve
+        box = box_inverse(K, liquid.grids)
+    D = np.asarray(solve(box, jnp.asarray(F[f]))) if box is not None else splu(K.tocsc()).solve(F[f])
     return jnp.asarray(D) @ g_b
 
 
