@@ -36,6 +36,37 @@ def vessel_scene(duration=10.0, dt=0.01, scheme="hht", alpha=0.01, omega=(0.0, 0
     return js.load_scene(text)
 
 
+# ------------------------------------------------------------------------------------------------
+# scenes with elastic structures (test_multibody.py, test_multibody_parts.py): TOML text to concatenate
+
+STEEL = "[structures.material]\nyoung = {young!r}\npoisson = 0.3\ndensity = 7850.0\n"
+
+
+def mast(name="mast", origin=(-0.15, -0.15, 1.0), size=(0.3, 0.3, 4.0), mesh=(1, 1, 8), attach="z-", to=None,
+         young=2.1e11):
+    s = (f'[[structures]]\nname = "{name}"\norigin = {list(origin)}\nsize = {list(size)}\nmesh = {list(mesh)}\n'
+         f'attach = "{attach}"\n')
+    if to:
+        s += f'attach_to = "{to}"\n'
+    return s + STEEL.format(young=young)
+
+
+def multibody_vessel(duration=1.0, dt=0.01, scheme="newmark", extra_sim="", gravity=9.81, hydro=True, initial="",
+           extra_vessel="", mass=3.25e5, displaced=None):
+    hyd = ""
+    if hydro:
+        hyd = (f"[vessel.hydrostatics]\nwaterplane_area = 200.0\ndisplaced_volume = {displaced or mass / 1025.0!r}\n"
+               "gm_t = 1.67\ngm_l = 14.2\n")
+    return (f'title = "multibody test"\n[environment]\ngravity = {gravity!r}\n'
+            f'[simulation]\nduration = {duration!r}\ndt = {dt!r}\nscheme = "{scheme}"\n{extra_sim}\n'
+            f"[vessel]\nmass = {mass!r}\ninertia = [4.9e6, 1.45e7, 1.6e7]\n{hyd}"
+            f"[vessel.initial]\n{initial}\n{extra_vessel}\n")
+
+
+MULTIBODY_TANK = ('[[tanks]]\nname = "tank"\norigin = [-1.5, -1.0, -2.0]\nsize = [3.0, 2.0, 2.0]\nfill_depth = 1.2\n'
+        'mesh = [3, 2, 2]\n')
+
+
 def zero_crossing_period(t, x):
     """Mean period from upward zero crossings (linear interpolation between samples)."""
     t, x = np.asarray(t), np.asarray(x)

@@ -67,7 +67,10 @@ def test_liquid_at_rest_stays_at_rest():
 
 
 def test_heave_period_counts_the_liquid_and_the_surface_moves_with_the_tank():
-    scene = ship_with_tank(duration=14.0, position=(0.0, 0.0, 0.05))
+    """20 s, seven heave periods (was 14 s; the margins are the same over both: period 4.3e-5 off,
+    surface 9e-7 m). The scene differs from the at-rest test's only in its initial position, a value,
+    so it runs in that test's compiled time loop instead of compiling a second one."""
+    scene = ship_with_tank(duration=20.0, position=(0.0, 0.0, 0.05))
     m_total = 3.35e5 + 1000.0 * 5 * 5 * 3
     expected = 2 * np.pi * np.sqrt(m_total / (RHO_W * G * AW))
     r = js.simulate(scene)
