@@ -78,15 +78,31 @@ element = "paper"
     return js.load_scene(text)
 
 
-def test_sparse_run_is_the_dense_run():
-    """The paper scene with a second tank (the stacked blocks' offsets) through the dense inverses
-    and products and through the box-grid ones: motion and probe B agree to the Newton tolerance's
-    order over 50 steps."""
-    dense = js.simulate(_paper("dense"))
-    fast = js.simulate(_paper("sparse"))
-    assert fast.status == "ok" and dense.status == "ok"
-    om_d, om_s = np.asarray(dense.vessel.angular_velocity), np.asarray(fast.vessel.angular_velocity)
-    assert np.max(np.abs(om_s - om_d)) <= 1e-9 * np.max(np.abs(om_d))
-    pd, ps = np.asarray(dense.probes["B"].displacement), np.asarray(fast.probes["B"].displacement)
-    assert np.max(np.abs(ps - pd)) <= 1e-9 * np.max(np.abs(pd))
-    assert abs(float(np.mean(fast.solver.iterations)) - float(np.mean(dense.solver.iterations))) < 0.5
+def test_sparse_system_has_the_dense_residual_and_inverses():
+    """The paper scene with a second tank (the stacked blocks' offsets) built the dense way and the
+    box-grid way: the residual at a disturbed state and the step and mass inverses applied to it
+    agree to round-off, so the Newton iterations of the two are the same (a whole run of each is left
+    to the benchmarks: its compilation would cost the suite a minute)."""
+    import jax
+    from jaxslosh.boxsolve import BoxInverse, Stencil
+    from jaxslosh.run import _core, prepare
+
+    out = {}
+    for solver in ("dense", "sparse"):
+        setup = prepare(_paper(solver), duration=0.5)
+        b, slv = _core(setup.built), setup.solver
+        rng = np.random.default_rng(3)
+        c = b.c0._replace(d=b.c0.d + 1e-3 * jnp.asarray(rng.standard_normal(b.c0.d.shape)))
+        nf = c.d.shape[0]
+        dd, acc = (jnp.asarray(rng.standard_normal(k)) for k in (nf, 6 + nf))
+        sysm = b.system
+        r = jax.jit(lambda c, dd, acc: sysm.residual(c, jnp.array([0.1, 0.0, 0.2]), jnp.array([0.1, 0.05, 0.0]),
+                                                     dd, acc, 0.0, None))(c, dd, acc)
+        out[solver] = (np.asarray(r), np.asarray(slv.Cinv_step @ r[6:]), np.asarray(slv.Cinv_mass @ r[6:]), b, slv)
+    assert isinstance(out["sparse"][3].system.liquid.K.grid, Stencil)
+    assert isinstance(out["sparse"][4].Cinv_step, BoxInverse)
+    # the residual to round-off; the inverses to the dense explicit inverse's own error (about
+    # cond(C) eps, 3e-10 here; the box solve agrees with SciPy's sparse solve to 1e-9, test above)
+    for k, tol in ((0, 1e-10), (1, 1e-8), (2, 1e-8)):
+        d, f = out["dense"][k], out["sparse"][k]
+        assert np.linalg.norm(f - d) <= tol * np.linalg.norm(d), k
