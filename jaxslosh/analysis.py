@@ -8,9 +8,14 @@ def sloshing_modes(scene: Scene, tank=None, n: int = 10):
     """The first n modes of a tank's liquid: `Modes(omega, kind, free_surface_share, shapes)`."""
     from .liquid import build_liquid
     from .modes import liquid_modes
+    from .effects import free_liquid_dofs
+    from .sparse import SPARSE_AUTO
     t = scene.tank(tank) if tank is not None else scene.tanks[0]
+    # large meshes as the simulation takes them: sparse matrices and shift-invert Lanczos (a dense
+    # generalized eigh of 20 x 20 x 12 needs 2 GB a matrix and crashed OpenBLAS)
+    large = t.wall_spec is None and free_liquid_dofs(t) > SPARSE_AUTO
     model = build_liquid(t.size, t.fill_depth, t.mesh, t.fluid.density, t.fluid.sound_speed,
-                         scene.environment.gravity, element=t.fluid.element)
+                         scene.environment.gravity, element=t.fluid.element, sparse=large)
     if t.wall_spec is not None:       # the liquid and its elastic walls together (kinds add "wall")
         from .tankwalls import build_tank_with_walls, tank_modes
         return tank_modes(build_tank_with_walls(t, model), n=n)

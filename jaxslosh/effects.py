@@ -105,14 +105,18 @@ def switched_off(scene: Scene) -> list[str]:
     return [k for k in EFFECTS if not getattr(scene.effects, k)]
 
 
+def free_liquid_dofs(tank) -> int:
+    """A tank's free liquid dofs: three per node, less the wall-normal ones the slip walls hold."""
+    nx, ny, nz = tank.mesh
+    nodes = (nx + 1) * (ny + 1) * (nz + 1)
+    return 3 * nodes - (2 * (ny + 1) * (nz + 1) + 2 * (nx + 1) * (nz + 1) + (nx + 1) * (ny + 1))
+
+
 def liquid_unknowns(scene: Scene) -> int:
     """Unknowns of the full-order liquid block: every tank's free liquid dofs, and its elastic walls'."""
     n = 0
     for t in scene.tanks:
-        nx, ny, nz = t.mesh
-        nodes = (nx + 1) * (ny + 1) * (nz + 1)
-        fixed = 2 * (ny + 1) * (nz + 1) + 2 * (nx + 1) * (nz + 1) + (nx + 1) * (ny + 1)
-        n += 3 * nodes - fixed
+        n += free_liquid_dofs(t)
         if t.wall_spec is not None:       # the walls' free nodes (the liquid's normal dofs share theirs)
             from .structure import wall_mesh
             _, _, _, held = wall_mesh(t.size, t.fill_depth, t.mesh, t.wall_spec.thickness, t.wall_spec.mesh)

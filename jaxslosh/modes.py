@@ -21,6 +21,7 @@ from dataclasses import dataclass
 
 import numpy as np
 import scipy.linalg as sl
+import scipy.sparse as sp
 
 from .liquid import LiquidModel
 
@@ -43,12 +44,13 @@ def free_mass(model: LiquidModel) -> np.ndarray:
 
 
 def liquid_modes(model: LiquidModel, n: int = 10) -> Modes:
-    """The n lowest modes of the liquid with the tank held fixed."""
+    """The n lowest modes of the liquid with the tank held fixed (a model built with sparse=True:
+    shift-invert Lanczos on its sparse matrices, for meshes whose dense matrices would not fit)."""
+    from .reduction import _free_matrices, _natural_modes
     f = model.free
-    K = model.stiffness[np.ix_(f, f)]
-    M = free_mass(model)
-    n = int(min(n, K.shape[0]))
-    lam, X = sl.eigh(K, M, subset_by_index=[0, n - 1])
+    K, M = _free_matrices(model)
+    n = int(min(n, K.shape[0] - (1 if sp.issparse(K) else 0)))
+    lam, X = _natural_modes(K, M, n)
     omega = np.sign(lam) * np.sqrt(np.abs(lam))
     shapes = np.zeros((n, f.size))
     shapes[:, f] = X.T
@@ -59,7 +61,7 @@ def liquid_modes(model: LiquidModel, n: int = 10) -> Modes:
 def energy_shares(model: LiquidModel, shapes: np.ndarray) -> dict:
     """Fractions of each mode's potential energy held by the measures in ``model.parts``."""
     shapes = np.atleast_2d(shapes)
-    total = np.einsum("ij,jk,ik->i", shapes, model.stiffness, shapes)
+    total = np.einsum("ij,ij->i", shapes, (model.stiffness @ shapes.T).T)
     total = np.where(total > 0, total, np.inf)
     out = {}
     for name, part in model.parts.items():

@@ -198,7 +198,7 @@ def wants_sparse(scene) -> bool:
     choice = getattr(scene.simulation, "linear_solver", "auto")
     if choice != "auto":
         return choice == "sparse"
-    if any(t.wall_spec is not None for t in scene.tanks) or any(t.reduction is not None for t in scene.tanks):
-        return False             # elastic walls and modal tanks have dense blocks of their own
+    if any(t.wall_spec is not None for t in scene.tanks):
+        return False             # elastic walls have dense blocks of their own
     from .effects import liquid_unknowns
     return liquid_unknowns(scene) > SPARSE_AUTO
