@@ -250,9 +250,10 @@ def _build_liquid(scene: Scene, params: Optional[dict] = None, gravity=None, inc
         meshes = [tuple(m.mesh) for m in models]
         nodes_of = [np.arange(m.nodes.shape[0]) for m in models]
         free_of = [np.flatnonzero(np.asarray(m.free)) for m in models]
+        layers = tuple(m.layers for m in models)
         liquid = Liquid(r=jnp.asarray(np.concatenate(rs)),
-                        Ms=host_sparse(sp.block_diag(Ms_list), tuple(zip(meshes, [1] * len(models), nodes_of))),
-                        K=host_sparse(sp.block_diag(K_list), tuple(zip(meshes, [3] * len(models), free_of))),
+                        Ms=host_sparse(sp.block_diag(Ms_list), tuple(zip(meshes, [1] * len(models), nodes_of)), layers),
+                        K=host_sparse(sp.block_diag(K_list), tuple(zip(meshes, [3] * len(models), free_of)), layers),
                         free=jnp.asarray(np.concatenate(free_list)),
                         n_nodes=offset, Kdt=Kdt, Ktt=jnp.asarray(Ktt) if coupled else None,
                         grids=tuple(m.mesh + (surface_bending_scale(m), m.element) for m in models))

@@ -158,6 +158,9 @@ class LiquidModel:
     rotation_stiffness: Optional[np.ndarray] = None
     parts: dict = field(default_factory=dict)
     traced: bool = False
+    # sparse builds on a grid whose layers are uniform: the element matrices of each layer, for
+    # products element by element (boxsolve.elements); None otherwise
+    layers: Optional[dict] = None
 
     @property
     def n_nodes(self) -> int:
@@ -237,12 +240,44 @@ def build_liquid(size, fill_depth, mesh, density, sound_speed, gravity, element=
     parts = {}
     if not traced:
         parts = topo.parts(el, out)
+    layers = _layer_blocks(el, out, (nx, ny, nz), element, bending) if sparse and not traced else None
     return LiquidModel(
         nodes=nodes, elements=topo.elements, mass=mass, stiffness=stiffness, free=topo.free.reshape(-1).copy(),
         surface=topo.surface.copy(), density=rho, sound_speed=c, gravity=g, size=tuple(float(s) for s in size),
         depth=h, element=element, mesh=(nx, ny, nz), rotation_coupling=coupling,
-        rotation_stiffness=theta_theta, parts=parts, traced=traced,
+        rotation_stiffness=theta_theta, parts=parts, traced=traced, layers=layers,
     )
+
+
+def _layer_blocks(el, out, mesh, form, bending):
+    """The stiffness and mass as element matrices per layer (every element of a layer has the same
+    ones on a uniform grid, see `_distinct`): {"stiffness": (nz, 24, 24), "mass": (nz, 8, 8),
+    "surface": (4, 4) on the top faces' vertical dofs or None, "bending": the surface bending's
+    scale}; None where the assembly holds anything else (the stabilized element's wall pairs of an
+    odd mesh) or a layer is not uniform."""
+    nx, ny, nz = mesh
+    if form == "paper":
+        Ke, Kf, bend = el["acoustic"] + el["prestress"], None, 0.0
+    else:
+        if len(out["pair_blocks"]):
+            return None
+        Ke = el["acoustic"] + el["coupling"] + out["rotation_blocks"]
+        Kf, bend = el["free_surface"] + el["surface_hourglass"], float(bending)
+
+    def per_layer(E, n):
+        E = np.asarray(E).reshape(nx * ny, nz, n, n)
+        if np.abs(E - E[:1]).max() > 1e-13 * np.abs(E).max():
+            return None
+        return E[0]
+    Ks, Ms = per_layer(Ke, 24), per_layer(el["mass"], 8)
+    if Ks is None or Ms is None:
+        return None
+    if Kf is not None:
+        Kf = np.asarray(Kf)
+        if np.abs(Kf - Kf[:1]).max() > 1e-13 * np.abs(Kf).max():
+            return None
+        Kf = 0.5 * (Kf[0] + Kf[0].T)
+    return {"stiffness": 0.5 * (Ks + np.swapaxes(Ks, 1, 2)), "mass": Ms, "surface": Kf, "bending": bend}
 
 
 def surface_bending_scale(model: LiquidModel) -> float:

@@ -8,8 +8,10 @@ free unknowns, whose dense stiffness, mass and step-matrix inverses would take 2
   (differentiable, transposable and batchable: the Newton preconditioner and the implicit
   gradients linearise and transpose the residual) and as SciPy CSR for the factors;
 * the constant liquid block C = c_a M + K is inverted by fast diagonalization where every tank is
-  a box grid it fits (boxsolve.py: pure JAX, under a millisecond at 20 x 20 x 12), and the
-  products of `HostSparse` are then grid stencils instead of BCOO gathers and scatters;
+  a box grid it fits (boxsolve.py: pure JAX, under a millisecond at 20 x 20 x 12);
+* the products of `HostSparse` go element by element where every tank's layers are uniform (one
+  element matrix per layer, boxsolve.Elements), else as grid stencils (boxsolve.Stencil), else
+  as BCOO gathers and scatters;
 * otherwise `HostInverse` applies a sparse LU factor (SuperLU, symmetric mode, minimum-degree
   ordering on A + A^T; 20-25 ms a solve at 20 x 20 x 12): the Newton iterations only need an
   approximate inverse (lax.custom_root), so a host-side factor is a legitimate preconditioner, and
@@ -93,7 +95,7 @@ class HostSparse(eqx.Module):
     bcoo: object
     rowsum: jax.Array
     handle: _Handle = eqx.field(static=True)
-    grid: object = None        # box tanks: the same matrix as a stencil (boxsolve.py), used instead
+    grid: object = None        # box tanks: the same matrix element by element or as a stencil (boxsolve.py), used instead
 
     @property
     def shape(self):
@@ -110,14 +112,19 @@ class HostSparse(eqx.Module):
         return self.rowsum.sum() if axis is None else self.rowsum
 
 
-def host_sparse(A, layout=None) -> HostSparse:
-    """`layout`: the rows' places on box grids (see boxsolve.stencil), for the stencil product."""
+def host_sparse(A, layout=None, layers=None) -> HostSparse:
+    """`layout`: the rows' places on box grids (see boxsolve.stencil), for the stencil product;
+    `layers`: each tank's element matrices per layer (LiquidModel.layers), for the product element
+    by element (boxsolve.elements), which is preferred where every tank has them."""
     from jax.experimental.sparse import BCOO
     A = sp.csr_matrix(A)
     A = (0.5 * (A + A.T)).tocsr()
     A.sort_indices()
     grid = None
-    if layout is not None:
+    if layers is not None and layout is not None:
+        from .boxsolve import elements
+        grid = elements(A, tuple(lay + (blk,) for lay, blk in zip(layout, layers)))
+    if grid is None and layout is not None:
         from .boxsolve import stencil
         grid = stencil(A, layout)
     return HostSparse(BCOO.from_scipy_sparse(A) if grid is None else None,
