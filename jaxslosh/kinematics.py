@@ -10,7 +10,6 @@ the unit-norm constraint of eq. (25) needs no multiplier (PHYSICS.md section 2, 
 from __future__ import annotations
 
 import jax.numpy as jnp
-import numpy as np
 
 
 def mv3(A, x):
@@ -24,24 +23,19 @@ def tv3(A, x):
     return A[0] * x[0] + A[1] * x[1] + A[2] * x[2]
 
 
-#: the Levi-Civita symbol: skew(v)_ik = sum_j EPS_ijk v_j
-EPS = np.zeros((3, 3, 3))
-EPS[0, 1, 2] = EPS[1, 2, 0] = EPS[2, 0, 1] = 1.0
-EPS[0, 2, 1] = EPS[2, 1, 0] = EPS[1, 0, 2] = -1.0
-
-
 def skew(v):
-    """The cross-product matrix: skew(a) @ b = a x b (the paper's tilde). One contraction with the
-    Levi-Civita symbol rather than nine scalars: every primitive costs tracing time under the
-    nested transformations of the Newton preconditioner, and these small matrices are built often."""
-    return jnp.einsum("ijk,j->ik", EPS, v)
+    """The cross-product matrix: skew(a) @ b = a x b (the paper's tilde)."""
+    return jnp.array([[0.0, -v[2], v[1]], [v[2], 0.0, -v[0]], [-v[1], v[0], 0.0]])
 
 
 def rotation_matrix(q):
-    """A(q): body to inertial, A = (q0^2 - v.v) I + 2 v v^T + 2 q0 skew(v) with v = (q1, q2, q3)
-    (Euler-Rodrigues; equal to the paper's quadratic form in q for any q)."""
-    q0, v = q[0], q[1:]
-    return (q0 * q0 - v @ v) * jnp.eye(3) + 2.0 * (v[:, None] * v[None, :] + q0 * skew(v))
+    """A(q): body to inertial."""
+    q0, q1, q2, q3 = q
+    return jnp.array([
+        [q0 * q0 + q1 * q1 - q2 * q2 - q3 * q3, 2 * (q1 * q2 - q0 * q3), 2 * (q1 * q3 + q0 * q2)],
+        [2 * (q1 * q2 + q0 * q3), q0 * q0 - q1 * q1 + q2 * q2 - q3 * q3, 2 * (q2 * q3 - q0 * q1)],
+        [2 * (q1 * q3 - q0 * q2), 2 * (q2 * q3 + q0 * q1), q0 * q0 - q1 * q1 - q2 * q2 + q3 * q3],
+    ])
 
 
 def G_matrix(q):
