@@ -100,6 +100,10 @@ class Solver(eqx.Module):
     # after each step, scale the velocities so that the total energy is the initial one (the
     # `simulation.energy_projection` key: trapezoidal rule, conservative scenes only; see project_energy)
     project: bool = eqx.field(static=True, default=False)
+    # with reuse and not adaptive (vmapped batches): the carried preconditioner is formed afresh at
+    # every this-many-th step (the step counter is the same for every run of a batch, so the cond
+    # stays a branch under vmap); 0: at every step
+    refresh_every: int = eqx.field(static=True, default=0)
 
     def sub_solver(self) -> "Solver":
         return Solver(self.Cinv_sub, self.Cinv_mass, self.h / self.substeps, self.scheme, self.tol, self.max_iter,
@@ -257,7 +261,7 @@ def _preconditioner(A, like, Cinv, ns=6):
 SLOW = 0.01
 
 
-def _newton(R, x0, Cinv, scale, tol, max_iter, pre=None, floor=0.0, adaptive=True, ns=6, split=None):
+def _newton(R, x0, Cinv, scale, tol, max_iter, pre=None, floor=0.0, adaptive=True, ns=6, split=None, fresh=None):
     """Quasi-Newton iterations on R(x) = 0 (x: ns rigid and algebraic unknowns, then the liquid's and
     the structures' modal ones) with the
     structured approximate inverse of the Jacobian, formed at the first iteration of the step and
@@ -267,8 +271,10 @@ def _newton(R, x0, Cinv, scale, tol, max_iter, pre=None, floor=0.0, adaptive=Tru
     convergence fast (and formed afresh when not valid); the one used last is returned with the
     aux. `floor`: the round-off floor of the scaled residual; the iterations stop below
     max(tol, floor). `adaptive=False`: formed once before the iterations, never inside (vmapped
-    batches, where a lax.cond computes both branches). `split` = (Rc, nr): unknowns nr..ns enter R
-    only through the cheap part Rc (see _precond_data_split)."""
+    batches, where a lax.cond computes both branches); then, with `pre` carried, `fresh` (a boolean
+    that is the same for every run of a batch) says whether to form it anew or use the carried one
+    through this step. `split` = (Rc, nr): unknowns nr..ns enter R only through the cheap part Rc
+    (see _precond_data_split)."""
     tol = jnp.maximum(tol, floor)
 
     def err_of(r):
@@ -300,7 +306,13 @@ def _newton(R, x0, Cinv, scale, tol, max_iter, pre=None, floor=0.0, adaptive=Tru
 
     r0 = R(x0)
     if not adaptive:
-        data0, need0 = refresh(x0), jnp.array(False)
+        if pre is not None and fresh is not None:
+            # `fresh` only, never the carried validity flag, which is per run: the predicate stays
+            # unbatched and the cond a branch (the first step of a run is always fresh)
+            data0 = jax.lax.cond(fresh, refresh, lambda _: pre[0], x0)
+        else:
+            data0 = refresh(x0)
+        need0 = jnp.array(False)
     elif pre is not None:
         data0, need0 = pre[0], ~(pre[1] > 0.5)
     else:
@@ -355,11 +367,12 @@ def solve_root(R, x0, Cinv, scale, tol, max_iter, ns=6, split=None):
     return x, (it.astype(jnp.int32), err, ok > 0.5)
 
 
-def solve_root_carried(R, x0, Cinv, scale, tol, max_iter, pre=None, floor=0.0, adaptive=True, ns=6, split=None):
+def solve_root_carried(R, x0, Cinv, scale, tol, max_iter, pre=None, floor=0.0, adaptive=True, ns=6, split=None,
+                       fresh=None):
     """`solve_root` with a preconditioner carried in and out (`pre`, see `_newton`; None: formed
     here and not returned), a round-off floor and the batch mode. Returns x, (it, err, ok), pre."""
     out = jax.lax.custom_root(
-        R, x0, lambda f, x: _newton(f, x, Cinv, scale, tol, max_iter, pre, floor, adaptive, ns, split),
+        R, x0, lambda f, x: _newton(f, x, Cinv, scale, tol, max_iter, pre, floor, adaptive, ns, split, fresh),
         _tangent_solver(Cinv, ns), has_aux=True)
     x, aux = out
     it, err, ok = jax.lax.stop_gradient(aux[:3])
@@ -534,7 +547,7 @@ def _flex_initial_state(system, solver: Solver, c0: Config, v0, alg0):
     return State(c0, v0, acc0, acc0, jnp.zeros(()), pre, alg, z0), info
 
 
-def _flex_step(system, solver: Solver, s: State) -> tuple[State, StepInfo]:
+def _flex_step(system, solver: Solver, s: State, fresh=None) -> tuple[State, StepInfo]:
     """The step with structures: unknowns [Delta_y, (X_f, lambda), Delta_z]; the constraint rows
     are g(q_{n+1}) m_ref / (beta h^2) (forces), converged when g / (beta h^2) is below the tolerance
     like the acceleration errors of the other rows, or |g| below 1e-13 of the interface's size
@@ -565,7 +578,7 @@ def _flex_step(system, solver: Solver, s: State) -> tuple[State, StepInfo]:
     pre = s.pre if solver.reuse else None
     x, (it, err, ok), pre_new = solve_root_carried(lambda x: Rm(x) + Rc(x), L.to_x(pred, s.alg), solver.Cinv_step,
                                                    scale, solver.tol, solver.max_iter, pre, floor, solver.adaptive,
-                                                   L.n_small, (Rc, L.n_rigid))
+                                                   L.n_small, (Rc, L.n_rigid), fresh)
     dyn, alg = L.from_x(x)
     c, v, acc, a = unpack(dyn)
     ok = ok & jnp.all(jnp.isfinite(x))
@@ -573,16 +586,17 @@ def _flex_step(system, solver: Solver, s: State) -> tuple[State, StepInfo]:
             StepInfo(it, err, ok))
 
 
-def step(system: System, solver: Solver, s: State) -> tuple[State, StepInfo]:
-    """One implicit step t_n -> t_{n+1}; the unknown is the increment Delta = (dX0, Theta, dd)."""
+def step(system: System, solver: Solver, s: State, fresh=None) -> tuple[State, StepInfo]:
+    """One implicit step t_n -> t_{n+1}; the unknown is the increment Delta = (dX0, Theta, dd).
+    `fresh`: batch mode with a carried preconditioner, whether this step forms it anew (see _newton)."""
     if _has_flex(system):
-        return _flex_step(system, solver, s)
+        return _flex_step(system, solver, s, fresh)
     scale = system.scales()            # residual rows / scale: accelerations (m/s^2, rad/s^2)
     R, unpack, x0 = step_equations(system, solver, s)
     floor = solver.noise * jnp.max(jnp.abs(s.c.d), initial=0.0)
     pre = s.pre if solver.reuse else None
     delta, (it, err, ok), pre_new = solve_root_carried(R, x0, solver.Cinv_step, scale, solver.tol, solver.max_iter,
-                                                       pre, floor, solver.adaptive)
+                                                       pre, floor, solver.adaptive, fresh=fresh)
     c, v, acc, a = unpack(delta)
     ok = ok & jnp.all(jnp.isfinite(delta))
     z = memory_next(system, solver, s, v)
@@ -592,10 +606,14 @@ def step(system: System, solver: Solver, s: State) -> tuple[State, StepInfo]:
             StepInfo(it, err, ok))
 
 
-def step_or_retry(system: System, solver: Solver, s: State) -> tuple[State, StepInfo]:
+def step_or_retry(system: System, solver: Solver, s: State, n=None) -> tuple[State, StepInfo]:
     """One step; when it fails and `solver.substeps` > 1, the step is redone as that many sub-steps
-    (the iterations of every attempt are counted)."""
-    s1, info = step(system, solver, s)
+    (the iterations of every attempt are counted). `n`: the steps attempted so far (the same for every
+    run of a batch), which times the preconditioner's refresh in batch mode (Solver.refresh_every)."""
+    fresh = None
+    if solver.refresh_every and n is not None:
+        fresh = n % solver.refresh_every == 0
+    s1, info = step(system, solver, s, fresh)
     if not solver.substeps:
         return s1, info
     sub = solver.sub_solver()

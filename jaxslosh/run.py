@@ -43,6 +43,7 @@ class Carry(NamedTuple):
     fail_step: jax.Array
     fail_err: jax.Array
     fail_it: jax.Array
+    n: jax.Array          # steps attempted, failed or not: the same for every run of a batch (never batched)
 
 
 class Frame(NamedTuple):
@@ -60,6 +61,11 @@ class Frame(NamedTuple):
     gmax: jax.Array       # max |g| of the interface constraints (m), 0 without structures
 
 
+#: in vmapped batches the Newton preconditioner is carried from step to step and formed anew every
+#: this many steps (single runs form it anew when convergence slows, which a batch cannot test per run)
+BATCH_REFRESH = 4
+
+
 class Setup(NamedTuple):
     built: Built
     solver: Solver
@@ -68,9 +74,9 @@ class Setup(NamedTuple):
 
 
 def prepare(scene: Scene, params=None, duration=None, dt=None, batch: bool = False) -> Setup:
-    """The static model, the solver and the step count. `batch`: the solver for vmapped runs (the
-    preconditioner formed once per step, no lax.cond in the iterations); otherwise it is carried
-    from step to step and formed again only when convergence slows."""
+    """The static model, the solver and the step count. The Newton preconditioner is carried from
+    step to step; single runs form it again when convergence slows, `batch` (vmapped runs: no
+    lax.cond on a per-run test) every BATCH_REFRESH steps."""
     sim = scene.simulation
     h = float(dt if dt is not None else sim.dt)
     T = float(duration if duration is not None else sim.duration)
@@ -81,7 +87,9 @@ def prepare(scene: Scene, params=None, duration=None, dt=None, batch: bool = Fal
         b = build(scene, params)
         scheme = make_scheme(sim.scheme, sim.alpha, sim.rho_inf)
         solver = make_solver(b.system, h, scheme, sim.tolerance, sim.max_iterations, sim.substeps,
-                             reuse=not batch, adaptive=not batch)
+                             reuse=True, adaptive=not batch)
+    if batch:      # carried, formed anew every BATCH_REFRESH steps (a cond inside the iterations would
+        solver = dataclasses.replace(solver, refresh_every=BATCH_REFRESH)    # run both branches under vmap)
     if sim.energy_projection:     # the scene check allows it only where it holds (scene._conservative)
         solver = dataclasses.replace(solver, project=True)
     n_steps = int(round(T / h))
@@ -139,7 +147,7 @@ def _select(pred, a, b):
 def start(b: Built, solver: Solver):
     s0, info = initial_state(b.system, solver, b.c0, b.v0, b.alg0)
     failed = ~info.ok
-    carry = Carry(s0, jnp.array(0), failed, jnp.where(failed, 0, -1), info.residual, info.iterations)
+    carry = Carry(s0, jnp.array(0), failed, jnp.where(failed, 0, -1), info.residual, info.iterations, jnp.array(0))
     return carry, _frame(b, s0, info.iterations, info.residual, failed)
 
 
@@ -152,13 +160,13 @@ def advance(b: Built, solver: Solver, carry: Carry, n_frames: int, save_every: i
     """n_frames frames of save_every steps each: one scan of scans, no Python loop in traced code."""
 
     def one_step(c: Carry, _):
-        s_new, info = step_or_retry(b.system, solver, c.s)
+        s_new, info = step_or_retry(b.system, solver, c.s, c.n)
         bad = ~info.ok & ~c.failed
         keep = c.failed | ~info.ok
         s = _select(keep, c.s, s_new)
         c2 = Carry(s, c.k + jnp.where(keep, 0, 1), c.failed | ~info.ok,
                    jnp.where(bad, c.k + 1, c.fail_step), jnp.where(bad, info.residual, c.fail_err),
-                   jnp.where(bad, info.iterations, c.fail_it))
+                   jnp.where(bad, info.iterations, c.fail_it), c.n + 1)
         return c2, (info.iterations, info.residual)
 
     def one_frame(c: Carry, _):
