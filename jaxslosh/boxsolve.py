@@ -233,6 +233,13 @@ class StencilTank(eqx.Module):
         return jnp.stack(y, axis=3).reshape(X * Y * Z * k, m)[self.free]
 
 
+def _stacked_apply(tanks, x):
+    """The block-diagonal product: each tank's `apply` on its rows of x ((n,) or (n, m))."""
+    x2 = x[:, None] if x.ndim == 1 else x
+    y = jnp.concatenate([t.apply(x2[t.start:t.stop]) for t in tanks])
+    return y[:, 0] if x.ndim == 1 else y
+
+
 class Stencil(eqx.Module):
     """`A @ x` for a block-diagonal sparse matrix whose blocks live on box grids: each row a fixed
     pattern of neighbours (27 for hexahedra, a few more for the surface bending), so the product is
@@ -244,9 +251,7 @@ class Stencil(eqx.Module):
     n: int = eqx.field(static=True)
 
     def __matmul__(self, x):
-        x2 = x[:, None] if x.ndim == 1 else x
-        y = jnp.concatenate([t.apply(x2[t.start:t.stop]) for t in self.tanks])
-        return y[:, 0] if x.ndim == 1 else y
+        return _stacked_apply(self.tanks, x)
 
 
 def stencil(A, layout):
@@ -354,9 +359,7 @@ class Elements(eqx.Module):
     n: int = eqx.field(static=True)
 
     def __matmul__(self, x):
-        x2 = x[:, None] if x.ndim == 1 else x
-        y = jnp.concatenate([t.apply(x2[t.start:t.stop]) for t in self.tanks])
-        return y[:, 0] if x.ndim == 1 else y
+        return _stacked_apply(self.tanks, x)
 
 
 def elements(A, layout, check=1e-12):
