@@ -104,10 +104,16 @@ class Solver(eqx.Module):
     # every this-many-th step (the step counter is the same for every run of a batch, so the cond
     # stays a branch under vmap); 0: at every step
     refresh_every: int = eqx.field(static=True, default=0)
+    # the Newton solves are differentiable (lax.custom_root: gradients by the implicit function
+    # theorem). False where nothing a run depends on is traced for differentiation (run.prepare):
+    # custom_root traces the linearisation and both tangent solves of every root even when no
+    # gradient is taken, a fifth of a scene's tracing; the iterations and their result are the same
+    implicit: bool = eqx.field(static=True, default=True)
 
     def sub_solver(self) -> "Solver":
         return Solver(self.Cinv_sub, self.Cinv_mass, self.h / self.substeps, self.scheme, self.tol, self.max_iter,
-                      noise=self.noise, adaptive=self.adaptive, ns=self.ns, project=self.project)
+                      noise=self.noise, adaptive=self.adaptive, ns=self.ns, project=self.project,
+                      implicit=self.implicit)
 
     @property
     def c_a(self):
@@ -357,23 +363,29 @@ def _tangent_solver(Cinv, ns=6):
     return tangent_solve
 
 
-def solve_root(R, x0, Cinv, scale, tol, max_iter, ns=6, split=None):
+def _root(R, x0, newton, Cinv, ns, implicit):
+    """newton(R, x0), differentiable by the implicit function theorem when `implicit`."""
+    if not implicit:
+        return newton(R, x0)
+    return jax.lax.custom_root(R, x0, newton, _tangent_solver(Cinv, ns), has_aux=True)
+
+
+def solve_root(R, x0, Cinv, scale, tol, max_iter, ns=6, split=None, implicit=True):
     """Root of R near x0; differentiable by the implicit function theorem (lax.custom_root), the
-    tangent systems solved with the same structure as the Newton iterations."""
-    x, (it, err, ok) = jax.lax.custom_root(
-        R, x0, lambda f, x: _newton(f, x, Cinv, scale, tol, max_iter, ns=ns, split=split),
-        _tangent_solver(Cinv, ns), has_aux=True)
+    tangent systems solved with the same structure as the Newton iterations (`implicit=False`: the
+    iterations alone, for runs that no gradient goes through)."""
+    x, (it, err, ok) = _root(R, x0, lambda f, x: _newton(f, x, Cinv, scale, tol, max_iter, ns=ns, split=split),
+                             Cinv, ns, implicit)
     it, err, ok = jax.lax.stop_gradient((it, err, ok))
     return x, (it.astype(jnp.int32), err, ok > 0.5)
 
 
 def solve_root_carried(R, x0, Cinv, scale, tol, max_iter, pre=None, floor=0.0, adaptive=True, ns=6, split=None,
-                       fresh=None):
+                       fresh=None, implicit=True):
     """`solve_root` with a preconditioner carried in and out (`pre`, see `_newton`; None: formed
     here and not returned), a round-off floor and the batch mode. Returns x, (it, err, ok), pre."""
-    out = jax.lax.custom_root(
-        R, x0, lambda f, x: _newton(f, x, Cinv, scale, tol, max_iter, pre, floor, adaptive, ns, split, fresh),
-        _tangent_solver(Cinv, ns), has_aux=True)
+    out = _root(R, x0, lambda f, x: _newton(f, x, Cinv, scale, tol, max_iter, pre, floor, adaptive, ns, split, fresh),
+                Cinv, ns, implicit)
     x, aux = out
     it, err, ok = jax.lax.stop_gradient(aux[:3])
     new_pre = jax.lax.stop_gradient(aux[3]) if pre is not None else None
@@ -422,7 +434,8 @@ def initial_state(system: System, solver: Solver, c0: Config, v0, alg0=None) -> 
         V0, om, dd = _split(v0)
         return system.residual(c0, V0, om, dd, acc, jnp.zeros(()), mu0)
 
-    acc0, (it, err, ok) = solve_root(R, jnp.zeros_like(v0), solver.Cinv_mass, scale, solver.tol, solver.max_iter)
+    acc0, (it, err, ok) = solve_root(R, jnp.zeros_like(v0), solver.Cinv_mass, scale, solver.tol, solver.max_iter,
+                                     implicit=solver.implicit)
     pre = empty_pre(system) if solver.reuse else None
     e0 = total_energy(system, c0, v0) if solver.project else None
     return State(c0, v0, acc0, acc0, jnp.zeros(()), pre=pre, z=z0, e0=e0), StepInfo(it, err, ok)
@@ -517,7 +530,7 @@ def static_structures(system, solver: Solver, c0: Config, v0, alg0):
         return jnp.where(held_x, 0.0, mb.constraint_rows(system, c, alg, mb.constraint(system, c, alg), gsc))
 
     x, (it, err, ok) = solve_root(lambda x: Rm(x) + Rc(x), L.to_x(z, alg0), Cinv, scale, solver.tol,
-                                  solver.max_iter, L.n_small, split=(Rc, L.n_rigid))
+                                  solver.max_iter, L.n_small, split=(Rc, L.n_rigid), implicit=solver.implicit)
     dyn, alg = L.from_x(x)
     c = mb.advance(system, c0, dyn)
     # every structure moves rigidly with the vessel: V_s = V + (A omega) x (X_s - X0), omega_s = A_s^T A omega
@@ -539,7 +552,7 @@ def _flex_initial_state(system, solver: Solver, c0: Config, v0, alg0):
     z0 = None if memory is None else memory.init()
     Rm, Rc = mb.initial_residuals(system, c0, v0, alg0, jnp.zeros(()), gsc, None if memory is None else memory.force(z0))
     x, (it, err, ok) = solve_root(lambda x: Rm(x) + Rc(x), jnp.zeros(L.n), solver.Cinv_mass, scale, solver.tol,
-                                  solver.max_iter, L.n_small, split=(Rc, L.n_rigid))
+                                  solver.max_iter, L.n_small, split=(Rc, L.n_rigid), implicit=solver.implicit)
     acc0, alg_a = L.from_x(x)
     alg = jnp.where(mb._position_mask(system.flex), alg0, alg_a)
     info = StepInfo(it + info0.iterations, jnp.maximum(err, info0.residual), ok & info0.ok)
@@ -578,7 +591,7 @@ def _flex_step(system, solver: Solver, s: State, fresh=None) -> tuple[State, Ste
     pre = s.pre if solver.reuse else None
     x, (it, err, ok), pre_new = solve_root_carried(lambda x: Rm(x) + Rc(x), L.to_x(pred, s.alg), solver.Cinv_step,
                                                    scale, solver.tol, solver.max_iter, pre, floor, solver.adaptive,
-                                                   L.n_small, (Rc, L.n_rigid), fresh)
+                                                   L.n_small, (Rc, L.n_rigid), fresh, solver.implicit)
     dyn, alg = L.from_x(x)
     c, v, acc, a = unpack(dyn)
     ok = ok & jnp.all(jnp.isfinite(x))
@@ -596,7 +609,8 @@ def step(system: System, solver: Solver, s: State, fresh=None) -> tuple[State, S
     floor = solver.noise * jnp.max(jnp.abs(s.c.d), initial=0.0)
     pre = s.pre if solver.reuse else None
     delta, (it, err, ok), pre_new = solve_root_carried(R, x0, solver.Cinv_step, scale, solver.tol, solver.max_iter,
-                                                       pre, floor, solver.adaptive, fresh=fresh)
+                                                       pre, floor, solver.adaptive, fresh=fresh,
+                                                       implicit=solver.implicit)
     c, v, acc, a = unpack(delta)
     ok = ok & jnp.all(jnp.isfinite(delta))
     z = memory_next(system, solver, s, v)

@@ -90,6 +90,10 @@ def prepare(scene: Scene, params=None, duration=None, dt=None, batch: bool = Fal
                              reuse=True, adaptive=not batch)
     if batch:      # carried, formed anew every BATCH_REFRESH steps (a cond inside the iterations would
         solver = dataclasses.replace(solver, refresh_every=BATCH_REFRESH)    # run both branches under vmap)
+    # a gradient can reach the run only through traced params (a batch is never differentiated):
+    # otherwise the Newton solves skip custom_root's tracing of the tangent solves
+    traced = any(isinstance(v, jax.core.Tracer) for v in jax.tree_util.tree_leaves(params or {}))
+    solver = dataclasses.replace(solver, implicit=traced and not batch)
     if sim.energy_projection:     # the scene check allows it only where it holds (scene._conservative)
         solver = dataclasses.replace(solver, project=True)
     n_steps = int(round(T / h))
