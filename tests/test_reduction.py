@@ -126,7 +126,7 @@ def test_gradient_through_a_reduced_run_agrees_with_finite_differences():
         r = js.simulate(scene, params={"vessel.hydrostatics.gm_t": gm}, duration=1.0)
         return jnp.sum(r.vessel.roll_pitch_yaw[:, 0] ** 2) + jnp.sum(r.probes["B"].displacement[:, 2] ** 2)
 
-    value_and_grad = jax.value_and_grad(loss)
+    value_and_grad = jax.jit(jax.value_and_grad(loss))
     g = float(value_and_grad(1.67)[1])
     eps = 1e-4
     fd = (float(value_and_grad(1.67 + eps)[0]) - float(value_and_grad(1.67 - eps)[0])) / (2 * eps)

@@ -421,7 +421,7 @@ def test_gradient_through_a_run_in_waves_with_memory_agrees_with_finite_differen
         r = js.simulate(scene, params={"vessel.hydrostatics.gm_t": gm, "waves.amplitude": amp})
         return jnp.sum(r.vessel.roll_pitch_yaw[:, 0] ** 2)
 
-    value_and_grad = jax.value_and_grad(loss, argnums=(0, 1))
+    value_and_grad = jax.jit(jax.value_and_grad(loss, argnums=(0, 1)))
 
     def value(gm, amp):
         return value_and_grad(gm, amp)[0]
