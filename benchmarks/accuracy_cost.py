@@ -27,10 +27,12 @@ jax.config.update("jax_enable_x64", True)
 import numpy as np  # noqa: E402
 
 import jaxslosh as js  # noqa: E402
-from jaxslosh.liquid import build_liquid  # noqa: E402
-from jaxslosh.modes import analytic_sloshing_omegas  # noqa: E402
-from jaxslosh.reduction import tank_basis  # noqa: E402
-from jaxslosh.run import _core, advance, prepare, start  # noqa: E402
+from jaxslosh.fem.liquid import build_liquid  # noqa: E402
+from jaxslosh.fem.modes import analytic_sloshing_omegas  # noqa: E402
+from jaxslosh.fem.reduction import tank_basis  # noqa: E402
+from jaxslosh.run.loop import core as _core, advance, start  # noqa: E402
+from jaxslosh.run.simulate import prepare
+from jaxslosh.scene.keys import with_overrides
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 from bench_paper import paper_variant  # noqa: E402
@@ -54,7 +56,7 @@ def run(text, duration, timed=True):
     """(time, probe B z-displacement, wall seconds per simulated second, unknowns, steps/s); the
     reference run (timed=False) is not run a second time for its timing."""
     scene = js.load_scene(text)
-    setup = prepare(scene, duration=duration)
+    setup = prepare(with_overrides(scene, duration=duration))
     b, solver = _core(setup.built), setup.solver
     carry, f0 = start(b, solver)
     c1, fr = advance(b, solver, carry, setup.n_steps, 1)        # compile and run

@@ -25,9 +25,11 @@ import jax
 jax.config.update("jax_enable_x64", True)
 
 import jaxslosh as js  # noqa: E402
-from jaxslosh.effects import count_unknowns, scene_effects  # noqa: E402
-from jaxslosh.run import _core, advance, prepare, start  # noqa: E402
-from jaxslosh.scene import tomllib  # noqa: E402  (tomli before Python 3.11)
+from jaxslosh.build.effects import count_unknowns, scene_effects  # noqa: E402
+from jaxslosh.run.loop import core as _core, advance, start  # noqa: E402
+from jaxslosh.run.simulate import prepare
+from jaxslosh.scene.keys import with_overrides
+from jaxslosh.scene.load import tomllib  # noqa: E402  (tomli before Python 3.11)
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 REFERENCE = "paper, all effects"
@@ -72,7 +74,7 @@ class Row:
     def __init__(self, label, filename, scene, steps):
         self.label, self.filename, self.scene, self.steps = label, filename, scene, steps
         t0 = time.perf_counter()
-        setup = prepare(scene, duration=steps * scene.simulation.dt)
+        setup = prepare(with_overrides(scene, duration=steps * scene.simulation.dt))
         self.b, self.solver = _core(setup.built), setup.solver
         t1 = time.perf_counter()
         self.carry, f0 = start(self.b, self.solver)

@@ -16,7 +16,9 @@ import jax
 jax.config.update("jax_enable_x64", True)
 
 import jaxslosh as js  # noqa: E402
-from jaxslosh.run import _core, advance, prepare, start  # noqa: E402
+from jaxslosh.run.loop import core as _core, advance, start  # noqa: E402
+from jaxslosh.run.simulate import prepare
+from jaxslosh.scene.keys import with_overrides
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 
@@ -34,7 +36,7 @@ def paper_variant(text, mesh=None, modes=None, dt=None, static_correction=True):
 
 
 def time_scene(scene, steps, save_every=1):
-    setup = prepare(scene, duration=steps * scene.simulation.dt)
+    setup = prepare(with_overrides(scene, duration=steps * scene.simulation.dt))
     b, solver = _core(setup.built), setup.solver
     t0 = time.perf_counter()
     carry, f0 = start(b, solver)

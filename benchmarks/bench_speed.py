@@ -22,8 +22,10 @@ import jax.numpy as jnp  # noqa: E402
 import numpy as np  # noqa: E402
 
 import jaxslosh as js  # noqa: E402
-from jaxslosh.integrator import State, StepInfo, step_equations  # noqa: E402
-from jaxslosh.run import _core, advance, prepare, start  # noqa: E402
+from jaxslosh.solve.integrator import State, StepInfo, step_equations  # noqa: E402
+from jaxslosh.run.loop import core as _core, advance, start  # noqa: E402
+from jaxslosh.run.simulate import prepare
+from jaxslosh.scene.keys import with_overrides
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 
@@ -63,7 +65,7 @@ def newton_table(scenes, steps):
     print(f"\n1. structured quasi-Newton against a naive Newton, {steps} steps")
     print(f"{'case':26} {'unknowns':>8} {'structured us/step':>19} {'naive us/step':>14} {'ratio':>7}")
     for name, scene in scenes:
-        setup = prepare(scene, duration=steps * scene.simulation.dt)
+        setup = prepare(with_overrides(scene, duration=steps * scene.simulation.dt))
         b, solver = _core(setup.built), setup.solver
         carry, _ = start(b, solver)
         timed(advance, b, solver, carry, steps, 1)

@@ -78,7 +78,9 @@ import scipy.linalg as sl  # noqa: E402
 import scipy.sparse as sp  # noqa: E402
 
 import jaxslosh as js  # noqa: E402
-from jaxslosh.run import _core, advance, prepare, start  # noqa: E402
+from jaxslosh.run.loop import core as _core, advance, start  # noqa: E402
+from jaxslosh.run.simulate import prepare
+from jaxslosh.scene.keys import with_overrides
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 
@@ -126,7 +128,7 @@ def exudyn_barge(scene, duration, dt):
 
 
 def jaxslosh_barge(scene, duration):
-    setup = prepare(scene, duration=duration)
+    setup = prepare(with_overrides(scene, duration=duration))
     b, solver = _core(setup.built), setup.solver
     carry, f0 = start(b, solver)
     advance(b, solver, carry, setup.n_steps, 1)             # compile
@@ -171,8 +173,8 @@ def relative_penalty():
     """Our liquid with its rotation penalty on the RELATIVE rotation (curl d) only: the coupling to
     the body rotation theta (Liquid.Kdt, Ktt; PHYSICS.md item 5) dropped. This is what a floating-
     frame body with a constant stiffness matrix can hold, so it is the model Exudyn is given."""
-    import jaxslosh.liquid as lq
-    import jaxslosh.reduction as rd
+    import jaxslosh.fem.liquid as lq
+    import jaxslosh.fem.reduction as rd
     orig = lq.build_liquid
 
     def patched(*args, **kw):
@@ -199,7 +201,7 @@ def jaxslosh_paper(text, duration, repeat, relative=False):
     """Our run of a paper-example variant: wall time of the compiled loop, roll-pitch-yaw, heave and
     the vertical displacement of probe B, t = 0 included."""
     with relative_penalty() if relative else contextlib.nullcontext():
-        setup = prepare(js.load_scene(text), duration=duration)
+        setup = prepare(with_overrides(js.load_scene(text), duration=duration))
     b, solver = _core(setup.built), setup.solver
     carry, f0 = start(b, solver)
     advance(b, solver, carry, setup.n_steps, 1)             # compile

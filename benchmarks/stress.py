@@ -21,9 +21,9 @@ jax.config.update("jax_enable_x64", True)
 import numpy as np  # noqa: E402
 
 import jaxslosh as js  # noqa: E402
-from jaxslosh.liquid import build_liquid  # noqa: E402
-from jaxslosh.modes import analytic_sloshing_table, liquid_modes  # noqa: E402
-from jaxslosh.run import run_to_file  # noqa: E402
+from jaxslosh.fem.liquid import build_liquid  # noqa: E402
+from jaxslosh.fem.modes import analytic_sloshing_table, liquid_modes  # noqa: E402
+from jaxslosh.run.tofile import run_to_file  # noqa: E402
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 G = 9.81

@@ -16,11 +16,11 @@ import numpy as np  # noqa: E402
 from scipy.integrate import solve_ivp  # noqa: E402
 
 import jaxslosh as js  # noqa: E402
-from jaxslosh.analysis import effective_roll_inertia  # noqa: E402
-from jaxslosh.build import build  # noqa: E402
-from jaxslosh.kinematics import rotation_matrix  # noqa: E402
-from jaxslosh.liquid import build_liquid  # noqa: E402
-from jaxslosh.modes import analytic_sloshing_omegas, liquid_modes  # noqa: E402
+from jaxslosh.fem.modes import effective_roll_inertia  # noqa: E402
+from jaxslosh.build.system import build  # noqa: E402
+from jaxslosh.physics.kinematics import rotation_matrix  # noqa: E402
+from jaxslosh.fem.liquid import build_liquid  # noqa: E402
+from jaxslosh.fem.modes import analytic_sloshing_omegas, liquid_modes  # noqa: E402
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 sys.path.insert(0, os.path.join(HERE, "..", "tests"))
@@ -109,8 +109,8 @@ def inertia():
 def waves():
     """The rows of tests/test_waves.py: the regular-wave RAO and the Cummins memory, Capytaine's box."""
     import test_waves as tw
-    from jaxslosh.hydrodynamics import capytaine_hydrostatics
-    from jaxslosh.scene_types import Hull
+    from jaxslosh.hydro.capytaine import capytaine_hydrostatics
+    from jaxslosh.scene.types import Hull
     w, Bv = 0.9, [0.0, 0.0, 0.0, 8.0e5, 0.0, 0.0]
     scene = tw.box_scene(tw.regular(w), duration=180.0, extra_hydro=f'viscous_damping = {Bv}\nexcitation = "froude-krylov"\n')
     r = js.simulate(scene)

@@ -7,7 +7,7 @@ import numpy as np
 import pytest
 
 from jaxslosh.cli import main
-from jaxslosh.result import load_result
+from jaxslosh.io.result import load_result
 
 from helpers import VESSEL
 

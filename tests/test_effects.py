@@ -3,9 +3,11 @@ import jax
 import numpy as np
 
 import jaxslosh as js
-from jaxslosh.build import build
+from jaxslosh.build.system import build
 from jaxslosh.cli import main
-from jaxslosh.integrator import initial_state, make_scheme, make_solver, step
+from jaxslosh.solve.integrator import initial_state, step
+from jaxslosh.solve.schemes import make_scheme
+from jaxslosh.solve.linear import make_solver
 
 from helpers import vessel_scene
 

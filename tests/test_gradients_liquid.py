@@ -7,10 +7,12 @@ import numpy as np
 import pytest
 
 import jaxslosh as js
-from jaxslosh.build import TRACEABLE, build
-from jaxslosh.integrator import make_scheme, make_solver
-from jaxslosh.liquid import build_liquid
-from jaxslosh.scene_types import SceneError
+from jaxslosh.scene.keys import TRACEABLE
+from jaxslosh.build.system import build
+from jaxslosh.solve.schemes import make_scheme
+from jaxslosh.solve.linear import make_solver
+from jaxslosh.fem.liquid import build_liquid
+from jaxslosh.scene.types import SceneError
 
 SIZE = (5.0, 5.0, 4.0)
 LIQUID = ("fill_depth", "density", "sound_speed", "gravity")
@@ -224,7 +226,7 @@ def test_gradient_of_a_trajectory_loss_wrt_tank_parameters_matches_central_diffe
 def test_checkpointed_long_runs_give_the_same_frames_and_gradient(monkeypatch, steps=103):
     """Runs of run.REMAT_MIN_STEPS steps or more are checkpointed in blocks of ~sqrt(n) frames (103:
     10 blocks of 10 and a remainder of 3): the frames and the gradient equal the plain scan's."""
-    import jaxslosh.run as run_mod
+    import jaxslosh.run.loop as run_mod
     from helpers import vessel_scene
     scene = vessel_scene(duration=steps * 0.01, omega=(0.03, 0.01, 0.0))
 

@@ -8,7 +8,8 @@ import numpy as np
 import pytest
 
 import jaxslosh as js
-from jaxslosh.identify import FitResult, add_noise, identify
+from jaxslosh.fit.identify import FitResult, identify
+from jaxslosh.fit.problem import add_noise
 
 from helpers import run_notebook, vessel_scene
 
@@ -49,14 +50,14 @@ def test_gradient_of_a_trajectory_loss_matches_central_differences():
 
 def test_identify_recovers_gm_from_noisy_roll_decay(decay, monkeypatch):
     """10 s of roll and pitch with 1e-4 rad of noise; GM_T and GM_L started 35 % off."""
-    import jaxslosh.run
+    import jaxslosh.fit.problem as problem
     scene, clean = decay
     true = {GM[0]: 1.5, GM[1]: 15.0}
     measured = add_noise(clean, {"roll": 1e-4, "pitch": 1e-4}, seed=7)
     start = {GM[0]: 1.5 * 1.35, GM[1]: 15.0 * 0.65}
     traces = []     # simulate runs in Python only while a function is traced
-    real = jaxslosh.run.simulate
-    monkeypatch.setattr(jaxslosh.run, "simulate", lambda *a, **k: traces.append(1) or real(*a, **k))
+    real = problem.simulate
+    monkeypatch.setattr(problem, "simulate", lambda *a, **k: traces.append(1) or real(*a, **k))
     seen = []
     fit = identify(scene, measured, GM, x0=start, callback=lambda it, v, loss: seen.append((it, loss)))
     assert len(traces) <= 1 and fit.evaluations >= fit.iterations + 1, (len(traces), fit.evaluations)

@@ -7,9 +7,11 @@ import pytest
 
 import equinox as eqx
 
-from jaxslosh.build import build
-from jaxslosh.integrator import State, make_scheme, make_solver, step
-from jaxslosh.model import Config
+from jaxslosh.build.system import build
+from jaxslosh.solve.integrator import State, step
+from jaxslosh.solve.schemes import make_scheme
+from jaxslosh.solve.linear import make_solver
+from jaxslosh.physics.system import Config
 
 from helpers import vessel_scene
 

@@ -5,9 +5,9 @@ import jax.numpy as jnp
 import numpy as np
 import pytest
 
-from jaxslosh.build import build
-from jaxslosh.kinematics import quat_exp, quat_from_rpy, quat_multiply
-from jaxslosh.model import Config
+from jaxslosh.build.system import build
+from jaxslosh.physics.kinematics import quat_exp, quat_from_rpy, quat_multiply
+from jaxslosh.physics.system import Config
 
 from test_coupled import ship_with_tank
 

@@ -8,8 +8,8 @@ import jax.numpy as jnp
 import numpy as np
 
 import jaxslosh as js
-from jaxslosh import multibody as mb
-from jaxslosh.build import build
+from jaxslosh.physics import structures as mb
+from jaxslosh.build.system import build
 
 from helpers import MULTIBODY_TANK as TANK, mast, multibody_vessel as vessel, zero_crossing_period
 
@@ -70,7 +70,7 @@ def test_constraint_acceleration_is_the_second_time_derivative_of_g():
     rng = np.random.default_rng(1)
     acc = jnp.asarray(rng.normal(size=L.n_dyn))
     Vf, Af = (jnp.asarray(rng.normal(size=L.n_alg)) for _ in range(2))
-    mask = mb._position_mask(system.flex)
+    mask = mb.position_mask(system.flex)
     Vf, Af = jnp.where(mask, Vf, 0.0), jnp.where(mask, Af, 0.0)
 
     def G(tau):

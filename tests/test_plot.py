@@ -8,9 +8,9 @@ import pytest
 from PIL import Image, ImageSequence
 
 from jaxslosh.cli import main
-from jaxslosh.liquid import _box_elements
-from jaxslosh.plot import animate_free_surface, plot_free_surface
-from jaxslosh.result import Energy, Result, SolverHistory, TankField, VesselHistory, save_result
+from jaxslosh.fem.mesh import box_elements as _box_elements
+from jaxslosh.plot.surface import animate_free_surface, plot_free_surface
+from jaxslosh.io.result import Energy, Result, SolverHistory, TankField, VesselHistory, save_result
 
 from helpers import VESSEL
 

@@ -5,9 +5,11 @@ import tomllib
 
 import pytest
 
-from jaxslosh.scene import (ELEMENT_FORMS, canonical_key, check_param_keys, describe, load_scene, parse_scene,
-                            scene_values)
-from jaxslosh.scene_types import SceneError
+from jaxslosh.scene.types import ELEMENT_FORMS
+from jaxslosh.scene.keys import canonical_key, check_param_keys, scene_values
+from jaxslosh.build.effects import describe
+from jaxslosh.scene.load import load_scene, parse_scene
+from jaxslosh.scene.types import SceneError
 
 # SPEC.md section 1, both examples together.
 SPEC_EXAMPLE = """

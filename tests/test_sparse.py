@@ -9,8 +9,8 @@ import scipy.sparse as sp
 from scipy.sparse.linalg import spsolve
 
 import jaxslosh as js
-from jaxslosh.boxsolve import box_inverse, elements, stencil
-from jaxslosh.liquid import build_liquid, surface_bending_scale
+from jaxslosh.solve.boxsolve import box_inverse, elements, stencil
+from jaxslosh.fem.liquid import build_liquid, surface_bending_scale
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 C_A = 1.0 / (0.25 * 1.01 ** 2 * 0.01 ** 2)        # the paper scene's step: HHT alpha 0.01, dt 0.01
@@ -74,7 +74,7 @@ def test_element_products_are_declined_where_layers_differ():
     """The stabilized element with an odd number of elements along x pairs its top wall elements:
     no element matrix per layer holds that, so the model carries none and the general sparse
     product stays (the pairs are too far apart for a stencil too)."""
-    from jaxslosh.sparse import host_sparse
+    from jaxslosh.solve.sparse import host_sparse
     m, free, _, K = _blocks((3, 4, 2), "stabilized")
     assert m.layers is None
     assert elements(K, (((3, 4, 2), 3, free, m.layers),)) is None
@@ -110,12 +110,14 @@ def test_sparse_system_has_the_dense_residual_and_inverses():
     agree to round-off, so the Newton iterations of the two are the same (a whole run of each is left
     to the benchmarks: its compilation would cost the suite a minute)."""
     import jax
-    from jaxslosh.boxsolve import BoxInverse, Elements
-    from jaxslosh.run import _core, prepare
+    from jaxslosh.solve.boxsolve import BoxInverse, Elements
+    from jaxslosh.run.loop import core as _core
+    from jaxslosh.run.simulate import prepare
+    from jaxslosh.scene.keys import with_overrides
 
     out = {}
     for solver in ("dense", "sparse"):
-        setup = prepare(_paper(solver), duration=0.5)
+        setup = prepare(with_overrides(_paper(solver), duration=0.5))
         b, slv = _core(setup.built), setup.solver
         rng = np.random.default_rng(3)
         c = b.c0._replace(d=b.c0.d + 1e-3 * jnp.asarray(rng.standard_normal(b.c0.d.shape)))

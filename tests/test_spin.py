@@ -12,8 +12,9 @@ import numpy as np
 import scipy.linalg as sl
 
 import jaxslosh as js
-from jaxslosh.kinematics import rotation_matrix
-from jaxslosh.structure import build_structure, centrifugal_stiffness, face_nodes
+from jaxslosh.physics.kinematics import rotation_matrix
+from jaxslosh.fem.structure import build_structure, centrifugal_stiffness
+from jaxslosh.fem.mesh import face_nodes
 
 A = 0.05
 EI, RHOA, L = 1.4e4, 1.2, 10.0

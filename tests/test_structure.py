@@ -3,8 +3,8 @@ independent references (scikit-fem's quadratic hexahedra, Euler-Bernoulli beams)
 import numpy as np
 import pytest
 
-from jaxslosh.structure import (build_structure, clamped_modes, euler_bernoulli_cantilever, face_nodes,
-                                free_modes, projector)
+from jaxslosh.fem.structure import build_structure, clamped_modes, euler_bernoulli_cantilever, free_modes, projector
+from jaxslosh.fem.mesh import face_nodes
 
 STEEL = dict(young=2.1e11, poisson=0.3, density=7850.0)
 

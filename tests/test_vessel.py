@@ -6,8 +6,8 @@ import pytest
 from scipy.integrate import solve_ivp
 
 import jaxslosh as js
-from jaxslosh.kinematics import G_matrix, quat_from_rpy, rotation_matrix, rpy_from_quat, skew
-from jaxslosh.model import A_PHI, A_THETA, Hydro
+from jaxslosh.physics.kinematics import G_matrix, quat_from_rpy, rotation_matrix, rpy_from_quat, skew
+from jaxslosh.physics.system import A_PHI, A_THETA, Hydro
 
 from helpers import vessel_scene, zero_crossing_period
 

@@ -11,12 +11,16 @@ import numpy as np
 import pytest
 
 import jaxslosh as js
-from jaxslosh.build import build
+from jaxslosh.build.system import build
 from jaxslosh.cli import main
-from jaxslosh.hydrodynamics import (linear_response, radiation_fit, restoring_matrix,
-                                    rigid_mass_matrix, scene_tables)
-from jaxslosh.integrator import initial_state, make_scheme, make_solver, step
-from jaxslosh.waves import box_hydrostatics, components, elevation, froude_krylov_box, jonswap, wavenumber
+from jaxslosh.hydro.radiation import linear_response, restoring_matrix, rigid_mass_matrix
+from jaxslosh.hydro.source import radiation_fit
+from jaxslosh.hydro.tables import scene_tables
+from jaxslosh.solve.integrator import initial_state, step
+from jaxslosh.solve.schemes import make_scheme
+from jaxslosh.solve.linear import make_solver
+from jaxslosh.hydro.box import box_hydrostatics, froude_krylov_box
+from jaxslosh.hydro.spectra import components, elevation, jonswap, wavenumber
 
 DATA = Path(__file__).resolve().parent / "data"
 RHO, G = 1025.0, 9.81
@@ -139,8 +143,8 @@ def test_froude_krylov_box_against_quadrature_and_long_wave_limit():
 def test_froude_krylov_box_against_capytaine():
     """Capytaine's Froude-Krylov force on the same box (panel centroids, its e^{-iwt} convention)."""
     import capytaine as cpt
-    from jaxslosh.hydrodynamics import _box_body
-    from jaxslosh.scene_types import Hull
+    from jaxslosh.hydro.capytaine import _box_body
+    from jaxslosh.scene.types import Hull
     body = _box_body(cpt, Hull(length=L, beam=B, draft=T, kg=KG), 0.5)
     from capytaine.bem.airy_waves import froude_krylov_force
     for w, beta in [(0.7, math.pi / 2), (1.2, 0.6)]:
@@ -260,8 +264,8 @@ def test_cummins_memory_reproduces_the_frequency_domain_roll_response():
 
 
 def test_capytaine_box_hydrostatics_equal_the_closed_forms_and_feed_a_scene(tmp_path, capsys):
-    from jaxslosh.hydrodynamics import capytaine_hydrostatics
-    from jaxslosh.scene_types import Hull
+    from jaxslosh.hydro.capytaine import capytaine_hydrostatics
+    from jaxslosh.scene.types import Hull
     for (l_, b_, t_, kg) in [(L, B, T, KG), (60.0, 12.0, 4.0, 5.0)]:
         hs = capytaine_hydrostatics(Hull(length=l_, beam=b_, draft=t_, kg=kg))
         closed = {"displaced_volume": l_ * b_ * t_, "waterplane_area": l_ * b_, "bm_t": b_ ** 2 / (12 * t_),

@@ -1,0 +1,34 @@
+"""Natural modes of a scene's tank liquid or flexible structure, the vessel held fixed (`jaxslosh modes`)."""
+from __future__ import annotations
+
+from ..build.effects import free_liquid_dofs
+from ..fem.liquid import build_liquid
+from ..fem.mesh import face_nodes
+from ..fem.modes import liquid_modes
+from ..fem.structure import build_structure, clamped_modes
+from ..fem.walls import build_tank_with_walls, tank_modes
+from ..scene.types import Scene
+from ..solve.sparse import SPARSE_AUTO
+
+
+def sloshing_modes(scene: Scene, tank=None, n: int = 10):
+    """The first n modes of a tank's liquid: `Modes(omega, kind, free_surface_share, shapes)`."""
+    t = scene.tank(tank) if tank is not None else scene.tanks[0]
+    # large meshes as the simulation takes them: sparse matrices and shift-invert Lanczos (a dense
+    # generalized eigh of 20 x 20 x 12 needs 2 GB a matrix and crashed OpenBLAS)
+    large = t.wall_spec is None and free_liquid_dofs(t) > SPARSE_AUTO
+    model = build_liquid(t.size, t.fill_depth, t.mesh, t.fluid.density, t.fluid.sound_speed,
+                         scene.environment.gravity, element=t.fluid.element, sparse=large)
+    if t.wall_spec is not None:       # the liquid and its elastic walls together (kinds add "wall")
+        return tank_modes(build_tank_with_walls(t, model), n=n)
+    return liquid_modes(model, n=n)
+
+
+def structure_modes(scene: Scene, structure: str, n: int = 10):
+    """The first n modes of a flexible structure held at its attachment face (the vessel, or the
+    structure it is attached to, held fixed): `StructureModes(omega, kind, shares, shapes)`; each mode
+    named by the pattern of its cross-sections that holds most of its kinetic energy (bending along
+    an axis, torsion, axial, other)."""
+    st = scene.structure(structure)
+    m = build_structure(st.size, st.mesh, st.material.young, st.material.poisson, st.material.density)
+    return clamped_modes(m, face_nodes(m.nodes, m.size, st.attach), n=n)

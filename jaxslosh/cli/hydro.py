@@ -1,0 +1,57 @@
+"""`jaxslosh hydro`: Capytaine's hydrostatics and tables of the scene's hull, as scene TOML."""
+from __future__ import annotations
+
+import os
+
+import numpy as np
+
+from ..hydro.capytaine import CAPYTAINE_MISSING, capytaine_version, have_capytaine, hull_hydrodynamics, to_toml
+from .common import EXIT_OK, InputError, load
+
+
+def add_parsers(sub):
+    hy = sub.add_parser("hydro", help="hull hydrostatics and hydrodynamic tables from Capytaine, as scene TOML")
+    hy.add_argument("scene", help="a scene with a [vessel.hull] table")
+    hy.add_argument("-o", "--output", help="write the TOML tables here (default: print them)")
+    hy.add_argument("--frequencies", default="0.1:2.5:25", help="LOW:HIGH:COUNT rad/s (default 0.1:2.5:25)")
+    hy.add_argument("--headings", help="comma-separated rad (default: the scene's wave heading, or 0)")
+    hy.add_argument("--panel-size", type=float, help="panel size of the box mesh, m")
+
+
+def cmd_hydro(a):
+    """Capytaine's hydrostatics and tables for the scene's hull, printed as the [vessel.hydrostatics]
+    and [vessel.hydrodynamics] tables of a scene (paste them in, drop [vessel.hull]'s capytaine)."""
+    scene = load(a.scene)
+    hull = scene.vessel.hull
+    if hull is None:
+        raise InputError(f"{a.scene}: the scene has no [vessel.hull] table")
+    try:
+        lo, hi, n = a.frequencies.split(":")
+        lo, hi, n = float(lo), float(hi), int(n)
+    except ValueError:
+        raise InputError(f"--frequencies: expected LOW:HIGH:COUNT, got {a.frequencies!r}") from None
+    if not (0 < lo < hi and n >= 4):
+        raise InputError(f"--frequencies: need 0 < LOW < HIGH and COUNT >= 4, got {a.frequencies!r}")
+    if a.headings:
+        try:
+            heads = tuple(float(x) for x in a.headings.split(","))
+        except ValueError:
+            raise InputError(f"--headings: expected comma-separated numbers, got {a.headings!r}") from None
+    else:
+        heads = (scene.waves.heading if scene.waves is not None else 0.0,)
+    if not have_capytaine():
+        raise InputError(f"hydro: {CAPYTAINE_MISSING}")
+    hd = scene.vessel.hydrodynamics
+    data = hull_hydrodynamics(hull, rho=scene.environment.water_density, g=scene.environment.gravity,
+                              depth=scene.waves.depth if scene.waves is not None else None,
+                              frequencies=tuple(np.linspace(lo, hi, n)), headings=heads,
+                              panel_size=a.panel_size, base_dir=hd.base_dir if hd is not None else os.path.dirname(os.path.abspath(a.scene)))
+    text = (f"# Capytaine {capytaine_version()}: hull of {a.scene}, about the COG; "
+            f"BM_T {data['bm_t']:.6g} m, BM_L {data['bm_l']:.6g} m\n" + to_toml(data))
+    if a.output:
+        with open(a.output, "w") as f:
+            f.write(text)
+        print(f"wrote {a.output}")
+    else:
+        print(text, end="")
+    return EXIT_OK

@@ -1,0 +1,105 @@
+"""`jaxslosh identify SCENE --data MEASURED.h5 --fit KEY[,KEY...] [-o FIT.json]`."""
+from __future__ import annotations
+
+import math
+import os
+import sys
+
+from ..fit.identify import METHODS, identify
+from ..fit.params import fit_keys
+from ..io.result import load_result
+from ..plot.fit import _fmt, plot_fit
+from ..scene.types import SceneError
+from .common import EXIT_NUMERICAL, EXIT_OK, InputError, enable_x64, load
+
+
+def add_parsers(subparsers):
+    """Add the `identify` subcommand to the `jaxslosh` sub-parsers; returns its parser."""
+    p = subparsers.add_parser("identify", help="fit scene values (dotted keys) to a measured result")
+    p.add_argument("scene")
+    p.add_argument("--data", required=True, metavar="MEASURED.h5", help="the measured result file")
+    p.add_argument("--fit", required=True, metavar="KEY[,KEY...]",
+                   help="dotted scene keys to fit, comma-separated, e.g. "
+                        "vessel.hydrostatics.gm_t,vessel.hydrostatics.gm_l")
+    p.add_argument("-o", "--output", metavar="FIT.json",
+                   help="the fit as JSON (default: the scene's name with _fit.json, here)")
+    p.add_argument("--method", default="gauss-newton", choices=METHODS, help="optimiser (default gauss-newton)")
+    p.add_argument("--max-iter", type=int, default=50, dest="max_iter", help="iterations at most (default 50)")
+    p.add_argument("--start", metavar="KEY=VALUE[,...]", help="start values (default: the scene's values)")
+    p.add_argument("--plot", metavar="FIG.png", help="also draw measured against fitted time histories")
+    return p
+
+
+def _split_keys(text):
+    return [k.strip() for k in str(text).split(",") if k.strip()]
+
+
+def cmd_identify(a) -> int:
+    """`jaxslosh identify`: returns the exit status; bad input raises jaxslosh.cli.InputError."""
+
+
+    method = getattr(a, "method", None) or "gauss-newton"
+    if method not in METHODS:
+        raise InputError(f"--method: unknown method {method!r} (choose from {', '.join(METHODS)})")
+    max_iter = getattr(a, "max_iter", None)
+    max_iter = 50 if max_iter is None else int(max_iter)
+    if max_iter < 0:
+        raise InputError(f"--max-iter: must be >= 0, got {max_iter}")
+    keys = _split_keys(a.fit or "")
+    if not keys:
+        raise InputError("--fit: give at least one dotted key, e.g. vessel.hydrostatics.gm_t")
+    if not os.path.exists(a.scene):
+        raise InputError(f"{a.scene}: no such scene file")
+    if not a.data or not os.path.exists(a.data):
+        raise InputError(f"--data: {a.data}: no such file")
+    out = getattr(a, "output", None) or os.path.splitext(os.path.basename(a.scene))[0] + "_fit.json"
+    for flag, path in (("-o", out), ("--plot", getattr(a, "plot", None))):
+        if path:
+            d = os.path.dirname(os.path.abspath(path))
+            if not os.path.isdir(d):
+                raise InputError(f"{flag}: the folder {d} does not exist")
+    x0 = {}
+    for item in _split_keys(getattr(a, "start", None) or ""):
+        k, sep, v = item.partition("=")
+        try:
+            x0[k.strip()] = float(v)
+        except ValueError:
+            raise InputError(f"--start: expected KEY=VALUE, got {item!r}")
+        if not sep:
+            raise InputError(f"--start: expected KEY=VALUE, got {item!r}")
+
+    enable_x64()
+    scene = load(a.scene)            # SceneError (exit 2, naming the key) for a bad scene
+    try:
+        fit_keys(scene, keys)
+    except SceneError as e:
+        raise InputError(f"--fit: {e}")
+    try:
+        measured = load_result(a.data)
+    except (OSError, ValueError, KeyError) as e:
+        msg = str(e).replace("\n", " ")
+        raise InputError(f"--data: {a.data}: not a jaxslosh result file ({msg})")
+    try:
+        fr = identify(scene, measured, keys, method=method, max_iter=max_iter, x0=x0 or None)
+    except SceneError as e:
+        msg = str(e).replace("\n", " ")
+        flag = "--start" if ("the start" in msg or "given in x0" in msg) else "--data" if e.key == "measured" else None
+        raise InputError(f"{flag}: {msg}" if flag else msg)
+    if not fr.loss_history or not math.isfinite(fr.loss_history[0]):
+        print(f"jaxslosh identify: numerical failure: {fr.message}", file=sys.stderr)
+        return EXIT_NUMERICAL
+    width = max(len(k) for k in fr.values)
+    for k, v in fr.values.items():
+        s = fr.standard_errors[k]
+        print(f"{k:<{width}} = {_fmt(v)} +- {_fmt(s)}   (start {_fmt(fr.start[k])})")
+    status = "converged" if fr.converged else "NOT converged"
+    print(f"{fr.method}: {status} after {fr.iterations} iterations ({fr.evaluations} simulations, "
+          f"{fr.wall_time:.1f} s); loss {fr.loss_history[0]:.4g} -> {fr.loss_history[-1]:.4g} ({fr.message})")
+    fr.to_json(out)
+    print(f"wrote {out}")
+    if getattr(a, "plot", None):
+        plot_fit(scene, measured, fr, a.plot)
+        print(f"wrote {a.plot}")
+    if not fr.converged:
+        print(f"warning: the fit did not converge ({fr.message})", file=sys.stderr)
+    return EXIT_OK

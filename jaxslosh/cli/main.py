@@ -1,0 +1,36 @@
+"""The `jaxslosh` command (SPEC section 2): the parser of every subcommand and the one place where
+exceptions become messages and exit codes (0 done, 2 bad input, 3 numerical failure)."""
+from __future__ import annotations
+
+import sys
+
+from ..scene.types import SceneError
+from . import hydro, identify, modes, plot, simulate, sweep
+from .common import EXIT_INPUT, InputError, Parser
+
+COMMANDS = {"run": simulate.cmd_run, "check": simulate.cmd_check, "plot": plot.cmd_plot, "modes": modes.cmd_modes,
+            "identify": identify.cmd_identify, "sweep": sweep.cmd_sweep, "hydro": hydro.cmd_hydro}
+
+
+def parser() -> Parser:
+    p = Parser(prog="jaxslosh", description="Floating vessels carrying sloshing liquid (Gonzalez & Park 2013).")
+    sub = p.add_subparsers(dest="command", required=True, parser_class=Parser)
+    for module in (simulate, plot, modes, identify, sweep, hydro):
+        module.add_parsers(sub)
+    return p
+
+
+def main(argv=None) -> int:
+    try:
+        a = parser().parse_args(argv)
+        return COMMANDS[a.command](a)
+    except (InputError, SceneError) as e:
+        print(f"error: {e}", file=sys.stderr)
+        return EXIT_INPUT
+    except KeyboardInterrupt:
+        print("interrupted", file=sys.stderr)
+        return 130
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())

@@ -1,0 +1,1 @@
+"""Parameter identification: scene values fitted to a measured result (identify.py)."""

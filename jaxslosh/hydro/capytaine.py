@@ -1,0 +1,193 @@
+"""Capytaine (an optional extra: pip install "jaxslosh[hydro]"): the hydrostatics of a hull and
+its hydrodynamic tables about the COG, and the TOML tables a scene can hold instead.
+
+Capytaine is imported inside the functions that need it: it is optional, and a scene without
+`capytaine = true` never loads it."""
+from __future__ import annotations
+
+import functools
+import importlib.util
+import inspect
+import logging
+import os
+
+import numpy as np
+
+from .tables import Tables
+
+
+CAPYTAINE_MISSING = "needs Capytaine, an optional extra: pip install 'jaxslosh[hydro]' (or pip install capytaine)"
+
+
+def have_capytaine() -> bool:
+    try:
+        return importlib.util.find_spec("capytaine") is not None
+    except (ImportError, ValueError):
+        return False
+
+
+def capytaine_version() -> str:
+    return _import_capytaine().__version__
+
+
+def _import_capytaine():
+    try:
+        import capytaine as cpt
+    except ImportError as e:
+        raise ImportError(CAPYTAINE_MISSING) from e
+    logging.getLogger("capytaine").setLevel(logging.ERROR)
+    return cpt
+
+
+def default_frequencies(n: int = 40, lo: float = 0.1, hi: float = 4.0):
+    return tuple(np.linspace(lo, hi, n))
+
+
+def _box_body(cpt, hull, panel_size, resolution=None, lid=True):
+    """The wetted part of a box hull (the COG at the origin), with a lid on the waterplane against
+    irregular frequencies, and the six rigid dofs about the COG."""
+    L, B, T, kg = hull.length, hull.beam, hull.draft, hull.kg
+    size = panel_size or max(min(L, B, T) / 4.0, max(L, B) / 24.0)
+    res = resolution or tuple(max(2, int(np.ceil(x / size))) for x in (L, B, 2 * T))
+    z_wl = T - kg
+    mesh = cpt.mesh_parallelepiped(size=(L, B, 2 * T), center=(0.0, 0.0, z_wl), resolution=res, name="hull")
+    return _body_from_mesh(cpt, mesh, z_wl, lid)
+
+
+def _body_from_mesh(cpt, mesh, z_wl, lid=True):
+    # Capytaine puts the free surface at z = 0: the mesh goes down by the waterline height; the COG
+    # (our origin) then sits at z = -z_wl.
+    mesh = mesh.translated((0.0, 0.0, -z_wl))
+    hull = mesh.immersed_part()
+    cog = (0.0, 0.0, -z_wl)
+    try:
+        if not lid:
+            raise TypeError
+        lid = hull.generate_lid(z=-1e-3 * max(1.0, abs(z_wl)))
+        body = cpt.FloatingBody(mesh=hull, lid_mesh=lid, dofs=cpt.rigid_body_dofs(rotation_center=cog),
+                                center_of_mass=cog, name="hull")
+    except (AttributeError, TypeError):    # Capytaine without lids
+        body = cpt.FloatingBody(mesh=hull, dofs=cpt.rigid_body_dofs(rotation_center=cog), center_of_mass=cog,
+                                name="hull")
+    return body
+
+
+def _mesh_body(cpt, hull, base_dir=""):
+    path = hull.file if os.path.isabs(hull.file) or not base_dir else os.path.join(base_dir, hull.file)
+    mesh = cpt.load_mesh(path)
+    # the mesh's coordinates: waterline at z = 0; our origin is the COG at `cog`
+    mesh = mesh.translated(tuple(-np.asarray(hull.cog)))
+    return _body_from_mesh(cpt, mesh, -float(hull.cog[2]))
+
+
+def capytaine_hydrostatics(hull, rho=1025.0, g=9.81, panel_size=None, base_dir=""):
+    """Hydrostatics of a hull from Capytaine: displaced volume, waterplane area, BM_T, BM_L, KB
+    (the centre of buoyancy's height above the keel for a box), GM_T and GM_L about the COG."""
+    cpt = _import_capytaine()
+    if hull.type == "box":
+        # Capytaine integrates the waterplane's second moments at panel centres: with n panels across,
+        # BM is low by 1/n^2, so hydrostatics (cheap: no BEM) take 40 along and across (BM -0.06 %)
+        res = None if panel_size else (40, 40, 4)
+        body = _box_body(cpt, hull, panel_size, resolution=res, lid=False)
+    else:
+        body = _mesh_body(cpt, hull, base_dir)
+    V = float(body.disp_volume)
+    zb = float(body.center_of_buoyancy[2])
+    zg = float(body.center_of_mass[2])
+    bmt = float(body.transversal_metacentric_radius)
+    bml = float(body.longitudinal_metacentric_radius)
+    return {"displaced_volume": V, "waterplane_area": float(body.waterplane_area), "bm_t": bmt, "bm_l": bml,
+            "gm_t": bmt + zb - zg, "gm_l": bml + zb - zg, "z_b": zb - zg}
+
+
+@functools.lru_cache(maxsize=16)
+def _capytaine_cached(hull, rho, g, depth, frequencies, headings, panel_size, base_dir):
+    cpt = _import_capytaine()
+    body = _box_body(cpt, hull, panel_size) if hull.type == "box" else _mesh_body(cpt, hull, base_dir)
+    w = np.asarray(frequencies if frequencies else default_frequencies(), dtype=float)
+    kw = {"rho": rho, "g": g}
+    if depth is not None:
+        kw["water_depth"] = depth
+    solver = cpt.BEMSolver()
+    dofs = list(body.dofs)
+    probs = [cpt.RadiationProblem(body=body, radiating_dof=d, omega=float(x), **kw) for d in dofs for x in w]
+    probs += [cpt.DiffractionProblem(body=body, wave_direction=float(b), omega=float(x), **kw)
+              for b in headings for x in w]
+    results = solver.solve_all(probs, progress_bar=False) if _accepts(solver.solve_all, "progress_bar") \
+        else solver.solve_all(probs)
+    ds = cpt.assemble_dataset(results)
+    order = [d for d in dofs]
+    A = ds["added_mass"].sel(omega=w, radiating_dof=order, influenced_dof=order).transpose(
+        "omega", "influenced_dof", "radiating_dof").values
+    B = ds["radiation_damping"].sel(omega=w, radiating_dof=order, influenced_dof=order).transpose(
+        "omega", "influenced_dof", "radiating_dof").values
+    try:
+        inf = [solver.solve(cpt.RadiationProblem(body=body, radiating_dof=d, omega=np.inf, **kw)) for d in dofs]
+        Ainf = np.array([[r.added_masses[i] for r in inf] for i in order])
+    except Exception:   # noqa: BLE001 - an older Capytaine without infinite frequency: fitted instead
+        Ainf = None
+    X = heads = None
+    if headings:
+        F = ds["excitation_force"].sel(omega=w, influenced_dof=order).transpose("omega", "wave_direction",
+                                                                                 "influenced_dof").values
+        X = np.conj(F)            # Capytaine's e^{-i w t} convention -> ours (waves.py)
+        heads = np.asarray(ds["wave_direction"].values, dtype=float)
+    return Tables(w, A, B, Ainf, heads, X)
+
+
+def _accepts(fn, name):
+    try:
+        return name in inspect.signature(fn).parameters
+    except (TypeError, ValueError):
+        return False
+
+
+def capytaine_tables(hull, rho=1025.0, g=9.81, depth=None, frequencies=None, headings=(), panel_size=None,
+                     base_dir="") -> Tables:
+    """Added mass, damping (n, 6, 6), A_inf and excitation (FK + diffraction) for the headings, from a
+    Capytaine BEM solve of the hull's wetted surface (with a lid against irregular frequencies),
+    about the COG. Cached: one solve per hull and settings in a process."""
+    return _capytaine_cached(hull, float(rho), float(g), None if depth is None else float(depth),
+                             tuple(float(x) for x in frequencies) if frequencies else None,
+                             tuple(float(x) for x in headings), panel_size, base_dir)
+
+
+def hull_hydrodynamics(hull, *, rho=1025.0, g=9.81, depth=None, frequencies=None, headings=(0.0,),
+                       panel_size=None, base_dir=""):
+    """Hydrostatics and hydrodynamic tables of a hull (scene_types.Hull) from Capytaine, as a dict
+    in the form of a scene's `[vessel.hydrostatics]` and `[vessel.hydrodynamics]` tables (see
+    `to_toml`): the way to feed a scene without Capytaine at run time."""
+    hs = capytaine_hydrostatics(hull, rho, g, None, base_dir)     # its own fine mesh (no BEM)
+    t = capytaine_tables(hull, rho, g, depth, frequencies, headings, panel_size, base_dir)
+    hydro = {"frequencies": t.omega.tolist(), "added_mass": t.added_mass.tolist(), "damping": t.damping.tolist()}
+    if t.added_mass_infinite is not None:
+        hydro["added_mass_infinite"] = t.added_mass_infinite.tolist()
+    if t.excitation is not None:
+        hydro["headings"] = t.headings.tolist()
+        hydro["excitation_amplitude"] = np.abs(t.excitation).tolist()
+        hydro["excitation_phase"] = np.angle(t.excitation).tolist()
+    return {"hydrostatics": {k: hs[k] for k in ("waterplane_area", "displaced_volume", "gm_t", "gm_l")},
+            "hydrodynamics": hydro, "bm_t": hs["bm_t"], "bm_l": hs["bm_l"]}
+
+
+def _toml_value(x, digits=10):
+    if isinstance(x, (list, tuple)):
+        if x and isinstance(x[0], (list, tuple)):
+            return "[\n" + ",\n".join("  " + _toml_value(r, digits) for r in x) + ",\n]"
+        return "[" + ", ".join(_toml_value(v, digits) for v in x) + "]"
+    v = float(x)
+    if v == 0.0:
+        return "0.0"
+    return f"{v:.{digits}g}" if ("e" in f"{v:.{digits}g}" or "." in f"{v:.{digits}g}") else f"{v:.{digits}g}.0"
+
+
+def to_toml(data: dict) -> str:
+    """The `[vessel.hydrostatics]` and `[vessel.hydrodynamics]` tables of `hull_hydrodynamics` as TOML."""
+    lines = ["[vessel.hydrostatics]"]
+    lines += [f"{k} = {_toml_value(v)}" for k, v in data["hydrostatics"].items()]
+    lines += ["", "[vessel.hydrodynamics]"]
+    for k, v in data["hydrodynamics"].items():
+        if k in ("excitation_amplitude", "excitation_phase"):
+            v = [[list(map(float, h)) for h in f] for f in v]
+        lines.append(f"{k} = {_toml_value(v)}")
+    return "\n".join(lines) + "\n"

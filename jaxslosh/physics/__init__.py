@@ -1,0 +1,2 @@
+"""What the time loop traces: the system's residual (the virtual work of eq. 26) and energy, as
+equinox modules built once from the scene (build/), evaluated inside the jitted step."""

@@ -1,0 +1,115 @@
+"""Hull hydrodynamics: added mass, radiation damping with the memory of the Cummins equation, wave
+excitation from tables, and Capytaine (an optional extra) to compute them.
+
+The rigid rows of the residual (model.System.residual) gain, for small motions xi about the
+initial equilibrium (translations of the COG, rotations about it):
+
+    A_inf xi_ddot + mu(t) + B_v xi_dot - F_exc(t),     mu(t) = int_0^t K(t - s) xi_dot(s) ds   (Cummins 1962)
+
+with A_inf the added mass at infinite frequency, K the retardation functions, B_v an optional linear
+(viscous) damping and F_exc the first-order wave excitation (waves.py). Coefficients are about the
+COG, in the axes of the residual's rows (translations inertial, rotations body: equal at small
+motions). In the frequency domain this is the classical
+
+    [-w^2 (M + A(w)) + i w (B(w) + B_v) + C] xi = F_exc,   A(w) = A_inf - int K sin / w,  B(w) = int K cos,
+
+which the tests check against the time-domain run.
+
+The memory (hydro/radiation.py fits it) is a set of complex poles p_k, each with a state
+w_k' = p_k w_k + xi_dot_j; the states live in the integrator's State and a step advances them exactly
+for a velocity linear over the step, so the memory force is linear in the step's unknown new velocity.
+"""
+from __future__ import annotations
+
+from typing import Optional
+
+import equinox as eqx
+import jax
+import jax.numpy as jnp
+
+
+class Memory(eqx.Module):
+    """The fitted radiation memory: complex poles (real, imaginary parts), their input dof (a one-hot
+    (M, 6) selection) and output coefficients c (6, M)."""
+    p_re: jax.Array
+    p_im: jax.Array
+    select: jax.Array     # (M, 6)
+    c_re: jax.Array       # (6, M)
+    c_im: jax.Array
+
+    def init(self):
+        return jnp.zeros((self.p_re.shape[0], 2))
+
+    def coefficients(self, h):
+        """exp(p h), g0, g1 of w_{n+1} = exp(p h) w_n + g0 u_n + g1 u_{n+1} (u linear over the step):
+        g1 = ((exp(p h) - 1) / (p h) - 1) / p, g0 = (exp(p h) - 1) / p - g1. As (re, im) pairs."""
+        p = self.p_re + 1j * self.p_im
+        ph = p * h
+        E = jnp.exp(ph)
+        em1 = jnp.expm1(ph)
+        small = jnp.abs(ph) < 1e-4
+        phs = jnp.where(small, 1.0, ph)
+        ratio = jnp.where(small, 1.0 + ph / 2.0 + ph * ph / 6.0, em1 / phs)   # (e^{ph} - 1) / (ph)
+        g1 = jnp.where(small, h * (0.5 + ph / 6.0 + ph * ph / 24.0), (ratio - 1.0) / jnp.where(small, 1.0, p))
+        g0 = h * ratio - g1
+        split = lambda z: (jnp.real(z), jnp.imag(z))  # noqa: E731
+        return split(E), split(g0), split(g1)
+
+    def advance(self, z, v_old, v_new, coef):
+        """The states at t_{n+1} from those at t_n and the rigid velocities (6,) at both ends."""
+        (Er, Ei), (g0r, g0i), (g1r, g1i) = coef
+        u0, u1 = self.select @ v_old, self.select @ v_new
+        wr, wi = z[:, 0], z[:, 1]
+        nr = Er * wr - Ei * wi + g0r * u0 + g1r * u1
+        ni = Er * wi + Ei * wr + g0i * u0 + g1i * u1
+        return jnp.stack([nr, ni], axis=1)
+
+    def force(self, z):
+        """mu = sum_k Re(c_k w_k) (6,)."""
+        return self.c_re @ z[:, 0] - self.c_im @ z[:, 1]
+
+
+class Seakeeping(eqx.Module):
+    """Wave loads and hull hydrodynamics on the rigid rows (see the module docstring); each part is
+    None when the scene lacks it or switches it off ([effects] waves, radiation), and is not traced."""
+    excitation: Optional[Excitation] = None
+    added_mass: Optional[jax.Array] = None     # (6, 6) A_inf about the COG
+    damping: Optional[jax.Array] = None        # (6, 6) linear (viscous) damping B_v
+    memory: Optional[Memory] = None
+
+    def rigid_rows(self, acc6, v6, t, mu=None):
+        """What the hydrodynamics add to the rigid rows of the residual (inertia minus forces)."""
+        r = jnp.zeros(6)
+        if self.added_mass is not None:
+            r = r + self.added_mass @ acc6
+        if self.damping is not None:
+            r = r + self.damping @ v6
+        if self.memory is not None and mu is not None:
+            r = r + mu
+        if self.excitation is not None:
+            r = r - self.excitation.force(t)
+        return r
+
+    def added_mass_diagonal(self):
+        return jnp.zeros(6) if self.added_mass is None else jnp.diag(self.added_mass)
+
+    def kinetic_energy(self, v6):
+        return 0.0 if self.added_mass is None else 0.5 * v6 @ (self.added_mass @ v6)
+
+
+class Excitation(eqx.Module):
+    """First-order wave forces as a known function of time: F_j(t) = r(t) height sum_i
+    amp_ji cos(w_i t + phase_ji), rows in the residual's frame (translations inertial, rotations
+    body; equal at small motions about the initial attitude). `height` is the scene's amplitude
+    (regular) or Hs (JONSWAP): the forces are linear in it, so it may be a traced parameter."""
+    omega: jax.Array      # (N,)
+    amp: jax.Array        # (6, N) per unit `height`
+    phase: jax.Array      # (6, N)
+    height: jax.Array     # ()
+    ramp: float = eqx.field(static=True, default=0.0)
+
+    def force(self, t):
+        F = self.height * jnp.sum(self.amp * jnp.cos(self.omega[None, :] * t + self.phase), axis=1)
+        if self.ramp > 0:
+            F = F * jnp.where(t < self.ramp, 0.5 * (1.0 - jnp.cos(jnp.pi * jnp.clip(t, 0.0, self.ramp) / self.ramp)), 1.0)
+        return F

@@ -1,0 +1,112 @@
+"""The tanks and their deformed free surface in the inertial frame: snapshots (the paper's Figure
+5(a)) and an animated GIF."""
+from __future__ import annotations
+
+import numpy as np
+from matplotlib.animation import FuncAnimation, PillowWriter
+from matplotlib.tri import Triangulation
+
+from ..physics.kinematics import rotation_matrix
+from ..scene.load import tomllib
+from .results import figure
+
+
+class _Tanks:
+    """What drawing the tanks of a result needs, computed once: each tank's origin, size, free-surface
+    nodes (those at the fill depth) and their triangulation, and the plot's half-width."""
+
+    def __init__(self, r):
+        if not r.tanks:
+            raise ValueError("the result holds no liquid fields (run with tanks, without --no-fields)")
+        scene = {t["name"]: t for t in tomllib.loads(r.scene_text).get("tanks", [])}
+        self.r = r
+        self.time = np.asarray(r.time)
+        self.tanks = []
+        for name, tf in r.tanks.items():
+            if name not in scene:
+                raise ValueError(f"the result's scene has no tank named {name!r}")
+            origin, size = np.asarray(scene[name]["origin"], float), np.asarray(scene[name]["size"], float)
+            nodes = np.asarray(tf.nodes)
+            s = np.flatnonzero(np.isclose(nodes[:, 2], float(scene[name]["fill_depth"])))
+            tri = Triangulation(nodes[s, 0], nodes[s, 1]).triangles
+            lo, hi = origin, origin + size
+            corners = np.array([[x, y, z] for x in (lo[0], hi[0]) for y in (lo[1], hi[1]) for z in (lo[2], hi[2])])
+            edges = [(a, b) for a in range(8) for b in range(a + 1, 8)
+                     if np.sum(np.abs(corners[a] - corners[b]) > 1e-12) == 1]
+            self.tanks.append((name, origin, nodes[s], s, tri, corners, edges))
+        self.span = max(float(np.max(scene[name]["size"])) for name in r.tanks) * 0.75
+
+    def index(self, t) -> int:
+        """The saved frame nearest to time t."""
+        return int(np.argmin(np.abs(self.time - t)))
+
+    def draw(self, ax, i: int, scale: float) -> None:
+        """Frame i on a 3D axes: the tanks' edges turned and moved with the hull, and each deformed
+        free surface (displacements magnified by `scale`), in the inertial frame around the COG."""
+        r = self.r
+        A = np.asarray(rotation_matrix(np.asarray(r.vessel.quaternion[i])))
+        X0 = np.asarray(r.vessel.position[i])
+        for name, origin, surface, s, tri, corners, edges in self.tanks:
+            D = np.asarray(r.tanks[name].displacement[i])[s]
+            p = X0 + (origin + surface + scale * D) @ A.T
+            ax.plot_trisurf(p[:, 0], p[:, 1], p[:, 2], triangles=tri, cmap="Blues", alpha=0.9, linewidth=0.2,
+                            edgecolor="k")
+            for a, b in edges:
+                seg = X0 + corners[[a, b]] @ A.T
+                ax.plot(seg[:, 0], seg[:, 1], seg[:, 2], color="0.3", lw=0.8)
+        ax.set_title(f"t = {self.time[i]:.2f} s", fontsize=9)
+        ax.set_xlim(X0[0] - self.span, X0[0] + self.span)
+        ax.set_ylim(X0[1] - self.span, X0[1] + self.span)
+        ax.set_zlim(X0[2] - self.span, X0[2] + self.span)
+        ax.set_box_aspect((1, 1, 1))
+        ax.set_xlabel("X")
+        ax.set_ylabel("Y")
+        ax.set_zlabel("Z")
+
+
+def _surface_title(scale: float) -> str:
+    return "tank and free surface in the inertial frame" + (f" (displacements x{scale:g})" if scale != 1 else "")
+
+
+def plot_free_surface(r, out: str, times=None, scale: float = 1.0) -> None:
+    """The counterpart of the paper's Figure 5(a): the hull's attitude and the deformed free surface
+    of every tank at a few instants, in the inertial frame (displacements magnified by `scale`)."""
+    tanks = _Tanks(r)
+    if times is None:
+        times = np.linspace(tanks.time[0], tanks.time[-1], 4)
+    idx = [tanks.index(tt) for tt in times]
+    fig = figure(4.2 * len(idx), 4.2)
+    for j, i in enumerate(idx):
+        tanks.draw(fig.add_subplot(1, len(idx), j + 1, projection="3d"), i, scale)
+    fig.suptitle(_surface_title(scale), fontsize=10)
+    fig.tight_layout()
+    fig.savefig(out, dpi=100)
+
+
+def animate_free_surface(r, out: str, scale: float = 1.0, fps: float = 10.0, every: int | None = None,
+                         max_frames: int = 100, dpi: int = 80) -> int:
+    """An animated GIF of the tanks and their deformed free surface in the inertial frame (the frames
+    of `plot_free_surface`, one per shown instant; displacements magnified by `scale`). Every
+    `every`-th saved frame is shown (default: the stride that keeps at most `max_frames`), `fps`
+    frames per second. Returns the number of frames written."""
+    tanks = _Tanks(r)
+    n = len(tanks.time)
+    if every is None:
+        every = max(1, -(-n // max(1, int(max_frames))))
+    if int(every) < 1:
+        raise ValueError(f"every: must be at least 1, got {every}")
+    if not fps > 0:
+        raise ValueError(f"fps: must be positive, got {fps}")
+    idx = list(range(0, n, int(every)))
+    fig = figure(5.0, 5.0)
+    ax = fig.add_subplot(projection="3d")
+    fig.suptitle(_surface_title(scale), fontsize=10)
+
+    def frame(i):
+        ax.cla()
+        tanks.draw(ax, i, scale)
+        return ()
+
+    anim = FuncAnimation(fig, frame, frames=idx, init_func=lambda: (), blit=False, cache_frame_data=False)
+    anim.save(out, writer=PillowWriter(fps=fps), dpi=dpi)
+    return len(idx)

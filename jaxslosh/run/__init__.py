@@ -1,0 +1,1 @@
+"""Running a scene: the compiled time loop, `simulate`, batches, and the command line's run to a file."""

@@ -1,0 +1,128 @@
+"""The time loop: one jit-compiled `lax.scan` over saved frames (each frame `save_every` steps).
+
+`simulate` runs the whole scan in one call (differentiable: `params` may hold tracers);
+`run_to_file` (tofile.py) runs the same compiled chunk repeatedly and appends each chunk to the
+result file; `simulate_batch` (batch.py) runs a vmapped batch. A step that fails (Newton not
+converged, non-finite values) freezes the state; the host finds the first failure, keeps every
+frame before it and reports the step, the time and the residual.
+"""
+from __future__ import annotations
+
+import dataclasses
+import math
+from typing import NamedTuple, Optional
+
+import jax
+import numpy as np
+
+from ..build.system import Built, build
+from ..io.result import Energy, ProbeHistory, Result, SolverHistory, TankField, VesselHistory, truncated
+from ..physics.kinematics import rpy_from_quat
+from ..scene.keys import with_overrides
+from ..scene.types import Scene
+from ..solve.linear import Solver, make_solver
+from ..solve.schemes import make_scheme
+from .loop import Carry, Frame, advance, concat_frames, core, nodal, start
+
+
+class NumericalFailure(RuntimeError):
+    """A step that did not converge or produced non-finite values (exit status 3 on the CLI)."""
+
+    def __init__(self, message: str, result: Optional[Result] = None):
+        super().__init__(message)
+        self.result = result
+
+
+#: in vmapped batches the Newton preconditioner is carried from step to step and formed anew every
+#: this many steps (single runs form it anew when convergence slows, which a batch cannot test per run)
+BATCH_REFRESH = 4
+
+
+class Setup(NamedTuple):
+    built: Built
+    solver: Solver
+    n_steps: int
+    save_every: int
+
+
+def prepare(scene: Scene, params=None, batch: bool = False) -> Setup:
+    """The static model, the solver and the step count. The Newton preconditioner is carried from
+    step to step; single runs form it again when convergence slows, `batch` (vmapped runs: no
+    lax.cond on a per-run test) every BATCH_REFRESH steps."""
+    sim = scene.simulation
+    h, T = float(sim.dt), float(sim.duration)
+    # Under an outer jax.jit (a user's jitted loss) every jnp operation is staged, even on
+    # constants; the build relies on the scene's own values being concrete (NumPy meshes, host
+    # factors), so what does not depend on traced `params` is evaluated now, as outside jit.
+    with jax.ensure_compile_time_eval():
+        b = build(scene, params)
+        scheme = make_scheme(sim.scheme, sim.alpha, sim.rho_inf)
+        solver = make_solver(b.system, h, scheme, sim.tolerance, sim.max_iterations, sim.substeps,
+                             reuse=True, adaptive=not batch)
+    if batch:      # carried, formed anew every BATCH_REFRESH steps (a cond inside the iterations would
+        solver = dataclasses.replace(solver, refresh_every=BATCH_REFRESH)    # run both branches under vmap)
+    # a gradient can reach the run only through traced params (a batch is never differentiated):
+    # otherwise the Newton solves skip custom_root's tracing of the tangent solves
+    traced = any(isinstance(v, jax.core.Tracer) for v in jax.tree_util.tree_leaves(params or {}))
+    solver = dataclasses.replace(solver, implicit=traced and not batch)
+    if sim.energy_projection:     # the scene check allows it only where it holds (scene._conservative)
+        solver = dataclasses.replace(solver, project=True)
+    n_steps = int(round(T / h))
+    return Setup(b, solver, n_steps, max(1, int(sim.save_every)))
+
+
+def to_result(b: Built, fr: Frame, scene_text: str, status: str, steps_done: int) -> Result:
+    probes = {}
+    for i, name in enumerate(b.probes.names):
+        pos = fr.probes[:, i, :]
+        probes[name] = ProbeHistory(pos, pos - pos[0])
+    tanks = {}
+    D = nodal(b, fr.D)
+    for t in b.tanks:
+        N = t.nodes.shape[0]
+        tanks[t.name] = TankField(t.nodes, t.elements, D[:, t.node_offset:t.node_offset + N, :])
+    return Result(time=fr.t, vessel=VesselHistory(fr.X0, fr.q, fr.omega, rpy_from_quat(fr.q)), probes=probes,
+                  energy=Energy(fr.ke, fr.pe), solver=SolverHistory(fr.iterations, fr.residual, fr.gmax), tanks=tanks,
+                  status=status, steps_done=steps_done, scene_text=scene_text)
+
+
+def failure_message(carry: Carry, h: float, tol: float, max_iter: int) -> str:
+    k = int(carry.fail_step)
+    err = float(carry.fail_err)
+    if k == 0:
+        return f"the initial accelerations could not be solved (scaled residual {err:.3g})"
+    t = k * h
+    if not math.isfinite(err):
+        return f"step {k} (t = {t:.6g} s): non-finite values (NaN or Inf) in the solution"
+    return (f"step {k} (t = {t:.6g} s): Newton did not converge in {int(carry.fail_it)} iterations "
+            f"(scaled residual {err:.3g}, tolerance {tol:.3g})")
+
+
+def simulate(scene: Scene, params: Optional[dict] = None, *, duration: Optional[float] = None,
+             dt: Optional[float] = None, throw: bool = False) -> Result:
+    """Run a scene; the result holds every `save_every`-th step, t = 0 included.
+
+    `params` maps dotted scene keys to replacement values, which may be JAX tracers:
+    `jax.grad` of any scalar function of the result works with respect to them.
+    A numerical failure truncates the result to the frames before it and sets `status`
+    (or raises NumericalFailure when `throw=True`); under tracing the status cannot be read.
+    """
+    scene = with_overrides(scene, duration=duration, dt=dt)
+    setup = prepare(scene, params)
+    b, solver = setup.built, setup.solver
+    n_frames = setup.n_steps // setup.save_every
+    carry, f0 = start(core(b), solver)
+    carry, frames = advance(core(b), solver, carry, n_frames, setup.save_every)
+    fr = concat_frames([jax.tree_util.tree_map(lambda x: x[None], f0), frames])
+    traced = isinstance(carry.failed, jax.core.Tracer)
+    if traced:
+        return to_result(b, fr, scene.text, "ok", setup.n_steps)
+    if bool(carry.failed):
+        msg = failure_message(carry, solver.h, solver.tol, solver.max_iter)
+        n_ok = int(np.sum(~np.asarray(fr.failed)))
+        res = to_result(b, fr, scene.text, msg, int(carry.k))
+        res = truncated(res, n_ok)
+        if throw:
+            raise NumericalFailure(msg, res)
+        return res
+    return to_result(b, fr, scene.text, "ok", int(carry.k))

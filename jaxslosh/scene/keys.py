@@ -1,0 +1,181 @@
+"""The registry of scene keys: every real value of a scene by its dotted TOML path, which of them
+`params` may trace, and the one place where overrides are resolved.
+
+A key names a value as the scene file writes it: `vessel.hydrostatics.gm_t`, `tanks.tank.fill_depth`
+or, by index, `tanks[0].fill_depth` (the canonical form is the name form). `simulate(params=...)`,
+`jaxslosh sweep --param` and `identify --fit` all go through `resolve_params`; `--duration` and
+`--dt` through `with_overrides`, which returns a scene validated like a loaded one.
+"""
+from __future__ import annotations
+
+import dataclasses
+import difflib
+from typing import Any, Iterable, Optional
+
+import numpy as np
+
+from .fields import show
+from .types import Material, Scene, SceneError
+
+
+class _Keys(tuple):
+    """The traceable keys; `<name>` in an entry stands for the name of any tank of the scene
+    (`tanks.<name>.fill_depth` holds `tanks.tank.fill_depth`)."""
+
+    def __contains__(self, key) -> bool:
+        if not isinstance(key, str):
+            return False
+        for pattern in self:
+            if "<name>" not in pattern:
+                if key == pattern:
+                    return True
+                continue
+            head, tail = pattern.split("<name>")
+            if key.startswith(head) and key.endswith(tail) and len(key) > len(head) + len(tail):
+                if not any(ch in key[len(head):len(key) - len(tail)] for ch in ".[]/"):
+                    return True
+        return False
+
+
+# Scene values that simulate(params=...) may replace by traced values (the vessel is rebuilt per
+# call; the liquid matrices are assembled from traced fill depth, density, sound speed and gravity).
+TANK_TRACEABLE = ("fill_depth", "fluid.density", "fluid.sound_speed")
+
+
+TRACEABLE = _Keys((
+    "environment.gravity", "environment.water_density", "vessel.mass", "vessel.inertia",
+    "vessel.hydrostatics.waterplane_area", "vessel.hydrostatics.displaced_volume",
+    "vessel.hydrostatics.gm_t", "vessel.hydrostatics.gm_l",
+    "vessel.initial.position", "vessel.initial.velocity", "vessel.initial.angular_velocity",
+    "vessel.initial.roll_pitch_yaw",
+) + tuple(f"tanks.<name>.{k}" for k in TANK_TRACEABLE) + ("waves.amplitude", "waves.hs"))
+
+
+def scene_values(scene: Scene) -> dict[str, Any]:
+    """Every real-valued quantity of the scene by its dotted TOML path.
+
+    Scalars are floats; vectors (`vessel.initial.velocity`, `tanks.<name>.origin`, ...) are tuples
+    of 3 floats and `vessel.inertia` a 3x3 nested tuple. Tanks, structures and probes appear twice,
+    by name (`tanks.tank.fill_depth`) and by index (`tanks[0].fill_depth`); `canonical_key` maps the
+    index form to the name form. Integer settings (mesh counts, save_every, ...) are not values.
+    """
+    v: dict[str, Any] = {}
+    env, sim, ves = scene.environment, scene.simulation, scene.vessel
+    v["environment.gravity"] = env.gravity
+    v["environment.water_density"] = env.water_density
+    for key in ("duration", "dt", "alpha", "rho_inf", "tolerance"):
+        v[f"simulation.{key}"] = getattr(sim, key)
+    v["vessel.mass"] = ves.mass
+    v["vessel.inertia"] = ves.inertia
+    if ves.hydrostatics is not None:
+        for key in ("waterplane_area", "displaced_volume", "gm_t", "gm_l"):
+            v[f"vessel.hydrostatics.{key}"] = getattr(ves.hydrostatics, key)
+    for key in ("position", "velocity", "angular_velocity", "roll_pitch_yaw"):
+        v[f"vessel.initial.{key}"] = getattr(ves.initial, key)
+    if scene.waves is not None:   # the wave forces are linear in these (waves.py)
+        v["waves.amplitude" if scene.waves.type == "regular" else "waves.hs"] = scene.waves.height
+
+    def material(prefix: str, m: Material) -> dict[str, float]:
+        return {f"{prefix}.young": m.young, f"{prefix}.poisson": m.poisson, f"{prefix}.density": m.density}
+
+    for i, t in enumerate(scene.tanks):
+        own = {"origin": t.origin, "size": t.size, "fill_depth": t.fill_depth,
+               "fluid.density": t.fluid.density, "fluid.sound_speed": t.fluid.sound_speed}
+        if t.wall_spec is not None:
+            own["walls.thickness"] = t.wall_spec.thickness
+            own |= material("walls.material", t.wall_spec.material)
+        for prefix in (f"tanks.{t.name}", f"tanks[{i}]"):
+            v.update({f"{prefix}.{k}": x for k, x in own.items()})
+    for i, s in enumerate(scene.structures):
+        own = {"origin": s.origin, "size": s.size} | material("material", s.material)
+        for prefix in (f"structures.{s.name}", f"structures[{i}]"):
+            v.update({f"{prefix}.{k}": x for k, x in own.items()})
+    for i, p in enumerate(scene.probes):
+        for prefix in (f"probes.{p.name}", f"probes[{i}]"):
+            v[f"{prefix}.point"] = p.point
+    return v
+
+
+def canonical_key(scene: Scene, key: str) -> str:
+    """The name form of a dotted key: `tanks[0].fill_depth` -> `tanks.tank.fill_depth` (others unchanged)."""
+    for group, items in (("tanks", scene.tanks), ("structures", scene.structures), ("probes", scene.probes)):
+        if key.startswith(group + "["):
+            index, sep, rest = key[len(group) + 1:].partition("]")
+            if sep and index.isdigit() and int(index) < len(items):
+                return f"{group}.{items[int(index)].name}{rest}"
+    return key
+
+
+def check_param_keys(scene: Scene, keys: Iterable[str]) -> tuple[str, ...]:
+    """Raise SceneError for a key that is not in `scene_values(scene)`, or for two keys (index form
+    and name form) that name the same value. Returns the keys in their canonical (name) form."""
+    known = scene_values(scene)
+    seen: dict[str, str] = {}
+    for key in keys:
+        if not isinstance(key, str):
+            raise SceneError("params", f"keys must be dotted TOML paths (strings), got {key!r}")
+        if key not in known:
+            close = difflib.get_close_matches(key, list(known), n=3, cutoff=0.6)
+            hint = f"did you mean {', '.join(close)}? " if close else ""
+            raise SceneError(key, f"not a value of this scene that params can set; {hint}"
+                                  f"(known: {', '.join(k for k in known if '[' not in k)})")
+        canon = canonical_key(scene, key)
+        if canon in seen:
+            raise SceneError(key, f"names the same value as {seen[canon]}; give it once")
+        seen[canon] = key
+    return tuple(seen)
+
+
+def resolve_params(scene: Scene, params: Optional[dict]) -> dict:
+    """`params` with canonical keys, each a traceable value of this scene given once, its value of
+    the scene's shape (a scalar, 3 numbers, or for `vessel.inertia` a 3 x 3 matrix or its diagonal).
+    SceneError names the first key that is not."""
+    params = dict(params or {})
+    keys = traceable(scene, params)
+    values = scene_values(scene)
+    return {key: _shaped(given, value, values[key]) for (given, value), key in zip(params.items(), keys)}
+
+
+def traceable(scene: Scene, keys: Iterable[str]) -> tuple[str, ...]:
+    """The canonical form of keys that params may trace; SceneError names the first that is not
+    a value of this scene, is not traceable, or names a value another key names too."""
+    keys = list(keys)
+    canon = check_param_keys(scene, keys)
+    for given, key in zip(keys, canon):
+        if key not in TRACEABLE:
+            raise SceneError(given, "cannot be traced by params, a sweep or a fit (traceable: "
+                                    + ", ".join(traceable_keys(scene)) + ")")
+    return canon
+
+
+def traceable_keys(scene: Scene) -> tuple[str, ...]:
+    """The keys of this scene that params may trace."""
+    return tuple(k for k in scene_values(scene) if "[" not in k and k in TRACEABLE)
+
+
+def _shaped(key: str, value, base):
+    """The value, checked against the shape of the scene's value (tracers keep their own)."""
+    want = np.shape(base)
+    got = np.shape(value)
+    if got == want:
+        return value
+    if key.endswith("inertia") and got == (3,):      # the diagonal (build makes the matrix)
+        return value
+    what = {(): "a number", (3,): "3 numbers", (3, 3): "3 diagonal values or a 3 x 3 matrix"}.get(want, str(want))
+    raise SceneError(key, f"needs {what}, got a value of shape {got}")
+
+
+def with_overrides(scene: Scene, *, duration: Optional[float] = None, dt: Optional[float] = None) -> Scene:
+    """The scene with its duration and step replaced (the command line's --duration and --dt),
+    checked as the loader checks them."""
+    if duration is None and dt is None:
+        return scene
+    sim = scene.simulation
+    for name, v in (("duration", duration), ("dt", dt)):
+        if v is not None and not (isinstance(v, (int, float)) and np.isfinite(v) and v > 0):
+            raise SceneError(f"simulation.{name}", f"must be a positive finite number, got {show(v)}")
+    sim = dataclasses.replace(sim, duration=float(duration if duration is not None else sim.duration),
+                              dt=float(dt if dt is not None else sim.dt))
+    if sim.dt > sim.duration:
+        raise SceneError("simulation.dt", f"{show(sim.dt)} s is longer than the duration {show(sim.duration)} s")
+    return dataclasses.replace(scene, simulation=sim)

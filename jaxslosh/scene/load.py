@@ -1,0 +1,445 @@
+"""Scene loader: a TOML file (SPEC.md section 1) to a validated, immutable `Scene`.
+
+Every input error is raised as one `SceneError` whose message starts with the dotted key of the
+offending value (`tanks[0].fill_depth: 4.5 m is above the tank height 4.0 m`); nothing is built
+from a scene that fails. Physically doubtful but legal choices (GM <= 0, a displacement that does
+not carry the mass) load, with a sentence in `Scene.warnings` that says what they mean.
+
+The field reader is fields.py; rules that involve several values (dt <= duration, fill_depth <=
+height, probes inside their owner, unique names) follow per table here.
+
+No JAX here: loading a scene is plain Python (and NumPy for the inertia's eigenvalues).
+"""
+from __future__ import annotations
+
+import dataclasses
+import os
+import re
+from pathlib import Path
+from typing import Any, Mapping
+
+import numpy as np
+
+try:
+    import tomllib
+except ModuleNotFoundError:  # Python 3.10
+    import tomli as tomllib  # type: ignore[no-redef]
+
+from ..fem.mesh import box_mesh, face_nodes
+from .fields import (at_least, counts, non_negative, one_of, poisson_ratio, positive, read, show, sizes,
+                     valid_name)
+from .types import (DOFS, EFFECTS, ELEMENT_FORMS, FACES, Effects, Environment, Forced, Fluid, Hydrostatics, Initial,
+                    Material, Probe, Reduction, Scene, SceneError, Simulation, Structure, Tank, Vessel, Walls)
+from .waves import check_waves, hull_hydrostatics, read_hull, read_hydrodynamics, read_waves
+
+SCHEMES = ("newmark", "hht", "generalized-alpha")
+LINEAR_SOLVERS = ("auto", "dense", "sparse")      # [simulation] linear_solver (sparse.py)
+WALLS = ("rigid", "elastic")
+MOMENTS = ("paper", "conservative")
+PROBE_TOLERANCE = 1e-9                           # m: how far outside its owner a probe may lie
+MASS_BALANCE_TOLERANCE = 0.01                    # relative mismatch of weight and buoyancy that warns
+HHT_ALPHA_MAX = 1.0 / 3.0
+
+
+# --------------------------------------------------------------------------------------------
+# Entry points
+def load_scene(path_or_text: str | os.PathLike) -> Scene:
+    """Load and validate a scene from a .toml path, or from TOML text (a string with a newline)."""
+    if isinstance(path_or_text, str) and "\n" in path_or_text:
+        text, path = path_or_text, ""
+    else:
+        path = os.fspath(path_or_text)
+        try:
+            text = Path(path).read_text(encoding="utf-8")
+        except FileNotFoundError:
+            raise SceneError("", f"{path}: no such file") from None
+        except IsADirectoryError:
+            raise SceneError("", f"{path}: is a directory, not a scene file") from None
+        except UnicodeDecodeError as e:
+            raise SceneError("", f"{path}: not valid TOML: not UTF-8 text ({e.reason} at byte {e.start})") from None
+        except OSError as e:
+            raise SceneError("", f"{path}: cannot be read ({e.strerror})") from None
+    try:
+        mapping = tomllib.loads(text)
+    except tomllib.TOMLDecodeError as e:  # its message ends with "(at line L, column C)"
+        raise SceneError("", f"{path or '<text>'}: not valid TOML: {e}{_toml_hint(text, str(e))}") from None
+    return parse_scene(mapping, text=text, path=path)
+
+
+def _toml_hint(text: str, message: str) -> str:
+    """A hint for the one TOML error SPEC's own wording invites: `walls = "elastic"` plus `[tanks.walls]`."""
+    m = re.search(r"at line (\d+)", message)
+    lines = text.splitlines()
+    if m and "overwrite" in message and 0 < int(m.group(1)) <= len(lines):
+        line = lines[int(m.group(1)) - 1].replace(" ", "")
+        if line.startswith("[tanks.walls") or line.startswith("walls."):
+            return ('; a tank\'s walls are either walls = "rigid" or a [tanks.walls] table (which makes them '
+                    'elastic): remove the line walls = "elastic"')
+    return ""
+
+
+def parse_scene(mapping: Mapping[str, Any], text: str = "", path: str = "") -> Scene:
+    """Validate a parsed TOML mapping and build the `Scene` (`text`, `path` are stored in it)."""
+    top = read(mapping, "", {
+        "title": ("str", None),
+        "environment": ("table", None),
+        "simulation": ("table", None),
+        "vessel": ("table", None),
+        "tanks": ("tables", None),
+        "structures": ("tables", None),
+        "probes": ("tables", None),
+        "effects": ("table", None),
+        "waves": ("table", None),
+    }, required=("simulation", "vessel"))
+    warnings: list[str] = []
+    title = top.get("title", Path(path).stem if path else "")
+    environment = _environment(mapping.get("environment", {}))
+    simulation = _simulation(mapping["simulation"], warnings)
+    vessel = _vessel(mapping["vessel"], environment, warnings)
+    tanks = tuple(_tank(t, f"tanks[{i}]") for i, t in enumerate(mapping.get("tanks", [])))
+    structures = tuple(_structure(s, f"structures[{i}]") for i, s in enumerate(mapping.get("structures", [])))
+    probes = tuple(_probe(p, f"probes[{i}]") for i, p in enumerate(mapping.get("probes", [])))
+    _unique_names(tanks, "tanks", "tank")
+    _unique_names(structures, "structures", "structure")
+    _attachments(structures)
+    _unique_names(probes, "probes", "probe")
+    for i, probe in enumerate(probes):
+        _place_probe(probe, f"probes[{i}]", tanks, structures)
+    _mass_balance(vessel, tanks, environment, warnings, structures)
+    effects = Effects(**read(mapping.get("effects", {}), "effects", {k: ("bool", None) for k in EFFECTS}))
+    waves = None
+    if "waves" in mapping:   # incident waves (waves.py)
+        waves = read_waves(mapping["waves"], warnings)
+    scene = Scene(title=title, environment=environment, simulation=simulation, vessel=vessel, tanks=tanks,
+                  structures=structures, probes=probes, effects=effects, text=text, path=path,
+                  warnings=tuple(warnings), waves=waves)
+    if waves is not None or vessel.hull is not None or vessel.hydrodynamics is not None:
+        scene = check_waves(scene, path, warnings)
+        scene = dataclasses.replace(scene, warnings=tuple(warnings))
+    if simulation.energy_projection:
+        _conservative(scene)
+    return scene
+
+
+def _conservative(scene: Scene) -> None:
+    """`simulation.energy_projection` holds the total energy at its initial value: only right when
+    nothing in the scene adds or removes energy and the equations are those of that energy."""
+    v, e = scene.vessel, scene.effects
+    why = []
+    if v.forced is not None:
+        why.append("[vessel.forced] prescribes motion (it does work)")
+    if scene.waves is not None or v.hydrodynamics is not None or v.hull is not None:
+        why.append("waves and hull hydrodynamics add and radiate energy")
+    if scene.structures:
+        why.append("flexible structures are not covered by the projection")
+    if v.hydrostatics is not None and v.hydrostatics.moment != "conservative":
+        why.append('vessel.hydrostatics.moment = "paper" is not the gradient of a potential')
+    off = [k for k in ("coriolis", "centrifugal", "gravity_turning") if not getattr(e, k)]
+    if off:
+        why.append(f"effects {', '.join(off)} off: the equations are no longer those of the total energy")
+    if why:
+        raise SceneError("simulation.energy_projection",
+                         "needs a conservative scene (the total energy must stay constant), but " + "; ".join(why))
+
+
+# --------------------------------------------------------------------------------------------
+# Tables
+def _environment(table) -> Environment:
+    v = read(table, "environment", {
+        "gravity": ("float", non_negative),
+        "water_density": ("float", positive),
+    })
+    return Environment(**v)
+
+
+def _simulation(table, warnings: list[str]) -> Simulation:
+    v = read(table, "simulation", {
+        "duration": ("float", positive),
+        "dt": ("float", positive),
+        "scheme": ("str", one_of(SCHEMES)),
+        "alpha": ("float", None),
+        "rho_inf": ("float", None),
+        "save_every": ("int", at_least(1)),
+        "tolerance": ("float", positive),
+        "max_iterations": ("int", at_least(1)),
+        "chunk": ("int", non_negative),
+        "substeps": ("int", non_negative),
+        "linear_solver": ("str", one_of(LINEAR_SOLVERS)),
+        "energy_projection": ("bool", None),
+    }, required=("duration", "dt"))
+    sim = Simulation(**v)
+    if sim.dt > sim.duration:
+        raise SceneError("simulation.dt", f"{show(sim.dt)} s is longer than the duration {show(sim.duration)} s")
+    if sim.scheme == "newmark" and sim.alpha != 0.0:
+        raise SceneError("simulation.alpha", (
+            f'{show(sim.alpha)} with scheme = "newmark": newmark is the trapezoidal rule (gamma = 1/2, '
+            f"beta = 1/4), and with alpha != 0 those coefficients amplify the response instead of damping it; "
+            f'use scheme = "hht" (gamma = 1/2 + alpha, beta = (1 + alpha)^2 / 4) or remove alpha'))
+    if sim.energy_projection and sim.scheme != "newmark":
+        raise SceneError("simulation.energy_projection", (
+            f'needs scheme = "newmark" (the trapezoidal rule), got "{sim.scheme}": it holds the total energy at '
+            f"its initial value, which contradicts the numerical damping of {sim.scheme}"))
+    if not 0.0 <= sim.alpha <= HHT_ALPHA_MAX + 1e-12:
+        raise SceneError("simulation.alpha", f"must lie in [0, 1/3], got {show(sim.alpha)}")
+    if not 0.0 <= sim.rho_inf <= 1.0:
+        raise SceneError("simulation.rho_inf", f"must lie in [0, 1], got {show(sim.rho_inf)}")
+    if "rho_inf" in v and sim.scheme != "generalized-alpha":
+        warnings.append(f'simulation.rho_inf = {show(sim.rho_inf)} is ignored with scheme = "{sim.scheme}" '
+                        f'(it only sets scheme = "generalized-alpha")')
+    if sim.alpha != 0.0 and sim.scheme == "generalized-alpha":
+        warnings.append(f'simulation.alpha = {show(sim.alpha)} is ignored with scheme = "generalized-alpha" '
+                        f"(its damping is set by rho_inf)")
+    steps = sim.duration / sim.dt
+    if abs(steps - round(steps)) > 1e-6 * max(1.0, steps):
+        warnings.append(f"simulation.duration = {show(sim.duration)} s is not a whole number of steps of "
+                        f"{show(sim.dt)} s; the run takes {sim.n_steps} steps, to t = {sim.n_steps * sim.dt:.6g} s")
+    return sim
+
+
+def _vessel(table, environment: Environment, warnings: list[str]) -> Vessel:
+    v = read(table, "vessel", {
+        "mass": ("float", positive),
+        "inertia": ("inertia", None),
+        "hydrostatics": ("table", None),
+        "initial": ("table", None),
+        "forced": ("table", None),
+        "hull": ("table", None),
+        "hydrodynamics": ("table", None),
+    }, required=("mass", "inertia"))
+    inertia = v["inertia"]
+    _inertia_warnings(inertia, warnings)
+    hydrostatics = _hydrostatics(table["hydrostatics"], warnings) if "hydrostatics" in table else None
+    hull = hydrodynamics = None
+    if "hull" in table or "hydrodynamics" in table:   # hull and its hydrodynamics (waves.py)
+        hull = read_hull(table["hull"]) if "hull" in table else None
+        if hull is not None:
+            hydrostatics = hull_hydrostatics(hull, hydrostatics, warnings)
+        hydrodynamics = read_hydrodynamics(table["hydrodynamics"], hull) if "hydrodynamics" in table else None
+    if hydrostatics is None and environment.gravity > 0:
+        warnings.append(f"vessel: no [vessel.hydrostatics] table, so nothing holds the vessel up: it falls "
+                        f"freely under gravity {show(environment.gravity)} m/s^2")
+    initial = Initial(**read(table.get("initial", {}), "vessel.initial", {
+        "position": ("vec3", None),
+        "velocity": ("vec3", None),
+        "angular_velocity": ("vec3", None),
+        "roll_pitch_yaw": ("vec3", None),
+    }))
+    forced = None
+    if "forced" in table:
+        f = read(table["forced"], "vessel.forced", {
+            "dof": ("str", one_of(DOFS)),
+            "profile": ("str", one_of(("harmonic", "spin-up"))),
+            "amplitude": ("float", None),
+            "frequency": ("float", positive),
+            "ramp": ("float", non_negative),
+            "rate": ("float", None),
+            "duration": ("float", positive),
+        }, required=("dof",))
+        profile = f.get("profile", "harmonic")
+        need = ("amplitude", "frequency") if profile == "harmonic" else ("rate", "duration")
+        for k in need:
+            if k not in f:
+                raise SceneError(f"vessel.forced.{k}", f"is required for the {profile} profile")
+        other = ("rate", "duration") if profile == "harmonic" else ("amplitude", "frequency", "ramp")
+        for k in other:
+            if k in f:
+                raise SceneError(f"vessel.forced.{k}", f"does not belong to the {profile} profile "
+                                                       f"(it takes {', '.join(need)})")
+        if profile == "spin-up" and f["dof"] not in ("roll", "pitch", "yaw"):
+            raise SceneError("vessel.forced.dof", f"the spin-up profile turns a rotation (roll, pitch or yaw), "
+                                                  f"not {f['dof']!r}")
+        forced = Forced(**f)
+    return Vessel(mass=v["mass"], inertia=inertia, hydrostatics=hydrostatics, initial=initial, forced=forced,
+                  hull=hull, hydrodynamics=hydrodynamics)
+
+
+def _hydrostatics(table, warnings: list[str]) -> Hydrostatics:
+    where = "vessel.hydrostatics"
+    h = Hydrostatics(**read(table, where, {
+        "waterplane_area": ("float", positive),
+        "displaced_volume": ("float", positive),
+        "gm_t": ("float", None),
+        "gm_l": ("float", None),
+        "moment": ("str", one_of(MOMENTS)),
+    }, required=("waterplane_area", "displaced_volume", "gm_t", "gm_l")))
+    for key, value, motion in (("gm_t", h.gm_t, "roll"), ("gm_l", h.gm_l, "pitch")):
+        if value <= 0:
+            warnings.append(f"{where}.{key} = {show(value)} m <= 0: the vessel is statically unstable in "
+                            f"{motion}; it will capsize or loll")
+    return h
+
+
+def _inertia_warnings(inertia, warnings: list[str]) -> None:
+    i1, i2, i3 = sorted(np.linalg.eigvalsh(np.asarray(inertia)))
+    if i1 + i2 < i3 * (1 - 1e-9):
+        warnings.append(f"vessel.inertia: the principal moments {i1:.6g}, {i2:.6g}, {i3:.6g} kg m^2 break the "
+                        f"triangle inequality I1 + I2 >= I3 that every rigid body's inertia keeps")
+
+
+def _material(table, where: str) -> Material:
+    return Material(**read(table, where, {
+        "young": ("float", positive),
+        "poisson": ("float", poisson_ratio),
+        "density": ("float", positive),
+    }, required=("young", "poisson", "density")))
+
+
+def _tank(table, where: str) -> Tank:
+    v = read(table, where, {
+        "name": ("str", valid_name),
+        "origin": ("vec3", None),
+        "size": ("vec3", sizes),
+        "fill_depth": ("float", None),
+        "mesh": ("mesh", counts),
+        "walls": ("str_or_table", None),
+        "fluid": ("table", None),
+        "reduction": ("table", None),
+    }, required=("name", "origin", "size", "fill_depth", "mesh"))
+    # SPEC writes `walls = "elastic"` and a `[tanks.walls]` table, but TOML cannot hold both under
+    # one key: `walls` is either the string "rigid" or the table, which makes the walls elastic.
+    raw_walls = table.get("walls", "rigid")
+    if isinstance(raw_walls, dict):
+        walls, wall_spec = "elastic", _walls(raw_walls, f"{where}.walls")
+    else:
+        walls, wall_spec = raw_walls, None
+        msg = one_of(WALLS)(walls)
+        if msg:
+            raise SceneError(f"{where}.walls", msg)
+    if walls == "elastic" and wall_spec is None:
+        raise SceneError(f"{where}.walls", 'elastic walls need a [tanks.walls] table (thickness, material, '
+                                           'optional mesh) instead of walls = "elastic"')
+    height = v["size"][2]
+    depth = v["fill_depth"]
+    if depth <= 0:
+        raise SceneError(f"{where}.fill_depth", f"must be positive, got {show(depth)}")
+    if depth > height:
+        raise SceneError(f"{where}.fill_depth", f"{show(depth)} m is above the tank height {show(height)} m")
+    fluid = Fluid(**read(table.get("fluid", {}), f"{where}.fluid", {
+        "density": ("float", positive),
+        "sound_speed": ("float", positive),
+        "element": ("str", one_of(ELEMENT_FORMS)),
+    }))
+    reduction = None
+    if "reduction" in table:
+        reduction = Reduction(**read(table["reduction"], f"{where}.reduction", {
+            "modes": ("int", at_least(1)),
+            "static_correction": ("bool", None),
+        }, required=("modes",)))
+    return Tank(name=v["name"], origin=v["origin"], size=v["size"], fill_depth=depth, mesh=v["mesh"],
+                walls=walls, fluid=fluid, wall_spec=wall_spec, reduction=reduction)
+
+
+def _walls(table, where: str) -> Walls:
+    v = read(table, where, {
+        "thickness": ("float", positive),
+        "material": ("table", None),
+        "mesh": ("mesh", counts),
+    }, required=("thickness", "material"))
+    return Walls(thickness=v["thickness"], material=_material(table["material"], f"{where}.material"),
+                 mesh=v.get("mesh"))
+
+
+def _structure(table, where: str) -> Structure:
+    v = read(table, where, {
+        "name": ("str", valid_name),
+        "origin": ("vec3", None),
+        "size": ("vec3", sizes),
+        "mesh": ("mesh", counts),
+        "attach": ("str", one_of(FACES)),
+        "attach_to": ("str", None),
+        "frame": ("str", one_of(("own", "vessel"))),
+        "stiffening": ("str", one_of(("none", "centrifugal"))),
+        "material": ("table", None),
+    }, required=("name", "origin", "size", "mesh", "attach", "material"))
+    return Structure(material=_material(table["material"], f"{where}.material"), **v)
+
+
+def _attachments(structures) -> None:
+    """A structure tied to another (`attach_to`) needs its attachment face's nodes to coincide with
+    nodes of the other's mesh (the interface frame's nodes are shared), and may not tie to itself."""
+    by_name = {s.name: s for s in structures}
+    for i, s in enumerate(structures):
+        if s.attach_to is None:
+            continue
+        key = f"structures[{i}].attach_to"
+        if s.frame == "vessel":
+            raise SceneError(key, 'a structure in the vessel\'s frame (frame = "vessel") is held at its face on the '
+                                  'vessel; attach_to needs frame = "own"')
+        if s.attach_to in by_name and by_name[s.attach_to].frame == "vessel":
+            raise SceneError(key, f"{s.attach_to!r} has frame = \"vessel\": attach to a structure with its own frame")
+        if s.attach_to == s.name:
+            raise SceneError(key, f"structure {s.name!r} cannot be attached to itself")
+        if s.attach_to not in by_name:
+            raise SceneError(key, f"names no structure ({', '.join(repr(n) for n in by_name if n != s.name) or 'none'}); "
+                                  "leave it out to attach to the vessel")
+        o = by_name[s.attach_to]
+        mine, _ = box_mesh(s.size, s.mesh)
+        mine = mine[face_nodes(mine, s.size, s.attach)] + np.asarray(s.origin)
+        theirs, _ = box_mesh(o.size, o.mesh)
+        theirs = theirs + np.asarray(o.origin)
+        tol = 1e-6 * max(max(s.size), max(o.size))
+        dist = np.min(np.linalg.norm(mine[:, None, :] - theirs[None, :, :], axis=2), axis=1)
+        if dist.max() > tol:
+            raise SceneError(key, f"the {s.attach} face of {s.name!r} does not lie on nodes of {o.name!r} "
+                                  f"(a node is {dist.max():.3g} m from the nearest): the meshes must match there")
+
+
+def _probe(table, where: str) -> Probe:
+    v = read(table, where, {
+        "name": ("str", valid_name),
+        "tank": ("str", None),
+        "structure": ("str", None),
+        "point": ("vec3", None),
+    }, required=("name", "point"))
+    if ("tank" in v) == ("structure" in v):
+        which = "both a tank and a structure" if "tank" in v else "neither a tank nor a structure"
+        raise SceneError(where, f"probe {v['name']!r} names {which}; set exactly one of tank = or structure =")
+    return Probe(**v)
+
+
+def _unique_names(items, where: str, what: str) -> None:
+    seen: dict[str, int] = {}
+    for i, item in enumerate(items):
+        if item.name in seen:
+            raise SceneError(f"{where}[{i}].name", f"two {what}s named {item.name!r} "
+                                                   f"(also {where}[{seen[item.name]}].name)")
+        seen[item.name] = i
+
+
+def _place_probe(probe: Probe, where: str, tanks, structures) -> None:
+    """The owner exists and the point lies in it (tank-local or structure-local coordinates)."""
+    kind, owner_name, owners = (("tank", probe.tank, tanks) if probe.tank is not None
+                                else ("structure", probe.structure, structures))
+    owner = next((o for o in owners if o.name == owner_name), None)
+    if owner is None:
+        names = ", ".join(repr(o.name) for o in owners) or "none"
+        raise SceneError(f"{where}.{kind}", f"no {kind} named {owner_name!r} ({kind}s: {names})")
+    p, size = probe.point, owner.size
+    if any(x < -PROBE_TOLERANCE or x > s + PROBE_TOLERANCE for x, s in zip(p, size)):
+        raise SceneError(f"{where}.point", (
+            f"{show(list(p))} is outside {kind} {owner_name!r}: {kind}-local coordinates from its "
+            f"{'inner corner' if kind == 'tank' else 'origin'} must lie in "
+            f"0 <= x <= {show(size[0])}, 0 <= y <= {show(size[1])}, 0 <= z <= {show(size[2])} m"))
+    if kind == "tank":
+        inside_walls = all(PROBE_TOLERANCE < x < s - PROBE_TOLERANCE for x, s in zip(p[:2], size[:2]))
+        if inside_walls and owner.fill_depth + PROBE_TOLERANCE < p[2] < size[2] - PROBE_TOLERANCE:
+            raise SceneError(f"{where}.point", (
+                f"{show(list(p))} is in the air above the liquid (fill_depth {show(owner.fill_depth)} m) and "
+                f"on no wall of tank {owner_name!r}: no material point is there to follow"))
+
+
+def _mass_balance(vessel: Vessel, tanks, environment: Environment, warnings: list[str], structures=()) -> None:
+    h = vessel.hydrostatics
+    if h is None or environment.gravity == 0:
+        return
+    liquid = sum(t.liquid_mass for t in tanks)
+    total = vessel.mass + liquid        # vessel.mass: the whole ship without its liquid (structures included)
+    buoyant = environment.water_density * h.displaced_volume
+    if abs(total - buoyant) > MASS_BALANCE_TOLERANCE * buoyant:
+        imbalance = (total - buoyant) * environment.gravity
+        warnings.append(
+            f"vessel.hydrostatics.displaced_volume: the total mass {total:.6g} kg (vessel {vessel.mass:.6g} kg + "
+            f"tank liquid {liquid:.6g} kg) differs from water_density * displaced_volume = {buoyant:.6g} kg by "
+            f"{100 * (total - buoyant) / buoyant:+.2f} %; the hydrostatic restoring forces are taken about the "
+            f"initial position as if it were the equilibrium; the static imbalance of {abs(imbalance):.4g} N "
+            f"({'weight' if imbalance > 0 else 'buoyancy'} in excess) is ignored")

@@ -1,0 +1,284 @@
+"""The validated, immutable scene: plain frozen dataclasses of Python numbers and tuples.
+
+A scene is what `load_scene` returns (see `scene.py` for the loader and its validation rules,
+SPEC.md section 1 for the file format). Everything here is static model data: nothing is traced.
+Values that `simulate(scene, params=...)` may override are looked up by their dotted TOML path
+(`vessel.hydrostatics.gm_t`, `tanks.tank.fill_depth` or `tanks[0].fill_depth`) in `Scene.values()`.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from typing import Optional
+
+
+#: the six rigid dofs, in the order of every 6-vector and 6 x 6 table
+DOFS = ("surge", "sway", "heave", "roll", "pitch", "yaw")
+#: faces of a block ("x-" is x = 0, "z+" is z = size_z)
+FACES = ("x-", "x+", "y-", "y+", "z-", "z+")
+#: liquid element forms (fem/liquid_element.py)
+ELEMENT_FORMS = ("stabilized", "paper")
+
+Vec3 = tuple[float, float, float]
+Mat3 = tuple[Vec3, Vec3, Vec3]
+
+
+class SceneError(ValueError):
+    """Bad input: `key` is the dotted path of the offending value, the message names it."""
+
+    def __init__(self, key: str, message: str):
+        self.key = key
+        super().__init__(f"{key}: {message}" if key else message)
+
+
+@dataclass(frozen=True)
+class Environment:
+    gravity: float = 9.81            # m/s^2, >= 0 (0: no gravity, e.g. a torque-free body)
+    water_density: float = 1025.0    # kg/m^3, > 0
+
+
+@dataclass(frozen=True)
+class Simulation:
+    duration: float                  # s, > 0
+    dt: float                        # s, > 0, <= duration
+    scheme: str = "hht"              # "newmark" | "hht" | "generalized-alpha"
+    alpha: float = 0.0               # HHT: 0 <= alpha <= 1/3
+    rho_inf: float = 1.0             # generalized-alpha: 0 <= rho_inf <= 1
+    save_every: int = 1              # >= 1
+    tolerance: float = 1e-10         # Newton: residual over mass, an acceleration error (m/s^2, rad/s^2)
+    max_iterations: int = 25         # Newton iterations per step before the step counts as failed
+    chunk: int = 0                   # steps per jitted chunk written to the result (0: automatic)
+    substeps: int = 0                # > 1: a step whose Newton iteration fails is retried as this many sub-steps
+    linear_solver: str = "auto"      # liquid block: "dense" inverse | "sparse" factor (sparse.py) | "auto" by size
+    energy_projection: bool = False  # trapezoidal rule only: scale the velocities after each step to the initial energy
+
+    @property
+    def n_steps(self) -> int:
+        return int(round(self.duration / self.dt))
+
+
+@dataclass(frozen=True)
+class Hydrostatics:
+    waterplane_area: float           # A_w, m^2, > 0
+    displaced_volume: float          # m^3, > 0
+    gm_t: float                      # m (<= 0 legal, warned)
+    gm_l: float                      # m (<= 0 legal, warned)
+    moment: str = "conservative"     # "conservative": gradient of a restoring potential | "paper": eq. (36) literally
+
+
+@dataclass(frozen=True)
+class Initial:
+    position: Vec3 = (0.0, 0.0, 0.0)          # m, inertial offset of the COG from equilibrium
+    velocity: Vec3 = (0.0, 0.0, 0.0)          # m/s, inertial
+    angular_velocity: Vec3 = (0.0, 0.0, 0.0)  # rad/s, body frame
+    roll_pitch_yaw: Vec3 = (0.0, 0.0, 0.0)    # rad, initial attitude (Z-Y-X: yaw, then pitch, then roll)
+
+
+@dataclass(frozen=True)
+class Forced:
+    """Prescribed motion of the vessel (tank tests, rotating hubs): one rigid dof follows a profile,
+    the other five are held at zero.
+    "harmonic": amplitude * sin(frequency * t), faded in over `ramp` seconds;
+    "spin-up" (a rotation dof): the rate grows smoothly from 0 to `rate` over `duration` seconds,
+    omega(t) = rate / duration (t - duration / (2 pi) sin(2 pi t / duration)), then stays (the
+    Kane-Ryan-Banerjee profile)."""
+    dof: str                         # "surge" | "sway" | "heave" | "roll" | "pitch" | "yaw"
+    amplitude: float = 0.0           # m or rad (harmonic)
+    frequency: float = 1.0           # rad/s, > 0 (harmonic)
+    ramp: float = 0.0                # s, >= 0: the amplitude grows as (1 - cos(pi t / ramp)) / 2
+    profile: str = "harmonic"        # "harmonic" | "spin-up"
+    rate: float = 0.0                # rad/s (spin-up: final rate)
+    duration: float = 0.0            # s, > 0 (spin-up time)
+
+
+@dataclass(frozen=True)
+class Vessel:
+    mass: float                      # kg, > 0 (everything except tank liquid)
+    inertia: Mat3                    # kg m^2 about the COG, body axes, symmetric positive definite
+    hydrostatics: Optional[Hydrostatics] = None   # None: no buoyancy (free body)
+    initial: Initial = field(default_factory=Initial)
+    forced: Optional[Forced] = None  # prescribed motion instead of free motion
+    hull: Optional["Hull"] = None    # hull geometry: Froude-Krylov forces, Capytaine (waves, hydrodynamics.py)
+    hydrodynamics: Optional["Hydrodynamics"] = None   # added mass, radiation damping, excitation tables
+
+
+@dataclass(frozen=True)
+class Material:
+    young: float                     # Pa, > 0
+    poisson: float                   # -1 < nu < 0.5
+    density: float                   # kg/m^3, > 0
+
+
+@dataclass(frozen=True)
+class Fluid:
+    density: float = 1000.0          # kg/m^3, > 0
+    sound_speed: float = 1500.0      # m/s, > 0
+    element: str = "stabilized"      # liquid element form, see liquid.py (ELEMENT_FORMS)
+
+
+@dataclass(frozen=True)
+class Reduction:
+    """`[tanks.reduction]`: the liquid on its first `modes` natural modes plus a static correction
+    (reduction.py), instead of every finite-element unknown."""
+    modes: int                       # >= 1 natural modes (a degenerate pair is never split)
+    static_correction: bool = True   # add the quasi-static response to the rigid body's loads
+
+
+@dataclass(frozen=True)
+class Walls:
+    thickness: float                 # m, > 0
+    material: Material
+    mesh: Optional[tuple[int, int, int]] = None
+
+
+@dataclass(frozen=True)
+class Tank:
+    name: str
+    origin: Vec3                     # inner min corner in the vessel frame, m
+    size: Vec3                       # inner length, breadth, height, m, each > 0
+    fill_depth: float                # m, 0 < fill_depth <= size[2]
+    mesh: tuple[int, int, int]       # liquid hexahedra along x, y, z, each >= 1
+    walls: str = "rigid"             # "rigid" | "elastic"
+    fluid: Fluid = field(default_factory=Fluid)
+    wall_spec: Optional[Walls] = None   # the [tanks.walls] table when walls = "elastic"
+    reduction: Optional[Reduction] = None   # None: full order
+
+    @property
+    def liquid_volume(self) -> float:
+        return self.size[0] * self.size[1] * self.fill_depth
+
+    @property
+    def liquid_mass(self) -> float:
+        return self.fluid.density * self.liquid_volume
+
+    @property
+    def wall_mass(self) -> float:
+        """Mass of elastic walls (an open box one wall thick around the inner size); 0 for rigid ones,
+        whose mass is the vessel's."""
+        if self.wall_spec is None:
+            return 0.0
+        a, b, H = self.size
+        t = self.wall_spec.thickness
+        return self.wall_spec.material.density * ((a + 2 * t) * (b + 2 * t) * (H + t) - a * b * H)
+
+
+@dataclass(frozen=True)
+class Structure:
+    name: str
+    origin: Vec3
+    size: Vec3
+    mesh: tuple[int, int, int]
+    attach: str                      # "x-" | "x+" | "y-" | "y+" | "z-" | "z+"
+    material: Material
+    attach_to: Optional[str] = None  # another structure's name: tie the face to it instead of the vessel
+    frame: str = "own"               # "own": its own floating frame, tied by multipliers; "vessel": deformation
+                                     # measured in the vessel's frame, the attachment face held (no multipliers)
+    stiffening: str = "none"         # "centrifugal": the geometric stiffness of the stress its spin causes
+
+
+@dataclass(frozen=True)
+class Probe:
+    name: str
+    point: Vec3                      # local coordinates from the owner's origin, m
+    tank: Optional[str] = None       # exactly one of tank / structure is set
+    structure: Optional[str] = None
+
+
+# ---- waves and hull hydrodynamics (waves.py, hydrodynamics.py)
+@dataclass(frozen=True)
+class Waves:
+    """The `[waves]` table: a regular wave or a JONSWAP sea (waves.py has the conventions)."""
+    type: str                        # "regular" | "jonswap"
+    heading: float = 0.0             # rad, the direction the waves travel to, from +X towards +Y
+    amplitude: float = 0.0           # m (regular)
+    omega: float = 0.0               # rad/s (regular; the scene gives `period` or `frequency`)
+    phase: float = 0.0               # rad (regular): eta = amplitude cos(omega t + phase) at the origin
+    hs: float = 0.0                  # m, significant wave height (jonswap)
+    tp: float = 0.0                  # s, peak period (jonswap)
+    gamma: float = 3.3               # peak enhancement (jonswap), >= 1
+    seed: int = 0                    # random phases and frequencies (jonswap)
+    components: int = 100            # regular components (jonswap), >= 1
+    omega_range: tuple[float, float] = (0.0, 0.0)   # rad/s (jonswap; default 0.5 to 3 times the peak frequency)
+    ramp: float = 0.0                # s, the forces fade in as (1 - cos(pi t / ramp)) / 2
+    depth: Optional[float] = None    # m, water depth (None: deep water)
+
+    @property
+    def height(self) -> float:
+        """The value the forces are proportional to: the amplitude (regular) or Hs (jonswap)."""
+        return self.amplitude if self.type == "regular" else self.hs
+
+
+@dataclass(frozen=True)
+class Hull:
+    """The `[vessel.hull]` table: a box (length x beam x draft, centred on the COG in plan, the COG
+    `kg` above the keel) or a mesh file (Capytaine only; waterline at z = 0, COG at `cog`)."""
+    type: str = "box"                # "box" | "mesh"
+    length: float = 0.0
+    beam: float = 0.0
+    draft: float = 0.0
+    kg: float = 0.0                  # m, COG above the keel (box)
+    file: str = ""                   # mesh file (type = "mesh"), relative to the scene's folder
+    cog: tuple[float, float, float] = (0.0, 0.0, 0.0)   # the COG in the mesh's coordinates (type = "mesh")
+
+
+@dataclass(frozen=True)
+class Hydrodynamics:
+    """The `[vessel.hydrodynamics]` table: frequency-domain coefficients about the COG, or
+    `capytaine = true` to compute them from the hull. Arrays are nested tuples as written."""
+    frequencies: tuple = ()          # rad/s, ascending
+    added_mass: Optional[tuple] = None            # (n, 6) diagonal or (n, 6, 6)
+    damping: Optional[tuple] = None               # radiation damping, same shapes
+    added_mass_infinite: Optional[tuple] = None   # (6,) or (6, 6); fitted when absent
+    headings: Optional[tuple] = None              # rad, the excitation tables' headings
+    excitation_amplitude: Optional[tuple] = None  # (n, headings, 6) or (n, 6): N/m, N m/m
+    excitation_phase: Optional[tuple] = None      # same shape, rad
+    viscous_damping: Optional[tuple] = None       # (6,) or (6, 6) linear damping added to the radiation
+    capytaine: bool = False          # compute added mass, damping, A_inf and excitation with Capytaine
+    panel_size: Optional[float] = None            # m, Capytaine's panels (default from the hull)
+    memory_order: int = 0            # complex pole pairs per column of the memory fit (0: automatic)
+    excitation: str = "auto"         # "auto" | "table" | "froude-krylov"
+    base_dir: str = ""               # the scene's folder (a mesh file is relative to it)
+
+
+EFFECTS = ("buoyancy", "liquid", "coriolis", "centrifugal", "gravity_turning", "waves", "radiation")
+
+
+@dataclass(frozen=True)
+class Effects:
+    """Switches of the `[effects]` table. An effect is simulated when the scene has what it needs
+    (a hydrostatics table, tanks, ...) and its switch is on; the model never traces an effect that
+    is off, so switching one off measures what it contributes."""
+    buoyancy: bool = True            # restoring force and moments, eqs. (33)-(36)
+    liquid: bool = True              # the tank liquid (off: the tanks are empty and carry nothing)
+    coriolis: bool = True            # 2 omega x d_dot on the liquid (eq. 19)
+    centrifugal: bool = True         # omega x (omega x r) on the liquid (eq. 19)
+    gravity_turning: bool = True     # gravity turning with the body as a load on the liquid (eq. 32)
+    waves: bool = True               # first-order wave excitation from the [waves] table
+    radiation: bool = True           # added mass, radiation damping and memory from [vessel.hydrodynamics]
+
+
+@dataclass(frozen=True)
+class Scene:
+    title: str
+    environment: Environment
+    simulation: Simulation
+    vessel: Vessel
+    tanks: tuple[Tank, ...] = ()
+    structures: tuple[Structure, ...] = ()
+    probes: tuple[Probe, ...] = ()
+    effects: Effects = field(default_factory=Effects)
+    text: str = ""                   # the TOML source, stored in result files
+    path: str = ""
+    warnings: tuple[str, ...] = ()   # physically doubtful but legal choices, said once at load
+    waves: Optional["Waves"] = None  # the [waves] table: incident regular waves or a JONSWAP sea
+
+    def tank(self, name: str) -> Tank:
+        for t in self.tanks:
+            if t.name == name:
+                return t
+        raise SceneError("tank", f"no tank named {name!r} (tanks: {', '.join(t.name for t in self.tanks) or 'none'})")
+
+    def structure(self, name: str) -> Structure:
+        for s in self.structures:
+            if s.name == name:
+                return s
+        raise SceneError("structure", f"no structure named {name!r}")

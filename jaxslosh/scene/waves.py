@@ -1,0 +1,297 @@
+"""Loader of the wave tables of a scene: `[waves]`, `[vessel.hull]`, `[vessel.hydrodynamics]`.
+
+Same rules as load.py (the field reader of fields.py): an unknown key, a wrong type, a missing required
+key or an impossible value is a SceneError naming the dotted key; a doubtful but legal choice is a
+warning. Cross-checks that need several tables (an excitation source for the waves, headings inside
+the tables, the hull against the hydrostatics) are in `check_waves`.
+"""
+from __future__ import annotations
+
+import dataclasses
+import math
+import os
+from typing import Optional
+
+import numpy as np
+
+from ..hydro.box import box_hydrostatics
+from ..hydro.capytaine import CAPYTAINE_MISSING, have_capytaine
+from .fields import at_least, non_negative, one_of, positive, read, show
+from .types import Hull, Hydrodynamics, Hydrostatics, Scene, SceneError, Waves
+
+WAVE_TYPES = ("regular", "jonswap")
+HULL_TYPES = ("box", "mesh")
+EXCITATION_SOURCES = ("auto", "table", "froude-krylov")
+HULL_MISMATCH_TOLERANCE = 0.01   # relative: the box's closed-form hydrostatics against the scene's table
+
+
+def read_waves(table, warnings: list[str]) -> Waves:
+    where = "waves"
+    v = read(table, where, {
+        "type": ("str", one_of(WAVE_TYPES)),
+        "heading": ("float", None),
+        "amplitude": ("float", non_negative),
+        "period": ("float", positive),
+        "frequency": ("float", positive),
+        "phase": ("float", None),
+        "hs": ("float", non_negative),
+        "tp": ("float", positive),
+        "gamma": ("float", _at_least_one),
+        "seed": ("int", non_negative),
+        "components": ("int", at_least(1)),
+        "frequency_range": ("numbers", None),
+        "ramp": ("float", non_negative),
+        "depth": ("float", positive),
+    }, required=("type",))
+    kind = v["type"]
+    own = {"regular": ("amplitude", "period", "frequency", "phase"),
+           "jonswap": ("hs", "tp", "gamma", "seed", "components", "frequency_range")}
+    for other, keys in own.items():
+        if other != kind:
+            for k in keys:
+                if k in v and k not in own[kind]:
+                    raise SceneError(f"{where}.{k}", f'is a key of type = "{other}" waves, not of type = "{kind}"')
+    common = {"heading": v.get("heading", 0.0), "ramp": v.get("ramp", 0.0), "depth": v.get("depth")}
+    if kind == "regular":
+        if "amplitude" not in v:
+            raise SceneError(f"{where}.amplitude", "a required key is missing (regular waves)")
+        if ("period" in v) == ("frequency" in v):
+            raise SceneError(f"{where}.period", "give exactly one of period (s) or frequency (rad/s)")
+        omega = v["frequency"] if "frequency" in v else 2.0 * math.pi / v["period"]
+        return Waves(type=kind, amplitude=v["amplitude"], omega=omega, phase=v.get("phase", 0.0), **common)
+    for k in ("hs", "tp"):
+        if k not in v:
+            raise SceneError(f"{where}.{k}", "a required key is missing (JONSWAP sea)")
+    wp = 2.0 * math.pi / v["tp"]
+    rng = v.get("frequency_range", [0.5 * wp, 3.0 * wp])
+    if not (isinstance(rng, list) and len(rng) == 2 and all(isinstance(x, float) for x in rng)):
+        raise SceneError(f"{where}.frequency_range", f"must be 2 numbers [low, high] in rad/s, got {show(rng)}")
+    lo, hi = rng
+    if not 0 < lo < hi:
+        raise SceneError(f"{where}.frequency_range", f"must satisfy 0 < low < high, got {show(rng)}")
+    if not lo <= wp <= hi:
+        warnings.append(f"waves.frequency_range = {show(rng)} rad/s does not hold the spectral peak "
+                        f"{wp:.4g} rad/s: most of the sea's energy is left out")
+    return Waves(type=kind, hs=v["hs"], tp=v["tp"], gamma=v.get("gamma", 3.3), seed=v.get("seed", 0),
+                 components=v.get("components", 100), omega_range=(lo, hi), **common)
+
+
+def _at_least_one(v):
+    return None if v >= 1.0 else f"must be >= 1, got {v}"
+
+
+def read_hull(table) -> Hull:
+    where = "vessel.hull"
+    v = read(table, where, {
+        "type": ("str", one_of(HULL_TYPES)),
+        "length": ("float", positive),
+        "beam": ("float", positive),
+        "draft": ("float", positive),
+        "kg": ("float", None),
+        "file": ("str", None),
+        "cog": ("vec3", None),
+    })
+    kind = v.get("type", "box")
+    if kind == "box":
+        for k in ("length", "beam", "draft", "kg"):
+            if k not in v:
+                raise SceneError(f"{where}.{k}", "a required key is missing (box hull)")
+        for k in ("file", "cog"):
+            if k in v:
+                raise SceneError(f"{where}.{k}", 'is a key of type = "mesh" hulls, not of a box')
+        if v["kg"] <= 0:
+            raise SceneError(f"{where}.kg", f"the COG must lie above the keel (kg > 0), got {show(v['kg'])}")
+        return Hull(type="box", length=v["length"], beam=v["beam"], draft=v["draft"], kg=v["kg"])
+    for k in ("length", "beam", "draft", "kg"):
+        if k in v:
+            raise SceneError(f"{where}.{k}", 'is a key of box hulls, not of type = "mesh"')
+    if "file" not in v:
+        raise SceneError(f"{where}.file", "a required key is missing (mesh hull)")
+    return Hull(type="mesh", file=v["file"], cog=v.get("cog", (0.0, 0.0, 0.0)))
+
+
+def _shape(x):
+    a = np.asarray(x, dtype=float)
+    return a.shape
+
+
+def _array(v: dict, key: str, where: str, shapes: tuple, what: str):
+    """A numbers array of one of `shapes` (None stands for any positive count); as nested tuples."""
+    x = v[key]
+    shape = _shape(x)
+    for sh in shapes:
+        if len(sh) == len(shape) and all(a is None or a == b for a, b in zip(sh, shape)):
+            return _tuples(x)
+    want = " or ".join("(" + ", ".join("n" if a is None else str(a) for a in sh) + ")" for sh in shapes)
+    raise SceneError(f"{where}.{key}", f"must be {what} of shape {want}, got shape {shape}")
+
+
+def _tuples(x):
+    return tuple(_tuples(e) for e in x) if isinstance(x, list) else float(x)
+
+
+def read_hydrodynamics(table, hull: Optional[Hull]) -> Hydrodynamics:
+    where = "vessel.hydrodynamics"
+    v = read(table, where, {
+        "frequencies": ("numbers", None),
+        "added_mass": ("numbers", None),
+        "damping": ("numbers", None),
+        "added_mass_infinite": ("numbers", None),
+        "headings": ("numbers", None),
+        "excitation_amplitude": ("numbers", None),
+        "excitation_phase": ("numbers", None),
+        "viscous_damping": ("numbers", None),
+        "capytaine": ("bool", None),
+        "panel_size": ("float", positive),
+        "memory_order": ("int", non_negative),
+        "excitation": ("str", one_of(EXCITATION_SOURCES)),
+    })
+    capy = v.get("capytaine", False)
+    out = {"capytaine": capy, "panel_size": v.get("panel_size"), "memory_order": v.get("memory_order", 0),
+           "excitation": v.get("excitation", "auto")}
+    if capy:
+        if hull is None:
+            raise SceneError(f"{where}.capytaine", "needs a [vessel.hull] table (the geometry to solve for)")
+        for k in ("added_mass", "damping", "added_mass_infinite", "headings", "excitation_amplitude", "excitation_phase"):
+            if k in v:
+                raise SceneError(f"{where}.{k}", "with capytaine = true the tables are computed; remove this key "
+                                                 "(or capytaine = true)")
+        if not have_capytaine():
+            raise SceneError(f"{where}.capytaine", CAPYTAINE_MISSING)
+    if "frequencies" in v:
+        w = v["frequencies"]
+        if not (isinstance(w, list) and w and all(isinstance(x, float) for x in w)):
+            raise SceneError(f"{where}.frequencies", f"must be a list of numbers (rad/s), got {show(w)}")
+        if w[0] <= 0 or any(b <= a for a, b in zip(w, w[1:])):
+            raise SceneError(f"{where}.frequencies", "must be positive and strictly ascending (rad/s)")
+        if len(w) < 4:
+            raise SceneError(f"{where}.frequencies", f"needs at least 4 frequencies, got {len(w)}")
+        out["frequencies"] = tuple(w)
+    n = len(out.get("frequencies", ()))
+    tabled = [k for k in ("added_mass", "damping", "excitation_amplitude", "excitation_phase") if k in v]
+    if tabled and not n:
+        raise SceneError(f"{where}.frequencies", f"a required key is missing (the tables {', '.join(tabled)} "
+                                                 f"are per frequency)")
+    if ("added_mass" in v) != ("damping" in v):
+        missing = "damping" if "added_mass" in v else "added_mass"
+        raise SceneError(f"{where}.{missing}", "added_mass and damping come together (the radiation memory needs both)")
+    for k in ("added_mass", "damping"):
+        if k in v:
+            out[k] = _array(v, k, where, ((n, 6), (n, 6, 6)), "one row of 6 (diagonal) or a 6 x 6 per frequency")
+    if "added_mass" in v:
+        A = np.asarray(out["added_mass"])
+        diag = A if A.ndim == 2 else A[:, range(6), range(6)]
+        if (diag < 0).any():
+            i, j = np.argwhere(diag < 0)[0]
+            raise SceneError(f"{where}.added_mass", f"diagonal added mass must be >= 0: {diag[i, j]:.6g} at "
+                                                    f"frequency {out['frequencies'][i]:g} rad/s, dof {j + 1}")
+        Bd = np.asarray(out["damping"])
+        bdiag = Bd if Bd.ndim == 2 else Bd[:, range(6), range(6)]
+        if (bdiag < 0).any():
+            i, j = np.argwhere(bdiag < 0)[0]
+            raise SceneError(f"{where}.damping", f"diagonal radiation damping must be >= 0 (a body does not gain "
+                                                 f"energy from radiating waves): {bdiag[i, j]:.6g} at frequency "
+                                                 f"{out['frequencies'][i]:g} rad/s, dof {j + 1}")
+    if "added_mass_infinite" in v:
+        if "added_mass" not in v:
+            raise SceneError(f"{where}.added_mass_infinite", "needs the added_mass and damping tables")
+        out["added_mass_infinite"] = _array(v, "added_mass_infinite", where, ((6,), (6, 6)), "6 values or a 6 x 6")
+    if "viscous_damping" in v:
+        out["viscous_damping"] = _array(v, "viscous_damping", where, ((6,), (6, 6)), "6 values or a 6 x 6")
+        Bv = np.asarray(out["viscous_damping"])
+        Bv = np.diag(Bv) if Bv.ndim == 1 else Bv
+        if np.linalg.eigvalsh(0.5 * (Bv + Bv.T)).min() < -1e-12 * max(1.0, np.abs(Bv).max()):
+            raise SceneError(f"{where}.viscous_damping", "must be positive semi-definite (damping dissipates)")
+    if ("excitation_amplitude" in v) != ("excitation_phase" in v):
+        missing = "excitation_phase" if "excitation_amplitude" in v else "excitation_amplitude"
+        raise SceneError(f"{where}.{missing}", "excitation_amplitude and excitation_phase come together")
+    if "excitation_amplitude" in v:
+        if "headings" not in v:
+            raise SceneError(f"{where}.headings", "a required key is missing (the excitation tables' headings, rad)")
+        h = v["headings"]
+        if isinstance(h, float):
+            h = [h]
+        if not (isinstance(h, list) and h and all(isinstance(x, float) for x in h)):
+            raise SceneError(f"{where}.headings", f"must be a list of numbers (rad), got {show(v['headings'])}")
+        if any(b <= a for a, b in zip(h, h[1:])):
+            raise SceneError(f"{where}.headings", "must be strictly ascending")
+        out["headings"] = tuple(h)
+        nh = len(h)
+        shapes = ((n, nh, 6),) + (((n, 6),) if nh == 1 else ())
+        out["excitation_amplitude"] = _array(v, "excitation_amplitude", where, shapes, "6 values per frequency and heading")
+        out["excitation_phase"] = _array(v, "excitation_phase", where, shapes, "6 values per frequency and heading")
+        if (np.asarray(out["excitation_amplitude"]) < 0).any():
+            raise SceneError(f"{where}.excitation_amplitude", "amplitudes must be >= 0 (the phase carries the sign)")
+    elif "headings" in v:
+        raise SceneError(f"{where}.headings", "is only used with excitation_amplitude and excitation_phase")
+    if not capy and not any(k in out for k in ("added_mass", "excitation_amplitude", "viscous_damping")):
+        raise SceneError(where, "holds nothing: give added_mass and damping, excitation tables, viscous_damping, "
+                                "or capytaine = true")
+    return Hydrodynamics(**out)
+
+
+def hull_hydrostatics(hull: Hull, hydrostatics: Optional[Hydrostatics], warnings: list[str]) -> Optional[Hydrostatics]:
+    """A box hull without a [vessel.hydrostatics] table gives its closed forms; with one, the two
+    are compared (a mismatch is warned about: the excitation's long-wave limit then disagrees with
+    the restoring)."""
+    if hull.type != "box":
+        return hydrostatics
+    box = box_hydrostatics(hull.length, hull.beam, hull.draft, hull.kg)
+    if hydrostatics is None:
+        return Hydrostatics(**box)
+    for key in ("waterplane_area", "displaced_volume", "gm_t", "gm_l"):
+        given, closed = getattr(hydrostatics, key), box[key]
+        if abs(given - closed) > HULL_MISMATCH_TOLERANCE * max(abs(closed), 1e-12):
+            warnings.append(f"vessel.hydrostatics.{key} = {given:.6g} differs from the box hull's {closed:.6g} "
+                            f"(vessel.hull); the restoring uses the table, the Froude-Krylov forces the box")
+    return hydrostatics
+
+
+def check_waves(scene: Scene, path: str, warnings: list[str]) -> Scene:
+    """Cross-checks of the wave tables; resolves a mesh file against the scene's folder."""
+    ves, waves = scene.vessel, scene.waves
+    hd = ves.hydrodynamics
+    if hd is not None and path:
+        scene = dataclasses.replace(scene, vessel=dataclasses.replace(
+            ves, hydrodynamics=dataclasses.replace(hd, base_dir=os.path.dirname(os.path.abspath(path)))))
+        ves, hd = scene.vessel, scene.vessel.hydrodynamics
+    if ves.hull is not None and ves.hull.type == "mesh" and not (hd is not None and hd.capytaine):
+        raise SceneError("vessel.hull.type", 'a "mesh" hull is only read by Capytaine: add '
+                                             "[vessel.hydrodynamics] capytaine = true (or use a box)")
+    if waves is None:
+        return scene
+    tables = hd is not None and (hd.capytaine or hd.excitation_amplitude is not None)
+    box = ves.hull is not None and ves.hull.type == "box"
+    source = "auto" if hd is None else hd.excitation
+    if source == "table" and not tables:
+        raise SceneError("vessel.hydrodynamics.excitation", '"table" needs excitation_amplitude and excitation_phase '
+                                                            "(or capytaine = true)")
+    if source == "froude-krylov" and not box:
+        raise SceneError("vessel.hydrodynamics.excitation", '"froude-krylov" needs a box [vessel.hull]')
+    if not tables and not box:
+        raise SceneError("waves", "nothing turns the waves into forces: give a box [vessel.hull] (Froude-Krylov) "
+                                  "or excitation tables in [vessel.hydrodynamics] (or capytaine = true)")
+    if ves.forced is not None:
+        warnings.append("waves: the vessel's motion is prescribed ([vessel.forced]): the wave forces act on nothing")
+    uses_table = tables and source != "froude-krylov"
+    if uses_table and hd.excitation_amplitude is not None:
+        heads = hd.headings
+        b = waves.heading
+        if len(heads) == 1:
+            if abs(b - heads[0]) > 1e-6:
+                raise SceneError("waves.heading", f"{b:.6g} rad: the excitation tables hold heading {heads[0]:.6g} rad "
+                                                  f"only")
+        elif not heads[0] - 1e-6 <= b <= heads[-1] + 1e-6:
+            raise SceneError("waves.heading", f"{b:.6g} rad lies outside the excitation tables' headings "
+                                              f"[{heads[0]:.6g}, {heads[-1]:.6g}] rad")
+        lo, hi = hd.frequencies[0], hd.frequencies[-1]
+        wl, wh = (waves.omega, waves.omega) if waves.type == "regular" else waves.omega_range
+        if wl < lo - 1e-9 or wh > hi + 1e-9:
+            if waves.type == "regular":
+                raise SceneError("waves.frequency", f"{waves.omega:.6g} rad/s lies outside the excitation tables' "
+                                                    f"frequencies [{lo:.6g}, {hi:.6g}] rad/s")
+            warnings.append(f"waves.frequency_range [{wl:.4g}, {wh:.4g}] rad/s reaches beyond the excitation tables' "
+                            f"[{lo:.4g}, {hi:.4g}] rad/s: components outside them exert no force")
+    if not box and not uses_table:
+        raise SceneError("waves", "no excitation source")
+    return scene

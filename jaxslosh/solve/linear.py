@@ -1,0 +1,165 @@
+"""The constant blocks of the Newton matrix, inverted once per run: the liquid's (dense inverses,
+the sparse path of sparse.py, or the modal liquid's small blocks) and the structures' modal block."""
+from __future__ import annotations
+
+import dataclasses
+from typing import Any, Optional
+
+import equinox as eqx
+import jax
+import jax.numpy as jnp
+import numpy as np
+
+from ..physics.modal_liquid import ReducedLiquid
+from ..physics.structures import layout
+from ..physics.system import System
+from .schemes import Scheme
+from .sparse import is_sparse, sparse_solver_blocks
+
+
+class Solver(eqx.Module):
+    """What the Newton iterations need besides the system: constant liquid-block inverses."""
+    Cinv_step: jax.Array   # (nf, nf) inverse of c_a M_ff + K_ff (liquid block of the step matrix)
+    Cinv_mass: jax.Array   # (nf, nf) inverse of M_ff (liquid block of the initial-acceleration matrix)
+    h: jax.Array                     # step (traced: one compilation serves every step size)
+    scheme: Scheme = eqx.field(static=True)
+    tol: float = eqx.field(static=True)
+    max_iter: int = eqx.field(static=True)
+    substeps: int = eqx.field(static=True, default=0)   # retry a failed step as this many sub-steps
+    Cinv_sub: Optional[jax.Array] = None                # liquid block inverse for the sub-step
+    # Speed (none changes what a converged step is):
+    # the round-off floor of the scaled residual per metre of liquid displacement, eps max_i
+    # sum_j |K_ij| / scale_i: a tolerance below eps |K| |d| cannot be met, so the iterations stop there
+    noise: Any = 0.0
+    # carry the preconditioner from step to step, formed again only when convergence slows (single
+    # runs); False: formed once at the start of every step
+    reuse: bool = eqx.field(static=True, default=False)
+    # refresh the preconditioner inside the iterations when convergence slows (a lax.cond); False
+    # for vmapped batches, where a cond computes both branches
+    adaptive: bool = eqx.field(static=True, default=True)
+    # unknowns of the exact (Schur) block: the 6 rigid ones, and with flexible structures their rigid
+    # unknowns and the interface frames and multipliers (multibody.Layout.n_small)
+    ns: int = eqx.field(static=True, default=6)
+    # after each step, scale the velocities so that the total energy is the initial one (the
+    # `simulation.energy_projection` key: trapezoidal rule, conservative scenes only; see project_energy)
+    project: bool = eqx.field(static=True, default=False)
+    # with reuse and not adaptive (vmapped batches): the carried preconditioner is formed afresh at
+    # every this-many-th step (the step counter is the same for every run of a batch, so the cond
+    # stays a branch under vmap); 0: at every step
+    refresh_every: int = eqx.field(static=True, default=0)
+    # the Newton solves are differentiable (lax.custom_root: gradients by the implicit function
+    # theorem). False where nothing a run depends on is traced for differentiation (run.prepare):
+    # custom_root traces the linearisation and both tangent solves of every root even when no
+    # gradient is taken, a fifth of a scene's tracing; the iterations and their result are the same
+    implicit: bool = eqx.field(static=True, default=True)
+
+    def sub_solver(self) -> "Solver":
+        return Solver(self.Cinv_sub, self.Cinv_mass, self.h / self.substeps, self.scheme, self.tol, self.max_iter,
+                      noise=self.noise, adaptive=self.adaptive, ns=self.ns, project=self.project,
+                      implicit=self.implicit)
+
+    @property
+    def c_a(self):
+        s = self.scheme
+        return (1.0 - s.alpha_m) / ((1.0 - s.alpha_f) * s.beta * self.h ** 2)
+
+
+def make_solver(system: System, h: float, scheme: Scheme, tol: float, max_iter: int, substeps: int = 0,
+                reuse: bool = False, adaptive: bool = True) -> Solver:
+    """Factor the constant liquid blocks once (float64): NumPy for concrete matrices, JAX when the
+    liquid was built from traced values (under jit).
+
+    The inverses only precondition the Newton iterations and the tangent solves, whose solutions do
+    not depend on them (`lax.custom_root` drops their tangents), so they are formed from
+    `stop_gradient` values: under `jax.grad` outside jit the matrices are then concrete again."""
+    nf = system.nf
+    substeps = int(substeps) if substeps and substeps > 1 else 0
+    if system.flex is not None:
+        return _flex_solver(system, h, scheme, tol, max_iter, substeps, reuse, adaptive)
+    if nf == 0:
+        z = jnp.zeros((0, 0))
+        return Solver(z, z, jnp.asarray(h, dtype=float), scheme, tol, max_iter, substeps, z if substeps else None,
+                      reuse=reuse, adaptive=adaptive)
+    L = system.liquid
+    if is_sparse(L):         # large mesh (sparse.py): host-side sparse LU factors
+        c_a = lambda hh: (1.0 - scheme.alpha_m) / ((1.0 - scheme.alpha_f) * scheme.beta * hh ** 2)  # noqa: E731
+        step_inv, mass_inv, sub_inv, K = sparse_solver_blocks(L, c_a(h), c_a(h / substeps) if substeps else None)
+        scale = np.asarray(jax.lax.stop_gradient(system.scales()[6:]))
+        noise = np.finfo(np.float64).eps * np.max(np.asarray(abs(K).sum(axis=1)).reshape(-1) / scale)
+        return Solver(step_inv, mass_inv, jnp.asarray(h, dtype=float), scheme, tol, max_iter, substeps, sub_inv,
+                      noise=noise, reuse=reuse, adaptive=adaptive)
+    if isinstance(L, ReducedLiquid):        # modal liquid (reduction.py): small dense blocks
+        M_ff, K_ff = jax.lax.stop_gradient(L.Mr), jax.lax.stop_gradient(L.Kr)
+        traced = isinstance(M_ff, jax.core.Tracer) or isinstance(K_ff, jax.core.Tracer)
+        if not traced:
+            M_ff, K_ff = np.asarray(M_ff), np.asarray(K_ff)
+    else:
+        Ms, K_ff = jax.lax.stop_gradient(L.Ms), jax.lax.stop_gradient(L.K)
+        free = np.asarray(L.free)
+        traced = isinstance(Ms, jax.core.Tracer) or isinstance(K_ff, jax.core.Tracer)
+        xp = jnp if traced else np
+        if not traced:
+            Ms, K_ff = np.asarray(Ms), np.asarray(K_ff)
+        M_ff = xp.kron(Ms, xp.eye(3))[np.ix_(free, free)]
+        if getattr(L, "dof_map", None) is not None:     # elastic tank walls: T^T kron(Ms, I3) T
+            dmap = np.asarray(L.dof_map)
+            T = np.zeros((dmap.size, free.size + 1))
+            T[np.arange(dmap.size), dmap] = 1.0
+            T = T[:, :-1]
+            M_ff = T.T @ np.kron(np.asarray(Ms), np.eye(3)) @ T
+
+    def inverse(A):
+        return jnp.linalg.inv(A) if traced else jnp.asarray(np.linalg.inv(A))
+
+    def step_block_inverse(hh):
+        c_a = (1.0 - scheme.alpha_m) / ((1.0 - scheme.alpha_f) * scheme.beta * hh ** 2)
+        Cs = c_a * M_ff + K_ff
+        return inverse(0.5 * (Cs + Cs.T))
+
+    scale = jax.lax.stop_gradient(system.scales()[6:])
+    noise = jnp.finfo(jnp.float64).eps * jnp.max(jnp.sum(jnp.abs(jnp.asarray(K_ff)), axis=1) / scale)
+    return Solver(step_block_inverse(h), inverse(M_ff), jnp.asarray(h, dtype=float), scheme, tol,
+                  max_iter, substeps, step_block_inverse(h / substeps) if substeps else None,
+                  noise=noise, reuse=reuse, adaptive=adaptive)
+
+
+class BlockInverse(eqx.Module):
+    """The constant-block inverse with flexible structures: the liquid's (a dense matrix, or the
+    sparse factors of sparse.py) and the structures' modal block, which is diagonal."""
+    liquid: Any           # (nf, nf)
+    modal: jax.Array      # (m,)
+
+    @property
+    def shape(self):
+        n = self.liquid.shape[0] + self.modal.shape[0]
+        return (n, n)
+
+    def __matmul__(self, x):
+        nf = self.liquid.shape[0]
+        bottom = self.modal[:, None] * x[nf:] if x.ndim == 2 else self.modal * x[nf:]
+        return jnp.concatenate([self.liquid @ x[:nf], bottom])
+
+
+def _flex_solver(system: System, h, scheme: Scheme, tol, max_iter, substeps, reuse, adaptive) -> Solver:
+    """With flexible structures: the liquid block inverses as without them, and the structures'
+    modal block, which is diagonal (Phi^T M Phi = I, Phi^T K Phi = omega^2): 1 / (c_a + omega^2)."""
+    base = make_solver(dataclasses.replace(system, flex=None), h, scheme, tol, max_iter, substeps, reuse, adaptive)
+    w2 = jax.lax.stop_gradient(jnp.concatenate([b.omega2 for b in system.flex.bodies]))
+
+    def c_a(hh):
+        return (1.0 - scheme.alpha_m) / ((1.0 - scheme.alpha_f) * scheme.beta * hh ** 2)
+
+    sub = BlockInverse(base.Cinv_sub, 1.0 / (c_a(h / substeps) + w2)) if substeps else None
+    return Solver(BlockInverse(base.Cinv_step, 1.0 / (c_a(h) + w2)), BlockInverse(base.Cinv_mass, jnp.ones_like(w2)),
+                  jnp.asarray(h, dtype=float), scheme, tol, max_iter, substeps, sub, noise=base.noise, reuse=reuse,
+                  adaptive=adaptive, ns=layout(system).n_small)
+
+
+def empty_pre(system: System):
+    """A carried preconditioner of the right shapes, marked not valid (formed at the first step)."""
+    ns, nz = 6, system.nf
+    if system.flex is not None:
+        L = layout(system)
+        ns, nz = L.n_small, L.nf + L.m
+    data = (jnp.zeros((ns, ns)),) if nz == 0 else (jnp.zeros((ns, ns)), jnp.zeros((ns, nz)), jnp.zeros((nz, ns)))
+    return data, jnp.zeros(())

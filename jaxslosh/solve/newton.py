@@ -1,0 +1,188 @@
+"""Newton iterations with the structured approximate inverse of the step matrix, and the tangent
+solves of the implicit function theorem (`lax.custom_root`).
+
+The first `ns` unknowns (the rigid ones, and with flexible structures their frames and multipliers)
+enter nonlinearly: their rows and columns of the Jacobian are linearised with JAX (ns products each
+way) and closed by a Schur complement; the rest (liquid and elastic modal coordinates) is replaced by
+a constant block whose inverse `Cinv` is formed once per run (solve/linear.py).
+"""
+from __future__ import annotations
+
+import jax
+import jax.numpy as jnp
+
+
+def _precond_data_split(A, Ac, like, Cinv, nr, ns):
+    """As _precond_data, when unknowns nr..ns (interface frames and multipliers) enter the residual
+    only through a cheap part Ac of A (the constraints), whose rows nr..ns are all of A's there: their
+    columns and rows are taken from Ac, and the expensive A is applied only nr times each way."""
+    n = like.shape[0]
+    I = jnp.eye(n, ns, dtype=like.dtype)
+    cols = jnp.concatenate([jax.vmap(A, in_axes=1, out_axes=1)(I[:, :nr]),
+                            jax.vmap(Ac, in_axes=1, out_axes=1)(I[:, nr:])], axis=1)
+    AT = jax.linear_transpose(A, like)
+    AcT = jax.linear_transpose(Ac, like)
+    rows = jnp.concatenate([jax.vmap(lambda e: AT(e)[0])(I[:, :nr].T), jax.vmap(lambda e: AcT(e)[0])(I[:, nr:].T)])
+    Ayz = rows[:, ns:]
+    Wz = Cinv @ cols[ns:]
+    return jnp.linalg.inv(cols[:ns] - Ayz @ Wz), Ayz, Wz
+
+
+def _precond_data(A, like, Cinv, ns=6):
+    """The factors of P^-1 for a linear map A with the Newton matrix's structure: the first ns rows
+    and columns exact (ns products with A, ns with its transpose: the rigid unknowns, and the
+    interface frames and multipliers when there are flexible structures), the rest (liquid and
+    elastic modal coordinates) replaced by the constant C (inverse Cinv); a Schur complement on the
+    ns unknowns. Exact without liquid and structures."""
+    n = like.shape[0]
+    E6 = jnp.eye(n, ns, dtype=like.dtype)
+    cols = jax.vmap(A, in_axes=1, out_axes=1)(E6)                   # [A_yy; A_zy]
+    if n == ns:
+        return (jnp.linalg.inv(cols),)
+    AT = jax.linear_transpose(A, like)
+    Ayz = jax.vmap(lambda e: AT(e)[0])(E6.T)[:, ns:]                 # (ns, nz)
+    Wz = Cinv @ cols[ns:]
+    return jnp.linalg.inv(cols[:ns] - Ayz @ Wz), Ayz, Wz
+
+
+def _precond_apply(data, Cinv, r, ns=6):
+    if len(data) == 1:
+        return data[0] @ r
+    S_inv, Ayz, Wz = data
+    wz = Cinv @ r[ns:]
+    xy = S_inv @ (r[:ns] - Ayz @ wz)
+    return jnp.concatenate([xy, wz - Wz @ xy])
+
+
+def _preconditioner(A, like, Cinv, ns=6):
+    data = _precond_data(A, like, Cinv, ns)
+    return lambda r: _precond_apply(data, Cinv, r, ns)
+
+#: a carried preconditioner is formed again when an iteration reduces the residual by less than this
+#: factor (a fresh one converges 1e-3 to 1e-4 per iteration on the paper example)
+SLOW = 0.01
+
+
+def _newton(R, x0, Cinv, scale, tol, max_iter, pre=None, floor=0.0, adaptive=True, ns=6, split=None, fresh=None):
+    """Quasi-Newton iterations on R(x) = 0 (x: ns rigid and algebraic unknowns, then the liquid's and
+    the structures' modal ones) with the
+    structured approximate inverse of the Jacobian, formed at the first iteration of the step and
+    formed again only when the residual stops falling fast (a rotation that changed a lot).
+
+    `pre` = (data, valid): a preconditioner carried from the previous step, used while it keeps the
+    convergence fast (and formed afresh when not valid); the one used last is returned with the
+    aux. `floor`: the round-off floor of the scaled residual; the iterations stop below
+    max(tol, floor). `adaptive=False`: formed once before the iterations, never inside (vmapped
+    batches, where a lax.cond computes both branches); then, with `pre` carried, `fresh` (a boolean
+    that is the same for every run of a batch) says whether to form it anew or use the carried one
+    through this step. `split` = (Rc, nr): unknowns nr..ns enter R only through the cheap part Rc
+    (see _precond_data_split)."""
+    tol = jnp.maximum(tol, floor)
+
+    def err_of(r):
+        return jnp.max(jnp.abs(r / scale))
+
+    def refresh(x):
+        _, jvp = jax.linearize(R, x)
+        if split is not None:
+            Rc, nr = split
+            _, jvp_c = jax.linearize(Rc, x)
+            return _precond_data_split(jvp, jvp_c, x, Cinv, nr, ns)
+        return _precond_data(jvp, x, Cinv, ns)
+
+    def body(carry):
+        x, r, it, err_prev, _, need, data = carry
+        if adaptive:
+            data = jax.lax.cond(need, refresh, lambda _: data, x)
+        x = x + _precond_apply(data, Cinv, -r, ns)
+        r = R(x)
+        err = err_of(r)
+        fresh = need | (not adaptive)
+        # a stale preconditioner that slows down is formed again; a fresh one that cannot is a stall
+        slow = err > jnp.where(fresh, 0.1, SLOW) * err_prev
+        return x, r, it + 1, err, fresh & (err > 0.5 * err_prev), slow, data
+
+    def cond(carry):
+        _, _, it, err, stalled, _, _ = carry
+        return (err > tol) & (it < max_iter) & jnp.isfinite(err) & ~stalled
+
+    r0 = R(x0)
+    if not adaptive:
+        if pre is not None and fresh is not None:
+            # `fresh` only, never the carried validity flag, which is per run: the predicate stays
+            # unbatched and the cond a branch (the first step of a run is always fresh)
+            data0 = jax.lax.cond(fresh, refresh, lambda _: pre[0], x0)
+        else:
+            data0 = refresh(x0)
+        need0 = jnp.array(False)
+    elif pre is not None:
+        data0, need0 = pre[0], ~(pre[1] > 0.5)
+    else:
+        data0 = jax.tree_util.tree_map(jnp.zeros_like, jax.eval_shape(refresh, x0))
+        need0 = jnp.array(True)
+    init = (x0, r0, jnp.array(0), err_of(r0), jnp.array(False), need0, data0)
+    x, r, it, err, stalled, _, data = jax.lax.while_loop(cond, body, init)
+    # Converged: below the tolerance, or stalled at round-off within a factor 100 of it.
+    ok = jnp.isfinite(err) & ((err <= tol) | (stalled & (err <= 100.0 * tol)))
+    # aux leaves are floats: custom_root's JVP rule cannot carry integer or boolean aux tangents
+    aux = (it.astype(float), err, ok.astype(float))
+    if pre is not None:
+        aux = aux + ((data, jnp.ones(())),)
+    return x, aux
+
+
+def _structured_linear_solve(A, b, Cinv, rtol=1e-13, max_sweeps=30, ns=6):
+    """Solve A x = b to full precision: the structured preconditioner, then Richardson sweeps.
+    The same code solves the transposed system (pass A^T), which reverse mode needs."""
+    P_inv = _preconditioner(A, b, Cinv, ns)
+    bnorm = jnp.max(jnp.abs(b)) + 1e-300
+
+    def cond(c):
+        _, res, k = c
+        return (jnp.max(jnp.abs(res)) > rtol * bnorm) & (k < max_sweeps)
+
+    def body(c):
+        x, res, k = c
+        x = x + P_inv(res)
+        return x, b - A(x), k + 1
+
+    x0 = P_inv(b)
+    x, _, _ = jax.lax.while_loop(cond, body, (x0, b - A(x0), 0))
+    return x
+
+
+def _tangent_solver(Cinv, ns=6):
+    def tangent_solve(g, y):
+        return jax.lax.custom_linear_solve(
+            g, y, solve=lambda A, b: _structured_linear_solve(A, b, Cinv, ns=ns),
+            transpose_solve=lambda AT, b: _structured_linear_solve(AT, b, Cinv, ns=ns))
+    return tangent_solve
+
+
+def _root(R, x0, newton, Cinv, ns, implicit):
+    """newton(R, x0), differentiable by the implicit function theorem when `implicit`."""
+    if not implicit:
+        return newton(R, x0)
+    return jax.lax.custom_root(R, x0, newton, _tangent_solver(Cinv, ns), has_aux=True)
+
+
+def solve_root(R, x0, Cinv, scale, tol, max_iter, ns=6, split=None, implicit=True):
+    """Root of R near x0; differentiable by the implicit function theorem (lax.custom_root), the
+    tangent systems solved with the same structure as the Newton iterations (`implicit=False`: the
+    iterations alone, for runs that no gradient goes through)."""
+    x, (it, err, ok) = _root(R, x0, lambda f, x: _newton(f, x, Cinv, scale, tol, max_iter, ns=ns, split=split),
+                             Cinv, ns, implicit)
+    it, err, ok = jax.lax.stop_gradient((it, err, ok))
+    return x, (it.astype(jnp.int32), err, ok > 0.5)
+
+
+def solve_root_carried(R, x0, Cinv, scale, tol, max_iter, pre=None, floor=0.0, adaptive=True, ns=6, split=None,
+                       fresh=None, implicit=True):
+    """`solve_root` with a preconditioner carried in and out (`pre`, see `_newton`; None: formed
+    here and not returned), a round-off floor and the batch mode. Returns x, (it, err, ok), pre."""
+    out = _root(R, x0, lambda f, x: _newton(f, x, Cinv, scale, tol, max_iter, pre, floor, adaptive, ns, split, fresh),
+                Cinv, ns, implicit)
+    x, aux = out
+    it, err, ok = jax.lax.stop_gradient(aux[:3])
+    new_pre = jax.lax.stop_gradient(aux[3]) if pre is not None else None
+    return x, (it.astype(jnp.int32), err, ok > 0.5), new_pre
