@@ -15,9 +15,11 @@ from ._version import __version__
 from .analysis.modes import sloshing_modes, structure_modes
 from .fit.identify import identify
 from .io.result import Result, load_result, save_result
+from .io.status import Status
 from .run.batch import simulate_batch
 from .run.simulate import NumericalFailure, simulate
+from .run.stepper import Stepper
 from .scene import Scene, SceneError, load_scene
 
 __all__ = ["structure_modes", "Scene", "SceneError", "Result", "NumericalFailure", "load_scene", "simulate", "save_result",
-           "load_result", "sloshing_modes", "identify", "simulate_batch", "__version__"]
+           "load_result", "sloshing_modes", "identify", "simulate_batch", "Stepper", "Status", "__version__"]

@@ -145,12 +145,19 @@ def test_tank_keys_are_traceable_by_name_and_by_index_and_reach_the_liquid():
     text = text.replace("density = 1000.0", "density = 900.0").replace("gravity = 9.81", "gravity = 9.0")
     want = build(js.load_scene(text))
     for f in ("r", "Ms", "K", "Kdt", "Ktt"):
-        a, b = np.asarray(getattr(got.system.liquid, f)), np.asarray(getattr(want.system.liquid, f))
+        a, b = np.asarray(_liquid_parts(got.system)[f]), np.asarray(_liquid_parts(want.system)[f])
         assert np.max(np.abs(a - b)) <= 1e-13 * np.max(np.abs(b)), f
     assert np.max(np.abs(np.asarray(got.c0.d) - np.asarray(want.c0.d))) <= 1e-12 * np.max(np.abs(np.asarray(want.c0.d)))
     assert abs(float(got.system.liquid.Ms.sum()) - 900.0 * 5.0 * 5.0 * 2.5) < 1e-8 * 900.0 * 62.5
     # the host-side mesh (probe weights, result fields) stays the scene's
     assert np.isclose(np.max(got.tanks[0].nodes[:, 2]), 3.0)
+
+
+def _liquid_parts(system):
+    """The liquid's matrices and the rotation penalty's blocks (a term of their own)."""
+    L = system.liquid
+    pen = next(t for t in system.terms if type(t).__name__ == "RotationPenalty")
+    return {"r": L.r, "Ms": L.Ms, "K": L.K, "Kdt": pen.Kdt, "Ktt": pen.Ktt}
 
 
 def test_build_and_solver_under_jit_match_the_numpy_ones():
@@ -163,8 +170,8 @@ def test_build_and_solver_under_jit_match_the_numpy_ones():
         with jax.ensure_compile_time_eval():
             b = build(scene, {"tanks.tank.fill_depth": h, "tanks[0].fluid.density": rho})
             s = make_solver(b.system, 0.01, scheme, 1e-10, 20, substeps=2)
-        L = b.system.liquid
-        return L.r, L.Ms, L.K, L.Kdt, L.Ktt, b.c0.d, s.Cinv_step, s.Cinv_mass, s.Cinv_sub
+        L = _liquid_parts(b.system)
+        return L["r"], L["Ms"], L["K"], L["Kdt"], L["Ktt"], b.c0.d, s.Cinv_step, s.Cinv_mass, s.Cinv_sub
 
     traced = jax.jit(parts)(2.8, 990.0)
     concrete = parts(2.8, 990.0)

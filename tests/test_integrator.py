@@ -11,7 +11,7 @@ from jaxslosh.build.system import build
 from jaxslosh.solve.integrator import State, step
 from jaxslosh.solve.schemes import make_scheme
 from jaxslosh.solve.linear import make_solver
-from jaxslosh.physics.system import Config
+from jaxslosh.physics.terms import Config
 
 from helpers import vessel_scene
 

@@ -7,7 +7,7 @@ from scipy.integrate import solve_ivp
 
 import jaxslosh as js
 from jaxslosh.physics.kinematics import G_matrix, quat_from_rpy, rotation_matrix, rpy_from_quat, skew
-from jaxslosh.physics.system import A_PHI, A_THETA, Hydro
+from jaxslosh.physics.vessel import A_PHI, A_THETA, Hydrostatics as Hydro
 
 from helpers import vessel_scene, zero_crossing_period
 
@@ -167,3 +167,17 @@ def test_rotation_helpers_agree():
         np.testing.assert_allclose(A @ A.T, np.eye(3), atol=1e-14)
         np.testing.assert_allclose(rotation_matrix(quat_from_rpy(rpy_from_quat(q))), A, atol=1e-12)
         np.testing.assert_allclose(G_matrix(q) @ q, 0.0, atol=1e-15)
+
+
+def test_conservative_hydrostatic_rows_are_the_gradient_of_the_restoring_potential():
+    """The hand-written rows of the buoyancy term (force and conservative moment) equal the gradient of
+    its potential along the step's increments (translations, body-frame rotations on the group)."""
+    from jaxslosh.physics.terms import Config, potential_rows
+    h = _hydro()
+    for X0, q in _random_states(6, seed=5):
+        if rotation_matrix(q)[2, 2] < -0.5:
+            continue
+        c = Config(X0, q, jnp.zeros(0))
+        rows = jnp.concatenate([-h.force(X0), -h.moment(q)])
+        ref = potential_rows(lambda cc: h.restoring_potential(cc.X0, cc.q), c)
+        np.testing.assert_allclose(rows, ref, rtol=1e-10, atol=1e-9 * float(jnp.max(jnp.abs(ref))))

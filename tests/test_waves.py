@@ -378,6 +378,10 @@ def test_box_hull_gives_the_closed_form_hydrostatics():
     assert not scene.warnings
 
 
+def _terms(system):
+    return {type(t).__name__: t for t in system.terms}
+
+
 def test_effects_switch_waves_and_radiation_off_and_check_lists_them(tmp_path, capsys):
     scene = box_scene(regular(0.9), extra_hydro="viscous_damping = [0, 0, 0, 1e5, 0, 0]\n")
     p = tmp_path / "s.toml"
@@ -386,9 +390,10 @@ def test_effects_switch_waves_and_radiation_off_and_check_lists_them(tmp_path, c
     out = capsys.readouterr().out
     assert "waves: regular" in out and "radiation:" in out and "viscous damping" in out
     b = build(scene)
-    assert b.system.sea.memory is not None and b.system.sea.excitation is not None
+    assert b.system.memory is not None and "WaveExcitation" in _terms(b.system)
     off = js.load_scene(scene.text + "\n[effects]\nwaves = false\nradiation = false\n")
-    assert build(off).system.sea is None
+    sea = {"WaveExcitation", "AddedMass", "LinearDamping", "RadiationMemory"}
+    assert build(off).system.memory is None and not sea & set(_terms(build(off).system))
     p.write_text(off.text)
     assert main(["check", str(p)]) == 0
     out = capsys.readouterr().out
@@ -396,19 +401,19 @@ def test_effects_switch_waves_and_radiation_off_and_check_lists_them(tmp_path, c
     # nothing of the memory is traced when it is off: the step's arrays are those of the rigid body
     only_waves = js.load_scene(scene.text + "\n[effects]\nradiation = false\n")
     bs = build(only_waves)
-    assert bs.system.sea.memory is None and bs.system.sea.added_mass is None
+    assert bs.system.memory is None and "AddedMass" not in _terms(bs.system)
     solver = make_solver(bs.system, 0.05, make_scheme("newmark"), 1e-10, 25)
     s0, _ = initial_state(bs.system, solver, bs.c0, bs.v0)
     assert s0.z is None
     jaxpr = jax.make_jaxpr(lambda s: step(bs.system, solver, s))(s0)
-    n_exc = bs.system.sea.excitation.omega.shape[0]
+    n_exc = _terms(bs.system)["WaveExcitation"].excitation.omega.shape[0]
     big = [v.aval.shape for e in jaxpr.jaxpr.eqns for v in e.outvars if hasattr(v.aval, "shape") and v.aval.shape]
     assert max(max(s) for s in big) <= 6 + n_exc
     # with the memory: its states are carried in the State
     b = build(scene)
     solver = make_solver(b.system, 0.05, make_scheme("newmark"), 1e-10, 25)
     s0, _ = initial_state(b.system, solver, b.c0, b.v0)
-    assert s0.z.shape == (b.system.sea.memory.p_re.shape[0], 2)
+    assert s0.z.shape == (b.system.memory.p_re.shape[0], 2)
 
 
 # --------------------------------------------------------------------------------------------

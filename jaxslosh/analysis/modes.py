@@ -15,7 +15,7 @@ def sloshing_modes(scene: Scene, tank=None, n: int = 10):
     """The first n modes of a tank's liquid: `Modes(omega, kind, free_surface_share, shapes)`."""
     t = scene.tank(tank) if tank is not None else scene.tanks[0]
     # large meshes as the simulation takes them: sparse matrices and shift-invert Lanczos (a dense
-    # generalized eigh of 20 x 20 x 12 needs 2 GB a matrix and crashed OpenBLAS)
+    # generalized eigh needs every matrix dense, and crashed OpenBLAS at 20 x 20 x 12)
     large = t.wall_spec is None and free_liquid_dofs(t) > SPARSE_AUTO
     model = build_liquid(t.size, t.fill_depth, t.mesh, t.fluid.density, t.fluid.sound_speed,
                          scene.environment.gravity, element=t.fluid.element, sparse=large)

@@ -1,8 +1,9 @@
 """The result of a run: a pytree mirroring the HDF5 result file (SPEC section 3), and its file io.
 
-The file is written in chunks while a run goes on (`ResultWriter`): datasets are resizable along
-time and `steps_done` is updated after each chunk, so a file left by a killed run opens and holds
-the steps done.
+The file's datasets are written down once (`schema`); the writer, the reader, `result_frames` (a
+Result as datasets) and `result_from` (datasets as a Result) all follow it. The file is written in
+chunks while a run goes on (`ResultWriter`): datasets are resizable along time and `steps_done` is
+updated after each chunk, so a file left by a killed run opens and holds the steps done.
 """
 from __future__ import annotations
 
@@ -14,6 +15,7 @@ import jax
 import numpy as np
 
 from .._version import __version__
+from .status import Status, code_of
 
 FORMAT = "jaxslosh.result"
 FORMAT_VERSION = 1
@@ -62,57 +64,20 @@ class Result(eqx.Module):
     status: str = eqx.field(static=True, default="ok")
     steps_done: int = eqx.field(static=True, default=0)
     scene_text: str = eqx.field(static=True, default="")
+    status_code: int = eqx.field(static=True, default=0)     # io.status.Status
 
 
-class ResultWriter:
-    """Appends frames to an HDF5 result file as a run goes on."""
-
-    def __init__(self, path: str, scene_text: str, probe_names, tanks=()):
-        self.path = path
-        self.f = h5py.File(path, "w")
-        a = self.f.attrs
-        a["format"] = FORMAT
-        a["format_version"] = FORMAT_VERSION
-        a["scene"] = scene_text
-        a["jaxslosh_version"] = __version__
-        a["status"] = "running"
-        a["steps_done"] = 0
-        self.n = 0
-        self.probe_names = list(probe_names)
-        self.tank_names = []
-        spec = {"time": (), "vessel/position": (3,), "vessel/quaternion": (4,), "vessel/angular_velocity": (3,),
-                "vessel/roll_pitch_yaw": (3,), "energy/kinetic": (), "energy/potential": (),
-                "solver/iterations": (), "solver/residual": (), "solver/constraint": ()}
-        for p in self.probe_names:
-            spec[f"probes/{p}/position"] = (3,)
-            spec[f"probes/{p}/displacement"] = (3,)
-        for t in tanks:
-            self.f.create_dataset(f"tanks/{t.name}/nodes", data=t.nodes)
-            self.f.create_dataset(f"tanks/{t.name}/elements", data=t.elements)
-            spec[f"tanks/{t.name}/displacement"] = (t.nodes.shape[0], 3)
-            self.tank_names.append(t.name)
-        for k, shape in spec.items():
-            dtype = "i8" if k == "solver/iterations" else "f8"
-            self.f.create_dataset(k, shape=(0, *shape), maxshape=(None, *shape), dtype=dtype,
-                                  chunks=(max(1, min(1024, 2 ** 20 // (8 * max(1, int(np.prod(shape)))))), *shape))
-        self.f.flush()
-
-    def append(self, frames: dict, steps_done: int):
-        k = len(frames["time"])
-        if k == 0:
-            return
-        for key, val in frames.items():
-            ds = self.f[key]
-            ds.resize(self.n + k, axis=0)
-            ds[self.n:self.n + k] = val
-        self.n += k
-        self.f.attrs["steps_done"] = int(steps_done)
-        self.f.flush()
-
-    def close(self, status: str, steps_done: int):
-        self.f.attrs["status"] = status
-        self.f.attrs["steps_done"] = int(steps_done)
-        self.f.close()
+def schema(probe_names=(), tank_nodes: Optional[dict] = None) -> dict:
+    """{dataset: shape of one frame} of a result file, in the file's order."""
+    spec = {"time": (), "vessel/position": (3,), "vessel/quaternion": (4,), "vessel/angular_velocity": (3,),
+            "vessel/roll_pitch_yaw": (3,), "energy/kinetic": (), "energy/potential": (),
+            "solver/iterations": (), "solver/residual": (), "solver/constraint": ()}
+    for p in probe_names:
+        spec[f"probes/{p}/position"] = (3,)
+        spec[f"probes/{p}/displacement"] = (3,)
+    for name, n in (tank_nodes or {}).items():
+        spec[f"tanks/{name}/displacement"] = (n, 3)
+    return spec
 
 
 def result_frames(r: Result) -> dict:
@@ -130,13 +95,76 @@ def result_frames(r: Result) -> dict:
     return {k: np.asarray(v) for k, v in d.items()}
 
 
+def result_from(d: dict, probe_names=(), tanks: Optional[dict] = None, *, status: str = "ok", steps_done: int = 0,
+                scene_text: str = "", status_code: Optional[int] = None) -> Result:
+    """A Result from {dataset: array} (the file's names; a leading batch axis is kept as it is) and
+    the tanks' meshes {name: (nodes, elements)} of the fields `d` holds."""
+    probes = {p: ProbeHistory(d[f"probes/{p}/position"], d[f"probes/{p}/displacement"]) for p in probe_names}
+    fields = {n: TankField(nodes, elements, d[f"tanks/{n}/displacement"]) for n, (nodes, elements) in (tanks or {}).items()
+              if f"tanks/{n}/displacement" in d}
+    return Result(time=d["time"],
+                  vessel=VesselHistory(d["vessel/position"], d["vessel/quaternion"], d["vessel/angular_velocity"],
+                                       d["vessel/roll_pitch_yaw"]),
+                  probes=probes, energy=Energy(d["energy/kinetic"], d["energy/potential"]),
+                  solver=SolverHistory(d["solver/iterations"], d["solver/residual"], d.get("solver/constraint")),
+                  tanks=fields, status=status, steps_done=steps_done, scene_text=scene_text,
+                  status_code=int(code_of(status) if status_code is None else status_code))
+
+
+class ResultWriter:
+    """Appends frames to an HDF5 result file as a run goes on."""
+
+    def __init__(self, path: str, scene_text: str, probe_names, tanks=()):
+        self.path = path
+        self.f = h5py.File(path, "w")
+        a = self.f.attrs
+        a["format"] = FORMAT
+        a["format_version"] = FORMAT_VERSION
+        a["scene"] = scene_text
+        a["jaxslosh_version"] = __version__
+        a["status"] = "running"
+        a["status_code"] = int(Status.RUNNING)
+        a["steps_done"] = 0
+        self.n = 0
+        for t in tanks:
+            self.f.create_dataset(f"tanks/{t.name}/nodes", data=t.nodes)
+            self.f.create_dataset(f"tanks/{t.name}/elements", data=t.elements)
+        for k, shape in schema(probe_names, {t.name: t.nodes.shape[0] for t in tanks}).items():
+            dtype = "i8" if k == "solver/iterations" else "f8"
+            self.f.create_dataset(k, shape=(0, *shape), maxshape=(None, *shape), dtype=dtype,
+                                  chunks=(max(1, min(1024, 2 ** 20 // (8 * max(1, int(np.prod(shape)))))), *shape))
+        self.f.flush()
+
+    def append(self, frames: dict, steps_done: int):
+        k = len(frames["time"])
+        if k == 0:
+            return
+        for key, val in frames.items():
+            ds = self.f[key]
+            ds.resize(self.n + k, axis=0)
+            ds[self.n:self.n + k] = val
+        self.n += k
+        self.f.attrs["steps_done"] = int(steps_done)
+        self.f.flush()
+
+    def close(self, status: str, steps_done: int, code: Optional[int] = None):
+        self.f.attrs["status"] = status
+        self.f.attrs["status_code"] = int(code_of(status) if code is None else code)
+        self.f.attrs["steps_done"] = int(steps_done)
+        self.f.close()
+
+
+class _Mesh:
+    """What the writer needs of a tank: its name and mesh."""
+
+    def __init__(self, name, nodes, elements):
+        self.name, self.nodes, self.elements = name, nodes, elements
+
+
 def save_result(r: Result, path: str) -> None:
-    class _T:  # the writer needs name/nodes/elements of each tank
-        def __init__(self, name, t):
-            self.name, self.nodes, self.elements = name, t.nodes, t.elements
-    w = ResultWriter(path, r.scene_text, list(r.probes), [_T(n, t) for n, t in r.tanks.items()])
+    w = ResultWriter(path, r.scene_text, list(r.probes), [_Mesh(n, t.nodes, t.elements) for n, t in r.tanks.items()])
     w.append(result_frames(r), r.steps_done)
-    w.close(r.status, r.steps_done)
+    w.close(r.status, r.steps_done, r.status_code)
 
 
 def _attr_str(v) -> str:
@@ -149,28 +177,17 @@ def load_result(path: str) -> Result:
         if _attr_str(a.get("format", "")) != FORMAT:
             raise ValueError(f"{path}: not a jaxslosh result file")
         n = f["time"].shape[0]
-        g = lambda k: np.asarray(f[k][:n])  # noqa: E731
-        probes = {}
-        if "probes" in f:
-            for name in f["probes"]:
-                probes[name] = ProbeHistory(g(f"probes/{name}/position"), g(f"probes/{name}/displacement"))
-        tanks = {}
-        if "tanks" in f:
-            for name in f["tanks"]:
-                tanks[name] = TankField(np.asarray(f[f"tanks/{name}/nodes"]), np.asarray(f[f"tanks/{name}/elements"]),
-                                        g(f"tanks/{name}/displacement"))
-        return Result(
-            time=g("time"),
-            vessel=VesselHistory(g("vessel/position"), g("vessel/quaternion"), g("vessel/angular_velocity"),
-                                 g("vessel/roll_pitch_yaw")),
-            probes=probes, energy=Energy(g("energy/kinetic"), g("energy/potential")),
-            solver=SolverHistory(g("solver/iterations"), g("solver/residual"),
-                                 g("solver/constraint") if "solver/constraint" in f else None), tanks=tanks,
-            status=_attr_str(a.get("status", "ok")), steps_done=int(a.get("steps_done", 0)),
-            scene_text=_attr_str(a.get("scene", "")))
+        probes = list(f["probes"]) if "probes" in f else []
+        tanks = {name: (np.asarray(f[f"tanks/{name}/nodes"]), np.asarray(f[f"tanks/{name}/elements"]))
+                 for name in (f["tanks"] if "tanks" in f else [])}
+        d = {k: np.asarray(f[k][:n]) for k in schema(probes, {name: 0 for name in tanks}) if k in f}
+        status = _attr_str(a.get("status", "ok"))
+        code = int(a["status_code"]) if "status_code" in a else None
+        return result_from(d, probes, tanks, status=status, steps_done=int(a.get("steps_done", 0)),
+                           scene_text=_attr_str(a.get("scene", "")), status_code=code)
 
 
-def truncated(r: Result, n: int, status: Optional[str] = None, steps_done: Optional[int] = None) -> Result:
+def truncated(r: Result, n: int) -> Result:
     """The first n frames of a result."""
     cut = lambda x: x[:n]  # noqa: E731
     return Result(
@@ -178,5 +195,4 @@ def truncated(r: Result, n: int, status: Optional[str] = None, steps_done: Optio
         probes={k: jax.tree_util.tree_map(cut, p) for k, p in r.probes.items()},
         energy=jax.tree_util.tree_map(cut, r.energy), solver=jax.tree_util.tree_map(cut, r.solver),
         tanks={k: TankField(t.nodes, t.elements, cut(t.displacement)) for k, t in r.tanks.items()},
-        status=r.status if status is None else status,
-        steps_done=r.steps_done if steps_done is None else steps_done, scene_text=r.scene_text)
+        status=r.status, steps_done=r.steps_done, scene_text=r.scene_text, status_code=r.status_code)

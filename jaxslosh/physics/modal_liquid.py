@@ -1,6 +1,6 @@
 """The tank liquid on a modal basis (fem/reduction.py builds the basis): d = V eta.
 
-The reduced equations are the Galerkin projection of the full ones (model.py), written with the
+The reduced equations are the Galerkin projection of the full ones (liquid.py), written with the
 inertia invariants of the basis, computed once (Exudyn's ObjectFFRFreducedOrder does the same): with
 T(P, Q) = sum_ij Ms_ij P_i Q_j^T (3x3) for nodal fields P, Q,
 
@@ -8,20 +8,20 @@ T(P, Q) = sum_ij Ms_ij P_i Q_j^T (3x3) for nodal fields P, Q,
 
 so a residual costs O(m^2) small products, independent of the mesh. The rigid rows, the modal rows,
 the kinetic and the potential energy are those of the full model at d = V eta, to round-off
-(tests/test_reduction.py checks them against model.py).
+(tests/test_reduction.py checks them against liquid.py).
 """
 from __future__ import annotations
-
-from typing import Optional
 
 import equinox as eqx
 import jax
 import jax.numpy as jnp
 
 from .kinematics import mv3, tv3
+from .liquid import AbstractLiquid
+from .terms import Kin, Rows
 
 
-class ReducedLiquid(eqx.Module):
+class ReducedLiquid(AbstractLiquid):
     """All tank liquid on a modal basis: d = V eta (eta: m modal coordinates, every tank's stacked).
 
     The invariants (see the module docstring) replace the dense N x N mass products of `Liquid`."""
@@ -38,8 +38,9 @@ class ReducedLiquid(eqx.Module):
     Kr: jax.Array         # (m, m) V^T K V
     row_scale: jax.Array  # (m,) a mass per modal row, so that row / scale is an acceleration (m/s^2)
     n_nodes: int = eqx.field(static=True)
-    Kdt: Optional[jax.Array] = None    # (m, 3) V^T K_dt
-    Ktt: Optional[jax.Array] = None    # (3, 3)
+    coriolis: bool = eqx.field(static=True, default=True)
+    centrifugal: bool = eqx.field(static=True, default=True)
+    sparse = False
 
     @property
     def nf(self) -> int:
@@ -61,11 +62,12 @@ class ReducedLiquid(eqx.Module):
         W = self._W(eta) if W is None else W
         return self.Q0 + jnp.einsum("l,lab->ab", eta, W + jnp.swapaxes(self.Q1, 1, 2))
 
-    def rows(self, system, c, omega, eta_dot, acc, A, g_b):
-        """The liquid's share of the residual of model.System.residual: (rigid translation rows
-        (inertial), rigid rotation rows (body), modal rows), as the full model's at d = V eta."""
-        eta, eta_dd = c.d, acc[6:]
-        a0, alpha = acc[:3], acc[3:6]
+    def rows(self, k: Kin) -> Rows:
+        """The liquid's share of the residual (liquid.Liquid.rows) at d = V eta: rigid translation
+        rows (inertial), rigid rotation rows (body), modal rows."""
+        A, omega, g_b, eta_dot = k.A, k.omega, k.g_b, k.d_dot
+        eta, eta_dd = k.c.d, k.acc[6:]
+        a0, alpha = k.acc[:3], k.acc[3:6]
         b = tv3(A, a0)
         W = self._W(eta)
         J = self.second_moment(eta, W)
@@ -77,31 +79,24 @@ class ReducedLiquid(eqx.Module):
         f_r = jnp.cross(Sx, b) + _axial(Txa) + jnp.trace(J) * alpha - mv3(J, alpha)
         # modal rows: sum_ij Ms_ij U_k,i . a_j
         r_d = mv3(self.U1, b) + self.Mr @ eta_dd + mv3(_axial(W), alpha)
-        if system.coriolis:
+        if self.coriolis:
             v1 = self.U1.T @ eta_dot
             s = s + 2.0 * jnp.cross(omega, v1)
             Txv = jnp.einsum("l,lab->ab", eta_dot, W)
             f_r = f_r + 2.0 * (jnp.trace(Txv) * omega - tv3(Txv, omega))
             Tvu = jnp.einsum("l,lkab->kab", eta_dot, self.Q2)            # T(v, U_k)
             r_d = r_d + 2.0 * mv3(_axial(Tvu), omega)
-        if system.centrifugal:
+        if self.centrifugal:
             s = s + jnp.cross(omega, jnp.cross(omega, Sx))
             f_r = f_r + jnp.cross(mv3(J, omega), omega)
             r_d = r_d + jnp.einsum("a,kba,b->k", omega, W, omega) - (omega @ omega) * jnp.trace(W, axis1=1, axis2=2)
         r_d = r_d - mv3(self.U1, g_b) + self.Kr @ eta
-        if self.Kdt is not None:
-            th, Jth = system.liquid_rotation(c.q, with_jacobian=True)
-            r_d = r_d + mv3(self.Kdt, th)
-            f_r = f_r + tv3(Jth, self.Kdt.T @ eta + mv3(self.Ktt, th))
-        mD = self.U1.T @ eta
-        if system.balanced:
-            f_r = f_r - jnp.cross(mD, g_b)
-        else:
-            f_r = f_r - jnp.cross(self.S0 + mD, g_b)
-        return mv3(A, s), f_r, r_d
+        f_r = f_r - jnp.cross(self.U1.T @ eta, g_b)
+        return Rows(jnp.concatenate([mv3(A, s), f_r]), r_d)
 
-    def kinetic_energy(self, A, V0, omega, eta, eta_dot):
-        c = A.T @ V0
+    def kinetic(self, k: Kin):
+        c = k.A.T @ k.V0
+        eta, eta_dot, omega = k.c.d, k.d_dot, k.omega
         W = self._W(eta)
         J = self.second_moment(eta, W)
         Sx = self.S0 + self.U1.T @ eta
@@ -110,14 +105,39 @@ class ReducedLiquid(eqx.Module):
                       + eta_dot @ (self.Mr @ eta_dot) + 2.0 * omega @ _axial(Txv)
                       + omega @ (jnp.trace(J) * omega - J @ omega))
 
-    def potential_energy(self, system, q, eta, g_b):
-        V = 0.5 * eta @ (self.Kr @ eta) - g_b @ (self.U1.T @ eta)
-        if self.Kdt is not None:
-            th = system.liquid_rotation(q)
-            V = V + eta @ (self.Kdt @ th) + 0.5 * th @ (self.Ktt @ th)
-        if not system.balanced:
-            V = V - g_b @ self.S0
-        return V
+    def potential(self, k: Kin):
+        eta = k.c.d
+        return 0.5 * eta @ (self.Kr @ eta) - k.g_b @ (self.U1.T @ eta)
+
+    def mass_scale(self):
+        m, x = self.m_nodes, self.r
+        I = jnp.array([m @ (x[:, 1] ** 2 + x[:, 2] ** 2), m @ (x[:, 0] ** 2 + x[:, 2] ** 2),
+                       m @ (x[:, 0] ** 2 + x[:, 1] ** 2)])
+        return jnp.concatenate([jnp.full(3, self.mass), I])
+
+    def d_scale(self):
+        return self.row_scale
+
+    def total_mass(self):
+        return self.mass
+
+    def rigid_first_moment(self):
+        return self.S0
+
+    def constant_blocks(self):
+        return self.Mr, self.Kr
+
+    def probe_modal(self, weights):
+        return jnp.einsum("pn,knc->pkc", weights, self.U)
+
+    def frame_field(self, d):
+        return d          # the frames keep eta; the nodal field is formed after the run
+
+    def nodal_fields(self, D):
+        return jnp.einsum("...k,knc->...nc", D, self.U)
+
+    def probe_displacements(self, weights, modal, d):
+        return jnp.einsum("pkc,k->pc", modal, d)
 
     def static_start(self, g_b):
         """The discrete hydrostatic equilibrium Kr eta = V^T F_g (exact with the static correction)."""

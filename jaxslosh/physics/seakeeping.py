@@ -21,11 +21,11 @@ for a velocity linear over the step, so the memory force is linear in the step's
 """
 from __future__ import annotations
 
-from typing import Optional
-
 import equinox as eqx
 import jax
 import jax.numpy as jnp
+
+from .terms import AbstractTerm, Kin, Rows
 
 
 class Memory(eqx.Module):
@@ -69,34 +69,6 @@ class Memory(eqx.Module):
         return self.c_re @ z[:, 0] - self.c_im @ z[:, 1]
 
 
-class Seakeeping(eqx.Module):
-    """Wave loads and hull hydrodynamics on the rigid rows (see the module docstring); each part is
-    None when the scene lacks it or switches it off ([effects] waves, radiation), and is not traced."""
-    excitation: Optional[Excitation] = None
-    added_mass: Optional[jax.Array] = None     # (6, 6) A_inf about the COG
-    damping: Optional[jax.Array] = None        # (6, 6) linear (viscous) damping B_v
-    memory: Optional[Memory] = None
-
-    def rigid_rows(self, acc6, v6, t, mu=None):
-        """What the hydrodynamics add to the rigid rows of the residual (inertia minus forces)."""
-        r = jnp.zeros(6)
-        if self.added_mass is not None:
-            r = r + self.added_mass @ acc6
-        if self.damping is not None:
-            r = r + self.damping @ v6
-        if self.memory is not None and mu is not None:
-            r = r + mu
-        if self.excitation is not None:
-            r = r - self.excitation.force(t)
-        return r
-
-    def added_mass_diagonal(self):
-        return jnp.zeros(6) if self.added_mass is None else jnp.diag(self.added_mass)
-
-    def kinetic_energy(self, v6):
-        return 0.0 if self.added_mass is None else 0.5 * v6 @ (self.added_mass @ v6)
-
-
 class Excitation(eqx.Module):
     """First-order wave forces as a known function of time: F_j(t) = r(t) height sum_i
     amp_ji cos(w_i t + phase_ji), rows in the residual's frame (translations inertial, rotations
@@ -113,3 +85,43 @@ class Excitation(eqx.Module):
         if self.ramp > 0:
             F = F * jnp.where(t < self.ramp, 0.5 * (1.0 - jnp.cos(jnp.pi * jnp.clip(t, 0.0, self.ramp) / self.ramp)), 1.0)
         return F
+
+
+class WaveExcitation(AbstractTerm):
+    """First-order wave forces on the rigid rows: a known function of time."""
+    excitation: Excitation
+
+    def rows(self, k: Kin) -> Rows:
+        return Rows(-self.excitation.force(k.t))
+
+
+class AddedMass(AbstractTerm):
+    """The radiation added mass at infinite frequency, A_inf (6, 6) about the COG: it moves with the hull."""
+    matrix: jax.Array
+
+    def rows(self, k: Kin) -> Rows:
+        return Rows(self.matrix @ k.acc[:6])
+
+    def kinetic(self, k: Kin):
+        v6 = k.v6
+        return 0.5 * v6 @ (self.matrix @ v6)
+
+    def mass_scale(self):
+        return jnp.diag(self.matrix)
+
+
+class LinearDamping(AbstractTerm):
+    """Linear (viscous) damping B_v (6, 6) added to the radiation: bilge keels, viscous roll damping."""
+    matrix: jax.Array
+
+    def rows(self, k: Kin) -> Rows:
+        return Rows(self.matrix @ k.v6)
+
+
+class RadiationMemory(AbstractTerm):
+    """The memory force mu(t) of the Cummins equation: the System's `memory` states give it (the
+    integrator advances them), this term puts it on the rigid rows."""
+
+    def rows(self, k: Kin) -> Rows:
+        return Rows(jnp.zeros(6) if k.mu is None else k.mu)
+

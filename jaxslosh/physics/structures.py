@@ -1,5 +1,5 @@
 """Flexible substructures in their own floating frames, tied by localized Lagrange multipliers
-(paper eqs. 12-27): the partitioned system of eq. (27) around the vessel-and-liquid core of model.py.
+(paper eqs. 12-27): the partitioned system of eq. (27) around the vessel-and-liquid core of system.py.
 
 Unknowns, in the order the Newton iterations see them (x):
 
@@ -38,7 +38,7 @@ import jax
 import jax.numpy as jnp
 
 from .kinematics import quat_exp, quat_multiply, rotation_matrix, spin_tensor_components
-from .system import Config
+from .terms import Config
 
 
 class Body(eqx.Module):
@@ -136,7 +136,7 @@ class Layout(NamedTuple):
 
 
 def layout(system) -> Layout:
-    flex = getattr(system, "flex", None)
+    flex = system.flex
     if flex is None:
         return Layout(0, system.nf, 0, 0)
     return Layout(flex.S, system.nf, flex.n_modal, flex.n_alg)
@@ -291,8 +291,8 @@ def inertia_rows(system, c: Config, v, acc, t, mu=None):
             r_eta = r_eta + jnp.einsum("k,kij,j->i", jnp.stack(spin_tensor_components(om)), b.Kg, eta)
         modal.append(r_eta)
     dyn = jnp.concatenate([core[:6], jnp.concatenate(rigid_s), core[6:], jnp.concatenate(modal)])
-    grad_V = _potential_forces(system, c)
-    if system.forced is not None:            # the vessel's rows prescribe its motion
+    grad_V = potential_forces(system, c)
+    if system.motion.prescribed:            # the vessel's rows prescribe its motion
         grad_V = grad_V.at[:6].set(0.0)
     return dyn + grad_V
 
@@ -303,12 +303,12 @@ def constraint_rows(system, c: Config, alg, g_rows, gscale):
     their second time derivative at the start) times `gscale` per interface."""
     L = layout(system)
     f_dyn, f_frames = _frame_rows(system, c, alg)
-    if system.forced is not None:
+    if system.motion.prescribed:
         f_dyn = f_dyn.at[:6].set(0.0)
     return L.to_x(f_dyn, _alg_rows(system.flex, f_frames, g_rows, gscale))
 
 
-def _potential_forces(system, c: Config):
+def potential_forces(system, c: Config):
     """The gradient of `structure_potential` along the increments, by hand (`test_multibody` checks
     it against jax.grad): omega^2 eta on the modal rows, -m_s g on each structure's translation and,
     when balanced, +m_s g on the vessel's translation and c_s x (m_s A_v^T g) on its rotation."""

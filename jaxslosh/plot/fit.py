@@ -10,6 +10,7 @@ from ..fit.params import param_value
 from ..fit.problem import as_result, channels_of
 from ..run.simulate import simulate
 from ..scene.types import Scene
+from .results import figure
 
 
 def plot_fit(scene: Scene, measured, fit_result: FitResult, out_png: Optional[str] = None, *, start: bool = True):

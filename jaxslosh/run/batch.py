@@ -8,11 +8,10 @@ import jax.numpy as jnp
 import numpy as np
 from jax.sharding import Mesh, NamedSharding, PartitionSpec
 
-from ..io.result import Energy, ProbeHistory, Result, SolverHistory, VesselHistory
-from ..physics.kinematics import rpy_from_quat
+from ..io.result import Result, result_from
 from ..scene.keys import with_overrides
 from ..scene.types import Scene
-from .loop import advance, concat_frames, core, start
+from .loop import advance, concat_frames, core, frame_datasets, start
 from .simulate import failure_message, prepare
 
 
@@ -77,15 +76,10 @@ def simulate_batch(scene: Scene, params: dict, *, duration: Optional[float] = No
     h = setup0.solver.h
     for i in range(B):
         ci = jax.tree_util.tree_map(lambda x: x[i], carry)
-        statuses.append(failure_message(ci, h, setup0.solver.tol, setup0.solver.max_iter)
+        statuses.append(failure_message(ci, h, setup0.solver.tol)
                         if bool(ci.failed) else "ok")
     b0 = setup0.built
-    probes = {}
-    for i, name in enumerate(b0.probes.names):
-        pos = fr.probes[:, :, i, :]
-        probes[name] = ProbeHistory(pos, pos - pos[:, :1])
-    res = Result(time=fr.t, vessel=VesselHistory(fr.X0, fr.q, fr.omega, rpy_from_quat(fr.q)), probes=probes,
-                 energy=Energy(fr.ke, fr.pe), solver=SolverHistory(fr.iterations, fr.residual, fr.gmax), tanks={},
-                 status="ok" if all(s == "ok" for s in statuses) else "some runs failed",
-                 steps_done=setup0.n_steps, scene_text=scene.text)
+    res = result_from(frame_datasets(b0, fr, fields=False), b0.probes.names,
+                      status="ok" if all(s == "ok" for s in statuses) else "some runs failed",
+                      steps_done=setup0.n_steps, scene_text=scene.text)
     return res, statuses

@@ -11,13 +11,15 @@ import jax
 import jax.numpy as jnp
 
 from ..build.system import Built
+from ..io.status import Status
 from ..physics import structures as mb
-from ..physics.kinematics import rotation_matrix
+from ..physics.kinematics import rotation_matrix, rpy_from_quat
 from ..solve.integrator import State, initial_state, step_or_retry
 from ..solve.linear import Solver
 
 
 class Carry(NamedTuple):
+    """The loop's state: the integrator's state and how the run is going."""
     s: State
     k: jax.Array          # steps done
     failed: jax.Array     # a step has failed: the state is frozen since
@@ -25,6 +27,11 @@ class Carry(NamedTuple):
     fail_err: jax.Array
     fail_it: jax.Array
     n: jax.Array          # steps attempted, failed or not: the same for every run of a batch (never batched)
+    code: jax.Array       # io.status.Status of the first failure (OK while none)
+
+    @property
+    def status(self):
+        return self.code
 
 
 class Frame(NamedTuple):
@@ -43,38 +50,22 @@ class Frame(NamedTuple):
 
 
 def _frame(b: Built, s: State, it, err, failed) -> Frame:
-    sysm = b.system
-    flex = getattr(sysm, "flex", None)
-    V0, om = s.v[:3], s.v[3:6]
-    if flex is None:
-        dd = s.v[6:]
-    else:
-        dd = mb.layout(sysm).split(s.v)[2]
+    """What a saved frame keeps of a state: the vessel, the probes, the energies, the solver's figures
+    and the liquid's field (its nodal displacement, or a modal liquid's coordinates)."""
+    sysm, pr, flex = b.system, b.probes, b.system.flex
     A = rotation_matrix(s.c.q)
-    pr = b.probes
-    if pr.modal is not None:       # reduced liquid: the frame keeps eta, mapped to nodes after the run
-        D = s.c.d
-        local = pr.points + jnp.einsum("pkc,k->pc", pr.modal, D)
-    elif sysm.liquid is not None:
-        D = sysm.liquid.full(s.c.d)
-        local = pr.points + pr.weights @ D
-    else:
-        D = jnp.zeros((0, 3))
-        local = pr.points
+    local = pr.points + sysm.liquid.probe_displacements(pr.weights, pr.modal, s.c.d)
     probes = s.c.X0[None, :] + local @ A.T
-    ke = sysm.kinetic_energy(s.c, V0, om, dd)
-    pe = sysm.potential_energy(s.c)
+    ke, pe = sysm.energy(s.c, s.v)
     gmax = jnp.zeros(())
     if flex is not None:
         gmax = jnp.max(jnp.abs(mb.constraint(sysm, s.c, s.alg)))
-        ke = ke + mb.structure_kinetic(sysm, s.c, s.v)
-        pe = pe + mb.structure_potential(sysm, s.c)
         etas = mb.split_eta(flex, s.c.eta)
         for sp in pr.on_structures:
             body = flex.bodies[sp.index]
             x = sp.r + sp.W @ body.u(etas[sp.index])
             probes = probes.at[sp.rows].set(s.c.Xs[sp.index][None, :] + x @ rotation_matrix(s.c.qs[sp.index]).T)
-    return Frame(s.t, s.c.X0, s.c.q, om, probes, ke, pe, it, err, D, failed, gmax)
+    return Frame(s.t, s.c.X0, s.c.q, s.v[3:6], probes, ke, pe, it, err, sysm.liquid.frame_field(s.c.d), failed, gmax)
 
 
 def core(b: Built) -> Built:
@@ -86,44 +77,65 @@ def _select(pred, a, b):
     return jax.tree_util.tree_map(lambda x, y: jnp.where(pred, x, y), a, b)
 
 
-@eqx.filter_jit
-def start(b: Built, solver: Solver):
-    s0, info = initial_state(b.system, solver, b.c0, b.v0, b.alg0)
+def init(b: Built, solver: Solver) -> tuple[Carry, Frame]:
+    """The state at t = 0 (consistent accelerations; structures in static equilibrium) and its frame."""
+    with jax.named_scope("initial state"):
+        s0, info = initial_state(b.system, solver, b.c0, b.v0, b.alg0)
     failed = ~info.ok
-    carry = Carry(s0, jnp.array(0), failed, jnp.where(failed, 0, -1), info.residual, info.iterations, jnp.array(0))
-    return carry, _frame(b, s0, info.iterations, info.residual, failed)
+    code = jnp.where(failed, int(Status.INITIAL), int(Status.OK))
+    carry = Carry(s0, jnp.array(0), failed, jnp.where(failed, 0, -1), info.residual, info.iterations, jnp.array(0),
+                  code)
+    return carry, observe(b, carry, info.iterations, info.residual)
+
+
+def step(b: Built, solver: Solver, c: Carry) -> tuple[Carry, tuple]:
+    """One step of the loop: the integrator's step (retried as sub-steps where the scene asks);
+    a step that fails freezes the state and records the first failure's step, residual and code."""
+    s_new, info = step_or_retry(b.system, solver, c.s, c.n)
+    bad = ~info.ok & ~c.failed
+    keep = c.failed | ~info.ok
+    s = _select(keep, c.s, s_new)
+    why = jnp.where(jnp.isfinite(info.residual), int(Status.NEWTON), int(Status.NONFINITE))
+    c2 = Carry(s, c.k + jnp.where(keep, 0, 1), c.failed | ~info.ok,
+               jnp.where(bad, c.k + 1, c.fail_step), jnp.where(bad, info.residual, c.fail_err),
+               jnp.where(bad, info.iterations, c.fail_it), c.n + 1, jnp.where(bad, why, c.code))
+    return c2, (info.iterations, info.residual)
+
+
+def observe(b: Built, c: Carry, iterations=None, residual=None) -> Frame:
+    """The frame of a state (iterations and residual of the steps since the last frame, if known)."""
+    z = jnp.zeros((), dtype=c.fail_err.dtype)
+    return _frame(b, c.s, jnp.zeros((), jnp.int32) if iterations is None else iterations,
+                  z if residual is None else residual, c.failed)
+
+
+#: init and the loop as traced (each trace counted, eqx.debug.get_num_traces: tests guard recompiles)
+traced_init = eqx.debug.assert_max_traces(init, max_traces=None)
+start = eqx.filter_jit(traced_init)
 
 
 #: runs of at least this many steps are checkpointed in blocks (see advance)
 REMAT_MIN_STEPS = 5000
 
 
-@eqx.filter_jit
-def advance(b: Built, solver: Solver, carry: Carry, n_frames: int, save_every: int):
+def _advance(b: Built, solver: Solver, carry: Carry, n_frames: int, save_every: int):
     """n_frames frames of save_every steps each: one scan of scans, no Python loop in traced code."""
 
     def one_step(c: Carry, _):
-        s_new, info = step_or_retry(b.system, solver, c.s, c.n)
-        bad = ~info.ok & ~c.failed
-        keep = c.failed | ~info.ok
-        s = _select(keep, c.s, s_new)
-        c2 = Carry(s, c.k + jnp.where(keep, 0, 1), c.failed | ~info.ok,
-                   jnp.where(bad, c.k + 1, c.fail_step), jnp.where(bad, info.residual, c.fail_err),
-                   jnp.where(bad, info.iterations, c.fail_it), c.n + 1)
-        return c2, (info.iterations, info.residual)
+        return step(b, solver, c)
 
     def one_frame(c: Carry, _):
         c, (its, errs) = jax.lax.scan(one_step, c, None, length=save_every)
-        return c, _frame(b, c.s, its.max(), errs.max(), c.failed)
+        with jax.named_scope("frame"):
+            return c, observe(b, c, its.max(), errs.max())
 
     def frames(c, n):
         return jax.lax.scan(one_frame, c, None, length=n)
 
     # Reverse mode through long runs: blocks of K ~ sqrt(n) frames are checkpointed (jax.checkpoint
     # keeps only the block boundaries and recomputes a block's steps when its gradient is taken), so
-    # a gradient's memory stops growing with the steps. Measured on the paper example (peak RSS of
-    # one gradient): 1.22 / 1.60 / 2.37 GB at 1,000 / 4,000 / 10,000 steps without, 1.76 / 1.67 /
-    # 1.45 GB with (a larger compiled program); so only runs of REMAT_MIN_STEPS or more take it.
+    # a gradient's memory stops growing with the steps; the checkpointed program is larger, so only
+    # runs of REMAT_MIN_STEPS or more take it (README "Gradient memory" has the measurements).
     K = _block_size(n_frames)
     if n_frames * save_every < REMAT_MIN_STEPS or K < 4:
         return frames(carry, n_frames)
@@ -134,6 +146,10 @@ def advance(b: Built, solver: Solver, carry: Carry, n_frames: int, save_every: i
         carry, tail = frames(carry, rem)
         fr = concat_frames([fr, tail])
     return carry, fr
+
+
+traced_advance = eqx.debug.assert_max_traces(_advance, max_traces=None)
+advance = eqx.filter_jit(traced_advance)
 
 
 def _block_size(n: int) -> int:
@@ -151,8 +167,26 @@ def concat_frames(frames):
 
 
 def nodal(b: Built, D):
-    """Frames' liquid displacement as nodal fields (..., N, 3): a reduced liquid's frames hold its
+    """Frames' liquid fields as nodal displacements (..., N, 3): a modal liquid's frames hold its
     modal coordinates (storing the nodal field every step cost more than the step itself)."""
-    if b.probes.modal is not None:
-        return jnp.einsum("...k,knc->...nc", D, b.system.liquid.U)
-    return D
+    return b.system.liquid.nodal_fields(D)
+
+
+def frame_datasets(b: Built, fr: Frame, p0=None, fields: bool = True) -> dict:
+    """Frames (leading axes [batch,] frame) as the result file's datasets (io/result.py `schema`).
+    `p0`: the probes' initial positions (default: the first frame's); `fields`: the tanks' nodal
+    displacement fields too (b.tanks: the host-side blocks)."""
+    d = {"time": fr.t, "vessel/position": fr.X0, "vessel/quaternion": fr.q, "vessel/angular_velocity": fr.omega,
+         "vessel/roll_pitch_yaw": rpy_from_quat(fr.q), "energy/kinetic": fr.ke, "energy/potential": fr.pe,
+         "solver/iterations": fr.iterations, "solver/residual": fr.residual, "solver/constraint": fr.gmax}
+    P = fr.probes                                                   # (..., n, P, 3)
+    p0 = P[..., :1, :, :] if p0 is None else p0
+    for i, name in enumerate(b.probes.names):
+        d[f"probes/{name}/position"] = P[..., i, :]
+        d[f"probes/{name}/displacement"] = P[..., i, :] - p0[..., i, :]
+    if fields and b.tanks:
+        D = nodal(b, fr.D)
+        for t in b.tanks:
+            d[f"tanks/{t.name}/displacement"] = D[..., t.node_offset:t.node_offset + t.nodes.shape[0], :]
+    return d
+

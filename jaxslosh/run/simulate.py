@@ -9,20 +9,20 @@ frame before it and reports the step, the time and the residual.
 from __future__ import annotations
 
 import dataclasses
-import math
 from typing import NamedTuple, Optional
 
+import equinox as eqx
 import jax
 import numpy as np
 
 from ..build.system import Built, build
-from ..io.result import Energy, ProbeHistory, Result, SolverHistory, TankField, VesselHistory, truncated
-from ..physics.kinematics import rpy_from_quat
+from ..io.status import TEXT, Status, failure_text
+from ..io.result import Result, result_from, truncated
 from ..scene.keys import with_overrides
 from ..scene.types import Scene
 from ..solve.linear import Solver, make_solver
 from ..solve.schemes import make_scheme
-from .loop import Carry, Frame, advance, concat_frames, core, nodal, start
+from .loop import Carry, Frame, advance, concat_frames, core, frame_datasets, start
 
 
 class NumericalFailure(RuntimeError):
@@ -71,31 +71,15 @@ def prepare(scene: Scene, params=None, batch: bool = False) -> Setup:
     return Setup(b, solver, n_steps, max(1, int(sim.save_every)))
 
 
-def to_result(b: Built, fr: Frame, scene_text: str, status: str, steps_done: int) -> Result:
-    probes = {}
-    for i, name in enumerate(b.probes.names):
-        pos = fr.probes[:, i, :]
-        probes[name] = ProbeHistory(pos, pos - pos[0])
-    tanks = {}
-    D = nodal(b, fr.D)
-    for t in b.tanks:
-        N = t.nodes.shape[0]
-        tanks[t.name] = TankField(t.nodes, t.elements, D[:, t.node_offset:t.node_offset + N, :])
-    return Result(time=fr.t, vessel=VesselHistory(fr.X0, fr.q, fr.omega, rpy_from_quat(fr.q)), probes=probes,
-                  energy=Energy(fr.ke, fr.pe), solver=SolverHistory(fr.iterations, fr.residual, fr.gmax), tanks=tanks,
-                  status=status, steps_done=steps_done, scene_text=scene_text)
+def to_result(b: Built, fr: Frame, scene_text: str, status: str, steps_done: int, code: int = 0) -> Result:
+    tanks = {t.name: (t.nodes, t.elements) for t in b.tanks}
+    return result_from(frame_datasets(b, fr), b.probes.names, tanks, status=status, steps_done=steps_done,
+                       scene_text=scene_text, status_code=code)
 
 
-def failure_message(carry: Carry, h: float, tol: float, max_iter: int) -> str:
-    k = int(carry.fail_step)
-    err = float(carry.fail_err)
-    if k == 0:
-        return f"the initial accelerations could not be solved (scaled residual {err:.3g})"
-    t = k * h
-    if not math.isfinite(err):
-        return f"step {k} (t = {t:.6g} s): non-finite values (NaN or Inf) in the solution"
-    return (f"step {k} (t = {t:.6g} s): Newton did not converge in {int(carry.fail_it)} iterations "
-            f"(scaled residual {err:.3g}, tolerance {tol:.3g})")
+def failure_message(carry: Carry, h: float, tol: float) -> str:
+    """The sentence of a carry's first failure (io/status.py)."""
+    return failure_text(int(carry.code), int(carry.fail_step), float(h), float(carry.fail_err), int(carry.fail_it), tol)
 
 
 def simulate(scene: Scene, params: Optional[dict] = None, *, duration: Optional[float] = None,
@@ -104,8 +88,10 @@ def simulate(scene: Scene, params: Optional[dict] = None, *, duration: Optional[
 
     `params` maps dotted scene keys to replacement values, which may be JAX tracers:
     `jax.grad` of any scalar function of the result works with respect to them.
-    A numerical failure truncates the result to the frames before it and sets `status`
-    (or raises NumericalFailure when `throw=True`); under tracing the status cannot be read.
+    A numerical failure truncates the result to the frames before it and sets `status` (its text)
+    and `status_code` (io.status.Status); with `throw=True` it raises NumericalFailure instead, and
+    inside `jax.jit` (where the status cannot be read) the compiled run raises an error naming the
+    failure (equinox's error_if) when it happens.
     """
     scene = with_overrides(scene, duration=duration, dt=dt)
     setup = prepare(scene, params)
@@ -116,11 +102,14 @@ def simulate(scene: Scene, params: Optional[dict] = None, *, duration: Optional[
     fr = concat_frames([jax.tree_util.tree_map(lambda x: x[None], f0), frames])
     traced = isinstance(carry.failed, jax.core.Tracer)
     if traced:
+        if throw:
+            fr = eqx.branched_error_if(fr, carry.failed, carry.code,
+                                       [f"jaxslosh: the run failed: {TEXT[s]}" for s in Status])
         return to_result(b, fr, scene.text, "ok", setup.n_steps)
     if bool(carry.failed):
-        msg = failure_message(carry, solver.h, solver.tol, solver.max_iter)
+        msg = failure_message(carry, solver.h, solver.tol)
         n_ok = int(np.sum(~np.asarray(fr.failed)))
-        res = to_result(b, fr, scene.text, msg, int(carry.k))
+        res = to_result(b, fr, scene.text, msg, int(carry.k), int(carry.code))
         res = truncated(res, n_ok)
         if throw:
             raise NumericalFailure(msg, res)

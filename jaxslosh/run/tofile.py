@@ -9,11 +9,9 @@ from typing import Optional
 import jax
 import numpy as np
 
-from ..build.system import Built
 from ..io.result import ResultWriter
-from ..physics.kinematics import rpy_from_quat
 from ..scene.types import Scene
-from .loop import Frame, advance, core, nodal, start
+from .loop import advance, core, frame_datasets, start
 from .simulate import failure_message, prepare
 
 
@@ -53,7 +51,7 @@ def run_to_file(scene: Scene, out: str, *, progress: bool = True,
     b, solver = setup.built, setup.solver
     se = setup.save_every
     n_frames = setup.n_steps // se
-    N = 0 if b.system.liquid is None else b.system.liquid.n_nodes
+    N = b.system.liquid.n_nodes
     if save_fields is None:
         save_fields = N * 3 * 8 * (n_frames + 1) < 200e6
     chunk_frames = scene.simulation.chunk or max(1, min(n_frames, max(1, 500 // se)))
@@ -64,12 +62,14 @@ def run_to_file(scene: Scene, out: str, *, progress: bool = True,
     try:
         carry, f0 = start(core(b), solver)
         first = jax.tree_util.tree_map(lambda x: np.asarray(x)[None], f0)
-        p0 = first.probes[0]
+        p0 = first.probes[:1]
         pending, done_frames = first, 0
         while True:
             ok = ~np.asarray(pending.failed)
             n_ok = int(ok.sum()) if ok.all() else int(np.argmin(ok))
-            writer.append(_file_frames(b, pending, p0, n_ok, save_fields), min(int(carry.k), setup.n_steps))
+            rows = jax.tree_util.tree_map(lambda x: x[:n_ok], pending)
+            writer.append({k: np.asarray(v) for k, v in frame_datasets(b, rows, p0, save_fields).items()},
+                          min(int(carry.k), setup.n_steps))
             if bool(carry.failed) or done_frames >= n_frames:
                 break
             carry, fr = advance(core(b), solver, carry, chunk_frames, se)
@@ -81,27 +81,10 @@ def run_to_file(scene: Scene, out: str, *, progress: bool = True,
             done_frames += take
             bar.update(min(int(carry.k), setup.n_steps))
         if bool(carry.failed):
-            status = failure_message(carry, solver.h, solver.tol, solver.max_iter)
+            status = failure_message(carry, solver.h, solver.tol)
         steps_done = min(int(carry.k), setup.n_steps)
     finally:
         bar.close()
         writer.close(status, steps_done)
     wall = (_time.perf_counter() - t_loop) if t_loop is not None else 0.0
     return status, steps_done, wall
-
-
-def _file_frames(b: Built, fr: Frame, p0, n: int, save_fields: bool) -> dict:
-    """Frames (first n rows) as {dataset: array} for the result file."""
-    q = np.asarray(fr.q[:n])
-    d = {"time": fr.t[:n], "vessel/position": fr.X0[:n], "vessel/quaternion": q,
-         "vessel/angular_velocity": fr.omega[:n], "vessel/roll_pitch_yaw": np.asarray(rpy_from_quat(q)).reshape(-1, 3),
-         "energy/kinetic": fr.ke[:n], "energy/potential": fr.pe[:n], "solver/iterations": fr.iterations[:n],
-         "solver/residual": fr.residual[:n], "solver/constraint": fr.gmax[:n]}
-    for i, name in enumerate(b.probes.names):
-        d[f"probes/{name}/position"] = fr.probes[:n, i]
-        d[f"probes/{name}/displacement"] = fr.probes[:n, i] - p0[i]
-    if save_fields:
-        D = nodal(b, fr.D[:n])
-        for t in b.tanks:
-            d[f"tanks/{t.name}/displacement"] = D[:, t.node_offset:t.node_offset + t.nodes.shape[0]]
-    return {k: np.asarray(v) for k, v in d.items()}

@@ -2,7 +2,8 @@
 
 A Newton iteration on a large mesh solves with the constant liquid block C = c_a M + K (and the
 initial accelerations with M). A sparse LU factor of the 20 x 20 x 12 mesh holds 24 million
-entries and one solve with it takes 20-25 ms; here the same solve takes well under a millisecond.
+entries, which every solve streams; here a solve is a few small dense transforms (README "Design"
+has the timings).
 
 Why it works. The tank is a box on a uniform grid, and every term of the liquid's energy is the same
 in every column of elements (it may change from layer to layer). The slip walls at x = 0, a and
@@ -246,8 +247,7 @@ class Stencil(eqx.Module):
     """`A @ x` for a block-diagonal sparse matrix whose blocks live on box grids: each row a fixed
     pattern of neighbours (27 for hexahedra, a few more for the surface bending), so the product is
     a sum of shifted copies of the grid field times per-node coefficients, where a general sparse
-    product gathers and scatters every entry (2-3x faster for the stiffness here, 6x for the mass;
-    linear, so differentiable and transposable). x: (n,) or (n, m); rows of width k (3 for the stiffness
+    product gathers and scatters every entry (linear, so differentiable and transposable). x: (n,) or (n, m); rows of width k (3 for the stiffness
     on the free dofs, 1 for the scalar mass on the nodes)."""
     tanks: tuple
     n: int = eqx.field(static=True)
@@ -319,8 +319,8 @@ class ElementTank(eqx.Module):
     applied element by element: gather each element's nodal values from shifted copies of the grid,
     one batched product with its layer's element matrix (every element of a layer has the same one),
     and the sum back onto the nodes as shifted copies again. The matrices held are a few per layer
-    (55 kB for the stiffness at 20 x 20 x 12, where a stencil holds 13 MB of coefficients) and the
-    products are small dense matrix products: 6-8 times faster than the stencil there. The top
+    (where a stencil holds coefficients for every node) and the products are small dense matrix
+    products, which stream far less memory than the stencil. The top
     faces' free-surface term and the surface bending act on the surface's vertical dofs."""
     Ke: jax.Array              # (nz, 8k, 8k) element matrix of each layer
     Kf: Optional[jax.Array]    # (4, 4) top-face matrix on the vertical dofs, or None

@@ -26,7 +26,8 @@ import jax.numpy as jnp
 
 from ..physics import structures as mb
 from ..physics.kinematics import rotation_matrix
-from ..physics.system import Config, System, advance_config
+from ..physics.system import System, advance_config
+from ..physics.terms import Config
 from .linear import Solver, empty_pre
 from .newton import solve_root, solve_root_carried
 
@@ -50,13 +51,9 @@ class StepInfo(NamedTuple):
 
 
 def _advance(system, c, delta):
-    if _has_flex(system):
+    if system.flex is not None:
         return mb.advance(system, c, delta)
     return advance_config(c, delta)
-
-
-def _has_flex(system) -> bool:
-    return getattr(system, "flex", None) is not None
 
 
 def _split(v):
@@ -67,11 +64,11 @@ def initial_state(system: System, solver: Solver, c0: Config, v0, alg0=None) -> 
     """Accelerations consistent with the initial configuration and velocities (with structures:
     their static equilibrium first, then the accelerations and multipliers from the constraints
     differentiated twice in time)."""
-    if _has_flex(system):
+    if system.flex is not None:
         return _flex_initial_state(system, solver, c0, v0, alg0)
     scale = system.scales()
 
-    memory = _memory(system)
+    memory = system.memory
     z0 = None if memory is None else memory.init()
     mu0 = None if memory is None else memory.force(z0)
 
@@ -87,8 +84,8 @@ def initial_state(system: System, solver: Solver, c0: Config, v0, alg0=None) -> 
 
 
 def total_energy(system: System, c: Config, v):
-    V0, om, dd = _split(v)
-    return system.kinetic_energy(c, V0, om, dd) + system.potential_energy(c)
+    T, V = system.energy(c, v)
+    return T + V
 
 
 def project_energy(system: System, c: Config, v, e0):
@@ -100,23 +97,16 @@ def project_energy(system: System, c: Config, v, e0):
     linear velocity constraint as they are. After a trapezoidal step s - 1 is of the order of the
     step's local energy error (dt^3), so the scheme stays second order. Where there is no kinetic
     energy to scale (T = 0) or the potential is above e0, the velocities are left as they are."""
-    V0, om, dd = _split(v)
-    T = system.kinetic_energy(c, V0, om, dd)
+    T = system.kinetic_energy(c, v)
     room = e0 - system.potential_energy(c)
     ok = (T > 0.0) & (room > 0.0)
     return v * jnp.sqrt(jnp.where(ok, room / jnp.where(ok, T, 1.0), 1.0))
 
 
-def _memory(system: System):
-    """The radiation memory of the system's hydrodynamics, or None (hydrodynamics.py)."""
-    sea = getattr(system, "sea", None)
-    return None if sea is None else sea.memory
-
-
 def memory_next(system: System, solver: Solver, s: State, v_new):
     """Radiation states at t_{n+1}: exact for a rigid velocity linear over the step, so they are a
     linear function of the step's unknown new velocity (None without radiation)."""
-    memory = _memory(system)
+    memory = system.memory
     if memory is None:
         return None
     return memory.advance(s.z, s.v[:6], v_new[:6], memory.coefficients(solver.h))
@@ -135,7 +125,7 @@ def step_equations(system: System, solver: Solver, s: State):
         acc_new = ((1.0 - am) * a_new + am * s.a - af * s.acc) / (1.0 - af)
         return _advance(system, s.c, delta), v_new, acc_new, a_new
 
-    memory = _memory(system)
+    memory = system.memory
     coef = None if memory is None else memory.coefficients(h)
 
     def R(delta):
@@ -191,7 +181,7 @@ def _flex_initial_state(system, solver: Solver, c0: Config, v0, alg0):
     c0, v0, alg0, info0 = static_structures(system, solver, c0, v0, alg0)
     gsc, alg_sc = mb.alg_scales(system, 1.0, lambda itf: 1.0)       # rows m_ref d2g/dt2: forces
     scale = L.to_x(mb.scales(system), alg_sc)
-    memory = _memory(system)
+    memory = system.memory
     z0 = None if memory is None else memory.init()
     Rm, Rc = mb.initial_residuals(system, c0, v0, alg0, jnp.zeros(()), gsc, None if memory is None else memory.force(z0))
     x, (it, err, ok) = solve_root(lambda x: Rm(x) + Rc(x), jnp.zeros(L.n), solver.Cinv_mass, scale, solver.tol,
@@ -215,7 +205,7 @@ def _flex_step(system, solver: Solver, s: State, fresh=None) -> tuple[State, Ste
     scale = L.to_x(mb.scales(system), alg_sc)
     _, unpack, pred = step_equations(system, solver, s)
 
-    memory = _memory(system)
+    memory = system.memory
     coef = None if memory is None else memory.coefficients(h)
 
     def Rm(x):
@@ -244,20 +234,23 @@ def _flex_step(system, solver: Solver, s: State, fresh=None) -> tuple[State, Ste
 def step(system: System, solver: Solver, s: State, fresh=None) -> tuple[State, StepInfo]:
     """One implicit step t_n -> t_{n+1}; the unknown is the increment Delta = (dX0, Theta, dd).
     `fresh`: batch mode with a carried preconditioner, whether this step forms it anew (see _newton)."""
-    if _has_flex(system):
+    if system.flex is not None:
         return _flex_step(system, solver, s, fresh)
-    scale = system.scales()            # residual rows / scale: accelerations (m/s^2, rad/s^2)
-    R, unpack, x0 = step_equations(system, solver, s)
-    floor = solver.noise * jnp.max(jnp.abs(s.c.d), initial=0.0)
+    with jax.named_scope("predictor"):
+        scale = system.scales()            # residual rows / scale: accelerations (m/s^2, rad/s^2)
+        R, unpack, x0 = step_equations(system, solver, s)
+        floor = solver.noise * jnp.max(jnp.abs(s.c.d), initial=0.0)
     pre = s.pre if solver.reuse else None
-    delta, (it, err, ok), pre_new = solve_root_carried(R, x0, solver.Cinv_step, scale, solver.tol, solver.max_iter,
-                                                       pre, floor, solver.adaptive, fresh=fresh,
-                                                       implicit=solver.implicit)
-    c, v, acc, a = unpack(delta)
-    ok = ok & jnp.all(jnp.isfinite(delta))
-    z = memory_next(system, solver, s, v)
-    if solver.project:
-        v = project_energy(system, c, v, s.e0)
+    with jax.named_scope("newton"):
+        delta, (it, err, ok), pre_new = solve_root_carried(R, x0, solver.Cinv_step, scale, solver.tol,
+                                                           solver.max_iter, pre, floor, solver.adaptive, fresh=fresh,
+                                                           implicit=solver.implicit)
+    with jax.named_scope("update"):
+        c, v, acc, a = unpack(delta)
+        ok = ok & jnp.all(jnp.isfinite(delta))
+        z = memory_next(system, solver, s, v)
+        if solver.project:
+            v = project_energy(system, c, v, s.e0)
     return (State(c, v, acc, a, s.t + solver.h, pre=pre_new if solver.reuse else s.pre, z=z, e0=s.e0),
             StepInfo(it, err, ok))
 

@@ -10,11 +10,10 @@ import jax
 import jax.numpy as jnp
 import numpy as np
 
-from ..physics.modal_liquid import ReducedLiquid
 from ..physics.structures import layout
 from ..physics.system import System
 from .schemes import Scheme
-from .sparse import is_sparse, sparse_solver_blocks
+from .sparse import sparse_solver_blocks
 
 
 class Solver(eqx.Module):
@@ -81,32 +80,17 @@ def make_solver(system: System, h: float, scheme: Scheme, tol: float, max_iter: 
         return Solver(z, z, jnp.asarray(h, dtype=float), scheme, tol, max_iter, substeps, z if substeps else None,
                       reuse=reuse, adaptive=adaptive)
     L = system.liquid
-    if is_sparse(L):         # large mesh (sparse.py): host-side sparse LU factors
+    if L.sparse:         # large mesh (sparse.py): fast diagonalization or host-side sparse LU factors
         c_a = lambda hh: (1.0 - scheme.alpha_m) / ((1.0 - scheme.alpha_f) * scheme.beta * hh ** 2)  # noqa: E731
         step_inv, mass_inv, sub_inv, K = sparse_solver_blocks(L, c_a(h), c_a(h / substeps) if substeps else None)
         scale = np.asarray(jax.lax.stop_gradient(system.scales()[6:]))
         noise = np.finfo(np.float64).eps * np.max(np.asarray(abs(K).sum(axis=1)).reshape(-1) / scale)
         return Solver(step_inv, mass_inv, jnp.asarray(h, dtype=float), scheme, tol, max_iter, substeps, sub_inv,
                       noise=noise, reuse=reuse, adaptive=adaptive)
-    if isinstance(L, ReducedLiquid):        # modal liquid (reduction.py): small dense blocks
-        M_ff, K_ff = jax.lax.stop_gradient(L.Mr), jax.lax.stop_gradient(L.Kr)
-        traced = isinstance(M_ff, jax.core.Tracer) or isinstance(K_ff, jax.core.Tracer)
-        if not traced:
-            M_ff, K_ff = np.asarray(M_ff), np.asarray(K_ff)
-    else:
-        Ms, K_ff = jax.lax.stop_gradient(L.Ms), jax.lax.stop_gradient(L.K)
-        free = np.asarray(L.free)
-        traced = isinstance(Ms, jax.core.Tracer) or isinstance(K_ff, jax.core.Tracer)
-        xp = jnp if traced else np
-        if not traced:
-            Ms, K_ff = np.asarray(Ms), np.asarray(K_ff)
-        M_ff = xp.kron(Ms, xp.eye(3))[np.ix_(free, free)]
-        if getattr(L, "dof_map", None) is not None:     # elastic tank walls: T^T kron(Ms, I3) T
-            dmap = np.asarray(L.dof_map)
-            T = np.zeros((dmap.size, free.size + 1))
-            T[np.arange(dmap.size), dmap] = 1.0
-            T = T[:, :-1]
-            M_ff = T.T @ np.kron(np.asarray(Ms), np.eye(3)) @ T
+    M_ff, K_ff = jax.lax.stop_gradient(L).constant_blocks()
+    traced = isinstance(M_ff, jax.core.Tracer) or isinstance(K_ff, jax.core.Tracer)
+    if not traced:
+        M_ff, K_ff = np.asarray(M_ff), np.asarray(K_ff)
 
     def inverse(A):
         return jnp.linalg.inv(A) if traced else jnp.asarray(np.linalg.inv(A))

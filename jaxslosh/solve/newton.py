@@ -82,6 +82,7 @@ def _newton(R, x0, Cinv, scale, tol, max_iter, pre=None, floor=0.0, adaptive=Tru
     def err_of(r):
         return jnp.max(jnp.abs(r / scale))
 
+    @jax.named_scope("preconditioner")
     def refresh(x):
         _, jvp = jax.linearize(R, x)
         if split is not None:

@@ -8,12 +8,13 @@ free unknowns, whose dense stiffness, mass and step-matrix inverses would take 2
   (differentiable, transposable and batchable: the Newton preconditioner and the implicit
   gradients linearise and transpose the residual) and as SciPy CSR for the factors;
 * the constant liquid block C = c_a M + K is inverted by fast diagonalization where every tank is
-  a box grid it fits (boxsolve.py: pure JAX, under a millisecond at 20 x 20 x 12);
+  a box grid it fits (boxsolve.py: pure JAX, small dense transforms instead of a factor's millions
+  of entries);
 * the products of `HostSparse` go element by element where every tank's layers are uniform (one
   element matrix per layer, boxsolve.Elements), else as grid stencils (boxsolve.Stencil), else
   as BCOO gathers and scatters;
 * otherwise `HostInverse` applies a sparse LU factor (SuperLU, symmetric mode, minimum-degree
-  ordering on A + A^T; 20-25 ms a solve at 20 x 20 x 12): the Newton iterations only need an
+  ordering on A + A^T): the Newton iterations only need an
   approximate inverse (lax.custom_root), so a host-side factor is a legitimate preconditioner, and
   the tangent solves of the gradients reach full precision by Richardson sweeps around it.
 
@@ -37,8 +38,8 @@ from scipy.sparse.linalg import splu
 from .boxsolve import box_inverse, elements, solve, stencil
 
 #: `linear_solver = "auto"` goes sparse above this many liquid unknowns (free dofs of all tanks):
-#: at 10 x 10 x 6 (2,112 unknowns) a sparse LU solve takes 0.5 ms against 3 ms for the dense
-#: inverse's product, and the dense inverses need 36 MB each
+#: above it the dense inverses' products cost more than the sparse path and their memory grows as
+#: the square (README "Speed" has the measurements)
 SPARSE_AUTO = 1500
 
 _REGISTRY: dict = {}
@@ -151,10 +152,6 @@ def host_inverse(A) -> HostInverse:
         return splu(M.tocsc(), permc_spec="MMD_AT_PLUS_A", diag_pivot_thresh=0.0,
                     options=dict(SymmetricMode=True))
     return HostInverse(_handle("lu", sp.csr_matrix(A), factor))
-
-
-def is_sparse(liquid) -> bool:
-    return liquid is not None and isinstance(getattr(liquid, "K", None), HostSparse)
 
 
 def free_blocks(liquid):

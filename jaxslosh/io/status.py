@@ -1,0 +1,54 @@
+"""How a run ended, as a code (like diffrax's RESULTS) with its text.
+
+The compiled loop carries the code of its first failure; the host turns it into the sentence that
+the result file's `status` attribute holds (SPEC section 3: "ok" or a reason) and keeps the code
+beside it (`status_code`). Codes are stable: files written by one version are read by the next.
+"""
+from __future__ import annotations
+
+import enum
+import math
+
+
+class Status(enum.IntEnum):
+    OK = 0
+    NEWTON = 1           # a step's Newton iterations did not converge
+    NONFINITE = 2        # NaN or Inf in a step's solution
+    INITIAL = 3          # the initial accelerations could not be solved
+    INTERRUPTED = 4      # stopped by SIGINT or SIGTERM
+    DISK_FULL = 5        # the result file could not be written further
+    ERROR = 6            # another exception stopped the run
+    RUNNING = 7          # the file is still being written (or its writer died without a word)
+
+    @property
+    def numerical(self) -> bool:
+        return self in (Status.NEWTON, Status.NONFINITE, Status.INITIAL)
+
+
+#: the short text of each code, for messages raised inside jax.jit (where no number can be formatted)
+TEXT = {Status.OK: "ok", Status.NEWTON: "Newton did not converge", Status.NONFINITE: "non-finite values (NaN or Inf)",
+        Status.INITIAL: "the initial accelerations could not be solved", Status.INTERRUPTED: "interrupted",
+        Status.DISK_FULL: "disk full", Status.ERROR: "error", Status.RUNNING: "running"}
+
+
+def failure_text(code: int, step: int, h: float, err: float, iterations: int, tol: float) -> str:
+    """The sentence of a numerical failure, naming the step and the time."""
+    code = Status(int(code))
+    if code == Status.INITIAL or step == 0:
+        return f"the initial accelerations could not be solved (scaled residual {err:.3g})"
+    t = step * h
+    if code == Status.NONFINITE or not math.isfinite(err):
+        return f"step {step} (t = {t:.6g} s): non-finite values (NaN or Inf) in the solution"
+    return (f"step {step} (t = {t:.6g} s): Newton did not converge in {iterations} iterations "
+            f"(scaled residual {err:.3g}, tolerance {tol:.3g})")
+
+
+def code_of(status: str) -> Status:
+    """The code of a status text (files written before codes were kept)."""
+    if status == "ok":
+        return Status.OK
+    for code in (Status.NONFINITE, Status.INITIAL, Status.NEWTON, Status.INTERRUPTED, Status.DISK_FULL,
+                 Status.RUNNING):
+        if TEXT[code] in status:
+            return code
+    return Status.ERROR

@@ -1,0 +1,174 @@
+"""The vessel's own terms: the hull's rigid-body inertia, the weight of a vessel that nothing holds
+up, buoyancy (eqs. 33-38), and a prescribed motion of the hull instead of a free one."""
+from __future__ import annotations
+
+import abc
+from typing import Optional
+
+import equinox as eqx
+import jax
+import jax.numpy as jnp
+import numpy as np
+
+from .kinematics import mv3, rotation_matrix, tv3
+from .terms import AbstractTerm, Kin, Rows
+
+# eq. (36): q^T A_phi q = 2 (q0 q1 + q2 q3) = sin(roll) cos(pitch), q^T A_theta q = 2 (q0 q2 - q1 q3)
+A_PHI = np.array([[0, 1, 0, 0], [1, 0, 0, 0], [0, 0, 0, 1], [0, 0, 1, 0]], dtype=float)
+A_THETA = np.array([[0, 0, 1, 0], [0, 0, 0, -1], [1, 0, 0, 0], [0, -1, 0, 0]], dtype=float)
+
+
+class RigidBody(AbstractTerm):
+    """The hull's inertia in the floating frame at the ship's COG (eqs. 14-16). The scene's mass and
+    inertia are the whole ship's but the liquid; flexible structures and elastic walls carry their
+    own mass in the model, so the hull is the ship less them, and its COG lies off the frame origin
+    by S / mass (S: its first moment, zero without such parts; eq. 14 with r_G)."""
+    mass: jax.Array
+    inertia: jax.Array                  # (3, 3) about the frame origin, body axes
+    S: Optional[jax.Array] = None       # (3,) first moment about the frame origin, kg m (None: zero)
+
+    def rows(self, k: Kin) -> Rows:
+        a0, alpha = k.acc[:3], k.acc[3:6]
+        w = k.omega
+        r_t = self.mass * a0
+        r_r = mv3(self.inertia, alpha) + jnp.cross(w, mv3(self.inertia, w))
+        if self.S is not None:
+            S = self.S
+            r_t = r_t + mv3(k.A, jnp.cross(alpha, S) + jnp.cross(w, jnp.cross(w, S)))
+            r_r = r_r + jnp.cross(S, tv3(k.A, a0))
+        return Rows(jnp.concatenate([r_t, r_r]))
+
+    def kinetic(self, k: Kin):
+        V0, w = k.V0, k.omega
+        T = 0.5 * self.mass * V0 @ V0 + 0.5 * w @ self.inertia @ w
+        return T if self.S is None else T + V0 @ (k.A @ jnp.cross(w, self.S))
+
+    def mass_scale(self):
+        return jnp.concatenate([jnp.full(3, self.mass), jnp.diag(self.inertia)])
+
+
+class Weight(AbstractTerm):
+    """Gravity on the whole vessel, liquid included, when no hydrostatics hold it up: mass M, first
+    moment S of its rigid parts about the frame origin (the deformed liquid's share is the liquid
+    term's). With hydrostatics the weight is balanced by the displaced water and this term is absent."""
+    mass: jax.Array
+    S: jax.Array
+    gravity: jax.Array
+
+    def rows(self, k: Kin) -> Rows:
+        g_vec = jnp.array([0.0, 0.0, -self.gravity])
+        return Rows(jnp.concatenate([-self.mass * g_vec, -jnp.cross(self.S, k.g_b)]))
+
+    def potential(self, k: Kin):
+        return self.mass * self.gravity * k.c.X0[2] - k.g_b @ self.S
+
+
+class Hydrostatics(AbstractTerm):
+    """Linear hydrostatic restoring about the initial equilibrium (eqs. 33-36). The moment is the
+    gradient of the restoring potential (`moment_form = "conservative"`, taken by JAX) or eq. (36)
+    literally ("paper"), which is not conservative when GM_T != GM_L."""
+    rho_w: jax.Array
+    gravity: jax.Array
+    waterplane_area: jax.Array
+    displaced_volume: jax.Array
+    gm_t: jax.Array
+    gm_l: jax.Array
+    moment_form: str = eqx.field(static=True, default="conservative")
+
+    def force(self, X0):
+        """Eq. (35) in the inertial frame: F_z = -rho g A_w (Z0 - Z0^0), equilibrium at Z0^0 = 0."""
+        return jnp.array([0.0, 0.0, -self.rho_w * self.gravity * self.waterplane_area * X0[2]])
+
+    def moment_paper(self, q):
+        """Eq. (36), body frame."""
+        k = self.rho_w * self.gravity * self.displaced_volume
+        return -k * jnp.array([self.gm_t * (q @ A_PHI @ q), self.gm_l * (q @ A_THETA @ q), 0.0])
+
+    def restoring_potential(self, X0, q):
+        """Restoring energy. The moment part, k_T g_y^2 + k_L g_x^2 over (1 + g_z) with g = A^T e_z,
+        is 1/2 (k_T roll^2 + k_L pitch^2) to second order, exact for pure roll and pure pitch, and
+        its gradient is eq. (36) exactly when GM_T = GM_L (eq. (36) is not conservative otherwise)."""
+        k = self.rho_w * self.gravity * self.displaced_volume
+        g = rotation_matrix(q)[2]
+        heave = 0.5 * self.rho_w * self.gravity * self.waterplane_area * X0[2] ** 2
+        return heave + k * (self.gm_t * g[1] ** 2 + self.gm_l * g[0] ** 2) / (1.0 + g[2])
+
+    def moment(self, q):
+        """The restoring moment (body frame) of the chosen form. The conservative one is minus the
+        derivative of the potential along body-frame rotations, written out (a JAX gradient inside
+        the residual would be linearised and transposed again in every Newton preconditioner):
+        with g = A^T e_z, a body rotation d theta changes g by g x d theta, so M = g x dV/dg.
+        tests/test_vessel.py checks it against the gradient of `restoring_potential`."""
+        if self.moment_form == "paper":
+            return self.moment_paper(q)
+        k = self.rho_w * self.gravity * self.displaced_volume
+        g = rotation_matrix(q)[2]
+        D = 1.0 + g[2]
+        N = self.gm_t * g[1] ** 2 + self.gm_l * g[0] ** 2
+        dV_dg = k * jnp.array([2.0 * self.gm_l * g[0] / D, 2.0 * self.gm_t * g[1] / D, -N / D ** 2])
+        return jnp.cross(g, dV_dg)
+
+    def rows(self, k: Kin) -> Rows:
+        return Rows(jnp.concatenate([-self.force(k.c.X0), -self.moment(k.c.q)]))
+
+    def potential(self, k: Kin):
+        return self.restoring_potential(k.c.X0, k.c.q)
+
+
+class AbstractMotion(eqx.Module):
+    """How the hull moves: free (its rigid rows are the equations of motion) or prescribed."""
+
+    @property
+    @abc.abstractmethod
+    def prescribed(self) -> bool:
+        """Whether the rigid rows prescribe the motion instead of being equations of motion."""
+
+    @abc.abstractmethod
+    def rigid_rows(self, rows, acc, t, scale):
+        """The rigid rows of the residual, from the terms' sum `rows` (`scale()`: the rigid rows' masses)."""
+
+
+class FreeMotion(AbstractMotion):
+    prescribed = False
+
+    def rigid_rows(self, rows, acc, t, scale):
+        return rows
+
+
+class PrescribedMotion(AbstractMotion):
+    """Prescribed motion of one rigid dof (the others held at zero): the rigid rows prescribe the
+    accelerations, scaled by the rigid masses like the free rows. "harmonic": amplitude
+    sin(frequency t) faded in over `ramp`; "spin-up": a rate growing smoothly to `rate` over `duration`."""
+    dof: int = eqx.field(static=True)      # 0-2 surge, sway, heave; 3-5 roll, pitch, yaw
+    amplitude: jax.Array
+    frequency: jax.Array
+    ramp: float = eqx.field(static=True, default=0.0)
+    profile: str = eqx.field(static=True, default="harmonic")
+    rate: float = eqx.field(static=True, default=0.0)      # spin-up: final rate, rad/s
+    duration: float = eqx.field(static=True, default=1.0)  # spin-up: its time, s
+    prescribed = True
+
+    def value(self, t):
+        if self.profile == "spin-up":
+            T, W = self.duration, self.rate
+            c = T / (2.0 * jnp.pi)
+            up = W / T * (0.5 * t * t + c * c * (jnp.cos(t / c) - 1.0))
+            return jnp.where(t < T, up, W * (0.5 * T) + W * (t - T))
+        x = self.amplitude * jnp.sin(self.frequency * t)
+        if self.ramp > 0:
+            x = x * jnp.where(t < self.ramp, 0.5 * (1.0 - jnp.cos(jnp.pi * t / self.ramp)), 1.0)
+        return x
+
+    def rates(self, t):
+        """Prescribed (dX0/dt, omega) at time t."""
+        v = jax.jvp(self.value, (t,), (jnp.ones_like(t),))[1]
+        return jnp.zeros(6).at[self.dof].set(v)
+
+    def accelerations(self, t):
+        a = jax.jvp(lambda tt: jax.jvp(self.value, (tt,), (jnp.ones_like(tt),))[1], (t,), (jnp.ones_like(t),))[1]
+        return jnp.zeros(6).at[self.dof].set(a)
+
+    def rigid_rows(self, rows, acc, t, scale):
+        """The prescribed accelerations (a single-axis rotation has omega_dot = theta_ddot e);
+        positions and velocities follow by the scheme from the prescribed initial rates."""
+        return scale() * (acc[:6] - self.accelerations(t))

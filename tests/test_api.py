@@ -1,0 +1,81 @@
+"""The Python API around simulate: stepping by hand, run status as codes, raising inside jax.jit,
+and no recompilation of a scene already compiled (single runs and batches)."""
+import equinox as eqx
+import h5py
+import jax
+import jax.numpy as jnp
+import numpy as np
+import pytest
+
+import jaxslosh as js
+from jaxslosh.run import loop
+
+from helpers import vessel_scene
+
+
+def _failing(duration=0.2):
+    """A scene whose first step cannot converge: one Newton iteration allowed, a tolerance below round-off."""
+    text = vessel_scene(duration=duration, omega=(0.05, 0.02, 0.0)).text
+    return js.load_scene(text.replace("[simulation]", "[simulation]\nmax_iterations = 1\ntolerance = 1e-16"))
+
+
+def test_stepping_by_hand_gives_the_states_of_simulate():
+    scene = vessel_scene(duration=0.3, omega=(0.05, 0.02, 0.0))
+    ref = js.simulate(scene)
+    stepper = js.Stepper(scene)
+    state = stepper.init()
+    for k in range(1, 31):
+        state = stepper.step(state)
+        if k % 10 == 0:
+            np.testing.assert_allclose(np.asarray(stepper.roll_pitch_yaw(state)),
+                                       np.asarray(ref.vessel.roll_pitch_yaw[k]), rtol=0, atol=1e-13)
+    assert stepper.status(state) == "ok" and int(state.code) == js.Status.OK
+    frame = stepper.observe(state)
+    assert abs(float(frame.t) - 0.3) < 1e-12
+    np.testing.assert_allclose(np.asarray(frame.X0), np.asarray(ref.vessel.position[-1]), atol=1e-13)
+
+
+def test_a_failure_is_a_code_with_its_text_in_the_result_and_the_file(tmp_path):
+    scene = _failing()
+    r = js.simulate(scene)
+    assert r.status_code == js.Status.NEWTON and r.status != "ok"
+    assert "step 1" in r.status and "Newton did not converge" in r.status
+    stepper = js.Stepper(scene)
+    state = stepper.step(stepper.init())
+    assert int(state.code) == js.Status.NEWTON and stepper.status(state) == r.status
+    with pytest.raises(js.NumericalFailure, match="Newton did not converge"):
+        js.simulate(scene, throw=True)
+    path = str(tmp_path / "r.h5")
+    js.save_result(r, path)
+    with h5py.File(path, "r") as f:
+        assert f.attrs["status"] == r.status and int(f.attrs["status_code"]) == js.Status.NEWTON
+    back = js.load_result(path)
+    assert back.status == r.status and back.status_code == js.Status.NEWTON
+
+
+def test_throw_raises_inside_jax_jit_and_a_good_run_passes():
+    scene = _failing()
+    run = jax.jit(lambda gm: js.simulate(scene, params={"vessel.hydrostatics.gm_t": gm}, throw=True).time[-1])
+    with pytest.raises(Exception, match="Newton did not converge"):
+        jax.block_until_ready(run(1.5))
+    good = vessel_scene(duration=0.1, omega=(0.05, 0.02, 0.0))
+    ok = jax.jit(lambda gm: js.simulate(good, params={"vessel.hydrostatics.gm_t": gm}, throw=True).time[-1])
+    assert abs(float(ok(1.5)) - 0.1) < 1e-12
+
+
+def test_a_scene_compiles_once_for_runs_and_batches():
+    scene = vessel_scene(duration=0.1, omega=(0.03, 0.01, 0.0))
+    js.simulate(scene)
+    n_init, n_loop = eqx.debug.get_num_traces(loop.traced_init), eqx.debug.get_num_traces(loop.traced_advance)
+    for gm in (1.2, 1.7):        # other values of a traced parameter: the same program
+        js.simulate(js.load_scene(scene.text.replace("gm_t = 1.5", f"gm_t = {gm}")))
+    js.simulate(scene)
+    assert eqx.debug.get_num_traces(loop.traced_init) == n_init
+    assert eqx.debug.get_num_traces(loop.traced_advance) == n_loop
+    gm = np.array([1.2, 1.5, 1.8, 2.1])
+    js.simulate_batch(scene, {"vessel.hydrostatics.gm_t": gm})
+    n_batch = eqx.debug.get_num_traces(loop.traced_advance)
+    r, _ = js.simulate_batch(scene, {"vessel.hydrostatics.gm_t": gm + 0.1})
+    assert eqx.debug.get_num_traces(loop.traced_advance) == n_batch
+    assert np.asarray(r.time).shape == (4, 11)
+    assert jnp.all(jnp.isfinite(r.vessel.roll_pitch_yaw))
