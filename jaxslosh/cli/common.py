@@ -9,11 +9,14 @@ import sys
 
 import jax
 
+from ..io.output import OutputError, check_output
 from ..scene.keys import with_overrides
 from ..scene.load import load_scene
 from ..scene.types import Scene, SceneError
 
-EXIT_OK, EXIT_INPUT, EXIT_NUMERICAL = 0, 2, 3
+#: exit statuses: done, bad input (one line), numerical failure (SPEC section 2); interrupted by a
+#: signal (128 + SIGINT, the shell's convention); the output could not be written (a full disk)
+EXIT_OK, EXIT_INPUT, EXIT_NUMERICAL, EXIT_INTERRUPTED, EXIT_IO = 0, 2, 3, 130, 1
 
 
 class InputError(Exception):
@@ -50,10 +53,23 @@ def output_folder(flag, path):
             raise InputError(f"{flag}: the folder {d} does not exist")
 
 
+def writable_output(flag, path, inputs=()) -> bool:
+    """Check an output file before any computing (io.output.check_output); True when an existing
+    jaxslosh file will be replaced."""
+    try:
+        return check_output(path, inputs) is not None
+    except OutputError as e:
+        raise InputError(f"{flag}: {e.strerror}") from None
+
+
 def overridden(scene: Scene, a) -> Scene:
     """The scene with the command line's --duration and --dt folded in (once, here)."""
     try:
-        return with_overrides(scene, duration=getattr(a, "duration", None), dt=getattr(a, "dt", None))
+        new = with_overrides(scene, duration=getattr(a, "duration", None), dt=getattr(a, "dt", None))
     except SceneError as e:
         flag = "--dt" if e.key == "simulation.dt" else "--duration"
         raise InputError(f"{flag}: {str(e).split(': ', 1)[1]}") from None
+    for w in new.warnings:
+        if w not in scene.warnings:
+            print(f"warning: {w}", file=sys.stderr)
+    return new

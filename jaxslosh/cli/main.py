@@ -2,11 +2,12 @@
 exceptions become messages and exit codes (0 done, 2 bad input, 3 numerical failure)."""
 from __future__ import annotations
 
+import os
 import sys
 
 from ..scene.types import SceneError
 from . import hydro, identify, modes, plot, simulate, sweep
-from .common import EXIT_INPUT, InputError, Parser
+from .common import EXIT_INPUT, EXIT_INTERRUPTED, InputError, Parser
 
 COMMANDS = {"run": simulate.cmd_run, "check": simulate.cmd_check, "plot": plot.cmd_plot, "modes": modes.cmd_modes,
             "identify": identify.cmd_identify, "sweep": sweep.cmd_sweep, "hydro": hydro.cmd_hydro}
@@ -21,6 +22,8 @@ def parser() -> Parser:
 
 
 def main(argv=None) -> int:
+    """Run a command; `argv` None: the program's own arguments (then an interruption ends the
+    process at once, past the interpreter's teardown, which XLA's threads could still be in)."""
     try:
         a = parser().parse_args(argv)
         return COMMANDS[a.command](a)
@@ -29,7 +32,11 @@ def main(argv=None) -> int:
         return EXIT_INPUT
     except KeyboardInterrupt:
         print("interrupted", file=sys.stderr)
-        return 130
+        if argv is None:
+            sys.stdout.flush()
+            sys.stderr.flush()
+            os._exit(EXIT_INTERRUPTED)
+        return EXIT_INTERRUPTED
 
 
 if __name__ == "__main__":

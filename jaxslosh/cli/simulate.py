@@ -6,9 +6,13 @@ import os
 import sys
 import time
 
+from ..build.cost import check_cost, describe_cost, estimate
 from ..build.effects import describe, effects_summary
+from ..io.output import OutputError
+from ..io.status import Status
 from ..run.tofile import run_to_file
-from .common import EXIT_NUMERICAL, EXIT_OK, enable_x64, load, output_folder, overridden, positive
+from .common import (EXIT_INTERRUPTED, EXIT_IO, EXIT_NUMERICAL, EXIT_OK, InputError, enable_x64, load, overridden,
+                     positive, writable_output)
 
 
 def add_parsers(sub):
@@ -19,8 +23,10 @@ def add_parsers(sub):
     r.add_argument("--dt", type=float, help="override simulation.dt (s)")
     r.add_argument("--no-progress", action="store_true", help="no progress bar")
     r.add_argument("--no-fields", action="store_true", help="do not store the liquid displacement fields")
-    c = sub.add_parser("check", help="validate a scene; list what it will simulate")
+    r.add_argument("--force", action="store_true", help="run even when the scene's cost estimate exceeds this machine")
+    c = sub.add_parser("check", help="validate a scene; list what it will simulate and what it will cost")
     c.add_argument("scene")
+    c.add_argument("--force", action="store_true", help="exit 0 even when the cost estimate exceeds this machine")
 
 
 def cmd_run(a):
@@ -29,22 +35,38 @@ def cmd_run(a):
     scene = overridden(load(a.scene), a)
     dt = scene.simulation.dt
     out = a.output or os.path.splitext(os.path.basename(a.scene))[0] + ".h5"
-    output_folder("-o", out)
+    replacing = writable_output("-o", out, inputs=(a.scene,))
+    check_cost(scene, force=a.force)
     enable_x64()
+    if replacing:
+        print(f"note: replacing the existing result file {out}", file=sys.stderr)
     t0 = time.perf_counter()
-    status, steps, wall = run_to_file(scene, out, progress=not a.no_progress,
-                                      save_fields=False if a.no_fields else None)
+    try:
+        rep = run_to_file(scene, out, progress=not a.no_progress, save_fields=False if a.no_fields else None)
+    except OutputError as e:
+        raise InputError(f"-o: {e.strerror}") from None
     total = time.perf_counter() - t0
-    if status != "ok":
-        print(f"jaxslosh: numerical failure at {status}; {steps} steps kept in {out}", file=sys.stderr)
+    for w in rep.warnings:
+        print(f"warning: {w}", file=sys.stderr)
+    code = Status(rep.code)
+    if code == Status.OK:
+        print(f"done: {rep.steps} steps to t = {rep.steps * dt:.6g} s in {total:.2f} s wall, compilation included "
+              f"({rep.wall:.2f} s after the first chunk) -> {out}")
+        return EXIT_OK
+    if code.numerical:
+        print(f"jaxslosh: numerical failure at {rep.status}; {rep.steps} steps kept in {out}", file=sys.stderr)
         return EXIT_NUMERICAL
-    print(f"done: {steps} steps to t = {steps * dt:.6g} s in {total:.2f} s wall, compilation included "
-          f"({wall:.2f} s after the first chunk) -> {out}")
-    return EXIT_OK
+    if code == Status.INTERRUPTED:
+        print(f"jaxslosh: {rep.status}; {rep.steps} steps kept in {out}", file=sys.stderr)
+        return EXIT_INTERRUPTED
+    print(f"error: {out}: {rep.status}; {rep.steps} steps kept", file=sys.stderr)
+    return EXIT_IO
 
 
 def cmd_check(a):
     scene = load(a.scene)
     print(describe(scene))
     print(effects_summary(scene))
+    print(describe_cost(estimate(scene)))
+    check_cost(scene, force=a.force)
     return EXIT_OK

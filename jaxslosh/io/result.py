@@ -15,6 +15,7 @@ import jax
 import numpy as np
 
 from .._version import __version__
+from .output import OutputLock, ensure_room
 from .status import Status, code_of
 
 FORMAT = "jaxslosh.result"
@@ -112,11 +113,17 @@ def result_from(d: dict, probe_names=(), tanks: Optional[dict] = None, *, status
 
 
 class ResultWriter:
-    """Appends frames to an HDF5 result file as a run goes on."""
+    """Appends frames to an HDF5 result file as a run goes on. It holds the output's lock from
+    before the file is truncated until it is closed (a second writer gets io.output.OutputError)."""
 
     def __init__(self, path: str, scene_text: str, probe_names, tanks=()):
         self.path = path
-        self.f = h5py.File(path, "w")
+        self.lock = OutputLock(path)
+        try:
+            self.f = h5py.File(path, "w")
+        except BaseException:
+            self.lock.release()
+            raise
         a = self.f.attrs
         a["format"] = FORMAT
         a["format_version"] = FORMAT_VERSION
@@ -139,6 +146,7 @@ class ResultWriter:
         k = len(frames["time"])
         if k == 0:
             return
+        ensure_room(self.path, sum(np.asarray(v).nbytes for v in frames.values()))
         for key, val in frames.items():
             ds = self.f[key]
             ds.resize(self.n + k, axis=0)
@@ -147,11 +155,20 @@ class ResultWriter:
         self.f.attrs["steps_done"] = int(steps_done)
         self.f.flush()
 
-    def close(self, status: str, steps_done: int, code: Optional[int] = None):
-        self.f.attrs["status"] = status
-        self.f.attrs["status_code"] = int(code_of(status) if code is None else code)
-        self.f.attrs["steps_done"] = int(steps_done)
-        self.f.close()
+    def close(self, status: str, steps_done: int, code: Optional[int] = None, warnings=()):
+        """Say how the run ended. On a full disk the attributes may not fit either: the file then
+        keeps its last flushed state ("running" and the steps of the last chunk written)."""
+        try:
+            self.f.attrs["status"] = status
+            self.f.attrs["status_code"] = int(code_of(status) if code is None else code)
+            self.f.attrs["steps_done"] = int(steps_done)
+            if warnings:
+                self.f.attrs["warnings"] = np.array(list(warnings), dtype=h5py.string_dtype())
+        finally:
+            try:
+                self.f.close()
+            finally:
+                self.lock.release()
 
 
 class _Mesh:

@@ -51,6 +51,10 @@ class AbstractLiquid(AbstractTerm):
     def probe_displacements(self, weights, modal, d):
         """(P, 3) displacement of the probes (interpolation `weights` (P, N), or `modal` (P, m, 3))."""
 
+    def surface_heave(self, d, nodes):
+        """The vertical displacement (k,) of the nodes `nodes` (the free surface of a tank)."""
+        return self.nodal_fields(self.frame_field(d))[nodes, 2]
+
     def probe_modal(self, weights):
         """The probes' weights on the modal coordinates (P, m, 3), for a liquid whose d is modal."""
         return None

@@ -127,6 +127,9 @@ class ReducedLiquid(AbstractLiquid):
     def constant_blocks(self):
         return self.Mr, self.Kr
 
+    def surface_heave(self, d, nodes):
+        return self.U[:, nodes, 2].T @ d
+
     def probe_modal(self, weights):
         return jnp.einsum("pn,knc->pkc", weights, self.U)
 

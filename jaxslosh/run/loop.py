@@ -47,6 +47,7 @@ class Frame(NamedTuple):
     D: jax.Array          # liquid nodal displacement (N, 3), empty without liquid; a reduced liquid's eta (m,)
     failed: jax.Array
     gmax: jax.Array       # max |g| of the interface constraints (m), 0 without structures
+    surface: jax.Array    # (tanks, 2): lowest and highest vertical displacement of each free surface (m)
 
 
 def _frame(b: Built, s: State, it, err, failed) -> Frame:
@@ -65,7 +66,10 @@ def _frame(b: Built, s: State, it, err, failed) -> Frame:
             body = flex.bodies[sp.index]
             x = sp.r + sp.W @ body.u(etas[sp.index])
             probes = probes.at[sp.rows].set(s.c.Xs[sp.index][None, :] + x @ rotation_matrix(s.c.qs[sp.index]).T)
-    return Frame(s.t, s.c.X0, s.c.q, s.v[3:6], probes, ke, pe, it, err, sysm.liquid.frame_field(s.c.d), failed, gmax)
+    heave = [sysm.liquid.surface_heave(s.c.d, idx) for idx in b.surfaces]
+    surface = jnp.array([[h.min(), h.max()] for h in heave]).reshape(len(heave), 2)
+    return Frame(s.t, s.c.X0, s.c.q, s.v[3:6], probes, ke, pe, it, err, sysm.liquid.frame_field(s.c.d), failed, gmax,
+                 surface)
 
 
 def core(b: Built) -> Built:

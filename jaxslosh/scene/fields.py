@@ -200,22 +200,13 @@ def _is_number(x) -> bool:
     return isinstance(x, (int, float)) and not isinstance(x, bool)
 
 
+#: the TOML name of a value's type (bool before int: a bool is an int in Python)
+_TOML_TYPES = ((bool, "boolean"), (int, "integer"), (float, "float"), (str, "string"), (list, "array"),
+               (dict, "table"), ((datetime.date, datetime.time), "date/time"))
+
+
 def _toml_type(x) -> str:
-    if isinstance(x, bool):
-        return "boolean"
-    if isinstance(x, int):
-        return "integer"
-    if isinstance(x, float):
-        return "float"
-    if isinstance(x, str):
-        return "string"
-    if isinstance(x, list):
-        return "array"
-    if isinstance(x, dict):
-        return "table"
-    if isinstance(x, (datetime.date, datetime.time)):
-        return "date/time"
-    return type(x).__name__
+    return next((name for kind, name in _TOML_TYPES if isinstance(x, kind)), type(x).__name__)
 
 
 def show(x) -> str:

@@ -15,6 +15,7 @@ from typing import Any, Iterable, Optional
 import numpy as np
 
 from .fields import show
+from .load import step_warnings
 from .types import Material, Scene, SceneError
 
 
@@ -178,4 +179,5 @@ def with_overrides(scene: Scene, *, duration: Optional[float] = None, dt: Option
                               dt=float(dt if dt is not None else sim.dt))
     if sim.dt > sim.duration:
         raise SceneError("simulation.dt", f"{show(sim.dt)} s is longer than the duration {show(sim.duration)} s")
-    return dataclasses.replace(scene, simulation=sim)
+    warnings = [w for w in scene.warnings if not w.startswith(("simulation.duration", "simulation.save_every"))]
+    return dataclasses.replace(scene, simulation=sim, warnings=tuple(warnings + step_warnings(sim)))

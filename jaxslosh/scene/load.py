@@ -81,15 +81,9 @@ def _toml_hint(text: str, message: str) -> str:
 def parse_scene(mapping: Mapping[str, Any], text: str = "", path: str = "") -> Scene:
     """Validate a parsed TOML mapping and build the `Scene` (`text`, `path` are stored in it)."""
     top = read(mapping, "", {
-        "title": ("str", None),
-        "environment": ("table", None),
-        "simulation": ("table", None),
-        "vessel": ("table", None),
-        "tanks": ("tables", None),
-        "structures": ("tables", None),
-        "probes": ("tables", None),
-        "effects": ("table", None),
-        "waves": ("table", None),
+        "title": ("str", None), "environment": ("table", None), "simulation": ("table", None),
+        "vessel": ("table", None), "tanks": ("tables", None), "structures": ("tables", None),
+        "probes": ("tables", None), "effects": ("table", None), "waves": ("table", None),
     }, required=("simulation", "vessel"))
     warnings: list[str] = []
     title = top.get("title", Path(path).stem if path else "")
@@ -100,6 +94,7 @@ def parse_scene(mapping: Mapping[str, Any], text: str = "", path: str = "") -> S
     structures = tuple(_structure(s, f"structures[{i}]") for i, s in enumerate(mapping.get("structures", [])))
     probes = tuple(_probe(p, f"probes[{i}]") for i, p in enumerate(mapping.get("probes", [])))
     _unique_names(tanks, "tanks", "tank")
+    _overlapping_tanks(tanks, warnings)
     _unique_names(structures, "structures", "structure")
     _attachments(structures)
     _unique_names(probes, "probes", "probe")
@@ -146,25 +141,17 @@ def _conservative(scene: Scene) -> None:
 # Tables
 def _environment(table) -> Environment:
     v = read(table, "environment", {
-        "gravity": ("float", non_negative),
-        "water_density": ("float", positive),
+        "gravity": ("float", non_negative), "water_density": ("float", positive),
     })
     return Environment(**v)
 
 
 def _simulation(table, warnings: list[str]) -> Simulation:
     v = read(table, "simulation", {
-        "duration": ("float", positive),
-        "dt": ("float", positive),
-        "scheme": ("str", one_of(SCHEMES)),
-        "alpha": ("float", None),
-        "rho_inf": ("float", None),
-        "save_every": ("int", at_least(1)),
-        "tolerance": ("float", positive),
-        "max_iterations": ("int", at_least(1)),
-        "chunk": ("int", non_negative),
-        "substeps": ("int", non_negative),
-        "linear_solver": ("str", one_of(LINEAR_SOLVERS)),
+        "duration": ("float", positive), "dt": ("float", positive), "scheme": ("str", one_of(SCHEMES)),
+        "alpha": ("float", None), "rho_inf": ("float", None), "save_every": ("int", at_least(1)),
+        "tolerance": ("float", positive), "max_iterations": ("int", at_least(1)), "chunk": ("int", non_negative),
+        "substeps": ("int", non_negative), "linear_solver": ("str", one_of(LINEAR_SOLVERS)),
         "energy_projection": ("bool", None),
     }, required=("duration", "dt"))
     sim = Simulation(**v)
@@ -189,21 +176,45 @@ def _simulation(table, warnings: list[str]) -> Simulation:
     if sim.alpha != 0.0 and sim.scheme == "generalized-alpha":
         warnings.append(f'simulation.alpha = {show(sim.alpha)} is ignored with scheme = "generalized-alpha" '
                         f"(its damping is set by rho_inf)")
+    warnings += step_warnings(sim)
+    return sim
+
+
+def step_warnings(sim: Simulation) -> list[str]:
+    """The steps and saved frames a duration, step and save_every give: SceneError when nothing
+    would be saved; warnings for a duration that is not a whole number of steps or of saved frames."""
+    out = []
     steps = sim.duration / sim.dt
     if abs(steps - round(steps)) > 1e-6 * max(1.0, steps):
-        warnings.append(f"simulation.duration = {show(sim.duration)} s is not a whole number of steps of "
-                        f"{show(sim.dt)} s; the run takes {sim.n_steps} steps, to t = {sim.n_steps * sim.dt:.6g} s")
-    return sim
+        out.append(f"simulation.duration = {show(sim.duration)} s is not a whole number of steps of "
+                   f"{show(sim.dt)} s; the run takes {sim.n_steps} steps, to t = {sim.n_steps * sim.dt:.6g} s")
+    if sim.save_every > max(sim.n_steps, 1):
+        raise SceneError("simulation.save_every", f"{sim.save_every} is more than the run's {sim.n_steps} steps: "
+                                                  f"nothing after t = 0 would be saved")
+    kept = (sim.n_steps // sim.save_every) * sim.save_every
+    if kept != sim.n_steps:
+        out.append(f"simulation.save_every = {sim.save_every} does not divide the run's {sim.n_steps} steps: the "
+                   f"run stops at the last saved frame, step {kept} (t = {kept * sim.dt:.6g} s)")
+    return out
+
+
+def _overlapping_tanks(tanks, warnings: list[str]) -> None:
+    """Two tanks' boxes that share volume are a scene error the model cannot see (each liquid is
+    meshed on its own): warn."""
+    for i, a in enumerate(tanks):
+        for j in range(i + 1, len(tanks)):
+            b = tanks[j]
+            lo = [max(a.origin[k], b.origin[k]) for k in range(3)]
+            hi = [min(a.origin[k] + a.size[k], b.origin[k] + b.size[k]) for k in range(3)]
+            if all(h - l > 1e-9 * max(max(a.size), max(b.size)) for l, h in zip(lo, hi)):
+                warnings.append(f"tanks[{j}] ({b.name!r}) overlaps tanks[{i}] ({a.name!r}): their liquids are "
+                                f"simulated apart, as if each had the shared space to itself")
 
 
 def _vessel(table, environment: Environment, warnings: list[str]) -> Vessel:
     v = read(table, "vessel", {
-        "mass": ("float", positive),
-        "inertia": ("inertia", None),
-        "hydrostatics": ("table", None),
-        "initial": ("table", None),
-        "forced": ("table", None),
-        "hull": ("table", None),
+        "mass": ("float", positive), "inertia": ("inertia", None), "hydrostatics": ("table", None),
+        "initial": ("table", None), "forced": ("table", None), "hull": ("table", None),
         "hydrodynamics": ("table", None),
     }, required=("mass", "inertia"))
     inertia = v["inertia"]
@@ -219,21 +230,15 @@ def _vessel(table, environment: Environment, warnings: list[str]) -> Vessel:
         warnings.append(f"vessel: no [vessel.hydrostatics] table, so nothing holds the vessel up: it falls "
                         f"freely under gravity {show(environment.gravity)} m/s^2")
     initial = Initial(**read(table.get("initial", {}), "vessel.initial", {
-        "position": ("vec3", None),
-        "velocity": ("vec3", None),
-        "angular_velocity": ("vec3", None),
+        "position": ("vec3", None), "velocity": ("vec3", None), "angular_velocity": ("vec3", None),
         "roll_pitch_yaw": ("vec3", None),
     }))
     forced = None
     if "forced" in table:
         f = read(table["forced"], "vessel.forced", {
-            "dof": ("str", one_of(DOFS)),
-            "profile": ("str", one_of(("harmonic", "spin-up"))),
-            "amplitude": ("float", None),
-            "frequency": ("float", positive),
-            "ramp": ("float", non_negative),
-            "rate": ("float", None),
-            "duration": ("float", positive),
+            "dof": ("str", one_of(DOFS)), "profile": ("str", one_of(("harmonic", "spin-up"))),
+            "amplitude": ("float", None), "frequency": ("float", positive), "ramp": ("float", non_negative),
+            "rate": ("float", None), "duration": ("float", positive),
         }, required=("dof",))
         profile = f.get("profile", "harmonic")
         need = ("amplitude", "frequency") if profile == "harmonic" else ("rate", "duration")
@@ -256,11 +261,8 @@ def _vessel(table, environment: Environment, warnings: list[str]) -> Vessel:
 def _hydrostatics(table, warnings: list[str]) -> Hydrostatics:
     where = "vessel.hydrostatics"
     h = Hydrostatics(**read(table, where, {
-        "waterplane_area": ("float", positive),
-        "displaced_volume": ("float", positive),
-        "gm_t": ("float", None),
-        "gm_l": ("float", None),
-        "moment": ("str", one_of(MOMENTS)),
+        "waterplane_area": ("float", positive), "displaced_volume": ("float", positive), "gm_t": ("float", None),
+        "gm_l": ("float", None), "moment": ("str", one_of(MOMENTS)),
     }, required=("waterplane_area", "displaced_volume", "gm_t", "gm_l")))
     for key, value, motion in (("gm_t", h.gm_t, "roll"), ("gm_l", h.gm_l, "pitch")):
         if value <= 0:
@@ -278,22 +280,15 @@ def _inertia_warnings(inertia, warnings: list[str]) -> None:
 
 def _material(table, where: str) -> Material:
     return Material(**read(table, where, {
-        "young": ("float", positive),
-        "poisson": ("float", poisson_ratio),
-        "density": ("float", positive),
+        "young": ("float", positive), "poisson": ("float", poisson_ratio), "density": ("float", positive),
     }, required=("young", "poisson", "density")))
 
 
 def _tank(table, where: str) -> Tank:
     v = read(table, where, {
-        "name": ("str", valid_name),
-        "origin": ("vec3", None),
-        "size": ("vec3", sizes),
-        "fill_depth": ("float", None),
-        "mesh": ("mesh", counts),
-        "walls": ("str_or_table", None),
-        "fluid": ("table", None),
-        "reduction": ("table", None),
+        "name": ("str", valid_name), "origin": ("vec3", None), "size": ("vec3", sizes),
+        "fill_depth": ("float", None), "mesh": ("mesh", counts), "walls": ("str_or_table", None),
+        "fluid": ("table", None), "reduction": ("table", None),
     }, required=("name", "origin", "size", "fill_depth", "mesh"))
     # SPEC writes `walls = "elastic"` and a `[tanks.walls]` table, but TOML cannot hold both under
     # one key: `walls` is either the string "rigid" or the table, which makes the walls elastic.
@@ -315,15 +310,13 @@ def _tank(table, where: str) -> Tank:
     if depth > height:
         raise SceneError(f"{where}.fill_depth", f"{show(depth)} m is above the tank height {show(height)} m")
     fluid = Fluid(**read(table.get("fluid", {}), f"{where}.fluid", {
-        "density": ("float", positive),
-        "sound_speed": ("float", positive),
+        "density": ("float", positive), "sound_speed": ("float", positive),
         "element": ("str", one_of(ELEMENT_FORMS)),
     }))
     reduction = None
     if "reduction" in table:
         reduction = Reduction(**read(table["reduction"], f"{where}.reduction", {
-            "modes": ("int", at_least(1)),
-            "static_correction": ("bool", None),
+            "modes": ("int", at_least(1)), "static_correction": ("bool", None),
         }, required=("modes",)))
     return Tank(name=v["name"], origin=v["origin"], size=v["size"], fill_depth=depth, mesh=v["mesh"],
                 walls=walls, fluid=fluid, wall_spec=wall_spec, reduction=reduction)
@@ -331,9 +324,7 @@ def _tank(table, where: str) -> Tank:
 
 def _walls(table, where: str) -> Walls:
     v = read(table, where, {
-        "thickness": ("float", positive),
-        "material": ("table", None),
-        "mesh": ("mesh", counts),
+        "thickness": ("float", positive), "material": ("table", None), "mesh": ("mesh", counts),
     }, required=("thickness", "material"))
     return Walls(thickness=v["thickness"], material=_material(table["material"], f"{where}.material"),
                  mesh=v.get("mesh"))
@@ -341,15 +332,9 @@ def _walls(table, where: str) -> Walls:
 
 def _structure(table, where: str) -> Structure:
     v = read(table, where, {
-        "name": ("str", valid_name),
-        "origin": ("vec3", None),
-        "size": ("vec3", sizes),
-        "mesh": ("mesh", counts),
-        "attach": ("str", one_of(FACES)),
-        "attach_to": ("str", None),
-        "frame": ("str", one_of(("own", "vessel"))),
-        "stiffening": ("str", one_of(("none", "centrifugal"))),
-        "material": ("table", None),
+        "name": ("str", valid_name), "origin": ("vec3", None), "size": ("vec3", sizes), "mesh": ("mesh", counts),
+        "attach": ("str", one_of(FACES)), "attach_to": ("str", None), "frame": ("str", one_of(("own", "vessel"))),
+        "stiffening": ("str", one_of(("none", "centrifugal"))), "material": ("table", None),
     }, required=("name", "origin", "size", "mesh", "attach", "material"))
     return Structure(material=_material(table["material"], f"{where}.material"), **v)
 
@@ -386,10 +371,7 @@ def _attachments(structures) -> None:
 
 def _probe(table, where: str) -> Probe:
     v = read(table, where, {
-        "name": ("str", valid_name),
-        "tank": ("str", None),
-        "structure": ("str", None),
-        "point": ("vec3", None),
+        "name": ("str", valid_name), "tank": ("str", None), "structure": ("str", None), "point": ("vec3", None),
     }, required=("name", "point"))
     if ("tank" in v) == ("structure" in v):
         which = "both a tank and a structure" if "tank" in v else "neither a tank nor a structure"

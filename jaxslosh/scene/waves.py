@@ -28,20 +28,11 @@ HULL_MISMATCH_TOLERANCE = 0.01   # relative: the box's closed-form hydrostatics 
 def read_waves(table, warnings: list[str]) -> Waves:
     where = "waves"
     v = read(table, where, {
-        "type": ("str", one_of(WAVE_TYPES)),
-        "heading": ("float", None),
-        "amplitude": ("float", non_negative),
-        "period": ("float", positive),
-        "frequency": ("float", positive),
-        "phase": ("float", None),
-        "hs": ("float", non_negative),
-        "tp": ("float", positive),
-        "gamma": ("float", _at_least_one),
-        "seed": ("int", non_negative),
-        "components": ("int", at_least(1)),
-        "frequency_range": ("numbers", None),
-        "ramp": ("float", non_negative),
-        "depth": ("float", positive),
+        "type": ("str", one_of(WAVE_TYPES)), "heading": ("float", None), "amplitude": ("float", non_negative),
+        "period": ("float", positive), "frequency": ("float", positive), "phase": ("float", None),
+        "hs": ("float", non_negative), "tp": ("float", positive), "gamma": ("float", _at_least_one),
+        "seed": ("int", non_negative), "components": ("int", at_least(1)), "frequency_range": ("numbers", None),
+        "ramp": ("float", non_negative), "depth": ("float", positive),
     }, required=("type",))
     kind = v["type"]
     own = {"regular": ("amplitude", "period", "frequency", "phase"),
@@ -83,13 +74,8 @@ def _at_least_one(v):
 def read_hull(table) -> Hull:
     where = "vessel.hull"
     v = read(table, where, {
-        "type": ("str", one_of(HULL_TYPES)),
-        "length": ("float", positive),
-        "beam": ("float", positive),
-        "draft": ("float", positive),
-        "kg": ("float", None),
-        "file": ("str", None),
-        "cog": ("vec3", None),
+        "type": ("str", one_of(HULL_TYPES)), "length": ("float", positive), "beam": ("float", positive),
+        "draft": ("float", positive), "kg": ("float", None), "file": ("str", None), "cog": ("vec3", None),
     })
     kind = v.get("type", "box")
     if kind == "box":
@@ -133,18 +119,11 @@ def _tuples(x):
 def read_hydrodynamics(table, hull: Optional[Hull]) -> Hydrodynamics:
     where = "vessel.hydrodynamics"
     v = read(table, where, {
-        "frequencies": ("numbers", None),
-        "added_mass": ("numbers", None),
-        "damping": ("numbers", None),
-        "added_mass_infinite": ("numbers", None),
-        "headings": ("numbers", None),
-        "excitation_amplitude": ("numbers", None),
-        "excitation_phase": ("numbers", None),
-        "viscous_damping": ("numbers", None),
-        "capytaine": ("bool", None),
-        "panel_size": ("float", positive),
-        "memory_order": ("int", non_negative),
-        "excitation": ("str", one_of(EXCITATION_SOURCES)),
+        "frequencies": ("numbers", None), "added_mass": ("numbers", None), "damping": ("numbers", None),
+        "added_mass_infinite": ("numbers", None), "headings": ("numbers", None),
+        "excitation_amplitude": ("numbers", None), "excitation_phase": ("numbers", None),
+        "viscous_damping": ("numbers", None), "capytaine": ("bool", None), "panel_size": ("float", positive),
+        "memory_order": ("int", non_negative), "excitation": ("str", one_of(EXCITATION_SOURCES)),
     })
     capy = v.get("capytaine", False)
     out = {"capytaine": capy, "panel_size": v.get("panel_size"), "memory_order": v.get("memory_order", 0),

@@ -1,0 +1,145 @@
+"""Result files as a user meets them (issue 21): one writer per file, a file that always says how its
+run ended (signals, full disks), outputs checked before any computing, the cost estimate, validity
+warnings. The faults are real: two processes, SIGINT and SIGTERM, a file size limit."""
+import os
+import resource
+import signal
+import subprocess
+import sys
+import time
+
+import h5py
+import numpy as np
+import pytest
+
+ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+PAPER = os.path.join(ROOT, "scenes", "paper_ship_tank.toml")
+
+
+def jaxslosh(*args, **kw):
+    return subprocess.Popen([sys.executable, "-m", "jaxslosh", *args], stdout=subprocess.PIPE,
+                            stderr=subprocess.PIPE, text=True, **kw)
+
+
+def wait_for_steps(path, proc, timeout=240.0):
+    """Wait until the running process has written frames after the first (its lock is held all along)."""
+    t0 = time.time()
+    while time.time() - t0 < timeout:
+        assert proc.poll() is None, proc.communicate()
+        try:
+            with h5py.File(path, "r", locking=False) as f:
+                if int(f.attrs["steps_done"]) > 0:
+                    return
+        except (OSError, KeyError):
+            pass
+        time.sleep(0.5)
+    raise AssertionError("no steps written in time")
+
+
+def attrs(path):
+    with h5py.File(path, "r") as f:
+        return dict(f.attrs), f["time"].shape[0]
+
+
+def _long_scene(tmp_path, duration=300.0):
+    """The paper example, long enough to be caught running, a chunk of 20 frames."""
+    text = open(PAPER).read().replace("duration = 20.0", f"duration = {duration}")
+    text = text.replace("[simulation]", "[simulation]\nchunk = 20")
+    p = tmp_path / "long.toml"
+    p.write_text(text)
+    return str(p)
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("sig", [signal.SIGINT, signal.SIGTERM])
+def test_a_stopped_run_says_so_and_keeps_its_steps_and_a_second_writer_is_refused(tmp_path, sig):
+    scene, out = _long_scene(tmp_path), str(tmp_path / "out.h5")
+    first = jaxslosh("run", scene, "-o", out, "--no-progress")
+    wait_for_steps(out, first)
+    if sig == signal.SIGINT:         # the second writer while the first runs: refused, nothing truncated
+        second = jaxslosh("run", scene, "-o", out, "--no-progress")
+        _, err = second.communicate(timeout=240)
+        assert second.returncode == 2 and "another run is writing" in err and "Traceback" not in err, err
+        assert len(err.strip().splitlines()) <= 2          # the scene's warning and one error line
+    first.send_signal(sig)
+    _, err = first.communicate(timeout=120)
+    assert first.returncode == 130, err
+    assert "Traceback" not in err and "interrupted" in err
+    a, n = attrs(out)
+    assert a["status"].startswith("interrupted") and int(a["status_code"]) == 4
+    steps = int(a["steps_done"])
+    assert steps > 0 and n == steps + 1                    # every step kept, the status says how many
+    assert not os.path.exists(os.path.join(tmp_path, ".out.h5.lock"))
+
+
+def test_a_full_disk_ends_the_run_with_one_line_and_a_readable_file(tmp_path):
+    out = str(tmp_path / "df.h5")
+
+    def limit():          # a file-size limit stands for a full disk: writes fail with EFBIG past it
+        signal.signal(signal.SIGXFSZ, signal.SIG_IGN)
+        resource.setrlimit(resource.RLIMIT_FSIZE, (6_000_000, 6_000_000))
+
+    p = subprocess.run([sys.executable, "-m", "jaxslosh", "run", PAPER, "-o", out, "--no-progress",
+                        "--duration", "5"], capture_output=True, text=True, preexec_fn=limit, timeout=300)
+    assert p.returncode == 1, p.stderr
+    lines = [ln for ln in p.stderr.splitlines() if ln.startswith("error")]
+    assert len(lines) == 1 and "disk full" in lines[0] and "Traceback" not in p.stderr
+    a, n = attrs(out)
+    assert a["status"].startswith("disk full") and int(a["status_code"]) == 5 and n == int(a["steps_done"]) + 1
+
+
+@pytest.mark.parametrize("case", ["scene", "directory", "foreign", "missing-folder", "duration-inf", "save-every"])
+def test_outputs_and_overrides_are_checked_before_computing(tmp_path, case):
+    from jaxslosh.cli import main
+    scene = tmp_path / "s.toml"
+    scene.write_text(open(PAPER).read().replace("duration = 20.0", "duration = 0.05"))
+    out = {"scene": str(scene), "directory": str(tmp_path), "missing-folder": str(tmp_path / "no" / "r.h5")}.get(
+        case, str(tmp_path / "r.h5"))
+    if case == "foreign":
+        with open(out, "w") as f:
+            f.write("not a result\n")
+    extra = {"duration-inf": ["--duration", "inf"], "save-every": ["--duration", "0.05", "--dt", "0.01"]}.get(case, [])
+    if case == "save-every":
+        scene.write_text(scene.read_text().replace("[simulation]", "[simulation]\nsave_every = 10"))
+    before = scene.read_text()
+    assert main(["run", str(scene), "-o", out, "--no-progress", *extra]) == 2
+    assert scene.read_text() == before                     # the scene is never overwritten
+    if case == "foreign":
+        assert open(out).read() == "not a result\n"
+    elif case not in ("scene", "directory"):
+        assert not os.path.exists(out)
+
+
+def test_the_cost_estimate_refuses_what_the_machine_cannot_hold(tmp_path, capsys):
+    from jaxslosh.cli import main
+    scene = tmp_path / "big.toml"
+    scene.write_text(open(PAPER).read().replace("mesh = [5, 5, 5]", "mesh = [200, 200, 100]"))
+    assert main(["check", str(scene)]) == 2
+    err = capsys.readouterr().err
+    assert "tanks[0].mesh" in err and "GB" in err and "--force" in err
+    assert main(["check", str(scene), "--force"]) == 0
+    out = capsys.readouterr().out
+    assert "12,119,904 unknowns" in out
+    assert main(["run", str(scene), "-o", str(tmp_path / "r.h5")]) == 2 and not os.path.exists(tmp_path / "r.h5")
+
+
+def test_validity_warnings_reach_the_summary_and_the_file(tmp_path, capsys):
+    """A roll started at 1 rad/s throws the paper tank's surface past its roof and floor; a second
+    tank overlapping the first is said at load."""
+    from jaxslosh.cli import main
+    text = open(PAPER).read().replace("angular_velocity = [0.1, 0.05, 0.0]", "angular_velocity = [1.0, 0.0, 0.0]")
+    text = text.replace("duration = 20.0", "duration = 1.5")
+    scene = tmp_path / "wild.toml"
+    scene.write_text(text)
+    out = str(tmp_path / "w.h5")
+    assert main(["run", str(scene), "-o", out, "--no-progress"]) in (0, 3)
+    err = capsys.readouterr().err
+    assert "outside its validity" in err
+    a, _ = attrs(out)
+    assert any("outside its validity" in str(w) for w in np.atleast_1d(a["warnings"]))
+    tank = text[text.index("[[tanks]]"):text.index("[[probes]]")]
+    second = tank.replace('name = "tank"', 'name = "other"').replace("origin = [-2.5, -2.5, -1.0]",
+                                                                        "origin = [0.0, 0.0, -1.0]")
+    scene.write_text(text.replace("[[probes]]", second + "\n[[probes]]", 1))
+    assert main(["check", str(scene)]) == 0
+    assert "overlaps tanks[0]" in capsys.readouterr().err
