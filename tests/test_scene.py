@@ -190,6 +190,19 @@ def test_optional_tables_default():
     assert s.vessel.hydrostatics is None and s.environment.gravity == 0.0 and s.warnings == ()
 
 
+def test_forced_motion_without_hydrostatics_does_not_say_the_vessel_falls():
+    """Issue 21: [vessel.forced] holds every rigid dof (one prescribed, five at zero), so a scene
+    without hydrostatics under gravity does not fall; the free-fall warning is for free vessels."""
+    d = tomllib.loads(VESSEL_ONLY)
+    del d["vessel"]["hydrostatics"]
+    free = parse_scene(d)
+    assert len(free.warnings) == 1 and "falls freely" in free.warnings[0]
+    d["vessel"]["forced"] = {"dof": "surge", "amplitude": 0.001, "frequency": 1.5, "ramp": 3.0}
+    s = parse_scene(d)
+    assert s.vessel.forced is not None and s.environment.gravity > 0
+    assert not any("falls" in w or "holds the vessel" in w for w in s.warnings), s.warnings
+
+
 def test_probe_on_boundaries_within_tolerance():
     s = parse_scene(mutated(("probes.0.point", [5.0 + 5e-10, -5e-10, 0.0]),
                             ("probes.1.point", [0.0, 2.5, 4.0])))          # on a wall, above the liquid
