@@ -1,4 +1,5 @@
 """Parameter identification (SPEC sections 2 and 4: `jaxslosh identify`, `js.identify`)."""
+import dataclasses
 import json
 from pathlib import Path
 
@@ -10,6 +11,7 @@ import pytest
 import jaxslosh as js
 from jaxslosh.fit.identify import FitResult, identify
 from jaxslosh.fit.problem import add_noise
+from jaxslosh.fit.quality import data_scene_mismatch
 
 from helpers import run_notebook, vessel_scene
 
@@ -78,6 +80,10 @@ def test_identify_recovers_gm_from_noisy_roll_decay(decay, monkeypatch):
     assert np.all(np.diff(fit.loss_history) <= 0)
     assert len(fit.loss_history) == fit.iterations + 1 and len(seen) == fit.iterations
     assert fit.iterations <= 15
+    # at the noise floor: a good fit, R^2 near 1, the residual the size of the noise the record shows
+    assert fit.quality == "" and not fit.poor_fit and fit.status == "converged" and fit.data_scene == ""
+    for c in ("roll", "pitch"):
+        assert fit.r2[c] > 0.999 and 0.8 < fit.residual_to_noise[c] < 1.25, (fit.r2, fit.residual_to_noise)
     # the same problem again (another start): nothing traced or compiled, the same minimum
     again = identify(scene, measured, GM, x0={GM[0]: 1.5 * 0.7, GM[1]: 15.0 * 1.3})
     assert len(traces) <= 1 and again.compile_time == 0.0
@@ -122,8 +128,9 @@ def test_cli_identify_writes_json(tmp_path, capsys):
     printed = capsys.readouterr().out
     assert code == 0, printed
     fit = json.loads(out.read_text())
-    assert set(fit) == {"values", "standard_errors", "loss_history", "iterations", "converged", "method"}
+    assert {"values", "standard_errors", "loss_history", "iterations", "converged", "method"} <= set(fit)
     assert fit["method"] == "gauss-newton" and fit["converged"] is True
+    assert fit["quality"] == "good" and fit["data_scene"] is None and min(fit["r2"].values()) > 0.999, fit
     for k, true in zip(GM, (1.6, 13.0)):
         assert abs(fit["values"][k] - true) < 1e-3 * true, fit
         assert fit["standard_errors"][k] > 0
@@ -159,6 +166,79 @@ def test_cli_identify_bad_data(tmp_path, capsys):
         code = main(["identify", str(scene_path), "--data", str(path), "--fit", GM[0]])
         err = capsys.readouterr().err
         assert code == 2 and len(err.strip().splitlines()) == 1 and "--data" in err and str(path) in err, err
+
+
+def _other_scene_record(path, **changes):
+    """A record (noise 1e-4 rad) made with the `_cli_files` scene text changed: {old: new} lines."""
+    from helpers import VESSEL
+    text = VESSEL.format(duration=DECAY["duration"], dt=0.01, scheme="hht", alpha=0.01, omega=list(DECAY["omega"]),
+                         position=[0.0, 0.0, 0.0])
+    for old, new in changes.items():
+        assert old in text
+        text = text.replace(old, new)
+    js.save_result(add_noise(js.simulate(js.load_scene(text)), {"roll": 1e-4, "pitch": 1e-4}, seed=5), path)
+    return path
+
+
+def test_cli_identify_refuses_data_from_another_scene(tmp_path, capsys):
+    """Issue 21: the record's file carries the scene that made it; one that differs in a value that
+    is not fitted (vessel.mass 4.4e5 against 4.0e5; and the initial roll rate reversed) is refused
+    with exit 2 and one line naming the keys and both values, before anything is compiled. With
+    --data-scene ignore it is fitted, and the fit, GM_T unable to turn the roll around, says it
+    is poor instead of a bare "converged" (R^2 about -0.2 on roll; the residual 650 times the
+    record's noise, pitch's 1.0 times)."""
+    from jaxslosh.cli import main
+    scene_path, _ = _cli_files(tmp_path, measure=False)
+    data = _other_scene_record(tmp_path / "other.h5", **{"mass = 4.0e5": "mass = 4.4e5",
+                                                         "angular_velocity = [0.1,": "angular_velocity = [-0.1,"})
+    out = tmp_path / "fit.json"
+    argv = ["identify", str(scene_path), "--data", str(data), "--fit", ",".join(GM), "-o", str(out)]
+    code = main(argv)
+    captured = capsys.readouterr()
+    err = captured.err
+    assert code == 2 and not out.exists() and captured.out == "", captured
+    assert len(err.strip().splitlines()) == 1, err
+    assert "vessel.mass = 440000.0 in the data's scene, 400000.0 here" in err, err
+    assert "vessel.initial.angular_velocity" in err and "--data-scene ignore" in err, err
+    assert "gm_t =" not in err and "duration" not in err         # fitted and harmless keys are not named
+
+    code = main(argv + ["--data-scene", "ignore"])
+    captured = capsys.readouterr()
+    assert code == 0, captured
+    assert "vessel.mass" in captured.err                          # said, not refused
+    summary = [line for line in captured.out.splitlines() if line.startswith("gauss-newton:")]
+    assert summary and "poor fit: R^2" in summary[0] and "on roll" in summary[0], captured.out
+    fit = json.loads(out.read_text())
+    assert fit["quality"].startswith("poor fit: R^2") and "on roll" in fit["quality"] and "pitch" not in fit["quality"]
+    assert fit["r2"]["roll"] < 0.5 and fit["r2"]["pitch"] > 0.999, fit["r2"]
+    assert fit["residual_to_noise"]["roll"] > 50 and fit["residual_to_noise"]["pitch"] < 1.5, fit
+    assert "vessel.mass" in fit["data_scene"]
+
+
+def test_identify_warns_on_data_from_another_scene(tmp_path, decay):
+    """The Python API warns (and fits) where the command refuses; data_scene="error" raises,
+    "ignore" says nothing. A record that differs only in fitted keys, or carries no scene, passes."""
+    import warnings
+    scene, _ = decay
+    data = _other_scene_record(tmp_path / "heavier.h5", **{"mass = 4.0e5": "mass = 4.4e5"})
+    with pytest.warns(UserWarning, match=r"vessel\.mass = 440000\.0 in the data's scene, 400000\.0 here"):
+        fit = identify(scene, data, GM, max_iter=0)
+    assert "vessel.mass" in fit.data_scene
+    with pytest.raises(js.SceneError, match="vessel.mass"):
+        identify(scene, data, GM, data_scene="error")
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        assert identify(scene, data, GM, max_iter=0, data_scene="ignore").data_scene != ""
+        external = dataclasses.replace(js.load_result(data), scene_text="")     # data from elsewhere
+        assert identify(scene, external, GM, max_iter=0).data_scene == ""
+    # the comparison alone: fitted keys and the duration do not count, anything else does
+    text = scene.text.replace("gm_t = 1.5", "gm_t = 1.6").replace("duration = 10.0", "duration = 12.0")
+    other = dataclasses.replace(js.load_result(data), scene_text=text)
+    assert data_scene_mismatch(scene, other, GM) == ""
+    assert data_scene_mismatch(scene, other, GM[1:]).endswith(
+        "vessel.hydrostatics.gm_t = 1.6 in the data's scene, 1.5 here (fitted: vessel.hydrostatics.gm_l)")
+    broken = dataclasses.replace(other, scene_text=text + '[[probes]]\nname = "deck"\ntank = "none"\npoint = [0, 0, 0]\n')
+    assert "does not load" in data_scene_mismatch(scene, broken, GM)
 
 
 def _execute_notebook(env):

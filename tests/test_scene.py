@@ -190,6 +190,40 @@ def test_optional_tables_default():
     assert s.vessel.hydrostatics is None and s.environment.gravity == 0.0 and s.warnings == ()
 
 
+def test_forced_motion_without_hydrostatics_does_not_say_the_vessel_falls():
+    """Issue 21: [vessel.forced] holds every rigid dof (one prescribed, five at zero), so a scene
+    without hydrostatics under gravity does not fall; the free-fall warning is for free vessels."""
+    d = tomllib.loads(VESSEL_ONLY)
+    del d["vessel"]["hydrostatics"]
+    free = parse_scene(d)
+    assert len(free.warnings) == 1 and "falls freely" in free.warnings[0]
+    d["vessel"]["forced"] = {"dof": "surge", "amplitude": 0.001, "frequency": 1.5, "ramp": 3.0}
+    s = parse_scene(d)
+    assert s.vessel.forced is not None and s.environment.gravity > 0
+    assert not any("falls" in w or "holds the vessel" in w for w in s.warnings), s.warnings
+
+
+def test_scene_differences_name_values_and_structure():
+    """scene/compare.py (identify's check of a record's scene): loaded scenes are compared, so a
+    default written out is no difference; values, meshes, dt, save_every and tables present in one
+    scene only are, named by dotted key; the duration and the fitted keys are not."""
+    from jaxslosh.scene.compare import differences
+    a = parse_scene(base())
+    assert differences(a, parse_scene(mutated(("effects", {"liquid": True}), ("simulation.duration", 5.0)))) == []
+    b = parse_scene(mutated(("simulation.dt", 0.02), ("simulation.save_every", 2), ("tanks.0.mesh", [4, 4, 4]),
+                            ("tanks.0.fluid", {"density": 1025.0}), ("vessel.hydrostatics.gm_t", 1.2),
+                            ("probes.1.point", [4.5, 2.5, 2.9]), ("structures", DELETE), ("probes.2", DELETE)))
+    diff = {k: (x, y) for k, x, y in differences(a, b)}
+    assert diff.pop("simulation.dt") == (0.01, 0.02) and diff.pop("simulation.save_every") == (1, 2)
+    assert diff.pop("tanks.tank.mesh") == ((5, 5, 5), (4, 4, 4))
+    assert diff.pop("tanks.tank.fluid.density") == (1000.0, 1025.0)
+    assert diff.pop("vessel.hydrostatics.gm_t") == (1.67, 1.2)
+    assert diff.pop("probes.B.point")[1] == (4.5, 2.5, 2.9)
+    assert diff.pop("structures.mast")[1] is None and diff.pop("probes.tip")[1] is None    # not key by key
+    assert diff == {}, diff
+    assert "vessel.hydrostatics.gm_t" not in {k for k, _, _ in differences(a, b, ignore=["vessel.hydrostatics.gm_t"])}
+
+
 def test_probe_on_boundaries_within_tolerance():
     s = parse_scene(mutated(("probes.0.point", [5.0 + 5e-10, -5e-10, 0.0]),
                             ("probes.1.point", [0.0, 2.5, 4.0])))          # on a wall, above the liquid

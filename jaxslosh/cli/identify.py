@@ -7,6 +7,7 @@ import sys
 
 from ..fit.identify import METHODS, identify
 from ..fit.params import fit_keys
+from ..fit.quality import data_scene_mismatch
 from ..io.result import load_result
 from ..plot.fit import _fmt, plot_fit
 from ..scene.types import SceneError
@@ -27,6 +28,9 @@ def add_parsers(subparsers):
     p.add_argument("--max-iter", type=int, default=50, dest="max_iter", help="iterations at most (default 50)")
     p.add_argument("--start", metavar="KEY=VALUE[,...]", help="start values (default: the scene's values)")
     p.add_argument("--plot", metavar="FIG.png", help="also draw measured against fitted time histories")
+    p.add_argument("--data-scene", default="check", choices=("check", "ignore"), dest="data_scene",
+                   help="when the data file carries a scene that differs from SCENE (besides the fitted keys): "
+                        "check (default) refuses with exit 2, ignore fits anyway")
     return p
 
 
@@ -39,6 +43,9 @@ def cmd_identify(a) -> int:
 
 
     method = getattr(a, "method", None) or "gauss-newton"
+    data_scene = getattr(a, "data_scene", None) or "check"
+    if data_scene not in ("check", "ignore"):
+        raise InputError(f"--data-scene: unknown choice {data_scene!r} (choose from check, ignore)")
     if method not in METHODS:
         raise InputError(f"--method: unknown method {method!r} (choose from {', '.join(METHODS)})")
     max_iter = getattr(a, "max_iter", None)
@@ -71,7 +78,7 @@ def cmd_identify(a) -> int:
     enable_x64()
     scene = load(a.scene)            # SceneError (exit 2, naming the key) for a bad scene
     try:
-        fit_keys(scene, keys)
+        canon = fit_keys(scene, keys)
     except SceneError as e:
         raise InputError(f"--fit: {e}")
     try:
@@ -79,8 +86,15 @@ def cmd_identify(a) -> int:
     except (OSError, ValueError, KeyError) as e:
         msg = str(e).replace("\n", " ")
         raise InputError(f"--data: {a.data}: not a jaxslosh result file ({msg})")
+    # data made with another scene: the fitted keys would absorb the difference and report it as a
+    # tight, converged fit; refuse before compiling anything unless told to fit anyway
+    mismatch = data_scene_mismatch(scene, measured, canon)
+    if mismatch and data_scene == "check":
+        raise InputError(f"--data: {a.data}: {mismatch}; to fit anyway: --data-scene ignore")
+    if mismatch:
+        print(f"jaxslosh identify: note: {mismatch}; fitting anyway (--data-scene ignore)", file=sys.stderr)
     try:
-        fr = identify(scene, measured, keys, method=method, max_iter=max_iter, x0=x0 or None)
+        fr = identify(scene, measured, keys, method=method, max_iter=max_iter, x0=x0 or None, data_scene="ignore")
     except SceneError as e:
         msg = str(e).replace("\n", " ")
         flag = "--start" if ("the start" in msg or "given in x0" in msg) else "--data" if e.key == "measured" else None
@@ -92,8 +106,7 @@ def cmd_identify(a) -> int:
     for k, v in fr.values.items():
         s = fr.standard_errors[k]
         print(f"{k:<{width}} = {_fmt(v)} +- {_fmt(s)}   (start {_fmt(fr.start[k])})")
-    status = "converged" if fr.converged else "NOT converged"
-    print(f"{fr.method}: {status} after {fr.iterations} iterations ({fr.evaluations} simulations, "
+    print(f"{fr.method}: {fr.status} after {fr.iterations} iterations ({fr.evaluations} simulations, "
           f"{fr.wall_time:.1f} s); loss {fr.loss_history[0]:.4g} -> {fr.loss_history[-1]:.4g} ({fr.message})")
     fr.to_json(out)
     print(f"wrote {out}")
@@ -102,4 +115,9 @@ def cmd_identify(a) -> int:
         print(f"wrote {a.plot}")
     if not fr.converged:
         print(f"warning: the fit did not converge ({fr.message})", file=sys.stderr)
+    if fr.quality:
+        ratio = ", ".join(f"{k} {v:.3g}" for k, v in fr.residual_to_noise.items())
+        print(f"warning: {fr.quality}: the model leaves much of the record unexplained (residual / noise "
+              f"estimated from the data: {ratio}); the standard errors assume the model is right: check the "
+              f"scene against the measurement", file=sys.stderr)
     return EXIT_OK

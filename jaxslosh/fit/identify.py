@@ -55,6 +55,16 @@ Standard errors
     weighting; with the default weights (1 / std of the signal) and unequal noise levels across
     channels they are only indicative.
 
+The data's scene and the quality of the fit (quality.py)
+    When the measured result carries the scene that made it (result files do), every value and
+    every part of the structure that differs from `scene`, apart from the fitted keys and harmless
+    ones (the duration, the solver's settings), is named: `data_scene="warn"` (default) warns,
+    "error" raises SceneError, "ignore" says nothing. After the fit, R^2 per channel and the
+    residual against the noise estimated from the record; a channel with R^2 < 0.9 whose residual
+    is more than 3 times that noise makes the fit poor (`quality`: "poor fit: R^2 0.12 on roll"):
+    the model, not the noise, leaves the record unexplained, and the standard errors (which assume
+    the model is right) are then not to be trusted.
+
 All model evaluations go through one jit-compiled function of the parameter vector theta and the
 data (r and J together for Gauss-Newton; the whole optimiser update, line search included, for the
 optax methods): the simulation is traced and compiled once, before the first iteration, never per
@@ -68,6 +78,7 @@ import dataclasses
 import json
 import math
 import time as _time
+import warnings
 from typing import Callable, Optional, Sequence
 
 import numpy as np
@@ -76,9 +87,11 @@ from ..scene.types import Scene, SceneError
 from .optimize import gauss_newton, optax_loop
 from .params import fit_keys, make_params
 from .problem import Problem, as_result
+from .quality import data_scene_mismatch, goodness
 
 
 METHODS = ("gauss-newton", "lbfgs", "adam")
+DATA_SCENE = ("warn", "error", "ignore")       # what identify does when the data's scene differs
 
 
 @dataclasses.dataclass
@@ -91,6 +104,9 @@ class FitResult:
     for the optax methods). evaluations: simulations run (line search and rejected
     trial steps included). channels: the weight of every channel used. wall_time: seconds in
     all; compile_time: of which tracing and compiling; solve_time: the iterations alone.
+    r2: channel -> R^2 at the returned parameters; residual_to_noise: channel -> the residual's
+    RMS over the noise estimated from the record; quality: "" or "poor fit: R^2 0.12 on roll";
+    data_scene: "" or how the scene stored with the data differs from the fitted one.
     """
     values: dict
     standard_errors: dict
@@ -107,19 +123,36 @@ class FitResult:
     compile_time: float = 0.0
     solve_time: float = 0.0
     correlation: Optional[list] = None
+    r2: dict = dataclasses.field(default_factory=dict)
+    residual_to_noise: dict = dataclasses.field(default_factory=dict)
+    quality: str = ""
+    data_scene: str = ""
 
     @property
     def loss(self) -> float:
         return self.loss_history[-1] if self.loss_history else float("nan")
 
+    @property
+    def poor_fit(self) -> bool:
+        return bool(self.quality)
+
+    @property
+    def status(self) -> str:
+        """"converged", "NOT converged", and the quality when the fit is poor: the summary's word."""
+        s = "converged" if self.converged else "NOT converged"
+        return f"{s}, {self.quality}" if self.quality else s
+
     def to_dict(self) -> dict:
         return {"values": self.values, "standard_errors": self.standard_errors,
                 "loss_history": [float(x) for x in self.loss_history], "iterations": int(self.iterations),
-                "converged": bool(self.converged), "method": self.method}
+                "converged": bool(self.converged), "method": self.method,
+                "quality": self.quality or "good", "r2": dict(self.r2),
+                "residual_to_noise": dict(self.residual_to_noise), "data_scene": self.data_scene or None}
 
     def to_json(self, path: Optional[str] = None, **kw) -> str:
         """The JSON text of {"values", "standard_errors", "loss_history", "iterations", "converged",
-        "method"}; also written to `path` when given."""
+        "method", "quality" ("good" or "poor fit: R^2 0.12 on roll"), "r2", "residual_to_noise",
+        "data_scene" (null, or how the data's scene differs)}; also written to `path` when given."""
         text = json.dumps(_json_safe(self.to_dict()), **({"indent": 2} | kw))
         if path is not None:
             with open(path, "w") as f:
@@ -140,23 +173,33 @@ def _json_safe(x):
 def identify(scene: Scene, measured, fit: Sequence[str], *, weights: Optional[dict] = None,
              method: str = "gauss-newton", max_iter: int = 50, x0: Optional[dict] = None,
              bounds: Optional[dict] = None, callback: Optional[Callable] = None,
-             learning_rate: Optional[float] = None) -> FitResult:
+             learning_rate: Optional[float] = None, data_scene: str = "warn") -> FitResult:
     """Fit the scene values named by `fit` (dotted keys) to `measured` (a Result or a result file).
 
     weights: channel -> weight ("roll", "pitch", "heave", "probes.<name>"), default 1 / std of the
     measured channel (0 for a constant channel). method: "gauss-newton" (default), "lbfgs" or
     "adam". x0: key -> start value (default the scene's). bounds: key -> (lo, hi), None for an open
     side (default: (0, None) for positive quantities, fitted in log). callback(iteration, values,
-    loss) after every iteration; returning True stops the fit. Raises SceneError (naming the key)
-    for bad input. See the module docstring for the details.
+    loss) after every iteration; returning True stops the fit. data_scene: when the measured result
+    carries a scene that differs from `scene` (besides the fitted keys), "warn" (default), "error"
+    (SceneError) or "ignore". Raises SceneError (naming the key) for bad input. See the module
+    docstring for the details.
     """
     if method not in METHODS:
         raise SceneError("method", f"unknown method {method!r} (choose from {', '.join(METHODS)})")
+    if data_scene not in DATA_SCENE:
+        raise SceneError("data_scene", f"unknown choice {data_scene!r} (choose from {', '.join(DATA_SCENE)})")
     if int(max_iter) < 0:
         raise SceneError("max_iter", f"must be >= 0, got {max_iter}")
     t0 = _time.perf_counter()
     measured = as_result(measured)
     keys = fit_keys(scene, fit)
+    mismatch = data_scene_mismatch(scene, measured, keys)
+    if mismatch and data_scene == "error":
+        raise SceneError("measured", mismatch)
+    if mismatch and data_scene == "warn":
+        warnings.warn(f"identify: {mismatch}; the fitted keys will absorb the difference "
+                      f"(data_scene='ignore' fits without this warning)", stacklevel=2)
     params = make_params(scene, keys, x0, bounds)
     pb = Problem(scene, measured, params, weights)
     history: list = []
@@ -191,8 +234,10 @@ def identify(scene: Scene, measured, fit: Sequence[str], *, weights: Optional[di
     if not final_known:
         history.append(float(res @ res) / pb.n if ok else math.inf)   # the loss at the returned parameters
     start = {p.key: (float(p.start[0]) if p.scalar else p.start.tolist()) for p in params}
+    r2, noise, quality = goodness(res, pb.data[1], pb.data[2], pb.active) if ok else ({}, {}, "")
     return FitResult(values=pb.values(theta), standard_errors=se, loss_history=[float(x) for x in history],
                      iterations=int(it), converged=bool(converged), method=method, message=message,
                      evaluations=pb.evaluations, n_residuals=pb.n, channels=dict(pb.weights), start=start,
                      wall_time=_time.perf_counter() - t0, compile_time=pb.compile_time, solve_time=solve_time,
-                     correlation=corr)
+                     correlation=corr, r2=r2, residual_to_noise=noise, quality=quality,
+                     data_scene=mismatch)       # kept, whatever data_scene says: the record of the fit

@@ -50,7 +50,8 @@ def plot_fit(scene: Scene, measured, fit_result: FitResult, out_png: Optional[st
         ax.legend(loc="upper right", fontsize=8)
     axes[-1, 0].set_xlabel("time (s)")
     vals = ", ".join(f"{k.split('.')[-1]} = {_fmt(v)}" for k, v in fit_result.values.items())
-    fig.suptitle(f"identify ({fit_result.method}, {fit_result.iterations} iterations): {vals}", fontsize=9)
+    quality = f"; {fit_result.quality}" if getattr(fit_result, "quality", "") else ""   # a poor fit says so
+    fig.suptitle(f"identify ({fit_result.method}, {fit_result.iterations} iterations): {vals}{quality}", fontsize=9)
     fig.tight_layout()
     if out_png is not None:
         fig.savefig(out_png, dpi=110)

@@ -226,7 +226,8 @@ def _vessel(table, environment: Environment, warnings: list[str]) -> Vessel:
         if hull is not None:
             hydrostatics = hull_hydrostatics(hull, hydrostatics, warnings)
         hydrodynamics = read_hydrodynamics(table["hydrodynamics"], hull) if "hydrodynamics" in table else None
-    if hydrostatics is None and environment.gravity > 0:
+    # a prescribed motion ([vessel.forced]) holds all six dofs, so then nothing falls
+    if hydrostatics is None and environment.gravity > 0 and "forced" not in table:
         warnings.append(f"vessel: no [vessel.hydrostatics] table, so nothing holds the vessel up: it falls "
                         f"freely under gravity {show(environment.gravity)} m/s^2")
     initial = Initial(**read(table.get("initial", {}), "vessel.initial", {

@@ -77,14 +77,15 @@ class Initial:
 class Forced:
     """Prescribed motion of the vessel (tank tests, rotating hubs): one rigid dof follows a profile,
     the other five are held at zero.
-    "harmonic": amplitude * sin(frequency * t), faded in over `ramp` seconds;
+    "harmonic": amplitude * sin(frequency * t), faded in over `ramp` seconds by the C2 ramp
+    s - sin(2 pi s) / (2 pi), s = t / ramp (physics/vessel.py smooth_ramp);
     "spin-up" (a rotation dof): the rate grows smoothly from 0 to `rate` over `duration` seconds,
     omega(t) = rate / duration (t - duration / (2 pi) sin(2 pi t / duration)), then stays (the
     Kane-Ryan-Banerjee profile)."""
     dof: str                         # "surge" | "sway" | "heave" | "roll" | "pitch" | "yaw"
     amplitude: float = 0.0           # m or rad (harmonic)
     frequency: float = 1.0           # rad/s, > 0 (harmonic)
-    ramp: float = 0.0                # s, >= 0: the amplitude grows as (1 - cos(pi t / ramp)) / 2
+    ramp: float = 0.0                # s, >= 0: the amplitude grows as s - sin(2 pi s) / (2 pi), s = t / ramp
     profile: str = "harmonic"        # "harmonic" | "spin-up"
     rate: float = 0.0                # rad/s (spin-up: final rate)
     duration: float = 0.0            # s, > 0 (spin-up time)
