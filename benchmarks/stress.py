@@ -87,7 +87,8 @@ def run(text, fields=False):
     with tempfile.TemporaryDirectory() as d:
         out = os.path.join(d, "r.h5")
         t0 = time.perf_counter()
-        status, steps, loop = run_to_file(scene, out, progress=False, save_fields=fields)
+        status, steps, times = run_to_file(scene, out, progress=False, save_fields=fields)
+        loop = times["stepping"]
         wall = time.perf_counter() - t0
         r = js.load_result(out)
     return r, wall, loop
