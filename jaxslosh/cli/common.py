@@ -4,6 +4,7 @@ messages and exit codes."""
 from __future__ import annotations
 
 import argparse
+import math
 import os
 import sys
 
@@ -38,13 +39,17 @@ def load(path) -> Scene:
 
 
 def positive(name, value):
-    if value is not None and not (value > 0):
-        raise InputError(f"--{name}: must be positive, got {value}")
+    """A number argument must be positive and finite (argparse's float takes "nan" and "inf")."""
+    if value is not None and not (value > 0 and math.isfinite(value)):
+        raise InputError(f"--{name}: must be a positive finite number, got {value}")
 
 
 def output_folder(flag, path):
-    """The folder a file is to be written in must exist (checked before any computing)."""
+    """The file to be written must not be a folder, and its folder must exist (checked before any
+    computing)."""
     if path:
+        if os.path.isdir(path):
+            raise InputError(f"{flag}: {path} is a folder; give a file name")
         d = os.path.dirname(os.path.abspath(path))
         if not os.path.isdir(d):
             raise InputError(f"{flag}: the folder {d} does not exist")

@@ -7,7 +7,7 @@ import sys
 
 from ..fit.identify import METHODS, identify
 from ..fit.params import fit_keys
-from ..io.result import load_result
+from ..io.result import ResultFileError, load_result
 from ..plot.fit import _fmt, plot_fit
 from ..scene.types import SceneError
 from .common import EXIT_NUMERICAL, EXIT_OK, InputError, enable_x64, load
@@ -76,6 +76,8 @@ def cmd_identify(a) -> int:
         raise InputError(f"--fit: {e}")
     try:
         measured = load_result(a.data)
+    except ResultFileError as e:         # one line naming the file and the fault
+        raise InputError(f"--data: {e}") from None
     except (OSError, ValueError, KeyError) as e:
         msg = str(e).replace("\n", " ")
         raise InputError(f"--data: {a.data}: not a jaxslosh result file ({msg})")
