@@ -2,6 +2,7 @@
 reductions of the paper example, a CSV table and a Pareto plot.
 
     python benchmarks/accuracy_cost.py [--duration 5] [-o docs/accuracy_cost]
+    python benchmarks/accuracy_cost.py --plot-only [-o docs/accuracy_cost]   # redraw the PNG from the CSV
 
 Every setting runs the paper scene for `duration` seconds. Errors:
   * first sloshing frequency: the mesh's first natural frequency of the liquid (tank held fixed),
@@ -21,6 +22,7 @@ import sys
 import time
 
 import jax
+from matplotlib.transforms import Bbox
 
 jax.config.update("jax_enable_x64", True)
 
@@ -99,7 +101,13 @@ def main():
     ap.add_argument("--ref-dt", type=float, default=0.0025)
     ap.add_argument("--quick", action="store_true", help="a few coarse settings and a 10x10x6 reference")
     ap.add_argument("-o", "--output", default=os.path.join(ROOT, "docs", "accuracy_cost"))
+    ap.add_argument("--plot-only", action="store_true", help="redraw OUTPUT.png from OUTPUT.csv, running nothing")
     a = ap.parse_args()
+    if a.plot_only:
+        rows, host = read_csv(a.output + ".csv")
+        plot(rows, a.output + ".png", host)
+        print(f"wrote {a.output}.png from {a.output}.csv")
+        return
     paper = open(os.path.join(ROOT, "scenes", "paper_ship_tank.toml")).read()
     scene = js.load_scene(paper)
     t = scene.tanks[0]
@@ -137,6 +145,19 @@ def main():
     print(f"wrote {a.output}.csv and {a.output}.png")
 
 
+def read_csv(path):
+    """The rows a run wrote (numbers as numbers) and the machine named in its first line."""
+    with open(path) as f:
+        head = f.readline()
+        rows = list(csv.DictReader(f))
+    host = head.split("machine: ", 1)[1].split(";", 1)[0].strip() if "machine: " in head else "machine not recorded"
+    for r in rows:
+        for k, v in r.items():
+            if k not in ("family", "mesh"):
+                r[k] = int(v) if k in ("modes", "unknowns") else float(v)
+    return rows, host
+
+
 def pareto(points):
     """Indices of the points no other point beats in both cost and error."""
     order = sorted(range(len(points)), key=lambda i: points[i])
@@ -153,6 +174,7 @@ def plot(rows, path, host):
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
     fig, axes = plt.subplots(1, 2, figsize=(12, 4.8))
+    labelled = []
     style = {"mesh": ("o", "C0"), "step": ("s", "C1"), "modes": ("^", "C2")}
     for ax, key, label in ((axes[0], "B_err", "probe B error (max over the run / peak)"),
                            (axes[1], "omega1_err", "first sloshing frequency error |relative|")):
@@ -160,19 +182,91 @@ def plot(rows, path, host):
         for fam, (mk, col) in style.items():
             sel = [i for i, r in enumerate(rows) if r["family"] == fam]
             ax.loglog([pts[i][0] for i in sel], [pts[i][1] for i in sel], mk, color=col, label=fam)
-            for i in sel:
-                r = rows[i]
-                tag = r["mesh"] if fam == "mesh" else (f"dt {r['dt']:g}" if fam == "step" else f"{r['modes']} modes")
-                ax.annotate(tag, pts[i], fontsize=7, xytext=(3, 3), textcoords="offset points")
         front = pareto(pts)
         ax.loglog([pts[i][0] for i in front], [pts[i][1] for i in front], "k--", lw=0.8, label="Pareto front")
         ax.set_xlabel("wall seconds per simulated second (after compilation)")
         ax.set_ylabel(label)
         ax.grid(True, which="both", alpha=0.3)
         ax.legend(fontsize=8)
+        tags = [r["mesh"] if r["family"] == "mesh" else (f"dt {r['dt']:g}" if r["family"] == "step"
+                                                          else f"{r['modes']} modes") for r in rows]
+        labelled.append((ax, pts, tags, [pts[i] for i in front]))
     fig.suptitle(f"jaxslosh accuracy-cost map, paper example ({host})", fontsize=10)
     fig.tight_layout()
+    for ax, pts, tags, front in labelled:      # after the layout: the placement works in pixels
+        place_labels(ax, pts, tags, front)
     fig.savefig(path, dpi=110)
+    return fig
+
+
+#: where a label may go around its point, tried in order: (dx, dy) in points, alignment
+_SPOTS = [(dx * r, dy * r, ha, va) for r in (1, 2.5, 4.5)
+          for dx, dy, ha, va in ((4, 3, "left", "bottom"), (4, -3, "left", "top"), (-4, 3, "right", "bottom"),
+                                 (-4, -3, "right", "top"), (0, 6, "center", "bottom"), (0, -6, "center", "top"))]
+
+
+def place_labels(ax, pts, tags, front, merge_px=6.0):
+    """Label the points without overlaps: points drawn on top of each other share one label ("8,
+    20 modes"); each label takes the first spot around its point (_SPOTS, nearest first) where it
+    overlaps no label placed before it, no marker, no stretch of the Pareto front, the legend
+    nor the axes' edge; a label set off further than the nearest ring gets a leader line."""
+    fig = ax.figure
+    fig.canvas.draw()
+    renderer = fig.canvas.get_renderer()
+    xy = ax.transData.transform(np.asarray(pts))
+    groups = []                                # [indices] of points within merge_px of each other
+    for i in np.argsort(xy[:, 0]):
+        for g in groups:
+            if np.hypot(*(xy[g[0]] - xy[i])) < merge_px:
+                g.append(i)
+                break
+        else:
+            groups.append([i])
+    obstacles = [Bbox.from_bounds(x - 4, y - 4, 8, 8) for x, y in xy]
+    line = ax.transData.transform(np.asarray(front)) if len(front) > 1 else np.zeros((0, 2))
+    for a, b in zip(line[:-1], line[1:]):
+        for s in np.linspace(0, 1, 25):
+            p = a + s * (b - a)
+            obstacles.append(Bbox.from_bounds(p[0] - 1.5, p[1] - 1.5, 3, 3))
+    leg = ax.get_legend()
+    if leg is not None:
+        obstacles.append(leg.get_window_extent(renderer))
+    frame = ax.get_window_extent(renderer)
+    for g in groups:
+        words = sorted((tags[i] for i in g), key=lambda w: (len(w), w))      # "8, 20 modes", not "20, 8"
+        unit = words[0].split(" ", 1)[1] if all(" " in w for w in words) else ""
+        if unit and all(w.endswith(" " + unit) and w[0].isdigit() for w in words) and len(words) > 1:
+            text = ", ".join(w.split(" ", 1)[0] for w in words) + " " + unit     # "8, 20 modes"
+        else:
+            text = ", ".join(words)
+        best = None
+        for k, (dx, dy, ha, va) in enumerate(_SPOTS):
+            ann = ax.annotate(text, pts[g[0]], xytext=(dx, dy), textcoords="offset points", fontsize=7,
+                              ha=ha, va=va)
+            box = ann.get_window_extent(renderer).expanded(1.05, 1.1)
+            clash = sum(box.overlaps(o) for o in obstacles) + (0 if frame.contains(box.x0, box.y0)
+                                                                and frame.contains(box.x1, box.y1) else 10)
+            clash *= 10
+            # a label about as near another point as its own would be read as that point's: a
+            # smaller cost than any overlap, growing as the other point comes nearer than its own
+            gap = np.hypot(np.maximum(0, np.maximum(box.x0 - xy[:, 0], xy[:, 0] - box.x1)),
+                           np.maximum(0, np.maximum(box.y0 - xy[:, 1], xy[:, 1] - box.y1)))
+            clash += max(0.0, gap[g].min() + 12 - np.delete(gap, g).min(initial=np.inf)) / 12
+            if best is None or clash < best[0]:
+                if best is not None:
+                    best[1].remove()
+                best = (clash, ann, box, k)
+            else:
+                ann.remove()
+            if clash == 0:
+                break
+        _, ann, box, k = best
+        if k >= 6:                             # set off from its point: a leader line says whose it is
+            ann.remove()
+            dx, dy, ha, va = _SPOTS[k]
+            ann = ax.annotate(text, pts[g[0]], xytext=(dx, dy), textcoords="offset points", fontsize=7, ha=ha,
+                              va=va, arrowprops=dict(arrowstyle="-", lw=0.5, color="0.4", shrinkA=0, shrinkB=3))
+        obstacles.append(box)
 
 
 if __name__ == "__main__":

@@ -87,7 +87,8 @@ def run(text, fields=False):
     with tempfile.TemporaryDirectory() as d:
         out = os.path.join(d, "r.h5")
         t0 = time.perf_counter()
-        status, _, steps, loop, _ = run_to_file(scene, out, progress=False, save_fields=fields)
+        rep = run_to_file(scene, out, progress=False, save_fields=fields)
+        loop = rep.times["stepping"]
         wall = time.perf_counter() - t0
         r = js.load_result(out)
     return r, wall, loop

@@ -11,6 +11,10 @@ _FAST_COMPILE = "--xla_backend_optimization_level=0 --xla_llvm_disable_expensive
 if "xla_backend_optimization_level" not in os.environ.get("XLA_FLAGS", ""):
     os.environ["XLA_FLAGS"] = (os.environ.get("XLA_FLAGS", "") + " " + _FAST_COMPILE).strip()
 
+# the command line keeps JAX's persistent compilation cache in the user's cache folder; tests that
+# call it in process would fill it: off here (a test of the cache gives its subprocess a folder)
+os.environ.setdefault("JAXSLOSH_CACHE_DIR", "")
+
 import jax  # noqa: E402
 import pytest  # noqa: E402
 from threadpoolctl import threadpool_limits  # noqa: E402

@@ -143,3 +143,25 @@ def test_validity_warnings_reach_the_summary_and_the_file(tmp_path, capsys):
     scene.write_text(text.replace("[[probes]]", second + "\n[[probes]]", 1))
     assert main(["check", str(scene)]) == 0
     assert "overlaps tanks[0]" in capsys.readouterr().err
+
+
+def test_a_second_run_takes_its_compiled_programs_from_the_cache(tmp_path):
+    """JAX's persistent compilation cache in JAXSLOSH_CACHE_DIR: the first run fills it, a second
+    process of the same scene finds its programs there (the same files, no new ones) and gives the
+    same result."""
+    cache = tmp_path / "cache"
+    env = dict(os.environ, JAXSLOSH_CACHE_DIR=str(cache))
+    scene = tmp_path / "s.toml"
+    scene.write_text(open(PAPER).read().replace("duration = 20.0", "duration = 0.3"))
+    outs = []
+    for k in range(2):
+        out = str(tmp_path / f"r{k}.h5")
+        p = subprocess.run([sys.executable, "-m", "jaxslosh", "run", str(scene), "-o", out, "--no-progress"],
+                           capture_output=True, text=True, env=env, timeout=300)
+        assert p.returncode == 0, p.stderr
+        outs.append(out)
+        if k == 0:
+            first = sorted(os.listdir(cache))
+    assert len(first) >= 2 and sorted(os.listdir(cache)) == first
+    with h5py.File(outs[0], "r") as a, h5py.File(outs[1], "r") as b:
+        np.testing.assert_array_equal(a["vessel/roll_pitch_yaw"][:], b["vessel/roll_pitch_yaw"][:])

@@ -113,3 +113,19 @@ def test_surface_figures_need_liquid_fields(tmp_path, capsys):
     save_result(dry, str(h5))
     assert main(["plot", str(h5), "--animate", str(tmp_path / "a.gif")]) == 2
     assert "--animate" in capsys.readouterr().err and not (tmp_path / "a.gif").exists()
+
+
+def test_surface_axes_are_labelled_in_metres(tmp_path):
+    fig = plot_free_surface(hand_result(), str(tmp_path / "s.png"))
+    assert len(fig.axes) == 4
+    for ax in fig.axes:
+        assert (ax.get_xlabel(), ax.get_ylabel(), ax.get_zlabel()) == ("X (m)", "Y (m)", "Z (m)")
+
+
+def test_animation_reports_the_frames_written(tmp_path):
+    calls = []
+    n = animate_free_surface(hand_result(), str(tmp_path / "a.gif"), every=4,
+                             progress=lambda done, total: calls.append((done, total)))
+    assert n == 4
+    # one call as each frame is drawn (frames written before it), then the last: all of them
+    assert calls == [(0, 4), (1, 4), (2, 4), (3, 4), (4, 4)]

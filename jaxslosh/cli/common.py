@@ -4,6 +4,7 @@ messages and exit codes."""
 from __future__ import annotations
 
 import argparse
+import math
 import os
 import sys
 
@@ -28,8 +29,24 @@ class Parser(argparse.ArgumentParser):
         raise InputError(f"{self.prog}: {message}")
 
 
-def enable_x64():
+#: the persistent compilation cache's folder: $JAXSLOSH_CACHE_DIR, else $XDG_CACHE_HOME/jaxslosh/xla;
+#: JAXSLOSH_CACHE_DIR="" turns it off (a JAX_COMPILATION_CACHE_DIR of the user's is used as it is)
+CACHE_ENV = "JAXSLOSH_CACHE_DIR"
+
+
+def setup_jax():
+    """float64, and JAX's persistent compilation cache: a second run of a scene skips XLA."""
     jax.config.update("jax_enable_x64", True)
+    if os.environ.get("JAX_COMPILATION_CACHE_DIR"):
+        return
+    d = os.environ.get(CACHE_ENV)
+    if d is None:
+        d = os.path.join(os.environ.get("XDG_CACHE_HOME") or os.path.expanduser("~/.cache"), "jaxslosh", "xla")
+    if not d:
+        return
+    jax.config.update("jax_compilation_cache_dir", d)
+    jax.config.update("jax_persistent_cache_min_compile_time_secs", 0.0)
+    jax.config.update("jax_persistent_cache_min_entry_size_bytes", -1)
 
 
 def load(path) -> Scene:
@@ -41,16 +58,22 @@ def load(path) -> Scene:
 
 
 def positive(name, value):
-    if value is not None and not (value > 0):
-        raise InputError(f"--{name}: must be positive, got {value}")
+    """A number argument must be positive and finite (argparse's float takes "nan" and "inf")."""
+    if value is not None and not (value > 0 and math.isfinite(value)):
+        raise InputError(f"--{name}: must be a positive finite number, got {value}")
 
 
 def output_folder(flag, path):
-    """The folder a file is to be written in must exist (checked before any computing)."""
+    """The file to be written must not be a folder, and its folder must exist (checked before any
+    computing)."""
     if path:
+        if os.path.isdir(path):
+            raise InputError(f"{flag}: {path} is a folder; give a file name")
         d = os.path.dirname(os.path.abspath(path))
         if not os.path.isdir(d):
             raise InputError(f"{flag}: the folder {d} does not exist")
+        if not os.access(d, os.W_OK):
+            raise InputError(f"{flag}: the folder {d} is not writable")
 
 
 def writable_output(flag, path, inputs=()) -> bool:

@@ -8,10 +8,10 @@ import sys
 from ..fit.identify import METHODS, identify
 from ..fit.params import fit_keys
 from ..fit.quality import data_scene_mismatch
-from ..io.result import load_result
+from ..io.result import ResultFileError, load_result
 from ..plot.fit import _fmt, plot_fit
 from ..scene.types import SceneError
-from .common import EXIT_NUMERICAL, EXIT_OK, InputError, enable_x64, load
+from .common import EXIT_NUMERICAL, EXIT_OK, InputError, load, output_folder, setup_jax
 
 
 def add_parsers(subparsers):
@@ -61,10 +61,9 @@ def cmd_identify(a) -> int:
         raise InputError(f"--data: {a.data}: no such file")
     out = getattr(a, "output", None) or os.path.splitext(os.path.basename(a.scene))[0] + "_fit.json"
     for flag, path in (("-o", out), ("--plot", getattr(a, "plot", None))):
-        if path:
-            d = os.path.dirname(os.path.abspath(path))
-            if not os.path.isdir(d):
-                raise InputError(f"{flag}: the folder {d} does not exist")
+        output_folder(flag, path)
+        if path and os.path.abspath(path) in (os.path.abspath(a.scene), os.path.abspath(a.data)):
+            raise InputError(f"{flag}: {path} is an input of this fit; write the output elsewhere")
     x0 = {}
     for item in _split_keys(getattr(a, "start", None) or ""):
         k, sep, v = item.partition("=")
@@ -75,7 +74,7 @@ def cmd_identify(a) -> int:
         if not sep:
             raise InputError(f"--start: expected KEY=VALUE, got {item!r}")
 
-    enable_x64()
+    setup_jax()
     scene = load(a.scene)            # SceneError (exit 2, naming the key) for a bad scene
     try:
         canon = fit_keys(scene, keys)
@@ -83,6 +82,8 @@ def cmd_identify(a) -> int:
         raise InputError(f"--fit: {e}")
     try:
         measured = load_result(a.data)
+    except ResultFileError as e:         # one line naming the file and the fault
+        raise InputError(f"--data: {e}") from None
     except (OSError, ValueError, KeyError) as e:
         msg = str(e).replace("\n", " ")
         raise InputError(f"--data: {a.data}: not a jaxslosh result file ({msg})")

@@ -28,7 +28,8 @@ def main(argv=None) -> int:
         a = parser().parse_args(argv)
         return COMMANDS[a.command](a)
     except (InputError, SceneError) as e:
-        print(f"error: {e}", file=sys.stderr)
+        # one line, whatever a library's message held (h5py's and the OS's carry newlines)
+        print("error: " + " ".join(str(e).split()), file=sys.stderr)
         return EXIT_INPUT
     except KeyboardInterrupt:
         print("interrupted", file=sys.stderr)

@@ -5,7 +5,7 @@ import json
 import math
 
 from ..analysis.modes import sloshing_modes, structure_modes
-from .common import EXIT_OK, InputError, enable_x64, load
+from .common import EXIT_OK, InputError, setup_jax, load
 
 
 def add_parsers(sub):
@@ -23,7 +23,7 @@ def cmd_modes(a):
     if a.n < 1:
         raise InputError(f"-n: must be at least 1, got {a.n}")
     scene = load(a.scene)
-    enable_x64()
+    setup_jax()
     if a.structure is not None:
         return _structure_modes(scene, a)
     tank = a.tank

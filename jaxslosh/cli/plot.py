@@ -1,16 +1,20 @@
-"""`jaxslosh plot`: time histories of a result, its free surface, an animation."""
+"""`jaxslosh plot`: time histories of a result (or of a sweep file's runs overlaid), its free
+surface, an animation (its frames counted on stderr as they are written)."""
 from __future__ import annotations
 
 import os
 
-from ..io.result import load_result
-from ..plot.results import plot_result
+from ..io.result import FORMAT, ResultFileError, file_format, load_result, open_h5
+from ..io.sweep import SWEEP_FORMAT, load_sweep
+from ..plot.results import plot_result, plot_sweep
 from ..plot.surface import animate_free_surface, plot_free_surface
-from .common import EXIT_OK, InputError, positive
+from ..run.progress import Progress, wanted
+from .common import EXIT_OK, InputError, output_folder, positive
 
 
 def add_parsers(sub):
-    pl = sub.add_parser("plot", help="time histories of a result: roll, pitch, heave and every probe")
+    pl = sub.add_parser("plot", help="time histories of a result: roll, pitch, heave and every probe "
+                                     "(of a sweep file: every run overlaid)")
     pl.add_argument("result")
     pl.add_argument("-o", "--output", help="figure file (default: the result's name with .png)")
     pl.add_argument("--surface", metavar="FIG", help="also draw the deformed free surface at a few instants to FIG")
@@ -19,24 +23,37 @@ def add_parsers(sub):
                     help="magnify liquid displacements in --surface and --animate (default 1)")
     pl.add_argument("--fps", type=float, default=10.0, help="--animate: frames per second (default 10)")
     pl.add_argument("--every", type=int, help="--animate: show every n-th saved frame (default: at most 100 frames)")
+    pl.add_argument("--no-progress", action="store_true",
+                    help="--animate: no progress on stderr (drawn only on a terminal unless JAXSLOSH_PROGRESS=1)")
+
+
+def _format(path) -> str:
+    try:
+        with open_h5(path) as f:
+            return file_format(f, path)
+    except ResultFileError as e:
+        raise InputError(str(e)) from None
 
 
 def cmd_plot(a):
-    if not os.path.exists(a.result):
-        raise InputError(f"{a.result}: no such file")
+    fmt = _format(a.result)
+    positive("scale", a.scale)
     positive("fps", a.fps)
     positive("every", a.every)
-    for flag, path in (("--surface", a.surface), ("--animate", a.animate)):
-        d = os.path.dirname(os.path.abspath(path)) if path else None
-        if d is not None and not os.path.isdir(d):
-            raise InputError(f"{flag}: the folder {d} does not exist")
+    out = a.output or os.path.splitext(a.result)[0] + ".png"
+    for flag, path in (("-o", out), ("--surface", a.surface), ("--animate", a.animate)):
+        output_folder(flag, path)
     if a.animate and not a.animate.lower().endswith(".gif"):
         raise InputError(f"--animate: writes a GIF, the file name must end in .gif, got {a.animate!r}")
-    out = a.output or os.path.splitext(a.result)[0] + ".png"
+    if fmt == SWEEP_FORMAT:
+        return _plot_sweep(a, out)
+    if fmt != FORMAT:
+        raise InputError(f"{a.result}: not a jaxslosh result file "
+                         f"({'format ' + repr(fmt) if fmt else 'no format attribute'})")
     try:
         r = load_result(a.result)
-    except (OSError, ValueError) as e:
-        raise InputError(f"{a.result}: not a readable jaxslosh result ({e})")
+    except ResultFileError as e:
+        raise InputError(str(e)) from None
     for flag, path in (("--surface", a.surface), ("--animate", a.animate)):
         if path and not r.tanks:
             raise InputError(f"{flag}: {a.result} holds no liquid fields (a scene with tanks, run without --no-fields)")
@@ -46,6 +63,27 @@ def cmd_plot(a):
         plot_free_surface(r, a.surface, scale=a.scale)
         print(f"wrote {a.surface}")
     if a.animate:
-        n = animate_free_surface(r, a.animate, scale=a.scale, fps=a.fps, every=a.every)
+        bar = Progress(enabled=wanted(a.no_progress))
+        bar.phase("frames", "writing the animation", unit="frame")
+        try:
+            n = animate_free_surface(r, a.animate, scale=a.scale, fps=a.fps, every=a.every,
+                                     progress=lambda done, total: bar.update(done, total))
+        finally:
+            bar.close()
         print(f"wrote {a.animate} ({n} frames)")
+    return EXIT_OK
+
+
+def _plot_sweep(a, out):
+    """A sweep file: its runs overlaid. Its runs keep no liquid meshes, so no surface figures."""
+    for flag, path in (("--surface", a.surface), ("--animate", a.animate)):
+        if path:
+            raise InputError(f"{flag}: {a.result} is a sweep file (format {SWEEP_FORMAT!r}), which keeps no liquid "
+                             f"meshes; run one of its scenes with `jaxslosh run` to draw its free surface")
+    try:
+        sw = load_sweep(a.result)
+    except ResultFileError as e:
+        raise InputError(str(e)) from None
+    plot_sweep(sw.params, sw.result, sw.statuses, out, sw.scene_text)
+    print(f"wrote {out} ({len(sw.statuses)} runs of a sweep)")
     return EXIT_OK

@@ -4,14 +4,14 @@ from __future__ import annotations
 
 import os
 import sys
-import time
 
 from ..build.cost import check_cost, describe_cost, estimate
 from ..build.effects import describe, effects_summary
 from ..io.output import OutputError
 from ..io.status import Status
+from ..run.progress import wanted
 from ..run.tofile import run_to_file
-from .common import (EXIT_INTERRUPTED, EXIT_IO, EXIT_NUMERICAL, EXIT_OK, InputError, enable_x64, load, overridden,
+from .common import (EXIT_INTERRUPTED, EXIT_IO, EXIT_NUMERICAL, EXIT_OK, InputError, setup_jax, load, overridden,
                      positive, writable_output)
 
 
@@ -21,7 +21,8 @@ def add_parsers(sub):
     r.add_argument("-o", "--output", help="result file (default: the scene's name with .h5, here)")
     r.add_argument("--duration", type=float, help="override simulation.duration (s)")
     r.add_argument("--dt", type=float, help="override simulation.dt (s)")
-    r.add_argument("--no-progress", action="store_true", help="no progress bar")
+    r.add_argument("--no-progress", action="store_true",
+                   help="no progress on stderr (drawn only on a terminal unless JAXSLOSH_PROGRESS=1)")
     r.add_argument("--no-fields", action="store_true", help="do not store the liquid displacement fields")
     r.add_argument("--force", action="store_true", help="run even when the scene's cost estimate exceeds this machine")
     c = sub.add_parser("check", help="validate a scene; list what it will simulate and what it will cost")
@@ -37,21 +38,18 @@ def cmd_run(a):
     out = a.output or os.path.splitext(os.path.basename(a.scene))[0] + ".h5"
     replacing = writable_output("-o", out, inputs=(a.scene,))
     check_cost(scene, force=a.force)
-    enable_x64()
+    setup_jax()
     if replacing:
         print(f"note: replacing the existing result file {out}", file=sys.stderr)
-    t0 = time.perf_counter()
     try:
-        rep = run_to_file(scene, out, progress=not a.no_progress, save_fields=False if a.no_fields else None)
+        rep = run_to_file(scene, out, progress=wanted(a.no_progress), save_fields=False if a.no_fields else None)
     except OutputError as e:
         raise InputError(f"-o: {e.strerror}") from None
-    total = time.perf_counter() - t0
     for w in rep.warnings:
         print(f"warning: {w}", file=sys.stderr)
     code = Status(rep.code)
     if code == Status.OK:
-        print(f"done: {rep.steps} steps to t = {rep.steps * dt:.6g} s in {total:.2f} s wall, compilation included "
-              f"({rep.wall:.2f} s after the first chunk) -> {out}")
+        print(f"done: {rep.steps} steps to t = {rep.steps * dt:.6g} s in {timing(rep.times)} -> {out}")
         return EXIT_OK
     if code.numerical:
         print(f"jaxslosh: numerical failure at {rep.status}; {rep.steps} steps kept in {out}", file=sys.stderr)
@@ -61,6 +59,13 @@ def cmd_run(a):
         return EXIT_INTERRUPTED
     print(f"error: {out}: {rep.status}; {rep.steps} steps kept", file=sys.stderr)
     return EXIT_IO
+
+
+def timing(times: dict) -> str:
+    """"12.34 s wall (build 0.50 s, compile 10.20 s, stepping 1.64 s)": the phases of the run on
+    the progress display's clock, so the total is the elapsed time it showed last."""
+    parts = ", ".join(f"{name} {s:.2f} s" for name, s in times.items())
+    return f"{sum(times.values()):.2f} s wall ({parts})"
 
 
 def cmd_check(a):

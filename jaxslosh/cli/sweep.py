@@ -12,7 +12,7 @@ from ..io.sweep import write_sweep
 from ..run.batch import simulate_batch
 from ..scene.keys import traceable
 from ..scene.types import SceneError
-from .common import InputError, enable_x64, load, output_folder, overridden, positive
+from .common import InputError, setup_jax, load, output_folder, overridden, positive
 
 
 def parse_grid(items):
@@ -64,7 +64,7 @@ def cmd_sweep(a):
         raise InputError(f"--param {e}") from None
     out = a.output or os.path.splitext(os.path.basename(a.scene))[0] + "_sweep.h5"
     output_folder("-o", out)
-    enable_x64()
+    setup_jax()
     params = grid_product(grid)
     n = len(next(iter(params.values())))
     print(f"sweep: {n} runs of {a.scene} in one batch", file=sys.stderr)

@@ -55,6 +55,8 @@ use >= 2 elements along every direction in which the surface should move.
 """
 from __future__ import annotations
 
+import contextlib
+
 import jax
 import jax.numpy as jnp
 import numpy as np
@@ -120,7 +122,8 @@ def element_matrices(xe, xf, rho, c, g, h, form, with_parts=True):
                     pad = _CHUNK - len(chunk)
                     if pad:
                         chunk = np.concatenate([chunk, np.repeat(chunk[:1], pad, axis=0)])
-                    blocks.append(np.asarray(fn(prm, jnp.asarray(chunk, dtype=jnp.float64)))[:_CHUNK - pad])
+                    blocks.append(np.asarray(fn(prm, jnp.asarray(chunk, dtype=jnp.float64), concrete=True))
+                                  [:_CHUNK - pad])
                 out[name] = np.concatenate(blocks)[expand]
             else:                     # traced: the same fixed-shape chunks, cut by dynamic slices
                 x = jnp.asarray(x, dtype=jnp.float64)
@@ -143,6 +146,21 @@ def _distinct(x, horizontal_only):
     return x[first], inverse.reshape(-1)
 
 _KERNEL_CACHE: dict = {}
+
+
+def _no_eager_folding():
+    """A context in which a jit trace stages its operations on constants even inside
+    `jax.ensure_compile_time_eval()` (JAX's eager_constant_folding state; a JAX without it: nothing)."""
+    state = getattr(getattr(jax, "_src", None) and jax._src.config, "eager_constant_folding", None)
+    return state(False) if state is not None else contextlib.nullcontext()
+
+
+def _kernel_compiler_options():
+    """XLA's cheapest CPU codegen (no LLVM optimisation, the classic loop emitters) for the kernels,
+    which run once per build; None elsewhere (the options are the CPU backend's)."""
+    if jax.default_backend() != "cpu":
+        return None
+    return {"xla_backend_optimization_level": 0, "xla_cpu_use_fusion_emitters": False}
 
 
 def _kernels(form):
@@ -231,9 +249,29 @@ def _kernels(form):
         A = 4.0 * face_at(y, jnp.zeros(2))[1]
         return 0.5 * SURFACE_HOURGLASS * prm[0] * prm[2] * A * (jnp.asarray(_FACE_HOURGLASS) @ uz / 4.0) ** 2
 
+    def jit(f):
+        """The jitted kernel for traced calls; for concrete ones (`concrete=True`) compiled ahead of
+        time, once per shape, with the cheapest CPU codegen (the kernels run once per build on a few
+        chunks) and traced as a staged program even under `jax.ensure_compile_time_eval()`, where
+        run/simulate.py prepare builds: there every constant operation of a jit trace would run
+        eagerly, op by op, each compiling a tiny XLA program of its own. A compiled kernel runs
+        eagerly even under a user's outer jit; the element matrices are the same bit for bit."""
+        out = jax.jit(f)
+        compiled = {}
+
+        def call(prm, x, concrete=False):
+            if not concrete:
+                return out(prm, x)
+            key = (x.shape, str(x.dtype), prm.shape)
+            if key not in compiled:
+                with _no_eager_folding():
+                    compiled[key] = out.lower(prm, x).compile(compiler_options=_kernel_compiler_options())
+            return compiled[key](prm, x)
+        return call
+
     def batched(fn, size, derivative=jax.hessian):
         H = derivative(fn)
-        return jax.jit(jax.vmap(lambda prm, x: H(jnp.zeros(size, dtype=x.dtype), prm, x), in_axes=(None, 0)))
+        return jit(jax.vmap(lambda prm, x: H(jnp.zeros(size, dtype=x.dtype), prm, x), in_axes=(None, 0)))
 
     kern = {
         "mass": (batched(e_kinetic, 8), False),
@@ -246,7 +284,7 @@ def _kernels(form):
     else:
         kern["free_surface"] = (batched(e_surface_mean, 4), True)
         kern["axial_curl"] = (batched(axial_curl, 24, jax.jacfwd), False)
-        kern["volume"] = (jax.jit(jax.vmap(volume, in_axes=(None, 0))), False)
+        kern["volume"] = (jit(jax.vmap(volume, in_axes=(None, 0))), False)
         kern["coupling"] = (batched(e_coupling, 24), False)
         kern["surface_hourglass"] = (batched(e_surface_hourglass, 4), True)
     _KERNEL_CACHE[form] = kern

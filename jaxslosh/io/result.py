@@ -7,6 +7,8 @@ updated after each chunk, so a file left by a killed run opens and holds the ste
 """
 from __future__ import annotations
 
+import contextlib
+import os
 from typing import Optional
 
 import equinox as eqx
@@ -184,24 +186,117 @@ def save_result(r: Result, path: str) -> None:
     w.close(r.status, r.steps_done, r.status_code)
 
 
-def _attr_str(v) -> str:
+def attr_str(v) -> str:
     return v.decode() if isinstance(v, bytes) else str(v)
 
 
+class ResultFileError(ValueError, OSError):
+    """A result (or sweep) file that cannot be read; the message is one line naming the file and
+    what is wrong with it (the command line prints it as it is, exit status 2). Both a ValueError
+    and an OSError: code written when load_result raised either (a wrong format; h5py's errors)
+    still catches it."""
+
+
+def _h5_reason(e: Exception) -> str:
+    """h5py's message on one line and cut short (its tail is HDF5's internals: the time, the file
+    descriptor, buffer addresses)."""
+    text = " ".join(str(e).split())
+    return text if len(text) <= 120 else text[:117] + "..."
+
+
+@contextlib.contextmanager
+def open_h5(path: str):
+    """The HDF5 file at `path`, open for reading, or a ResultFileError that says why not. h5py
+    reports a damaged file by several exceptions (OSError, RuntimeError, KeyError, ...), wherever
+    a read meets the damage: inside this block each becomes a ResultFileError naming the file."""
+    if os.path.isdir(path):
+        raise ResultFileError(f"{path}: is a directory, not a result file")
+    if not os.path.exists(path):
+        raise ResultFileError(f"{path}: no such file")
+    try:
+        f = h5py.File(path, "r")
+    except OSError as e:
+        raise ResultFileError(f"{path}: not an HDF5 file, or truncated or corrupt ({_h5_reason(e)})") from None
+    try:
+        yield f
+    except ResultFileError:
+        raise
+    except (OSError, RuntimeError, KeyError, ValueError, TypeError, IndexError) as e:
+        raise ResultFileError(f"{path}: cannot be read, the file is truncated or corrupt ({_h5_reason(e)})") from None
+    finally:
+        try:
+            f.close()
+        except (OSError, RuntimeError):
+            pass
+
+
+def file_format(f: h5py.File, path: str) -> str:
+    """The file's `format` attribute, after checking its `format_version` is one this jaxslosh reads
+    (files written before the attribute existed are version 1); a newer one is refused, since its
+    datasets may mean what this version does not know."""
+    fmt = attr_str(f.attrs.get("format", ""))
+    v = f.attrs.get("format_version", 1)
+    try:
+        version = int(v)
+        if version != float(v):
+            raise ValueError
+    except (TypeError, ValueError):
+        raise ResultFileError(f"{path}: format_version {attr_str(v)!r} is not a whole number") from None
+    if version > FORMAT_VERSION:
+        raise ResultFileError(f"{path}: format_version {version} is newer than jaxslosh {__version__} reads "
+                              f"(up to {FORMAT_VERSION}); upgrade jaxslosh to read it")
+    return fmt
+
+
+def read_frames(f: h5py.File, names, axis: int = 0) -> dict:
+    """{dataset: array} of the frame datasets `names` (absent ones skipped), cut to the frames every
+    one of them holds along `axis` (a run stopped while writing a chunk may have grown some
+    datasets and not yet the others: the frames all hold are the ones written)."""
+    present = [k for k in names if k in f]
+    if not present:
+        return {}
+    n = min(f[k].shape[axis] for k in present)
+    cut = (slice(None),) * axis + (slice(0, n),)
+    return {k: np.asarray(f[k][cut]) for k in present}
+
+
+#: the datasets every result holds (solver/constraint came later: older files lack it)
+REQUIRED = ("time", "vessel/position", "vessel/quaternion", "vessel/angular_velocity", "vessel/roll_pitch_yaw",
+            "energy/kinetic", "energy/potential", "solver/iterations", "solver/residual")
+
+
+def check_required(d: dict, probe_names, path: str) -> None:
+    """A ResultFileError naming the first dataset a result needs that `d` lacks."""
+    need = list(REQUIRED) + [f"probes/{p}/{q}" for p in probe_names for q in ("position", "displacement")]
+    for k in need:
+        if k not in d:
+            raise ResultFileError(f"{path}: the dataset /{k} is missing")
+
+
 def load_result(path: str) -> Result:
-    with h5py.File(path, "r") as f:
+    """The result file at `path` (SPEC section 3). A file that is not one, cannot be read, lacks a
+    dataset or has a newer format_version raises ResultFileError (a ValueError) with a one-line
+    message naming the file and the fault."""
+    with open_h5(path) as f:
+        fmt = file_format(f, path)
+        if fmt != FORMAT:
+            what = ("a sweep file: jaxslosh.io.sweep.load_sweep reads it" if fmt == "jaxslosh.sweep"
+                    else f"format {fmt!r}" if fmt else "no format attribute")
+            raise ResultFileError(f"{path}: not a jaxslosh result file ({what})")
         a = f.attrs
-        if _attr_str(a.get("format", "")) != FORMAT:
-            raise ValueError(f"{path}: not a jaxslosh result file")
-        n = f["time"].shape[0]
         probes = list(f["probes"]) if "probes" in f else []
-        tanks = {name: (np.asarray(f[f"tanks/{name}/nodes"]), np.asarray(f[f"tanks/{name}/elements"]))
-                 for name in (f["tanks"] if "tanks" in f else [])}
-        d = {k: np.asarray(f[k][:n]) for k in schema(probes, {name: 0 for name in tanks}) if k in f}
-        status = _attr_str(a.get("status", "ok"))
+        tanks = {}
+        for name in (f["tanks"] if "tanks" in f else []):
+            for part in ("nodes", "elements"):
+                if f"tanks/{name}/{part}" not in f:
+                    raise ResultFileError(f"{path}: the dataset /tanks/{name}/{part} is missing")
+            tanks[name] = (np.asarray(f[f"tanks/{name}/nodes"]), np.asarray(f[f"tanks/{name}/elements"]))
+        d = read_frames(f, schema(probes, {name: 0 for name in tanks}))
+        check_required(d, probes, path)
+        status = attr_str(a.get("status", "ok"))
         code = int(a["status_code"]) if "status_code" in a else None
         return result_from(d, probes, tanks, status=status, steps_done=int(a.get("steps_done", 0)),
-                           scene_text=_attr_str(a.get("scene", "")), status_code=code)
+                           scene_text=attr_str(a.get("scene", "")), status_code=code)
 
 
 def truncated(r: Result, n: int) -> Result:

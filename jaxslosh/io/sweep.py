@@ -3,11 +3,14 @@ run axis, the grid under /sweep/<key> (one value per run) and one status per run
 `statuses`)."""
 from __future__ import annotations
 
+from typing import NamedTuple
+
 import h5py
 import numpy as np
 
 from .._version import __version__
-from .result import result_frames
+from .result import (Result, ResultFileError, attr_str, check_required, file_format, open_h5, read_frames,
+                     result_from, result_frames, schema)
 
 
 SWEEP_FORMAT = "jaxslosh.sweep"
@@ -26,3 +29,32 @@ def write_sweep(path, scene, params, result, statuses):
             f.create_dataset(f"sweep/{k}", data=np.asarray(v))
         for k, v in result_frames(result).items():
             f.create_dataset(k, data=v)
+
+
+class Sweep(NamedTuple):
+    """A sweep file read back: the grid {key: values, one per run}, the runs' results as one Result
+    with a leading run axis, each run's status, and the scene's TOML text."""
+    params: dict
+    result: Result
+    statuses: list
+    scene_text: str
+
+
+def load_sweep(path) -> Sweep:
+    """The sweep file at `path`; a file that is not one or cannot be read raises ResultFileError."""
+    with open_h5(path) as f:
+        fmt = file_format(f, path)
+        if fmt != SWEEP_FORMAT:
+            raise ResultFileError(f"{path}: not a jaxslosh sweep file (format {fmt!r})")
+        probes = list(f["probes"]) if "probes" in f else []
+        params = read_frames(f, [f"sweep/{k}" for k in (f["sweep"] if "sweep" in f else [])])
+        d = read_frames(f, schema(probes), axis=1)
+        check_required(d, probes, path)
+        runs = d["time"].shape[0]
+        if not params or any(len(v) != runs for v in params.values()):
+            raise ResultFileError(f"{path}: the grid /sweep/<key> is missing or does not hold one value per run")
+        statuses = [attr_str(x) for x in f.attrs.get("statuses", ["ok"] * runs)]
+        scene = attr_str(f.attrs.get("scene", ""))
+    r = result_from(d, probes, status="ok" if all(x == "ok" for x in statuses) else "some runs failed",
+                    scene_text=scene)
+    return Sweep({k[len("sweep/"):]: v for k, v in params.items()}, r, statuses, scene)

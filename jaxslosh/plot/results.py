@@ -1,9 +1,15 @@
-"""Time histories of a result: roll, pitch, heave and every probe."""
+"""Time histories of a result: roll, pitch, heave and every probe; of a sweep, every run overlaid."""
 from __future__ import annotations
 
 import numpy as np
+from matplotlib import colormaps
 from matplotlib.backends.backend_agg import FigureCanvasAgg
 from matplotlib.figure import Figure
+
+from ..scene.load import tomllib
+
+#: a sweep's figure names each run in its legend up to this many runs (more would hide the curves)
+MAX_LEGEND = 12
 
 
 def figure(width: float, height: float) -> Figure:
@@ -13,28 +19,91 @@ def figure(width: float, height: float) -> Figure:
     return fig
 
 
-def plot_result(r, out: str) -> None:
-    """Time histories: roll, pitch, heave and the vertical displacement of every probe."""
-    t = np.asarray(r.time)
-    rpy = np.asarray(r.vessel.roll_pitch_yaw)
-    z = np.asarray(r.vessel.position)[:, 2]
-    n_probe = len(r.probes)
-    rows = 2 + (1 if n_probe else 0)
+def scene_title(scene_text: str, default: str = "jaxslosh result") -> str:
+    """The scene's `title` from the TOML text a result file keeps (attribute `scene`), else `default`."""
+    try:
+        title = tomllib.loads(scene_text or "").get("title")
+    except (tomllib.TOMLDecodeError, TypeError, ValueError):
+        return default
+    return title.strip() if isinstance(title, str) and title.strip() else default
+
+
+def _axes(r):
+    rows = 2 + (1 if r.probes else 0)
     fig = figure(9, 2.6 * rows)
     ax = fig.subplots(rows, 1, sharex=True)
-    ax[0].plot(t, np.degrees(rpy[:, 0]), label="roll")
-    ax[0].plot(t, np.degrees(rpy[:, 1]), label="pitch")
     ax[0].set_ylabel("angle (deg)")
-    ax[0].legend(loc="upper right")
-    ax[1].plot(t, z, color="C2")
     ax[1].set_ylabel("heave (m)")
-    if n_probe:
-        for name, p in r.probes.items():
-            ax[2].plot(t, np.asarray(p.displacement)[:, 2], label=f"probe {name}")
+    if r.probes:
         ax[2].set_ylabel("vertical displacement (m)")
-        ax[2].legend(loc="upper right")
     ax[-1].set_xlabel("time (s)")
-    status = "" if r.status == "ok" else f"  [{r.status}]"
-    fig.suptitle(f"jaxslosh result{status}", fontsize=10)
+    return fig, ax
+
+
+def _finish(fig, title: str, out: str) -> Figure:
+    fig.suptitle(title, fontsize=10)
     fig.tight_layout()
     fig.savefig(out, dpi=110)
+    return fig
+
+
+def plot_result(r, out: str) -> Figure:
+    """Time histories: roll, pitch, heave and the vertical displacement of every probe, titled with
+    the scene's title (and the status of a run that failed). Returns the figure written."""
+    t = np.asarray(r.time)
+    rpy = np.asarray(r.vessel.roll_pitch_yaw)
+    fig, ax = _axes(r)
+    ax[0].plot(t, np.degrees(rpy[:, 0]), label="roll")
+    ax[0].plot(t, np.degrees(rpy[:, 1]), label="pitch")
+    ax[0].legend(loc="upper right")
+    ax[1].plot(t, np.asarray(r.vessel.position)[:, 2], color="C2")
+    if r.probes:
+        for name, p in r.probes.items():
+            ax[2].plot(t, np.asarray(p.displacement)[:, 2], label=f"probe {name}")
+        ax[2].legend(loc="upper right")
+    status = "" if r.status == "ok" else f"  [{r.status}]"
+    return _finish(fig, scene_title(r.scene_text) + status, out)
+
+
+def _short_keys(keys):
+    """The swept keys by their last dotted part where that names them uniquely (gm_t, not
+    vessel.hydrostatics.gm_t), else in full."""
+    last = [k.rsplit(".", 1)[-1] for k in keys]
+    return [s if last.count(s) == 1 else k for s, k in zip(last, keys)]
+
+
+def plot_sweep(params: dict, r, statuses, out: str, scene_text: str = "") -> Figure:
+    """A sweep file's runs overlaid (one colour per run, the same in every panel): roll (solid) and
+    pitch (dashed), heave, and each probe's vertical displacement (one line style per probe); the
+    legend names each run's swept values (up to MAX_LEGEND runs), a failed run is marked. Returns
+    the figure written."""
+    keys = list(params)
+    names = _short_keys(keys)
+    t = np.asarray(r.time)
+    rpy = np.degrees(np.asarray(r.vessel.roll_pitch_yaw))
+    z = np.asarray(r.vessel.position)[..., 2]
+    runs = t.shape[0]
+    fig, ax = _axes(r)
+    # up to ten runs the default colour cycle (easiest told apart); more: a colour map in run order
+    cmap = colormaps["viridis"] if runs > 10 else None
+    styles = ["-", "--", ":", "-."]
+    for i in range(runs):
+        c = cmap(i / max(1, runs - 1)) if cmap is not None else f"C{i % 10}"
+        label = ", ".join(f"{n} = {params[k][i]:.4g}" for n, k in zip(names, keys))
+        if statuses[i] != "ok":
+            label += " [failed]"
+        ax[0].plot(t[i], rpy[i, :, 0], color=c, label=label if runs <= MAX_LEGEND else None)
+        ax[0].plot(t[i], rpy[i, :, 1], color=c, ls="--", lw=0.9)
+        ax[1].plot(t[i], z[i], color=c)
+        for j, (pname, p) in enumerate(r.probes.items()):
+            ax[2].plot(t[i], np.asarray(p.displacement)[i, :, 2], color=c, ls=styles[j % len(styles)],
+                       label=f"probe {pname}" if i == 0 else None)
+    ax[0].set_ylabel("roll (solid), pitch (dashed) (deg)")
+    if runs <= MAX_LEGEND:             # beside the panel: a legend of many runs would cover their curves
+        ax[0].legend(loc="upper left", bbox_to_anchor=(1.01, 1.0), fontsize=7, borderaxespad=0.0)
+    if r.probes:
+        ax[2].legend(loc="upper right", fontsize=7)
+    ranges = ", ".join(f"{n} {np.min(params[k]):.4g} to {np.max(params[k]):.4g}" for n, k in zip(names, keys))
+    failed = sum(s != "ok" for s in statuses)
+    return _finish(fig, f"{scene_title(scene_text, 'jaxslosh sweep')}: {runs} runs ({ranges})"
+            + (f"  [{failed} failed]" if failed else ""), out)

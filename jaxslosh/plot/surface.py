@@ -59,18 +59,19 @@ class _Tanks:
         ax.set_ylim(X0[1] - self.span, X0[1] + self.span)
         ax.set_zlim(X0[2] - self.span, X0[2] + self.span)
         ax.set_box_aspect((1, 1, 1))
-        ax.set_xlabel("X")
-        ax.set_ylabel("Y")
-        ax.set_zlabel("Z")
+        ax.set_xlabel("X (m)")
+        ax.set_ylabel("Y (m)")
+        ax.set_zlabel("Z (m)")
 
 
 def _surface_title(scale: float) -> str:
     return "tank and free surface in the inertial frame" + (f" (displacements x{scale:g})" if scale != 1 else "")
 
 
-def plot_free_surface(r, out: str, times=None, scale: float = 1.0) -> None:
+def plot_free_surface(r, out: str, times=None, scale: float = 1.0):
     """The counterpart of the paper's Figure 5(a): the hull's attitude and the deformed free surface
-    of every tank at a few instants, in the inertial frame (displacements magnified by `scale`)."""
+    of every tank at a few instants, in the inertial frame (displacements magnified by `scale`).
+    Returns the figure written."""
     tanks = _Tanks(r)
     if times is None:
         times = np.linspace(tanks.time[0], tanks.time[-1], 4)
@@ -81,14 +82,16 @@ def plot_free_surface(r, out: str, times=None, scale: float = 1.0) -> None:
     fig.suptitle(_surface_title(scale), fontsize=10)
     fig.tight_layout()
     fig.savefig(out, dpi=100)
+    return fig
 
 
 def animate_free_surface(r, out: str, scale: float = 1.0, fps: float = 10.0, every: int | None = None,
-                         max_frames: int = 100, dpi: int = 80) -> int:
+                         max_frames: int = 100, dpi: int = 80, progress=None) -> int:
     """An animated GIF of the tanks and their deformed free surface in the inertial frame (the frames
     of `plot_free_surface`, one per shown instant; displacements magnified by `scale`). Every
     `every`-th saved frame is shown (default: the stride that keeps at most `max_frames`), `fps`
-    frames per second. Returns the number of frames written."""
+    frames per second. `progress(done, total)`, if given, is called as the frames are written
+    (done = frames written so far, last with done = total). Returns the number of frames written."""
     tanks = _Tanks(r)
     n = len(tanks.time)
     if every is None:
@@ -108,5 +111,10 @@ def animate_free_surface(r, out: str, scale: float = 1.0, fps: float = 10.0, eve
         return ()
 
     anim = FuncAnimation(fig, frame, frames=idx, init_func=lambda: (), blit=False, cache_frame_data=False)
-    anim.save(out, writer=PillowWriter(fps=fps), dpi=dpi)
+    # matplotlib calls back once a frame is drawn, before it is rendered into the file: frames
+    # written so far = its index
+    report = None if progress is None else (lambda i, _: progress(i, len(idx)))
+    anim.save(out, writer=PillowWriter(fps=fps), dpi=dpi, progress_callback=report)
+    if progress is not None:
+        progress(len(idx), len(idx))
     return len(idx)

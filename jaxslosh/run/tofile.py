@@ -1,8 +1,13 @@
 """The command line's run: chunks of the compiled loop appended to the result file as they finish,
-with a progress bar, so that long runs show progress and a killed run leaves a readable file."""
+with its progress on stderr, so that long runs show progress and a killed run leaves a readable file
+that says how it ended.
+
+The chunk is compiled ahead of time (`advance.lower(...).compile()`, equinox's AOT API), as a phase
+of its own: the first chunk then runs precompiled, so the stepping phase, its rate and its estimate
+hold steps only, and the compile time is measured apart instead of hiding in the first chunk."""
 from __future__ import annotations
 
-import time as _time
+import os
 from typing import NamedTuple, Optional
 
 import jax
@@ -12,20 +17,21 @@ from ..io.output import is_disk_full
 from ..io.result import ResultWriter
 from ..io.status import Status
 from ..scene.types import Scene
+from .guard import Interrupted, interrupts
 from .loop import advance, core, frame_datasets, start
 from .progress import Progress
-from .guard import Interrupted, interrupts
 from .simulate import failure_message, prepare
 from .validity import Watch
 
 
 class RunReport(NamedTuple):
     """How a run to a file ended: its status text and code (io.status), the steps in the file, the
-    wall seconds of the stepping after the first chunk compiled, and the validity warnings."""
+    wall seconds of its phases ({"build", "compile", "stepping"}, contiguous on one clock: their sum
+    is the run's wall time), and the validity warnings."""
     status: str
     code: int
     steps: int
-    wall: float
+    times: dict
     warnings: tuple
 
 
@@ -33,23 +39,32 @@ def run_to_file(scene: Scene, out: str, *, progress: bool = True,
                 save_fields: Optional[bool] = None) -> RunReport:
     """The CLI's run: chunks of the compiled loop appended to `out` as they finish. The file always
     says how the run ended (`status`, `status_code`, `steps_done`): ok, a numerical failure, an
-    interruption (SIGINT, SIGTERM), a full disk or another error (then re-raised)."""
-    setup = prepare(scene)
-    b, solver = setup.built, setup.solver
-    se = setup.save_every
-    n_frames = setup.n_steps // se
-    N = b.system.liquid.n_nodes
-    if save_fields is None:
-        save_fields = N * 3 * 8 * (n_frames + 1) < 200e6
-    chunk_frames = scene.simulation.chunk or max(1, min(n_frames, max(1, 500 // se)))
-    writer = ResultWriter(out, scene.text, b.probes.names, b.tanks if save_fields else ())
+    interruption (SIGINT, SIGTERM), a full disk or another error (then re-raised). `progress`: draw
+    the phases on stderr."""
+    bar = Progress(enabled=progress)
     status, code, steps_written = "ok", Status.OK, 0
     watch = Watch(scene)
-    bar = Progress(setup.n_steps, enabled=progress)
-    t_loop = None
+    writer = None
     try:
-        with interrupts():
-            carry, f0 = start(core(b), solver)
+        with interrupts() as stop:
+            bar.phase("build", "building the model")
+            setup = prepare(scene)
+            b, solver = setup.built, setup.solver
+            se = setup.save_every
+            n_frames = setup.n_steps // se
+            N = b.system.liquid.n_nodes
+            if save_fields is None:
+                save_fields = N * 3 * 8 * (n_frames + 1) < 200e6
+            chunk_frames = scene.simulation.chunk or max(1, min(n_frames, max(1, 500 // se)))
+            writer = ResultWriter(out, scene.text, b.probes.names, b.tanks if save_fields else ())
+            stop.check()
+            bar.phase("compile", "compiling the step")
+            bc = core(b)
+            carry, f0 = start.lower(bc, solver).compile(compiler_options=compiler_options("start"))(bc, solver)
+            chunk = advance.lower(bc, solver, carry, chunk_frames, se).compile(
+                compiler_options=compiler_options("advance"))
+            stop.check()
+            bar.phase("stepping", "stepping", total=setup.n_steps)
             pending = jax.tree_util.tree_map(lambda x: np.asarray(x)[None], f0)
             p0 = pending.probes[:1]
             done_frames = 0
@@ -63,10 +78,9 @@ def run_to_file(scene: Scene, out: str, *, progress: bool = True,
                 steps_written = steps
                 if bool(carry.failed) or done_frames >= n_frames:
                     break
-                carry, fr = advance(core(b), solver, carry, chunk_frames, se)
+                stop.check()
+                carry, fr = chunk(bc, solver, carry, chunk_frames, se)
                 fr = jax.device_get(fr)
-                if t_loop is None:
-                    t_loop = _time.perf_counter()
                 take = min(chunk_frames, n_frames - done_frames)
                 pending = jax.tree_util.tree_map(lambda x: x[:take], fr)
                 done_frames += take
@@ -74,25 +88,43 @@ def run_to_file(scene: Scene, out: str, *, progress: bool = True,
             if bool(carry.failed):
                 status, code = failure_message(carry, solver.h, solver.tol), int(carry.code)
     except KeyboardInterrupt as e:
-        how = str(e) if isinstance(e, Interrupted) else "SIGINT"
+        how = str(e) if isinstance(e, Interrupted) else "SIGINT"       # Python's own KeyboardInterrupt
         status, code = f"interrupted ({how}) after {steps_written} steps", Status.INTERRUPTED
+        if writer is None:          # nothing was written yet: nothing to say it in
+            raise
     except Exception as e:
-        if not is_disk_full(e):
+        if not is_disk_full(e) or writer is None:
             status, code = f"error: {type(e).__name__}: {e}", Status.ERROR
             raise
         status, code = f"disk full ({_reason(e)})", Status.DISK_FULL
     finally:
-        bar.close()
+        times = bar.close()
         warnings = tuple(watch.warnings())
-        try:
-            writer.close(status, steps_written, code, warnings)
-        except Exception as e:      # a full disk may refuse the closing attributes too
-            if not is_disk_full(e):
-                raise
-            status, code = f"disk full ({_reason(e)})", Status.DISK_FULL
-    wall = (_time.perf_counter() - t_loop) if t_loop is not None else 0.0
-    return RunReport(status, int(code), steps_written, wall, warnings)
+        if writer is not None:
+            try:
+                writer.close(status, steps_written, code, warnings)
+            except Exception as e:      # a full disk may refuse the closing attributes too
+                if not is_disk_full(e):
+                    raise
+                status, code = f"disk full ({_reason(e)})", Status.DISK_FULL
+    return RunReport(status, int(code), steps_written, times, warnings)
 
 
 def _reason(e: BaseException) -> str:
     return e.strerror if isinstance(e, OSError) and e.strerror else str(e).splitlines()[0]
+
+
+#: JAXSLOSH_FAST_COMPILE=1: the loop too with XLA's classic CPU loop emitters (about half its compile
+#: time; the results then differ at round-off from the default program)
+FAST_COMPILE_ENV = "JAXSLOSH_FAST_COMPILE"
+
+
+def compiler_options(which: str):
+    """XLA options of the run's two programs (CPU only). `start` runs once: XLA's classic loop
+    emitters compile it in about half the time with the same results bit for bit. The loop keeps
+    XLA's defaults unless JAXSLOSH_FAST_COMPILE=1."""
+    if jax.default_backend() != "cpu":
+        return None
+    if which == "start" or os.environ.get(FAST_COMPILE_ENV) == "1":
+        return {"xla_cpu_use_fusion_emitters": False}
+    return None

@@ -164,7 +164,7 @@ def static_structures(system, solver: Solver, c0: Config, v0, alg0):
         return jnp.where(held_x, 0.0, mb.constraint_rows(system, c, alg, mb.constraint(system, c, alg), gsc))
 
     x, (it, err, ok) = solve_root(lambda x: Rm(x) + Rc(x), L.to_x(z, alg0), Cinv, scale, solver.tol,
-                                  solver.max_iter, L.n_small, split=(Rc, L.n_rigid), implicit=solver.implicit)
+                                  solver.max_iter, L.n_small, split=(Rm, Rc, L.n_rigid), implicit=solver.implicit)
     dyn, alg = L.from_x(x)
     c = mb.advance(system, c0, dyn)
     # every structure moves rigidly with the vessel: V_s = V + (A omega) x (X_s - X0), omega_s = A_s^T A omega
@@ -185,7 +185,7 @@ def _flex_initial_state(system, solver: Solver, c0: Config, v0, alg0):
     z0 = None if memory is None else memory.init()
     Rm, Rc = mb.initial_residuals(system, c0, v0, alg0, jnp.zeros(()), gsc, None if memory is None else memory.force(z0))
     x, (it, err, ok) = solve_root(lambda x: Rm(x) + Rc(x), jnp.zeros(L.n), solver.Cinv_mass, scale, solver.tol,
-                                  solver.max_iter, L.n_small, split=(Rc, L.n_rigid), implicit=solver.implicit)
+                                  solver.max_iter, L.n_small, split=(Rm, Rc, L.n_rigid), implicit=solver.implicit)
     acc0, alg_a = L.from_x(x)
     alg = jnp.where(mb.position_mask(system.flex), alg0, alg_a)
     info = StepInfo(it + info0.iterations, jnp.maximum(err, info0.residual), ok & info0.ok)
@@ -223,7 +223,7 @@ def _flex_step(system, solver: Solver, s: State, fresh=None) -> tuple[State, Ste
     pre = s.pre if solver.reuse else None
     x, (it, err, ok), pre_new = solve_root_carried(lambda x: Rm(x) + Rc(x), L.to_x(pred, s.alg), solver.Cinv_step,
                                                    scale, solver.tol, solver.max_iter, pre, floor, solver.adaptive,
-                                                   L.n_small, (Rc, L.n_rigid), fresh, solver.implicit)
+                                                   L.n_small, (Rm, Rc, L.n_rigid), fresh, solver.implicit)
     dyn, alg = L.from_x(x)
     c, v, acc, a = unpack(dyn)
     ok = ok & jnp.all(jnp.isfinite(x))

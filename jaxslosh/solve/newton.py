@@ -12,17 +12,19 @@ import jax
 import jax.numpy as jnp
 
 
-def _precond_data_split(A, Ac, like, Cinv, nr, ns):
-    """As _precond_data, when unknowns nr..ns (interface frames and multipliers) enter the residual
-    only through a cheap part Ac of A (the constraints), whose rows nr..ns are all of A's there: their
-    columns and rows are taken from Ac, and the expensive A is applied only nr times each way."""
+def _precond_data_split(Am, Ac, like, Cinv, nr, ns):
+    """As _precond_data for A = Am + Ac, when unknowns nr..ns (interface frames and multipliers) enter
+    the residual only through the cheap part Ac (the constraints), whose rows nr..ns are all of A's
+    there: the first ns columns and rows of A are Ac's plus, in the first nr, Am's (the expensive Am
+    is applied only nr times each way; each part is linearised and transposed once)."""
     n = like.shape[0]
     I = jnp.eye(n, ns, dtype=like.dtype)
-    cols = jnp.concatenate([jax.vmap(A, in_axes=1, out_axes=1)(I[:, :nr]),
-                            jax.vmap(Ac, in_axes=1, out_axes=1)(I[:, nr:])], axis=1)
-    AT = jax.linear_transpose(A, like)
+    cols = jax.vmap(Ac, in_axes=1, out_axes=1)(I)
+    cols = cols.at[:, :nr].add(jax.vmap(Am, in_axes=1, out_axes=1)(I[:, :nr]))
+    AmT = jax.linear_transpose(Am, like)
     AcT = jax.linear_transpose(Ac, like)
-    rows = jnp.concatenate([jax.vmap(lambda e: AT(e)[0])(I[:, :nr].T), jax.vmap(lambda e: AcT(e)[0])(I[:, nr:].T)])
+    rows = jax.vmap(lambda e: AcT(e)[0])(I.T)
+    rows = rows.at[:nr].add(jax.vmap(lambda e: AmT(e)[0])(I[:, :nr].T))
     Ayz = rows[:, ns:]
     Wz = Cinv @ cols[ns:]
     return jnp.linalg.inv(cols[:ns] - Ayz @ Wz), Ayz, Wz
@@ -75,8 +77,8 @@ def _newton(R, x0, Cinv, scale, tol, max_iter, pre=None, floor=0.0, adaptive=Tru
     max(tol, floor). `adaptive=False`: formed once before the iterations, never inside (vmapped
     batches, where a lax.cond computes both branches); then, with `pre` carried, `fresh` (a boolean
     that is the same for every run of a batch) says whether to form it anew or use the carried one
-    through this step. `split` = (Rc, nr): unknowns nr..ns enter R only through the cheap part Rc
-    (see _precond_data_split)."""
+    through this step. `split` = (Rm, Rc, nr): R = Rm + Rc, and unknowns nr..ns enter R only through
+    the cheap part Rc (see _precond_data_split)."""
     tol = jnp.maximum(tol, floor)
 
     def err_of(r):
@@ -84,11 +86,12 @@ def _newton(R, x0, Cinv, scale, tol, max_iter, pre=None, floor=0.0, adaptive=Tru
 
     @jax.named_scope("preconditioner")
     def refresh(x):
-        _, jvp = jax.linearize(R, x)
-        if split is not None:
-            Rc, nr = split
+        if split is not None:     # R = Rm + Rc, each part linearised once (not R, then Rc again)
+            Rm, Rc, nr = split
+            _, jvp_m = jax.linearize(Rm, x)
             _, jvp_c = jax.linearize(Rc, x)
-            return _precond_data_split(jvp, jvp_c, x, Cinv, nr, ns)
+            return _precond_data_split(jvp_m, jvp_c, x, Cinv, nr, ns)
+        _, jvp = jax.linearize(R, x)
         return _precond_data(jvp, x, Cinv, ns)
 
     def body(carry):
@@ -118,8 +121,10 @@ def _newton(R, x0, Cinv, scale, tol, max_iter, pre=None, floor=0.0, adaptive=Tru
         need0 = jnp.array(False)
     elif pre is not None:
         data0, need0 = pre[0], ~(pre[1] > 0.5)
-    else:
-        data0 = jax.tree_util.tree_map(jnp.zeros_like, jax.eval_shape(refresh, x0))
+    else:    # placeholders of the shapes refresh returns (jax.eval_shape(refresh) would trace it again)
+        n = x0.shape[0]
+        data0 = ((jnp.zeros((ns, ns), x0.dtype),) if split is None and n == ns else
+                 (jnp.zeros((ns, ns), x0.dtype), jnp.zeros((ns, n - ns), x0.dtype), jnp.zeros((n - ns, ns), x0.dtype)))
         need0 = jnp.array(True)
     init = (x0, r0, jnp.array(0), err_of(r0), jnp.array(False), need0, data0)
     x, r, it, err, stalled, _, data = jax.lax.while_loop(cond, body, init)

@@ -1,0 +1,86 @@
+"""What a run of a scene costs before its first step, in a fresh process: the first call (a cold
+compilation cache) and a second process (the cache warm), tracing and XLA apart.
+
+    python benchmarks/compile_time.py [SCENE ...] [--repeat 2]
+
+Each measurement is one fresh Python process that does what `jaxslosh run` does up to the end of
+its first chunk (tofile.run_to_file's phases: build the model, compile `start` and the chunk ahead
+of time, run the first chunk), with JAX's compilation events summed by kind (jax.monitoring):
+tracing (jaxpr_trace_duration), lowering (jaxpr_to_mlir_module_duration) and XLA
+(backend_compile_duration). Prints a table; no assertion. Default scenes: the paper example and the
+paper ship with its mast.
+"""
+import argparse
+import json
+import os
+import subprocess
+import sys
+import tempfile
+
+ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+
+CHILD = r"""
+import collections, json, sys, time
+T0 = time.perf_counter()
+import jax
+jax.config.update("jax_enable_x64", True)
+cache = sys.argv[2]
+jax.config.update("jax_compilation_cache_dir", cache)
+jax.config.update("jax_persistent_cache_min_compile_time_secs", 0.0)
+jax.config.update("jax_persistent_cache_min_entry_size_bytes", -1)
+events = collections.defaultdict(float)
+jax.monitoring.register_event_duration_secs_listener(
+    lambda name, d, **kw: events.__setitem__(name.split("/")[-1], events[name.split("/")[-1]] + d))
+import jaxslosh as js
+from jaxslosh.run.loop import advance, core, start
+from jaxslosh.run.simulate import prepare
+from jaxslosh.run.tofile import compiler_options
+t_import = time.perf_counter()
+scene = js.load_scene(sys.argv[1])
+setup = prepare(scene)
+b, solver = core(setup.built), setup.solver
+t_build = time.perf_counter()
+se = setup.save_every
+chunk = scene.simulation.chunk or max(1, min(setup.n_steps // se, max(1, 500 // se)))
+carry, f0 = start.lower(b, solver).compile(compiler_options=compiler_options("start"))(b, solver)
+jax.block_until_ready(f0)
+t_first = time.perf_counter()
+adv = advance.lower(b, solver, carry, chunk, se).compile(compiler_options=compiler_options("advance"))
+carry, fr = adv(b, solver, carry, chunk, se)
+jax.block_until_ready(fr)
+t_chunk = time.perf_counter()
+print(json.dumps({"import": t_import - T0, "build": t_build - t_import, "first_step": t_first - T0,
+                  "first_chunk": t_chunk - T0, "steps": chunk * se,
+                  "trace": events["jaxpr_trace_duration"], "lower": events["jaxpr_to_mlir_module_duration"],
+                  "xla": events["backend_compile_duration"]}))
+"""
+
+
+def measure(scene, cache):
+    p = subprocess.run([sys.executable, "-c", CHILD, scene, cache], capture_output=True, text=True, cwd=ROOT)
+    if p.returncode:
+        raise SystemExit(p.stderr)
+    return json.loads(p.stdout.strip().splitlines()[-1])
+
+
+def main():
+    ap = argparse.ArgumentParser()
+    ap.add_argument("scenes", nargs="*", default=[os.path.join(ROOT, "scenes", "paper_ship_tank.toml"),
+                                                 os.path.join(ROOT, "scenes", "paper_ship_mast.toml")])
+    ap.add_argument("--repeat", type=int, default=1, help="cold/warm pairs per scene (a shared machine varies)")
+    a = ap.parse_args()
+    print(f"{'scene':24} {'cache':6} {'import':>7} {'build':>7} {'1st step':>9} {'1st chunk':>10} {'trace':>7} "
+          f"{'lower':>7} {'XLA':>7}   (seconds, one fresh process each)")
+    for scene in a.scenes:
+        for _ in range(a.repeat):
+            with tempfile.TemporaryDirectory() as cache:
+                for label in ("cold", "warm"):
+                    r = measure(scene, cache)
+                    print(f"{os.path.basename(scene)[:24]:24} {label:6} {r['import']:7.2f} {r['build']:7.2f} "
+                          f"{r['first_step']:9.2f} {r['first_chunk']:10.2f} {r['trace']:7.2f} {r['lower']:7.2f} "
+                          f"{r['xla']:7.2f}")
+                    sys.stdout.flush()
+
+
+if __name__ == "__main__":
+    main()
