@@ -9,7 +9,7 @@ from ..fit.identify import METHODS, identify
 from ..fit.params import fit_keys
 from ..fit.quality import data_scene_mismatch
 from ..io.result import ResultFileError, load_result
-from ..plot.fit import _fmt, plot_fit
+from ..plot.fit import format_value, plot_fit
 from ..scene.types import SceneError
 from .common import EXIT_NUMERICAL, EXIT_OK, InputError, load, output_folder, setup_jax
 
@@ -106,7 +106,7 @@ def cmd_identify(a) -> int:
     width = max(len(k) for k in fr.values)
     for k, v in fr.values.items():
         s = fr.standard_errors[k]
-        print(f"{k:<{width}} = {_fmt(v)} +- {_fmt(s)}   (start {_fmt(fr.start[k])})")
+        print(f"{k:<{width}} = {format_value(v)} +- {format_value(s)}   (start {format_value(fr.start[k])})")
     print(f"{fr.method}: {fr.status} after {fr.iterations} iterations ({fr.evaluations} simulations, "
           f"{fr.wall_time:.1f} s); loss {fr.loss_history[0]:.4g} -> {fr.loss_history[-1]:.4g} ({fr.message})")
     fr.to_json(out)

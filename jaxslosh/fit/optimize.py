@@ -81,7 +81,7 @@ def optax_loop(pb: Problem, theta, method, max_iter, callback, history, learning
         opt = optax.adam(lr)
 
         def update(th, state, data):
-            value, grad = jax.value_and_grad(pb._loss)(th, data)
+            value, grad = jax.value_and_grad(pb.loss)(th, data)
             upd, state = opt.update(grad, state, th)
             return optax.apply_updates(th, upd), state, value, 1
     else:
@@ -94,7 +94,7 @@ def optax_loop(pb: Problem, theta, method, max_iter, callback, history, learning
         lr = learning_rate
 
         def update(th, state, data):
-            loss = lambda x: pb._loss(x, data)  # noqa: E731
+            loss = lambda x: pb.loss(x, data)  # noqa: E731
             value, grad = optax.value_and_grad_from_state(loss)(th, state=state)
             upd, state = opt.update(grad, state, th, value=value, grad=grad, value_fn=loss)
             n_ls = optax.tree_utils.tree_get(state, "info").num_linesearch_steps

@@ -187,7 +187,7 @@ class Problem:
         J, (res, ok) = jax.jacfwd(f, has_aux=True)(theta)
         return res, J, ok
 
-    def _loss(self, theta, data):
+    def loss(self, theta, data):
         res, ok = self._residual_ok(theta, data)
         return jnp.where(ok, jnp.mean(res ** 2), jnp.inf)
 

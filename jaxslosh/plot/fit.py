@@ -49,7 +49,7 @@ def plot_fit(scene: Scene, measured, fit_result: FitResult, out_png: Optional[st
         ax.set_ylabel(f"{k} ({unit})")
         ax.legend(loc="upper right", fontsize=8)
     axes[-1, 0].set_xlabel("time (s)")
-    vals = ", ".join(f"{k.split('.')[-1]} = {_fmt(v)}" for k, v in fit_result.values.items())
+    vals = ", ".join(f"{k.split('.')[-1]} = {format_value(v)}" for k, v in fit_result.values.items())
     quality = f"; {fit_result.quality}" if getattr(fit_result, "quality", "") else ""   # a poor fit says so
     fig.suptitle(f"identify ({fit_result.method}, {fit_result.iterations} iterations): {vals}{quality}", fontsize=9)
     fig.tight_layout()
@@ -58,5 +58,5 @@ def plot_fit(scene: Scene, measured, fit_result: FitResult, out_png: Optional[st
     return fig
 
 
-def _fmt(v):
+def format_value(v):
     return f"{v:.5g}" if isinstance(v, float) else "[" + ", ".join(f"{x:.5g}" for x in v) + "]"
