@@ -6,6 +6,7 @@ from __future__ import annotations
 import argparse
 import os
 import sys
+import tempfile
 
 import jax
 
@@ -42,12 +43,26 @@ def positive(name, value):
         raise InputError(f"--{name}: must be positive, got {value}")
 
 
-def output_folder(flag, path):
-    """The folder a file is to be written in must exist (checked before any computing)."""
-    if path:
-        d = os.path.dirname(os.path.abspath(path))
-        if not os.path.isdir(d):
-            raise InputError(f"{flag}: the folder {d} does not exist")
+def output_folder(flag, path, scene=None):
+    """The file a command is to write, checked before any computing: not a folder, not the scene
+    file (`scene`), in a folder that exists and takes a new file (a file is created there and
+    removed: permissions alone do not tell, e.g. for root or on a read-only file system)."""
+    if not path:
+        return
+    if os.path.isdir(path):
+        raise InputError(f"{flag}: {path} is a folder; name the file to write")
+    if scene and os.path.exists(path) and os.path.exists(scene) and os.path.samefile(path, scene):
+        raise InputError(f"{flag}: {path} is the scene file; name another file to write")
+    d = os.path.dirname(os.path.abspath(path))
+    if not os.path.isdir(d):
+        raise InputError(f"{flag}: the folder {d} does not exist")
+    try:
+        with tempfile.TemporaryFile(dir=d):
+            pass
+    except OSError as e:
+        raise InputError(f"{flag}: cannot write in the folder {d} ({e.strerror})") from None
+    if os.path.exists(path) and not os.access(path, os.W_OK):
+        raise InputError(f"{flag}: {path} exists and cannot be written")
 
 
 def overridden(scene: Scene, a) -> Scene:

@@ -29,7 +29,7 @@ def cmd_run(a):
     scene = overridden(load(a.scene), a)
     dt = scene.simulation.dt
     out = a.output or os.path.splitext(os.path.basename(a.scene))[0] + ".h5"
-    output_folder("-o", out)
+    output_folder("-o", out, scene=a.scene)
     enable_x64()
     t0 = time.perf_counter()
     status, steps, wall = run_to_file(scene, out, progress=not a.no_progress,
