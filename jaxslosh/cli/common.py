@@ -7,6 +7,7 @@ import argparse
 import math
 import os
 import sys
+import tempfile
 
 import jax
 
@@ -63,22 +64,32 @@ def positive(name, value):
         raise InputError(f"--{name}: must be a positive finite number, got {value}")
 
 
-def output_folder(flag, path):
-    """The file to be written must not be a folder, and its folder must exist (checked before any
-    computing)."""
-    if path:
-        if os.path.isdir(path):
-            raise InputError(f"{flag}: {path} is a folder; give a file name")
-        d = os.path.dirname(os.path.abspath(path))
-        if not os.path.isdir(d):
-            raise InputError(f"{flag}: the folder {d} does not exist")
-        if not os.access(d, os.W_OK):
-            raise InputError(f"{flag}: the folder {d} is not writable")
+def output_folder(flag, path, scene=None):
+    """The file a command is to write, checked before any computing: not a folder, not the scene
+    file (`scene`), in a folder that exists and takes a new file (a file is created there and
+    removed: permissions alone do not tell, e.g. for root or on a read-only file system)."""
+    if not path:
+        return
+    if os.path.isdir(path):
+        raise InputError(f"{flag}: {path} is a folder; name the file to write")
+    if scene and os.path.exists(path) and os.path.exists(scene) and os.path.samefile(path, scene):
+        raise InputError(f"{flag}: {path} is the scene file; name another file to write")
+    d = os.path.dirname(os.path.abspath(path))
+    if not os.path.isdir(d):
+        raise InputError(f"{flag}: the folder {d} does not exist")
+    try:
+        with tempfile.TemporaryFile(dir=d):
+            pass
+    except OSError as e:
+        raise InputError(f"{flag}: cannot write in the folder {d} ({e.strerror})") from None
+    if os.path.exists(path) and not os.access(path, os.W_OK):
+        raise InputError(f"{flag}: {path} exists and cannot be written")
 
 
 def writable_output(flag, path, inputs=()) -> bool:
     """Check an output file before any computing (io.output.check_output); True when an existing
     jaxslosh file will be replaced."""
+    output_folder(flag, path, scene=inputs[0] if inputs else None)
     try:
         return check_output(path, inputs) is not None
     except OutputError as e:

@@ -9,10 +9,10 @@ import time
 import numpy as np
 
 from ..io.sweep import write_sweep
-from ..run.batch import simulate_batch
-from ..scene.keys import traceable
+from ..run.batch import check_runs, simulate_batch
+from ..scene.keys import scene_values, traceable
 from ..scene.types import SceneError
-from .common import InputError, setup_jax, load, output_folder, overridden, positive
+from .common import InputError, load, overridden, positive, setup_jax, writable_output
 
 
 def parse_grid(items):
@@ -28,8 +28,27 @@ def parse_grid(items):
             raise ValueError(f"--param {key}: values must be numbers, got {vals!r}") from None
         if not values:
             raise ValueError(f"--param {key}: no values")
-        grid[key.strip()] = values
+        key = key.strip()
+        if key in grid:
+            raise ValueError(f"--param {key}: given twice; give each key once, with all its values")
+        grid[key] = values
     return grid
+
+
+def check_grid(scene, grid):
+    """The keys: traceable values of this scene, each given once, each a single number per run (a
+    vector or `vessel.inertia` is refused: its runs are swept from Python, js.simulate_batch)."""
+    try:
+        traceable(scene, grid)
+    except SceneError as e:
+        raise InputError(f"--param {e}") from None
+    values = scene_values(scene)
+    for key in grid:
+        shape = np.shape(values[key])
+        if shape != ():
+            what = "3 diagonal values or a 3 x 3 matrix" if key == "vessel.inertia" else f"{shape[0]} numbers"
+            raise InputError(f"--param {key}: holds {what}, and a sweep gives each run one number; sweep it "
+                             f"from Python: js.simulate_batch(scene, {{{key!r}: an array with a row per run}})")
 
 
 def grid_product(grid):
@@ -58,15 +77,21 @@ def cmd_sweep(a):
     positive("duration", a.duration)
     positive("dt", a.dt)
     scene = overridden(load(a.scene), a)
-    try:
-        traceable(scene, grid)
-    except SceneError as e:
-        raise InputError(f"--param {e}") from None
+    check_grid(scene, grid)
     out = a.output or os.path.splitext(os.path.basename(a.scene))[0] + "_sweep.h5"
-    output_folder("-o", out)
-    setup_jax()
+    writable_output("-o", out, inputs=(a.scene,))
     params = grid_product(grid)
     n = len(next(iter(params.values())))
+    try:             # every run checked as a scene file with its values would be, before computing
+        runs = check_runs(scene, params)
+    except SceneError as e:
+        raise InputError(f"--param {e}") from None
+    for i, run in enumerate(runs):
+        for w in run.warnings:
+            if w not in scene.warnings:
+                shown = ", ".join(f"{k} = {params[k][i]:g}" for k in params)
+                print(f"warning: run {i} ({shown}): {w}", file=sys.stderr)
+    setup_jax()
     print(f"sweep: {n} runs of {a.scene} in one batch", file=sys.stderr)
     t0 = time.perf_counter()
     result, statuses = simulate_batch(scene, params)

@@ -61,6 +61,7 @@ import jax
 import jax.numpy as jnp
 import numpy as np
 
+from .linalg import det2, det3, inv3
 from .mesh import GAUSS8, GAUSS_1D, HEX_CORNERS
 
 #: kappa = ROTATION_PENALTY * rho * g * max(a, b, h): kappa k^2 / rho >= 10 pi g k / L puts every circulation
@@ -183,7 +184,7 @@ def _kernels(form):
         dN = jnp.stack([XI[:, k] * jnp.prod(jnp.where(jnp.arange(3) == k, 1.0, 1.0 + XI * xi), axis=1)
                         for k in range(3)], axis=1) / 8.0
         J = x.T @ dN
-        return N, dN @ jnp.linalg.inv(J), jnp.linalg.det(J)
+        return N, dN @ inv3(J), det3(J)                 # closed forms: no LAPACK (fem/linalg.py)
 
     def points(x, pts):
         return jax.vmap(at, in_axes=(None, 0))(x, pts)
@@ -235,7 +236,7 @@ def _kernels(form):
     def face_at(y, xi):
         N = jnp.prod(1.0 + XI2 * xi, axis=1) / 4.0
         dN = jnp.stack([XI2[:, 0] * (1 + XI2[:, 1] * xi[1]), XI2[:, 1] * (1 + XI2[:, 0] * xi[0])], 1) / 4.0
-        return N, jnp.linalg.det(y.T @ dN)
+        return N, det2(y.T @ dN)
 
     def e_surface_consistent(uz, prm, y):                   # 1/2 rho g int_FS u_z^2 (2x2 Gauss)
         N, dJ = jax.vmap(face_at, in_axes=(None, 0))(y, gauss4)

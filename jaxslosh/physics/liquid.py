@@ -22,6 +22,7 @@ import jax
 import jax.numpy as jnp
 import numpy as np
 
+from ..fem.linalg import solve
 from .kinematics import mv3, quat_multiply, skew, spin_tensor_components, tv3
 from .terms import AbstractTerm, Config, Kin, Rows
 
@@ -204,7 +205,7 @@ class Liquid(AbstractLiquid):
     def static_start(self, g_b):
         """The discrete hydrostatic equilibrium K d0 = F_g under the body gravity g_b (PHYSICS.md
         item 6), dense (large meshes: solve/sparse.py)."""
-        return jnp.linalg.solve(self.K, self.free_part(self.m_nodes[:, None] * g_b[None, :]))
+        return solve(self.K, self.free_part(self.m_nodes[:, None] * g_b[None, :]))
 
 
 class RotationPenalty(AbstractTerm):

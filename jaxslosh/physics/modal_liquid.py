@@ -16,6 +16,7 @@ import equinox as eqx
 import jax
 import jax.numpy as jnp
 
+from ..fem.linalg import solve
 from .kinematics import mv3, tv3
 from .liquid import AbstractLiquid
 from .terms import Kin, Rows
@@ -144,7 +145,7 @@ class ReducedLiquid(AbstractLiquid):
 
     def static_start(self, g_b):
         """The discrete hydrostatic equilibrium Kr eta = V^T F_g (exact with the static correction)."""
-        return jnp.linalg.solve(self.Kr, self.U1 @ g_b)
+        return solve(self.Kr, self.U1 @ g_b)
 
 
 def _axial(T):

@@ -9,19 +9,22 @@ import numpy as np
 from jax.sharding import Mesh, NamedSharding, PartitionSpec
 
 from ..io.result import Result, result_from
-from ..scene.keys import with_overrides
-from ..scene.types import Scene
+from ..scene.keys import check_values, with_overrides
+from ..scene.types import Scene, SceneError
 from .loop import advance, concat_frames, core, frame_datasets, start
-from .simulate import failure_message, prepare
+from .simulate import failure_message, is_traced, prepare
 
 
 _BATCH_FNS: dict = {}
 
 
-def _batch_fn(scene: Scene, keys: tuple):
-    """The jitted, vmapped run of a batch, kept per scene, keys and times: a second batch of the
-    same structure does not compile again."""
-    cache_key = (scene, keys)
+def _batch_fn(scene: Scene, keys: tuple, mesh: Optional[Mesh] = None):
+    """The jitted, vmapped run of a batch, kept per scene, keys, times and devices: a second batch
+    of the same structure does not compile again. With a device `mesh` each device runs the vmap
+    over its own runs (shard_map): the per-run loops of fem/linalg.py then stay on the device's
+    share, where the compiler's partitioning of one global vmap gathered every run's matrices on
+    every device."""
+    cache_key = (scene, keys, mesh)
     try:
         hit = _BATCH_FNS.get(cache_key)
     except TypeError:                 # an unhashable scene: no reuse
@@ -40,7 +43,11 @@ def _batch_fn(scene: Scene, keys: tuple):
         fr = concat_frames([jax.tree_util.tree_map(lambda x: x[None], f0), frames])
         return carry, fr
 
-    fn = jax.jit(jax.vmap(one))
+    fn = jax.vmap(one)
+    if mesh is not None:
+        fn = jax.shard_map(fn, mesh=mesh, in_specs=PartitionSpec("batch"), out_specs=PartitionSpec("batch"),
+                           check_vma=False)
+    fn = jax.jit(fn)
     if cache_key is not None:
         _BATCH_FNS[cache_key] = fn
         while len(_BATCH_FNS) > 8:
@@ -48,14 +55,36 @@ def _batch_fn(scene: Scene, keys: tuple):
     return fn
 
 
+def check_runs(scene: Scene, params: dict) -> list:
+    """Check every run of a batch as a scene file with its values would be checked (check_values);
+    SceneError names the key, the run and its values. Returns each run's checked scene (their
+    warnings are the loader's for that run)."""
+    if is_traced(params):
+        return []
+    runs = []
+    n = len(np.asarray(next(iter(params.values()))))
+    for i in range(n):
+        values = {k: np.asarray(v)[i] for k, v in params.items()}
+        try:
+            runs.append(check_values(scene, values))
+        except SceneError as e:
+            if n == 1:
+                raise
+            shown = ", ".join(f"{k} = {np.asarray(v).tolist()}" for k, v in values.items())
+            raise SceneError(e.key, f"{str(e)[len(e.key) + 2:] if e.key else e} (run {i}: {shown})") from None
+    return runs
+
+
 def simulate_batch(scene: Scene, params: dict, *, duration: Optional[float] = None,
                    dt: Optional[float] = None) -> tuple[Result, list]:
     """Run a batch of parameter sets in one compiled, vmapped loop.
 
-    `params` maps dotted scene keys to arrays of equal leading length B (one value per run).
-    Returns (result, statuses): the result's arrays carry a leading batch axis, statuses is one
-    string per run ("ok" or why it stopped; a failed run keeps its last good state after that).
-    With several devices the batch is sharded over them (jax.sharding), B divisible by their count.
+    `params` maps dotted scene keys to arrays of equal leading length B (one value per run; a
+    vector key takes (B, 3), `vessel.inertia` (B, 3) diagonals or (B, 3, 3)). Every run's values
+    are checked as a scene file with them would be, before anything is computed (SceneError names
+    the key and the run). Returns (result, statuses): the result's arrays carry a leading batch
+    axis, statuses is one string per run ("ok" or why it stopped; a failed run keeps its last good
+    state after that). With several devices the batch is sharded over them (jax.sharding), B divisible by their count.
     """
     scene = with_overrides(scene, duration=duration, dt=dt)
     keys = list(params)
@@ -65,13 +94,15 @@ def simulate_batch(scene: Scene, params: dict, *, duration: Optional[float] = No
     B = int(vals[0].shape[0])
     if any(int(v.shape[0]) != B for v in vals):
         raise ValueError("every parameter array must have the same leading length")
+    check_runs(scene, params)
     devices = jax.devices()
+    mesh = None
     if len(devices) > 1 and B % len(devices) == 0:
         mesh = Mesh(np.array(devices), ("batch",))
         vals = [jax.device_put(v, NamedSharding(mesh, PartitionSpec("batch", *([None] * (v.ndim - 1)))))
                 for v in vals]
     setup0 = prepare(scene)
-    carry, fr = _batch_fn(scene, tuple(keys))(*vals)
+    carry, fr = _batch_fn(scene, tuple(keys), mesh)(*vals)
     statuses = []
     h = setup0.solver.h
     for i in range(B):

@@ -18,7 +18,7 @@ import numpy as np
 from ..build.system import Built, build
 from ..io.status import TEXT, Status, failure_text
 from ..io.result import Result, result_from, truncated
-from ..scene.keys import with_overrides
+from ..scene.keys import check_values, with_overrides
 from ..scene.types import Scene
 from ..solve.linear import Solver, make_solver
 from ..solve.schemes import make_scheme
@@ -51,6 +51,9 @@ def prepare(scene: Scene, params=None, batch: bool = False) -> Setup:
     lax.cond on a per-run test) every BATCH_REFRESH steps."""
     sim = scene.simulation
     h, T = float(sim.dt), float(sim.duration)
+    concrete = {k: v for k, v in (params or {}).items() if not is_traced(v)}
+    if concrete:        # checked as a scene file with these values would be (a tracer has no value to check)
+        check_values(scene, concrete)
     # Under an outer jax.jit (a user's jitted loss) every jnp operation is staged, even on
     # constants; the build relies on the scene's own values being concrete (NumPy meshes, host
     # factors), so what does not depend on traced `params` is evaluated now, as outside jit.
@@ -63,12 +66,17 @@ def prepare(scene: Scene, params=None, batch: bool = False) -> Setup:
         solver = dataclasses.replace(solver, refresh_every=BATCH_REFRESH)    # run both branches under vmap)
     # a gradient can reach the run only through traced params (a batch is never differentiated):
     # otherwise the Newton solves skip custom_root's tracing of the tangent solves
-    traced = any(isinstance(v, jax.core.Tracer) for v in jax.tree_util.tree_leaves(params or {}))
+    traced = is_traced(params or {})
     solver = dataclasses.replace(solver, implicit=traced and not batch)
     if sim.energy_projection:     # the scene check allows it only where it holds (scene._conservative)
         solver = dataclasses.replace(solver, project=True)
     n_steps = int(round(T / h))
     return Setup(b, solver, n_steps, max(1, int(sim.save_every)))
+
+
+def is_traced(value) -> bool:
+    """Whether a value (or a pytree of them) holds a JAX tracer: no value to check or to convert."""
+    return any(isinstance(x, jax.core.Tracer) for x in jax.tree_util.tree_leaves(value))
 
 
 def to_result(b: Built, fr: Frame, scene_text: str, status: str, steps_done: int, code: int = 0) -> Result:

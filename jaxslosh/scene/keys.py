@@ -4,7 +4,8 @@
 A key names a value as the scene file writes it: `vessel.hydrostatics.gm_t`, `tanks.tank.fill_depth`
 or, by index, `tanks[0].fill_depth` (the canonical form is the name form). `simulate(params=...)`,
 `jaxslosh sweep --param` and `identify --fit` all go through `resolve_params`; `--duration` and
-`--dt` through `with_overrides`, which returns a scene validated like a loaded one.
+`--dt` through `with_overrides`, which returns a scene validated like a loaded one. Concrete values
+(each run of a sweep, concrete `params`) are checked as the loader checks a scene by `check_values`.
 """
 from __future__ import annotations
 
@@ -14,8 +15,13 @@ from typing import Any, Iterable, Optional
 
 import numpy as np
 
+try:
+    import tomllib
+except ModuleNotFoundError:  # Python 3.10
+    import tomli as tomllib  # type: ignore[no-redef]
+
 from .fields import show
-from .load import step_warnings
+from .load import parse_scene, step_warnings
 from .types import Material, Scene, SceneError
 
 
@@ -181,3 +187,62 @@ def with_overrides(scene: Scene, *, duration: Optional[float] = None, dt: Option
         raise SceneError("simulation.dt", f"{show(sim.dt)} s is longer than the duration {show(sim.duration)} s")
     warnings = [w for w in scene.warnings if not w.startswith(("simulation.duration", "simulation.save_every"))]
     return dataclasses.replace(scene, simulation=sim, warnings=tuple(warnings + step_warnings(sim)))
+
+
+def check_values(scene: Scene, values: dict) -> Scene:
+    """The scene with concrete `values` for dotted keys (a run of a sweep, concrete `params`),
+    checked as the loader checks a scene file: the values are written into the scene's TOML mapping
+    (`scene.text`, with its current duration and step) at their keys (name or index form) and the
+    mapping is parsed again (`parse_scene`). A value the loader refuses raises SceneError naming
+    the given key (`vessel.mass: must be positive, got -4.1e+05`). Returns the parsed scene, whose
+    warnings are the loader's for these values. A scene without text (built in Python) is returned
+    as it is: there is nothing to parse again."""
+    canon = check_param_keys(scene, values)
+    if not scene.text:
+        return scene
+    mapping = tomllib.loads(scene.text)
+    sim = mapping.setdefault("simulation", {})
+    sim["duration"], sim["dt"] = float(scene.simulation.duration), float(scene.simulation.dt)
+    given = list(values)
+    for key, name in zip(given, canon):
+        _set(mapping, _toml_path(scene, name), _plain(values[key]))
+    try:
+        return parse_scene(mapping, text=scene.text, path=scene.path)
+    except SceneError as e:
+        message = str(e)[len(e.key) + 2:] if e.key else str(e)
+        for key, name in zip(given, canon):
+            for form in (key, name, _index_form(scene, name)):
+                if e.key == form or e.key.startswith((form + "[", form + ".")):  # the value or a part of it
+                    raise SceneError(key + e.key[len(form):], message) from None
+        shown = ", ".join(f"{k} = {show(_plain(values[k]))}" for k in given)
+        raise SceneError(given[0] if len(given) == 1 else ", ".join(given),
+                         f"with {shown} the scene is not valid: {e}") from None
+
+
+def _plain(value):
+    """A concrete value as TOML holds it: a float, or (nested) lists of floats."""
+    return np.asarray(value, dtype=float).tolist()
+
+
+def _toml_path(scene: Scene, key: str) -> list:
+    """The path of a canonical key in the TOML mapping: `tanks.tank.fill_depth` -> ["tanks", 0, "fill_depth"]."""
+    for group, items in (("tanks", scene.tanks), ("structures", scene.structures), ("probes", scene.probes)):
+        for i, item in enumerate(items):
+            head = f"{group}.{item.name}."
+            if key.startswith(head):
+                return [group, i] + key[len(head):].split(".")
+    return key.split(".")
+
+
+def _index_form(scene: Scene, key: str) -> str:
+    path = _toml_path(scene, key)
+    if len(path) > 1 and isinstance(path[1], int):
+        return f"{path[0]}[{path[1]}]." + ".".join(path[2:])
+    return key
+
+
+def _set(mapping: dict, path: list, value) -> None:
+    node = mapping
+    for part in path[:-1]:
+        node = node[part] if isinstance(part, int) else node.setdefault(part, {})
+    node[path[-1]] = value

@@ -10,6 +10,7 @@ import jax
 import jax.numpy as jnp
 import numpy as np
 
+from ..fem.linalg import inv
 from ..physics.structures import layout
 from ..physics.system import System
 from .schemes import Scheme
@@ -93,7 +94,7 @@ def make_solver(system: System, h: float, scheme: Scheme, tol: float, max_iter: 
         M_ff, K_ff = np.asarray(M_ff), np.asarray(K_ff)
 
     def inverse(A):
-        return jnp.linalg.inv(A) if traced else jnp.asarray(np.linalg.inv(A))
+        return inv(A) if traced else jnp.asarray(np.linalg.inv(A))
 
     def step_block_inverse(hh):
         c_a = (1.0 - scheme.alpha_m) / ((1.0 - scheme.alpha_f) * scheme.beta * hh ** 2)

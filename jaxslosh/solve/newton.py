@@ -11,6 +11,8 @@ from __future__ import annotations
 import jax
 import jax.numpy as jnp
 
+from ..fem.linalg import inv
+
 
 def _precond_data_split(Am, Ac, like, Cinv, nr, ns):
     """As _precond_data for A = Am + Ac, when unknowns nr..ns (interface frames and multipliers) enter
@@ -27,7 +29,7 @@ def _precond_data_split(Am, Ac, like, Cinv, nr, ns):
     rows = rows.at[:nr].add(jax.vmap(lambda e: AmT(e)[0])(I[:, :nr].T))
     Ayz = rows[:, ns:]
     Wz = Cinv @ cols[ns:]
-    return jnp.linalg.inv(cols[:ns] - Ayz @ Wz), Ayz, Wz
+    return inv(cols[:ns] - Ayz @ Wz), Ayz, Wz
 
 
 def _precond_data(A, like, Cinv, ns=6):
@@ -40,11 +42,11 @@ def _precond_data(A, like, Cinv, ns=6):
     E6 = jnp.eye(n, ns, dtype=like.dtype)
     cols = jax.vmap(A, in_axes=1, out_axes=1)(E6)                   # [A_yy; A_zy]
     if n == ns:
-        return (jnp.linalg.inv(cols),)
+        return (inv(cols),)
     AT = jax.linear_transpose(A, like)
     Ayz = jax.vmap(lambda e: AT(e)[0])(E6.T)[:, ns:]                 # (ns, nz)
     Wz = Cinv @ cols[ns:]
-    return jnp.linalg.inv(cols[:ns] - Ayz @ Wz), Ayz, Wz
+    return inv(cols[:ns] - Ayz @ Wz), Ayz, Wz
 
 
 def _precond_apply(data, Cinv, r, ns=6):
