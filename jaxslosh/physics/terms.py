@@ -11,10 +11,11 @@ step. A term gives
 * `mass_scale()`: its characteristic mass on each rigid row (kg, kg m^2), so that a row over the
   summed scale is an acceleration error.
 
-Where a term has a potential and its rows are the potential's gradient, the rows come from it by
-JAX (`potential_rows`); the liquid's rows are written out (they must stay linear and sparse for
-large meshes) and tests/test_model.py checks them against the gradient and the Hessian of its
-energies.
+A term's rows are written out. Where the term has a potential, a test checks its rows against
+the potential's gradient along the step's increments (`potential_rows`, by JAX): a gradient inside
+the residual would be linearised and transposed again in every Newton preconditioner, which
+lengthens compilation; the liquid's rows must also stay linear and sparse for large meshes
+(tests/test_model.py checks them against the gradient and the Hessian of its energies).
 """
 from __future__ import annotations
 
