@@ -195,7 +195,12 @@ def tank_modes(tw: TankWithWalls, n=10) -> TankModes:
     the walls' strain holds most of the potential energy, else as the liquid's (modes.py)."""
 
     n = int(min(n, tw.nf))
-    lam, X = sl.eigh(tw.stiffness, tw.mass_ff, subset_by_index=[0, n - 1])
+    # the lowest modes as the largest of M x = (1 / lambda) K x: stiff walls put eigenvalues many
+    # orders above the sloshing band, and eigh(K, M) resolves the low ones only to eps times the
+    # largest, while eigh(M, K) resolves them to eps times themselves (K is positive definite: the
+    # walls are held at their attachment, the liquid's circulation held by its penalty)
+    mu, X = sl.eigh(tw.mass_ff, tw.stiffness, subset_by_index=[tw.nf - n, tw.nf - 1])
+    lam, X = 1.0 / mu[::-1], X[:, ::-1]
     omega = np.sign(lam) * np.sqrt(np.abs(lam))
     T = tw.T()
     full = (T @ X).T                                            # (n, 3N)

@@ -45,14 +45,15 @@ class Setup(NamedTuple):
     save_every: int
 
 
-def prepare(scene: Scene, params=None, batch: bool = False) -> Setup:
+def prepare(scene: Scene, params=None, batch: bool = False, check: bool = True) -> Setup:
     """The static model, the solver and the step count. The Newton preconditioner is carried from
     step to step; single runs form it again when convergence slows, `batch` (vmapped runs: no
-    lax.cond on a per-run test) every BATCH_REFRESH steps."""
+    lax.cond on a per-run test) every BATCH_REFRESH steps. `check`: concrete params are checked as
+    a scene file with them would be."""
     sim = scene.simulation
     h, T = float(sim.dt), float(sim.duration)
     concrete = {k: v for k, v in (params or {}).items() if not is_traced(v)}
-    if concrete:        # checked as a scene file with these values would be (a tracer has no value to check)
+    if concrete and check:        # checked as a scene file with these values would be (a tracer has no value to check)
         check_values(scene, concrete)
     # Under an outer jax.jit (a user's jitted loss) every jnp operation is staged, even on
     # constants; the build relies on the scene's own values being concrete (NumPy meshes, host
@@ -91,18 +92,21 @@ def failure_message(carry: Carry, h: float, tol: float) -> str:
 
 
 def simulate(scene: Scene, params: Optional[dict] = None, *, duration: Optional[float] = None,
-             dt: Optional[float] = None, throw: bool = False) -> Result:
+             dt: Optional[float] = None, throw: bool = False, check: bool = True) -> Result:
     """Run a scene; the result holds every `save_every`-th step, t = 0 included.
 
     `params` maps dotted scene keys to replacement values, which may be JAX tracers:
-    `jax.grad` of any scalar function of the result works with respect to them.
+    `jax.grad` of any scalar function of the result works with respect to them. Concrete values
+    are checked as the scene file with them would be (SceneError naming the key); `check=False`
+    takes them as they are (a numerical experiment: a coefficient set to zero to switch its term
+    off, say).
     A numerical failure truncates the result to the frames before it and sets `status` (its text)
     and `status_code` (io.status.Status); with `throw=True` it raises NumericalFailure instead, and
     inside `jax.jit` (where the status cannot be read) the compiled run raises an error naming the
     failure (equinox's error_if) when it happens.
     """
     scene = with_overrides(scene, duration=duration, dt=dt)
-    setup = prepare(scene, params)
+    setup = prepare(scene, params, check=check)
     b, solver = setup.built, setup.solver
     n_frames = setup.n_steps // setup.save_every
     carry, f0 = start(core(b), solver)
