@@ -1,0 +1,107 @@
+"""Probes: material points recorded in the result (SPEC section 1), as interpolation weights over
+the liquid's nodes (or a structure's), computed once."""
+from __future__ import annotations
+
+from typing import NamedTuple, Optional
+
+import jax.numpy as jnp
+import numpy as np
+
+from ..scene.types import Scene
+
+
+class Probes(NamedTuple):
+    names: tuple
+    points: jnp.ndarray    # (P, 3) undeformed positions in the vessel frame
+    weights: jnp.ndarray   # (P, N) interpolation of the liquid displacement (zero rows: the probe follows the tank)
+    on_structures: tuple = ()   # StructureProbes per structure that has probes
+    modal: Optional[jnp.ndarray] = None   # (P, m, 3) weights @ basis, with a reduced liquid: probes from eta
+
+
+class StructureProbes(NamedTuple):
+    """Probes on structure `index`: rows `rows` of the probe table, points `r` in its frame (from its
+    COG) and trilinear weights `W` (k, N_s) over its nodes."""
+    index: int
+    rows: np.ndarray
+    r: jnp.ndarray
+    W: jnp.ndarray
+
+
+def build_probes(scene: Scene, tanks, liquid, structures=(), vstructs=()) -> Probes:
+    names, pts, W = [], [], []
+    N = liquid.n_nodes
+    by_name = {b.name: b for b in tanks}
+    on_struct = {}
+    for i, p in enumerate(scene.probes):
+        w = np.zeros(N)
+        if p.tank is not None:
+            t = scene.tank(p.tank)
+            pts.append(np.asarray(t.origin) + np.asarray(p.point))
+            b = by_name.get(t.name)
+            if b is not None:
+                local = probe_weights(np.asarray(p.point), t.size, t.fill_depth, b.nodes, b.elements)
+                w[b.node_offset:b.node_offset + b.nodes.shape[0]] = local
+        elif scene.structure(p.structure).frame == "vessel":     # in the vessel-frame block, like a liquid point
+            st = scene.structure(p.structure)
+            pts.append(np.asarray(st.origin) + np.asarray(p.point))
+            vb = next(b for b in vstructs if b.name == st.name)
+            w[vb.node_offset:vb.node_offset + vb.nodes.shape[0]] = block_weights(np.asarray(p.point), vb.nodes,
+                                                                                 vb.elements)
+        else:
+            st = scene.structure(p.structure)
+            pts.append(np.asarray(st.origin) + np.asarray(p.point))
+            blk = next(b for b in structures if b.name == st.name)
+            on_struct.setdefault(blk.index, []).append((i, np.asarray(p.point) - blk.model.cog,
+                                                        block_weights(np.asarray(p.point), blk.model.nodes,
+                                                                      blk.model.elements)))
+        names.append(p.name)
+        W.append(w)
+    sp = tuple(StructureProbes(k, np.array([e[0] for e in v]), jnp.asarray(np.array([e[1] for e in v])),
+                               jnp.asarray(np.array([e[2] for e in v]))) for k, v in sorted(on_struct.items()))
+    return Probes(tuple(names), jnp.asarray(np.array(pts).reshape(-1, 3)),
+                  jnp.asarray(np.array(W, dtype=float).reshape(len(W), N)), sp)
+
+
+def block_weights(point, nodes, elements, tol=1e-9):
+    """Trilinear weights (N,) of a point of a meshed block (any point inside or on it)."""
+    scale = np.ptp(nodes, axis=0).max()
+    w = np.zeros(nodes.shape[0])
+    for el in elements:
+        X = nodes[el]
+        lo, hi = X.min(axis=0), X.max(axis=0)
+        if np.all(point >= lo - tol * scale) and np.all(point <= hi + tol * scale):
+            xi = np.clip((point - lo) / (hi - lo), 0.0, 1.0)
+            for k, node in enumerate(el):
+                corner = (X[k] - lo) / (hi - lo)
+                w[node] = np.prod(np.where(corner > 0.5, xi, 1.0 - xi))
+            return w
+    return w
+
+
+def probe_weights(point, size, depth, nodes, elements, eps=1e-9):
+    """SPEC section 1: a probe at the fill depth follows the free surface (even at a wall), a probe
+    inside the liquid follows the liquid particle, a probe on the bottom or on a wall below the
+    surface (or in the air above the liquid) follows the tank. Between nodes, the hexahedron's
+    trilinear shape functions interpolate."""
+    x, y, z = point
+    a, b = size[0], size[1]
+    scale = max(a, b, depth)
+    tol = eps * scale + 1e-12
+    w = np.zeros(nodes.shape[0])
+    at_surface = abs(z - depth) <= 1e-6 * scale
+    if z > depth and not at_surface:
+        return w
+    on_wall = min(x, a - x, y, b - y, z) <= tol
+    if on_wall and not at_surface:
+        return w
+    for el in elements:
+        X = nodes[el]
+        lo, hi = X.min(axis=0), X.max(axis=0)
+        p = np.array([x, y, min(z, depth)])
+        if np.all(p >= lo - tol) and np.all(p <= hi + tol):
+            xi = np.clip((p - lo) / (hi - lo), 0.0, 1.0)
+            for k, node in enumerate(el):
+                corner = (X[k] - lo) / (hi - lo)     # 0 or 1 per axis
+                w[node] = np.prod(np.where(corner > 0.5, xi, 1.0 - xi))
+            return w
+    return w

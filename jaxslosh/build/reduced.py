@@ -1,0 +1,85 @@
+"""The reduced liquid of a scene's tanks: their modal bases (fem/reduction.py) and the inertia
+invariants of physics/modal_liquid.py, computed once."""
+from __future__ import annotations
+
+import jax.numpy as jnp
+import numpy as np
+import scipy.sparse as sp
+from jax.scipy.linalg import block_diag as jax_block_diag
+from scipy.linalg import block_diag
+
+from ..fem.reduction import tank_basis
+from ..physics.modal_liquid import ReducedLiquid
+
+
+def reduce_liquid(models, concrete_models, origins, offsets, reductions):
+    """The reduced liquid of every tank (stacked), from the per-tank `LiquidModel`s.
+
+    `models` may hold traced values (then JAX arithmetic); `concrete_models` are the same tanks at
+    the scene's values, from which the bases are computed (they are the `models` when concrete).
+    `reductions` holds (modes, static_correction) per tank. Returns (ReducedLiquid, (K_dt, K_tt) of
+    the rotation penalty on the modal coordinates, or None)."""
+    traced = any(m.traced for m in models)
+    xp = jnp if traced else np
+    N = sum(int(m.n_nodes) for m in models)
+    Us, Kr_blocks, Mr_blocks, Kdt_rows, scales = [], [], [], [], []
+    S0, Q0, mass, Ktt = 0.0, 0.0, 0.0, xp.zeros((3, 3))
+    U1s, Q1s, Q2_blocks = [], [], []
+    rs, ms = [], []
+    coupled = any(m.rotation_coupling is not None for m in models)
+    for model, cmodel, origin, off, (n, static) in zip(models, concrete_models, origins, offsets, reductions):
+        basis = tank_basis(cmodel, origin, n, static)
+        f = np.flatnonzero(np.asarray(model.free))
+        Nt, m = int(model.n_nodes), basis.V.shape[1]
+        Ut = np.zeros((m, 3 * Nt))
+        Ut[:, f] = basis.V.T
+        Ut = Ut.reshape(m, Nt, 3)
+        r = xp.asarray(model.nodes) + xp.asarray(origin)[None, :]
+        Ms = model.mass
+        mvec = xp.asarray(Ms.sum(axis=1)).reshape(-1)
+        MU = Ms @ Ut.transpose(1, 0, 2).reshape(Nt, 3 * m)            # (Nt, 3m)
+        MU = xp.asarray(MU).reshape(Nt, m, 3).transpose(1, 0, 2)       # (m, Nt, 3)
+        Mr_ = xp.asarray(Ms @ r)                                        # (Nt, 3)
+        S0 = S0 + mvec @ r
+        Q0 = Q0 + r.T @ Mr_
+        mass = mass + mvec.sum()
+        U1s.append(xp.einsum("i,kia->ka", mvec, Ut))
+        Q1s.append(xp.einsum("ia,kib->kab", Mr_, Ut))                  # T(r, U_k) = (Ms r)^T U_k
+        Q2_blocks.append(xp.einsum("kia,lib->klab", Ut, MU))
+        Mr_blocks.append(xp.einsum("kia,lia->kl", Ut, MU))
+        Kff = model.stiffness
+        if sp.issparse(Kff):
+            Kr_t = basis.V.T @ (Kff.tocsr()[f][:, f] @ basis.V)
+        else:
+            Kr_t = basis.V.T @ xp.asarray(Kff)[np.ix_(f, f)] @ basis.V
+        Kr_blocks.append(0.5 * (Kr_t + Kr_t.T))
+        if coupled:
+            if model.rotation_coupling is not None:
+                Kdt_rows.append(basis.V.T @ xp.asarray(model.rotation_coupling)[f])
+                Ktt = Ktt + xp.asarray(model.rotation_stiffness)
+            else:
+                Kdt_rows.append(xp.zeros((m, 3)))
+        scales.append(1.0 / np.abs(basis.V).max(axis=0))
+        Us.append((off, Ut))
+        rs.append(r)
+        ms.append(mvec)
+    mtot = sum(U.shape[0] for _, U in Us)
+    U = np.zeros((mtot, N, 3))
+    Q2 = xp.zeros((mtot, mtot, 3, 3))
+    k = 0
+    for (off, Ut), Q2t in zip(Us, Q2_blocks):
+        mt, Nt = Ut.shape[0], Ut.shape[1]
+        U[k:k + mt, off:off + Nt] = Ut
+        if traced:
+            Q2 = Q2.at[k:k + mt, k:k + mt].set(Q2t)
+        else:
+            Q2[k:k + mt, k:k + mt] = Q2t
+        k += mt
+    block_diag_ = jax_block_diag if traced else block_diag
+    liquid = ReducedLiquid(
+        r=jnp.asarray(xp.concatenate(rs)), m_nodes=jnp.asarray(xp.concatenate(ms)), U=jnp.asarray(U),
+        mass=jnp.asarray(mass), S0=jnp.asarray(S0), U1=jnp.asarray(xp.concatenate(U1s)), Q0=jnp.asarray(Q0),
+        Q1=jnp.asarray(xp.concatenate(Q1s)), Q2=jnp.asarray(Q2), Mr=jnp.asarray(block_diag_(*Mr_blocks)),
+        Kr=jnp.asarray(block_diag_(*Kr_blocks)), row_scale=jnp.asarray(np.concatenate(scales)), n_nodes=N)
+    penalty = (jnp.asarray(xp.concatenate(Kdt_rows)), jnp.asarray(Ktt)) if coupled else None
+    return liquid, penalty

@@ -1,0 +1,85 @@
+"""Flexible structures in their own floating frames (physics/structures.py), from the scene: each
+tied at its `attach` face to an interface frame that the vessel (or another structure) is tied to."""
+from __future__ import annotations
+
+from typing import NamedTuple
+
+import jax.numpy as jnp
+import numpy as np
+
+from ..fem.mesh import face_nodes
+from ..fem.structure import build_structure, centrifugal_stiffness
+from ..physics.kinematics import rotation_matrix
+from ..physics.structures import Body, Flex, Interface, Side, layout
+from ..physics.system import System
+from ..physics.terms import Config
+from ..scene.types import Scene
+
+
+class StructureBlock(NamedTuple):
+    """Host-side data of one structure: its model (structure.StructureModel) and where its modal
+    coordinates sit in the stacked eta."""
+    name: str
+    index: int
+    eta_offset: int
+    model: object
+
+
+def build_flex(scene: Scene):
+    """Each structure in its own floating frame (origin at its COG), tied at its `attach` face to an
+    interface frame that the vessel is tied to as well (localized multipliers on both sides)."""
+    bodies, interfaces, blocks, models = [], [], [], {}
+    offset = 0
+    own = [st for st in scene.structures if st.frame == "own"]
+    for i, st in enumerate(own):
+        mat = st.material
+        m = build_structure(st.size, st.mesh, mat.young, mat.poisson, mat.density)
+        models[st.name] = (i, m, np.asarray(st.origin, dtype=float))
+        Kg = None
+        if st.stiffening == "centrifugal":   # spin about axes through the vessel's COG, modal form
+            held = np.zeros(m.n_nodes, dtype=bool)
+            held[face_nodes(m.nodes, m.size, st.attach)] = True
+            sizes = np.tile(np.asarray([a / n for a, n in zip(m.size, m.mesh)]), (m.elements.shape[0], 1))
+            Kg = jnp.asarray(np.stack([m.Phi.T @ k @ m.Phi for k in centrifugal_stiffness(
+                m.nodes, m.elements, sizes, m.stiffness, m.mass, held, mat.young, mat.poisson,
+                axis_point=-np.asarray(st.origin, dtype=float))]))
+        bodies.append(Body(r=jnp.asarray(m.r), Ms=jnp.asarray(m.mass), Phi=jnp.asarray(m.Phi),
+                           omega2=jnp.asarray(m.omega ** 2), mass=jnp.asarray(m.total_mass),
+                           c0=jnp.asarray(models[st.name][2] + m.cog), Kg=Kg))
+        blocks.append(StructureBlock(st.name, i, offset, m))
+        offset += m.Phi.shape[1]
+    for i, st in enumerate(own):
+        _, m, origin = models[st.name]
+        nodes = face_nodes(m.nodes, m.size, st.attach)
+        points = origin[None, :] + m.nodes[nodes]           # vessel frame, from the vessel's COG
+        if st.attach_to is None:                             # tied to the vessel
+            other = Side(-1, jnp.asarray(nodes), jnp.asarray(points))
+            m_ref = m.total_mass
+        else:                                                # tied to another structure's coincident nodes
+            j, mo, oo = models[st.attach_to]
+            theirs = oo[None, :] + mo.nodes
+            match = np.argmin(np.linalg.norm(points[:, None, :] - theirs[None, :, :], axis=2), axis=1)
+            other = Side(j, jnp.asarray(match), jnp.asarray(points))
+            m_ref = min(m.total_mass, mo.total_mass)
+        L_ref = float(max(max(st.size), np.abs(points).max()))
+        interfaces.append(Interface(sides=(other, Side(i, jnp.asarray(nodes), jnp.asarray(points))),
+                                    m_ref=jnp.asarray(m_ref), L_ref=L_ref))
+    return Flex(bodies=tuple(bodies), interfaces=tuple(interfaces)), tuple(blocks)
+
+
+def flex_start(system: System, c0: Config, v0):
+    """Structures at rest relative to the vessel, undeformed: frames aligned with the vessel's, at
+    their centres of gravity, moving with it; interface frames on the vessel's attachment points."""
+    flex = system.flex
+    L = layout(system)
+    A = rotation_matrix(c0.q)
+    V, om = v0[:3], v0[3:6]
+    Xs = jnp.stack([c0.X0 + A @ b.c0 for b in flex.bodies])
+    qs = jnp.tile(c0.q, (L.S, 1))
+    c = c0._replace(Xs=Xs, qs=qs, eta=jnp.zeros(L.m))
+    rig = jnp.concatenate([jnp.concatenate([V + A @ jnp.cross(om, b.c0), om]) for b in flex.bodies])
+    v = jnp.concatenate([v0[:6], rig, v0[6:], jnp.zeros(L.m)])
+    alg = []
+    for itf in flex.interfaces:
+        alg += [(c0.X0[None, :] + itf.sides[0].points @ A.T).reshape(-1), jnp.zeros(3 * itf.n * len(itf.sides))]
+    return c, v, jnp.concatenate(alg)
