@@ -13,6 +13,7 @@ import os
 
 import numpy as np
 
+from .database import save_netcdf, tables_from_dataset
 from .tables import Tables
 
 
@@ -119,6 +120,8 @@ def capytaine_hydrostatics(hull, rho=1025.0, g=9.81, panel_size=None, base_dir="
 
 @functools.lru_cache(maxsize=16)
 def _capytaine_cached(hull, rho, g, depth, frequencies, headings, panel_size, base_dir):
+    """Capytaine's dataset (assemble_dataset) of the hull's radiation at the frequencies and at
+    infinite frequency (A_inf), and its diffraction for the headings, about the COG."""
     cpt = _import_capytaine()
     w = np.asarray(frequencies if frequencies else default_frequencies(), dtype=float)
     body = _box_body(cpt, hull, panel_size, omega_max=w.max()) if hull.type == "box" else \
@@ -131,26 +134,32 @@ def _capytaine_cached(hull, rho, g, depth, frequencies, headings, panel_size, ba
     probs = [cpt.RadiationProblem(body=body, radiating_dof=d, omega=float(x), **kw) for d in dofs for x in w]
     probs += [cpt.DiffractionProblem(body=body, wave_direction=float(b), omega=float(x), **kw)
               for b in headings for x in w]
-    results = solver.solve_all(probs, progress_bar=False) if _accepts(solver.solve_all, "progress_bar") \
-        else solver.solve_all(probs)
-    ds = cpt.assemble_dataset(results)
-    order = [d for d in dofs]
-    A = ds["added_mass"].sel(omega=w, radiating_dof=order, influenced_dof=order).transpose(
-        "omega", "influenced_dof", "radiating_dof").values
-    B = ds["radiation_damping"].sel(omega=w, radiating_dof=order, influenced_dof=order).transpose(
-        "omega", "influenced_dof", "radiating_dof").values
+    solve = (lambda ps: solver.solve_all(ps, progress_bar=False)) if _accepts(solver.solve_all, "progress_bar") \
+        else solver.solve_all
+    results = solve(probs)
     try:
-        inf = [solver.solve(cpt.RadiationProblem(body=body, radiating_dof=d, omega=np.inf, **kw)) for d in dofs]
-        Ainf = np.array([[r.added_masses[i] for r in inf] for i in order])
-    except Exception:   # noqa: BLE001 - an older Capytaine without infinite frequency: fitted instead
-        Ainf = None
-    X = heads = None
-    if headings:
-        F = ds["excitation_force"].sel(omega=w, influenced_dof=order).transpose("omega", "wave_direction",
-                                                                                 "influenced_dof").values
-        X = np.conj(F)            # Capytaine's e^{-i w t} convention -> ours (waves.py)
-        heads = np.asarray(ds["wave_direction"].values, dtype=float)
-    return Tables(w, A, B, Ainf, heads, X)
+        results += solve([cpt.RadiationProblem(body=body, radiating_dof=d, omega=np.inf, **kw) for d in dofs])
+    except Exception:   # noqa: BLE001 - an older Capytaine without infinite frequency: A_inf fitted instead
+        pass
+    return cpt.assemble_dataset(results)
+
+
+def capytaine_dataset(hull, rho=1025.0, g=9.81, depth=None, frequencies=None, headings=(), panel_size=None,
+                      base_dir=""):
+    """Capytaine's own dataset of the hull (what `capytaine.io.xarray.save_dataset_as_netcdf` saves):
+    cached, one solve per hull and settings in a process."""
+    return _capytaine_cached(hull, float(rho), float(g), None if depth is None else float(depth),
+                             tuple(float(x) for x in frequencies) if frequencies else None,
+                             tuple(float(x) for x in headings), panel_size, base_dir)
+
+
+def save_capytaine_dataset(ds, path: str) -> None:
+    """The dataset as Capytaine exports it (complex values split along `complex`), to NetCDF."""
+    from capytaine.io.xarray import separate_complex_values
+    ds = separate_complex_values(ds)
+    for k in ("radiating_dof", "influenced_dof"):      # Capytaine's own workaround (its issue 683)
+        ds[k] = ds[k].astype("str")
+    save_netcdf(ds, path)
 
 
 def _accepts(fn, name):
@@ -165,9 +174,7 @@ def capytaine_tables(hull, rho=1025.0, g=9.81, depth=None, frequencies=None, hea
     """Added mass, damping (n, 6, 6), A_inf and excitation (FK + diffraction) for the headings, from a
     Capytaine BEM solve of the hull's wetted surface (with a lid against irregular frequencies),
     about the COG. Cached: one solve per hull and settings in a process."""
-    return _capytaine_cached(hull, float(rho), float(g), None if depth is None else float(depth),
-                             tuple(float(x) for x in frequencies) if frequencies else None,
-                             tuple(float(x) for x in headings), panel_size, base_dir)
+    return tables_from_dataset(capytaine_dataset(hull, rho, g, depth, frequencies, headings, panel_size, base_dir))
 
 
 def hull_hydrodynamics(hull, *, rho=1025.0, g=9.81, depth=None, frequencies=None, headings=(0.0,),
