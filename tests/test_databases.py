@@ -157,3 +157,11 @@ def test_bad_databases_are_input_errors(tmp_path, capsys):
         assert main(["check", str(p)]) == 2, hydro
         err = capsys.readouterr().err
         assert what in err and err.count("\n") == 1, (hydro, err)
+
+
+def test_tables_written_as_a_netcdf_dataset_read_back(dataset, tmp_path):
+    """write_netcdf (tables to Capytaine's layout, without Capytaine) then file = ...: the same tables."""
+    from jaxslosh.hydro.database import write_netcdf
+    ref = tables_from_dataset(dataset)
+    write_netcdf(str(tmp_path / "t.nc"), ref, RHO, G, stiffness=dataset["hydrostatic_stiffness"].values)
+    same(scene_tables(js.load_scene(scene_text(f'file = "{tmp_path / "t.nc"}"')).vessel.hydrodynamics), ref, 1e-12)
