@@ -13,6 +13,7 @@ The package's layers, lowest first (README "Design"): scene/ (TOML to a Scene), 
 """
 from ._version import __version__
 from .analysis.modes import sloshing_modes, structure_modes
+from .analysis.rao import rao
 from .fit.identify import identify
 from .io.result import Result, load_result, save_result
 from .io.status import Status
@@ -22,4 +23,5 @@ from .run.stepper import Stepper
 from .scene import Scene, SceneError, load_scene
 
 __all__ = ["structure_modes", "Scene", "SceneError", "Result", "NumericalFailure", "load_scene", "simulate", "save_result",
-           "load_result", "sloshing_modes", "identify", "simulate_batch", "Stepper", "Status", "__version__"]
+           "load_result", "sloshing_modes", "identify", "simulate_batch", "Stepper", "Status", "rao",
+           "__version__"]

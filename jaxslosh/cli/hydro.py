@@ -5,8 +5,9 @@ import os
 
 import numpy as np
 
-from ..hydro.capytaine import CAPYTAINE_MISSING, capytaine_version, have_capytaine, hull_hydrodynamics, to_toml
-from .common import EXIT_OK, InputError, load
+from ..hydro.capytaine import (CAPYTAINE_MISSING, capytaine_dataset, capytaine_version, have_capytaine,
+                               hull_hydrodynamics, save_capytaine_dataset, to_toml)
+from .common import EXIT_OK, InputError, load, output_folder
 
 
 def add_parsers(sub):
@@ -16,6 +17,9 @@ def add_parsers(sub):
     hy.add_argument("--frequencies", default="0.1:2.5:25", help="LOW:HIGH:COUNT rad/s (default 0.1:2.5:25)")
     hy.add_argument("--headings", help="comma-separated rad (default: the scene's wave heading, or 0)")
     hy.add_argument("--panel-size", type=float, help="panel size of the box mesh, m")
+    hy.add_argument("--netcdf", metavar="OUT.nc",
+                    help="also write Capytaine's dataset as Capytaine exports it (NetCDF), for "
+                         "[vessel.hydrodynamics] file = ... or other tools")
 
 
 def cmd_hydro(a):
@@ -41,11 +45,17 @@ def cmd_hydro(a):
         heads = (scene.waves.heading if scene.waves is not None else 0.0,)
     if not have_capytaine():
         raise InputError(f"hydro: {CAPYTAINE_MISSING}")
+    if a.netcdf:
+        output_folder("--netcdf", a.netcdf)
     hd = scene.vessel.hydrodynamics
-    data = hull_hydrodynamics(hull, rho=scene.environment.water_density, g=scene.environment.gravity,
-                              depth=scene.waves.depth if scene.waves is not None else None,
-                              frequencies=tuple(np.linspace(lo, hi, n)), headings=heads,
-                              panel_size=a.panel_size, base_dir=hd.base_dir if hd is not None else os.path.dirname(os.path.abspath(a.scene)))
+    kw = dict(rho=scene.environment.water_density, g=scene.environment.gravity,
+              depth=scene.waves.depth if scene.waves is not None else None, frequencies=tuple(np.linspace(lo, hi, n)),
+              headings=heads, panel_size=a.panel_size,
+              base_dir=hd.base_dir if hd is not None else os.path.dirname(os.path.abspath(a.scene)))
+    data = hull_hydrodynamics(hull, **kw)
+    if a.netcdf:       # the same (cached) solve, as Capytaine's own dataset
+        save_capytaine_dataset(capytaine_dataset(hull, **kw), a.netcdf)
+        print(f"wrote {a.netcdf}")
     text = (f"# Capytaine {capytaine_version()}: hull of {a.scene}, about the COG; "
             f"BM_T {data['bm_t']:.6g} m, BM_L {data['bm_l']:.6g} m\n" + to_toml(data))
     if a.output:

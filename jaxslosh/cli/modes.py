@@ -4,6 +4,7 @@ from __future__ import annotations
 import json
 import math
 
+from ..analysis.coupled import coupled_modes
 from ..analysis.modes import sloshing_modes, structure_modes
 from .common import EXIT_OK, InputError, setup_jax, load
 
@@ -15,6 +16,8 @@ def add_parsers(sub):
     g = m.add_mutually_exclusive_group()
     g.add_argument("--tank")
     g.add_argument("--structure")
+    g.add_argument("--coupled", action="store_true",
+                   help="the coupled system's modes (vessel, liquid, structures), linearised about rest")
     m.add_argument("-n", type=int, default=10, help="number of modes (default 10)")
     m.add_argument("--json", action="store_true", help="print one JSON object")
 
@@ -24,6 +27,8 @@ def cmd_modes(a):
         raise InputError(f"-n: must be at least 1, got {a.n}")
     scene = load(a.scene)
     setup_jax()
+    if a.coupled:
+        return _coupled_modes(scene, a)
     if a.structure is not None:
         return _structure_modes(scene, a)
     tank = a.tank
@@ -58,4 +63,27 @@ def _structure_modes(scene, a):
     for i, (w, k) in enumerate(zip(modes.omega, modes.kind)):
         f = w / (2 * math.pi)
         print(f"{i + 1:>3} {w:12.5f} {f:10.5f} {1 / f if f > 0 else float('inf'):10.4f} {modes.shares[k][i]:6.3f}  {k}")
+    return EXIT_OK
+
+
+def _coupled_modes(scene, a):
+    m = coupled_modes(scene, n=a.n)
+    if a.json:
+        print(json.dumps({"coupled": True, "omega": [float(w) for w in m.omega],
+                          "damped_omega": [float(w) for w in m.damped],
+                          "damping_ratio": [float(z) for z in m.damping_ratio], "dominant": list(m.dominant),
+                          "shares": [{k: float(v) for k, v in s.items()} for s in m.shares],
+                          "radiation": list(m.radiation), "not_oscillating": m.not_oscillating}))
+        return EXIT_OK
+    print("coupled modes (vessel, liquid and structures, linearised about rest; radiation A(w), B(w) at each "
+          "mode's frequency where the tables reach it):")
+    print(f"{'#':>3} {'omega rad/s':>12} {'damped rad/s':>13} {'period s':>10} {'damping':>9}  {'dominant':<18} "
+          f"{'share':>6}  radiation")
+    for i in range(len(m.omega)):
+        w, wd, z, dom = m.omega[i], m.damped[i], m.damping_ratio[i], m.dominant[i]
+        print(f"{i + 1:>3} {w:12.5f} {wd:13.5f} {2 * math.pi / wd:10.4f} {z:9.5f}  {dom:<18} {m.shares[i][dom]:6.3f}  "
+              f"{m.radiation[i]}")
+    if m.not_oscillating:
+        print(f"({m.not_oscillating} non-oscillating modes left out: rigid-body modes without restoring, such as "
+              f"surge and sway, or overdamped ones)")
     return EXIT_OK

@@ -13,6 +13,7 @@ import os
 
 import numpy as np
 
+from .database import save_netcdf, tables_from_dataset
 from .tables import Tables
 
 
@@ -43,18 +44,35 @@ def default_frequencies(n: int = 40, lo: float = 0.1, hi: float = 4.0):
     return tuple(np.linspace(lo, hi, n))
 
 
-def _box_body(cpt, hull, panel_size, resolution=None, lid=True):
-    """The wetted part of a box hull (the COG at the origin), with a lid on the waterplane against
-    irregular frequencies, and the six rigid dofs about the COG."""
+def _box_body(cpt, hull, panel_size, resolution=None, lid=True, omega_max=None):
+    """The wetted part of a box hull (the COG at the origin), with a lid inside the waterplane
+    against irregular frequencies (see `_lid_depth`), and the six rigid dofs about the COG."""
     L, B, T, kg = hull.length, hull.beam, hull.draft, hull.kg
     size = panel_size or max(min(L, B, T) / 4.0, max(L, B) / 24.0)
     res = resolution or tuple(max(2, int(np.ceil(x / size))) for x in (L, B, 2 * T))
     z_wl = T - kg
     mesh = cpt.mesh_parallelepiped(size=(L, B, 2 * T), center=(0.0, 0.0, z_wl), resolution=res, name="hull")
-    return _body_from_mesh(cpt, mesh, z_wl, lid)
+    return _body_from_mesh(cpt, mesh, z_wl, lid, omega_max)
 
 
-def _body_from_mesh(cpt, mesh, z_wl, lid=True):
+def _lid_depth(hull, omega_max):
+    """Where the lid goes: a lid closer to the free surface pushes the irregular frequencies of
+    the lidded interior problem higher, but one a millimetre below it (as this module had) sits
+    against the waterline's panels and left spikes in the box tables (B_33 < 0 at 2.3 rad/s for a
+    16 x 10 x 2.5 m box): the lid goes as deep as keeps the irregular frequencies above
+    `omega_max` (Capytaine's `lowest_lid_position`), and no deeper than a quarter of the draft
+    (where a hull that is not wall-sided could narrow)."""
+    depth = -float(np.min(hull.vertices[:, 2]))
+    z = -0.25 * depth
+    if omega_max is not None and hasattr(hull, "lowest_lid_position"):
+        with np.errstate(invalid="ignore"):
+            lowest = float(hull.lowest_lid_position(float(omega_max)))
+        if np.isfinite(lowest):            # nan: no irregular frequency below omega_max at all
+            z = max(z, lowest)
+    return min(z, -1e-3 * max(1.0, depth))
+
+
+def _body_from_mesh(cpt, mesh, z_wl, lid=True, omega_max=None):
     # Capytaine puts the free surface at z = 0: the mesh goes down by the waterline height; the COG
     # (our origin) then sits at z = -z_wl.
     mesh = mesh.translated((0.0, 0.0, -z_wl))
@@ -63,7 +81,7 @@ def _body_from_mesh(cpt, mesh, z_wl, lid=True):
     try:
         if not lid:
             raise TypeError
-        lid = hull.generate_lid(z=-1e-3 * max(1.0, abs(z_wl)))
+        lid = hull.generate_lid(z=_lid_depth(hull, omega_max))
         body = cpt.FloatingBody(mesh=hull, lid_mesh=lid, dofs=cpt.rigid_body_dofs(rotation_center=cog),
                                 center_of_mass=cog, name="hull")
     except (AttributeError, TypeError):    # Capytaine without lids
@@ -72,12 +90,12 @@ def _body_from_mesh(cpt, mesh, z_wl, lid=True):
     return body
 
 
-def _mesh_body(cpt, hull, base_dir=""):
+def _mesh_body(cpt, hull, base_dir="", omega_max=None):
     path = hull.file if os.path.isabs(hull.file) or not base_dir else os.path.join(base_dir, hull.file)
     mesh = cpt.load_mesh(path)
     # the mesh's coordinates: waterline at z = 0; our origin is the COG at `cog`
     mesh = mesh.translated(tuple(-np.asarray(hull.cog)))
-    return _body_from_mesh(cpt, mesh, -float(hull.cog[2]))
+    return _body_from_mesh(cpt, mesh, -float(hull.cog[2]), omega_max=omega_max)
 
 
 def capytaine_hydrostatics(hull, rho=1025.0, g=9.81, panel_size=None, base_dir=""):
@@ -102,9 +120,12 @@ def capytaine_hydrostatics(hull, rho=1025.0, g=9.81, panel_size=None, base_dir="
 
 @functools.lru_cache(maxsize=16)
 def _capytaine_cached(hull, rho, g, depth, frequencies, headings, panel_size, base_dir):
+    """Capytaine's dataset (assemble_dataset) of the hull's radiation at the frequencies and at
+    infinite frequency (A_inf), and its diffraction for the headings, about the COG."""
     cpt = _import_capytaine()
-    body = _box_body(cpt, hull, panel_size) if hull.type == "box" else _mesh_body(cpt, hull, base_dir)
     w = np.asarray(frequencies if frequencies else default_frequencies(), dtype=float)
+    body = _box_body(cpt, hull, panel_size, omega_max=w.max()) if hull.type == "box" else \
+        _mesh_body(cpt, hull, base_dir, omega_max=w.max())
     kw = {"rho": rho, "g": g}
     if depth is not None:
         kw["water_depth"] = depth
@@ -113,26 +134,32 @@ def _capytaine_cached(hull, rho, g, depth, frequencies, headings, panel_size, ba
     probs = [cpt.RadiationProblem(body=body, radiating_dof=d, omega=float(x), **kw) for d in dofs for x in w]
     probs += [cpt.DiffractionProblem(body=body, wave_direction=float(b), omega=float(x), **kw)
               for b in headings for x in w]
-    results = solver.solve_all(probs, progress_bar=False) if _accepts(solver.solve_all, "progress_bar") \
-        else solver.solve_all(probs)
-    ds = cpt.assemble_dataset(results)
-    order = [d for d in dofs]
-    A = ds["added_mass"].sel(omega=w, radiating_dof=order, influenced_dof=order).transpose(
-        "omega", "influenced_dof", "radiating_dof").values
-    B = ds["radiation_damping"].sel(omega=w, radiating_dof=order, influenced_dof=order).transpose(
-        "omega", "influenced_dof", "radiating_dof").values
+    solve = (lambda ps: solver.solve_all(ps, progress_bar=False)) if _accepts(solver.solve_all, "progress_bar") \
+        else solver.solve_all
+    results = solve(probs)
     try:
-        inf = [solver.solve(cpt.RadiationProblem(body=body, radiating_dof=d, omega=np.inf, **kw)) for d in dofs]
-        Ainf = np.array([[r.added_masses[i] for r in inf] for i in order])
-    except Exception:   # noqa: BLE001 - an older Capytaine without infinite frequency: fitted instead
-        Ainf = None
-    X = heads = None
-    if headings:
-        F = ds["excitation_force"].sel(omega=w, influenced_dof=order).transpose("omega", "wave_direction",
-                                                                                 "influenced_dof").values
-        X = np.conj(F)            # Capytaine's e^{-i w t} convention -> ours (waves.py)
-        heads = np.asarray(ds["wave_direction"].values, dtype=float)
-    return Tables(w, A, B, Ainf, heads, X)
+        results += solve([cpt.RadiationProblem(body=body, radiating_dof=d, omega=np.inf, **kw) for d in dofs])
+    except Exception:   # noqa: BLE001 - an older Capytaine without infinite frequency: A_inf fitted instead
+        pass
+    return cpt.assemble_dataset(results)
+
+
+def capytaine_dataset(hull, rho=1025.0, g=9.81, depth=None, frequencies=None, headings=(), panel_size=None,
+                      base_dir=""):
+    """Capytaine's own dataset of the hull (what `capytaine.io.xarray.save_dataset_as_netcdf` saves):
+    cached, one solve per hull and settings in a process."""
+    return _capytaine_cached(hull, float(rho), float(g), None if depth is None else float(depth),
+                             tuple(float(x) for x in frequencies) if frequencies else None,
+                             tuple(float(x) for x in headings), panel_size, base_dir)
+
+
+def save_capytaine_dataset(ds, path: str) -> None:
+    """The dataset as Capytaine exports it (complex values split along `complex`), to NetCDF."""
+    from capytaine.io.xarray import separate_complex_values
+    ds = separate_complex_values(ds)
+    for k in ("radiating_dof", "influenced_dof"):      # Capytaine's own workaround (its issue 683)
+        ds[k] = ds[k].astype("str")
+    save_netcdf(ds, path)
 
 
 def _accepts(fn, name):
@@ -147,9 +174,7 @@ def capytaine_tables(hull, rho=1025.0, g=9.81, depth=None, frequencies=None, hea
     """Added mass, damping (n, 6, 6), A_inf and excitation (FK + diffraction) for the headings, from a
     Capytaine BEM solve of the hull's wetted surface (with a lid against irregular frequencies),
     about the COG. Cached: one solve per hull and settings in a process."""
-    return _capytaine_cached(hull, float(rho), float(g), None if depth is None else float(depth),
-                             tuple(float(x) for x in frequencies) if frequencies else None,
-                             tuple(float(x) for x in headings), panel_size, base_dir)
+    return tables_from_dataset(capytaine_dataset(hull, rho, g, depth, frequencies, headings, panel_size, base_dir))
 
 
 def hull_hydrodynamics(hull, *, rho=1025.0, g=9.81, depth=None, frequencies=None, headings=(0.0,),

@@ -63,3 +63,18 @@ def excitation_rao(scene, omega):
     h = ves.hull
     return froude_krylov_box(omega, waves.heading, h.length, h.beam, h.draft, h.kg, env.water_density,
                              env.gravity, waves.depth)
+
+
+def excitation_at(hd, hull, tables: Optional[Tables], omega, heading, rho, g, depth=None):
+    """X (N, 6) complex per unit wave amplitude at frequencies omega for one heading, our phase
+    convention (F = a |X| cos(w t + arg X) for eta = a cos(w t) at the COG): the excitation tables
+    (interpolated in w and heading) where the scene has them and `excitation` does not say
+    "froude-krylov", else Froude-Krylov on the box hull; None when the scene has neither."""
+    source = "auto" if hd is None else hd.excitation
+    has_table = tables is not None and tables.excitation is not None
+    box = hull is not None and hull.type == "box"
+    if has_table and source != "froude-krylov":
+        return interpolate_excitation(tables, omega, heading)
+    if box and source != "table":
+        return froude_krylov_box(omega, heading, hull.length, hull.beam, hull.draft, hull.kg, rho, g, depth)
+    return None

@@ -71,3 +71,16 @@ def interpolate_excitation(tables: Tables, omega, heading):
     for j in range(6):
         out[:, j] = (np.interp(w, tables.omega, Xh[:, j].real) + 1j * np.interp(w, tables.omega, Xh[:, j].imag))
     return out * inside[:, None]
+
+
+def interpolate_radiation(tables: Tables, omega):
+    """A(w), B(w) (N, 6, 6) at frequencies omega, linear in w between the tabulated ones (inside
+    their range only: the caller checks it)."""
+    w = np.asarray(omega, dtype=float)
+    A = np.zeros((w.size, 6, 6))
+    B = np.zeros((w.size, 6, 6))
+    for i in range(6):
+        for j in range(6):
+            A[:, i, j] = np.interp(w, tables.omega, tables.added_mass[:, i, j])
+            B[:, i, j] = np.interp(w, tables.omega, tables.damping[:, i, j])
+    return A, B

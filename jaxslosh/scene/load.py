@@ -30,7 +30,7 @@ from .fields import (at_least, counts, non_negative, one_of, poisson_ratio, posi
                      valid_name)
 from .types import (DOFS, EFFECTS, ELEMENT_FORMS, FACES, Effects, Environment, Forced, Fluid, Hydrostatics, Initial,
                     Material, Probe, Reduction, Scene, SceneError, Simulation, Structure, Tank, Vessel, Walls)
-from .waves import check_waves, hull_hydrostatics, read_hull, read_hydrodynamics, read_waves
+from .waves import FileContext, check_waves, hull_hydrostatics, read_hull, read_hydrodynamics, read_waves
 
 SCHEMES = ("newmark", "hht", "generalized-alpha")
 LINEAR_SOLVERS = ("auto", "dense", "sparse")      # [simulation] linear_solver (sparse.py)
@@ -89,7 +89,11 @@ def parse_scene(mapping: Mapping[str, Any], text: str = "", path: str = "") -> S
     title = top.get("title", Path(path).stem if path else "")
     environment = _environment(mapping.get("environment", {}))
     simulation = _simulation(mapping["simulation"], warnings)
-    vessel = _vessel(mapping["vessel"], environment, warnings)
+    raw_waves = mapping.get("waves")
+    depth = raw_waves.get("depth") if isinstance(raw_waves, dict) else None
+    files = FileContext(os.path.dirname(os.path.abspath(path)) if path else os.getcwd(), environment.water_density,
+                        environment.gravity, depth if isinstance(depth, (int, float)) and depth > 0 else None)
+    vessel = _vessel(mapping["vessel"], environment, warnings, files)
     tanks = tuple(_tank(t, f"tanks[{i}]") for i, t in enumerate(mapping.get("tanks", [])))
     structures = tuple(_structure(s, f"structures[{i}]") for i, s in enumerate(mapping.get("structures", [])))
     probes = tuple(_probe(p, f"probes[{i}]") for i, p in enumerate(mapping.get("probes", [])))
@@ -211,7 +215,7 @@ def _overlapping_tanks(tanks, warnings: list[str]) -> None:
                                 f"simulated apart, as if each had the shared space to itself")
 
 
-def _vessel(table, environment: Environment, warnings: list[str]) -> Vessel:
+def _vessel(table, environment: Environment, warnings: list[str], files=None) -> Vessel:
     v = read(table, "vessel", {
         "mass": ("float", positive), "inertia": ("inertia", None), "hydrostatics": ("table", None),
         "initial": ("table", None), "forced": ("table", None), "hull": ("table", None),
@@ -225,7 +229,8 @@ def _vessel(table, environment: Environment, warnings: list[str]) -> Vessel:
         hull = read_hull(table["hull"]) if "hull" in table else None
         if hull is not None:
             hydrostatics = hull_hydrostatics(hull, hydrostatics, warnings)
-        hydrodynamics = read_hydrodynamics(table["hydrodynamics"], hull) if "hydrodynamics" in table else None
+        hydrodynamics = read_hydrodynamics(table["hydrodynamics"], hull, files, warnings, hydrostatics) \
+            if "hydrodynamics" in table else None
     # a prescribed motion ([vessel.forced]) holds all six dofs, so then nothing falls
     if hydrostatics is None and environment.gravity > 0 and "forced" not in table:
         warnings.append(f"vessel: no [vessel.hydrostatics] table, so nothing holds the vessel up: it falls "

@@ -238,6 +238,9 @@ class Hydrodynamics:
     memory_order: int = 0            # complex pole pairs per column of the memory fit (0: automatic)
     excitation: str = "auto"         # "auto" | "table" | "froude-krylov"
     base_dir: str = ""               # the scene's folder (a mesh file is relative to it)
+    file: str = ""                   # a hydrodynamic database the tables above were read from (hydro/database.py)
+    cog: Optional[tuple] = None      # the COG in the database's coordinates (None: its own, or WAMIT's origin)
+    length_scale: float = 1.0        # WAMIT's ULEN, m
 
 
 EFFECTS = ("buoyancy", "liquid", "coriolis", "centrifugal", "gravity_turning", "waves", "radiation")

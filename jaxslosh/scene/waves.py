@@ -10,12 +10,13 @@ from __future__ import annotations
 import dataclasses
 import math
 import os
-from typing import Optional
+from typing import NamedTuple, Optional
 
 import numpy as np
 
 from ..hydro.box import box_hydrostatics
 from ..hydro.capytaine import CAPYTAINE_MISSING, have_capytaine
+from ..hydro.database import DatabaseError, read_database
 from .fields import at_least, non_negative, one_of, positive, read, show
 from .types import Hull, Hydrodynamics, Hydrostatics, Scene, SceneError, Waves
 
@@ -116,7 +117,61 @@ def _tuples(x):
     return tuple(_tuples(e) for e in x) if isinstance(x, list) else float(x)
 
 
-def read_hydrodynamics(table, hull: Optional[Hull]) -> Hydrodynamics:
+class FileContext(NamedTuple):
+    """What reading a hydrodynamic database needs besides its table: the scene's folder (a relative
+    `file` is relative to it), water density and gravity (WAMIT's files are non-dimensional; the
+    wavenumber that moves phases), the water depth (None: deep)."""
+    base_dir: str = ""
+    rho: float = 1025.0
+    g: float = 9.81
+    depth: Optional[float] = None
+
+
+#: the tables a `file` holds: the scene may not give them too
+FILE_TABLES = ("frequencies", "added_mass", "damping", "added_mass_infinite", "headings", "excitation_amplitude",
+               "excitation_phase", "capytaine", "panel_size")
+
+
+def _from_file(v: dict, where: str, files: Optional[FileContext], hydrostatics, warnings: list[str]) -> dict:
+    """The tables of `file` (hydro/database.py) as the table's own keys would hold them."""
+    for k in FILE_TABLES:
+        if k in v:
+            raise SceneError(f"{where}.{k}", "the tables come from `file`; remove this key (or the file)")
+    files = files or FileContext()
+    path = v["file"] if os.path.isabs(v["file"]) else os.path.join(files.base_dir, v["file"])
+    try:
+        db = read_database(path, files.rho, files.g, v.get("cog"), v.get("length_scale", 1.0), files.depth)
+    except DatabaseError as e:
+        raise SceneError(f"{where}.file", " ".join(str(e).split())) from None
+    t = db.tables
+    if t.omega.size < 4 or t.added_mass is None:
+        raise SceneError(f"{where}.file", f"{path}: holds {t.omega.size} frequencies of added mass and damping; "
+                                          f"the radiation memory needs at least 4")
+    out = dict(v, frequencies=t.omega.tolist(), added_mass=t.added_mass.tolist(), damping=t.damping.tolist())
+    if t.added_mass_infinite is not None:
+        out["added_mass_infinite"] = t.added_mass_infinite.tolist()
+    if t.excitation is not None:
+        out.update(headings=t.headings.tolist(), excitation_amplitude=np.abs(t.excitation).tolist(),
+                   excitation_phase=np.angle(t.excitation).tolist())
+    if db.rho is not None and abs(db.rho / files.rho - 1) > 1e-9:
+        warnings.append(f"{where}.file: the dataset was computed with water density {db.rho:.6g} kg/m^3, the scene "
+                        f"has {files.rho:.6g}: its coefficients are used as they are")
+    C = db.stiffness
+    if hydrostatics is not None and C is not None and np.abs(C).max() > 0:
+        rg = files.rho * files.g
+        h = hydrostatics
+        pairs = [("waterplane_area", 2, rg * h.waterplane_area)]
+        if db.point_is_cog:     # roll and pitch restoring depend on the point they are about
+            pairs += [("gm_t", 3, rg * h.displaced_volume * h.gm_t), ("gm_l", 4, rg * h.displaced_volume * h.gm_l)]
+        for key, i, mine in pairs:
+            if abs(C[i, i] - mine) > HULL_MISMATCH_TOLERANCE * abs(mine):
+                warnings.append(f"vessel.hydrostatics.{key} gives C_{i + 1}{i + 1} = {mine:.6g}, the file's hydrostatic "
+                                f"stiffness {C[i, i]:.6g}: the restoring uses the table")
+    return out
+
+
+def read_hydrodynamics(table, hull: Optional[Hull], files: Optional[FileContext] = None,
+                       warnings: Optional[list] = None, hydrostatics=None) -> Hydrodynamics:
     where = "vessel.hydrodynamics"
     v = read(table, where, {
         "frequencies": ("numbers", None), "added_mass": ("numbers", None), "damping": ("numbers", None),
@@ -124,10 +179,17 @@ def read_hydrodynamics(table, hull: Optional[Hull]) -> Hydrodynamics:
         "excitation_amplitude": ("numbers", None), "excitation_phase": ("numbers", None),
         "viscous_damping": ("numbers", None), "capytaine": ("bool", None), "panel_size": ("float", positive),
         "memory_order": ("int", non_negative), "excitation": ("str", one_of(EXCITATION_SOURCES)),
+        "file": ("str", None), "cog": ("vec3", None), "length_scale": ("float", positive),
     })
+    for k in ("cog", "length_scale"):
+        if k in v and "file" not in v:
+            raise SceneError(f"{where}.{k}", "only goes with `file` (a hydrodynamic database)")
+    if "file" in v:
+        v = _from_file(v, where, files, hydrostatics, warnings if warnings is not None else [])
     capy = v.get("capytaine", False)
     out = {"capytaine": capy, "panel_size": v.get("panel_size"), "memory_order": v.get("memory_order", 0),
-           "excitation": v.get("excitation", "auto")}
+           "excitation": v.get("excitation", "auto"), "file": v.get("file", ""),
+           "cog": tuple(v["cog"]) if "cog" in v else None, "length_scale": v.get("length_scale", 1.0)}
     if capy:
         if hull is None:
             raise SceneError(f"{where}.capytaine", "needs a [vessel.hull] table (the geometry to solve for)")

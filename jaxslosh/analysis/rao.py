@@ -1,0 +1,144 @@
+"""Response amplitude operators of the coupled vessel (SPEC section 7): the linearised scene
+(linear.py) in regular waves of unit amplitude,
+
+    [K - w^2 (M - A_inf + A(w)) + i w (C + B(w))] X = F(w, beta),      x(t) = Re(X e^{i w t}),
+
+with A(w), B(w) the hull's radiation tables interpolated linearly in w (not the time domain's
+memory fit, whose error is the time domain's), A_inf the added mass the residual carries on the
+vessel's rows, and F the wave excitation on them (the tables interpolated in w and heading, or
+Froude-Krylov on the box hull) for eta = cos(w t) at the COG's rest position. X holds the vessel's
+six dofs (m/m, rad/m; rotations about the COG in body axes, equal to roll, pitch, yaw at first
+order) and every unknown of the liquid and structures; the probes' RAOs are their inertial
+displacements (the result file's `displacement`) per unit amplitude.
+"""
+from __future__ import annotations
+
+from typing import NamedTuple, Optional
+
+import numpy as np
+
+from ..hydro.source import excitation_at, tables_of
+from ..hydro.tables import interpolate_radiation
+from ..scene.types import Scene, SceneError
+from .linear import Linearisation, linearise
+
+#: the default frequencies without radiation tables (rad/s): the band of ship motions and of the
+#: first sloshing modes of ship tanks
+DEFAULT_BAND = (0.1, 4.0)
+DEFAULT_COUNT = 200
+
+
+class RAO(NamedTuple):
+    frequency: np.ndarray      # (f,) rad/s
+    heading: np.ndarray        # (h,) rad
+    vessel: np.ndarray         # (f, h, 6) complex: surge, sway, heave (m/m), roll, pitch, yaw (rad/m)
+    probes: dict               # name -> (f, h, 3) complex (m/m)
+    scene_text: str = ""
+
+
+class Hydro(NamedTuple):
+    """The hull's frequency-domain data for a scene: radiation tables (or None) and excitation."""
+    tables: object
+    radiation: bool
+
+
+def hull_tables(scene: Scene, headings):
+    """The scene's hydrodynamic tables (Capytaine's for these headings where it says so), or None."""
+    hd, env = scene.vessel.hydrodynamics, scene.environment
+    if hd is None:
+        return None
+    depth = scene.waves.depth if scene.waves is not None else None
+    return tables_of(hd, scene.vessel.hull, env.water_density, env.gravity, depth, tuple(float(b) for b in headings))
+
+
+def default_headings(scene: Scene, tables=None):
+    if scene.waves is not None:
+        return np.array([scene.waves.heading])
+    if tables is not None and tables.headings is not None:
+        return np.asarray(tables.headings, dtype=float)
+    return np.array([0.0, np.pi / 2, np.pi])
+
+
+def _check(scene: Scene, tables, radiation, w, heads):
+    if w.ndim != 1 or w.size == 0 or not np.all(np.isfinite(w)) or np.any(w <= 0):
+        raise SceneError("frequencies", "must be positive finite numbers (rad/s)")
+    if radiation:
+        lo, hi = tables.omega[0], tables.omega[-1]
+        if w.min() < lo - 1e-9 or w.max() > hi + 1e-9:
+            raise SceneError("frequencies", f"[{w.min():.6g}, {w.max():.6g}] rad/s reaches beyond the radiation "
+                                            f"tables' [{lo:.6g}, {hi:.6g}] rad/s (vessel.hydrodynamics.frequencies)")
+    hd = scene.vessel.hydrodynamics
+    if tables is not None and tables.excitation is not None and (hd is None or hd.excitation != "froude-krylov"):
+        th = np.asarray(tables.headings, dtype=float)
+        for b in heads:
+            if (th.size == 1 and abs(b - th[0]) > 1e-6) or not th[0] - 1e-6 <= b <= th[-1] + 1e-6:
+                raise SceneError("headings", f"{b:.6g} rad lies outside the excitation tables' headings "
+                                             f"{np.round(th, 6).tolist()} rad")
+        lo, hi = tables.omega[0], tables.omega[-1]
+        if w.min() < lo - 1e-9 or w.max() > hi + 1e-9:
+            raise SceneError("frequencies", f"[{w.min():.6g}, {w.max():.6g}] rad/s reaches beyond the excitation "
+                                            f"tables' [{lo:.6g}, {hi:.6g}] rad/s")
+
+
+def default_frequencies(scene: Scene, tables=None, radiation=None, count: int = DEFAULT_COUNT):
+    if radiation is None:
+        radiation = scene.effects.radiation and tables is not None and tables.added_mass is not None
+    if radiation or (tables is not None and tables.excitation is not None):
+        return np.linspace(tables.omega[0], tables.omega[-1], count)
+    return np.linspace(*DEFAULT_BAND, count)
+
+
+def solve_equilibrated(Z, F):
+    """Z X = F with rows and columns scaled to unit max norm first: the acoustic rows of the liquid
+    are 1e10 times the vessel's, and the interface rows of structures carry no inertia."""
+    r = 1.0 / np.maximum(np.abs(Z).max(axis=1), 1e-300)
+    Zr = Z * r[:, None]
+    c = 1.0 / np.maximum(np.abs(Zr).max(axis=0), 1e-300)
+    return c[:, None] * np.linalg.solve(Zr * c[None, :], F * r[:, None])
+
+
+def frequency_matrices(lin: Linearisation, tables, radiation: bool, w):
+    """(M(w), C(w)) of the coupled system at frequency w: the radiation tables' A(w) in place of
+    the A_inf the residual carries, B(w) added, on the vessel's rows and columns."""
+    M, C = lin.M.copy(), lin.C.copy()
+    if radiation:
+        A, B = interpolate_radiation(tables, [w])
+        M[:6, :6] += A[0] - lin.added_mass_infinite
+        C[:6, :6] += B[0]
+    return M, C
+
+
+def rao(scene: Scene, frequencies=None, headings=None, *, params=None,
+        linearisation: Optional[Linearisation] = None) -> RAO:
+    """Complex RAOs of the vessel's six dofs and every probe over `frequencies` (rad/s; default:
+    the radiation tables' range, else 0.1 to 4 rad/s) and `headings` (rad, the direction the waves
+    travel to; default the scene's wave heading, else the excitation tables', else 0, pi/2, pi).
+    Input the frequency domain cannot take raises SceneError naming it."""
+    env, ves = scene.environment, scene.vessel
+    heads = None if headings is None else np.atleast_1d(np.asarray(headings, dtype=float))
+    tables = hull_tables(scene, heads if heads is not None else
+                         (() if scene.waves is None else (scene.waves.heading,)))
+    if heads is None:
+        heads = default_headings(scene, tables)
+    radiation = bool(scene.effects.radiation and tables is not None and tables.added_mass is not None)
+    w = default_frequencies(scene, tables, radiation) if frequencies is None else \
+        np.atleast_1d(np.asarray(frequencies, dtype=float))
+    _check(scene, tables, radiation, w, heads)
+    depth = scene.waves.depth if scene.waves is not None else None
+    X = [excitation_at(ves.hydrodynamics, ves.hull, tables, w, b, env.water_density, env.gravity, depth)
+         for b in heads]
+    if X[0] is None:
+        raise SceneError("vessel.hull", "the RAO needs the wave forces: a box [vessel.hull] (Froude-Krylov) or "
+                                        "excitation tables in [vessel.hydrodynamics] (or capytaine = true)")
+    X = np.stack(X, axis=1)                                  # (f, h, 6)
+    lin = linearisation if linearisation is not None else linearise(scene, params)
+    n = lin.n
+    out = np.zeros((w.size, heads.size, n), dtype=complex)
+    for i, wi in enumerate(w):
+        M, C = frequency_matrices(lin, tables, radiation, wi)
+        Z = lin.K - wi * wi * M + 1j * wi * C
+        F = np.zeros((n, heads.size), dtype=complex)
+        F[:6] = X[i].T
+        out[i] = solve_equilibrated(Z, F).T
+    probes = {name: np.einsum("cn,fhn->fhc", lin.probes[k], out) for k, name in enumerate(lin.probe_names)}
+    return RAO(w, heads, out[:, :, :6], probes, scene.text)

@@ -1,0 +1,181 @@
+"""A result file as ParaView reads it: XDMF 3 time series over one HDF5 file (`jaxslosh export`).
+
+Each mesh is its own XDMF file (one temporal collection each, so meshio's TimeSeriesReader reads
+every one; ParaView opens them together), all over one HDF5 file `STEM_paraview.h5`:
+
+* `STEM.xdmf`: the liquid of every tank (without tanks: the vessel), hexahedra in the inertial frame (the tank moved with the
+  vessel, plus the liquid's displacement), point data `displacement` (the result's deformational
+  displacement, tank frame, m) and `elevation` (its vertical part);
+* `STEM_surface.xdmf`: the free surfaces (the top faces of the liquid meshes), quadrilaterals,
+  `elevation`;
+* `STEM_vessel.xdmf`: the hull as its wetted box (a `[vessel.hull]` box: keel to waterline), or
+  the vessel's frame as three lines along its axes from the COG;
+* `STEM_structures.xdmf`: flexible structures as their undeformed blocks carried by the vessel
+  (a result file keeps no structure fields: their probes carry their deformation);
+* `STEM_probes.xdmf`: the probes' material points, `displacement` (the result's, inertial).
+
+Every step has its own geometry (the meshes move) and attributes, one HDF5 dataset each; the
+topology is written once. The scene's tanks, hull and structures come from the TOML text the
+result keeps (tomllib: io sits below the scene loader).
+"""
+from __future__ import annotations
+
+import os
+from typing import NamedTuple
+
+import h5py
+import numpy as np
+
+from ..fem.mesh import box_mesh
+from .result import Result
+
+try:
+    import tomllib
+except ModuleNotFoundError:        # Python 3.10
+    import tomli as tomllib
+
+#: XDMF topology names and nodes per cell
+TOPOLOGY = {"hexahedron": ("Hexahedron", 8), "quad": ("Quadrilateral", 4), "line": ("Polyline", 2),
+            "vertex": ("Polyvertex", 1)}
+
+
+class Series(NamedTuple):
+    """One mesh over time: cells (E, c) of `kind`, points (k, N, 3) per frame, point data
+    {name: (k, N) or (k, N, 3)}."""
+    name: str
+    kind: str
+    cells: np.ndarray
+    points: np.ndarray
+    data: dict
+
+
+def rotation_matrices(q):
+    """A(q) (k, 3, 3), body to inertial, of Euler parameters (k, 4) scalar first."""
+    q0, q1, q2, q3 = np.moveaxis(np.asarray(q, dtype=float), -1, 0)
+    return np.stack([
+        np.stack([q0 * q0 + q1 * q1 - q2 * q2 - q3 * q3, 2 * (q1 * q2 - q0 * q3), 2 * (q1 * q3 + q0 * q2)], -1),
+        np.stack([2 * (q1 * q2 + q0 * q3), q0 * q0 - q1 * q1 + q2 * q2 - q3 * q3, 2 * (q2 * q3 - q0 * q1)], -1),
+        np.stack([2 * (q1 * q3 - q0 * q2), 2 * (q2 * q3 + q0 * q1), q0 * q0 - q1 * q1 - q2 * q2 + q3 * q3], -1),
+    ], -2)
+
+
+def carried(X0, A, body_points):
+    """Inertial positions (k, N, 3) of points fixed in the vessel frame, or moving in it ((k, N, 3))."""
+    p = np.asarray(body_points, dtype=float)
+    if p.ndim == 2:
+        return X0[:, None, :] + np.einsum("kij,nj->kni", A, p)
+    return X0[:, None, :] + np.einsum("kij,knj->kni", A, p)
+
+
+def _scene(text: str) -> dict:
+    try:
+        return tomllib.loads(text or "")
+    except (tomllib.TOMLDecodeError, TypeError, ValueError):
+        return {}
+
+
+def _tank_origins(scene: dict) -> dict:
+    return {t.get("name"): np.asarray(t.get("origin", (0.0, 0.0, 0.0)), dtype=float) for t in scene.get("tanks", [])}
+
+
+def series_of(r: Result, every: int = 1) -> list:
+    """The meshes of a result over its frames (every `every`-th), in the inertial frame."""
+    scene = _scene(r.scene_text)
+    sl = slice(None, None, every)
+    X0 = np.asarray(r.vessel.position, dtype=float)[sl]
+    A = rotation_matrices(np.asarray(r.vessel.quaternion)[sl])
+    out = []
+    origins = _tank_origins(scene)
+    nodes, cells, disp, surf_cells, offset = [], [], [], [], 0
+    for name, t in r.tanks.items():
+        n = np.asarray(t.nodes, dtype=float)
+        d = np.asarray(t.displacement, dtype=float)[sl]
+        nodes.append(n + origins.get(name, np.zeros(3)))
+        cells.append(np.asarray(t.elements) + offset)
+        disp.append(d)
+        el = np.asarray(t.elements)
+        top = np.isclose(n[:, 2], n[:, 2].max())
+        faces = el[:, 4:8]                                 # hex8: the top face is the last four corners
+        surf_cells.append(faces[top[faces].all(axis=1)] + offset)
+        offset += n.shape[0]
+    if nodes:
+        D = np.concatenate(disp, axis=1)
+        P = carried(X0, A, np.concatenate(nodes)[None] + D)
+        data = {"displacement": D, "elevation": D[..., 2]}
+        out.append(Series("liquid", "hexahedron", np.concatenate(cells), P, data))
+        out.append(Series("surface", "quad", np.concatenate(surf_cells), P, {"elevation": D[..., 2]}))
+    hull = scene.get("vessel", {}).get("hull")
+    if hull and hull.get("type", "box") == "box":
+        L, B, T, kg = (float(hull[k]) for k in ("length", "beam", "draft", "kg"))
+        pts, el = box_mesh((L, B, T), (1, 1, 1))
+        out.append(Series("vessel", "hexahedron", el, carried(X0, A, pts + np.array([-L / 2, -B / 2, -kg])), {}))
+    else:
+        size = max([max(t.get("size", (1.0,))) for t in scene.get("tanks", [])] + [1.0])
+        pts = np.array([[0.0, 0.0, 0.0], [size, 0, 0], [0, size, 0], [0, 0, size]])
+        out.append(Series("vessel", "line", np.array([[0, 1], [0, 2], [0, 3]]), carried(X0, A, pts), {}))
+    blocks = []
+    for st in scene.get("structures", []):
+        pts, el = box_mesh(st["size"], st["mesh"])
+        blocks.append((pts + np.asarray(st["origin"], dtype=float), el))
+    if blocks:
+        offs = np.cumsum([0] + [p.shape[0] for p, _ in blocks])
+        out.append(Series("structures", "hexahedron", np.concatenate([e + o for (_, e), o in zip(blocks, offs)]),
+                          carried(X0, A, np.concatenate([p for p, _ in blocks])), {}))
+    if r.probes:
+        names = list(r.probes)
+        pos = np.stack([np.asarray(r.probes[k].position, dtype=float)[sl] for k in names], axis=1)
+        dis = np.stack([np.asarray(r.probes[k].displacement, dtype=float)[sl] for k in names], axis=1)
+        out.append(Series("probes", "vertex", np.arange(len(names))[:, None], pos, {"displacement": dis}))
+    return out
+
+
+def _item(h5name: str, path: str, shape, kind="Float") -> str:
+    dims = " ".join(str(s) for s in shape)
+    return f'<DataItem DataType="{kind}" Dimensions="{dims}" Format="HDF" Precision="8">{h5name}:{path}</DataItem>'
+
+
+def write_series(xdmf: str, h5: h5py.File, h5name: str, s: Series, times) -> None:
+    """One mesh's XDMF file; its arrays into the open HDF5 file `h5` under /<name>."""
+    g = h5.create_group(s.name)
+    g.create_dataset("topology", data=np.asarray(s.cells, dtype=np.int64))
+    topo, per = TOPOLOGY[s.kind]
+    ne, nn = s.cells.shape[0], s.points.shape[1]
+    extra = f' NodesPerElement="{per}"' if s.kind in ("line", "vertex") else ""
+    topology = (f'<Topology TopologyType="{topo}" NumberOfElements="{ne}"{extra}>'
+                f'{_item(h5name, f"/{s.name}/topology", s.cells.shape, "Int")}</Topology>')
+    geo = g.create_group("geometry")
+    groups = {k: g.create_group(k) for k in s.data}
+    lines = ['<?xml version="1.0"?>', '<Xdmf Version="3.0">', "<Domain>",
+             f'<Grid Name="{s.name}" GridType="Collection" CollectionType="Temporal">']
+    for k, t in enumerate(times):
+        geo.create_dataset(str(k), data=s.points[k])
+        lines += [f'<Grid Name="{s.name}" GridType="Uniform">', f'<Time Value="{float(t)!r}"/>', topology,
+                  f'<Geometry GeometryType="XYZ">{_item(h5name, f"/{s.name}/geometry/{k}", (nn, 3))}</Geometry>']
+        for name, v in s.data.items():
+            groups[name].create_dataset(str(k), data=v[k])
+            kind = "Vector" if v.ndim == 3 else "Scalar"
+            lines.append(f'<Attribute Name="{name}" AttributeType="{kind}" Center="Node">'
+                         f'{_item(h5name, f"/{s.name}/{name}/{k}", v.shape[1:])}</Attribute>')
+        lines.append("</Grid>")
+    lines += ["</Grid>", "</Domain>", "</Xdmf>", ""]
+    with open(xdmf, "w") as f:
+        f.write("\n".join(lines))
+
+
+def export_paraview(r: Result, xdmf: str, every: int = 1) -> list:
+    """Write the result's meshes (series_of) as XDMF files beside `xdmf` (see the module's
+    docstring); returns the files written, the HDF5 file last."""
+    stem = os.path.splitext(xdmf)[0]
+    h5path = stem + "_paraview.h5"
+    h5name = os.path.basename(h5path)
+    times = np.asarray(r.time, dtype=float)[::every]
+    written = []
+    meshes = series_of(r, every)
+    main = "liquid" if any(s.name == "liquid" for s in meshes) else "vessel"     # no tanks: the vessel's
+    with h5py.File(h5path, "w") as h5:
+        h5.attrs["format"] = "jaxslosh.paraview"
+        for s in meshes:
+            path = xdmf if s.name == main else f"{stem}_{s.name}.xdmf"
+            write_series(path, h5, h5name, s, times)
+            written.append(path)
+    return written + [h5path]
