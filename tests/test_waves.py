@@ -286,6 +286,17 @@ def test_capytaine_box_hydrostatics_equal_the_closed_forms_and_feed_a_scene(tmp_
     assert r.status == "ok" and np.abs(np.asarray(r.vessel.roll_pitch_yaw)[:, 0]).max() > 1e-3
 
 
+@pytest.mark.parametrize("target", ["folder", "scene"])
+def test_hydro_output_is_checked_before_the_solve(tmp_path, capsys, target):
+    p = tmp_path / "box.toml"
+    p.write_text((DATA / "box_20x10x2.toml").read_text())
+    out = tmp_path if target == "folder" else p
+    assert main(["hydro", str(p), "-o", str(out)]) == 2
+    err = capsys.readouterr().err
+    assert err.startswith("error: -o:") and err.count("\n") == 1, err
+    assert p.read_text() == (DATA / "box_20x10x2.toml").read_text()
+
+
 def test_capytaine_missing_is_an_input_error(tmp_path, monkeypatch, capsys):
     monkeypatch.setitem(sys.modules, "capytaine", None)
     import importlib.util

@@ -45,8 +45,9 @@ def cmd_hydro(a):
         heads = (scene.waves.heading if scene.waves is not None else 0.0,)
     if not have_capytaine():
         raise InputError(f"hydro: {CAPYTAINE_MISSING}")
+    output_folder("-o", a.output, scene=a.scene)
     if a.netcdf:
-        output_folder("--netcdf", a.netcdf)
+        output_folder("--netcdf", a.netcdf, scene=a.scene)
     hd = scene.vessel.hydrodynamics
     kw = dict(rho=scene.environment.water_density, g=scene.environment.gravity,
               depth=scene.waves.depth if scene.waves is not None else None, frequencies=tuple(np.linspace(lo, hi, n)),
@@ -58,9 +59,11 @@ def cmd_hydro(a):
         print(f"wrote {a.netcdf}")
     text = (f"# Capytaine {capytaine_version()}: hull of {a.scene}, about the COG; "
             f"BM_T {data['bm_t']:.6g} m, BM_L {data['bm_l']:.6g} m\n" + to_toml(data))
-    if a.output:
-        with open(a.output, "w") as f:
+    if a.output:       # a temporary name beside the target, renamed when complete
+        tmp = os.path.join(os.path.dirname(os.path.abspath(a.output)), f".{os.path.basename(a.output)}.part")
+        with open(tmp, "w") as f:
             f.write(text)
+        os.replace(tmp, a.output)
         print(f"wrote {a.output}")
     else:
         print(text, end="")
