@@ -10,6 +10,7 @@ the unit-norm constraint of eq. (25) needs no multiplier (PHYSICS.md section 2, 
 from __future__ import annotations
 
 import jax.numpy as jnp
+import numpy as np
 
 
 def mv3(A, x):
@@ -23,25 +24,33 @@ def tv3(A, x):
     return A[0] * x[0] + A[1] * x[1] + A[2] * x[2]
 
 
+#: gather indices and signs of the cross-product matrix of v, read from (0, v0, v1, v2): one gather
+#: and one product, where a nested jnp.array is some twenty operations, each repeated by every
+#: jacfwd and vmap around it (rotations are traced hundreds of times in a step with structures)
+_SKEW_INDEX = np.array([[0, 3, 2], [3, 0, 1], [2, 1, 0]])
+_SKEW_SIGN = np.array([[0.0, -1.0, 1.0], [1.0, 0.0, -1.0], [-1.0, 1.0, 0.0]])
+#: G(q) read from q the same way
+_G_INDEX = np.array([[1, 0, 3, 2], [2, 3, 0, 1], [3, 2, 1, 0]])
+_G_SIGN = np.array([[-1.0, 1.0, 1.0, -1.0], [-1.0, -1.0, 1.0, 1.0], [-1.0, 1.0, -1.0, 1.0]])
+
+
 def skew(v):
     """The cross-product matrix: skew(a) @ b = a x b (the paper's tilde)."""
-    return jnp.array([[0.0, -v[2], v[1]], [v[2], 0.0, -v[0]], [-v[1], v[0], 0.0]])
+    v = jnp.asarray(v)
+    return jnp.concatenate([jnp.zeros((1,), v.dtype), v])[_SKEW_INDEX] * _SKEW_SIGN
 
 
 def rotation_matrix(q):
-    """A(q): body to inertial."""
-    q0, q1, q2, q3 = q
-    return jnp.array([
-        [q0 * q0 + q1 * q1 - q2 * q2 - q3 * q3, 2 * (q1 * q2 - q0 * q3), 2 * (q1 * q3 + q0 * q2)],
-        [2 * (q1 * q2 + q0 * q3), q0 * q0 - q1 * q1 + q2 * q2 - q3 * q3, 2 * (q2 * q3 - q0 * q1)],
-        [2 * (q1 * q3 - q0 * q2), 2 * (q2 * q3 + q0 * q1), q0 * q0 - q1 * q1 - q2 * q2 + q3 * q3],
-    ])
+    """A(q) = (q0^2 - v.v) I + 2 v v^T + 2 q0 skew(v): body to inertial (elementwise products, so
+    that XLA fuses them; see skew for why not entry by entry)."""
+    q = jnp.asarray(q)
+    q0, v = q[0], q[1:]
+    return (q0 * q0 - jnp.sum(v * v)) * np.eye(3) + 2.0 * (v[:, None] * v[None, :]) + (2.0 * q0) * skew(v)
 
 
 def G_matrix(q):
     """G(q) with omega_body = 2 G q_dot (Nikravesh's L matrix)."""
-    q0, q1, q2, q3 = q
-    return jnp.array([[-q1, q0, q3, -q2], [-q2, -q3, q0, q1], [-q3, q2, -q1, q0]])
+    return jnp.asarray(q)[_G_INDEX] * _G_SIGN
 
 
 def quat_multiply(p, q):
