@@ -7,7 +7,7 @@ Each measurement is one fresh Python process that does what `jaxslosh run` does 
 its first chunk (tofile.run_to_file's phases: build the model, compile `start` and the chunk ahead
 of time, run the first chunk), with JAX's compilation events summed by kind (jax.monitoring):
 tracing (jaxpr_trace_duration), lowering (jaxpr_to_mlir_module_duration) and XLA
-(backend_compile_duration). Prints a table; no assertion. Default scenes: the paper example and the
+(backend_compile_duration). Prints a table; no assertion. `--equations` adds the traced programs' sizes. Default scenes: the paper example and the
 paper ship with its mast.
 """
 import argparse
@@ -49,15 +49,33 @@ adv = advance.lower(b, solver, carry, chunk, se).compile(compiler_options=compil
 carry, fr = adv(b, solver, carry, chunk, se)
 jax.block_until_ready(fr)
 t_chunk = time.perf_counter()
-print(json.dumps({"import": t_import - T0, "build": t_build - t_import, "first_step": t_first - T0,
+eqns = {}
+if sys.argv[3] == "1":     # the traced programs' sizes (equations, counted into sub-programs): what XLA compiles
+    import equinox as eqx
+    from jax.extend import core as jcore
+    from jaxslosh.run.loop import traced_advance, traced_init
+
+    def count(jaxpr):
+        n = 0
+        for e in jaxpr.eqns:
+            n += 1
+            for p in e.params.values():
+                for sub in (p if isinstance(p, (list, tuple)) else [p]):
+                    n += count(sub.jaxpr) if isinstance(sub, jcore.ClosedJaxpr) else \
+                        count(sub) if isinstance(sub, jcore.Jaxpr) else 0
+        return n
+    eqns["start_eqns"] = count(eqx.filter_make_jaxpr(traced_init)(b, solver)[0].jaxpr)
+    eqns["chunk_eqns"] = count(eqx.filter_make_jaxpr(lambda b_, s_, c_: traced_advance(b_, s_, c_, chunk, se))(
+        b, solver, carry)[0].jaxpr)
+print(json.dumps({**eqns, "import": t_import - T0, "build": t_build - t_import, "first_step": t_first - T0,
                   "first_chunk": t_chunk - T0, "steps": chunk * se,
                   "trace": events["jaxpr_trace_duration"], "lower": events["jaxpr_to_mlir_module_duration"],
                   "xla": events["backend_compile_duration"]}))
 """
 
 
-def measure(scene, cache):
-    p = subprocess.run([sys.executable, "-c", CHILD, scene, cache], capture_output=True, text=True, cwd=ROOT)
+def measure(scene, cache, equations=False):
+    p = subprocess.run([sys.executable, "-c", CHILD, scene, cache, "1" if equations else "0"], capture_output=True, text=True, cwd=ROOT)
     if p.returncode:
         raise SystemExit(p.stderr)
     return json.loads(p.stdout.strip().splitlines()[-1])
@@ -68,6 +86,9 @@ def main():
     ap.add_argument("scenes", nargs="*", default=[os.path.join(ROOT, "scenes", "paper_ship_tank.toml"),
                                                  os.path.join(ROOT, "scenes", "paper_ship_mast.toml")])
     ap.add_argument("--repeat", type=int, default=1, help="cold/warm pairs per scene (a shared machine varies)")
+    ap.add_argument("--equations", action="store_true",
+                    help="also count the traced programs' equations (start, chunk): a measure of what tracing "
+                         "and XLA work on that does not depend on the machine's load")
     a = ap.parse_args()
     print(f"{'scene':24} {'cache':6} {'import':>7} {'build':>7} {'1st step':>9} {'1st chunk':>10} {'trace':>7} "
           f"{'lower':>7} {'XLA':>7}   (seconds, one fresh process each)")
@@ -75,10 +96,11 @@ def main():
         for _ in range(a.repeat):
             with tempfile.TemporaryDirectory() as cache:
                 for label in ("cold", "warm"):
-                    r = measure(scene, cache)
+                    r = measure(scene, cache, a.equations and label == "warm")
                     print(f"{os.path.basename(scene)[:24]:24} {label:6} {r['import']:7.2f} {r['build']:7.2f} "
                           f"{r['first_step']:9.2f} {r['first_chunk']:10.2f} {r['trace']:7.2f} {r['lower']:7.2f} "
-                          f"{r['xla']:7.2f}")
+                          f"{r['xla']:7.2f}" + (f"   equations: start {r['start_eqns']}, chunk {r['chunk_eqns']}"
+                                                 if "start_eqns" in r else ""))
                     sys.stdout.flush()
 
 
