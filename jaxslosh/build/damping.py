@@ -18,7 +18,9 @@ from ..fem.liquid import build_liquid
 from ..fem.modes import free_matrices
 from ..fem.reduction import tank_basis
 from ..physics.damping import ModalDamping
+from ..scene.fields import show
 from ..scene.types import Scene, SceneError
+from .liquid import build_liquid_block
 
 
 class TankDamping(NamedTuple):
@@ -86,14 +88,20 @@ def build_damping(scene: Scene, params: Optional[dict], block) -> tuple[Optional
     return ModalDamping(B=jnp.asarray(B), c=jnp.concatenate(cs)), tuple(table)
 
 
-def describe_damping(scene: Scene, built_table) -> list[str]:
-    """`jaxslosh check`'s lines: each damped tank's modes, frequency and damping ratio."""
+def describe_damping(scene: Scene) -> list[str]:
+    """`jaxslosh check`'s lines: each damped tank's sloshing modes, frequency and damping ratio
+    (SceneError where the table does not fit the mesh, as a run would raise)."""
+    if not any(t.damping is not None for t in scene.tanks) or not scene.effects.liquid:
+        return []
+    block = build_liquid_block(scene, None, scene.environment.gravity)
     lines = []
-    for d in built_table:
+    for d in build_damping(scene, None, block)[1]:
         t = next(x for x in scene.tanks if x.name == d.name)
         zeta = np.asarray(d.zeta)
-        shown = ", ".join(f"{w:.4g} rad/s: {z:.4g}" for w, z in zip(d.omega[:12], zeta[:12]))
+        shown = ", ".join(f"{w:.4g} rad/s {z:.4g}" for w, z in zip(d.omega[:12], zeta[:12]))
         more = f", ... ({len(zeta)} modes)" if len(zeta) > 12 else ""
-        src = f"ratio {t.damping.ratio}" + (f", viscosity {t.damping.viscosity:g} m^2/s" if t.damping.viscosity else "")
-        lines.append(f"damping of tank {d.name!r} ({src}), per sloshing mode: {shown}{more}")
+        given = f"ratio {show(list(t.damping.ratio) if isinstance(t.damping.ratio, tuple) else t.damping.ratio)}"
+        if t.damping.viscosity:
+            given += f", viscosity {t.damping.viscosity:g} m^2/s"
+        lines.append(f"damping of tank {d.name!r} ({given}), per sloshing mode: {shown}{more}")
     return lines
