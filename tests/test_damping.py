@@ -265,6 +265,14 @@ def test_a_list_longer_than_the_meshs_sloshing_modes_is_refused(tmp_path, capsys
     assert "reduced basis" in capsys.readouterr().err
 
 
+def test_sweep_refuses_a_ratio_the_loader_refuses(tmp_path, capsys):
+    p = tmp_path / "s.toml"
+    p.write_text(HELD.format(duration=0.1, dt=0.01, scheme="newmark", alpha=0.0) + "[tanks.damping]\nratio = 0.02\n")
+    assert main(["sweep", str(p), "--param", "tanks.tank.damping.ratio=0.01,1.5", "-o", str(tmp_path / "o.h5")]) == 2
+    err = capsys.readouterr().err
+    assert "tanks.tank.damping.ratio" in err and "[0, 1)" in err, err
+
+
 def test_check_prints_the_damping_per_mode(tmp_path, capsys):
     p = tmp_path / "s.toml"
     p.write_text(HELD.format(duration=0.1, dt=0.01, scheme="newmark", alpha=0.0)
