@@ -147,11 +147,17 @@ def _block(scene):
     return build_liquid_block(scene, None, scene.environment.gravity)
 
 
-def test_the_step_block_takes_the_damping_by_a_low_rank_update():
-    """The Woodbury update of the step block's inverse equals the dense inverse of c_a M + c_v C + K."""
-    scene = held(extra="[tanks.damping]\nratio = 0.03\nviscosity = 1e-6\n")
+@pytest.mark.parametrize("linear_solver", ["dense", "sparse"])
+def test_the_step_block_takes_the_damping_by_a_low_rank_update(linear_solver):
+    """The Woodbury update of the step block's inverse (on the dense inverse, or on the fast
+    diagonalization of the sparse path) equals the dense inverse of c_a M + c_v C + K."""
+    table = "[tanks.damping]\nratio = 0.03\nviscosity = 1e-6\n"
+    scene = held(extra=table)
     setup = prepare(scene)
     system, solver = setup.built.system, setup.solver
+    if linear_solver == "sparse":
+        text = scene.text.replace("[simulation]", '[simulation]\nlinear_solver = "sparse"')
+        solver = prepare(js.load_scene(text)).solver
     assert isinstance(solver.Cinv_step, LowRankUpdate)
     M, K = (np.asarray(x) for x in system.liquid.constant_blocks())
     B, c = np.asarray(system.damping.B), np.asarray(system.damping.c)
