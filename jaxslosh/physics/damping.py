@@ -28,8 +28,3 @@ class ModalDamping(AbstractTerm):
 
     def rows(self, k: Kin) -> Rows:
         return Rows(jnp.zeros(6), self.B @ (self.c * (self.B.T @ k.d_dot)))
-
-    def dissipation(self, d_dot):
-        """d_dot^T C d_dot >= 0: the power the damping takes from the liquid (W)."""
-        y = self.B.T @ d_dot
-        return jnp.sum(self.c * y * y)
