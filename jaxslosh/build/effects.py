@@ -60,6 +60,12 @@ def scene_effects(scene: Scene) -> list[tuple[str, str]]:
         for t in scene.tanks:
             eff.append((f"liquid in tank {t.name!r}", f"{t.mesh[0]}x{t.mesh[1]}x{t.mesh[2]} hexahedra, "
                         f"{t.liquid_mass:.6g} kg, element {t.fluid.element!r}, {t.walls} walls (slip)"))
+            if t.damping is not None:
+                d = t.damping
+                ratio = list(d.ratio) if isinstance(d.ratio, tuple) else d.ratio
+                layers = f" plus laminar boundary layers (viscosity {d.viscosity:g} m^2/s)" if d.viscosity else ""
+                eff.append((f"liquid damping in tank {t.name!r}",
+                            f"modal damping of the sloshing modes, ratio {ratio}{layers}"))
             if t.wall_spec is not None:
                 eff.append((f"elastic walls of tank {t.name!r}",
                             f"{t.wall_spec.thickness:g} m thick, {t.wall_mass:.6g} kg of elastic hexahedra built into "

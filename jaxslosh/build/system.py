@@ -22,6 +22,7 @@ from ..physics.vessel import FreeMotion, Hydrostatics, PrescribedMotion, RigidBo
 from ..scene.keys import resolve_params
 from ..scene.types import DOFS, Scene, SceneError
 from ..solve.sparse import hydrostatic_start
+from .damping import build_damping
 from .liquid import build_liquid_block, rigid_part
 from .probes import Probes, build_probes
 from .seakeeping import build_seakeeping
@@ -93,8 +94,10 @@ def build(scene: Scene, params: Optional[dict] = None) -> Built:
         terms.append(RotationPenalty(Kdt=block.penalty[0], Ktt=block.penalty[1], q_ref=q0))
     if block.Kg is not None:
         terms.append(SpinStiffening(block.Kg))
+    damping, _ = build_damping(scene, params, block) if eff.liquid else (None, ())
     system = System(body=body, terms=tuple(terms), liquid=liquid, gravity=g, q_ref=q0, motion=motion, memory=memory,
-                    flex=flex, gravity_turning=eff.gravity_turning or not liquid.nf, balanced=balanced)
+                    flex=flex, gravity_turning=eff.gravity_turning or not liquid.nf, balanced=balanced,
+                    damping=damping)
     nf = system.nf
     d_init = jnp.zeros(nf)
     if nf:

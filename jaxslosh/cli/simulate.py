@@ -6,6 +6,7 @@ import os
 import sys
 
 from ..build.cost import check_cost, describe_cost, estimate
+from ..build.damping import describe_damping
 from ..build.effects import describe, effects_summary
 from ..io.output import OutputError
 from ..io.status import Status
@@ -71,6 +72,8 @@ def timing(times: dict) -> str:
 def cmd_check(a):
     scene = load(a.scene)
     print(describe(scene))
+    for line in describe_damping(scene):
+        print(line)
     print(effects_summary(scene))
     print(describe_cost(estimate(scene)))
     check_cost(scene, force=a.force)

@@ -19,6 +19,7 @@ import jax
 import jax.numpy as jnp
 
 from . import structures as mb
+from .damping import ModalDamping
 from .kinematics import G_matrix, quat_exp, quat_multiply, rotation_matrix, tv3
 from .liquid import AbstractLiquid
 from .seakeeping import Memory
@@ -35,6 +36,7 @@ class System(eqx.Module):
     motion: AbstractMotion = FreeMotion()
     memory: Optional[Memory] = None  # radiation memory states (advanced by the integrator)
     flex: Optional[mb.Flex] = None   # flexible structures in their own frames, and their interfaces
+    damping: Optional[ModalDamping] = None   # the liquid's modal damping ([tanks.damping]), the last term
     gravity_turning: bool = eqx.field(static=True, default=True)   # off: g_b stays as at the start
     balanced: bool = eqx.field(static=True, default=True)          # weight balanced by static buoyancy
 
@@ -47,7 +49,9 @@ class System(eqx.Module):
         return 6 + self.nf
 
     def all_terms(self) -> tuple:
-        return (self.body, *self.terms, self.liquid)
+        if self.damping is None:
+            return (self.body, *self.terms, self.liquid)
+        return (self.body, *self.terms, self.liquid, self.damping)
 
     def total_mass(self):
         return self.body.mass + self.liquid.total_mass()

@@ -45,8 +45,9 @@ class _Keys(tuple):
 
 
 # Scene values that simulate(params=...) may replace by traced values (the vessel is rebuilt per
-# call; the liquid matrices are assembled from traced fill depth, density, sound speed and gravity).
-TANK_TRACEABLE = ("fill_depth", "fluid.density", "fluid.sound_speed")
+# call; the liquid matrices are assembled from traced fill depth, density, sound speed and gravity;
+# a traced damping ratio scales the modal damping, whose modes come from the scene's values).
+TANK_TRACEABLE = ("fill_depth", "fluid.density", "fluid.sound_speed", "damping.ratio")
 
 
 TRACEABLE = _Keys((
@@ -88,6 +89,8 @@ def scene_values(scene: Scene) -> dict[str, Any]:
     for i, t in enumerate(scene.tanks):
         own = {"origin": t.origin, "size": t.size, "fill_depth": t.fill_depth,
                "fluid.density": t.fluid.density, "fluid.sound_speed": t.fluid.sound_speed}
+        if t.damping is not None:
+            own["damping.ratio"], own["damping.viscosity"] = t.damping.ratio, t.damping.viscosity
         if t.wall_spec is not None:
             own["walls.thickness"] = t.wall_spec.thickness
             own |= material("walls.material", t.wall_spec.material)

@@ -28,8 +28,8 @@ except ModuleNotFoundError:  # Python 3.10
 from ..fem.mesh import box_mesh, face_nodes
 from .fields import (at_least, counts, non_negative, one_of, poisson_ratio, positive, read, show, sizes,
                      valid_name)
-from .types import (DOFS, EFFECTS, ELEMENT_FORMS, FACES, Effects, Environment, Forced, Fluid, Hydrostatics, Initial,
-                    Material, Probe, Reduction, Scene, SceneError, Simulation, Structure, Tank, Vessel, Walls)
+from .types import (DOFS, EFFECTS, ELEMENT_FORMS, FACES, Damping, Effects, Environment, Forced, Fluid, Hydrostatics,
+                    Initial, Material, Probe, Reduction, Scene, SceneError, Simulation, Structure, Tank, Vessel, Walls)
 from .waves import FileContext, check_waves, hull_hydrostatics, read_hull, read_hydrodynamics, read_waves
 
 SCHEMES = ("newmark", "hht", "generalized-alpha")
@@ -129,6 +129,8 @@ def _conservative(scene: Scene) -> None:
         why.append("[vessel.forced] prescribes motion (it does work)")
     if scene.waves is not None or v.hydrodynamics is not None or v.hull is not None:
         why.append("waves and hull hydrodynamics add and radiate energy")
+    if any(t.damping is not None for t in scene.tanks):
+        why.append("[tanks.damping] removes energy")
     if scene.structures:
         why.append("flexible structures are not covered by the projection")
     if v.hydrostatics is not None and v.hydrostatics.moment != "conservative":
@@ -294,7 +296,7 @@ def _tank(table, where: str) -> Tank:
     v = read(table, where, {
         "name": ("str", valid_name), "origin": ("vec3", None), "size": ("vec3", sizes),
         "fill_depth": ("float", None), "mesh": ("mesh", counts), "walls": ("str_or_table", None),
-        "fluid": ("table", None), "reduction": ("table", None),
+        "fluid": ("table", None), "reduction": ("table", None), "damping": ("table", None),
     }, required=("name", "origin", "size", "fill_depth", "mesh"))
     # SPEC writes `walls = "elastic"` and a `[tanks.walls]` table, but TOML cannot hold both under
     # one key: `walls` is either the string "rigid" or the table, which makes the walls elastic.
@@ -324,8 +326,29 @@ def _tank(table, where: str) -> Tank:
         reduction = Reduction(**read(table["reduction"], f"{where}.reduction", {
             "modes": ("int", at_least(1)), "static_correction": ("bool", None),
         }, required=("modes",)))
+    damping = _damping(table["damping"], f"{where}.damping") if "damping" in table else None
     return Tank(name=v["name"], origin=v["origin"], size=v["size"], fill_depth=depth, mesh=v["mesh"],
-                walls=walls, fluid=fluid, wall_spec=wall_spec, reduction=reduction)
+                walls=walls, fluid=fluid, wall_spec=wall_spec, reduction=reduction, damping=damping)
+
+
+def _damping(table, where: str) -> Damping:
+    """`[tanks.damping]`: `ratio` a number in [0, 1) or a non-empty list of them (the lowest sloshing
+    modes'; whether the mesh has that many modes is checked when the liquid is built), `viscosity` >= 0."""
+    v = read(table, where, {"ratio": ("numbers", _ratio), "viscosity": ("float", non_negative)})
+    ratio = v.get("ratio", 0.0)
+    return Damping(ratio=tuple(ratio) if isinstance(ratio, list) else ratio, viscosity=v.get("viscosity", 0.0))
+
+
+def _ratio(v):
+    values = v if isinstance(v, list) else [v]
+    if not values:
+        return "must be a number or a non-empty list of numbers"
+    if any(isinstance(x, list) for x in values):
+        return f"must be a number or a flat list of numbers, got {show(v)}"
+    bad = [x for x in values if not 0.0 <= x < 1.0]
+    if bad:
+        return f"a damping ratio must be in [0, 1) (1: critical damping, no oscillation left), got {show(bad[0])}"
+    return None
 
 
 def _walls(table, where: str) -> Walls:

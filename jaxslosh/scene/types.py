@@ -8,7 +8,7 @@ Values that `simulate(scene, params=...)` may override are looked up by their do
 from __future__ import annotations
 
 from dataclasses import dataclass, field
-from typing import Optional
+from typing import Optional, Union
 
 
 #: the six rigid dofs, in the order of every 6-vector and 6 x 6 table
@@ -125,6 +125,13 @@ class Reduction:
 
 
 @dataclass(frozen=True)
+class Damping:
+    """`[tanks.damping]`: linear damping of the liquid's sloshing modes (physics/damping.py)."""
+    ratio: Union[float, tuple] = 0.0   # every sloshing mode's damping ratio, or one per lowest mode (others 0)
+    viscosity: float = 0.0             # m^2/s, >= 0: adds each mode's laminar boundary-layer damping
+
+
+@dataclass(frozen=True)
 class Walls:
     thickness: float                 # m, > 0
     material: Material
@@ -142,6 +149,7 @@ class Tank:
     fluid: Fluid = field(default_factory=Fluid)
     wall_spec: Optional[Walls] = None   # the [tanks.walls] table when walls = "elastic"
     reduction: Optional[Reduction] = None   # None: full order
+    damping: Optional[Damping] = None       # None: an inviscid, undamped liquid
 
     @property
     def liquid_volume(self) -> float:

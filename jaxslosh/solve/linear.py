@@ -10,7 +10,7 @@ import jax
 import jax.numpy as jnp
 import numpy as np
 
-from ..fem.linalg import inv
+from ..fem.linalg import inv, solve
 from ..physics.structures import layout
 from ..physics.system import System
 from .schemes import Scheme
@@ -84,6 +84,8 @@ def make_solver(system: System, h: float, scheme: Scheme, tol: float, max_iter: 
     if L.sparse:         # large mesh (sparse.py): fast diagonalization or host-side sparse LU factors
         c_a = lambda hh: (1.0 - scheme.alpha_m) / ((1.0 - scheme.alpha_f) * scheme.beta * hh ** 2)  # noqa: E731
         step_inv, mass_inv, sub_inv, K = sparse_solver_blocks(L, c_a(h), c_a(h / substeps) if substeps else None)
+        step_inv = damped(step_inv, system, scheme, h)
+        sub_inv = damped(sub_inv, system, scheme, h / substeps) if substeps else None
         scale = np.asarray(jax.lax.stop_gradient(system.scales()[6:]))
         noise = np.finfo(np.float64).eps * np.max(np.asarray(abs(K).sum(axis=1)).reshape(-1) / scale)
         return Solver(step_inv, mass_inv, jnp.asarray(h, dtype=float), scheme, tol, max_iter, substeps, sub_inv,
@@ -103,9 +105,45 @@ def make_solver(system: System, h: float, scheme: Scheme, tol: float, max_iter: 
 
     scale = jax.lax.stop_gradient(system.scales()[6:])
     noise = jnp.finfo(jnp.float64).eps * jnp.max(jnp.sum(jnp.abs(jnp.asarray(K_ff)), axis=1) / scale)
-    return Solver(step_block_inverse(h), inverse(M_ff), jnp.asarray(h, dtype=float), scheme, tol,
-                  max_iter, substeps, step_block_inverse(h / substeps) if substeps else None,
+    return Solver(damped(step_block_inverse(h), system, scheme, h), inverse(M_ff), jnp.asarray(h, dtype=float),
+                  scheme, tol, max_iter, substeps,
+                  damped(step_block_inverse(h / substeps), system, scheme, h / substeps) if substeps else None,
                   noise=noise, reuse=reuse, adaptive=adaptive)
+
+
+class LowRankUpdate(eqx.Module):
+    """The inverse of A + U D U^T from A's: the step block with the liquid's modal damping
+    (physics/damping.py), whose C = B diag(c) B^T has the rank of its few sloshing modes. By the
+    Sherman-Morrison-Woodbury formula, in the form that allows zero entries of D (undamped modes):
+
+        (A + U D U^T)^-1 = A^-1 - W D (I + G D)^-1 W^T,   W = A^-1 U,  G = U^T W
+
+    W is formed once per run (k solves with the constant block's inverse, dense or sparse); a solve
+    is A's and two thin products. D follows a traced damping ratio (a k x k solve per run)."""
+    base: Any              # A^-1: a matrix, or an object with `@` (the sparse paths)
+    W: jax.Array           # (nf, k)
+    S: jax.Array           # (k, k) D (I + G D)^-1
+
+    @property
+    def shape(self):
+        return self.base.shape
+
+    def __matmul__(self, x):
+        return self.base @ x - self.W @ (self.S @ (self.W.T @ x))
+
+
+def damped(base, system: System, scheme: Scheme, hh):
+    """The step block's inverse with the modal damping's c_v C added (c_v = d v_{n+1} / d Delta =
+    gamma / (beta h)); `base` itself where the system has none. Formed from stop_gradient values:
+    it only preconditions the iterations, whose solutions do not depend on it."""
+    if system.damping is None:
+        return base
+    B, c = jax.lax.stop_gradient((system.damping.B, system.damping.c))
+    W = base @ B
+    D = scheme.gamma / (scheme.beta * hh) * c
+    G = B.T @ W
+    S = solve(jnp.eye(c.shape[0]) + D[:, None] * G, jnp.diag(D))      # (I + D G)^-1 D = D (I + G D)^-1
+    return LowRankUpdate(base, W, S)
 
 
 class BlockInverse(eqx.Module):

@@ -1,0 +1,133 @@
+"""Host-side data of the liquid's modal damping (`[tanks.damping]`, physics/damping.py): the sloshing
+modes a damping acts on, and each mode's laminar boundary-layer damping ratio.
+
+Boundary-layer damping. Outside a wall's Stokes layer the inviscid flow slides along the wall with a
+tangential velocity U cos(omega t); the layer (thickness sqrt(2 nu / omega)) dissipates, averaged over
+a period, (rho / 2) sqrt(nu omega / 2) U^2 per unit wall area (Landau & Lifshitz, Fluid Mechanics,
+2nd ed., section 24). A mode of energy E (the maximum kinetic energy) decays as exp(-2 zeta omega t),
+so zeta = D / (2 omega E) (Keulegan 1959, "Energy dissipation in standing waves in rectangular
+basins", J. Fluid Mech. 6, 33-50: the same wall-and-bottom integration, without his surface-film
+term). For a mass-normalised mode shape phi (1/2 omega^2 phi^T M phi = E with phi^T M phi = 1) and
+U = omega phi_t this is
+
+    zeta = (rho / 2) sqrt(nu / (2 omega)) int_wetted |phi_t|^2 dA,
+
+integrated here over the tank's bottom and its four walls up to the fill depth with the bilinear
+(consistent) face mass on the element faces. `rectangular_ratio` is the closed form of the same
+integral for the first mode of a rectangular tank with the linear potential-flow mode, the reference
+the tests hold the finite-element value to.
+"""
+from __future__ import annotations
+
+import functools
+
+import numpy as np
+import scipy.linalg as sl
+import scipy.sparse as sp
+
+from .mesh import grid_index
+from .modes import classify, free_matrices, natural_modes
+
+#: modes searched for sloshing ones on a sparse (large) mesh, where all of them cannot be found
+SPARSE_SEARCH = 48
+
+
+def sloshing_modes(model, search: int = 0):
+    """(omega (k,), Phi (nf_t, k)): the liquid's sloshing modes (fem/modes.py classification) in
+    ascending frequency, mass-normalised on the free dofs, of a concrete model. Dense models: among
+    all their modes; sparse ones: among the lowest `search` (SPARSE_SEARCH when 0). Cached per tank."""
+    key = (tuple(model.size), float(model.depth), tuple(model.mesh), float(model.density),
+           float(model.sound_speed), float(model.gravity), model.element, sp.issparse(model.stiffness), int(search))
+    return _cached_modes(key, _Ref(model))
+
+
+@functools.lru_cache(maxsize=16)
+def _cached_modes(key, ref):
+    model = ref.obj
+    K, M = free_matrices(model)
+    if sp.issparse(K):
+        lam, X = natural_modes(K, M, min(K.shape[0] - 1, key[-1] or SPARSE_SEARCH))
+    else:
+        lam, X = sl.eigh(K, M)
+    keep = sloshing_share(model, X) & (lam > 0)
+    return np.sqrt(lam[keep]), X[:, keep]
+
+
+def sloshing_share(model, X) -> np.ndarray:
+    """(k,) bool: which columns of X (mode shapes on the free dofs) are sloshing modes."""
+    shapes = np.zeros((X.shape[1], np.asarray(model.free).size))
+    shapes[:, np.flatnonzero(np.asarray(model.free))] = X.T
+    _, kind = classify(model, shapes)
+    return np.array([k == "sloshing" for k in kind], dtype=bool)
+
+
+class _Ref:
+    """Hashes by nothing: the cache key says what the modes depend on."""
+
+    def __init__(self, obj):
+        self.obj = obj
+
+    def __hash__(self):
+        return 0
+
+    def __eq__(self, other):
+        return isinstance(other, _Ref)
+
+
+def wall_integrals(model, Phi):
+    """(k,) int_wetted |phi_t|^2 dA of each mode (columns of Phi on the free dofs): the tangential
+    components on the bottom (z = 0) and the four walls (x = 0, a; y = 0, b) up to the fill depth."""
+    nx, ny, nz = (int(n) for n in model.mesh)
+    a, b = float(model.size[0]), float(model.size[1])
+    hx, hy, hz = a / nx, b / ny, float(model.depth) / nz
+    f = np.flatnonzero(np.asarray(model.free))
+    full = np.zeros((Phi.shape[1], 3 * model.n_nodes))
+    full[:, f] = Phi.T
+    U = full.reshape(Phi.shape[1], model.n_nodes, 3)
+    ijk = grid_index(nx, ny, nz)
+    planes = (  # (nodes on the plane, in-plane axes (grid index, count, spacing) x 2, tangential components)
+        (ijk[:, 0] == 0, (1, ny, hy), (2, nz, hz), (1, 2)), (ijk[:, 0] == nx, (1, ny, hy), (2, nz, hz), (1, 2)),
+        (ijk[:, 1] == 0, (0, nx, hx), (2, nz, hz), (0, 2)), (ijk[:, 1] == ny, (0, nx, hx), (2, nz, hz), (0, 2)),
+        (ijk[:, 2] == 0, (0, nx, hx), (1, ny, hy), (0, 1)),
+    )
+    out = np.zeros(Phi.shape[1])
+    for on, (ax1, n1, h1), (ax2, n2, h2), comps in planes:
+        idx = np.flatnonzero(on)
+        order = np.lexsort((ijk[idx, ax2], ijk[idx, ax1]))      # node order on the plane: ax1 major
+        idx = idx[order]
+        M1, M2 = _line_mass(n1, h1), _line_mass(n2, h2)
+        for c in comps:
+            F = U[:, idx, c].reshape(-1, n1 + 1, n2 + 1)
+            out += np.einsum("kij,kij->k", F, M1 @ F @ M2)
+    return out
+
+
+def _line_mass(n: int, h: float) -> np.ndarray:
+    """The consistent mass of n linear elements of length h on a line: int f g = f^T M g."""
+    M = np.zeros((n + 1, n + 1))
+    i = np.arange(n)
+    M[i, i] += 2.0
+    M[i + 1, i + 1] += 2.0
+    M[i, i + 1] += 1.0
+    M[i + 1, i] += 1.0
+    return M * h / 6.0
+
+
+def boundary_layer_ratios(model, omega, Phi, viscosity: float) -> np.ndarray:
+    """(k,) each mode's laminar boundary-layer damping ratio (module docstring)."""
+    if viscosity == 0.0:
+        return np.zeros(omega.shape)
+    return 0.5 * float(model.density) * np.sqrt(viscosity / (2.0 * omega)) * wall_integrals(model, Phi)
+
+
+def rectangular_ratio(a: float, b: float, h: float, g: float, viscosity: float) -> float:
+    """The boundary-layer damping ratio of the first sloshing mode (one half-wave along a) of a
+    rectangular tank a x b filled to h, from the linear mode phi = cos(k x) cosh(k (z + h)), k = pi / a,
+    omega^2 = g k tanh(k h): the module docstring's integral over the bottom (u), the walls y = 0, b
+    (u and w) and the end walls x = 0, a (w), over the energy, in closed form:
+
+        zeta = sqrt(nu / (2 omega)) [1/a + 1/b + k (1 - 2 h / a) / sinh(2 k h)]."""
+    k = np.pi / a
+    omega = np.sqrt(g * k * np.tanh(k * h))
+    bracket = 1.0 / a + 1.0 / b + k * (1.0 - 2.0 * h / a) / np.sinh(2.0 * k * h)
+    return float(np.sqrt(viscosity / (2.0 * omega)) * bracket)
