@@ -23,7 +23,6 @@ from jaxslosh.hydro.radiation import linear_response, restoring_matrix, rigid_ma
 from jaxslosh.hydro.tables import interpolate_excitation, scene_tables
 from jaxslosh.io.rao import load_rao
 from jaxslosh.physics.system import advance_config
-from jaxslosh.scene.types import SceneError
 
 from helpers import mast, multibody_vessel
 
@@ -186,7 +185,7 @@ def paper_regular_scene(omega, heading=math.pi / 4, amplitude=0.02, duration=300
     """The paper ship with its tank (scenes/paper_ship_waves.toml) in a regular wave: its box hull's
     Capytaine tables to 3.2 rad/s (tests/data/paper_hull_hydro.toml: the first sloshing modes are at
     2.53 rad/s), Froude-Krylov excitation (any heading), the trapezoidal rule (no numerical damping).
-    With `damping`, a 1 % liquid damping ([tanks.damping], SPEC section 5) where the loader knows it."""
+    With `damping`, a 1 % liquid damping ([tanks.damping], SPEC section 5)."""
     text = (ROOT / "scenes" / "paper_ship_waves.toml").read_text()
     head = text[:text.index("[vessel.hydrodynamics]")]
     head = head.replace('scheme = "hht"', 'scheme = "newmark"').replace("alpha = 0.05\n", "") \
@@ -199,14 +198,9 @@ def paper_regular_scene(omega, heading=math.pi / 4, amplitude=0.02, duration=300
     waves = (f'\n[waves]\ntype = "regular"\namplitude = {amplitude!r}\nfrequency = {omega!r}\n'
              f'heading = {heading!r}\nramp = 30.0\n\n')
     tail = text[text.index("[[tanks]]"):]
-    plain = js.load_scene(head + tab + waves + tail)
-    if not damping:
-        return plain
-    try:
-        return js.load_scene(head + tab + waves + tail.replace("[[probes]]", "[tanks.damping]\nratio = 0.01\n\n"
-                                                                             "[[probes]]", 1))
-    except SceneError:          # no liquid damping in this version: the undamped liquid
-        return plain
+    if damping:
+        tail = tail.replace("[[probes]]", "[tanks.damping]\nratio = 0.01\n\n[[probes]]", 1)
+    return js.load_scene(head + tab + waves + tail)
 
 
 def steady_harmonic(t, x, w, modes, t0):
