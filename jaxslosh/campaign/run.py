@@ -83,13 +83,15 @@ def _check_limits(limits, chans) -> dict:
 
 def campaign(scene, scatter, headings=None, seeds: int = 1, duration: Optional[float] = None, client=None, *,
              output: Optional[str] = None, limits: Optional[dict] = None, resume: bool = False,
-             workers: int = 2, batch: int = BATCH, progress: Optional[bool] = None) -> CampaignResult:
+             workers: int = 2, batch: int = BATCH, progress: Optional[bool] = None,
+             cache_dir: Optional[str] = None) -> CampaignResult:
     """Run the scene (its `[waves]` table the template) for every scatter cell x heading x seed on
     Dask. `scatter`: a CSV path or text (read_scatter) or a Scatter; `headings` (rad, default the
     template's); `seeds` per cell and heading (the template's `waves.seed` + 0 .. seeds - 1);
     `duration` replaces the scene's. `client`: a dask.distributed Client, else a LocalCluster of
     `workers` processes is started and closed here. `output`: the campaign file (written as
-    batches finish, locked against a second writer); `resume`: keep its "ok" cases."""
+    batches finish, locked against a second writer); `resume`: keep its "ok" cases. `cache_dir`:
+    the workers' persistent compilation cache (default: this process's, jax_compilation_cache_dir)."""
     t_start = time.perf_counter()
     template = load_scene(scene) if isinstance(scene, (str, os.PathLike)) else scene
     if template.waves is None or template.waves.type == "regular":
@@ -134,7 +136,7 @@ def campaign(scene, scatter, headings=None, seeds: int = 1, duration: Optional[f
             create_campaign(output, template.text, _case_table(cases), chans, freq, attrs)
         todo = [i for i in range(n) if status[i] != "ok"]
         run_now, failed = _run(template, duration, cases, scenes, todo, client, workers, batch, output, status,
-                               stats, spectra, progress)
+                               stats, spectra, progress, cache_dir or jax.config.jax_compilation_cache_dir or None)
     finally:
         if lock is not None:
             lock.release()
@@ -168,7 +170,8 @@ def _batches(scenes, todo, batch):
     return [idx[k:k + batch] for idx in groups.values() for k in range(0, len(idx), batch)]
 
 
-def _run(template, duration, cases, scenes, todo, client, workers, batch, output, status, stats, spectra, progress):
+def _run(template, duration, cases, scenes, todo, client, workers, batch, output, status, stats, spectra, progress,
+         cache_dir):
     if not todo:
         return 0, 0
     own = client is None
@@ -176,7 +179,6 @@ def _run(template, duration, cases, scenes, todo, client, workers, batch, output
     if own:
         cluster = LocalCluster(n_workers=int(workers), threads_per_worker=1, processes=True, dashboard_address=None)
         client = Client(cluster)
-    cache_dir = jax.config.jax_compilation_cache_dir or None
     bar = Progress(enabled=wanted() if progress is None else progress)
     bar.phase("cases", "cases", total=len(todo), unit="case")
     run_now = failed = 0

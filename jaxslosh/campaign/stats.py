@@ -40,9 +40,12 @@ def statistics(t, x) -> dict:
     y = x - x.mean()
     std = float(y.std())
     duration = float(t[-1] - t[0]) + float(t[1] - t[0])
-    up = int(np.count_nonzero((y[:-1] < 0) & (y[1:] >= 0)))
-    tz = duration / up if up else math.nan
-    n_cycles = duration / tz if up else 0.0
+    # the mean period between the first and last upcrossings (interpolated between frames): a count
+    # over the whole record would be off by the part-cycles at its ends
+    k = np.flatnonzero((y[:-1] < 0) & (y[1:] >= 0))
+    tc = t[k] + (t[k + 1] - t[k]) * (-y[k]) / (y[k + 1] - y[k])
+    tz = float(tc[-1] - tc[0]) / (k.size - 1) if k.size >= 2 else math.nan
+    n_cycles = duration / tz if k.size >= 2 else 0.0
     mpm = std * math.sqrt(2.0 * math.log(n_cycles)) if n_cycles > 1 else math.nan
     # Welch (averaged, windowed periodograms of overlapping segments) rather than one periodogram:
     # a single periodogram's scatter at each frequency does not fall as the record grows, the
