@@ -150,19 +150,19 @@ def test_one_or_two_workers_give_the_same_statistics_as_jaxslosh_run(env):
     assert f.attrs["format"] == "jaxslosh.campaign" and f.status == ["ok"] * 12
     np.testing.assert_array_equal(f.statistics["roll"]["std"], two.statistics["roll"]["std"])
     np.testing.assert_allclose(f.cases["weight"].sum(), 1.0, rtol=1e-12)
-    # case 5 (cell 1, heading pi/2, seed 1) as its own scene file, run alone by `jaxslosh run`
+    # case 7 (cell 1, heading pi/2, seed 1) as its own scene file, run alone by `jaxslosh run`
     case = case_scene(js.load_scene(str(p)), {"hs": 0.6, "tp": 7.0, "heading": BEAM, "seed": 1})
-    assert (f.cases["hs"][5], f.cases["heading"][5], f.cases["seed"][5]) == (0.6, BEAM, 1)
-    cp = env / "case5.toml"
+    assert (f.cases["hs"][7], f.cases["heading"][7], f.cases["seed"][7]) == (0.6, BEAM, 1)
+    cp = env / "case7.toml"
     cp.write_text(case.text)
-    assert main(["run", str(cp), "-o", str(env / "case5.h5"), "--no-progress"]) == 0
-    r = js.load_result(str(env / "case5.h5"))
+    assert main(["run", str(cp), "-o", str(env / "case7.h5"), "--no-progress"]) == 0
+    r = js.load_result(str(env / "case7.h5"))
     t = np.asarray(r.time)
     roll = np.asarray(r.vessel.roll_pitch_yaw)[:, 0][t >= 10.0 - 1e-9]
     # single runs refresh their Newton preconditioner when convergence slows, batches every 4 steps:
     # both converge to Newton's tolerance
-    np.testing.assert_allclose(roll.std(), two.statistics["roll"]["std"][5], rtol=1e-7)
-    np.testing.assert_allclose(np.abs(roll - roll.mean()).max(), two.statistics["roll"]["max"][5], rtol=1e-6)
+    np.testing.assert_allclose(roll.std(), two.statistics["roll"]["std"][7], rtol=1e-7)
+    np.testing.assert_allclose(np.abs(roll - roll.mean()).max(), two.statistics["roll"]["max"][7], rtol=1e-6)
 
 
 def test_a_killed_worker_has_its_cases_rerun(env):
@@ -176,23 +176,23 @@ def test_a_killed_worker_has_its_cases_rerun(env):
 
         def kill_when_started():         # the first worker, once the campaign has finished a batch
             deadline = time.time() + 300
-            while time.time() < deadline:
+            n_ok = 0
+            while time.time() < deadline and n_ok == 0:
                 try:
                     with h5py.File(out, "r") as f:
-                        if any(x == b"ok" for x in f["cases/status"][()]):
-                            break
+                        n_ok = sum(x == b"ok" for x in f["cases/status"][()])
                 except (OSError, KeyError):
                     pass
-                time.sleep(0.05)
+                time.sleep(0.02)
             os.kill(pids[0], signal.SIGKILL)
-            killed.append(pids[0])
+            killed.append(n_ok)
 
         th = threading.Thread(target=kill_when_started)
         th.start()
         r = js.campaign(js.load_scene(str(p)), str(s), headings=[1.2, BEAM], seeds=2, cache_dir=str(CACHE), batch=1,
                         client=client, output=str(out))
         th.join()
-    assert killed and r.status == ["ok"] * 12
+    assert killed and killed[0] < 12 and r.status == ["ok"] * 12       # killed mid-campaign, yet complete
     for ch in ("roll", "heave"):
         np.testing.assert_allclose(r.statistics[ch]["std"], ref.statistics[ch]["std"], rtol=1e-12)
 
