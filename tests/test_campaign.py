@@ -312,3 +312,30 @@ def test_bad_campaign_input_exits_2(tmp_path, capsys):
         f["spectra/roll"] = np.zeros((1, 3))
     assert main(["campaign", str(p), "--scatter", str(s), "-o", str(out), "--resume"]) == 2
     assert "another scene" in capsys.readouterr().err
+
+
+# --------------------------------------------------------------------------------------------
+# the figure
+
+
+def test_plot_of_a_campaign_file(tmp_path, capsys):
+    from jaxslosh.io.campaign import create_campaign, write_cases, write_summary
+    out = tmp_path / "c.h5"
+    hs, tp = np.repeat([1.0, 2.0], 4), np.tile(np.repeat([6.0, 8.0], 2), 2)
+    heading = np.tile([0.0, BEAM], 4)
+    cases = {"hs": hs, "tp": tp, "heading": heading, "seed": np.zeros(8, int), "weight": np.full(8, 1 / 8)}
+    freq = np.linspace(0.0, 3.0, 20)
+    create_campaign(str(out), scene_text(), cases, ["roll", "heave"], freq, {"record_duration": 50.0})
+    rng = np.random.default_rng(0)
+    outcomes = [{"status": "ok", "stats": {ch: dict(std=s, significant=4 * s, max=3 * s, mpm=2.9 * s, tz=6.0,
+                                                    spectrum=rng.uniform(size=20))
+                                           for ch, s in (("roll", 0.02 * hs[i]), ("heave", 0.3 * hs[i]))}}
+                for i in range(7)]
+    write_cases(str(out), range(7), outcomes)
+    write_summary(str(out), {"roll": 0.1}, {"roll": 0.2}, 75.0)
+    assert load_campaign(str(out)).status[-1] == "pending"
+    png = tmp_path / "c.png"
+    assert main(["plot", str(out), "-o", str(png), "--case", "3"]) == 0 and png.stat().st_size > 10000
+    assert main(["plot", str(out), "-o", str(png), "--limits", "heave=0.5"]) == 0
+    assert main(["plot", str(out), "-o", str(png), "--case", "9"]) == 2
+    assert "--case" in capsys.readouterr().err

@@ -14,7 +14,7 @@ import jax
 import numpy as np
 from dask.distributed import Client, LocalCluster, as_completed
 
-from ..io.campaign import PENDING, create_campaign, load_campaign, write_cases
+from ..io.campaign import PENDING, create_campaign, load_campaign, write_cases, write_summary
 from ..io.output import OutputLock
 from ..run.progress import Progress, wanted
 from ..scene.load import load_scene
@@ -121,7 +121,7 @@ def campaign(scene, scatter, headings=None, seeds: int = 1, duration: Optional[f
     stats = {ch: {s: np.full(n, np.nan) for s in STATISTICS} for ch in chans}
     spectra = {ch: np.full((n, freq.size), np.nan) for ch in chans}
     lock = OutputLock(output) if output else None
-    attrs = {"duration": float(scenes[0].simulation.duration), "seeds": int(seeds),
+    attrs = {"record_duration": float(scenes[0].simulation.duration - scenes[0].waves.ramp), "seeds": int(seeds),
              "headings": np.asarray(heads, dtype=float)}
     try:
         done_before = 0
@@ -142,6 +142,8 @@ def campaign(scene, scatter, headings=None, seeds: int = 1, duration: Optional[f
             lock.release()
     ok = np.array([s == "ok" for s in status])
     ops = operability(stats, cases.weight, ok, lim, float(scenes[0].simulation.duration - scenes[0].waves.ramp))
+    if output and lim:
+        write_summary(output, lim, ops["exceedance"], ops["operability"])
     return CampaignResult(cases, status, stats, freq, spectra, run_now, done_before, failed,
                           time.perf_counter() - t_start, lim, ops["exceedance"], ops["operability"])
 
@@ -153,7 +155,7 @@ def _check_resume(old, template, cases, chans, attrs, path):
                for k, v in _case_table(cases).items())
     if not same or len(old.status) != cases.n:
         raise CampaignError(f"--resume: {path} holds other cases (scatter, headings or seeds differ)")
-    if list(old.statistics) != chans or abs(float(old.attrs.get("duration", -1)) - attrs["duration"]) > 1e-12:
+    if list(old.statistics) != chans or abs(float(old.attrs.get("record_duration", -1)) - attrs["record_duration"]) > 1e-12:
         raise CampaignError(f"--resume: {path} was run with another duration or other channels")
 
 

@@ -3,6 +3,7 @@ statistics and spectra written as it finishes. The file is opened, written and c
 finished batch, so that a reader (or a --resume after a kill) always finds a consistent file."""
 from __future__ import annotations
 
+import json
 from typing import NamedTuple
 
 import h5py
@@ -82,3 +83,18 @@ def load_campaign(path) -> Campaign:
             raise ResultFileError(f"{path}: a campaign dataset is missing ({e})") from None
         attrs = {k: (attr_str(v) if isinstance(v, (bytes, str)) else v) for k, v in f.attrs.items()}
     return Campaign(cases, status, stats, freq, spectra, attrs.get("scene", ""), attrs)
+
+
+def write_summary(path, limits: dict, exceedance: dict, operability: float):
+    """The limits a campaign was judged by, each one's exceedance probability and the operability."""
+    with h5py.File(path, "r+") as f:
+        f.attrs["limits"] = json.dumps(limits)
+        f.attrs["exceedance"] = json.dumps(exceedance)
+        f.attrs["operability"] = float(operability)
+
+
+def file_limits(c: Campaign) -> dict:
+    try:
+        return {k: float(v) for k, v in json.loads(c.attrs.get("limits", "{}") or "{}").items()}
+    except (ValueError, TypeError, AttributeError):
+        return {}
