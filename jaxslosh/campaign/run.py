@@ -8,6 +8,7 @@ from __future__ import annotations
 
 import os
 import time
+import warnings
 from typing import NamedTuple, Optional
 
 import jax
@@ -179,7 +180,10 @@ def _run(template, duration, cases, scenes, todo, client, workers, batch, output
     own = client is None
     cluster = None
     if own:
-        cluster = LocalCluster(n_workers=int(workers), threads_per_worker=1, processes=True, dashboard_address=None)
+        with warnings.catch_warnings():     # its HTTP server moves to a free port when 8787 is taken: say nothing
+            warnings.filterwarnings("ignore", message=".*already in use.*")
+            cluster = LocalCluster(n_workers=int(workers), threads_per_worker=1, processes=True,
+                                   dashboard_address=None)
         client = Client(cluster)
     bar = Progress(enabled=wanted() if progress is None else progress)
     bar.phase("cases", "cases", total=len(todo), unit="case")
