@@ -1,6 +1,5 @@
 """Irregular seas: the Pierson-Moskowitz spectrum, cos-2s directional spreading, reproducible phases,
 and a spread sea through a run (Froude-Krylov per heading)."""
-import math
 
 import numpy as np
 import pytest
