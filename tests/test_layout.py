@@ -17,7 +17,7 @@ LAYERS = [
     {"solve"},
     {"build"},
     {"run"},
-    {"analysis", "fit"},
+    {"analysis", "campaign", "fit"},
     {"plot"},
     {"cli"},
     {"__init__", "__main__"},

@@ -126,7 +126,10 @@ def _wave_effects(scene: Scene) -> list[tuple[str, str]]:
         src = ("Froude-Krylov on the box hull" if src == "froude-krylov" else
                "Capytaine (Froude-Krylov + diffraction)" if ves.hydrodynamics.capytaine else "excitation tables")
         sea = (f"regular, amplitude {w.amplitude:g} m, {w.omega:.4g} rad/s" if w.type == "regular" else
-               f"JONSWAP Hs {w.hs:g} m, Tp {w.tp:g} s, gamma {w.gamma:g}, {w.components} components, seed {w.seed}")
+               (f"JONSWAP Hs {w.hs:g} m, Tp {w.tp:g} s, gamma {w.gamma:g}" if w.type == "jonswap" else
+                f"Pierson-Moskowitz Hs {w.hs:g} m, Tp {w.tp:g} s")
+               + f", {w.components} components, seed {w.seed}"
+               + (f", cos-2s spreading s = {w.spreading:g} over {w.directions} headings" if w.spreading > 0 else ""))
         out.append(("waves", f"{sea}, heading {w.heading:.4g} rad; forces from {src}"
                              + (f", faded in over {w.ramp:g} s" if w.ramp > 0 else "")))
     hd = ves.hydrodynamics

@@ -43,7 +43,8 @@ def build_seakeeping(scene, params: dict) -> tuple:
     terms, memory = [], None
     if waves is not None and eff.waves:
         key = "waves.amplitude" if waves.type == "regular" else "waves.hs"
-        X = excitation_rao(scene, components(waves).omega)
+        c = components(waves)
+        X = excitation_rao(scene, c.omega, c.headings)
         terms.append(WaveExcitation(make_excitation(waves, X, params.get(key, waves.height))))
     hd = ves.hydrodynamics
     if hd is not None and eff.radiation:

@@ -6,18 +6,19 @@ import os
 import sys
 
 from ..scene.types import SceneError
-from . import export, hydro, identify, modes, plot, rao, simulate, sweep
+from . import campaign, export, hydro, identify, modes, plot, rao, simulate, sweep
 from .common import EXIT_INPUT, EXIT_INTERRUPTED, InputError, Parser
 
 COMMANDS = {"run": simulate.cmd_run, "check": simulate.cmd_check, "plot": plot.cmd_plot, "modes": modes.cmd_modes,
             "identify": identify.cmd_identify, "sweep": sweep.cmd_sweep, "hydro": hydro.cmd_hydro,
-            "rao": rao.cmd_rao, "export": export.cmd_export}
+            "rao": rao.cmd_rao, "export": export.cmd_export,
+            "campaign": campaign.cmd_campaign}
 
 
 def parser() -> Parser:
     p = Parser(prog="jaxslosh", description="Floating vessels carrying sloshing liquid (Gonzalez & Park 2013).")
     sub = p.add_subparsers(dest="command", required=True, parser_class=Parser)
-    for module in (simulate, plot, modes, identify, sweep, hydro, rao, export):
+    for module in (simulate, plot, modes, identify, sweep, hydro, rao, export, campaign):
         module.add_parsers(sub)
     return p
 

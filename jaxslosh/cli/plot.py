@@ -4,11 +4,14 @@ from __future__ import annotations
 
 import os
 
+from ..io.campaign import CAMPAIGN_FORMAT, file_limits, load_campaign
 from ..io.result import FORMAT, ResultFileError, file_format, load_result, open_h5
 from ..io.sweep import SWEEP_FORMAT, load_sweep
+from ..plot.campaign import plot_campaign
 from ..plot.results import plot_result, plot_sweep
 from ..plot.surface import animate_free_surface, plot_free_surface
 from ..run.progress import Progress, wanted
+from .campaign import parse_limits
 from .common import EXIT_OK, InputError, output_folder, positive
 
 
@@ -23,6 +26,9 @@ def add_parsers(sub):
                     help="magnify liquid displacements in --surface and --animate (default 1)")
     pl.add_argument("--fps", type=float, default=10.0, help="--animate: frames per second (default 10)")
     pl.add_argument("--every", type=int, help="--animate: show every n-th saved frame (default: at most 100 frames)")
+    pl.add_argument("--case", type=int, help="a campaign file: the case whose response spectra are drawn")
+    pl.add_argument("--limits", metavar="KEY=VALUE,...",
+                    help="a campaign file: limits of its operability plot (default: the campaign's own)")
     pl.add_argument("--no-progress", action="store_true",
                     help="--animate: no progress on stderr (drawn only on a terminal unless JAXSLOSH_PROGRESS=1)")
 
@@ -47,6 +53,11 @@ def cmd_plot(a):
         raise InputError(f"--animate: writes a GIF, the file name must end in .gif, got {a.animate!r}")
     if fmt == SWEEP_FORMAT:
         return _plot_sweep(a, out)
+    if fmt == CAMPAIGN_FORMAT:
+        return _plot_campaign(a, out)
+    for flag in ("case", "limits"):
+        if getattr(a, flag) is not None:
+            raise InputError(f"--{flag}: only for a campaign file ({CAMPAIGN_FORMAT!r}); {a.result} is {fmt!r}")
     if fmt != FORMAT:
         raise InputError(f"{a.result}: not a jaxslosh result file "
                          f"({'format ' + repr(fmt) if fmt else 'no format attribute'})")
@@ -86,4 +97,22 @@ def _plot_sweep(a, out):
         raise InputError(str(e)) from None
     plot_sweep(sw.params, sw.result, sw.statuses, out, sw.scene_text)
     print(f"wrote {out} ({len(sw.statuses)} runs of a sweep)")
+    return EXIT_OK
+
+
+def _plot_campaign(a, out):
+    """A campaign file: significant responses over the scatter per heading, operability, spectra."""
+    for flag, path in (("--surface", a.surface), ("--animate", a.animate)):
+        if path:
+            raise InputError(f"{flag}: {a.result} is a campaign file, which keeps statistics, not liquid fields")
+    try:
+        c = load_campaign(a.result)
+    except ResultFileError as e:
+        raise InputError(str(e)) from None
+    n = len(c.status)
+    if a.case is not None and not 0 <= a.case < n:
+        raise InputError(f"--case: {a.case} is not a case of {a.result} (0 to {n - 1})")
+    limits = parse_limits(a.limits, list(c.statistics)) if a.limits is not None else file_limits(c)
+    plot_campaign(c, out, limits=limits, case=a.case)
+    print(f"wrote {out} ({n} cases of a campaign)")
     return EXIT_OK

@@ -2,8 +2,11 @@
 and the radiation memory fitted to its tables (cached per table)."""
 from __future__ import annotations
 
+import dataclasses
 import functools
 from typing import Optional
+
+import numpy as np
 
 from .box import froude_krylov_box
 from .capytaine import capytaine_tables
@@ -54,10 +57,19 @@ def radiation_fit(scene) -> Optional[RadiationFit]:
                                  None if w is None else w.depth, None if w is None or not hd.capytaine else w.heading)
 
 
-def excitation_rao(scene, omega):
+def excitation_rao(scene, omega, headings=None):
     """X (N, 6) complex: the scene's wave forces per unit amplitude at frequencies omega, for its
-    wave heading, from its source (tables or Froude-Krylov on the box hull)."""
+    wave heading (or each component's, `headings` (N,): a spread sea), from its source (tables or
+    Froude-Krylov on the box hull)."""
     waves, ves, env = scene.waves, scene.vessel, scene.environment
+    if headings is not None:
+        omega, headings = np.asarray(omega, dtype=float), np.asarray(headings, dtype=float)
+        X = np.zeros((omega.size, 6), dtype=complex)
+        for b in np.unique(headings):
+            sel = headings == b
+            X[sel] = excitation_rao(dataclasses.replace(scene, waves=dataclasses.replace(waves, heading=float(b))),
+                                    omega[sel])
+        return X
     if excitation_source(scene) == "table":
         return interpolate_excitation(scene_hydro_tables(scene), omega, waves.heading)
     h = ves.hull

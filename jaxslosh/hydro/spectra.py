@@ -1,4 +1,4 @@
-"""Incident waves: regular waves and JONSWAP seas, and their Froude-Krylov forces on a box hull.
+"""Incident waves: regular waves, JONSWAP and Pierson-Moskowitz seas (long-crested or spread), and their Froude-Krylov forces on a box hull.
 
 Conventions (linear Airy waves, the frame of the scene: inertial, Z up, the vessel's COG at the
 origin at rest, its body axes along the inertial axes at t = 0):
@@ -17,6 +17,7 @@ Everything here is host-side NumPy run once per build; the traced sum of the com
 """
 from __future__ import annotations
 
+import math
 from typing import NamedTuple, Optional
 
 import numpy as np
@@ -48,6 +49,40 @@ def jonswap(omega, hs: float, tp: float, gamma: float = 3.3):
     return (hs * hs / 16.0) * _jonswap_shape(np.asarray(omega, dtype=float), wp, gamma) / _jonswap_norm(wp, gamma)
 
 
+def pierson_moskowitz(omega, hs: float, tp: float):
+    """Pierson-Moskowitz spectral density S(w) (m^2 s / rad), one-sided, peak at wp = 2 pi / tp
+    (the fully developed sea, JONSWAP with gamma = 1): (5/16) Hs^2 wp^4 w^-5 exp(-5/4 (wp/w)^4),
+    whose integral over (0, inf) is exactly Hs^2 / 16."""
+    wp = 2.0 * np.pi / tp
+    w = np.maximum(np.asarray(omega, dtype=float), 1e-12)
+    return (5.0 / 16.0) * hs * hs * wp ** 4 * w ** -5 * np.exp(-1.25 * (wp / w) ** 4)
+
+
+def spectrum(waves, omega):
+    """The spectral density of an irregular `[waves]` table at frequencies omega."""
+    if waves.type == "pierson-moskowitz":
+        return pierson_moskowitz(omega, waves.hs, waves.tp)
+    return jonswap(omega, waves.hs, waves.tp, waves.gamma)
+
+
+def spreading_density(theta, s: float):
+    """The cos-2s directional spreading D(theta) = C(s) cos^(2s)(theta / 2) over theta in [-pi, pi]
+    (theta from the mean heading), C(s) = Gamma(s + 1) / (2 sqrt(pi) Gamma(s + 1/2)): integral 1."""
+    c = math.exp(math.lgamma(s + 1.0) - math.lgamma(s + 0.5)) / (2.0 * math.sqrt(math.pi))
+    return c * np.abs(np.cos(0.5 * np.asarray(theta, dtype=float))) ** (2.0 * s)
+
+
+def spreading(s: float, n: int):
+    """(theta, weight): n headings relative to the mean, the midpoints of equal bins over [-pi, pi)
+    (an odd n puts one on the mean heading), and their share of the sea's energy, D(theta) dtheta
+    normalised to sum to 1 (so the discretised sea keeps its Hs). s = 0 or n = 1: long-crested."""
+    if s <= 0 or n <= 1:
+        return np.zeros(1), np.ones(1)
+    theta = -np.pi + (np.arange(n) + 0.5) * (2.0 * np.pi / n)
+    wgt = spreading_density(theta, s) * (2.0 * np.pi / n)
+    return theta, wgt / wgt.sum()
+
+
 def _jonswap_shape(w, wp, gamma):
     w = np.maximum(np.asarray(w, dtype=float), 1e-12)
     sigma = np.where(w <= wp, 0.07, 0.09)
@@ -68,15 +103,23 @@ class Components(NamedTuple):
     omega: np.ndarray      # (N,) rad/s
     amplitude: np.ndarray  # (N,) m, for the scene's wave height (regular: amplitude; JONSWAP: Hs)
     phase: np.ndarray      # (N,) rad
-    heading: float         # rad
+    heading: float         # rad, the mean heading
+    headings: Optional[np.ndarray] = None   # (N,) rad, each component's heading (a spread sea); None: `heading`
+
+    def each_heading(self) -> np.ndarray:
+        return np.full(self.omega.shape, self.heading) if self.headings is None else self.headings
 
 
 def components(waves) -> Components:
     """The components of a scene's `[waves]` table (scene_types.Waves).
 
-    JONSWAP: `components` frequencies, one drawn uniformly in each of equal bins over
-    `frequency_range` (so the record does not repeat after 2 pi / dw), amplitudes
-    sqrt(2 S(w_i) dw), phases uniform in [0, 2 pi); both drawn from numpy's default_rng(seed)."""
+    JONSWAP or Pierson-Moskowitz: `components` frequencies, one drawn uniformly in each of equal
+    bins over `frequency_range` (so the record does not repeat after 2 pi / dw), amplitudes
+    sqrt(2 S(w_i) dw), phases uniform in [0, 2 pi); both drawn from numpy's default_rng(seed), so
+    that a sea's components depend on its own table only. A spread sea (`spreading` s > 0) has
+    each frequency at `directions` headings (`spreading`), amplitudes sqrt(2 S dw D_j dtheta) and a
+    phase of its own per (frequency, heading), drawn after the long-crested ones (a long-crested
+    sea of the same seed keeps its phases)."""
     if waves.type == "regular":
         return Components(np.array([waves.omega]), np.array([waves.amplitude]), np.array([waves.phase]),
                           float(waves.heading))
@@ -86,8 +129,15 @@ def components(waves) -> Components:
     dw = (hi - lo) / n
     w = lo + (np.arange(n) + rng.uniform(size=n)) * dw
     eps = rng.uniform(0.0, 2.0 * np.pi, size=n)
-    a = np.sqrt(2.0 * jonswap(w, waves.hs, waves.tp, waves.gamma) * dw)
-    return Components(w, a, eps, float(waves.heading))
+    a = np.sqrt(2.0 * spectrum(waves, w) * dw)
+    s = float(getattr(waves, "spreading", 0.0))
+    if s <= 0:
+        return Components(w, a, eps, float(waves.heading))
+    theta, wgt = spreading(s, int(waves.directions))
+    m = theta.size
+    eps = rng.uniform(0.0, 2.0 * np.pi, size=(n, m))
+    return Components(np.repeat(w, m), (a[:, None] * np.sqrt(wgt)[None, :]).ravel(), eps.ravel(),
+                      float(waves.heading), np.tile(waves.heading + theta, n))
 
 
 def elevation(waves, t, point=(0.0, 0.0), g: float = 9.81):
@@ -96,8 +146,9 @@ def elevation(waves, t, point=(0.0, 0.0), g: float = 9.81):
     c = components(waves)
     t = np.asarray(t, dtype=float)
     k = wavenumber(c.omega, g, waves.depth)
-    x = point[0] * np.cos(c.heading) + point[1] * np.sin(c.heading)
-    eta = (c.amplitude[None, :] * np.cos(np.outer(t, c.omega) + c.phase[None, :] - k[None, :] * x)).sum(axis=1)
+    b = c.each_heading()
+    x = point[0] * np.cos(b) + point[1] * np.sin(b)
+    eta = (c.amplitude[None, :] * np.cos(np.outer(t, c.omega) + c.phase[None, :] - (k * x)[None, :])).sum(axis=1)
     return eta.reshape(t.shape) * ramp_factor(t, waves.ramp)
 
 

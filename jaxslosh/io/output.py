@@ -103,7 +103,7 @@ def jaxslosh_format(path: str):
     return v.decode() if isinstance(v, bytes) else (None if v is None else str(v))
 
 
-def check_output(path: str, inputs=(), overwrite_formats=("jaxslosh.result", "jaxslosh.sweep")) -> str | None:
+def check_output(path: str, inputs=(), overwrite_formats=("jaxslosh.result", "jaxslosh.sweep", "jaxslosh.campaign")) -> str | None:
     """Raise OutputError when `path` cannot take the output: a directory, a missing or read-only
     folder, one of the run's input files (the scene, the data), or an existing file that is not
     one of ours (anything else would be destroyed). Returns the format of an existing file of ours

@@ -3,12 +3,14 @@ from __future__ import annotations
 
 from typing import Optional
 
+import equinox as eqx
 import jax
 import jax.numpy as jnp
 import numpy as np
 from jax.sharding import Mesh, NamedSharding, PartitionSpec
 
 from ..io.result import Result, result_from
+from ..physics.seakeeping import Excitation, WaveExcitation
 from ..scene.keys import check_values, with_overrides
 from ..scene.types import Scene, SceneError
 from .loop import advance, concat_frames, core, frame_datasets, start
@@ -18,13 +20,24 @@ from .simulate import failure_message, is_traced, prepare
 _BATCH_FNS: dict = {}
 
 
-def _batch_fn(scene: Scene, keys: tuple, mesh: Optional[Mesh] = None):
+def _excited(b, exc):
+    """The built model with its wave excitation replaced by `exc` (omega, amp, phase, height): the
+    runs of a campaign differ only in their sea, whose components are drawn on the host."""
+    omega, amp, phase, height = exc
+    terms = tuple(WaveExcitation(Excitation(omega, amp, phase, height, ramp=t.excitation.ramp))
+                  if isinstance(t, WaveExcitation) else t for t in b.system.terms)
+    if not any(isinstance(t, WaveExcitation) for t in terms):
+        raise ValueError("the scene has no wave excitation to replace")
+    return b._replace(system=eqx.tree_at(lambda s: s.terms, b.system, terms))
+
+
+def _batch_fn(scene: Scene, keys: tuple, mesh: Optional[Mesh] = None, excited: bool = False):
     """The jitted, vmapped run of a batch, kept per scene, keys, times and devices: a second batch
     of the same structure does not compile again. With a device `mesh` each device runs the vmap
     over its own runs (shard_map): the per-run loops of fem/linalg.py then stay on the device's
     share, where the compiler's partitioning of one global vmap gathered every run's matrices on
     every device."""
-    cache_key = (scene, keys, mesh)
+    cache_key = (scene, keys, mesh, excited)
     try:
         hit = _BATCH_FNS.get(cache_key)
     except TypeError:                 # an unhashable scene: no reuse
@@ -35,9 +48,13 @@ def _batch_fn(scene: Scene, keys: tuple, mesh: Optional[Mesh] = None):
     n_frames = setup0.n_steps // setup0.save_every
 
     def one(*v):
+        if excited:
+            exc, v = v[:4], v[4:]
         with jax.ensure_compile_time_eval():     # the liquid's matrices are built on the host, once
             setup = prepare(scene, dict(zip(keys, v)), batch=True)
         b = core(setup.built)
+        if excited:
+            b = _excited(b, exc)
         carry, f0 = start(b, setup.solver)
         carry, frames = advance(b, setup.solver, carry, n_frames, setup.save_every)
         fr = concat_frames([jax.tree_util.tree_map(lambda x: x[None], f0), frames])
@@ -75,6 +92,31 @@ def check_runs(scene: Scene, params: dict) -> list:
     return runs
 
 
+def simulate_seas(scene: Scene, omega, amp, phase, height) -> tuple[Result, list]:
+    """Runs of one scene in B seas, one compiled vmapped loop: each run's wave excitation is
+    omega (B, N), amp (B, 6, N) per unit height, phase (B, 6, N) and height (B,) (the arrays
+    build/seakeeping.make_excitation makes of a scene's sea, all with the same component count).
+    Returns (result with a leading run axis, one status per run), as simulate_batch."""
+    vals = [jnp.asarray(x, dtype=float) for x in (omega, amp, phase, height)]
+    setup0 = prepare(scene)
+    carry, fr = _batch_fn(scene, (), None, excited=True)(*vals)
+    return _batch_result(scene, setup0, carry, fr, int(vals[0].shape[0]))
+
+
+def _batch_result(scene, setup0, carry, fr, B):
+    statuses = []
+    h = setup0.solver.h
+    for i in range(B):
+        ci = jax.tree_util.tree_map(lambda x: x[i], carry)
+        statuses.append(failure_message(ci, h, setup0.solver.tol)
+                        if bool(ci.failed) else "ok")
+    b0 = setup0.built
+    res = result_from(frame_datasets(b0, fr, fields=False), b0.probes.names,
+                      status="ok" if all(s == "ok" for s in statuses) else "some runs failed",
+                      steps_done=setup0.n_steps, scene_text=scene.text)
+    return res, statuses
+
+
 def simulate_batch(scene: Scene, params: dict, *, duration: Optional[float] = None,
                    dt: Optional[float] = None) -> tuple[Result, list]:
     """Run a batch of parameter sets in one compiled, vmapped loop.
@@ -103,14 +145,4 @@ def simulate_batch(scene: Scene, params: dict, *, duration: Optional[float] = No
                 for v in vals]
     setup0 = prepare(scene)
     carry, fr = _batch_fn(scene, tuple(keys), mesh)(*vals)
-    statuses = []
-    h = setup0.solver.h
-    for i in range(B):
-        ci = jax.tree_util.tree_map(lambda x: x[i], carry)
-        statuses.append(failure_message(ci, h, setup0.solver.tol)
-                        if bool(ci.failed) else "ok")
-    b0 = setup0.built
-    res = result_from(frame_datasets(b0, fr, fields=False), b0.probes.names,
-                      status="ok" if all(s == "ok" for s in statuses) else "some runs failed",
-                      steps_done=setup0.n_steps, scene_text=scene.text)
-    return res, statuses
+    return _batch_result(scene, setup0, carry, fr, B)

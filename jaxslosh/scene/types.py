@@ -196,7 +196,7 @@ class Probe:
 @dataclass(frozen=True)
 class Waves:
     """The `[waves]` table: a regular wave or a JONSWAP sea (waves.py has the conventions)."""
-    type: str                        # "regular" | "jonswap"
+    type: str                        # "regular" | "jonswap" | "pierson-moskowitz"
     heading: float = 0.0             # rad, the direction the waves travel to, from +X towards +Y
     amplitude: float = 0.0           # m (regular)
     omega: float = 0.0               # rad/s (regular; the scene gives `period` or `frequency`)
@@ -209,6 +209,8 @@ class Waves:
     omega_range: tuple[float, float] = (0.0, 0.0)   # rad/s (jonswap; default 0.5 to 3 times the peak frequency)
     ramp: float = 0.0                # s, the forces fade in as (1 - cos(pi t / ramp)) / 2
     depth: Optional[float] = None    # m, water depth (None: deep water)
+    spreading: float = 0.0           # cos-2s directional spreading exponent s (irregular seas); 0: long-crested
+    directions: int = 1              # headings the spreading is discretised into (odd: one on the mean heading)
 
     @property
     def height(self) -> float:

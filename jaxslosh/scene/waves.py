@@ -20,7 +20,8 @@ from ..hydro.database import DatabaseError, read_database
 from .fields import at_least, non_negative, one_of, positive, read, show
 from .types import Hull, Hydrodynamics, Hydrostatics, Scene, SceneError, Waves
 
-WAVE_TYPES = ("regular", "jonswap")
+WAVE_TYPES = ("regular", "jonswap", "pierson-moskowitz")
+DEFAULT_DIRECTIONS = 15          # headings of a spread sea when `directions` is not given
 HULL_TYPES = ("box", "mesh")
 EXCITATION_SOURCES = ("auto", "table", "froude-krylov")
 HULL_MISMATCH_TOLERANCE = 0.01   # relative: the box's closed-form hydrostatics against the scene's table
@@ -34,10 +35,12 @@ def read_waves(table, warnings: list[str]) -> Waves:
         "hs": ("float", non_negative), "tp": ("float", positive), "gamma": ("float", _at_least_one),
         "seed": ("int", non_negative), "components": ("int", at_least(1)), "frequency_range": ("numbers", None),
         "ramp": ("float", non_negative), "depth": ("float", positive),
+        "spreading": ("float", non_negative), "directions": ("int", at_least(1)),
     }, required=("type",))
     kind = v["type"]
+    irregular = ("hs", "tp", "seed", "components", "frequency_range", "spreading", "directions")
     own = {"regular": ("amplitude", "period", "frequency", "phase"),
-           "jonswap": ("hs", "tp", "gamma", "seed", "components", "frequency_range")}
+           "jonswap": irregular + ("gamma",), "pierson-moskowitz": irregular}
     for other, keys in own.items():
         if other != kind:
             for k in keys:
@@ -53,7 +56,7 @@ def read_waves(table, warnings: list[str]) -> Waves:
         return Waves(type=kind, amplitude=v["amplitude"], omega=omega, phase=v.get("phase", 0.0), **common)
     for k in ("hs", "tp"):
         if k not in v:
-            raise SceneError(f"{where}.{k}", "a required key is missing (JONSWAP sea)")
+            raise SceneError(f"{where}.{k}", f"a required key is missing ({kind} sea)")
     wp = 2.0 * math.pi / v["tp"]
     rng = v.get("frequency_range", [0.5 * wp, 3.0 * wp])
     if not (isinstance(rng, list) and len(rng) == 2 and all(isinstance(x, float) for x in rng)):
@@ -64,8 +67,13 @@ def read_waves(table, warnings: list[str]) -> Waves:
     if not lo <= wp <= hi:
         warnings.append(f"waves.frequency_range = {show(rng)} rad/s does not hold the spectral peak "
                         f"{wp:.4g} rad/s: most of the sea's energy is left out")
-    return Waves(type=kind, hs=v["hs"], tp=v["tp"], gamma=v.get("gamma", 3.3), seed=v.get("seed", 0),
-                 components=v.get("components", 100), omega_range=(lo, hi), **common)
+    spreading = v.get("spreading", 0.0)
+    if "directions" in v and spreading == 0:
+        raise SceneError(f"{where}.directions", "only goes with spreading > 0 (a long-crested sea has one heading)")
+    directions = v.get("directions", DEFAULT_DIRECTIONS) if spreading > 0 else 1
+    return Waves(type=kind, hs=v["hs"], tp=v["tp"], gamma=v.get("gamma", 3.3) if kind == "jonswap" else 1.0,
+                 seed=v.get("seed", 0), components=v.get("components", 100), omega_range=(lo, hi),
+                 spreading=spreading, directions=directions, **common)
 
 
 def _at_least_one(v):
@@ -315,6 +323,10 @@ def check_waves(scene: Scene, path: str, warnings: list[str]) -> Scene:
     if ves.forced is not None:
         warnings.append("waves: the vessel's motion is prescribed ([vessel.forced]): the wave forces act on nothing")
     uses_table = tables and source != "froude-krylov"
+    if uses_table and waves.spreading > 0:   # the tables hold one heading or a few, the spread sea comes from all
+        raise SceneError("waves.spreading", "a spread sea has components from every heading: its forces need "
+                                            'Froude-Krylov on a box hull ([vessel.hydrodynamics] excitation = '
+                                            '"froude-krylov")')
     if uses_table and hd.excitation_amplitude is not None:
         heads = hd.headings
         b = waves.heading

@@ -1,0 +1,222 @@
+"""The client side of a campaign (`js.campaign`, `jaxslosh campaign`): the cases, their batches on
+Dask (a LocalCluster of worker processes, or a given Client), the campaign file written by this
+process alone as batches finish, --resume, and the scatter's exceedance and operability.
+
+A worker that dies takes its running batch with it; Dask's scheduler then runs that batch on
+another worker (its `distributed.scheduler.allowed-failures` bounds how often)."""
+from __future__ import annotations
+
+import os
+import time
+import warnings
+from typing import NamedTuple, Optional
+
+import jax
+import numpy as np
+from dask.distributed import Client, LocalCluster, as_completed
+
+from ..io.campaign import PENDING, create_campaign, load_campaign, write_cases, write_summary
+from ..io.output import OutputLock
+from ..run.progress import Progress, wanted
+from ..scene.load import load_scene
+from ..scene.types import Scene, SceneError
+from .cases import Cases, Scatter, case_scene, case_values, make_cases, read_scatter
+from .stats import STATISTICS, frequencies, operability
+from .worker import run_batch
+
+#: cases per vmapped batch: enough to fill a core's vector units, few enough to share cases out
+BATCH = 8
+
+
+class CampaignError(ValueError):
+    """Input a campaign cannot take (a file to resume that is another campaign, a bad limit):
+    one line, exit status 2 on the command line."""
+
+
+class CampaignResult(NamedTuple):
+    cases: Cases
+    status: list                 # per case "ok" | "pending" | a reason
+    statistics: dict             # {channel: {stat: (n,)}}
+    frequency: np.ndarray        # (f,) rad/s
+    spectra: dict                # {channel: (n, f)}
+    run_now: int
+    done_before: int
+    failed: int
+    wall: float
+    limits: dict                 # {channel: limit}
+    exceedance: dict             # {channel: scatter-weighted probability of exceeding its limit}
+    operability: float           # % of the scatter's weight whose cases stay within every limit
+
+
+def channel_names(scene: Scene) -> list:
+    return ["roll", "pitch", "heave"] + [f"probe.{p.name}" for p in scene.probes]
+
+
+def _frequency_grid(scene: Scene) -> np.ndarray:
+    sim = scene.simulation
+    n_steps = int(round(sim.duration / sim.dt))
+    every = max(1, int(sim.save_every))
+    dt_frame = sim.dt * every
+    t = np.arange(n_steps // every + 1) * dt_frame
+    kept = int(np.count_nonzero(t >= scene.waves.ramp - 1e-9 * max(1.0, scene.waves.ramp)))
+    if kept < 16:
+        raise CampaignError(f"the campaign's records keep {kept} frames after waves.ramp = {scene.waves.ramp:g} s: "
+                            f"give a longer --duration")
+    return frequencies(kept, dt_frame)
+
+
+def _case_table(cases: Cases) -> dict:
+    d = {"hs": cases.hs, "tp": cases.tp, "heading": cases.heading, "seed": cases.seed, "weight": cases.weight}
+    d.update(cases.extra)
+    return d
+
+
+def _check_limits(limits, chans) -> dict:
+    out = {}
+    for k, v in (limits or {}).items():
+        if k not in chans:
+            raise CampaignError(f"--limits {k}: not a channel of this scene ({', '.join(chans)})")
+        if not (isinstance(v, (int, float)) and np.isfinite(v) and v > 0):
+            raise CampaignError(f"--limits {k}: must be a positive number, got {v!r}")
+        out[k] = float(v)
+    return out
+
+
+def campaign(scene, scatter, headings=None, seeds: int = 1, duration: Optional[float] = None, client=None, *,
+             output: Optional[str] = None, limits: Optional[dict] = None, resume: bool = False,
+             workers: int = 2, batch: int = BATCH, progress: Optional[bool] = None,
+             cache_dir: Optional[str] = None) -> CampaignResult:
+    """Run the scene (its `[waves]` table the template) for every scatter cell x heading x seed on
+    Dask. `scatter`: a CSV path or text (read_scatter) or a Scatter; `headings` (rad, default the
+    template's); `seeds` per cell and heading (the template's `waves.seed` + 0 .. seeds - 1);
+    `duration` replaces the scene's. `client`: a dask.distributed Client, else a LocalCluster of
+    `workers` processes is started and closed here. `output`: the campaign file (written as
+    batches finish, locked against a second writer); `resume`: keep its "ok" cases. `cache_dir`:
+    the workers' persistent compilation cache (default: this process's, jax_compilation_cache_dir)."""
+    t_start = time.perf_counter()
+    template = load_scene(scene) if isinstance(scene, (str, os.PathLike)) else scene
+    if template.waves is None or template.waves.type == "regular":
+        raise SceneError("waves.type", "a campaign's template is an irregular sea: type = \"jonswap\" or "
+                                       "\"pierson-moskowitz\"")
+    if not template.text:
+        raise CampaignError("the scene has no TOML text (a campaign's cases are written as scene files): "
+                            "load it with js.load_scene")
+    sc = scatter if isinstance(scatter, Scatter) else read_scatter(scatter)
+    heads = [template.waves.heading] if headings is None else [float(h) for h in np.atleast_1d(headings)]
+    if int(seeds) < 1:
+        raise CampaignError(f"--seeds: must be at least 1, got {seeds}")
+    cases = make_cases(sc, heads, int(seeds), template.waves.seed)
+    scenes = []
+    for i in range(cases.n):               # every case checked as its scene file would be, before running
+        v = case_values(cases, i)
+        try:
+            scenes.append(case_scene(template, v, duration))
+        except SceneError as e:
+            shown = ", ".join(f"{k} = {x:g}" for k, x in v.items())
+            raise SceneError(e.key, f"{str(e)[len(e.key) + 2:] if e.key else e} (case {i}: {shown})") from None
+    chans = channel_names(template)
+    lim = _check_limits(limits, chans)
+    freq = _frequency_grid(scenes[0])
+    n = cases.n
+    status = [PENDING] * n
+    stats = {ch: {s: np.full(n, np.nan) for s in STATISTICS} for ch in chans}
+    spectra = {ch: np.full((n, freq.size), np.nan) for ch in chans}
+    lock = OutputLock(output) if output else None
+    attrs = {"record_duration": float(scenes[0].simulation.duration - scenes[0].waves.ramp), "seeds": int(seeds),
+             "headings": np.asarray(heads, dtype=float)}
+    try:
+        done_before = 0
+        if output and resume and os.path.exists(output):
+            old = load_campaign(output)
+            _check_resume(old, template, cases, chans, attrs, output)
+            status = list(old.status)
+            stats = {ch: {s: np.array(old.statistics[ch][s]) for s in STATISTICS} for ch in chans}
+            spectra = {ch: np.array(old.spectra[ch]) for ch in chans}
+            done_before = sum(s == "ok" for s in status)
+        elif output:
+            create_campaign(output, template.text, _case_table(cases), chans, freq, attrs)
+        todo = [i for i in range(n) if status[i] != "ok"]
+        run_now, failed = _run(template, duration, cases, scenes, todo, client, workers, batch, output, status,
+                               stats, spectra, progress, cache_dir or jax.config.jax_compilation_cache_dir or None)
+    finally:
+        if lock is not None:
+            lock.release()
+    ok = np.array([s == "ok" for s in status])
+    ops = operability(stats, cases.weight, ok, lim, float(scenes[0].simulation.duration - scenes[0].waves.ramp))
+    if output and lim:
+        write_summary(output, lim, ops["exceedance"], ops["operability"])
+    return CampaignResult(cases, status, stats, freq, spectra, run_now, done_before, failed,
+                          time.perf_counter() - t_start, lim, ops["exceedance"], ops["operability"])
+
+
+def _check_resume(old, template, cases, chans, attrs, path):
+    if old.scene_text != template.text:
+        raise CampaignError(f"--resume: {path} holds a campaign of another scene (its scene text differs)")
+    same = all(k in old.cases and np.array_equal(np.asarray(old.cases[k], dtype=float), np.asarray(v, dtype=float))
+               for k, v in _case_table(cases).items())
+    if not same or len(old.status) != cases.n:
+        raise CampaignError(f"--resume: {path} holds other cases (scatter, headings or seeds differ)")
+    if list(old.statistics) != chans or abs(float(old.attrs.get("record_duration", -1)) - attrs["record_duration"]) > 1e-12:
+        raise CampaignError(f"--resume: {path} was run with another duration or other channels")
+
+
+def _structure(scene: Scene) -> tuple:
+    w = scene.waves
+    return (w.components, w.directions if w.spreading > 0 else 1)
+
+
+def _batches(scenes, todo, batch):
+    """Pending cases in batches of `batch`, each of one sea structure, in case order."""
+    groups: dict = {}
+    for i in todo:
+        groups.setdefault(_structure(scenes[i]), []).append(i)
+    return [idx[k:k + batch] for idx in groups.values() for k in range(0, len(idx), batch)]
+
+
+def _run(template, duration, cases, scenes, todo, client, workers, batch, output, status, stats, spectra, progress,
+         cache_dir):
+    if not todo:
+        return 0, 0
+    own = client is None
+    cluster = None
+    if own:
+        with warnings.catch_warnings():     # its HTTP server moves to a free port when 8787 is taken: say nothing
+            warnings.filterwarnings("ignore", message=".*already in use.*")
+            cluster = LocalCluster(n_workers=int(workers), threads_per_worker=1, processes=True,
+                                   dashboard_address=None)
+        client = Client(cluster)
+    bar = Progress(enabled=wanted() if progress is None else progress)
+    bar.phase("cases", "cases", total=len(todo), unit="case")
+    run_now = failed = 0
+    try:
+        futures = {}
+        for idx in _batches(scenes, todo, batch):
+            values = [case_values(cases, i) for i in idx]
+            fut = client.submit(run_batch, template.text, template.path, duration, values, batch, cache_dir,
+                                pure=False, retries=1)
+            futures[fut] = idx
+        for fut in as_completed(list(futures)):
+            idx = futures[fut]
+            try:
+                outcomes = fut.result()
+            except Exception as e:          # a batch that raised: its cases fail with the reason
+                reason = "error: " + " ".join(f"{type(e).__name__}: {e}".split())[:300]
+                outcomes = [{"status": reason, "stats": None} for _ in idx]
+            for i, o in zip(idx, outcomes):
+                status[i] = o["status"]
+                if o["stats"] is not None:
+                    for ch, st in o["stats"].items():
+                        for s in STATISTICS:
+                            stats[ch][s][i] = st[s]
+                        spectra[ch][i] = st["spectrum"]
+                failed += o["status"] != "ok"
+            if output:
+                write_cases(output, idx, outcomes)
+            run_now += len(idx)
+            bar.update(run_now)
+    finally:
+        bar.close()
+        if own:
+            client.close()
+            cluster.close()
+    return run_now, failed

@@ -1,0 +1,93 @@
+"""Response statistics of one case: per channel (roll, pitch, heave, probe.<name> vertical
+displacement) over the saved frames from t = waves.ramp on; the Rayleigh exceedance and the
+operability of a scatter (host NumPy / SciPy)."""
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from scipy import signal
+
+STATISTICS = ("std", "significant", "max", "mpm", "tz")
+
+
+def channels(result, run=None) -> dict:
+    """{channel: (frames,) series} of a result (`run`: the index along a batch's leading axis)."""
+    pick = (lambda x: np.asarray(x)) if run is None else (lambda x: np.asarray(x)[run])
+    rpy = pick(result.vessel.roll_pitch_yaw)
+    out = {"roll": rpy[:, 0], "pitch": rpy[:, 1], "heave": pick(result.vessel.position)[:, 2]}
+    for name, p in result.probes.items():
+        out[f"probe.{name}"] = pick(p.displacement)[:, 2]
+    return out
+
+
+def segment_length(n_frames: int) -> int:
+    """Welch's segment: a quarter of the record (7 half-overlapping segments), the same for every
+    case of a campaign (equal records), so that their spectra share one frequency grid."""
+    return max(8, n_frames // 4)
+
+
+def frequencies(n_frames: int, dt_frame: float) -> np.ndarray:
+    """The response spectra's frequencies (rad/s) for records of `n_frames` frames `dt_frame` apart."""
+    return 2.0 * np.pi * np.fft.rfftfreq(segment_length(n_frames), dt_frame)
+
+
+def statistics(t, x) -> dict:
+    """std, significant (4 std), max |x - mean|, most probable maximum over the record (Rayleigh:
+    std sqrt(2 ln N), N = duration / tz), the mean zero-upcrossing period tz, and the one-sided
+    spectral density in rad/s (Welch) of the record x(t), t equally spaced."""
+    t, x = np.asarray(t, dtype=float), np.asarray(x, dtype=float)
+    y = x - x.mean()
+    std = float(y.std())
+    duration = float(t[-1] - t[0]) + float(t[1] - t[0])
+    # the mean period between the first and last upcrossings (interpolated between frames): a count
+    # over the whole record would be off by the part-cycles at its ends
+    k = np.flatnonzero((y[:-1] < 0) & (y[1:] >= 0))
+    tc = t[k] + (t[k + 1] - t[k]) * (-y[k]) / (y[k + 1] - y[k])
+    tz = float(tc[-1] - tc[0]) / (k.size - 1) if k.size >= 2 else math.nan
+    n_cycles = duration / tz if k.size >= 2 else 0.0
+    mpm = std * math.sqrt(2.0 * math.log(n_cycles)) if n_cycles > 1 else math.nan
+    # Welch (averaged, windowed periodograms of overlapping segments) rather than one periodogram:
+    # a single periodogram's scatter at each frequency does not fall as the record grows, the
+    # average of segments' does, at the price of the segment's coarser resolution
+    dt = float(t[1] - t[0])
+    f, p = signal.welch(y, fs=1.0 / dt, nperseg=segment_length(y.size), detrend="constant")
+    return {"std": std, "significant": 4.0 * std, "max": float(np.abs(y).max()), "mpm": mpm, "tz": tz,
+            "spectrum": p / (2.0 * np.pi)}
+
+
+def case_statistics(t, series: dict, t0: float) -> dict:
+    """{channel: statistics} of one case over its frames from t0 (waves.ramp) on."""
+    t = np.asarray(t, dtype=float)
+    keep = t >= t0 - 1e-9 * max(1.0, abs(t0))
+    return {ch: statistics(t[keep], np.asarray(x)[keep]) for ch, x in series.items()}
+
+
+def exceedance(std, tz, duration: float, limit: float):
+    """The probability that a narrow-band Gaussian response of this std and zero-upcrossing period
+    exceeds `limit` (in |x|, its peaks Rayleigh) at least once in `duration`:
+    1 - exp(-N exp(-limit^2 / (2 std^2))), N = duration / tz."""
+    std, tz = np.asarray(std, dtype=float), np.asarray(tz, dtype=float)
+    n = np.where(np.isfinite(tz) & (tz > 0), duration / np.where(tz > 0, tz, 1.0), 0.0)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        q = np.where(std > 0, np.exp(-0.5 * (limit / np.where(std > 0, std, 1.0)) ** 2), 0.0)
+    return 1.0 - np.exp(-n * q)
+
+
+def operability(stats: dict, weight, ok, limits: dict, duration: float) -> dict:
+    """Per limited channel the scatter-weighted probability of exceeding its limit in `duration`
+    (Rayleigh, from each case's std and tz), and the operability: the weighted share (%) of the
+    cases whose every limited channel's largest |x - mean| stayed within its limit. Only cases
+    that finished (`ok`) count; their weights are renormalised."""
+    w = np.where(ok, np.asarray(weight, dtype=float), 0.0)
+    total = w.sum()
+    out = {"exceedance": {}, "operability": math.nan}
+    if total <= 0:
+        return out
+    within = np.ones(w.shape, dtype=bool)
+    for ch, lim in limits.items():
+        p = exceedance(stats[ch]["std"], stats[ch]["tz"], duration, lim)
+        out["exceedance"][ch] = float(np.sum(w * np.nan_to_num(p)) / total)
+        within &= np.asarray(stats[ch]["max"]) <= lim
+    out["operability"] = float(100.0 * np.sum(w * within) / total)
+    return out

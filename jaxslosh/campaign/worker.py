@@ -1,0 +1,78 @@
+"""What a Dask worker runs: a batch of a campaign's cases in one compiled, vmapped loop
+(run/batch.simulate_seas), reduced to their statistics on the worker (only those travel back).
+
+Every batch of a campaign has the same length (a short last batch is padded with copies of its
+last case, whose results are dropped), so that a worker compiles the scene's loop once per sea
+structure (component count) and a case's numbers do not depend on which batch, worker or order
+ran it."""
+from __future__ import annotations
+
+import dataclasses
+import os
+from typing import Optional
+
+import jax
+import numpy as np
+
+try:
+    import tomllib
+except ModuleNotFoundError:  # Python 3.10
+    import tomli as tomllib  # type: ignore[no-redef]
+
+from ..run.batch import simulate_seas
+from ..scene.load import parse_scene
+from ..scene.types import Scene
+from .cases import case_scene, sea_arrays
+from .stats import case_statistics, channels
+
+_TEMPLATES: dict = {}
+
+
+def configure_jax(cache_dir: Optional[str]):
+    """float64, and the client's persistent compilation cache folder (shared by every worker of
+    one machine: the second worker to compile a scene's loop reads the first one's)."""
+    jax.config.update("jax_enable_x64", True)
+    if cache_dir:
+        jax.config.update("jax_compilation_cache_dir", cache_dir)
+        jax.config.update("jax_persistent_cache_min_compile_time_secs", 0.0)
+        jax.config.update("jax_persistent_cache_min_entry_size_bytes", -1)
+
+
+def template_scene(text: str, path: str, duration: Optional[float]) -> Scene:
+    key = (text, path, duration)
+    if key not in _TEMPLATES:
+        scene = parse_scene(tomllib.loads(text), text=text, path=path)
+        if duration is not None:
+            scene = dataclasses.replace(scene, simulation=dataclasses.replace(scene.simulation,
+                                                                              duration=float(duration)))
+        _TEMPLATES.clear()
+        _TEMPLATES[key] = scene
+    return _TEMPLATES[key]
+
+
+def structure_scene(template: Scene, case: Scene) -> Scene:
+    """The scene a batch is compiled for: the template with the case's sea structure (its
+    component count), the sea's values fixed; the runs replace its excitation by their own."""
+    w = dataclasses.replace(template.waves, spreading=case.waves.spreading, directions=case.waves.directions,
+                            components=case.waves.components)
+    return dataclasses.replace(template, waves=w)
+
+
+def run_batch(text: str, path: str, duration: Optional[float], values: list, batch: int,
+              cache_dir: Optional[str] = None) -> list:
+    """Run the cases `values` (their [waves] values, all of one sea structure) padded to `batch`
+    runs; returns per case {"status": ..., "stats": {channel: {std, significant, max, mpm, tz,
+    spectrum}}, "pid": the worker's process id}."""
+    configure_jax(cache_dir)
+    template = template_scene(text, path, duration)
+    scenes = [case_scene(template, v, duration) for v in values]
+    seas = [sea_arrays(s) for s in scenes]
+    seas += [seas[-1]] * (batch - len(seas))
+    omega, amp, phase, hs = (np.stack([s[k] for s in seas]) for k in range(4))
+    result, statuses = simulate_seas(structure_scene(template, scenes[0]), omega, amp, phase, hs)
+    t = np.asarray(result.time)
+    out = []
+    for i, s in enumerate(scenes):
+        st = case_statistics(t[i], channels(result, i), s.waves.ramp) if statuses[i] == "ok" else None
+        out.append({"status": statuses[i], "stats": st, "pid": os.getpid()})
+    return out

@@ -1,0 +1,112 @@
+"""`jaxslosh campaign`: the scene's sea template over a scatter of sea states x headings x seeds on
+Dask (campaign/), statistics written to a campaign file as cases finish."""
+from __future__ import annotations
+
+import math
+import os
+import sys
+
+from dask.distributed import Client
+
+from ..campaign.cases import ScatterError
+from ..campaign.run import CampaignError, campaign, channel_names
+from ..io.output import OutputError
+from ..io.result import ResultFileError
+from .common import InputError, load, positive, setup_jax, writable_output
+
+
+def add_parsers(sub):
+    s = sub.add_parser("campaign", help="run a scatter of sea states x headings x seeds on Dask, write statistics")
+    s.add_argument("scene")
+    s.add_argument("--scatter", required=True, metavar="SCATTER.csv",
+                   help="CSV: hs, tp, probability or occurrences; more columns set [waves] keys (gamma, ...)")
+    s.add_argument("--headings", metavar="B1,B2,...", help="wave headings in rad (default: the scene's)")
+    s.add_argument("--seeds", type=int, default=1, help="random seeds per cell and heading (default 1)")
+    s.add_argument("--duration", type=float, help="s, replaces the scene's")
+    s.add_argument("--limits", metavar="KEY=VALUE,...", help="limits per channel: roll=0.1,probe.B=0.5")
+    g = s.add_mutually_exclusive_group()
+    g.add_argument("--workers", type=int, help="worker processes of a local Dask cluster (default 2)")
+    g.add_argument("--scheduler", metavar="ADDRESS", help="a running Dask scheduler (tcp://host:8786)")
+    s.add_argument("--batch", type=int, default=8, help="cases per vmapped batch (default 8)")
+    s.add_argument("--resume", action="store_true", help="keep the finished cases of the existing file")
+    s.add_argument("--no-progress", action="store_true")
+    s.add_argument("-o", "--output", help="campaign file (default: the scene's name with _campaign.h5)")
+
+
+def parse_limits(text, chans) -> dict:
+    out = {}
+    for item in (text or "").split(","):
+        if not item.strip():
+            continue
+        if "=" not in item:
+            raise InputError(f"--limits {item.strip()!r}: expected KEY=VALUE")
+        k, v = (x.strip() for x in item.split("=", 1))
+        if k not in chans:
+            raise InputError(f"--limits {k}: not a channel of this scene ({', '.join(chans)})")
+        try:
+            x = float(v)
+        except ValueError:
+            raise InputError(f"--limits {k}: {v!r} is not a number") from None
+        if not (x > 0 and math.isfinite(x)):
+            raise InputError(f"--limits {k}: must be a positive number, got {v}")
+        out[k] = x
+    return out
+
+
+def parse_headings(text):
+    if text is None:
+        return None
+    try:
+        heads = [float(h) for h in text.split(",") if h.strip()]
+    except ValueError:
+        raise InputError(f"--headings: expected numbers in rad separated by commas, got {text!r}") from None
+    if not heads or not all(math.isfinite(h) for h in heads):
+        raise InputError(f"--headings: expected finite numbers in rad, got {text!r}")
+    return heads
+
+
+def cmd_campaign(a):
+    positive("duration", a.duration)
+    if a.seeds < 1:
+        raise InputError(f"--seeds: must be at least 1, got {a.seeds}")
+    if a.workers is not None and a.workers < 1:
+        raise InputError(f"--workers: must be at least 1, got {a.workers}")
+    if a.batch < 1:
+        raise InputError(f"--batch: must be at least 1, got {a.batch}")
+    if not os.path.isfile(a.scatter):
+        raise InputError(f"--scatter: {a.scatter}: no such file")
+    scene = load(a.scene)
+    heads = parse_headings(a.headings)
+    limits = parse_limits(a.limits, channel_names(scene))
+    out = a.output or os.path.splitext(os.path.basename(a.scene))[0] + "_campaign.h5"
+    writable_output("-o", out, inputs=(a.scene, a.scatter))
+    if a.resume and not os.path.exists(out):
+        print(f"warning: --resume: {out} does not exist yet; starting the campaign", file=sys.stderr)
+    setup_jax()
+    client = None
+    if a.scheduler:
+        try:
+            client = Client(a.scheduler, timeout=30)
+        except (OSError, TimeoutError) as e:
+            raise InputError(f"--scheduler {a.scheduler}: cannot connect ({' '.join(str(e).split())})") from None
+    try:
+        r = campaign(scene, a.scatter, headings=heads, seeds=a.seeds, duration=a.duration, client=client,
+                     output=out, limits=limits, resume=a.resume, workers=a.workers or 2, batch=a.batch,
+                     progress=None if not a.no_progress else False)
+    except ScatterError as e:
+        raise InputError(f"--scatter {a.scatter}: {e}") from None
+    except (CampaignError, ResultFileError) as e:
+        raise InputError(str(e)) from None
+    except OutputError as e:
+        raise InputError(f"-o: {e.strerror}") from None
+    finally:
+        if client is not None:
+            client.close()
+    print(f"{'channel':>12} {'limit':>10} {'P(exceed)':>10}")
+    for ch, lim in r.limits.items():
+        print(f"{ch:>12} {lim:10.4g} {r.exceedance[ch]:10.4g}")
+    if r.limits:
+        print(f"operability: {r.operability:.2f} % of the scatter's weight within every limit")
+    print(f"done: {r.run_now} cases run now, {r.done_before} already done, {r.failed} failed, "
+          f"{r.wall:.1f} s wall -> {out}")
+    return 0 if r.failed == 0 else 3

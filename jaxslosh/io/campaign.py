@@ -1,0 +1,100 @@
+"""The campaign file (SPEC section 6): every case created "pending" when the campaign starts, its
+statistics and spectra written as it finishes. The file is opened, written and closed for each
+finished batch, so that a reader (or a --resume after a kill) always finds a consistent file."""
+from __future__ import annotations
+
+import json
+from typing import NamedTuple
+
+import h5py
+import numpy as np
+
+from .._version import __version__
+from .result import ResultFileError, attr_str, file_format, open_h5
+
+CAMPAIGN_FORMAT = "jaxslosh.campaign"
+CASE_KEYS = ("hs", "tp", "heading", "seed", "weight")
+STATS = ("std", "significant", "max", "mpm", "tz")
+PENDING = "pending"
+
+
+def create_campaign(path, scene_text: str, cases: dict, channels, frequency, attrs=None):
+    """A new campaign file: the case table (`cases`: {hs, tp, heading, seed, weight, and the
+    scatter's extra [waves] keys}), every status "pending", statistics and spectra NaN."""
+    n = len(cases["hs"])
+    with h5py.File(path, "w") as f:
+        f.attrs["format"] = CAMPAIGN_FORMAT
+        f.attrs["format_version"] = 1
+        f.attrs["scene"] = scene_text
+        f.attrs["jaxslosh_version"] = __version__
+        for k, v in (attrs or {}).items():
+            f.attrs[k] = v
+        for k, v in cases.items():
+            f.create_dataset(f"cases/{k}", data=np.asarray(v))
+        f.create_dataset("cases/status", data=np.array([PENDING] * n, dtype=object), dtype=h5py.string_dtype())
+        f.attrs["channels"] = np.array(list(channels), dtype=h5py.string_dtype())
+        for ch in channels:
+            for s in STATS:
+                f.create_dataset(f"statistics/{ch}/{s}", data=np.full(n, np.nan))
+            f.create_dataset(f"spectra/{ch}", data=np.full((n, len(frequency)), np.nan))
+        f.create_dataset("spectra/frequency", data=np.asarray(frequency, dtype=float))
+
+
+def write_cases(path, indices, outcomes):
+    """Store finished cases: `outcomes[i]` {"status", "stats": {channel: {std, ..., spectrum}}}."""
+    with h5py.File(path, "r+") as f:
+        status = f["cases/status"]
+        for i, o in zip(indices, outcomes):
+            if o["stats"] is not None:
+                for ch, st in o["stats"].items():
+                    for s in STATS:
+                        f[f"statistics/{ch}/{s}"][i] = st[s]
+                    f[f"spectra/{ch}"][i] = st["spectrum"]
+            status[i] = o["status"]
+        f.flush()
+
+
+class Campaign(NamedTuple):
+    """A campaign file read back: the case table, each case's status, {channel: {stat: (n,)}},
+    the spectra's frequencies (rad/s) and {channel: (n, f)}, the scene's TOML text, the attrs."""
+    cases: dict
+    status: list
+    statistics: dict
+    frequency: np.ndarray
+    spectra: dict
+    scene_text: str
+    attrs: dict
+
+
+def load_campaign(path) -> Campaign:
+    """The campaign file at `path`; one that is not one or cannot be read raises ResultFileError."""
+    with open_h5(path) as f:
+        fmt = file_format(f, path)
+        if fmt != CAMPAIGN_FORMAT:
+            raise ResultFileError(f"{path}: not a jaxslosh campaign file (format {fmt!r})")
+        try:
+            cases = {k: f[f"cases/{k}"][()] for k in f["cases"] if k != "status"}
+            status = [attr_str(x) for x in f["cases/status"][()]]
+            chans = [attr_str(c) for c in f.attrs["channels"]]
+            stats = {ch: {s: f[f"statistics/{ch}/{s}"][()] for s in STATS} for ch in chans}
+            freq = f["spectra/frequency"][()]
+            spectra = {ch: f[f"spectra/{ch}"][()] for ch in chans}
+        except KeyError as e:
+            raise ResultFileError(f"{path}: a campaign dataset is missing ({e})") from None
+        attrs = {k: (attr_str(v) if isinstance(v, (bytes, str)) else v) for k, v in f.attrs.items()}
+    return Campaign(cases, status, stats, freq, spectra, attrs.get("scene", ""), attrs)
+
+
+def write_summary(path, limits: dict, exceedance: dict, operability: float):
+    """The limits a campaign was judged by, each one's exceedance probability and the operability."""
+    with h5py.File(path, "r+") as f:
+        f.attrs["limits"] = json.dumps(limits)
+        f.attrs["exceedance"] = json.dumps(exceedance)
+        f.attrs["operability"] = float(operability)
+
+
+def file_limits(c: Campaign) -> dict:
+    try:
+        return {k: float(v) for k, v in json.loads(c.attrs.get("limits", "{}") or "{}").items()}
+    except (ValueError, TypeError, AttributeError):
+        return {}

@@ -1,0 +1,341 @@
+"""Campaigns: response statistics against the frequency domain and Rayleigh, the Dask path (a local
+cluster started here: 1 vs 2 workers, a killed worker, a killed campaign resumed), the command's
+bad input. Small cases: the box alone (Froude-Krylov, a viscous roll damping), coarse dt."""
+import os
+import signal
+import subprocess
+import sys
+import threading
+import time
+from pathlib import Path
+
+import h5py
+import numpy as np
+import pytest
+from dask.distributed import Client, LocalCluster
+
+import jaxslosh as js
+from jaxslosh.campaign.cases import case_scene, read_scatter, ScatterError
+from jaxslosh.campaign.stats import exceedance, statistics
+from jaxslosh.campaign.worker import run_batch
+from jaxslosh.cli import main
+from jaxslosh.hydro.spectra import spectrum
+from jaxslosh.io.campaign import load_campaign
+from jaxslosh.io.output import OutputLock
+
+ROOT = Path(__file__).resolve().parents[1]
+BEAM = 1.5707963267948966
+
+SCENE = """
+title = "box alone in irregular seas"
+[environment]
+gravity = 9.81
+water_density = 1025.0
+[simulation]
+duration = {duration}
+dt = 0.1
+scheme = "newmark"
+save_every = 2
+[vessel]
+mass = 4.1e5
+inertia = [6.0e6, 1.6e7, 2.0e7]
+[vessel.hull]
+length = 20.0
+beam = 10.0
+draft = 2.0
+kg = 2.5
+[vessel.hydrodynamics]
+viscous_damping = [0.0, 0.0, 1.0e5, 1.5e6, 5.0e6, 0.0]
+[waves]
+type = "pierson-moskowitz"
+hs = 0.3
+tp = 7.0
+heading = 1.5707963267948966
+seed = 0
+components = {components}
+frequency_range = [0.3, 2.5]
+ramp = 10.0
+"""
+
+SCATTER = "hs,tp,occurrences\n0.3,6.0,30\n0.6,7.0,50\n0.9,8.0,20\n"
+
+
+def scene_text(duration=60.0, components=30):
+    return SCENE.format(duration=duration, components=components)
+
+
+@pytest.fixture
+def env(tmp_path, monkeypatch):
+    """Workers (and subprocesses) import this worktree's package, share one compilation cache."""
+    path = os.pathsep.join([str(ROOT), str(ROOT / "tests"), os.environ.get("PYTHONPATH", "")])
+    monkeypatch.setenv("PYTHONPATH", path)
+    monkeypatch.setenv("JAXSLOSH_CACHE_DIR", str(CACHE))
+    monkeypatch.setenv("JAXSLOSH_PROGRESS", "0")
+    return tmp_path
+
+
+CACHE = Path(os.environ.get("TMPDIR", "/tmp")) / f"jaxslosh-test-campaign-cache-{os.getuid()}"
+
+
+def files(tmp_path, duration=60.0):
+    p = tmp_path / "box.toml"
+    p.write_text(scene_text(duration))
+    s = tmp_path / "scatter.csv"
+    s.write_text(SCATTER)
+    return p, s
+
+
+# --------------------------------------------------------------------------------------------
+# statistics against theory
+
+
+def test_statistics_of_a_sine_and_the_rayleigh_exceedance():
+    t = np.arange(0.0, 1000.0, 0.05)
+    st = statistics(t, 2.0 * np.sin(2 * np.pi * t / 8.0) + 5.0)
+    assert abs(st["std"] - np.sqrt(2.0)) < 1e-3 and abs(st["significant"] - 4 * np.sqrt(2.0)) < 4e-3
+    assert abs(st["tz"] - 8.0) < 0.01 and abs(st["max"] - 2.0) < 1e-3
+    f = np.fft.rfftfreq(len(t) // 4, 0.05) * 2 * np.pi
+    assert abs(np.trapezoid(st["spectrum"], f) - 2.0) < 0.05          # the spectrum holds the variance
+    # P(max > mpm) over the record where N = duration / tz: 1 - exp(-1)
+    n = 1000.0 / 8.0
+    mpm = np.sqrt(2 * np.log(n))
+    assert abs(exceedance(1.0, 8.0, 1000.0, mpm) - (1 - np.exp(-1))) < 1e-12
+
+
+def test_roll_std_equals_the_rao_integral_and_max_follows_rayleigh():
+    """The box alone (linear: Hs 0.3 m) in a beam Pierson-Moskowitz sea, 16 seeds x 600 s: the time
+    domain's roll std against sqrt(int |RAO|^2 S dw) from js.rao (the frequency-domain
+    linearisation), and the records' largest roll against the Rayleigh most probable maximum."""
+    text = scene_text(duration=600.0, components=80)
+    template = js.load_scene(text)
+    out = run_batch(text, "", None, [{"hs": 0.3, "tp": 7.0, "heading": BEAM, "seed": k} for k in range(16)], 16)
+    assert all(o["status"] == "ok" for o in out)
+    w = np.linspace(0.3, 2.5, 1500)
+    case = case_scene(template, {"hs": 0.3, "tp": 7.0, "heading": BEAM, "seed": 0})
+    H = np.abs(np.asarray(js.rao(case, w, [BEAM]).vessel)[:, 0, 3])
+    theory = np.sqrt(np.trapezoid(H ** 2 * spectrum(case.waves, w), w))
+    std = np.array([o["stats"]["roll"]["std"] for o in out])
+    assert abs(np.sqrt(np.mean(std ** 2)) / theory - 1) < 0.03
+    # the largest of N Rayleigh peaks: mean mpm (1 + 0.5772 / (2 ln N)), scatter pi / sqrt(6) / sqrt(2 ln N) std
+    mx = np.array([o["stats"]["roll"]["max"] for o in out])
+    mpm = np.array([o["stats"]["roll"]["mpm"] for o in out])
+    two_ln_n = (mpm / std) ** 2
+    expected = mpm * (1 + 0.5772 / two_ln_n)
+    sigma = np.pi / np.sqrt(6) / np.sqrt(two_ln_n) * std
+    assert abs(np.mean(mx - expected)) < 3 * np.sqrt(np.mean(sigma ** 2) / mx.size)
+
+
+# --------------------------------------------------------------------------------------------
+# the Dask path
+
+
+def _campaign(p, s, **kw):
+    return js.campaign(js.load_scene(str(p)), str(s), headings=[1.2, BEAM], seeds=2, cache_dir=str(CACHE),
+                       batch=4, **kw)
+
+
+def test_one_or_two_workers_give_the_same_statistics_as_jaxslosh_run(env):
+    p, s = files(env)
+    with LocalCluster(n_workers=2, threads_per_worker=1, processes=True, dashboard_address=None) as cl, \
+            Client(cl) as client:
+        two = _campaign(p, s, client=client, output=str(env / "two.h5"))
+        pids = set(client.run(os.getpid).values())
+    one = _campaign(p, s, workers=1, output=str(env / "one.h5"))
+    assert two.status == ["ok"] * 12 and one.status == ["ok"] * 12 and len(pids) == 2
+    for ch in ("roll", "pitch", "heave"):
+        for st in ("std", "max", "mpm", "tz"):
+            np.testing.assert_allclose(one.statistics[ch][st], two.statistics[ch][st], rtol=1e-12, atol=1e-300)
+        np.testing.assert_allclose(one.spectra[ch], two.spectra[ch], rtol=1e-12, atol=1e-300)
+    f = load_campaign(str(env / "two.h5"))
+    assert f.attrs["format"] == "jaxslosh.campaign" and f.status == ["ok"] * 12
+    np.testing.assert_array_equal(f.statistics["roll"]["std"], two.statistics["roll"]["std"])
+    np.testing.assert_allclose(f.cases["weight"].sum(), 1.0, rtol=1e-12)
+    # case 7 (cell 1, heading pi/2, seed 1) as its own scene file, run alone by `jaxslosh run`
+    case = case_scene(js.load_scene(str(p)), {"hs": 0.6, "tp": 7.0, "heading": BEAM, "seed": 1})
+    assert (f.cases["hs"][7], f.cases["heading"][7], f.cases["seed"][7]) == (0.6, BEAM, 1)
+    cp = env / "case7.toml"
+    cp.write_text(case.text)
+    assert main(["run", str(cp), "-o", str(env / "case7.h5"), "--no-progress"]) == 0
+    r = js.load_result(str(env / "case7.h5"))
+    t = np.asarray(r.time)
+    roll = np.asarray(r.vessel.roll_pitch_yaw)[:, 0][t >= 10.0 - 1e-9]
+    # single runs refresh their Newton preconditioner when convergence slows, batches every 4 steps:
+    # both converge to Newton's tolerance
+    np.testing.assert_allclose(roll.std(), two.statistics["roll"]["std"][7], rtol=1e-7)
+    np.testing.assert_allclose(np.abs(roll - roll.mean()).max(), two.statistics["roll"]["max"][7], rtol=1e-6)
+
+
+def test_a_killed_worker_has_its_cases_rerun(env):
+    p, s = files(env)
+    with LocalCluster(n_workers=2, threads_per_worker=1, processes=True, dashboard_address=None) as cl, \
+            Client(cl) as client:
+        ref = _campaign(p, s, client=client, output=str(env / "ref.h5"))
+        pids = list(client.run(os.getpid).values())
+        out = env / "killed.h5"
+        killed = []
+
+        def kill_when_started():         # the first worker, once the campaign has finished a batch
+            deadline = time.time() + 300
+            n_ok = 0
+            while time.time() < deadline and n_ok == 0:
+                try:
+                    with h5py.File(out, "r") as f:
+                        n_ok = sum(x == b"ok" for x in f["cases/status"][()])
+                except (OSError, KeyError):
+                    pass
+                time.sleep(0.02)
+            os.kill(pids[0], signal.SIGKILL)
+            killed.append(n_ok)
+
+        th = threading.Thread(target=kill_when_started)
+        th.start()
+        r = js.campaign(js.load_scene(str(p)), str(s), headings=[1.2, BEAM], seeds=2, cache_dir=str(CACHE), batch=1,
+                        client=client, output=str(out))
+        th.join()
+    assert killed and killed[0] < 12 and r.status == ["ok"] * 12       # killed mid-campaign, yet complete
+    for ch in ("roll", "heave"):
+        np.testing.assert_allclose(r.statistics[ch]["std"], ref.statistics[ch]["std"], rtol=1e-12)
+
+
+def _descendants(pid):
+    out, todo = [], [pid]
+    while todo:
+        p = todo.pop()
+        for task in Path(f"/proc/{p}/task").glob("*"):
+            try:
+                kids = [int(x) for x in (task / "children").read_text().split()]
+            except OSError:
+                kids = []
+            out += kids
+            todo += kids
+    return out
+
+
+def test_an_interrupted_campaign_resumes_without_recomputing_finished_cases(env):
+    p, s = files(env)
+    out = env / "c.h5"
+    args = [sys.executable, "-m", "jaxslosh", "campaign", str(p), "--scatter", str(s), "--headings", f"1.2,{BEAM}",
+            "--seeds", "2", "--workers", "1", "--batch", "1", "-o", str(out)]
+    proc = subprocess.Popen(args, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, cwd=env)
+    children = []
+    try:
+        deadline = time.time() + 300
+        done = 0
+        while time.time() < deadline and proc.poll() is None:
+            children = set(children) | set(_descendants(proc.pid))
+            try:
+                with h5py.File(out, "r") as f:
+                    done = sum(x == b"ok" for x in f["cases/status"][()])
+            except (OSError, KeyError):
+                pass
+            if done >= 3:
+                break
+            time.sleep(0.05)
+        assert proc.poll() is None, proc.communicate()[1][-2000:]
+        proc.send_signal(signal.SIGINT)
+        proc.communicate(timeout=120)
+    finally:
+        if proc.poll() is None:
+            proc.kill()
+        for c in children:          # the cluster's processes, were any left behind
+            try:
+                os.kill(c, signal.SIGKILL)
+            except (ProcessLookupError, PermissionError):
+                pass
+    before = load_campaign(str(out))
+    n_ok = sum(x == "ok" for x in before.status)
+    assert 3 <= n_ok < 12 and all(x in ("ok", "pending") for x in before.status)
+    res = subprocess.run(args + ["--resume"], capture_output=True, text=True, cwd=env, timeout=600)
+    assert res.returncode == 0, res.stderr[-2000:]
+    assert f"{12 - n_ok} cases run now, {n_ok} already done, 0 failed" in res.stdout
+    after = load_campaign(str(out))
+    assert after.status == ["ok"] * 12
+    ok = np.array([x == "ok" for x in before.status])
+    np.testing.assert_array_equal(after.statistics["roll"]["std"][ok], before.statistics["roll"]["std"][ok])
+    ref = _campaign(p, s, workers=1)
+    np.testing.assert_allclose(after.statistics["roll"]["std"], ref.statistics["roll"]["std"], rtol=1e-12)
+
+
+# --------------------------------------------------------------------------------------------
+# the command's input
+
+
+@pytest.mark.parametrize("csv, word", [("hs,tp\n1,7\n", "probability"), ("hs,probability\n1,1\n", "'tp'"),
+                                       ("hs,tp,probability,colour\n1,7,1,2\n", "'colour'"),
+                                       ("hs,tp,probability\n1,x,1\n", "'tp'"),
+                                       ("hs,tp,probability\n-1,7,1\n", "'hs'")])
+def test_bad_scatter_names_the_column(tmp_path, capsys, csv, word):
+    with pytest.raises(ScatterError, match=word):
+        read_scatter(csv)
+    p, s = files(tmp_path)
+    s.write_text(csv)
+    assert main(["campaign", str(p), "--scatter", str(s), "-o", str(tmp_path / "c.h5")]) == 2
+    err = capsys.readouterr().err
+    assert word in err and len(err.strip().splitlines()) == 1
+
+
+def test_bad_campaign_input_exits_2(tmp_path, capsys):
+    p, s = files(tmp_path)
+    out = tmp_path / "c.h5"
+    for extra, word in ((["--limits", "yaw=0.1"], "yaw"), (["--limits", "roll=-1"], "roll"),
+                        (["--headings", "a,b"], "--headings"), (["--seeds", "0"], "--seeds"),
+                        (["--duration", "5"], "waves.ramp")):
+        assert main(["campaign", str(p), "--scatter", str(s), "-o", str(out)] + extra) == 2, extra
+        assert word in capsys.readouterr().err
+    q = tmp_path / "regular.toml"
+    q.write_text(scene_text().split("[waves]")[0] + '[waves]\ntype = "regular"\namplitude = 0.5\nperiod = 7.0\n')
+    assert main(["campaign", str(q), "--scatter", str(s), "-o", str(out)]) == 2
+    assert "waves.type" in capsys.readouterr().err
+    # a case the scene loader refuses names the key and the case
+    s2 = tmp_path / "s2.csv"
+    s2.write_text("hs,tp,probability,gamma\n1,7,1,2\n")
+    assert main(["campaign", str(p), "--scatter", str(s2), "-o", str(out)]) == 2
+    assert "waves.gamma" in capsys.readouterr().err
+    # a second writer
+    lock = OutputLock(str(out))
+    try:
+        assert main(["campaign", str(p), "--scatter", str(s), "-o", str(out)]) == 2
+        assert "another run" in capsys.readouterr().err
+    finally:
+        lock.release()
+    # --resume of another scene's campaign
+    with h5py.File(out, "w") as f:
+        f.attrs["format"] = "jaxslosh.campaign"
+        f.attrs["scene"] = "title = 'other'"
+        f.attrs["channels"] = ["roll"]
+        for k in ("hs", "tp", "heading", "seed", "weight"):
+            f[f"cases/{k}"] = np.zeros(1)
+        f["cases/status"] = np.array([b"ok"])
+        for st in ("std", "significant", "max", "mpm", "tz"):
+            f[f"statistics/roll/{st}"] = np.zeros(1)
+        f["spectra/frequency"] = np.zeros(3)
+        f["spectra/roll"] = np.zeros((1, 3))
+    assert main(["campaign", str(p), "--scatter", str(s), "-o", str(out), "--resume"]) == 2
+    assert "another scene" in capsys.readouterr().err
+
+
+# --------------------------------------------------------------------------------------------
+# the figure
+
+
+def test_plot_of_a_campaign_file(tmp_path, capsys):
+    from jaxslosh.io.campaign import create_campaign, write_cases, write_summary
+    out = tmp_path / "c.h5"
+    hs, tp = np.repeat([1.0, 2.0], 4), np.tile(np.repeat([6.0, 8.0], 2), 2)
+    heading = np.tile([0.0, BEAM], 4)
+    cases = {"hs": hs, "tp": tp, "heading": heading, "seed": np.zeros(8, int), "weight": np.full(8, 1 / 8)}
+    freq = np.linspace(0.0, 3.0, 20)
+    create_campaign(str(out), scene_text(), cases, ["roll", "heave"], freq, {"record_duration": 50.0})
+    rng = np.random.default_rng(0)
+    outcomes = [{"status": "ok", "stats": {ch: dict(std=s, significant=4 * s, max=3 * s, mpm=2.9 * s, tz=6.0,
+                                                    spectrum=rng.uniform(size=20))
+                                           for ch, s in (("roll", 0.02 * hs[i]), ("heave", 0.3 * hs[i]))}}
+                for i in range(7)]
+    write_cases(str(out), range(7), outcomes)
+    write_summary(str(out), {"roll": 0.1}, {"roll": 0.2}, 75.0)
+    assert load_campaign(str(out)).status[-1] == "pending"
+    png = tmp_path / "c.png"
+    assert main(["plot", str(out), "-o", str(png), "--case", "3"]) == 0 and png.stat().st_size > 10000
+    assert main(["plot", str(out), "-o", str(png), "--limits", "heave=0.5"]) == 0
+    assert main(["plot", str(out), "-o", str(png), "--case", "9"]) == 2
+    assert "--case" in capsys.readouterr().err
