@@ -26,7 +26,7 @@ def tv3(A, x):
 
 #: gather indices and signs of the cross-product matrix of v, read from (0, v0, v1, v2): one gather
 #: and one product, where a nested jnp.array is some twenty operations, each repeated by every
-#: jacfwd and vmap around it (rotations are traced hundreds of times in a step with structures)
+#: jacfwd and vmap around it
 _SKEW_INDEX = np.array([[0, 3, 2], [3, 0, 1], [2, 1, 0]])
 _SKEW_SIGN = np.array([[0.0, -1.0, 1.0], [1.0, 0.0, -1.0], [-1.0, 1.0, 0.0]])
 #: G(q) read from q the same way
@@ -41,11 +41,15 @@ def skew(v):
 
 
 def rotation_matrix(q):
-    """A(q) = (q0^2 - v.v) I + 2 v v^T + 2 q0 skew(v): body to inertial (elementwise products, so
-    that XLA fuses them; see skew for why not entry by entry)."""
-    q = jnp.asarray(q)
-    q0, v = q[0], q[1:]
-    return (q0 * q0 - jnp.sum(v * v)) * np.eye(3) + 2.0 * (v[:, None] * v[None, :]) + (2.0 * q0) * skew(v)
+    """A(q): body to inertial. Entry by entry: XLA fuses the nine products into one loop; the
+    compact (q0^2 - v.v) I + 2 v v^T + 2 q0 skew(v) traces to fewer operations but runs slower in
+    the step (benchmarks/bench_paper.py), as the loops it becomes are not fused into one."""
+    q0, q1, q2, q3 = q
+    return jnp.array([
+        [q0 * q0 + q1 * q1 - q2 * q2 - q3 * q3, 2 * (q1 * q2 - q0 * q3), 2 * (q1 * q3 + q0 * q2)],
+        [2 * (q1 * q2 + q0 * q3), q0 * q0 - q1 * q1 + q2 * q2 - q3 * q3, 2 * (q2 * q3 - q0 * q1)],
+        [2 * (q1 * q3 - q0 * q2), 2 * (q2 * q3 + q0 * q1), q0 * q0 - q1 * q1 - q2 * q2 + q3 * q3],
+    ])
 
 
 def G_matrix(q):
