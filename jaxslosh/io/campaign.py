@@ -3,7 +3,9 @@ statistics and spectra written as it finishes. The file is opened, written and c
 finished batch, so that a reader (or a --resume after a kill) always finds a consistent file."""
 from __future__ import annotations
 
+import errno
 import json
+import time
 from typing import NamedTuple
 
 import h5py
@@ -16,6 +18,23 @@ CAMPAIGN_FORMAT = "jaxslosh.campaign"
 CASE_KEYS = ("hs", "tp", "heading", "seed", "weight")
 STATS = ("std", "significant", "max", "mpm", "tz")
 PENDING = "pending"
+#: how long a write waits for readers: HDF5 locks the file, and a reader that holds it (a plot of
+#: the campaign so far, a script polling it) makes the writer's open fail until it closes the file
+WRITE_WAIT = 120.0
+
+
+def _open_for_writing(path):
+    """h5py.File(path, "r+"), waiting while a reader holds HDF5's lock on it."""
+    deadline = time.monotonic() + WRITE_WAIT
+    while True:
+        try:
+            return h5py.File(path, "r+")
+        except OSError as e:
+            busy = isinstance(e, BlockingIOError) or e.errno in (errno.EAGAIN, errno.EWOULDBLOCK) or \
+                "unable to lock file" in str(e)
+            if not busy or time.monotonic() > deadline:
+                raise
+            time.sleep(0.05)
 
 
 def create_campaign(path, scene_text: str, cases: dict, channels, frequency, attrs=None):
@@ -42,7 +61,7 @@ def create_campaign(path, scene_text: str, cases: dict, channels, frequency, att
 
 def write_cases(path, indices, outcomes):
     """Store finished cases: `outcomes[i]` {"status", "stats": {channel: {std, ..., spectrum}}}."""
-    with h5py.File(path, "r+") as f:
+    with _open_for_writing(path) as f:
         status = f["cases/status"]
         for i, o in zip(indices, outcomes):
             if o["stats"] is not None:
@@ -87,7 +106,7 @@ def load_campaign(path) -> Campaign:
 
 def write_summary(path, limits: dict, exceedance: dict, operability: float):
     """The limits a campaign was judged by, each one's exceedance probability and the operability."""
-    with h5py.File(path, "r+") as f:
+    with _open_for_writing(path) as f:
         f.attrs["limits"] = json.dumps(limits)
         f.attrs["exceedance"] = json.dumps(exceedance)
         f.attrs["operability"] = float(operability)
