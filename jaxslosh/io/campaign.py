@@ -12,7 +12,7 @@ import h5py
 import numpy as np
 
 from .._version import __version__
-from .result import ResultFileError, attr_str, file_format, open_h5
+from .result import ResultFileError, attr_str, expect_format, open_h5
 
 CAMPAIGN_FORMAT = "jaxslosh.campaign"
 CASE_KEYS = ("hs", "tp", "heading", "seed", "weight")
@@ -88,9 +88,7 @@ class Campaign(NamedTuple):
 def load_campaign(path) -> Campaign:
     """The campaign file at `path`; one that is not one or cannot be read raises ResultFileError."""
     with open_h5(path) as f:
-        fmt = file_format(f, path)
-        if fmt != CAMPAIGN_FORMAT:
-            raise ResultFileError(f"{path}: not a jaxslosh campaign file (format {fmt!r})")
+        expect_format(f, path, CAMPAIGN_FORMAT, "campaign")
         try:
             cases = {k: f[f"cases/{k}"][()] for k in f["cases"] if k != "status"}
             status = [attr_str(x) for x in f["cases/status"][()]]

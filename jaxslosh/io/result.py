@@ -230,6 +230,14 @@ def open_h5(path: str):
             pass
 
 
+def expect_format(f: h5py.File, path: str, expected: str, what: str):
+    """Raise ResultFileError unless the file's format (file_format) is `expected` ("sweep",
+    "campaign": what the message calls it)."""
+    fmt = file_format(f, path)
+    if fmt != expected:
+        raise ResultFileError(f"{path}: not a jaxslosh {what} file (format {fmt!r})")
+
+
 def file_format(f: h5py.File, path: str) -> str:
     """The file's `format` attribute, after checking its `format_version` is one this jaxslosh reads
     (files written before the attribute existed are version 1); a newer one is refused, since its
