@@ -9,7 +9,8 @@ ROOT = os.path.join(os.path.dirname(os.path.dirname(os.path.abspath(__file__))),
 
 # lowest first; a module may import its own package and the packages on earlier lines
 LAYERS = [
-    {"_version", "fem.mesh", "physics.kinematics"},
+    {"_version", "fem.mesh", "fem.slip", "physics.kinematics"},
+    {"fem.shapes"},
     {"hydro", "io"},
     {"scene"},
     {"fem"},

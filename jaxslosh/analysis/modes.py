@@ -16,9 +16,10 @@ def sloshing_modes(scene: Scene, tank=None, n: int = 10):
     t = scene.tank(tank) if tank is not None else scene.tanks[0]
     # large meshes as the simulation takes them: sparse matrices and shift-invert Lanczos (a dense
     # generalized eigh needs every matrix dense, and crashed OpenBLAS at 20 x 20 x 12)
-    large = t.wall_spec is None and free_liquid_dofs(t) > SPARSE_AUTO
+    # (tanks of other shapes too: their walls' frames make the dense mass full, shift-invert is quicker)
+    large = t.wall_spec is None and (free_liquid_dofs(t) > SPARSE_AUTO or not t.geometry.plain_box)
     model = build_liquid(t.size, t.fill_depth, t.mesh, t.fluid.density, t.fluid.sound_speed,
-                         scene.environment.gravity, element=t.fluid.element, sparse=large)
+                         scene.environment.gravity, element=t.fluid.element, sparse=large, geometry=t.geometry)
     if t.wall_spec is not None:       # the liquid and its elastic walls together (kinds add "wall")
         return tank_modes(build_tank_with_walls(t, model), n=n)
     return liquid_modes(model, n=n)

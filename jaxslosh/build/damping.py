@@ -47,7 +47,7 @@ def build_damping(scene: Scene, params: Optional[dict], block) -> tuple[Optional
         model = tb.model
         if model.traced:
             model = build_liquid(t.size, t.fill_depth, t.mesh, t.fluid.density, t.fluid.sound_speed,
-                                 scene.environment.gravity, element=t.fluid.element)
+                                 scene.environment.gravity, element=t.fluid.element, geometry=t.geometry)
         if reduced:
             basis = tank_basis(model, t.origin, t.reduction.modes, t.reduction.static_correction)
             n_t = basis.V.shape[1]

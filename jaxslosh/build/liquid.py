@@ -63,9 +63,12 @@ def build_liquid_block(scene: Scene, params: Optional[dict] = None, gravity=None
     models = []
     for i, t in enumerate(rigid):
         P = lambda k, d: params.get(f"tanks.{t.name}.{k}", d)  # noqa: E731
+        if not t.geometry.plain_box and isinstance(P("fill_depth", t.fill_depth), jax.core.Tracer):
+            raise SceneError(f"tanks[{i}].fill_depth", f"the fill depth of a {t.shape} tank (or one with baffles) "
+                                                      "cannot be traced: its mesh follows the fill")
         models.append(build_liquid(t.size, P("fill_depth", t.fill_depth), t.mesh, P("fluid.density", t.fluid.density),
                                    P("fluid.sound_speed", t.fluid.sound_speed), g, element=t.fluid.element,
-                                   sparse=sparse))
+                                   sparse=sparse, geometry=t.geometry))
         if sparse and models[-1].traced:
             raise SceneError(f"tanks[{i}]", "a traced tank value (fill depth, density, sound speed or gravity in "
                                             "params or a sweep) needs the dense liquid matrices; this mesh uses the "
@@ -76,6 +79,9 @@ def build_liquid_block(scene: Scene, params: Optional[dict] = None, gravity=None
     elastic = [t.wall_spec is not None for t in rigid]
     if any(elastic) or in_vessel_frame:
         for i, t in enumerate(rigid):
+            if models[i].frames is not None:
+                raise SceneError(f"tanks[{i}].shape", "structures in the vessel's frame go with box tanks (and "
+                                                      "shapes whose walls are all along the axes) only")
             if reduced[i] or sparse or models[i].traced:
                 raise SceneError(f"tanks[{i}].walls" if elastic[i] else f"tanks[{i}]",
                                  "elastic walls, and structures in the vessel's frame, need the full-order dense "
@@ -107,22 +113,30 @@ def build_liquid_block(scene: Scene, params: Optional[dict] = None, gravity=None
             Kdt_list.append(xp.zeros((free.size, 3)))
         free_list.append(free + 3 * offset)
         offset += N
+    frames = None
+    if any(m.frames is not None for m in models):       # shaped tanks: every node's frame (identity on boxes)
+        frames = jnp.asarray(np.concatenate([np.tile(np.eye(3), (m.n_nodes, 1, 1)) if m.frames is None
+                                             else np.asarray(m.frames) for m in models]))
     if sparse:
         Kdt = jnp.asarray(np.concatenate(Kdt_list)) if coupled else None
+        boxes = all(m.geometry is None for m in models)     # the fast diagonalization needs box grids
         meshes = [tuple(m.mesh) for m in models]
         nodes_of = [np.arange(m.nodes.shape[0]) for m in models]
         free_of = [np.flatnonzero(np.asarray(m.free)) for m in models]
-        layers = tuple(m.layers for m in models)
+        layers = tuple(m.layers for m in models) if boxes else None
         liquid = Liquid(r=jnp.asarray(np.concatenate(rs)),
-                        Ms=host_sparse(sp.block_diag(Ms_list), tuple(zip(meshes, [1] * len(models), nodes_of)), layers),
-                        K=host_sparse(sp.block_diag(K_list), tuple(zip(meshes, [3] * len(models), free_of)), layers),
-                        free=jnp.asarray(np.concatenate(free_list)),
-                        n_nodes=offset, grids=tuple(m.mesh + (surface_bending_scale(m), m.element) for m in models),
-                        sparse=True)
+                        Ms=host_sparse(sp.block_diag(Ms_list), tuple(zip(meshes, [1] * len(models), nodes_of))
+                                       if boxes else None, layers),
+                        K=host_sparse(sp.block_diag(K_list), tuple(zip(meshes, [3] * len(models), free_of))
+                                      if boxes else None, layers),
+                        free=jnp.asarray(np.concatenate(free_list)), n_nodes=offset,
+                        grids=tuple(m.mesh + (surface_bending_scale(m), m.element) for m in models) if boxes else None,
+                        sparse=True, frames=frames)
         return LiquidBlock(liquid, tuple(blocks), (Kdt, jnp.asarray(Ktt)) if coupled else None)
     stack = jax_block_diag if traced else block_diag
     liquid = Liquid(r=jnp.asarray(xp.concatenate(rs)), Ms=jnp.asarray(stack(*Ms_list)),
-                    K=jnp.asarray(stack(*K_list)), free=jnp.asarray(np.concatenate(free_list)), n_nodes=offset)
+                    K=jnp.asarray(stack(*K_list)), free=jnp.asarray(np.concatenate(free_list)), n_nodes=offset,
+                    frames=frames)
     penalty = (jnp.asarray(xp.concatenate(Kdt_list)), jnp.asarray(Ktt)) if coupled else None
     return LiquidBlock(liquid, tuple(blocks), penalty)
 
@@ -229,7 +243,7 @@ class VesselFrameStructure(NamedTuple):
 def _host_block(t, m, offset) -> TankBlock:
     """The tank's block for probes and result fields, with the mesh at the scene's fill depth: a
     probe keeps its place relative to the mesh whatever a traced fill depth says."""
-    if not m.traced and m.depth == t.fill_depth:
+    if m.geometry is not None or (not m.traced and m.depth == t.fill_depth):
         nodes = np.asarray(m.nodes)
     else:
         nodes = grid_nodes((t.size[0], t.size[1], t.fill_depth), m.mesh)
@@ -246,7 +260,7 @@ def _reduced_liquid(scene: Scene, tanks, models, reduced, g):
     for t, m in zip(tanks, models):
         if m.traced or isinstance(g, jax.core.Tracer):
             m = build_liquid(t.size, t.fill_depth, t.mesh, t.fluid.density, t.fluid.sound_speed,
-                             scene.environment.gravity, element=t.fluid.element)
+                             scene.environment.gravity, element=t.fluid.element, geometry=t.geometry)
         concrete.append(m)
     offsets, blocks, offset = [], [], 0
     for t, m in zip(tanks, models):

@@ -7,6 +7,7 @@ from typing import NamedTuple, Optional
 import jax.numpy as jnp
 import numpy as np
 
+from ..fem.mesh import HEX_CORNERS
 from ..scene.types import Scene
 
 
@@ -38,7 +39,10 @@ def build_probes(scene: Scene, tanks, liquid, structures=(), vstructs=()) -> Pro
             t = scene.tank(p.tank)
             pts.append(np.asarray(t.origin) + np.asarray(p.point))
             b = by_name.get(t.name)
-            if b is not None:
+            if b is not None and getattr(b.model, "geometry", None) is not None:
+                local = mapped_weights(np.asarray(p.point), t.fill_depth, b.nodes, b.elements)
+                w[b.node_offset:b.node_offset + b.nodes.shape[0]] = local
+            elif b is not None:
                 local = probe_weights(np.asarray(p.point), t.size, t.fill_depth, b.nodes, b.elements)
                 w[b.node_offset:b.node_offset + b.nodes.shape[0]] = local
         elif scene.structure(p.structure).frame == "vessel":     # in the vessel-frame block, like a liquid point
@@ -105,3 +109,38 @@ def probe_weights(point, size, depth, nodes, elements, eps=1e-9):
                 w[node] = np.prod(np.where(corner > 0.5, xi, 1.0 - xi))
             return w
     return w
+
+
+def mapped_weights(point, depth, nodes, elements, tol=1e-9):
+    """`probe_weights` in a tank of another shape (fem/shapes.py): the trilinear weights of the point in
+    the hexahedron that holds it (its reference coordinates by Newton's method), a point at the fill
+    depth on the free surface; outside the liquid (in the air, in a wall): zeros, the probe follows
+    the tank. (Unlike the box, a point on a wall below the surface follows the liquid there.)"""
+    scale = float(np.ptp(nodes, axis=0).max())
+    p = np.array(point, dtype=float)
+    if p[2] > depth + 1e-6 * scale:
+        return np.zeros(nodes.shape[0])
+    p[2] = min(p[2], depth)
+    C = HEX_CORNERS
+    for el in elements:
+        X = nodes[el]
+        if np.any(p < X.min(axis=0) - tol * scale) or np.any(p > X.max(axis=0) + tol * scale):
+            continue
+        xi = np.zeros(3)
+        for _ in range(30):
+            N = np.prod(1 + C * xi, axis=1) / 8.0
+            dN = np.stack([C[:, k] * np.prod(np.where(np.arange(3) == k, 1.0, 1 + C * xi), axis=1)
+                           for k in range(3)], axis=1) / 8.0
+            r = N @ X - p
+            J = X.T @ dN
+            if abs(np.linalg.det(J)) < 1e-300:
+                break
+            step = np.linalg.solve(J, r)
+            xi = np.clip(xi - step, -1.5, 1.5)
+            if np.abs(step).max() < 1e-13:
+                break
+        if np.all(np.abs(xi) <= 1 + 1e-7):
+            w = np.zeros(nodes.shape[0])
+            np.add.at(w, el, np.prod(1 + C * np.clip(xi, -1, 1), axis=1) / 8.0)
+            return w
+    return np.zeros(nodes.shape[0])

@@ -33,7 +33,7 @@ def reduce_liquid(models, concrete_models, origins, offsets, reductions):
         Nt, m = int(model.n_nodes), basis.V.shape[1]
         Ut = np.zeros((m, 3 * Nt))
         Ut[:, f] = basis.V.T
-        Ut = Ut.reshape(m, Nt, 3)
+        Ut = np.asarray(cmodel.to_global(Ut.reshape(m, Nt, 3)))     # shaped tanks: from the nodes' frames
         r = xp.asarray(model.nodes) + xp.asarray(origin)[None, :]
         Ms = model.mass
         mvec = xp.asarray(Ms.sum(axis=1)).reshape(-1)

@@ -37,7 +37,8 @@ def sloshing_modes(model, search: int = 0):
     ascending frequency, mass-normalised on the free dofs, of a concrete model. Dense models: among
     all their modes; sparse ones: among the lowest `search` (SPARSE_SEARCH when 0). Cached per tank."""
     key = (tuple(model.size), float(model.depth), tuple(model.mesh), float(model.density),
-           float(model.sound_speed), float(model.gravity), model.element, sp.issparse(model.stiffness), int(search))
+           float(model.sound_speed), float(model.gravity), model.element, sp.issparse(model.stiffness), int(search),
+           model.geometry)
     return _cached_modes(key, _Ref(model))
 
 
@@ -46,7 +47,7 @@ def _cached_modes(key, ref):
     model = ref.obj
     K, M = free_matrices(model)
     if sp.issparse(K):
-        lam, X = natural_modes(K, M, min(K.shape[0] - 1, key[-1] or SPARSE_SEARCH))
+        lam, X = natural_modes(K, M, min(K.shape[0] - 1, key[-2] or SPARSE_SEARCH))
     else:
         lam, X = sl.eigh(K, M)
     keep = sloshing_share(model, X) & (lam > 0)
@@ -76,7 +77,10 @@ class _Ref:
 
 def wall_integrals(model, Phi):
     """(k,) int_wetted |phi_t|^2 dA of each mode (columns of Phi on the free dofs): the tangential
-    components on the bottom (z = 0) and the four walls (x = 0, a; y = 0, b) up to the fill depth."""
+    components on the bottom (z = 0) and the four walls (x = 0, a; y = 0, b) up to the fill depth
+    (a tank of another shape: on its wall faces, both faces of baffles included)."""
+    if model.wall_faces is not None:
+        return _face_integrals(model, Phi)
     nx, ny, nz = (int(n) for n in model.mesh)
     a, b = float(model.size[0]), float(model.size[1])
     hx, hy, hz = a / nx, b / ny, float(model.depth) / nz
@@ -131,3 +135,27 @@ def rectangular_ratio(a: float, b: float, h: float, g: float, viscosity: float) 
     omega = np.sqrt(g * k * np.tanh(k * h))
     bracket = 1.0 / a + 1.0 / b + k * (1.0 - 2.0 * h / a) / np.sinh(2.0 * k * h)
     return float(np.sqrt(viscosity / (2.0 * omega)) * bracket)
+
+
+def _face_integrals(model, Phi):
+    """`wall_integrals` over the wall faces of any mesh: each face's tangential field, integrated by
+    the bilinear face's consistent mass (2 x 2 Gauss on the curved quadrilateral)."""
+    f = np.flatnonzero(np.asarray(model.free))
+    full = np.zeros((Phi.shape[1], 3 * model.n_nodes))
+    full[:, f] = Phi.T
+    U = np.asarray(model.to_global(full.reshape(Phi.shape[1], model.n_nodes, 3)))
+    faces = np.asarray(model.wall_faces)
+    X = np.asarray(model.nodes)[faces]                                  # (W, 4, 3)
+    corners = np.array([[-1, -1], [1, -1], [1, 1], [-1, 1]], dtype=float)
+    g = 1.0 / np.sqrt(3.0)
+    Mf = np.zeros((len(faces), 4, 4))
+    for p in np.array([[sx, sy] for sx in (-g, g) for sy in (-g, g)]):
+        N = (1 + corners[:, 0] * p[0]) * (1 + corners[:, 1] * p[1]) / 4.0
+        dN = np.stack([corners[:, 0] * (1 + corners[:, 1] * p[1]), corners[:, 1] * (1 + corners[:, 0] * p[0])], 1) / 4.0
+        t1, t2 = np.einsum("a,wai->wi", dN[:, 0], X), np.einsum("a,wai->wi", dN[:, 1], X)
+        Mf += np.linalg.norm(np.cross(t1, t2), axis=1)[:, None, None] * np.outer(N, N)[None]
+    nrm = np.cross(X[:, 2] - X[:, 0], X[:, 3] - X[:, 1])
+    nrm /= np.linalg.norm(nrm, axis=1, keepdims=True)
+    Uf = U[:, faces]                                                      # (k, W, 4, 3)
+    Ut = Uf - np.einsum("kwac,wc->kwa", Uf, nrm)[..., None] * nrm[None, :, None, :]
+    return np.einsum("kwac,wab,kwbc->k", Ut, Mf, Ut)

@@ -43,8 +43,10 @@ import numpy as np
 import scipy.sparse as sp
 
 from ..scene.types import ELEMENT_FORMS
-from .liquid_element import ROTATION_PENALTY, SURFACE_BENDING, element_matrices, is_traced
+from .liquid_element import FLAT_CORNER_PENALTY, ROTATION_PENALTY, SURFACE_BENDING, element_matrices, is_traced
 from .mesh import box_elements, grid_index, grid_nodes
+from .shapes import tank_mesh
+from .slip import rotate_matrix, rotate_rows, surface_jump_pattern
 
 
 @dataclass(frozen=True, eq=False)
@@ -88,42 +90,70 @@ class LiquidModel:
     # sparse builds on a grid whose layers are uniform: the element matrices of each layer, for
     # products element by element (boxsolve.elements); None otherwise
     layers: Optional[dict] = None
+    # tanks of other shapes (fem/shapes.py): each node's frame (N, 3, 3), whose columns are its axes;
+    # `stiffness`, `rotation_coupling`, `parts` and `free` are then on the components in these frames
+    # (the scalar `mass` stays on the tank's axes); None: every frame is the tank's
+    frames: Optional[np.ndarray] = None
+    top_faces: Optional[np.ndarray] = None     # (F, 4) free-surface faces of a shaped tank
+    wall_faces: Optional[np.ndarray] = None    # (W, 4) its wetted wall faces, outward
+    geometry: Optional[object] = None          # fem/shapes.TankGeometry of a shaped tank
 
     @property
     def n_nodes(self) -> int:
         return int(self.nodes.shape[0])
 
     def mass3(self):
-        """The (3N, 3N) mass matrix kron(mass, I3)."""
-        if self.traced:
-            return jnp.kron(self.mass, jnp.eye(3))
-        return np.kron(self.mass, np.eye(3))
+        """The (3N, 3N) mass matrix kron(mass, I3) (in the nodes' frames: R^T kron(mass, I3) R)."""
+        xp = jnp if self.traced else np
+        M3 = xp.kron(self.mass, xp.eye(3))
+        return M3 if self.frames is None else rotate_matrix(xp, M3, self.frames)
+
+    def to_local(self, F):
+        """Nodal vectors (N, 3) on the tank's axes -> on the nodes' frames (the identity for a box)."""
+        if self.frames is None:
+            return F
+        xp = jnp if (self.traced or is_traced(F)) else np
+        return xp.einsum("nji,nj->ni", self.frames, F)
+
+    def to_global(self, U):
+        """Nodal vectors (..., N, 3) on the nodes' frames -> on the tank's axes."""
+        if self.frames is None:
+            return U
+        xp = jnp if (self.traced or is_traced(U)) else np
+        return xp.einsum("nij,...nj->...ni", self.frames, U)
 
     def body_force(self, g_body):
         """Nodal force (3N,) of a uniform body acceleration field g_body (3,), m/s^2: kron(M, I3) tile(g)."""
         if self.traced or is_traced(g_body):
-            return (self.mass @ jnp.tile(jnp.asarray(g_body, dtype=float), (self.n_nodes, 1))).reshape(-1)
-        g_body = np.asarray(g_body, dtype=float)
-        return (self.mass @ np.tile(g_body, (self.n_nodes, 1))).reshape(-1)
+            F = self.mass @ jnp.tile(jnp.asarray(g_body, dtype=float), (self.n_nodes, 1))
+        else:
+            F = self.mass @ np.tile(np.asarray(g_body, dtype=float), (self.n_nodes, 1))
+        return self.to_local(F).reshape(-1)
 
     def surface_faces(self) -> np.ndarray:
         """(F, 4) node indices of the top faces (counter-clockwise seen from above)."""
+        if self.top_faces is not None:
+            return self.top_faces
         nx, ny, nz = self.mesh
         top = np.arange(len(self.elements)).reshape(nx, ny, nz)[:, :, -1].reshape(-1)
         return self.elements[top][:, 4:8]
 
 
 def build_liquid(size, fill_depth, mesh, density, sound_speed, gravity, element="stabilized",
-                 sparse=False) -> LiquidModel:
+                 sparse=False, geometry=None) -> LiquidModel:
     """Build the liquid model of a rigid tank of inner size (a, b, H) filled to ``fill_depth``.
 
     ``mesh`` = (nx, ny, nz) hexahedra over the liquid region; ``element`` one of ``ELEMENT_FORMS``.
     ``fill_depth``, ``density``, ``sound_speed`` and ``gravity`` may be JAX tracers (float64).
     ``sparse=True`` (concrete values only): ``mass`` and ``stiffness`` are SciPy CSR matrices, for
-    meshes whose dense matrices would not fit (see solve/sparse.py).
+    meshes whose dense matrices would not fit (see solve/sparse.py). ``geometry``: a
+    fem/shapes.TankGeometry for tanks of other shapes than the plain box (then the fill depth is
+    concrete).
     """
     if element not in ELEMENT_FORMS:
         raise ValueError(f"element form {element!r} unknown; choose one of {ELEMENT_FORMS}")
+    if geometry is not None and not geometry.plain_box:
+        return _build_shaped(geometry, fill_depth, mesh, density, sound_speed, gravity, element, sparse)
     a, b = float(size[0]), float(size[1])
     nx, ny, nz = (int(m) for m in mesh)
     traced = any(is_traced(v) for v in (fill_depth, density, sound_speed, gravity))
@@ -167,6 +197,53 @@ def build_liquid(size, fill_depth, mesh, density, sound_speed, gravity, element=
         depth=h, element=element, mesh=(nx, ny, nz), rotation_coupling=coupling,
         rotation_stiffness=theta_theta, parts=parts, traced=traced, layers=layers,
     )
+
+
+def _build_shaped(geometry, fill_depth, mesh, rho, c, g, element, sparse) -> LiquidModel:
+    """`build_liquid` for a tank of another shape (fem/shapes.py): its mesh, the nodes' wall frames,
+    the same element matrices and assembly, then the matrices turned onto the nodes' frames."""
+    if is_traced(fill_depth):
+        raise ValueError("the fill depth of a tank that is not a plain box cannot be traced (its mesh follows it)")
+    traced = any(is_traced(v) for v in (rho, c, g))
+    h = float(fill_depth)
+    tm = tank_mesh(geometry, h, mesh)
+    nodes, elements, faces = tm.nodes, tm.elements, tm.top_faces
+    n = len(nodes)
+    pairs = bending = None
+    if element != "paper":
+        pairs = _rotation_pairs(*tm.grid) if tm.grid is not None else (np.ones((len(elements), 6), bool), [])
+        bending = surface_jump_pattern(nodes, faces)
+    flat = tm.flat.astype(float)
+    assemble, parts_of = _assembler(n, elements, faces, element, pairs, bending, flat)
+    xp = jnp if traced else np
+    with jax.enable_x64(True):
+        if traced:
+            density, sound_speed, gravity = (jnp.asarray(v, dtype=jnp.float64) for v in (rho, c, g))
+        else:
+            density, sound_speed, gravity = float(rho), float(c), float(g)
+        el = element_matrices(nodes[elements], nodes[faces][:, :, :2], density, sound_speed, gravity, h, element,
+                              with_parts=not traced, div_variation=element != "paper" and bool(flat.any()))
+        kappa = ROTATION_PENALTY * density * gravity * float(np.ptp(nodes, axis=0).max())
+        out = assemble(el, kappa, SURFACE_BENDING * density * gravity, traced, sparse=sparse and not traced)
+        K, C, T = out["stiffness"], out.get("coupling"), out.get("theta_theta")
+        if sp.issparse(C):
+            C = np.asarray(C.todense())
+        frames = tm.frames
+        if frames is not None:
+            K = rotate_matrix(xp, K, frames)
+            C = None if C is None else rotate_rows(xp, C, frames)
+    parts = {}
+    if not traced:
+        parts = parts_of(el, out)
+        if frames is not None:
+            parts = {k: rotate_matrix(np, v, frames) for k, v in parts.items()}
+    return LiquidModel(
+        nodes=nodes, elements=elements, mass=out["mass"], stiffness=K, free=tm.free.reshape(-1).copy(),
+        surface=np.unique(faces), density=density, sound_speed=sound_speed, gravity=gravity,
+        size=tuple(float(s) for s in geometry.size), depth=h, element=element,
+        mesh=tuple(tm.grid) if tm.grid is not None else tuple(int(m) for m in mesh), rotation_coupling=C,
+        rotation_stiffness=T, parts=parts, traced=traced, layers=None, frames=frames, top_faces=faces,
+        wall_faces=tm.wall_faces, geometry=geometry)
 
 
 def layer_blocks(el, out, mesh, form, bending):
@@ -255,17 +332,28 @@ def topology(nx, ny, nz, form) -> Topology:
     are concrete (nothing to compile per mesh), JAX (jitted, scatter-add) when they are traced."""
     grid = grid_index(nx, ny, nz)
     n = len(grid)
-    size = 3 * n
     elements = box_elements(nx, ny, nz)
-    E = len(elements)
     faces = elements.reshape(nx, ny, nz, 8)[:, :, -1, 4:8].reshape(-1, 4)
-    dofs = (3 * elements[:, :, None] + np.arange(3)).reshape(E, 24)
-    fs_dofs = 3 * faces + 2
     free = np.ones((n, 3), dtype=bool)                     # slip walls: no normal displacement
     free[(grid[:, 0] == 0) | (grid[:, 0] == nx), 0] = False
     free[(grid[:, 1] == 0) | (grid[:, 1] == ny), 1] = False
     free[grid[:, 2] == 0, 2] = False
     surface = np.flatnonzero(grid[:, 2] == nz)
+    pairs = _rotation_pairs(nx, ny, nz) if form != "paper" else None
+    bending = surface_bending_pattern(nx, ny, nz) if form != "paper" else None
+    assemble, parts = _assembler(n, elements, faces, form, pairs, bending)
+    return Topology(grid, elements, faces, free, surface, assemble, parts)
+
+
+def _assembler(n, elements, faces, form, rotation_pairs, bending, flat=None):
+    """(assemble, parts) of a mesh of n nodes: `rotation_pairs` = (keep, pairs) of the stabilized
+    element's rotation rows (see `_rotation_pairs`), `bending` the COO (rows, cols, values) of its
+    surface bending measure, `flat` (E,) 1.0 for the elements that get the divergence-variation
+    penalty (liquid_element.FLAT_CORNER_PENALTY)."""
+    size = 3 * n
+    E = len(elements)
+    dofs = (3 * elements[:, :, None] + np.arange(3)).reshape(E, 24)
+    fs_dofs = 3 * faces + 2
 
     r24, c24 = _block_index(dofs)
     r4, c4 = _block_index(fs_dofs)
@@ -283,14 +371,14 @@ def topology(nx, ny, nz, form) -> Topology:
                     "rotation": _coo(np.asarray(el["rotation"])[:, :24, :24], r24, c24, (size, size))}
     else:
         # stabilized: the rotation penalty's rows, the wall pairs and the surface bending pattern
-        keep, pairs = _rotation_pairs(nx, ny, nz)
+        keep, pairs = rotation_pairs
         keep_f = keep.astype(float)
         comp = np.repeat(np.arange(3), 2)                    # curl component of each of the six rows
         pe0, pe1, pk = (np.array([p[i] for p in pairs], dtype=int) for i in range(3))
         prow = 2 * pk[:, None] + np.arange(2)[None, :]       # (P, 2) curl rows of each pair
         pdofs = np.concatenate([dofs[pe0], dofs[pe1]], axis=1) if pairs else np.zeros((0, 48), dtype=int)
         pr, pc = _block_index(np.repeat(pdofs, 2, axis=0))   # two rows (s = 0, 1) per pair
-        Br, Bc, Bv = surface_bending_pattern(nx, ny, nz)
+        Br, Bc, Bv = bending
         Cr = np.repeat(dofs[:, None, :], 6, axis=1).reshape(-1)     # (E, 6, 24) -> d dof
         Cc = np.broadcast_to(comp[None, :, None], (E, 6, 24)).reshape(-1)
         rows_all = np.concatenate([r24, r4, pr, Br])
@@ -312,8 +400,11 @@ def topology(nx, ny, nz, form) -> Topology:
 
         def assemble_xp(xp, el, kappa, bending):
             w, ck, rblocks, pblocks = rotation_blocks(xp, el, kappa)
+            K24 = el["acoustic"] + el["coupling"] + rblocks
+            if "div_variation" in el:                         # flat corners of a mapped mesh only
+                K24 = K24 + (FLAT_CORNER_PENALTY * kappa) * el["div_variation"] * flat[:, None, None]
             vals = xp.concatenate([
-                (el["acoustic"] + el["coupling"] + rblocks).reshape(-1),
+                K24.reshape(-1),
                 (el["free_surface"] + el["surface_hourglass"]).reshape(-1),
                 pblocks.reshape(-1),
                 bending * Bv])
@@ -338,7 +429,7 @@ def topology(nx, ny, nz, form) -> Topology:
             return traced_assemble(el, kappa, bending)
         return assemble_xp(_SPARSE_NP if sparse else np, el, kappa, bending)
 
-    return Topology(grid, elements, faces, free, surface, assemble, parts)
+    return assemble, parts
 
 
 def _rotation_pairs(nx, ny, nz):

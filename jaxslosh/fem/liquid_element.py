@@ -74,6 +74,14 @@ SURFACE_HOURGLASS = 1.0
 #: weight of the surface second-difference ("bending") term relative to the free-surface stiffness.
 SURFACE_BENDING = 0.025
 
+#: the divergence's variation inside an element, penalised where a mapped mesh has an element with
+#: two faces on one smooth wall (fem/slip.py): 1/2 eps kappa int (div u - mean div u)^2 dV (2x2x2
+#: Gauss). Such an element (a disk meshed from a square: a corner of the square on the circle) has an
+#: angle near 180 degrees there, and the node at it slides along the wall with no energy of the
+#: one-point divergence or the axial curl; this term holds it. Only those elements get it: sloshing
+#: fields carry a divergence variation at the mesh's resolution, which it would stiffen everywhere.
+FLAT_CORNER_PENALTY = 1.0
+
 #: 1D kinetic-energy quadrature points +-xi for the stabilized mass (consistent: 1/sqrt(3)).
 #: xi = sqrt(1 - 4 b) for the 1D off-diagonal mass b; b = (1 - beta)/6 with beta the blend towards
 #: lumped (beta < 0: towards the mid-point rule). Horizontal beta = -0.05, vertical beta = -0.45.
@@ -90,7 +98,7 @@ def is_traced(x) -> bool:
 _CHUNK = 128          # elements per jitted batch: fixed shapes, so each kernel compiles once per process
 
 
-def element_matrices(xe, xf, rho, c, g, h, form, with_parts=True):
+def element_matrices(xe, xf, rho, c, g, h, form, with_parts=True, div_variation=False):
     """Element matrices of every term (Hessians of the energies below): NumPy arrays for concrete
     values, JAX arrays when any input is traced.
 
@@ -109,6 +117,8 @@ def element_matrices(xe, xf, rho, c, g, h, form, with_parts=True):
         out = {}
         for name, (fn, on_faces) in kern.items():
             if not with_parts and form == "paper" and name in ("free_surface", "rotation"):
+                continue
+            if name == "div_variation" and not div_variation:
                 continue
             x = xf if on_faces else xe
             n = len(x)
@@ -228,6 +238,12 @@ def _kernels(form):
     def volume(prm, x):
         return jnp.sum(points(x, gauss)[2])
 
+    def e_div_variation(d, prm, x):                         # 1/2 int (div u - mean div u)^2
+        _, dNx, dJ = points(x, gauss)
+        div = jnp.trace(grads(d, dNx), axis1=1, axis2=2)
+        mean = jnp.sum(div * dJ) / jnp.sum(dJ)
+        return 0.5 * jnp.sum((div - mean) ** 2 * dJ)
+
     def e_kinetic(v, prm, x):                               # 1/2 rho int v^2, scalar field, spread rule
         pts = corners * jnp.array([prm[5], prm[5], prm[6]])
         N, dNx, dJ = points(x, pts)
@@ -288,5 +304,6 @@ def _kernels(form):
         kern["volume"] = (jit(jax.vmap(volume, in_axes=(None, 0))), False)
         kern["coupling"] = (batched(e_coupling, 24), False)
         kern["surface_hourglass"] = (batched(e_surface_hourglass, 4), True)
+        kern["div_variation"] = (batched(e_div_variation, 24), False)
     _KERNEL_CACHE[form] = kern
     return kern

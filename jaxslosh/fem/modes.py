@@ -25,6 +25,7 @@ import scipy.sparse as sp
 from scipy.sparse.linalg import eigsh
 
 from .liquid import LiquidModel, build_liquid
+from .slip import rotate_matrix
 
 
 KINDS = ("sloshing", "acoustic", "circulation", "spurious")
@@ -35,12 +36,14 @@ class Modes:
     omega: np.ndarray                 # (n,) rad/s, ascending (negative: -sqrt(-lambda), never expected)
     kind: tuple                       # (n,) one of KINDS
     free_surface_share: np.ndarray    # (n,) in [0, 1]
-    shapes: np.ndarray                # (n, 3N) mass-normalised (x^T kron(M, I3) x = 1), zero on fixed dofs
+    shapes: np.ndarray                # (n, 3N) mass-normalised (x^T kron(M, I3) x = 1), on the tank's axes
 
 
 def free_mass(model: LiquidModel) -> np.ndarray:
     """kron(mass, I3) restricted to the free dofs, without forming the full 3N matrix."""
     f = np.flatnonzero(model.free)
+    if model.frames is not None:                       # a shaped tank: on the nodes' frames
+        return np.asarray(model.mass3())[np.ix_(f, f)]
     node, comp = f // 3, f % 3
     return model.mass[np.ix_(node, node)] * (comp[:, None] == comp[None, :])
 
@@ -50,7 +53,10 @@ def free_matrices(model):
     f = np.flatnonzero(np.asarray(model.free))
     if sp.issparse(model.stiffness):
         K = model.stiffness.tocsr()[f][:, f]
-        M = sp.kron(model.mass, sp.eye(3), format="csr")[f][:, f]
+        M = sp.kron(model.mass, sp.eye(3), format="csr")
+        if model.frames is not None:
+            M = rotate_matrix(np, M, model.frames)
+        M = M.tocsr()[f][:, f]
         return 0.5 * (K + K.T), M
     K = np.asarray(model.stiffness)[np.ix_(f, f)]
     return 0.5 * (K + K.T), free_mass(model)
@@ -77,6 +83,8 @@ def liquid_modes(model: LiquidModel, n: int = 10) -> Modes:
     shapes = np.zeros((n, f.size))
     shapes[:, f] = X.T
     share, kind = classify(model, shapes)
+    if model.frames is not None:                   # nodal fields on the tank's axes
+        shapes = model.to_global(shapes.reshape(n, -1, 3)).reshape(n, -1)
     return Modes(omega=omega, kind=kind, free_surface_share=share, shapes=shapes)
 
 

@@ -63,12 +63,12 @@ def _load_patterns(model, origin):
     for c in range(3):
         F = np.zeros((N, 3))
         F[:, c] = m
-        cols.append(F.reshape(-1)[f])
+        cols.append(model.to_local(F).reshape(-1)[f])
     for a in range(3):
         for b in range(3):
             F = np.zeros((N, 3))
             F[:, a] = Mr[:, b]
-            cols.append(F.reshape(-1)[f])
+            cols.append(model.to_local(F).reshape(-1)[f])
     if model.rotation_coupling is not None:
         C = np.asarray(model.rotation_coupling)[f]
         cols += [C[:, k] for k in range(3)]
@@ -91,7 +91,7 @@ def tank_basis(model, origin, n: int, static_correction: bool = True) -> TankBas
     static correction. Cached per tank geometry, mesh, liquid and reduction."""
     key = (tuple(model.size), float(model.depth), tuple(model.mesh), float(model.density),
            float(model.sound_speed), float(model.gravity), model.element, tuple(float(o) for o in origin),
-           int(n), bool(static_correction), sp.issparse(model.stiffness))
+           int(n), bool(static_correction), sp.issparse(model.stiffness), model.geometry)
     return _cached_basis(key, _Ref(model), tuple(float(o) for o in origin), int(n), bool(static_correction))
 
 

@@ -23,6 +23,7 @@ import jax.numpy as jnp
 import numpy as np
 
 from ..fem.linalg import solve
+from ..fem.slip import rotate_matrix
 from .kinematics import mv3, quat_multiply, skew, spin_tensor_components, tv3
 from .terms import AbstractTerm, Config, Kin, Rows
 
@@ -113,6 +114,9 @@ class Liquid(AbstractLiquid):
     # element form), ...) in the stacking order, for the fast-diagonalization inverse (solve/boxsolve.py)
     grids: Optional[tuple] = eqx.field(static=True, default=None)
     sparse: bool = eqx.field(static=True, default=False)
+    # tanks of other shapes (fem/shapes.py): each node's frame (N, 3, 3); the unknowns are the free
+    # components in these frames (tangential on a wall). None: the vessel's axes everywhere
+    frames: Optional[jax.Array] = None
 
     @property
     def nf(self) -> int:
@@ -123,13 +127,16 @@ class Liquid(AbstractLiquid):
         walls: equal to the wall's there, through `dof_map`)."""
         if self.dof_map is not None:
             return jnp.concatenate([d, jnp.zeros(1, d.dtype)])[self.dof_map].reshape(self.n_nodes, 3)
-        return jnp.zeros(3 * self.n_nodes, d.dtype).at[self.free].set(d).reshape(self.n_nodes, 3)
+        D = jnp.zeros(3 * self.n_nodes, d.dtype).at[self.free].set(d).reshape(self.n_nodes, 3)
+        return D if self.frames is None else jnp.einsum("nij,nj->ni", self.frames, D)
 
     def free_part(self, F):
         """The transpose of `full`: nodal forces -> generalized forces on the free dofs."""
         if self.dof_map is not None:
             nf = self.free.shape[0]
             return jax.ops.segment_sum(F.reshape(-1), self.dof_map, nf + 1)[:nf]
+        if self.frames is not None:
+            F = jnp.einsum("nji,nj->ni", self.frames, F)
         return F.reshape(-1)[self.free]
 
     @property
@@ -176,6 +183,8 @@ class Liquid(AbstractLiquid):
         return jnp.concatenate([jnp.full(3, m.sum()), I])
 
     def d_scale(self):
+        if self.frames is not None:
+            return jnp.repeat(self.m_nodes, 3)[self.free]
         return self.free_part(jnp.repeat(self.m_nodes, 3))
 
     def frame_field(self, d):
@@ -195,7 +204,10 @@ class Liquid(AbstractLiquid):
         Ms = self.Ms if traced else np.asarray(self.Ms)
         free = np.asarray(self.free)
         if self.dof_map is None:
-            return xp.kron(Ms, xp.eye(3))[np.ix_(free, free)], self.K
+            M3 = xp.kron(Ms, xp.eye(3))
+            if self.frames is not None:
+                M3 = rotate_matrix(xp, M3, self.frames if traced else np.asarray(self.frames))
+            return M3[np.ix_(free, free)], self.K
         dmap = np.asarray(self.dof_map)         # elastic tank walls: T^T kron(Ms, I3) T
         T = np.zeros((dmap.size, free.size + 1))
         T[np.arange(dmap.size), dmap] = 1.0

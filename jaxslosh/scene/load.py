@@ -26,11 +26,51 @@ except ModuleNotFoundError:  # Python 3.10
     import tomli as tomllib  # type: ignore[no-redef]
 
 from ..fem.mesh import box_mesh, face_nodes
-from .fields import (at_least, counts, non_negative, one_of, poisson_ratio, positive, read, show, sizes,
-                     valid_name)
-from .types import (DOFS, EFFECTS, ELEMENT_FORMS, FACES, Damping, Effects, Environment, Forced, Fluid, Hydrostatics,
-                    Initial, Material, Probe, Reduction, Scene, SceneError, Simulation, Structure, Tank, Vessel, Walls)
-from .waves import FileContext, check_waves, hull_hydrostatics, read_hull, read_hydrodynamics, read_waves
+from ..fem.shapes import AXES, SHAPES
+from .fields import (
+    at_least,
+    counts,
+    non_negative,
+    one_of,
+    poisson_ratio,
+    positive,
+    read,
+    show,
+    sizes,
+    valid_name,
+)
+from .shape import read_shape
+from .types import (
+    DOFS,
+    EFFECTS,
+    ELEMENT_FORMS,
+    FACES,
+    Damping,
+    Effects,
+    Environment,
+    Fluid,
+    Forced,
+    Hydrostatics,
+    Initial,
+    Material,
+    Probe,
+    Reduction,
+    Scene,
+    SceneError,
+    Simulation,
+    Structure,
+    Tank,
+    Vessel,
+    Walls,
+)
+from .waves import (
+    FileContext,
+    check_waves,
+    hull_hydrostatics,
+    read_hull,
+    read_hydrodynamics,
+    read_waves,
+)
 
 SCHEMES = ("newmark", "hht", "generalized-alpha")
 LINEAR_SOLVERS = ("auto", "dense", "sparse")      # [simulation] linear_solver (sparse.py)
@@ -94,7 +134,7 @@ def parse_scene(mapping: Mapping[str, Any], text: str = "", path: str = "") -> S
     files = FileContext(os.path.dirname(os.path.abspath(path)) if path else os.getcwd(), environment.water_density,
                         environment.gravity, depth if isinstance(depth, (int, float)) and depth > 0 else None)
     vessel = _vessel(mapping["vessel"], environment, warnings, files)
-    tanks = tuple(_tank(t, f"tanks[{i}]") for i, t in enumerate(mapping.get("tanks", [])))
+    tanks = tuple(_tank(t, f"tanks[{i}]", files.base_dir) for i, t in enumerate(mapping.get("tanks", [])))
     structures = tuple(_structure(s, f"structures[{i}]") for i, s in enumerate(mapping.get("structures", [])))
     probes = tuple(_probe(p, f"probes[{i}]") for i, p in enumerate(mapping.get("probes", [])))
     _unique_names(tanks, "tanks", "tank")
@@ -292,11 +332,13 @@ def _material(table, where: str) -> Material:
     }, required=("young", "poisson", "density")))
 
 
-def _tank(table, where: str) -> Tank:
+def _tank(table, where: str, base_dir: str = "") -> Tank:
     v = read(table, where, {
         "name": ("str", valid_name), "origin": ("vec3", None), "size": ("vec3", sizes),
         "fill_depth": ("float", None), "mesh": ("mesh", counts), "walls": ("str_or_table", None),
         "fluid": ("table", None), "reduction": ("table", None), "damping": ("table", None),
+        "shape": ("str", one_of(SHAPES)), "chamfers": ("table", None), "axis": ("str", one_of(AXES)),
+        "file": ("str", None), "baffles": ("tables", None),
     }, required=("name", "origin", "size", "fill_depth", "mesh"))
     # SPEC writes `walls = "elastic"` and a `[tanks.walls]` table, but TOML cannot hold both under
     # one key: `walls` is either the string "rigid" or the table, which makes the walls elastic.
@@ -327,8 +369,9 @@ def _tank(table, where: str) -> Tank:
             "modes": ("int", at_least(1)), "static_correction": ("bool", None),
         }, required=("modes",)))
     damping = _damping(table["damping"], f"{where}.damping") if "damping" in table else None
+    shape = read_shape(table, v, where, base_dir, elastic=wall_spec is not None)
     return Tank(name=v["name"], origin=v["origin"], size=v["size"], fill_depth=depth, mesh=v["mesh"],
-                walls=walls, fluid=fluid, wall_spec=wall_spec, reduction=reduction, damping=damping)
+                walls=walls, fluid=fluid, wall_spec=wall_spec, reduction=reduction, damping=damping, **shape)
 
 
 def _damping(table, where: str) -> Damping:

@@ -10,6 +10,7 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 from typing import Optional, Union
 
+from ..fem.shapes import TankGeometry, liquid_volume
 
 #: the six rigid dofs, in the order of every 6-vector and 6 x 6 table
 DOFS = ("surge", "sway", "heave", "roll", "pitch", "yaw")
@@ -150,10 +151,22 @@ class Tank:
     wall_spec: Optional[Walls] = None   # the [tanks.walls] table when walls = "elastic"
     reduction: Optional[Reduction] = None   # None: full order
     damping: Optional[Damping] = None       # None: an inviscid, undamped liquid
+    shape: str = "box"                      # "box" | "prismatic" | "cylinder" | "mesh" (fem/shapes.py)
+    chamfers: tuple = ((0.0, 0.0), (0.0, 0.0))   # prismatic: (width y, height z) of the bottom and top cuts
+    axis: str = "x"                         # cylinder: "x", "y" (horizontal) or "z" (vertical)
+    file: str = ""                          # mesh: the mesh file (absolute path)
+    baffles: tuple = ()                     # fem/shapes.Baffle per [[tanks.baffles]]
+
+    @property
+    def geometry(self) -> TankGeometry:
+        return TankGeometry(kind=self.shape, size=tuple(self.size), chamfers=self.chamfers, axis=self.axis,
+                            file=self.file, baffles=self.baffles)
 
     @property
     def liquid_volume(self) -> float:
-        return self.size[0] * self.size[1] * self.fill_depth
+        if self.shape == "box":
+            return self.size[0] * self.size[1] * self.fill_depth
+        return liquid_volume(self.geometry, self.fill_depth)
 
     @property
     def liquid_mass(self) -> float:

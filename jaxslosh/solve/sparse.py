@@ -35,6 +35,7 @@ import scipy.sparse as sp
 from jax.experimental.sparse import BCOO
 from scipy.sparse.linalg import splu
 
+from ..fem.slip import rotate_matrix
 from .boxsolve import box_inverse, elements, solve, stencil
 
 #: `linear_solver = "auto"` goes sparse above this many liquid unknowns (free dofs of all tanks):
@@ -157,8 +158,10 @@ def host_inverse(A) -> HostInverse:
 def free_blocks(liquid):
     """(M_ff, K_ff) of a sparse `Liquid` as SciPy matrices on its free dofs."""
     f = np.asarray(liquid.free)
-    M = sp.kron(liquid.Ms.matrix, sp.eye(3), format="csr")[f][:, f]
-    return M, liquid.K.matrix
+    M = sp.kron(liquid.Ms.matrix, sp.eye(3), format="csr")
+    if liquid.frames is not None:
+        M = rotate_matrix(np, M, np.asarray(liquid.frames))
+    return M.tocsr()[f][:, f], liquid.K.matrix
 
 
 def sparse_solver_blocks(liquid, c_a_step, c_a_sub=None):
@@ -186,6 +189,8 @@ def hydrostatic_start(liquid, g_b):
     F = np.zeros((3 * m.size, 3))
     for c in range(3):
         F[c::3, c] = m
+    if liquid.frames is not None:              # onto the nodes' frames
+        F = np.einsum("nji,njc->nic", np.asarray(liquid.frames), F.reshape(m.size, 3, 3)).reshape(-1, 3)
     K = liquid.K.matrix
     box = None
     if liquid.grids is not None:          # box tanks: K itself diagonalizes (boxsolve.py)
