@@ -45,7 +45,7 @@ import scipy.sparse as sp
 from ..scene.types import ELEMENT_FORMS
 from .liquid_element import FLAT_CORNER_PENALTY, ROTATION_PENALTY, SURFACE_BENDING, element_matrices, is_traced
 from .mesh import box_elements, grid_index, grid_nodes
-from .shapes import tank_mesh
+from .shapes import box_equivalent, tank_mesh
 from .slip import rotate_matrix, rotate_rows, surface_jump_pattern
 
 
@@ -146,12 +146,15 @@ def build_liquid(size, fill_depth, mesh, density, sound_speed, gravity, element=
     ``mesh`` = (nx, ny, nz) hexahedra over the liquid region; ``element`` one of ``ELEMENT_FORMS``.
     ``fill_depth``, ``density``, ``sound_speed`` and ``gravity`` may be JAX tracers (float64).
     ``sparse=True`` (concrete values only): ``mass`` and ``stiffness`` are SciPy CSR matrices, for
-    meshes whose dense matrices would not fit (see solve/sparse.py). ``geometry``: a
-    fem/shapes.TankGeometry for tanks of other shapes than the plain box (then the fill depth is
-    concrete).
+    meshes whose dense matrices would not fit (see solve/sparse.py). ``geometry``: a fem/shapes
+    TankGeometry for other shapes than the plain box (then the fill depth is concrete).
     """
     if element not in ELEMENT_FORMS:
         raise ValueError(f"element form {element!r} unknown; choose one of {ELEMENT_FORMS}")
+    if geometry is not None and geometry.kind == "mesh" and not is_traced(fill_depth):
+        counts = box_equivalent(geometry, float(fill_depth))
+        if counts is not None:                 # a box grid given as a mesh file: the box itself
+            return build_liquid(size, fill_depth, counts, density, sound_speed, gravity, element, sparse)
     if geometry is not None and not geometry.plain_box:
         return _build_shaped(geometry, fill_depth, mesh, density, sound_speed, gravity, element, sparse)
     a, b = float(size[0]), float(size[1])
@@ -200,8 +203,7 @@ def build_liquid(size, fill_depth, mesh, density, sound_speed, gravity, element=
 
 
 def _build_shaped(geometry, fill_depth, mesh, rho, c, g, element, sparse) -> LiquidModel:
-    """`build_liquid` for a tank of another shape (fem/shapes.py): its mesh, the nodes' wall frames,
-    the same element matrices and assembly, then the matrices turned onto the nodes' frames."""
+    """`build_liquid` for another shape (fem/shapes.py): its mesh, then the matrices on the nodes' frames."""
     if is_traced(fill_depth):
         raise ValueError("the fill depth of a tank that is not a plain box cannot be traced (its mesh follows it)")
     traced = any(is_traced(v) for v in (rho, c, g))

@@ -1,0 +1,173 @@
+"""Tanks of other shapes (issue 18): sloshing frequencies against closed forms and an independent
+solver (tests/sloshing_reference.py), the hydrostatics of inclined walls, a box given as a mesh file,
+the scene's checks, and a coupled run."""
+import os
+import subprocess
+import sys
+
+import numpy as np
+import pytest
+
+import jaxslosh as js
+from jaxslosh.fem.liquid import build_liquid
+from jaxslosh.fem.modes import free_matrices, liquid_modes
+from jaxslosh.fem.shapes import Baffle, TankGeometry
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+import sloshing_reference as ref  # noqa: E402
+
+ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+G = 9.81
+
+
+def modes(geo, depth, mesh, n=8):
+    m = build_liquid(geo.size, depth, mesh, 1000.0, 1500.0, G, geometry=geo, sparse=True)
+    md = liquid_modes(m, n)
+    assert all(k == "sloshing" for k in md.kind), md.kind       # no spurious or circulation mode in the band
+    return m, md
+
+
+def distinct(omega, rtol=2e-3):
+    out = [omega[0]]
+    for w in omega[1:]:
+        if w > out[-1] * (1 + rtol):
+            out.append(w)
+    return np.array(out)
+
+
+def test_vertical_cylinder_first_three_modes_against_bessel():
+    # R = 2 m filled to 2 m; the disk is mapped from the square (its mode pairs split slightly)
+    geo = TankGeometry(kind="cylinder", size=(4.0, 4.0, 3.0), axis="z")
+    _, md = modes(geo, 2.0, (16, 16, 6), n=8)
+    exact = ref.vertical_cylinder_omegas(2.0, 2.0, G, n=3)          # k R = 1.8412, 3.0542, 3.8317
+    for w_exact in exact:
+        nearest = md.omega[np.argmin(np.abs(md.omega - w_exact))]
+        assert abs(nearest / w_exact - 1) < 0.01, (nearest, w_exact)
+    # each of the three is there: the m = 1 pair, both m = 2 modes and the axisymmetric one
+    assert np.sum(np.abs(md.omega / exact[0] - 1) < 0.01) == 2
+    assert np.sum(np.abs(md.omega / exact[1] - 1) < 0.01) == 2
+
+
+def test_horizontal_cylinder_half_full_against_mciver():
+    # R = 1.5 m, a 1 m slice along x (its longitudinal modes lie far above the first transverse one)
+    geo = TankGeometry(kind="cylinder", size=(1.0, 3.0, 3.0), axis="x")
+    m, md = modes(geo, 1.5, (2, 12, 6), n=3)
+    exact = ref.horizontal_cylinder_half_full_first(1.5, G)          # omega^2 R / g = 1.3557
+    assert abs(md.omega[0] / exact - 1) < 0.015
+    # the liquid's volume is the half disk's, and every wall node sits on the circle
+    assert abs(m.mass.sum() / 1000.0 / (0.5 * np.pi * 1.5 ** 2 * 1.0) - 1) < 0.01
+    walls = np.unique(m.wall_faces)
+    side = walls[np.abs(m.nodes[walls, 0] - 0.5) < 0.49]             # not on the end walls
+    r = np.hypot(m.nodes[side, 1] - 1.5, m.nodes[side, 2] - 1.5)
+    assert side.size > 0 and np.abs(r - 1.5).max() < 1e-12
+
+
+def test_v_section_against_kirchhoff():
+    # chamfers meeting at the centre line at 45 degrees: a 90-degree V, 2 m deep at the apex
+    geo = TankGeometry(kind="prismatic", size=(1.0, 4.0, 3.0), chamfers=((2.0, 2.0), (0.0, 0.0)))
+    _, md = modes(geo, 2.0, (2, 8, 6), n=3)
+    assert abs(md.omega[0] / ref.v_section_first(2.0, G) - 1) < 0.01
+
+
+def test_trapezoidal_section_against_the_section_solver():
+    # bottom chamfers 1.5 m wide, 3 m high, filled to 2.5 m: straight inclined walls
+    geo = TankGeometry(kind="prismatic", size=(1.0, 6.0, 4.0), chamfers=((1.5, 3.0), (0.0, 0.0)))
+    _, md = modes(geo, 2.5, (2, 12, 8), n=3)
+    w = ref.section_sloshing_omegas(ref.prismatic(6.0, 4.0, 1.5, 3.0), 2.5, G, n=2)
+    assert abs(md.omega[0] / w[0] - 1) < 0.015
+
+
+def test_chamfer_kink_under_the_liquid_locks_and_is_refused():
+    """Measured why such prismatic tanks are refused for now (turn round when fixed)."""
+    geo = TankGeometry(kind="prismatic", size=(1.0, 6.0, 4.0), chamfers=((1.5, 1.0), (0.0, 0.0)))
+    m = build_liquid(geo.size, 2.5, (2, 12, 8), 1000.0, 1500.0, G, geometry=geo, sparse=True)
+    w = ref.section_sloshing_omegas(ref.prismatic(6.0, 4.0, 1.5, 1.0), 2.5, G, n=1)[0]
+    assert liquid_modes(m, 1).omega[0] > 1.04 * w
+    from jaxslosh.fem.shapes import check_geometry
+    assert check_geometry(geo, 2.5, (2, 12, 8))[0] == "chamfers"
+
+
+def test_heeled_trapezoidal_tank_keeps_its_surface_as_level_as_the_box():
+    """Gravity tilted by 5 degrees about x, the discrete static equilibrium: the free surface's
+    spread of heights along gravity (compression included) is no larger with inclined walls than in
+    the box of the same mesh and depth, and under 3 % of the tilt's."""
+    def spread(chamfers):
+        geo = TankGeometry(kind="prismatic", size=(4.0, 6.0, 4.0), chamfers=chamfers)
+        m = build_liquid(geo.size, 2.5, (4, 8, 6), 1000.0, 1500.0, G, geometry=geo)
+        th = np.radians(5.0)
+        g_b = G * np.array([0.0, np.sin(th), -np.cos(th)])
+        K, _ = free_matrices(m)
+        f = np.flatnonzero(m.free)
+        d = np.zeros(3 * m.n_nodes)
+        d[f] = np.linalg.solve(K, m.body_force(g_b)[f])
+        D = m.to_global(d.reshape(-1, 3))
+        s, up = m.surface, -g_b / G
+        return np.ptp((m.nodes[s] + D[s]) @ up), np.ptp(m.nodes[s] @ up)
+    trapezoid, tilt = spread(((1.5, 3.0), (0.0, 0.0)))
+    box, _ = spread(((0.0, 0.0), (0.0, 0.0)))
+    assert trapezoid <= box and trapezoid < 0.03 * tilt, (trapezoid, box, tilt)
+
+
+def test_bottom_plate_locks_the_element_so_baffles_are_refused(tmp_path):
+    """Why [[tanks.baffles]] is refused for now: the mesh does hold a plate (its nodes doubled), but
+    the stabilized element locks there. Kept as a measured fact, to be turned round when fixed."""
+    geo = TankGeometry(kind="box", size=(5.0, 1.0, 3.0), baffles=(Baffle("x", 2.5, "bottom", 1.0),))
+    m = build_liquid(geo.size, 2.0, (10, 2, 6), 1000.0, 1500.0, G, geometry=geo)
+    w = liquid_modes(m, 2).omega[0]
+    exact = ref.section_sloshing_omegas(ref.rectangle(5.0), 2.0, G, n=1, baffles=(ref.Baffle(2.5, 1.0),))[0]
+    assert w > 1.3 * exact
+    text = _scene_text('shape = "box"\n[[tanks.baffles]]\nat = 2.5\nheight = 1.0\n')
+    path = tmp_path / "b.toml"
+    path.write_text(text)
+    out = subprocess.run([sys.executable, "-m", "jaxslosh", "check", str(path)], capture_output=True, text=True)
+    assert out.returncode == 2 and "tanks[0].baffles" in out.stderr
+
+
+def _scene_text(extra, size="[5.0, 5.0, 4.0]", mesh="[5, 5, 5]", fill="3.0", duration="0.3"):
+    t = open(os.path.join(ROOT, "scenes", "paper_ship_tank.toml")).read()
+    t = t.replace("size = [5.0, 5.0, 4.0]", "size = " + size).replace("mesh = [5, 5, 5]", "mesh = " + mesh)
+    t = t.replace("fill_depth = 3.0", "fill_depth = " + fill).replace("duration = 20.0", f"duration = {duration}")
+    return t.replace('walls = "rigid"\n', 'walls = "rigid"\n' + extra + "\n")
+
+
+def test_box_given_as_a_gmsh_file_runs_as_the_box(tmp_path):
+    meshio = pytest.importorskip("meshio")
+    from jaxslosh.fem.mesh import box_mesh
+    nodes, elements = box_mesh((5.0, 5.0, 3.0), (5, 5, 5))
+    path = tmp_path / "tank.msh"
+    # a shuffled node order, as a mesher writes it
+    perm = np.random.default_rng(0).permutation(len(nodes))
+    inv = np.argsort(perm)
+    meshio.write(str(path), meshio.Mesh(nodes[perm], [("hexahedron", inv[elements])]), file_format="gmsh22")
+    box = js.simulate(js.load_scene(_scene_text("")))
+    scene = _scene_text(f'shape = "mesh"\nfile = "{path}"')
+    mesh = js.simulate(js.load_scene(scene))
+    assert box.status == mesh.status == "ok"
+    np.testing.assert_allclose(mesh.vessel.roll_pitch_yaw, box.vessel.roll_pitch_yaw, rtol=0, atol=1e-10)
+    np.testing.assert_allclose(mesh.probes["B"].position, box.probes["B"].position, rtol=0, atol=1e-10)
+
+
+def test_shape_keys_are_checked(tmp_path):
+    cases = [('shape = "prismatic"\nchamfers = { bottom = [3.0, 1.0] }', "tanks[0].chamfers"),
+             ('shape = "cylinder"\naxis = "w"', "tanks[0].axis"),
+             ('shape = "mesh"\nfile = "nowhere.msh"', "tanks[0].file"),
+             ('axis = "x"', "tanks[0].axis")]
+    for extra, key in cases:
+        path = tmp_path / "s.toml"
+        path.write_text(_scene_text(extra))
+        out = subprocess.run([sys.executable, "-m", "jaxslosh", "check", str(path)], capture_output=True, text=True)
+        assert out.returncode == 2 and key in out.stderr, (extra, out.stderr)
+
+
+def test_ship_with_a_vertical_cylinder_tank_full_and_reduced():
+    """The paper's ship with a vertical cylindrical tank: a run at full order and one on 12 modes
+    agree, and the liquid started at rest in an upright ship stays at rest."""
+    text = _scene_text('shape = "cylinder"\naxis = "z"', mesh="[6, 6, 3]", duration="1.0")
+    full = js.simulate(js.load_scene(text))
+    red = js.simulate(js.load_scene(text + "\n[tanks.reduction]\nmodes = 12\n"))
+    assert full.status == red.status == "ok"
+    roll_full, roll_red = full.vessel.roll_pitch_yaw[:, 0], red.vessel.roll_pitch_yaw[:, 0]
+    assert np.abs(roll_red - roll_full).max() < 0.02 * np.abs(roll_full).max()
+    rest = js.simulate(js.load_scene(text.replace("angular_velocity = [0.1, 0.05, 0.0]",
+                                                  "angular_velocity = [0.0, 0.0, 0.0]")))
+    assert np.abs(rest.vessel.roll_pitch_yaw).max() < 1e-9
