@@ -213,7 +213,10 @@ def _build_shaped(geometry, fill_depth, mesh, rho, c, g, element, sparse) -> Liq
     n = len(nodes)
     pairs = bending = None
     if element != "paper":
-        pairs = _rotation_pairs(*tm.grid) if tm.grid is not None else (np.ones((len(elements), 6), bool), [])
+        keep, pairs = _rotation_pairs(*tm.grid) if tm.grid is not None else (np.ones((len(elements), 6), bool), [])
+        for e0, e1, k in tm.pairs:                 # the shape's extra wall constraints (fem/shapes.py)
+            keep[[e0, e1], 2 * k:2 * k + 2] = False
+        pairs = (keep, list(pairs) + list(tm.pairs))
         bending = surface_jump_pattern(nodes, faces)
     flat = tm.flat.astype(float)
     assemble, parts_of = _assembler(n, elements, faces, element, pairs, bending, flat)

@@ -74,6 +74,7 @@ class TankMesh(NamedTuple):
     depth: float                 # the free surface's height (the fill depth)
     doubled: np.ndarray          # grid indices of nodes doubled by baffles
     flat: np.ndarray             # (E,) bool: elements with two faces on one smooth wall (fem/slip.py)
+    pairs: tuple = ()            # (e0, e1, k): curl rows k of two elements penalised on their difference
 
 
 # ----------------------------------------------------------------------------------------------- checks
@@ -94,15 +95,6 @@ def check_geometry(geo: TankGeometry, fill_depth: float, mesh) -> Optional[tuple
             return "chamfers", f"the bottom and top chamfers ({ch:g} + {th:g} m) are taller than the tank ({H:g} m)"
         if abs(tw - b / 2) <= 1e-12 * b and h > H - th:
             return "fill_depth", "the liquid reaches the ridge where the top chamfers meet"
-        # not released: where a chamfer meets a vertical wall under the liquid, the stabilized element
-        # locks at the kink (a hopper 1.5 x 1.0 m in a 6 m section: first mode 7 % high, a heeled
-        # surface 13 % off level; tests/test_shapes.py). Straight inclined walls (a V, a trapezoid
-        # filled within its chamfers) are exact.
-        kinks = ([ch] if 0 < cw < b / 2 * (1 - 1e-12) else []) + ([H - th] if th > 0 else [])
-        if any(z < h * (1 - 1e-12) for z in kinks):
-            return "chamfers", ("a chamfer that meets a vertical wall below the free surface is not available yet "
-                                "(the liquid element locks at the kink); a V bottom, or a fill within the bottom "
-                                "chamfers, is")
     elif geo.kind == "cylinder":
         if geo.axis not in AXES:
             return "axis", f"must be one of {AXES}, got {geo.axis!r}"
@@ -194,7 +186,10 @@ def tank_mesh(geo: TankGeometry, fill_depth: float, mesh) -> TankMesh:
     else:                                                  # box with baffles, prismatic
         nodes = _prismatic(geo, h, (nx, ny, nz))
         elements = box_elements(nx, ny, nz)
+        pairs = _extra_pairs(geo, h, (nx, ny, nz), nodes)
         nodes, elements, doubled = _baffles(geo, h, (nx, ny, nz), nodes, elements)
+        nodes, elements = _merge_coincident(nodes, elements, (nx + 1) * (ny + 1) * (nz + 1))
+        return _finish(nodes, elements, (nx, ny, nz), h, doubled, pairs)
     nodes, elements = _merge_coincident(nodes, elements, (nx + 1) * (ny + 1) * (nz + 1))
     return _finish(nodes, elements, (nx, ny, nz), h, doubled)
 
@@ -424,9 +419,46 @@ def mesh_counts(geo: TankGeometry, mesh):
     return (nx + 1) * (ny + 1) * (nz + 1), nx * ny * nz
 
 
-def _finish(nodes, elements, grid, depth, doubled) -> TankMesh:
+def _finish(nodes, elements, grid, depth, doubled, pairs=()) -> TankMesh:
     bd = boundary(nodes, elements, depth)
-    return TankMesh(nodes, elements, bd.top_faces, bd.wall_faces, bd.free, bd.frames, grid, depth, doubled, bd.flat)
+    return TankMesh(nodes, elements, bd.top_faces, bd.wall_faces, bd.free, bd.frames, grid, depth, doubled, bd.flat,
+                    tuple(pairs))
+
+
+def _extra_pairs(geo, h, mesh, nodes):
+    """The box scheme's count of constraints, kept (fem/liquid.py `_rotation_pairs`): the one-point
+    divergence and the axial curl leave exactly as many free fields as the box has sloshing modes,
+    so every wall constraint beyond the box's removes a whole mode (a pinned line of nodes inside
+    the liquid locks it: measured, a 5 m tank's first mode went from 2.29 to 3.43 rad/s). Each line
+    of nodes that a shape pins once more than the box does -- the foot of a standing baffle, the kink
+    where a bottom (hopper) chamfer meets the vertical wall -- gets, for each element along it, the
+    curl rows about the line's direction of the two elements across it replaced by their difference
+    (one constraint less), as `_rotation_pairs` does for odd rows. (The kink of a top chamfer needs
+    none: with one there, a spurious mode enters below the first; tests/test_shapes.py.)"""
+    nx, ny, nz = mesh
+    eid = lambda i, j, k: (i * ny + j) * nz + k           # noqa: E731
+    pairs = []
+    for bf in geo.baffles:
+        if bf.mount != "bottom":
+            continue                                   # a hanging plate pins nothing more than it doubles
+        ax = 0 if bf.normal == "x" else 1
+        coords = nodes[: (nx + 1) * (ny + 1) * (nz + 1)].reshape(nx + 1, ny + 1, nz + 1, 3)
+        line = coords[:, 0, 0, 0] if ax == 0 else coords[0, :, 0, 1]
+        p = int(np.argmin(np.abs(line - bf.at)))
+        if ax == 0:
+            pairs += [(eid(p - 1, j, 0), eid(p, j, 0), 1) for j in range(ny)]
+        else:
+            pairs += [(eid(i, p - 1, 0), eid(i, p, 0), 0) for i in range(nx)]
+    if geo.kind == "prismatic":
+        a, b, H = geo.size
+        (cw, ch), (tw, th) = geo.chamfers
+        zs = nodes[: nz + 1, 2]
+        kinks = [ch] if 0 < cw < b / 2 * (1 - 1e-12) and ch < h else []
+        for z in kinks:
+            k = int(np.argmin(np.abs(zs - z)))
+            if 0 < k < nz:
+                pairs += [(eid(i, j, k - 1), eid(i, j, k), 0) for i in range(nx) for j in (0, ny - 1)]
+    return pairs
 
 
 def box_equivalent(geo: TankGeometry, fill_depth: float):

@@ -20,7 +20,7 @@ import numpy as np
 import scipy.sparse as sp
 
 #: wall faces whose normals differ by less than this are one smooth (curved) wall at a node
-FEATURE_ANGLE = 60.0
+FEATURE_ANGLE = 30.0
 #: hex8 faces, outward for a positively oriented element: bottom, top, y-, x+, y+, x-
 HEX_FACES = np.array([[0, 3, 2, 1], [4, 5, 6, 7], [0, 1, 5, 4], [1, 2, 6, 5], [2, 3, 7, 6], [3, 0, 4, 7]])
 

@@ -36,13 +36,6 @@ def read_shape(table, v, where: str, base_dir: str, elastic: bool = False) -> di
         path = v["file"] if os.path.isabs(v["file"]) else os.path.join(base_dir, v["file"])
         if not os.path.isfile(path):
             raise SceneError(f"{where}.file", f"no such file: {path}")
-    if table.get("baffles"):
-        # built (fem/shapes.py doubles the plate's nodes), but not released: a wall node inside the
-        # liquid pins the stabilized element's discrete potential flow, which then locks (a 0.1 m
-        # plate on the bottom of a 5 m tank lifts its first mode by 50 %; tests/test_shapes.py)
-        raise SceneError(f"{where}.baffles", "baffles are not available yet (the liquid element locks at a "
-                                             "plate inside the liquid); model a baffled tank by its "
-                                             "compartments or leave the baffles out")
     baffles = []
     for i, b in enumerate(table.get("baffles", [])):
         bw = f"{where}.baffles[{i}]"
