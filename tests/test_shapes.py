@@ -182,3 +182,11 @@ def test_ship_with_a_vertical_cylinder_tank_full_and_reduced():
     rest = js.simulate(js.load_scene(text.replace("angular_velocity = [0.1, 0.05, 0.0]",
                                                   "angular_velocity = [0.0, 0.0, 0.0]")))
     assert np.abs(rest.vessel.roll_pitch_yaw).max() < 1e-9
+
+
+@pytest.mark.parametrize("name", ["type_c_tank", "lng_carrier"])
+def test_shape_scenes_check(name):
+    out = subprocess.run([sys.executable, "-m", "jaxslosh", "check", os.path.join(ROOT, "scenes", f"{name}.toml")],
+                         capture_output=True, text=True)
+    assert out.returncode == 0, out.stderr
+    assert "warning" not in out.stderr                 # the masses balance the displacement

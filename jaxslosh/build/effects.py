@@ -3,6 +3,7 @@ calls for: the model is assembled from the scene, so an effect the scene lacks, 
 `[effects]`, is never traced) and its unknowns."""
 from __future__ import annotations
 
+from ..fem.shapes import free_count
 from ..fem.walls import shell_mesh
 from ..hydro.source import excitation_source
 from ..scene.types import EFFECTS, Scene
@@ -20,7 +21,7 @@ def describe(scene: Scene) -> str:
     for t in scene.tanks:
         nx, ny, nz = t.mesh
         walls = t.walls if t.wall_spec is None else f"elastic, {t.wall_spec.thickness:g} m thick"
-        lines.append(f"tank {t.name!r}: {t.size[0]:g} x {t.size[1]:g} x {t.size[2]:g} m filled to "
+        lines.append(f"tank {t.name!r}: {shape_words(t)}{t.size[0]:g} x {t.size[1]:g} x {t.size[2]:g} m filled to "
                      f"{t.fill_depth:g} m, liquid {t.liquid_mass:.4g} kg ({t.liquid_volume:.4g} m^3), "
                      f"mesh {nx} x {ny} x {nz} = {nx * ny * nz} hexahedra, walls {walls}")
     for s in scene.structures:
@@ -58,7 +59,7 @@ def scene_effects(scene: Scene) -> list[tuple[str, str]]:
     liquid = bool(scene.tanks) and e.liquid
     if liquid:
         for t in scene.tanks:
-            eff.append((f"liquid in tank {t.name!r}", f"{t.mesh[0]}x{t.mesh[1]}x{t.mesh[2]} hexahedra, "
+            eff.append((f"liquid in tank {t.name!r}", f"{shape_words(t)}{t.mesh[0]}x{t.mesh[1]}x{t.mesh[2]} hexahedra, "
                         f"{t.liquid_mass:.6g} kg, element {t.fluid.element!r}, {t.walls} walls (slip)"))
             if t.damping is not None:
                 d = t.damping
@@ -147,8 +148,27 @@ def switched_off(scene: Scene) -> list[str]:
     return [k for k in EFFECTS if not getattr(scene.effects, k)]
 
 
+def shape_words(t) -> str:
+    """"prismatic (chamfers ...) " and the like for a tank that is not a plain box, else ""."""
+    if t.geometry.plain_box:
+        return ""
+    words = {"box": "box", "prismatic": "prismatic", "cylinder": "cylinder", "mesh": "mesh"}[t.shape]
+    if t.shape == "prismatic":
+        (cw, ch), (tw, th) = t.chamfers
+        words += f" (chamfers bottom {cw:g} x {ch:g} m, top {tw:g} x {th:g} m)"
+    elif t.shape == "cylinder":
+        words += " (vertical)" if t.axis == "z" else f" (horizontal, along {t.axis})"
+    elif t.shape == "mesh":
+        words += f" ({t.file})"
+    if t.baffles:
+        words += f" with {len(t.baffles)} baffle{'s' if len(t.baffles) > 1 else ''}"
+    return words + ", "
+
+
 def free_liquid_dofs(tank) -> int:
     """A tank's free liquid dofs: three per node, less the wall-normal ones the slip walls hold."""
+    if not tank.geometry.plain_box:
+        return free_count(tank.geometry, tank.fill_depth, tuple(tank.mesh))
     nx, ny, nz = tank.mesh
     nodes = (nx + 1) * (ny + 1) * (nz + 1)
     return 3 * nodes - (2 * (ny + 1) * (nz + 1) + 2 * (nx + 1) * (nz + 1) + (nx + 1) * (ny + 1))

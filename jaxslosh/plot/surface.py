@@ -4,10 +4,12 @@ from __future__ import annotations
 
 import numpy as np
 from matplotlib.animation import FuncAnimation, PillowWriter
-from matplotlib.tri import Triangulation
 
+from ..fem.shapes import TankGeometry, outline
+from ..fem.slip import HEX_FACES
 from ..physics.kinematics import rotation_matrix
-from ..scene.load import tomllib
+from ..scene.load import load_scene, tomllib
+from ..scene.types import SceneError
 from .results import figure
 
 
@@ -19,21 +21,23 @@ class _Tanks:
         if not r.tanks:
             raise ValueError("the result holds no liquid fields (run with tanks, without --no-fields)")
         scene = {t["name"]: t for t in tomllib.loads(r.scene_text).get("tanks", [])}
+        try:
+            shapes = {t.name: t for t in load_scene(r.scene_text).tanks}
+        except (SceneError, OSError):       # e.g. a mesh file named relative to a folder left behind
+            shapes = {}
         self.r = r
         self.time = np.asarray(r.time)
         self.tanks = []
         for name, tf in r.tanks.items():
             if name not in scene:
                 raise ValueError(f"the result's scene has no tank named {name!r}")
-            origin, size = np.asarray(scene[name]["origin"], float), np.asarray(scene[name]["size"], float)
+            origin = np.asarray(scene[name]["origin"], float)
+            depth = float(scene[name]["fill_depth"])
+            geo = shapes[name].geometry if name in shapes else TankGeometry(size=tuple(scene[name]["size"]))
             nodes = np.asarray(tf.nodes)
-            s = np.flatnonzero(np.isclose(nodes[:, 2], float(scene[name]["fill_depth"])))
-            tri = Triangulation(nodes[s, 0], nodes[s, 1]).triangles
-            lo, hi = origin, origin + size
-            corners = np.array([[x, y, z] for x in (lo[0], hi[0]) for y in (lo[1], hi[1]) for z in (lo[2], hi[2])])
-            edges = [(a, b) for a in range(8) for b in range(a + 1, 8)
-                     if np.sum(np.abs(corners[a] - corners[b]) > 1e-12) == 1]
-            self.tanks.append((name, origin, nodes[s], s, tri, corners, edges))
+            s, tri = _surface_triangles(nodes, np.asarray(tf.elements), depth)
+            lines = [origin + line for line in outline(geo, depth)]
+            self.tanks.append((name, origin, nodes[s], s, tri, lines))
         self.span = max(float(np.max(scene[name]["size"])) for name in r.tanks) * 0.75
 
     def index(self, t) -> int:
@@ -46,13 +50,13 @@ class _Tanks:
         r = self.r
         A = np.asarray(rotation_matrix(np.asarray(r.vessel.quaternion[i])))
         X0 = np.asarray(r.vessel.position[i])
-        for name, origin, surface, s, tri, corners, edges in self.tanks:
+        for name, origin, surface, s, tri, lines in self.tanks:
             D = np.asarray(r.tanks[name].displacement[i])[s]
             p = X0 + (origin + surface + scale * D) @ A.T
             ax.plot_trisurf(p[:, 0], p[:, 1], p[:, 2], triangles=tri, cmap="Blues", alpha=0.9, linewidth=0.2,
                             edgecolor="k")
-            for a, b in edges:
-                seg = X0 + corners[[a, b]] @ A.T
+            for line in lines:
+                seg = X0 + line @ A.T
                 ax.plot(seg[:, 0], seg[:, 1], seg[:, 2], color="0.3", lw=0.8)
         ax.set_title(f"t = {self.time[i]:.2f} s", fontsize=9)
         ax.set_xlim(X0[0] - self.span, X0[0] + self.span)
@@ -62,6 +66,19 @@ class _Tanks:
         ax.set_xlabel("X (m)")
         ax.set_ylabel("Y (m)")
         ax.set_zlabel("Z (m)")
+
+
+def _surface_triangles(nodes, elements, depth):
+    """(the free surface's node indices, its triangles over them): each element face whose four nodes
+    lie at the fill depth, cut in two (a baffled or U-shaped surface is not bridged, as Delaunay would)."""
+    on = np.isclose(nodes[:, 2], depth)
+    F = elements[:, HEX_FACES].reshape(-1, 4)
+    F = F[on[F].all(axis=1) & (np.array([len(set(f)) for f in F]) == 4)]
+    s = np.unique(F)
+    local = np.full(nodes.shape[0], -1)
+    local[s] = np.arange(s.size)
+    tri = np.concatenate([local[F[:, [0, 1, 2]]], local[F[:, [0, 2, 3]]]])
+    return s, tri
 
 
 def _surface_title(scale: float) -> str:
