@@ -151,7 +151,8 @@ def test_box_given_as_a_gmsh_file_runs_as_the_box(tmp_path):
     inv = np.argsort(perm)
     meshio.write(str(path), meshio.Mesh(nodes[perm], [("hexahedron", inv[elements])]), file_format="gmsh22")
     box = js.simulate(js.load_scene(_scene_text("")))
-    scene = _scene_text(f'shape = "mesh"\nfile = "{path}"')
+    # SPEC section 5: a mesh tank gives neither fill_depth nor mesh (its file does)
+    scene = _scene_text(f'shape = "mesh"\nfile = "{path}"').replace("fill_depth = 3.0\n", "").replace("mesh = [5, 5, 5]\n", "")
     mesh = js.simulate(js.load_scene(scene))
     assert box.status == mesh.status == "ok"
     np.testing.assert_allclose(mesh.vessel.roll_pitch_yaw, box.vessel.roll_pitch_yaw, rtol=0, atol=1e-10)
@@ -160,12 +161,20 @@ def test_box_given_as_a_gmsh_file_runs_as_the_box(tmp_path):
 
 def test_shape_keys_are_checked(tmp_path):
     cases = [('shape = "prismatic"\nchamfers = { bottom = [3.0, 1.0] }', "tanks[0].chamfers"),
+             ('shape = "prismatic"\nchamfers = [[1.0, 1.0], [1.0]]', "tanks[0].chamfers[1]"),
+             ('shape = "cylinder"\naxis = "z"', "tanks[0].size"),         # 5 x 4 across: not a circle
+             ('[[tanks.baffles]]\nposition = 6.0\nheight = 1.0', "tanks[0].baffles[0].position"),
+             ('[[tanks.baffles]]\nposition = 2.0\nfrom = "top"\nheight = 3.5', "tanks[0].baffles[0].height"),
+             ('shape = "mesh"\nfile = "x.msh"', "tanks[0].mesh"),
              ('shape = "cylinder"\naxis = "w"', "tanks[0].axis"),
              ('shape = "mesh"\nfile = "nowhere.msh"', "tanks[0].file"),
              ('axis = "x"', "tanks[0].axis")]
     for extra, key in cases:
         path = tmp_path / "s.toml"
-        path.write_text(_scene_text(extra))
+        text = _scene_text(extra, size="[5.0, 4.0, 4.0]")
+        if "nowhere" in extra:
+            text = text.replace("fill_depth = 3.0\n", "").replace("mesh = [5, 5, 5]\n", "")
+        path.write_text(text)
         out = subprocess.run([sys.executable, "-m", "jaxslosh", "check", str(path)], capture_output=True, text=True)
         assert out.returncode == 2 and key in out.stderr, (extra, out.stderr)
 

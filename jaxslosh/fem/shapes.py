@@ -110,10 +110,10 @@ def check_geometry(geo: TankGeometry, fill_depth: float, mesh) -> Optional[tuple
         if bf.normal not in ("x", "y"):
             return f"{where}.normal", f'must be "x" or "y" (the plate stands across that axis), got {bf.normal!r}'
         if bf.mount not in ("bottom", "top"):
-            return f"{where}.mount", f'must be "bottom" or "top", got {bf.mount!r}'
+            return f"{where}.from", f'must be "bottom" or "top", got {bf.mount!r}'
         ext = a if bf.normal == "x" else b
         if not 0 < bf.at < ext:
-            return f"{where}.at", f"must lie inside the tank (0 < at < {ext:g} m along {bf.normal}), got {bf.at:g}"
+            return f"{where}.position", f"must lie inside the tank (0 < position < {ext:g} m along {bf.normal}), got {bf.at:g}"
         if geo.kind == "prismatic" and bf.normal == "y":
             return f"{where}.normal", "a prismatic tank's baffles stand across its length (normal = \"x\")"
         if not 0 < bf.height <= H:
@@ -388,6 +388,12 @@ def read_mesh(path):
     if np.any(np.abs(vol) <= 1e-14 * np.abs(vol).max()):
         raise ValueError(f"the mesh file {path!r} has degenerate hexahedra (zero volume)")
     return nodes, elements
+
+
+def grid_counts(nodes, elements):
+    """(nx, ny, nz) if the mesh is a box grid, else None."""
+    g = _as_grid(nodes, elements)
+    return None if g is None else tuple(int(d) for d in g[2])
 
 
 def _as_grid(nodes, elements):

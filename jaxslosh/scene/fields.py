@@ -193,7 +193,8 @@ def numbers(name: str, x):
 
 
 _CONVERT = {"bool": _bool, "float": _float, "int": _int, "str": _str, "vec3": _vec3, "mesh": _mesh, "inertia": _inertia,
-            "table": _table, "tables": _tables, "str_or_table": _str_or_table, "numbers": numbers}
+            "table": _table, "tables": _tables, "str_or_table": _str_or_table, "numbers": numbers,
+            "any": lambda name, x: x}          # checked by the caller
 
 
 def _is_number(x) -> bool:

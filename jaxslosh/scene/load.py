@@ -39,7 +39,7 @@ from .fields import (
     sizes,
     valid_name,
 )
-from .shape import read_shape
+from .shape import fill_and_mesh, read_shape
 from .types import (
     DOFS,
     EFFECTS,
@@ -337,9 +337,10 @@ def _tank(table, where: str, base_dir: str = "") -> Tank:
         "name": ("str", valid_name), "origin": ("vec3", None), "size": ("vec3", sizes),
         "fill_depth": ("float", None), "mesh": ("mesh", counts), "walls": ("str_or_table", None),
         "fluid": ("table", None), "reduction": ("table", None), "damping": ("table", None),
-        "shape": ("str", one_of(SHAPES)), "chamfers": ("table", None), "axis": ("str", one_of(AXES)),
+        "shape": ("str", one_of(SHAPES)), "chamfers": ("any", None), "axis": ("str", one_of(AXES)),
         "file": ("str", None), "baffles": ("tables", None),
-    }, required=("name", "origin", "size", "fill_depth", "mesh"))
+    }, required=("name", "origin", "size"))
+    fill_and_mesh(table, v, where, base_dir)
     # SPEC writes `walls = "elastic"` and a `[tanks.walls]` table, but TOML cannot hold both under
     # one key: `walls` is either the string "rigid" or the table, which makes the walls elastic.
     raw_walls = table.get("walls", "rigid")
