@@ -199,3 +199,62 @@ def test_shape_scenes_check(name):
                          capture_output=True, text=True)
     assert out.returncode == 0, out.stderr
     assert "warning" not in out.stderr                 # the masses balance the displacement
+
+
+def test_horizontal_cylinder_longitudinal_mode_against_the_box():
+    """A check: the lowest longitudinal mode of a half-full horizontal cylinder (R = 1.5 m, 6 m long)
+    against the box of the same free surface and volume (6 m long, its depth the mean, pi R / 4)."""
+    geo = TankGeometry(kind="cylinder", size=(6.0, 3.0, 3.0), axis="x")
+    _, md = modes(geo, 1.5, (8, 12, 6), n=2)
+    box = ref.rectangular_omegas(6.0, np.pi * 1.5 / 4, G, n=1)[0]
+    assert abs(md.omega[0] / box - 1) < 0.01
+
+
+def test_wall_integrals_on_faces_equal_the_box_planes():
+    """The boundary-layer damping's wall integral over any mesh's wall faces (fem/damping.py) equals
+    the box's plane-by-plane one on the same box grid."""
+    from jaxslosh.fem.damping import wall_integrals
+    box = build_liquid((5.0, 4.0, 3.0), 2.0, (6, 4, 4), 1000.0, 1500.0, G)
+    same = build_liquid((5.0, 4.0, 3.0), 2.0, (6, 4, 4), 1000.0, 1500.0, G,
+                        geometry=TankGeometry(kind="prismatic", size=(5.0, 4.0, 3.0)))
+    assert same.wall_faces is not None and box.wall_faces is None
+    X = liquid_modes(box, 3).shapes[:, np.flatnonzero(box.free)].T
+    np.testing.assert_allclose(wall_integrals(same, X), wall_integrals(box, X), rtol=1e-10)
+
+
+def test_box_written_by_gmsh_runs_as_the_box(tmp_path):
+    """A box meshed by gmsh itself (transfinite, recombined into hexahedra, gmsh's own .msh 4.1)."""
+    gmsh = pytest.importorskip("gmsh")
+    path = str(tmp_path / "tank.msh")
+    gmsh.initialize()
+    try:
+        gmsh.option.setNumber("General.Terminal", 0)
+        gmsh.model.add("tank")
+        gmsh.model.occ.addBox(0.0, 0.0, 0.0, 5.0, 5.0, 3.0)
+        gmsh.model.occ.synchronize()
+        for _, c in gmsh.model.getEntities(1):
+            gmsh.model.mesh.setTransfiniteCurve(c, 6)
+        for _, s in gmsh.model.getEntities(2):
+            gmsh.model.mesh.setTransfiniteSurface(s)
+            gmsh.model.mesh.setRecombine(2, s)
+        for _, v in gmsh.model.getEntities(3):
+            gmsh.model.mesh.setTransfiniteVolume(v)
+        gmsh.model.mesh.generate(3)
+        gmsh.write(path)
+    finally:
+        gmsh.finalize()
+    geo = TankGeometry(kind="mesh", size=(5.0, 5.0, 4.0), file=path)
+    m = build_liquid(geo.size, 3.0, (5, 5, 5), 1000.0, 1500.0, G, geometry=geo)
+    box = build_liquid((5.0, 5.0, 4.0), 3.0, (5, 5, 5), 1000.0, 1500.0, G)
+    assert m.geometry is None                  # recognised as the box grid, built as the box
+    np.testing.assert_allclose(np.asarray(m.stiffness), np.asarray(box.stiffness), rtol=0, atol=1e-6)
+
+
+def test_shaped_tank_sparse_solver_agrees_with_dense():
+    """Full order through SciPy's sparse LU (the box's fast diagonalization needs the box grid)."""
+    text = _scene_text('shape = "cylinder"\naxis = "z"', mesh="[6, 6, 3]", duration="0.2")
+    dense = js.simulate(js.load_scene(text.replace("save_every = 1", 'save_every = 1\nlinear_solver = "dense"')))
+    sparse = js.simulate(js.load_scene(text.replace("save_every = 1", 'save_every = 1\nlinear_solver = "sparse"')))
+    assert dense.status == sparse.status == "ok"
+    np.testing.assert_allclose(sparse.vessel.roll_pitch_yaw, dense.vessel.roll_pitch_yaw, rtol=0, atol=1e-9)
+    np.testing.assert_allclose(sparse.probes["B"].position, dense.probes["B"].position, rtol=0, atol=1e-8)
