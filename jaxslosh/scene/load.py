@@ -26,6 +26,7 @@ except ModuleNotFoundError:  # Python 3.10
     import tomli as tomllib  # type: ignore[no-redef]
 
 from ..fem.mesh import box_mesh, face_nodes
+from .campaign import read_campaign
 from .fields import (at_least, counts, non_negative, one_of, poisson_ratio, positive, read, show, sizes,
                      valid_name)
 from .types import (DOFS, EFFECTS, ELEMENT_FORMS, FACES, Damping, Effects, Environment, Forced, Fluid, Hydrostatics,
@@ -84,6 +85,7 @@ def parse_scene(mapping: Mapping[str, Any], text: str = "", path: str = "") -> S
         "title": ("str", None), "environment": ("table", None), "simulation": ("table", None),
         "vessel": ("table", None), "tanks": ("tables", None), "structures": ("tables", None),
         "probes": ("tables", None), "effects": ("table", None), "waves": ("table", None),
+        "campaign": ("table", None),
     }, required=("simulation", "vessel"))
     warnings: list[str] = []
     title = top.get("title", Path(path).stem if path else "")
@@ -109,9 +111,12 @@ def parse_scene(mapping: Mapping[str, Any], text: str = "", path: str = "") -> S
     waves = None
     if "waves" in mapping:   # incident waves (waves.py)
         waves = read_waves(mapping["waves"], warnings)
+    campaign = None
+    if "campaign" in mapping:   # a campaign's limits and defaults (campaign.py)
+        campaign = read_campaign(mapping["campaign"], probes, waves, simulation.dt, warnings)
     scene = Scene(title=title, environment=environment, simulation=simulation, vessel=vessel, tanks=tanks,
                   structures=structures, probes=probes, effects=effects, text=text, path=path,
-                  warnings=tuple(warnings), waves=waves)
+                  warnings=tuple(warnings), waves=waves, campaign=campaign)
     if waves is not None or vessel.hull is not None or vessel.hydrodynamics is not None:
         scene = check_waves(scene, path, warnings)
         scene = dataclasses.replace(scene, warnings=tuple(warnings))
