@@ -77,6 +77,9 @@ def scene_text() -> str:
     old = "viscous_damping = [0.0, 0.0, 0.0, 4.0e5, 0.0, 0.0]"
     assert old in text, "scenes/paper_ship_waves.toml's viscous_damping changed: update this benchmark"
     text = text.replace(old, f"viscous_damping = [0.0, 0.0, 0.0, 4.0e5, 0.0, {YAW_DAMPING:.1e}]", 1)
+    title = next(ln for ln in text.splitlines() if ln.startswith("title ="))
+    text = text.replace(title, 'title = "benchmarks/campaign.py: the paper ship, its tank on 20 modes, Froude-Krylov '
+                               'forces, yaw damping"', 1)
     return text + "\n[tanks.reduction]\nmodes = 20\nstatic_correction = false\n" + CAMPAIGN_TABLE
 
 

@@ -44,8 +44,9 @@ def read_campaign(table, probes: tuple[Probe, ...], waves: Waves | None, simulat
                                               f"(simulation.dt = {show(simulation_dt)} s)")
     irregular = waves is not None and waves.type != "regular"
     if duration is not None and irregular and duration <= waves.ramp:
-        raise SceneError(f"{where}.duration", f"{show(duration)} s ends before waves.ramp = {show(waves.ramp)} s "
-                                              f"does: a campaign's statistics are over the frames after the ramp")
+        raise SceneError(f"{where}.duration", f"{show(duration)} s is not longer than waves.ramp = "
+                                              f"{show(waves.ramp)} s: a campaign's statistics are over the frames "
+                                              f"after the ramp")
     if not irregular:
         warnings.append('campaign: the [campaign] table is for `jaxslosh campaign`, whose template is an irregular '
                         '[waves] table (type = "jonswap" or "pierson-moskowitz"); this scene has none, and '
