@@ -72,7 +72,8 @@ PROJECT_CELLS, PROJECT_HOURS, PROJECT_CORES = 300, 3.0, 100
 
 
 def scene_text() -> str:
-    text = open(os.path.join(ROOT, "scenes", "paper_ship_waves.toml")).read()
+    with open(os.path.join(ROOT, "scenes", "paper_ship_waves.toml")) as f:
+        text = f.read()
     text = text.replace("[vessel.hydrodynamics]\n", '[vessel.hydrodynamics]\nexcitation = "froude-krylov"\n', 1)
     old = "viscous_damping = [0.0, 0.0, 0.0, 4.0e5, 0.0, 0.0]"
     assert old in text, "scenes/paper_ship_waves.toml's viscous_damping changed: update this benchmark"
@@ -160,9 +161,11 @@ def main(argv=None):
           f"{load[1]:.2f} {load[2]:.2f}", file=sys.stderr)
     with tempfile.TemporaryDirectory() as d:
         scene_path = os.path.join(d, "ship.toml")
-        open(scene_path, "w").write(scene_text())
+        with open(scene_path, "w") as f:
+            f.write(scene_text())
         csv_path = os.path.join(d, "scatter.csv")
-        open(csv_path, "w").write(scatter_csv(a.cells))
+        with open(csv_path, "w") as f:
+            f.write(scatter_csv(a.cells))
         scene = js.load_scene(scene_path)
         n = a.cells * heads.size * a.seeds
         print(f"{n} cases: {a.cells} sea states x {heads.size} headings x {a.seeds} seeds, {a.duration:g} s each "
