@@ -121,6 +121,11 @@ def run_serial_child(scene_path, csv_path, heads, a, indices, d):
         return wall, json.load(f)
 
 
+def _load() -> str:
+    """The machine's load averages (1, 5, 15 min): other jobs on the same cores slow every row."""
+    return "load average " + " ".join(f"{x:.2f}" for x in os.getloadavg())
+
+
 def check_file(path, n):
     c = load_campaign(path)
     st = np.array(c.status)
@@ -156,9 +161,7 @@ def main(argv=None):
     os.environ["PYTHONPATH"] = os.pathsep.join([ROOT, os.environ.get("PYTHONPATH", "")])
     heads = np.linspace(0.0, np.pi, a.headings) if a.headings > 1 else np.array([np.pi / 2])
     batches = [int(b) for b in a.batch.split(",")]
-    load = os.getloadavg()
-    print(f"{time.strftime('%Y-%m-%d %H:%M %Z')}, {os.cpu_count()} cores, load average {load[0]:.2f} "
-          f"{load[1]:.2f} {load[2]:.2f}", file=sys.stderr)
+    print(f"{time.strftime('%Y-%m-%d %H:%M %Z')}, {os.cpu_count()} cores, {_load()}", file=sys.stderr)
     with tempfile.TemporaryDirectory() as d:
         scene_path = os.path.join(d, "ship.toml")
         with open(scene_path, "w") as f:
@@ -179,7 +182,7 @@ def main(argv=None):
                             batch=b, output=out, progress=False)
             wall = time.perf_counter() - t0
             results[b] = r
-            print(f"cluster, batch {b}: {wall:.1f} s, {r.failed} of {n} cases failed" +
+            print(f"cluster, batch {b}: {wall:.1f} s, {r.failed} of {n} cases failed; {_load()}" +
                   "".join(f"\n  case {i}: {st}" for i, st in enumerate(r.status) if st != "ok"), file=sys.stderr)
             check_file(out, n)
             rows.append((f"Dask LocalCluster, {a.workers} workers, --batch {b}", a.workers, wall, n))
@@ -200,7 +203,8 @@ def main(argv=None):
                     worst = max(worst, abs(x - y) / max(abs(y), 1e-300))
             sub = "all cases" if len(indices) == n else f"{len(indices)} of the {n} cases, evenly spaced"
             rows.append((f"one by one, one process, 1 core ({sub})", 1, wall, len(indices)))
-            print(f"one by one: first case (compilation and run) {s['first']:.1f} s; {bad} failed; largest relative "
+            print(f"one by one: {wall:.1f} s, first case (compilation and run) {s['first']:.1f} s; {_load()}; {bad} "
+                  f"failed; largest relative "
                   f"difference of a channel's std against the cluster (--batch {batches[0]}): {worst:.2g}",
                   file=sys.stderr)
     print(f"{'':62} {'cores':>5} {'cases':>6} {'wall s':>8} {'cases/core-hour':>16}")
