@@ -38,6 +38,7 @@ one instead of all. No assertion.
 """
 import argparse
 import json
+import math
 import os
 import subprocess
 import sys
@@ -173,7 +174,7 @@ def main(argv=None):
         n = a.cells * heads.size * a.seeds
         print(f"{n} cases: {a.cells} sea states x {heads.size} headings x {a.seeds} seeds, {a.duration:g} s each "
               f"(dt {scene.simulation.dt:g} s, {a.duration / scene.simulation.dt:.0f} steps)", file=sys.stderr)
-        rows, results = [], {}
+        rows, results, compile_s = [], {}, None
         for b in batches:
             out = (os.path.join(d, f"c_b{b}.h5") if not a.output else a.output if len(batches) == 1
                    else f"{os.path.splitext(a.output)[0]}_b{b}.h5")
@@ -185,7 +186,7 @@ def main(argv=None):
             print(f"cluster, batch {b}: {wall:.1f} s, {r.failed} of {n} cases failed; {_load()}" +
                   "".join(f"\n  case {i}: {st}" for i, st in enumerate(r.status) if st != "ok"), file=sys.stderr)
             check_file(out, n)
-            rows.append((f"Dask LocalCluster, {a.workers} workers, --batch {b}", a.workers, wall, n))
+            rows.append((f"Dask LocalCluster, {a.workers} workers, --batch {b}", a.workers, wall, n, b))
         if not a.skip_serial:
             k = n if a.serial_cases is None else max(1, min(n, a.serial_cases))
             indices = sorted({int(i) for i in np.linspace(0, n - 1, k).round()})
@@ -202,14 +203,15 @@ def main(argv=None):
                     y = r.statistics[ch]["std"][i]
                     worst = max(worst, abs(x - y) / max(abs(y), 1e-300))
             sub = "all cases" if len(indices) == n else f"{len(indices)} of the {n} cases, evenly spaced"
-            rows.append((f"one by one, one process, 1 core ({sub})", 1, wall, len(indices)))
+            rows.append((f"one by one, one process, 1 core ({sub})", 1, wall, len(indices), 1))
+            compile_s = s["first"] - (wall - s["first"]) / max(1, len(indices) - 1)
             print(f"one by one: {wall:.1f} s, first case (compilation and run) {s['first']:.1f} s; {_load()}; {bad} "
                   f"failed; largest relative "
                   f"difference of a channel's std against the cluster (--batch {batches[0]}): {worst:.2g}",
                   file=sys.stderr)
     print(f"{'':62} {'cores':>5} {'cases':>6} {'wall s':>8} {'cases/core-hour':>16}")
     rates = []
-    for name, cores, wall, cases in rows:
+    for name, cores, wall, cases, _ in rows:
         rates.append(cases / (wall * cores / 3600.0))
         print(f"{name:62} {cores:5d} {cases:6d} {wall:8.1f} {rates[-1]:16.0f}")
     if len(rows) > len(batches):
@@ -218,10 +220,18 @@ def main(argv=None):
                   f"speed-up per case: {rows[-1][2] / rows[-1][3] / (rows[batches.index(b)][2] / n):.2f}")
     sim = PROJECT_HOURS * 3600.0
     print(f"projection, {PROJECT_CELLS} cells x {PROJECT_HOURS:g} h sea states ({sim / scene.simulation.dt:.0f} "
-          f"steps each) on {PROJECT_CORES} cores, at each row's rate (cases of {a.duration:g} s):")
-    for (name, *_), rate in zip(rows, rates):
-        core_hours = PROJECT_CELLS * (sim / a.duration) / rate
-        print(f"  {name:60} {core_hours:7.1f} core-hours, {60 * core_hours / PROJECT_CORES:6.1f} min wall")
+          f"steps each) on {PROJECT_CORES} cores at each row's rate (its {a.duration:g} s cases, compilation "
+          f"amortised as measured); batches of a row's size go out whole, so rounds = ceil(ceil(cells / batch) / "
+          f"cores) and wall = rounds x batch x the core time of a case:")
+    for (name, *_, b), rate in zip(rows, rates):
+        case_s = 3600.0 / rate * (sim / a.duration)          # core-seconds per 3-hour case
+        core_hours = PROJECT_CELLS * case_s / 3600.0
+        rounds = math.ceil(math.ceil(PROJECT_CELLS / b) / PROJECT_CORES)
+        print(f"  {name:60} {core_hours:6.1f} core-hours, {rounds} round(s) of batches of {b}: "
+              f"{rounds * b * case_s / 60:5.1f} min wall")
+    if compile_s is not None:
+        print(f"  plus each worker's compilation at the start, about {compile_s:.0f} s (the one-by-one row's first "
+              f"case less a case's time)")
 
 
 if __name__ == "__main__":
