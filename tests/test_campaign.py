@@ -315,6 +315,113 @@ def test_bad_campaign_input_exits_2(tmp_path, capsys):
 
 
 # --------------------------------------------------------------------------------------------
+# the scene's [campaign] table
+
+TABLE = f"""
+[campaign]
+headings = [1.2, {BEAM!r}]
+seeds = 1
+[campaign.limits]
+roll = {{roll}}
+heave = 0.35
+"""
+
+
+def test_scene_limits_give_the_operability_of_the_same_limits_on_the_command_line(env, capsys):
+    """A scene whose [campaign] table holds limits, headings and seeds, run with no options, against
+    the plain scene with the same limits, headings and seeds on the command line: the same cases,
+    statistics, exceedance and operability, printed and in the file."""
+    p, s = files(env)
+    roll = 0.1                         # the largest roll of the cases: 0.05 to 0.13 rad, heave 0.15 to 0.44 m
+    q = env / "box_limits.toml"
+    q.write_text(scene_text() + TABLE.format(roll=roll))
+    common = ["--workers", "1", "--batch", "3", "--no-progress"]
+    assert main(["campaign", str(q), "--scatter", str(s), "-o", str(env / "scene.h5")] + common) == 0
+    from_scene = capsys.readouterr().out
+    assert main(["campaign", str(p), "--scatter", str(s), "-o", str(env / "cli.h5"), "--headings", f"1.2,{BEAM}",
+                 "--seeds", "1", "--limits", f"roll={roll},heave=0.35"] + common) == 0
+    from_cli = capsys.readouterr().out
+    def table(out):
+        return [ln for ln in out.splitlines() if not ln.startswith("done:")]
+    assert table(from_scene) == table(from_cli) and "operability" in from_scene
+    a, b = load_campaign(str(env / "scene.h5")), load_campaign(str(env / "cli.h5"))
+    assert a.status == ["ok"] * 6 and b.status == ["ok"] * 6
+    for k in ("hs", "tp", "heading", "seed", "weight"):
+        np.testing.assert_array_equal(a.cases[k], b.cases[k])
+    np.testing.assert_array_equal(a.statistics["roll"]["max"], b.statistics["roll"]["max"])
+    assert a.attrs["limits"] == b.attrs["limits"] and a.attrs["exceedance"] == b.attrs["exceedance"]
+    assert a.attrs["operability"] == b.attrs["operability"]
+    np.testing.assert_allclose(a.attrs["operability"], 55.0, rtol=1e-12)    # cases 0-2: within both limits
+
+
+def test_the_command_line_wins_over_the_scene():
+    from jaxslosh.campaign.run import settings
+    scene = js.load_scene(scene_text() + TABLE.format(roll=0.1))
+    base = settings(scene)
+    assert base == ([1.2, BEAM], 1, None, {"roll": 0.1, "heave": 0.35})
+    # given limits replace the table's as a whole; {} is none
+    assert settings(scene, [0.0], 3, 50.0, {"pitch": 0.2}) == ([0.0], 3, 50.0, {"pitch": 0.2})
+    assert settings(scene, limits={}).limits == {}
+    plain = settings(js.load_scene(scene_text()))
+    assert plain == (None, 1, None, {})
+    timed = js.load_scene(scene_text() + "[campaign]\nduration = 40.0\n")
+    assert settings(timed).duration == 40.0 and settings(timed, duration=30.0).duration == 30.0
+
+
+@pytest.mark.parametrize("table, key", [
+    ("[campaign.limits]\nroll = -0.1\n", "campaign.limits.roll"),
+    ("[campaign.limits]\nroll = 0.0\n", "campaign.limits.roll"),
+    ('[campaign.limits]\nroll = "a"\n', "campaign.limits.roll"),
+    ("[campaign.limits]\nyaw = 0.1\n", "campaign.limits.yaw"),
+    ("[campaign.limits]\nprobe.C = 0.1\n", "campaign.limits.probe.C"),
+    ("[campaign]\nlimits = 0.1\n", "campaign.limits"),
+    ("[campaign]\nseeds = 0\n", "campaign.seeds"),
+    ("[campaign]\nseeds = 1.5\n", "campaign.seeds"),
+    ('[campaign]\nheadings = "beam"\n', "campaign.headings"),
+    ("[campaign]\nheadings = []\n", "campaign.headings"),
+    ("[campaign]\nduration = -600.0\n", "campaign.duration"),
+    ("[campaign]\nduration = 5.0\n", "campaign.duration"),        # before waves.ramp
+    ("[campaign]\nlimit = {roll = 0.1}\n", "campaign.limit"),
+])
+def test_a_bad_campaign_table_is_refused_naming_the_key(tmp_path, capsys, table, key):
+    p, s = files(tmp_path)
+    p.write_text(scene_text() + table)
+    with pytest.raises(js.SceneError) as e:
+        js.load_scene(str(p))
+    assert e.value.key == key
+    for argv in (["check", str(p)], ["campaign", str(p), "--scatter", str(s), "-o", str(tmp_path / "c.h5")]):
+        assert main(argv) == 2
+        err = capsys.readouterr().err.strip()
+        assert err.startswith(f"{key}: ") or f" {key}: " in err, err
+        assert len(err.splitlines()) == 1
+    assert not (tmp_path / "c.h5").exists()
+
+
+def test_campaign_table_forms_and_registry():
+    """probe.B as a dotted or a quoted key; the limits and duration in the key registry, not
+    traceable; a campaign table changes no run (identify's scene comparison passes over it)."""
+    from jaxslosh.scene.compare import differences
+    from jaxslosh.scene.keys import scene_values, traceable
+    probes = '[[probes]]\nname = "B"\ntank = "t"\npoint = [1.0, 1.0, 0.5]\n'
+    tank = '[[tanks]]\nname = "t"\norigin = [-1.0, -1.0, 0.0]\nsize = [2.0, 2.0, 1.0]\nfill_depth = 0.5\nmesh = [1, 1, 1]\n'
+    plain = scene_text() + tank + probes
+    for form in ("probe.B = 0.5", '"probe.B" = 0.5', "probe = {B = 0.5}"):
+        scene = js.load_scene(plain + f"[campaign]\nduration = 40.0\n[campaign.limits]\n{form}\n")
+        assert scene.campaign.limits == (("probe.B", 0.5),)
+        values = scene_values(scene)
+        assert values["campaign.limits.probe.B"] == 0.5 and values["campaign.duration"] == 40.0
+    with pytest.raises(js.SceneError, match="campaign.limits.probe.B: is given twice"):
+        js.load_scene(plain + '[campaign.limits]\n"probe.B" = 0.5\nprobe.B = 0.6\n')
+    with pytest.raises(js.SceneError, match="cannot be traced"):
+        traceable(scene, ["campaign.limits.probe.B"])
+    assert differences(scene, js.load_scene(plain)) == []
+    # a regular sea: the table loads, with a warning that a campaign needs an irregular one
+    regular = scene_text().split("[waves]")[0] + '[waves]\ntype = "regular"\namplitude = 0.5\nperiod = 7.0\n'
+    scene = js.load_scene(regular + "[campaign.limits]\nroll = 0.1\n")
+    assert any(w.startswith("campaign:") for w in scene.warnings)
+
+
+# --------------------------------------------------------------------------------------------
 # the figure
 
 

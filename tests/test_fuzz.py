@@ -260,7 +260,8 @@ KNOWN_KEYS = {
     "displaced_volume", "gm_t", "gm_l", "moment", "position", "velocity", "angular_velocity", "roll_pitch_yaw",
     "dof", "amplitude", "frequency", "ramp", "name", "origin", "size", "fill_depth", "mesh", "walls", "fluid",
     "density", "sound_speed", "element", "thickness", "material", "young", "poisson", "attach", "tank",
-    "structure", "point", "buoyancy", "liquid", "coriolis", "centrifugal", "gravity_turning"}
+    "structure", "point", "buoyancy", "liquid", "coriolis", "centrifugal", "gravity_turning", "campaign", "limits",
+    "headings", "seeds"}
 TABLES = ["", "environment", "simulation", "vessel", "vessel.hydrostatics", "vessel.initial", "tanks[0]",
           "tanks[0].fluid", "probes[0]"]
 

@@ -19,7 +19,8 @@ from ..io.campaign import PENDING, create_campaign, load_campaign, write_cases, 
 from ..io.output import OutputLock
 from ..run.progress import Progress, wanted
 from ..scene.load import load_scene
-from ..scene.types import Scene, SceneError
+from ..scene.campaign import channels
+from ..scene.types import CampaignTable, Scene, SceneError
 from .cases import Cases, Scatter, case_scene, case_values, make_cases, read_scatter
 from .stats import STATISTICS, frequencies, operability
 from .worker import run_batch
@@ -49,7 +50,28 @@ class CampaignResult(NamedTuple):
 
 
 def channel_names(scene: Scene) -> list:
-    return ["roll", "pitch", "heave"] + [f"probe.{p.name}" for p in scene.probes]
+    return channels(scene.probes)
+
+
+class Settings(NamedTuple):
+    """A campaign's headings (rad; None: the template's), seeds, duration (None: the scene's) and
+    limits: the arguments given, else the scene's `[campaign]` table, else the defaults."""
+    headings: list | None
+    seeds: int
+    duration: float | None
+    limits: dict
+
+
+def settings(template: Scene, headings=None, seeds=None, duration=None, limits=None) -> Settings:
+    """What a campaign of `template` runs with: each argument that is not None wins over the scene's
+    `[campaign]` table (limits as a whole: given limits replace the scene's, {} means none)."""
+    table = template.campaign or CampaignTable()
+    if headings is None and table.headings is not None:
+        headings = list(table.headings)
+    return Settings(None if headings is None else [float(h) for h in np.atleast_1d(headings)],
+                    int(seeds if seeds is not None else table.seeds if table.seeds is not None else 1),
+                    duration if duration is not None else table.duration,
+                    dict(limits) if limits is not None else table.limit_map)
 
 
 def _frequency_grid(scene: Scene) -> np.ndarray:
@@ -82,16 +104,20 @@ def _check_limits(limits, chans) -> dict:
     return out
 
 
-def campaign(scene, scatter, headings=None, seeds: int = 1, duration: Optional[float] = None, client=None, *,
+def campaign(scene, scatter, headings=None, seeds: int | None = None, duration: Optional[float] = None,
+             client=None, *,
              output: Optional[str] = None, limits: Optional[dict] = None, resume: bool = False,
              workers: int = 2, batch: int = BATCH, progress: Optional[bool] = None,
              cache_dir: Optional[str] = None) -> CampaignResult:
     """Run the scene (its `[waves]` table the template) for every scatter cell x heading x seed on
     Dask. `scatter`: a CSV path or text (read_scatter) or a Scatter; `headings` (rad, default the
     template's); `seeds` per cell and heading (the template's `waves.seed` + 0 .. seeds - 1);
-    `duration` replaces the scene's. `client`: a dask.distributed Client, else a LocalCluster of
-    `workers` processes is started and closed here. `output`: the campaign file (written as
-    batches finish, locked against a second writer); `resume`: keep its "ok" cases. `cache_dir`:
+    `duration` replaces the scene's; `limits` {channel: limit} (rad for roll and pitch, m). Left out
+    (None), `headings`, `seeds`, `duration` and `limits` are the scene's `[campaign]` table's where
+    it gives them (given limits replace the table's as a whole; {}: none). `client`: a
+    dask.distributed Client, else a LocalCluster of `workers` processes is started and closed here.
+    `output`: the campaign file (written as batches finish, locked against a second writer);
+    `resume`: keep its "ok" cases. `cache_dir`:
     the workers' persistent compilation cache (default: this process's, jax_compilation_cache_dir)."""
     t_start = time.perf_counter()
     template = load_scene(scene) if isinstance(scene, (str, os.PathLike)) else scene
@@ -102,10 +128,11 @@ def campaign(scene, scatter, headings=None, seeds: int = 1, duration: Optional[f
         raise CampaignError("the scene has no TOML text (a campaign's cases are written as scene files): "
                             "load it with js.load_scene")
     sc = scatter if isinstance(scatter, Scatter) else read_scatter(scatter)
-    heads = [template.waves.heading] if headings is None else [float(h) for h in np.atleast_1d(headings)]
-    if int(seeds) < 1:
+    headings, seeds, duration, limits = settings(template, headings, seeds, duration, limits)
+    heads = [template.waves.heading] if headings is None else headings
+    if seeds < 1:
         raise CampaignError(f"--seeds: must be at least 1, got {seeds}")
-    cases = make_cases(sc, heads, int(seeds), template.waves.seed)
+    cases = make_cases(sc, heads, seeds, template.waves.seed)
     scenes = []
     for i in range(cases.n):               # every case checked as its scene file would be, before running
         v = case_values(cases, i)

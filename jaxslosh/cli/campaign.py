@@ -1,5 +1,6 @@
 """`jaxslosh campaign`: the scene's sea template over a scatter of sea states x headings x seeds on
-Dask (campaign/), statistics written to a campaign file as cases finish."""
+Dask (campaign/), statistics written to a campaign file as cases finish. The options left out come
+from the scene's `[campaign]` table (scene/campaign.py); the command line wins."""
 from __future__ import annotations
 
 import math
@@ -20,10 +21,13 @@ def add_parsers(sub):
     s.add_argument("scene")
     s.add_argument("--scatter", required=True, metavar="SCATTER.csv",
                    help="CSV: hs, tp, probability or occurrences; more columns set [waves] keys (gamma, ...)")
-    s.add_argument("--headings", metavar="B1,B2,...", help="wave headings in rad (default: the scene's)")
-    s.add_argument("--seeds", type=int, default=1, help="random seeds per cell and heading (default 1)")
-    s.add_argument("--duration", type=float, help="s, replaces the scene's")
-    s.add_argument("--limits", metavar="KEY=VALUE,...", help="limits per channel: roll=0.1,probe.B=0.5")
+    s.add_argument("--headings", metavar="B1,B2,...",
+                   help="wave headings in rad (default: campaign.headings, else waves.heading)")
+    s.add_argument("--seeds", type=int, help="random seeds per cell and heading (default: campaign.seeds, else 1)")
+    s.add_argument("--duration", type=float, help="s, replaces the scene's (default: campaign.duration, else "
+                                                  "simulation.duration)")
+    s.add_argument("--limits", metavar="KEY=VALUE,...",
+                   help="limits per channel: roll=0.1,probe.B=0.5 (replace the scene's [campaign.limits])")
     g = s.add_mutually_exclusive_group()
     g.add_argument("--workers", type=int, help="worker processes of a local Dask cluster (default 2)")
     g.add_argument("--scheduler", metavar="ADDRESS", help="a running Dask scheduler (tcp://host:8786)")
@@ -67,7 +71,7 @@ def parse_headings(text):
 
 def cmd_campaign(a):
     positive("duration", a.duration)
-    if a.seeds < 1:
+    if a.seeds is not None and a.seeds < 1:
         raise InputError(f"--seeds: must be at least 1, got {a.seeds}")
     if a.workers is not None and a.workers < 1:
         raise InputError(f"--workers: must be at least 1, got {a.workers}")
@@ -77,7 +81,7 @@ def cmd_campaign(a):
         raise InputError(f"--scatter: {a.scatter}: no such file")
     scene = load(a.scene)
     heads = parse_headings(a.headings)
-    limits = parse_limits(a.limits, channel_names(scene))
+    limits = parse_limits(a.limits, channel_names(scene)) if a.limits is not None else None   # None: the scene's
     out = a.output or os.path.splitext(os.path.basename(a.scene))[0] + "_campaign.h5"
     writable_output("-o", out, inputs=(a.scene, a.scatter))
     if a.resume and not os.path.exists(out):

@@ -19,9 +19,11 @@ from .fields import show
 from .types import Scene
 
 # what does not change the model a result was made with: the run's length (a fit runs as long as
-# its record), the title, and the Newton solver's own settings (they change a run within its tolerance)
+# its record), the title, the Newton solver's own settings (they change a run within its tolerance),
+# and the [campaign] table (a campaign's limits and defaults: no run reads them)
 HARMLESS = frozenset(("title", "simulation.duration", "simulation.chunk", "simulation.max_iterations",
-                      "simulation.substeps", "simulation.linear_solver", "simulation.tolerance"))
+                      "simulation.substeps", "simulation.linear_solver", "simulation.tolerance",
+                      "campaign", "campaign.limits", "campaign.headings", "campaign.seeds", "campaign.duration"))
 
 # dataclass fields written under another name in the scene file; None: not compared
 _TOML_NAME = {("Tank", "wall_spec"): "walls", ("Tank", "walls"): None,      # the [tanks.walls] table says it

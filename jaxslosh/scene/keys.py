@@ -63,7 +63,8 @@ def scene_values(scene: Scene) -> dict[str, Any]:
     """Every real-valued quantity of the scene by its dotted TOML path.
 
     Scalars are floats; vectors (`vessel.initial.velocity`, `tanks.<name>.origin`, ...) are tuples
-    of 3 floats and `vessel.inertia` a 3x3 nested tuple. Tanks, structures and probes appear twice,
+    of 3 floats and `vessel.inertia` a 3x3 nested tuple; a `[campaign]` table adds its duration and
+    its limits (`campaign.limits.roll`, `campaign.limits.probe.B`). Tanks, structures and probes appear twice,
     by name (`tanks.tank.fill_depth`) and by index (`tanks[0].fill_depth`); `canonical_key` maps the
     index form to the name form. Integer settings (mesh counts, save_every, ...) are not values.
     """
@@ -103,6 +104,11 @@ def scene_values(scene: Scene) -> dict[str, Any]:
     for i, p in enumerate(scene.probes):
         for prefix in (f"probes.{p.name}", f"probes[{i}]"):
             v[f"{prefix}.point"] = p.point
+    if scene.campaign is not None:   # a campaign's settings (never traced: they change no run)
+        if scene.campaign.duration is not None:
+            v["campaign.duration"] = scene.campaign.duration
+        for channel, limit in scene.campaign.limits:
+            v[f"campaign.limits.{channel}"] = limit
     return v
 
 

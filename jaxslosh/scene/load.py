@@ -27,50 +27,13 @@ except ModuleNotFoundError:  # Python 3.10
 
 from ..fem.mesh import box_mesh, face_nodes
 from ..fem.shapes import AXES, SHAPES
-from .fields import (
-    at_least,
-    counts,
-    non_negative,
-    one_of,
-    poisson_ratio,
-    positive,
-    read,
-    show,
-    sizes,
-    valid_name,
-)
+from .campaign import read_campaign
+from .fields import (at_least, counts, non_negative, one_of, poisson_ratio, positive, read, show, sizes,
+                     valid_name)
 from .shape import fill_and_mesh, read_shape
-from .types import (
-    DOFS,
-    EFFECTS,
-    ELEMENT_FORMS,
-    FACES,
-    Damping,
-    Effects,
-    Environment,
-    Fluid,
-    Forced,
-    Hydrostatics,
-    Initial,
-    Material,
-    Probe,
-    Reduction,
-    Scene,
-    SceneError,
-    Simulation,
-    Structure,
-    Tank,
-    Vessel,
-    Walls,
-)
-from .waves import (
-    FileContext,
-    check_waves,
-    hull_hydrostatics,
-    read_hull,
-    read_hydrodynamics,
-    read_waves,
-)
+from .types import (DOFS, EFFECTS, ELEMENT_FORMS, FACES, Damping, Effects, Environment, Forced, Fluid, Hydrostatics,
+                    Initial, Material, Probe, Reduction, Scene, SceneError, Simulation, Structure, Tank, Vessel, Walls)
+from .waves import FileContext, check_waves, hull_hydrostatics, read_hull, read_hydrodynamics, read_waves
 
 SCHEMES = ("newmark", "hht", "generalized-alpha")
 LINEAR_SOLVERS = ("auto", "dense", "sparse")      # [simulation] linear_solver (sparse.py)
@@ -124,6 +87,7 @@ def parse_scene(mapping: Mapping[str, Any], text: str = "", path: str = "") -> S
         "title": ("str", None), "environment": ("table", None), "simulation": ("table", None),
         "vessel": ("table", None), "tanks": ("tables", None), "structures": ("tables", None),
         "probes": ("tables", None), "effects": ("table", None), "waves": ("table", None),
+        "campaign": ("table", None),
     }, required=("simulation", "vessel"))
     warnings: list[str] = []
     title = top.get("title", Path(path).stem if path else "")
@@ -149,9 +113,12 @@ def parse_scene(mapping: Mapping[str, Any], text: str = "", path: str = "") -> S
     waves = None
     if "waves" in mapping:   # incident waves (waves.py)
         waves = read_waves(mapping["waves"], warnings)
+    campaign = None
+    if "campaign" in mapping:   # a campaign's limits and defaults (campaign.py)
+        campaign = read_campaign(mapping["campaign"], probes, waves, simulation.dt, warnings)
     scene = Scene(title=title, environment=environment, simulation=simulation, vessel=vessel, tanks=tanks,
                   structures=structures, probes=probes, effects=effects, text=text, path=path,
-                  warnings=tuple(warnings), waves=waves)
+                  warnings=tuple(warnings), waves=waves, campaign=campaign)
     if waves is not None or vessel.hull is not None or vessel.hydrodynamics is not None:
         scene = check_waves(scene, path, warnings)
         scene = dataclasses.replace(scene, warnings=tuple(warnings))

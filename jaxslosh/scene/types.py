@@ -266,6 +266,20 @@ class Hydrodynamics:
     length_scale: float = 1.0        # WAMIT's ULEN, m
 
 
+@dataclass(frozen=True)
+class CampaignTable:
+    """The `[campaign]` table: what `jaxslosh campaign` and `js.campaign` take when the command line
+    (or the call) does not give it (scene/campaign.py reads it). Nothing here changes a run."""
+    limits: tuple[tuple[str, float], ...] = ()   # (channel, limit) in the file's order: rad (roll, pitch), m
+    headings: tuple[float, ...] | None = None     # rad; None: the template's waves.heading
+    seeds: int | None = None                      # per cell and heading; None: 1
+    duration: float | None = None                 # s, each case's; None: simulation.duration
+
+    @property
+    def limit_map(self) -> dict[str, float]:
+        return dict(self.limits)
+
+
 EFFECTS = ("buoyancy", "liquid", "coriolis", "centrifugal", "gravity_turning", "waves", "radiation")
 
 
@@ -297,6 +311,7 @@ class Scene:
     path: str = ""
     warnings: tuple[str, ...] = ()   # physically doubtful but legal choices, said once at load
     waves: Optional["Waves"] = None  # the [waves] table: incident regular waves or a JONSWAP sea
+    campaign: CampaignTable | None = None      # the [campaign] table: a campaign's limits and defaults
 
     def tank(self, name: str) -> Tank:
         for t in self.tanks:

@@ -1,0 +1,89 @@
+"""The `[campaign]` table: operability limits per response channel and the defaults of a campaign
+(headings, seeds, duration) kept with the scene, so that a campaign's criteria travel with the ship
+they judge. `jaxslosh campaign` and `js.campaign` take them when their own arguments leave them out
+(the command line wins); `jaxslosh run` ignores the table.
+
+    [campaign]
+    headings = [0.0, 0.785, 1.571]    # rad
+    seeds = 2
+    duration = 600.0                  # s
+    [campaign.limits]                 # channel = limit: rad for roll and pitch, m for heave and probes
+    roll = 0.1
+    "probe.B" = 0.5                   # or probe.B = 0.5 (TOML's dotted key: a table probe = {B = 0.5})
+"""
+from __future__ import annotations
+
+import math
+
+from .fields import at_least, positive, read, show
+from .types import CampaignTable, Probe, SceneError, Waves
+
+#: the channels of every scene; probes add `probe.<name>` (their vertical displacement)
+RIGID_CHANNELS = ("roll", "pitch", "heave")
+UNITS = {"roll": "rad", "pitch": "rad", "heave": "m"}      # probe.<name>: its vertical displacement, m
+
+
+def channels(probes) -> list[str]:
+    """The response channels of a scene with these probes: roll, pitch, heave, probe.<name>."""
+    return list(RIGID_CHANNELS) + [f"probe.{p.name}" for p in probes]
+
+
+def read_campaign(table, probes: tuple[Probe, ...], waves: Waves | None, simulation_dt: float,
+                  warnings: list[str]) -> CampaignTable:
+    where = "campaign"
+    v = read(table, where, {
+        "limits": ("table", None), "headings": ("numbers", _headings), "seeds": ("int", at_least(1)),
+        "duration": ("float", positive),
+    })
+    heads = v.get("headings")
+    if heads is not None:
+        heads = tuple(heads) if isinstance(heads, list) else (heads,)
+    duration = v.get("duration")
+    if duration is not None and duration < simulation_dt:
+        raise SceneError(f"{where}.duration", f"{show(duration)} s is shorter than one step "
+                                              f"(simulation.dt = {show(simulation_dt)} s)")
+    irregular = waves is not None and waves.type != "regular"
+    if duration is not None and irregular and duration <= waves.ramp:
+        raise SceneError(f"{where}.duration", f"{show(duration)} s is not longer than waves.ramp = "
+                                              f"{show(waves.ramp)} s: a campaign's statistics are over the frames "
+                                              f"after the ramp")
+    if not irregular:
+        warnings.append('campaign: the [campaign] table is for `jaxslosh campaign`, whose template is an irregular '
+                        '[waves] table (type = "jonswap" or "pierson-moskowitz"); this scene has none, and '
+                        '`jaxslosh run` ignores the table')
+    limits = _limits(table["limits"], f"{where}.limits", channels(probes)) if "limits" in table else ()
+    return CampaignTable(limits=limits, headings=heads, seeds=v.get("seeds"), duration=duration)
+
+
+def _headings(v):
+    values = v if isinstance(v, list) else [v]
+    if not values:
+        return "must be a heading in rad or a non-empty list of them"
+    if any(isinstance(x, list) for x in values):
+        return f"must be a number or a flat list of numbers (rad), got {show(v)}"
+    return None
+
+
+def _limits(table, where: str, chans: list[str]) -> tuple[tuple[str, float], ...]:
+    """{channel: limit} as written; `probe.B = 0.5` (a dotted key, which TOML reads as a table
+    probe = {B = 0.5}) and `"probe.B" = 0.5` (a quoted key) name the same channel."""
+    if not isinstance(table, dict):
+        raise SceneError(where, f"must be a table of channel = limit ({', '.join(chans)}), got {show(table)}")
+    flat: dict = {}
+    for key, value in table.items():
+        items = ([(f"probe.{k}", x) for k, x in value.items()] if key == "probe" and isinstance(value, dict)
+                 else [(key, value)])
+        for ch, x in items:
+            if ch in flat:
+                raise SceneError(f"{where}.{ch}", "is given twice (as a quoted key and as a dotted key)")
+            if ch not in chans:
+                raise SceneError(f"{where}.{ch}", f"not a channel of this scene (channels: {', '.join(chans)})")
+            flat[ch] = x
+    spec = {ch: ("float", _positive_limit(UNITS.get(ch, "m"))) for ch in flat}   # probes: m
+    out = read(flat, where, spec)
+    return tuple((ch, out[ch]) for ch in flat)
+
+
+def _positive_limit(unit: str):
+    return lambda x: None if x > 0 and math.isfinite(x) else f"must be a positive limit in {unit}, got {show(x)}"
+
