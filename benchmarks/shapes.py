@@ -50,7 +50,8 @@ def main():
     rows = [
         ("box 5x5x5 (paper)", base),
         ("box as a .msh file", shape_text(base, f'shape = "mesh"\nfile = "{msh}"', "[5.0, 5.0, 4.0]", "[5, 5, 5]",
-                                          "3.0", "[-2.5, -2.5, -1.0]")),
+                                          "3.0", "[-2.5, -2.5, -1.0]").replace("fill_depth = 3.0\n", "")
+         .replace("mesh = [5, 5, 5]\n", "")),
         ("prismatic (LNG section) 4x12x8", shape_text(
             base, 'shape = "prismatic"\nchamfers = [[1.5, 1.0], [1.5, 1.0]]',
             "[4.0, 6.0, 4.0]", "[4, 12, 8]", "3.5", "[-2.0, -3.0, -1.0]")),

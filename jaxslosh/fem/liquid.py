@@ -209,8 +209,7 @@ def _build_shaped(geometry, fill_depth, mesh, rho, c, g, element, sparse) -> Liq
     traced = any(is_traced(v) for v in (rho, c, g))
     h = float(fill_depth)
     tm = tank_mesh(geometry, h, mesh)
-    nodes, elements, faces = tm.nodes, tm.elements, tm.top_faces
-    n = len(nodes)
+    nodes, elements, faces, frames = tm.nodes, tm.elements, tm.top_faces, tm.frames
     pairs = bending = None
     if element != "paper":
         keep, pairs = _rotation_pairs(*tm.grid) if tm.grid is not None else (np.ones((len(elements), 6), bool), [])
@@ -219,7 +218,7 @@ def _build_shaped(geometry, fill_depth, mesh, rho, c, g, element, sparse) -> Liq
         pairs = (keep, list(pairs) + list(tm.pairs))
         bending = surface_jump_pattern(nodes, faces)
     flat = tm.flat.astype(float)
-    assemble, parts_of = _assembler(n, elements, faces, element, pairs, bending, flat)
+    assemble, parts_of = _assembler(len(nodes), elements, faces, element, pairs, bending, flat)
     xp = jnp if traced else np
     with jax.enable_x64(True):
         if traced:
@@ -231,17 +230,13 @@ def _build_shaped(geometry, fill_depth, mesh, rho, c, g, element, sparse) -> Liq
         kappa = ROTATION_PENALTY * density * gravity * float(np.ptp(nodes, axis=0).max())
         out = assemble(el, kappa, SURFACE_BENDING * density * gravity, traced, sparse=sparse and not traced)
         K, C, T = out["stiffness"], out.get("coupling"), out.get("theta_theta")
-        if sp.issparse(C):
-            C = np.asarray(C.todense())
-        frames = tm.frames
+        C = np.asarray(C.todense()) if sp.issparse(C) else C
         if frames is not None:
             K = rotate_matrix(xp, K, frames)
             C = None if C is None else rotate_rows(xp, C, frames)
-    parts = {}
-    if not traced:
-        parts = parts_of(el, out)
-        if frames is not None:
-            parts = {k: rotate_matrix(np, v, frames) for k, v in parts.items()}
+    parts = {} if traced else parts_of(el, out)
+    if frames is not None:
+        parts = {k: rotate_matrix(np, v, frames) for k, v in parts.items()}
     return LiquidModel(
         nodes=nodes, elements=elements, mass=out["mass"], stiffness=K, free=tm.free.reshape(-1).copy(),
         surface=np.unique(faces), density=density, sound_speed=sound_speed, gravity=gravity,

@@ -5,7 +5,8 @@ from __future__ import annotations
 import numpy as np
 from matplotlib.animation import FuncAnimation, PillowWriter
 
-from ..fem.shapes import TankGeometry, outline
+from ..fem.outline import outline
+from ..fem.shapes import TankGeometry
 from ..fem.slip import HEX_FACES
 from ..physics.kinematics import rotation_matrix
 from ..scene.load import load_scene, tomllib
