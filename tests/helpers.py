@@ -91,8 +91,15 @@ def run_notebook(name: str, env: dict | None = None, timeout: int = 900) -> list
     old = {k: os.environ.get(k) for k in env}
     os.environ.update(env)
     try:
-        nbclient.NotebookClient(nb, timeout=timeout, kernel_name="python3",
-                                resources={"metadata": {"path": str(folder)}}).execute()
+        try:
+            nbclient.NotebookClient(nb, timeout=timeout, kernel_name="python3",
+                                    resources={"metadata": {"path": str(folder)}}).execute()
+        except nbclient.exceptions.DeadKernelError:
+            # the kernel process died (seen once in a CI run of the quickstart, never again on the
+            # same commit): a second one runs it afresh; a crash of ours would kill it again
+            nb = nbformat.read(folder / name, as_version=4)
+            nbclient.NotebookClient(nb, timeout=timeout, kernel_name="python3",
+                                    resources={"metadata": {"path": str(folder)}}).execute()
     finally:
         for k, v in old.items():
             if v is None:
