@@ -17,6 +17,7 @@ from dask.distributed import Client, LocalCluster, as_completed
 
 from ..io.campaign import PENDING, create_campaign, load_campaign, write_cases, write_summary
 from ..io.output import OutputLock
+from ..run.guard import interrupts
 from ..run.progress import Progress, wanted
 from ..scene.load import load_scene
 from ..scene.campaign import channels
@@ -215,6 +216,11 @@ def _run(template, duration, cases, scenes, todo, client, workers, batch, output
     bar = Progress(enabled=wanted() if progress is None else progress)
     bar.phase("cases", "cases", total=len(todo), unit="case")
     run_now = failed = 0
+    # SIGINT / SIGTERM: asked, then looked at after each finished batch (run/guard.py): a
+    # KeyboardInterrupt raised where the signal lands, inside Dask's callbacks, can be swallowed
+    # there, and the campaign went on to its end
+    guard = interrupts()
+    stop = guard.__enter__()
     try:
         futures = {}
         for idx in _batches(scenes, todo, batch):
@@ -241,7 +247,9 @@ def _run(template, duration, cases, scenes, todo, client, workers, batch, output
                 write_cases(output, idx, outcomes)
             run_now += len(idx)
             bar.update(run_now)
+            stop.check()
     finally:
+        guard.__exit__(None, None, None)
         bar.close()
         if own:
             client.close()
