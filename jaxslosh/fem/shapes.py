@@ -29,6 +29,7 @@ NumPy only (the scene loader uses it to check shapes and to compute their volume
 from __future__ import annotations
 
 import functools
+import os
 from dataclasses import dataclass
 from typing import NamedTuple, Optional
 
@@ -73,7 +74,6 @@ class TankMesh(NamedTuple):
     frames: Optional[np.ndarray]  # (N, 3, 3) columns: the node's axes; None: every frame is the identity
     grid: Optional[tuple]        # (nx, ny, nz) when the elements are numbered as the box grid's
     depth: float                 # the free surface's height (the fill depth)
-    doubled: np.ndarray          # grid indices of nodes doubled by baffles
     flat: np.ndarray             # (E,) bool: elements with two faces on one smooth wall (fem/slip.py)
     pairs: tuple = ()            # (e0, e1, k): curl rows k of two elements penalised on their difference
 
@@ -167,17 +167,22 @@ def _jacobian_det(X, xi):
 # ------------------------------------------------------------------------------------------ the meshes
 
 def tank_mesh(geo: TankGeometry, fill_depth: float, mesh) -> TankMesh:
-    """The liquid at rest of a tank of this geometry filled to `fill_depth`, on `mesh` = (nx, ny, nz)."""
-    nx, ny, nz = (int(m) for m in mesh)
-    h = float(fill_depth)
-    doubled = np.zeros(0, dtype=int)
+    """The liquid at rest of a tank of this geometry filled to `fill_depth`, on `mesh` = (nx, ny, nz).
+    Built once per geometry, fill and counts (`jaxslosh check` counts its unknowns, the build uses it);
+    its arrays are shared: read them, do not write them."""
+    return _tank_mesh(geo, float(fill_depth), tuple(int(m) for m in mesh))
+
+
+@functools.lru_cache(maxsize=16)
+def _tank_mesh(geo: TankGeometry, h: float, mesh: tuple) -> TankMesh:
+    nx, ny, nz = mesh
     if geo.kind == "mesh":
         nodes, elements = read_mesh(geo.file)
         grid = _as_grid(nodes, elements)
         if grid is not None:
             nodes, elements, dims = grid
-            return _finish(nodes, elements, dims, float(nodes[:, 2].max()), doubled)
-        return _finish(nodes, elements, None, float(nodes[:, 2].max()), doubled)
+            return _finish(nodes, elements, dims, float(nodes[:, 2].max()))
+        return _finish(nodes, elements, None, float(nodes[:, 2].max()))
     if geo.kind == "cylinder" and geo.axis == "z":
         nodes = _vertical_cylinder(geo.size, h, (nx, ny, nz))
         elements = box_elements(nx, ny, nz)
@@ -188,11 +193,11 @@ def tank_mesh(geo: TankGeometry, fill_depth: float, mesh) -> TankMesh:
         nodes = _prismatic(geo, h, (nx, ny, nz))
         elements = box_elements(nx, ny, nz)
         pairs = _extra_pairs(geo, h, (nx, ny, nz), nodes)
-        nodes, elements, doubled = _baffles(geo, h, (nx, ny, nz), nodes, elements)
+        nodes, elements = _baffles(geo, h, (nx, ny, nz), nodes, elements)
         nodes, elements = _merge_coincident(nodes, elements, (nx + 1) * (ny + 1) * (nz + 1))
-        return _finish(nodes, elements, (nx, ny, nz), h, doubled, pairs)
+        return _finish(nodes, elements, (nx, ny, nz), h, pairs)
     nodes, elements = _merge_coincident(nodes, elements, (nx + 1) * (ny + 1) * (nz + 1))
-    return _finish(nodes, elements, (nx, ny, nz), h, doubled)
+    return _finish(nodes, elements, (nx, ny, nz), h)
 
 
 def _breaks(lo, hi, points, n, where="mesh"):
@@ -307,13 +312,12 @@ def _baffles(geo, h, mesh, nodes, elements):
     """Double the nodes on each plate (below its free edge), the copies for the elements on its far side."""
     nx, ny, nz = mesh
     if not geo.baffles:
-        return nodes, elements, np.zeros(0, dtype=int)
+        return nodes, elements
     g = grid_index(nx, ny, nz)
     H = geo.size[2]
     ei = np.stack(np.meshgrid(np.arange(nx), np.arange(ny), np.arange(nz), indexing="ij"), -1).reshape(-1, 3)
     nodes = list(nodes)
     elements = elements.copy()
-    doubled = []
     scale = max(geo.size)
     for bf in geo.baffles:
         ax = 0 if bf.normal == "x" else 1
@@ -334,8 +338,7 @@ def _baffles(geo, h, mesh, nodes, elements):
         far = np.flatnonzero(ei[:, ax] == plane)
         for e in far:
             elements[e] = [copy.get(n, n) for n in elements[e]]
-        doubled += list(idx)
-    return np.asarray(nodes), elements, np.asarray(sorted(set(doubled)), dtype=int)
+    return np.asarray(nodes), elements
 
 
 def _merge_coincident(nodes, elements, n_grid=None):
@@ -358,7 +361,17 @@ def _merge_coincident(nodes, elements, n_grid=None):
 
 
 def read_mesh(path):
-    """(nodes, elements) of the hexahedra of a mesh file (meshio), oriented positively."""
+    """(nodes, elements) of the hexahedra of a mesh file (meshio), oriented positively. Read once per
+    file version (the loader, the volume, the build and `check` all ask); shared arrays: read only."""
+    try:
+        st = os.stat(path)
+    except OSError as e:
+        raise ValueError(f"cannot read the mesh file {path!r}: {e}") from e
+    return _read_mesh(str(path), st.st_mtime_ns, st.st_size)
+
+
+@functools.lru_cache(maxsize=8)
+def _read_mesh(path, mtime_ns, size):
     try:
         import meshio
     except ImportError as e:                        # an optional dependency: say how to get it
@@ -417,18 +430,11 @@ def _as_grid(nodes, elements):
     return out, box, dims
 
 
-def mesh_counts(geo: TankGeometry, mesh):
-    """(nodes, elements) the liquid's mesh will have (a mesh file: read), for cost estimates."""
-    if geo.kind == "mesh":
-        nodes, elements = read_mesh(geo.file)
-        return len(nodes), len(elements)
-    nx, ny, nz = mesh
-    return (nx + 1) * (ny + 1) * (nz + 1), nx * ny * nz
-
-
-def _finish(nodes, elements, grid, depth, doubled, pairs=()) -> TankMesh:
+def _finish(nodes, elements, grid, depth, pairs=()) -> TankMesh:
     bd = boundary(nodes, elements, depth)
-    return TankMesh(nodes, elements, bd.top_faces, bd.wall_faces, bd.free, bd.frames, grid, depth, doubled, bd.flat,
+    for a in (nodes, elements, bd.free):            # cached and shared (tank_mesh): read only
+        a.flags.writeable = False
+    return TankMesh(nodes, elements, bd.top_faces, bd.wall_faces, bd.free, bd.frames, grid, depth, bd.flat,
                     tuple(pairs))
 
 
@@ -485,7 +491,6 @@ def box_equivalent(geo: TankGeometry, fill_depth: float):
     return dims
 
 
-@functools.lru_cache(maxsize=32)
 def free_count(geo: TankGeometry, fill_depth: float, mesh) -> int:
-    """The liquid's unknowns in a tank of this shape (its mesh built once, cached)."""
+    """The liquid's unknowns in a tank of this shape."""
     return int(tank_mesh(geo, fill_depth, mesh).free.sum())

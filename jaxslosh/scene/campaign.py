@@ -15,7 +15,7 @@ from __future__ import annotations
 
 import math
 
-from .fields import at_least, positive, read, show
+from .fields import at_least, flat_list, positive, read, show
 from .types import CampaignTable, Probe, SceneError, Waves
 
 #: the channels of every scene; probes add `probe.<name>` (their vertical displacement)
@@ -56,12 +56,7 @@ def read_campaign(table, probes: tuple[Probe, ...], waves: Waves | None, simulat
 
 
 def _headings(v):
-    values = v if isinstance(v, list) else [v]
-    if not values:
-        return "must be a heading in rad or a non-empty list of them"
-    if any(isinstance(x, list) for x in values):
-        return f"must be a number or a flat list of numbers (rad), got {show(v)}"
-    return None
+    return flat_list(v, "a heading in rad")[1]
 
 
 def _limits(table, where: str, chans: list[str]) -> tuple[tuple[str, float], ...]:

@@ -223,3 +223,13 @@ def show(x) -> str:
     else:
         s = str(x)
     return s if len(s) <= 80 else s[:77] + "..."
+
+
+def flat_list(v, what: str):
+    """(the values of a number or a flat list, None) or (None, the message): `what` names one item."""
+    values = v if isinstance(v, list) else [v]
+    if not values:
+        return None, f"must be {what} or a non-empty list of them"
+    if any(isinstance(x, list) for x in values):
+        return None, f"must be a number or a flat list of numbers, got {show(v)}"
+    return values, None

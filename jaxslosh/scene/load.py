@@ -28,7 +28,7 @@ except ModuleNotFoundError:  # Python 3.10
 from ..fem.mesh import box_mesh, face_nodes
 from ..fem.shapes import AXES, SHAPES
 from .campaign import read_campaign
-from .fields import (at_least, counts, non_negative, one_of, poisson_ratio, positive, read, show, sizes,
+from .fields import (at_least, counts, flat_list, non_negative, one_of, poisson_ratio, positive, read, show, sizes,
                      valid_name)
 from .shape import fill_and_mesh, read_shape
 from .types import (DOFS, EFFECTS, ELEMENT_FORMS, FACES, Damping, Effects, Environment, Forced, Fluid, Hydrostatics,
@@ -351,11 +351,9 @@ def _damping(table, where: str) -> Damping:
 
 
 def _ratio(v):
-    values = v if isinstance(v, list) else [v]
-    if not values:
-        return "must be a number or a non-empty list of numbers"
-    if any(isinstance(x, list) for x in values):
-        return f"must be a number or a flat list of numbers, got {show(v)}"
+    values, msg = flat_list(v, "a number")
+    if msg:
+        return msg
     bad = [x for x in values if not 0.0 <= x < 1.0]
     if bad:
         return f"a damping ratio must be in [0, 1) (1: critical damping, no oscillation left), got {show(bad[0])}"
