@@ -1,14 +1,17 @@
-"""What a run of a scene costs before its first step, in a fresh process: the first call (a cold
-compilation cache) and a second process (the cache warm), tracing and XLA apart.
+"""What a run of a scene costs before its first step, in a fresh process: the first call (empty
+caches) and a second process (the caches the first filled), tracing and XLA apart.
 
-    python benchmarks/compile_time.py [SCENE ...] [--repeat 2]
+    python benchmarks/compile_time.py [SCENE ...] [--repeat 2] [--equations]
 
 Each measurement is one fresh Python process that does what `jaxslosh run` does up to the end of
-its first chunk (tofile.run_to_file's phases: build the model, compile `start` and the chunk ahead
-of time, run the first chunk), with JAX's compilation events summed by kind (jax.monitoring):
+its first chunk: import, build the model (`build`), compile `start` and the chunk (tofile.compile_run:
+JAX's persistent compilation cache and the exported programs, programs.py, in a temporary folder)
+and run `start` (`compile`), then the first chunk. `1st step` is the process's time to its first
+step (import + build + compile). JAX's compilation events are summed by kind (jax.monitoring):
 tracing (jaxpr_trace_duration), lowering (jaxpr_to_mlir_module_duration) and XLA
-(backend_compile_duration). Prints a table; no assertion. `--equations` adds the traced programs' sizes. Default scenes: the paper example and the
-paper ship with its mast.
+(backend_compile_duration; in a second process, reading XLA's cache). Prints a table; no assertion.
+`--equations` adds the traced programs' sizes. Default scenes: the paper example and the paper ship
+with its mast.
 """
 import argparse
 import json
@@ -20,32 +23,29 @@ import tempfile
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 
 CHILD = r"""
-import collections, json, sys, time
+import collections, json, os, sys, time
 T0 = time.perf_counter()
+os.environ["JAXSLOSH_CACHE_DIR"] = sys.argv[2]
 import jax
-jax.config.update("jax_enable_x64", True)
-cache = sys.argv[2]
-jax.config.update("jax_compilation_cache_dir", cache)
-jax.config.update("jax_persistent_cache_min_compile_time_secs", 0.0)
-jax.config.update("jax_persistent_cache_min_entry_size_bytes", -1)
+from jaxslosh.cli.common import setup_jax
+setup_jax()                 # as `jaxslosh run`: float64, XLA's cache and the exported programs in the folder
 events = collections.defaultdict(float)
 jax.monitoring.register_event_duration_secs_listener(
     lambda name, d, **kw: events.__setitem__(name.split("/")[-1], events[name.split("/")[-1]] + d))
-import jaxslosh as js
-from jaxslosh.run.loop import advance, core, start
+from jaxslosh.run.loop import core
 from jaxslosh.run.simulate import prepare
-from jaxslosh.run.tofile import compiler_options
+from jaxslosh.run.tofile import compile_run
+from jaxslosh.scene import load_scene
 t_import = time.perf_counter()
-scene = js.load_scene(sys.argv[1])
+scene = load_scene(sys.argv[1])
 setup = prepare(scene)
 b, solver = core(setup.built), setup.solver
 t_build = time.perf_counter()
 se = setup.save_every
 chunk = scene.simulation.chunk or max(1, min(setup.n_steps // se, max(1, 500 // se)))
-carry, f0 = start.lower(b, solver).compile(compiler_options=compiler_options("start"))(b, solver)
+carry, f0, adv = compile_run(b, solver, chunk, se)
 jax.block_until_ready(f0)
 t_first = time.perf_counter()
-adv = advance.lower(b, solver, carry, chunk, se).compile(compiler_options=compiler_options("advance"))
 carry, fr = adv(b, solver, carry, chunk, se)
 jax.block_until_ready(fr)
 t_chunk = time.perf_counter()
@@ -67,7 +67,7 @@ if sys.argv[3] == "1":     # the traced programs' sizes (equations, counted into
     eqns["start_eqns"] = count(eqx.filter_make_jaxpr(traced_init)(b, solver)[0].jaxpr)
     eqns["chunk_eqns"] = count(eqx.filter_make_jaxpr(lambda b_, s_, c_: traced_advance(b_, s_, c_, chunk, se))(
         b, solver, carry)[0].jaxpr)
-print(json.dumps({**eqns, "import": t_import - T0, "build": t_build - t_import, "first_step": t_first - T0,
+print(json.dumps({**eqns, "import": t_import - T0, "build": t_build - t_import, "compile": t_first - t_build, "first_step": t_first - T0,
                   "first_chunk": t_chunk - T0, "steps": chunk * se,
                   "trace": events["jaxpr_trace_duration"], "lower": events["jaxpr_to_mlir_module_duration"],
                   "xla": events["backend_compile_duration"]}))
@@ -90,7 +90,7 @@ def main():
                     help="also count the traced programs' equations (start, chunk): a measure of what tracing "
                          "and XLA work on that does not depend on the machine's load")
     a = ap.parse_args()
-    print(f"{'scene':24} {'cache':6} {'import':>7} {'build':>7} {'1st step':>9} {'1st chunk':>10} {'trace':>7} "
+    print(f"{'scene':24} {'cache':6} {'import':>7} {'build':>7} {'compile':>8} {'1st step':>9} {'1st chunk':>10} {'trace':>7} "
           f"{'lower':>7} {'XLA':>7}   (seconds, one fresh process each)")
     for scene in a.scenes:
         for _ in range(a.repeat):
@@ -98,7 +98,7 @@ def main():
                 for label in ("cold", "warm"):
                     r = measure(scene, cache, a.equations and label == "warm")
                     print(f"{os.path.basename(scene)[:24]:24} {label:6} {r['import']:7.2f} {r['build']:7.2f} "
-                          f"{r['first_step']:9.2f} {r['first_chunk']:10.2f} {r['trace']:7.2f} {r['lower']:7.2f} "
+                          f"{r['compile']:8.2f} {r['first_step']:9.2f} {r['first_chunk']:10.2f} {r['trace']:7.2f} {r['lower']:7.2f} "
                           f"{r['xla']:7.2f}" + (f"   equations: start {r['start_eqns']}, chunk {r['chunk_eqns']}"
                                                  if "start_eqns" in r else ""))
                     sys.stdout.flush()

@@ -10,19 +10,34 @@ sloshing" (2013). Entry points switch on float64 (`jax_enable_x64`); a library u
 The package's layers, lowest first (README "Design"): scene/ (TOML to a Scene), fem/ and hydro/
 (host-side models), physics/ (traced terms), solve/ (schemes, Newton, linear solvers), build/
 (scene to System), run/ (time loop), io/ (files), analysis/, campaign/, fit/, plot/, cli/.
-"""
-from ._version import __version__
-from .analysis.modes import sloshing_modes, structure_modes
-from .analysis.rao import rao
-from .campaign.run import campaign
-from .fit.identify import identify
-from .io.result import Result, load_result, save_result
-from .io.status import Status
-from .run.batch import simulate_batch
-from .run.simulate import NumericalFailure, simulate
-from .run.stepper import Stepper
-from .scene import Scene, SceneError, load_scene
 
-__all__ = ["structure_modes", "Scene", "SceneError", "Result", "NumericalFailure", "load_scene", "simulate", "save_result",
-           "load_result", "sloshing_modes", "identify", "simulate_batch", "Stepper", "Status", "rao", "campaign",
-           "__version__"]
+The public names below are imported on first use (PEP 562): `import jaxslosh` stays light, and a
+command such as `jaxslosh run` loads neither Dask nor SciPy's signal and statistics modules, which
+only campaigns and fits need (a second run of a scene starts in seconds: README "Compilation").
+"""
+from importlib import import_module
+
+from ._version import __version__
+
+#: public name -> the module that defines it
+_PUBLIC = {
+    "sloshing_modes": ".analysis.modes", "structure_modes": ".analysis.modes", "rao": ".analysis.rao",
+    "campaign": ".campaign.run", "identify": ".fit.identify", "Result": ".io.result", "load_result": ".io.result",
+    "save_result": ".io.result", "Status": ".io.status", "simulate_batch": ".run.batch",
+    "NumericalFailure": ".run.simulate", "simulate": ".run.simulate", "Stepper": ".run.stepper", "Scene": ".scene",
+    "SceneError": ".scene", "load_scene": ".scene",
+}
+
+__all__ = [*_PUBLIC, "__version__"]
+
+
+def __getattr__(name):
+    if name in _PUBLIC:
+        value = getattr(import_module(_PUBLIC[name], __name__), name)
+        globals()[name] = value           # looked up once
+        return value
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
+
+
+def __dir__():
+    return sorted(set(globals()) | set(_PUBLIC))

@@ -9,7 +9,7 @@ ROOT = os.path.join(os.path.dirname(os.path.dirname(os.path.abspath(__file__))),
 
 # lowest first; a module may import its own package and the packages on earlier lines
 LAYERS = [
-    {"_version", "fem.mesh", "fem.slip", "physics.kinematics"},
+    {"_version", "programs", "fem.mesh", "fem.slip", "physics.kinematics"},
     {"fem.shapes"},
     {"hydro", "io"},
     {"scene"},

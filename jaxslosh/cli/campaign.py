@@ -13,11 +13,11 @@ from ..campaign.cases import ScatterError
 from ..campaign.run import CampaignError, campaign, channel_names
 from ..io.output import OutputError
 from ..io.result import ResultFileError
-from .common import InputError, load, positive, setup_jax, writable_output
+from .common import COMMANDS, InputError, load, positive, setup_jax, writable_output
 
 
 def add_parsers(sub):
-    s = sub.add_parser("campaign", help="run a scatter of sea states x headings x seeds on Dask, write statistics")
+    s = sub.add_parser("campaign", help=COMMANDS["campaign"][1])
     s.add_argument("scene")
     s.add_argument("--scatter", required=True, metavar="SCATTER.csv",
                    help="CSV: hs, tp, probability or occurrences; more columns set [waves] keys (gamma, ...)")

@@ -11,6 +11,7 @@ import tempfile
 
 import jax
 
+from .. import programs
 from ..io.output import OutputError, check_output
 from ..scene.keys import with_overrides
 from ..scene.load import load_scene
@@ -25,6 +26,24 @@ class InputError(Exception):
     """Bad command-line input: one line on stderr, exit status 2."""
 
 
+#: every command: the module (jaxslosh/cli/<module>.py, whose cmd_<command> runs it) and its help. main.py
+#: imports only the module of the command asked for, so `jaxslosh run` loads neither Dask nor SciPy's
+#: signal and statistics modules (README "Compilation": what a run costs before its first step)
+COMMANDS = {
+    "run": ("simulate", "simulate a scene, write the result file"),
+    "check": ("simulate", "validate a scene; list what it will simulate and what it will cost"),
+    "plot": ("plot", "time histories of a result: roll, pitch, heave and every probe "
+                     "(of a sweep file: every run overlaid)"),
+    "modes": ("modes", "natural frequencies of a tank's liquid, or of a flexible structure, with the vessel held fixed"),
+    "identify": ("identify", "fit scene values (dotted keys) to a measured result"),
+    "sweep": ("sweep", "run a grid of parameter values as one batch, write one file"),
+    "hydro": ("hydro", "hull hydrostatics and hydrodynamic tables from Capytaine, as scene TOML"),
+    "rao": ("rao", "response amplitude operators of the vessel and the probes, from the scene linearised about rest"),
+    "export": ("export", "write a result for ParaView (XDMF 3 time series over one HDF5 file)"),
+    "campaign": ("campaign", "run a scatter of sea states x headings x seeds on Dask, write statistics"),
+}
+
+
 class Parser(argparse.ArgumentParser):
     def error(self, message):  # one line, no usage block
         raise InputError(f"{self.prog}: {message}")
@@ -36,18 +55,22 @@ CACHE_ENV = "JAXSLOSH_CACHE_DIR"
 
 
 def setup_jax():
-    """float64, and JAX's persistent compilation cache: a second run of a scene skips XLA."""
+    """float64, JAX's persistent compilation cache and the exported programs beside it (programs.py):
+    a second run of a scene skips tracing and XLA."""
     jax.config.update("jax_enable_x64", True)
     if os.environ.get("JAX_COMPILATION_CACHE_DIR"):
+        programs.use(os.path.join(os.environ["JAX_COMPILATION_CACHE_DIR"], "jaxslosh-programs"))
         return
     d = os.environ.get(CACHE_ENV)
     if d is None:
         d = os.path.join(os.environ.get("XDG_CACHE_HOME") or os.path.expanduser("~/.cache"), "jaxslosh", "xla")
     if not d:
+        programs.use(None)
         return
     jax.config.update("jax_compilation_cache_dir", d)
     jax.config.update("jax_persistent_cache_min_compile_time_secs", 0.0)
     jax.config.update("jax_persistent_cache_min_entry_size_bytes", -1)
+    programs.use(os.path.join(d, "programs"))
 
 
 def load(path) -> Scene:

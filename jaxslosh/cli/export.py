@@ -8,11 +8,11 @@ import time
 from ..io.output import OutputError, OutputLock
 from ..io.paraview import export_paraview
 from ..io.result import ResultFileError, load_result
-from .common import EXIT_OK, InputError, output_folder
+from .common import COMMANDS, EXIT_OK, InputError, output_folder
 
 
 def add_parsers(sub):
-    e = sub.add_parser("export", help="write a result for ParaView (XDMF 3 time series over one HDF5 file)")
+    e = sub.add_parser("export", help=COMMANDS["export"][1])
     e.add_argument("result")
     e.add_argument("--paraview", required=True, metavar="OUT.xdmf",
                    help="the liquid's XDMF file; the free surface, vessel, structures and probes go beside it "

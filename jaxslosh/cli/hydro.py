@@ -7,11 +7,11 @@ import numpy as np
 
 from ..hydro.capytaine import (CAPYTAINE_MISSING, capytaine_dataset, capytaine_version, have_capytaine,
                                hull_hydrodynamics, save_capytaine_dataset, to_toml)
-from .common import EXIT_OK, InputError, load, output_folder
+from .common import COMMANDS, EXIT_OK, InputError, load, output_folder
 
 
 def add_parsers(sub):
-    hy = sub.add_parser("hydro", help="hull hydrostatics and hydrodynamic tables from Capytaine, as scene TOML")
+    hy = sub.add_parser("hydro", help=COMMANDS["hydro"][1])
     hy.add_argument("scene", help="a scene with a [vessel.hull] table")
     hy.add_argument("-o", "--output", help="write the TOML tables here (default: print them)")
     hy.add_argument("--frequencies", default="0.1:2.5:25", help="LOW:HIGH:COUNT rad/s (default 0.1:2.5:25)")

@@ -11,12 +11,12 @@ from ..fit.quality import data_scene_mismatch
 from ..io.result import ResultFileError, load_result
 from ..plot.fit import format_value, plot_fit
 from ..scene.types import SceneError
-from .common import EXIT_NUMERICAL, EXIT_OK, InputError, load, output_folder, setup_jax
+from .common import COMMANDS, EXIT_NUMERICAL, EXIT_OK, InputError, load, output_folder, setup_jax
 
 
 def add_parsers(subparsers):
     """Add the `identify` subcommand to the `jaxslosh` sub-parsers; returns its parser."""
-    p = subparsers.add_parser("identify", help="fit scene values (dotted keys) to a measured result")
+    p = subparsers.add_parser("identify", help=COMMANDS["identify"][1])
     p.add_argument("scene")
     p.add_argument("--data", required=True, metavar="MEASURED.h5", help="the measured result file")
     p.add_argument("--fit", required=True, metavar="KEY[,KEY...]",

@@ -6,12 +6,11 @@ import math
 
 from ..analysis.coupled import coupled_modes
 from ..analysis.modes import sloshing_modes, structure_modes
-from .common import EXIT_OK, InputError, setup_jax, load
+from .common import COMMANDS, EXIT_OK, InputError, setup_jax, load
 
 
 def add_parsers(sub):
-    m = sub.add_parser("modes", help="natural frequencies of a tank's liquid, or of a flexible structure, with the "
-                                     "vessel held fixed")
+    m = sub.add_parser("modes", help=COMMANDS["modes"][1])
     m.add_argument("scene")
     g = m.add_mutually_exclusive_group()
     g.add_argument("--tank")

@@ -12,12 +12,11 @@ from ..plot.results import plot_result, plot_sweep
 from ..plot.surface import animate_free_surface, plot_free_surface
 from ..run.progress import Progress, wanted
 from .campaign import parse_limits
-from .common import EXIT_OK, InputError, output_folder, positive
+from .common import COMMANDS, EXIT_OK, InputError, output_folder, positive
 
 
 def add_parsers(sub):
-    pl = sub.add_parser("plot", help="time histories of a result: roll, pitch, heave and every probe "
-                                     "(of a sweep file: every run overlaid)")
+    pl = sub.add_parser("plot", help=COMMANDS["plot"][1])
     pl.add_argument("result")
     pl.add_argument("-o", "--output", help="figure file (default: the result's name with .png)")
     pl.add_argument("--surface", metavar="FIG", help="also draw the deformed free surface at a few instants to FIG")

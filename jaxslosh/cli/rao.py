@@ -12,12 +12,11 @@ from ..io.output import OutputError, check_output
 from ..io.rao import RAO_FORMAT, write_rao
 from ..plot.rao import plot_rao
 from ..scene.types import DOFS
-from .common import EXIT_OK, InputError, load, output_folder, setup_jax
+from .common import COMMANDS, EXIT_OK, InputError, load, output_folder, setup_jax
 
 
 def add_parsers(sub):
-    r = sub.add_parser("rao", help="response amplitude operators of the vessel and the probes, from the scene "
-                                   "linearised about rest")
+    r = sub.add_parser("rao", help=COMMANDS["rao"][1])
     r.add_argument("scene")
     r.add_argument("--frequencies", help="LOW:HIGH:COUNT rad/s (default: the radiation tables' range, else "
                                          "0.1:4:200)")

@@ -12,12 +12,12 @@ from ..io.output import OutputError
 from ..io.status import Status
 from ..run.progress import wanted
 from ..run.tofile import run_to_file
-from .common import (EXIT_INTERRUPTED, EXIT_IO, EXIT_NUMERICAL, EXIT_OK, InputError, setup_jax, load, overridden,
+from .common import (COMMANDS, EXIT_INTERRUPTED, EXIT_IO, EXIT_NUMERICAL, EXIT_OK, InputError, setup_jax, load, overridden,
                      positive, writable_output)
 
 
 def add_parsers(sub):
-    r = sub.add_parser("run", help="simulate a scene, write the result file")
+    r = sub.add_parser("run", help=COMMANDS["run"][1])
     r.add_argument("scene")
     r.add_argument("-o", "--output", help="result file (default: the scene's name with .h5, here)")
     r.add_argument("--duration", type=float, help="override simulation.duration (s)")
@@ -26,7 +26,7 @@ def add_parsers(sub):
                    help="no progress on stderr (drawn only on a terminal unless JAXSLOSH_PROGRESS=1)")
     r.add_argument("--no-fields", action="store_true", help="do not store the liquid displacement fields")
     r.add_argument("--force", action="store_true", help="run even when the scene's cost estimate exceeds this machine")
-    c = sub.add_parser("check", help="validate a scene; list what it will simulate and what it will cost")
+    c = sub.add_parser("check", help=COMMANDS["check"][1])
     c.add_argument("scene")
     c.add_argument("--force", action="store_true", help="exit 0 even when the cost estimate exceeds this machine")
 

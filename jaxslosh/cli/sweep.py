@@ -12,7 +12,7 @@ from ..io.sweep import write_sweep
 from ..run.batch import check_runs, simulate_batch
 from ..scene.keys import scene_values, traceable
 from ..scene.types import SceneError
-from .common import InputError, load, overridden, positive, setup_jax, writable_output
+from .common import COMMANDS, InputError, load, overridden, positive, setup_jax, writable_output
 
 
 def parse_grid(items):
@@ -58,7 +58,7 @@ def grid_product(grid):
 
 
 def add_parsers(sub):
-    s = sub.add_parser("sweep", help="run a grid of parameter values as one batch, write one file")
+    s = sub.add_parser("sweep", help=COMMANDS["sweep"][1])
     s.add_argument("scene")
     s.add_argument("--param", action="append", default=[], metavar="KEY=V1,V2,...",
                    help="a dotted scene key and its values; several --param make a grid")

@@ -61,6 +61,7 @@ import jax
 import jax.numpy as jnp
 import numpy as np
 
+from ..programs import compile_program
 from .linalg import det2, det3, inv3
 from .mesh import GAUSS8, GAUSS_1D, HEX_CORNERS
 
@@ -266,7 +267,7 @@ def _kernels(form):
         A = 4.0 * face_at(y, jnp.zeros(2))[1]
         return 0.5 * SURFACE_HOURGLASS * prm[0] * prm[2] * A * (jnp.asarray(_FACE_HOURGLASS) @ uz / 4.0) ** 2
 
-    def jit(f):
+    def jit(f, name):
         """The jitted kernel for traced calls; for concrete ones (`concrete=True`) compiled ahead of
         time, once per shape, with the cheapest CPU codegen (the kernels run once per build on a few
         chunks) and traced as a staged program even under `jax.ensure_compile_time_eval()`, where
@@ -280,15 +281,16 @@ def _kernels(form):
             if not concrete:
                 return out(prm, x)
             key = (x.shape, str(x.dtype), prm.shape)
-            if key not in compiled:
+            if key not in compiled:       # read from the exported programs where a process compiled it before
                 with _no_eager_folding():
-                    compiled[key] = out.lower(prm, x).compile(compiler_options=_kernel_compiler_options())
+                    compiled[key] = compile_program(f"element-{form}-{name}", f, (prm, x),
+                                                    _kernel_compiler_options())[0]
             return compiled[key](prm, x)
         return call
 
     def batched(fn, size, derivative=jax.hessian):
         H = derivative(fn)
-        return jit(jax.vmap(lambda prm, x: H(jnp.zeros(size, dtype=x.dtype), prm, x), in_axes=(None, 0)))
+        return jit(jax.vmap(lambda prm, x: H(jnp.zeros(size, dtype=x.dtype), prm, x), in_axes=(None, 0)), fn.__name__)
 
     kern = {
         "mass": (batched(e_kinetic, 8), False),
@@ -301,7 +303,7 @@ def _kernels(form):
     else:
         kern["free_surface"] = (batched(e_surface_mean, 4), True)
         kern["axial_curl"] = (batched(axial_curl, 24, jax.jacfwd), False)
-        kern["volume"] = (jit(jax.vmap(volume, in_axes=(None, 0))), False)
+        kern["volume"] = (jit(jax.vmap(volume, in_axes=(None, 0)), "volume"), False)
         kern["coupling"] = (batched(e_coupling, 24), False)
         kern["surface_hourglass"] = (batched(e_surface_hourglass, 4), True)
         kern["div_variation"] = (batched(e_div_variation, 24), False)

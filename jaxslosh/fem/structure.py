@@ -26,7 +26,6 @@ import numpy as np
 import scipy.linalg as sl
 import scipy.sparse as sp
 import scipy.sparse.linalg as spl
-from scipy.optimize import brentq
 
 from .mesh import GAUSS8, HEX_CORNERS, box_mesh
 
@@ -274,18 +273,28 @@ def classify(model: StructureModel, shapes, axis=None):
     return shares, kinds
 
 
+def _roots(f, centres, half):
+    """The root of f in each bracket [centre - half, centre + half], by bisection (vectorised; to the
+    last bit of the bracket: SciPy's brentq would be no more exact here and costs its import)."""
+    lo, hi = np.asarray(centres, float) - half, np.asarray(centres, float) + half
+    neg = f(lo) < 0.0
+    for _ in range(64):
+        mid = 0.5 * (lo + hi)
+        same = (f(mid) < 0.0) == neg
+        lo, hi = np.where(same, mid, lo), np.where(same, hi, mid)
+    return 0.5 * (lo + hi)
+
+
 def euler_bernoulli_cantilever(length, EI, rhoA, n=3) -> np.ndarray:
     """First n bending angular frequencies of a clamped-free Euler-Bernoulli beam (rad/s)."""
-    roots = [brentq(lambda x: np.cos(x) * np.cosh(x) + 1.0, (k + 0.5) * np.pi - 1.0, (k + 0.5) * np.pi + 1.0)
-             for k in range(n)]
-    return np.array([(b / length) ** 2 * np.sqrt(EI / rhoA) for b in roots])
+    b = _roots(lambda x: np.cos(x) * np.cosh(x) + 1.0, (np.arange(n) + 0.5) * np.pi, 1.0)
+    return (b / length) ** 2 * np.sqrt(EI / rhoA)
 
 
 def euler_bernoulli_free_free(length, EI, rhoA, n=3) -> np.ndarray:
     """First n elastic bending angular frequencies of a free-free Euler-Bernoulli beam (rad/s)."""
-    roots = [brentq(lambda x: np.cos(x) * np.cosh(x) - 1.0, (k + 1.5) * np.pi - 0.5, (k + 1.5) * np.pi + 0.5)
-             for k in range(n)]
-    return np.array([(b / length) ** 2 * np.sqrt(EI / rhoA) for b in roots])
+    b = _roots(lambda x: np.cos(x) * np.cosh(x) - 1.0, (np.arange(n) + 1.5) * np.pi, 0.5)
+    return (b / length) ** 2 * np.sqrt(EI / rhoA)
 
 
 def centrifugal_stiffness(nodes, elements, sizes, stiffness, mass, held, young, poisson, axis_point):

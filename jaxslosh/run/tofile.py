@@ -2,12 +2,11 @@
 with its progress on stderr, so that long runs show progress and a killed run leaves a readable file
 that says how it ended.
 
-The chunk is compiled ahead of time (`advance.lower(...).compile()`, equinox's AOT API), as a phase
+The chunk is compiled ahead of time (compile_run: traced once and exported, programs.py), as a phase
 of its own: the first chunk then runs precompiled, so the stepping phase, its rate and its estimate
 hold steps only, and the compile time is measured apart instead of hiding in the first chunk."""
 from __future__ import annotations
 
-import os
 from typing import NamedTuple, Optional
 
 import jax
@@ -16,9 +15,10 @@ import numpy as np
 from ..io.output import is_disk_full
 from ..io.result import ResultWriter
 from ..io.status import Status
+from ..programs import XLA_OPTIONS, compile_program
 from ..scene.types import Scene
 from .guard import Interrupted, interrupts
-from .loop import advance, core, frame_datasets, start
+from .loop import core, frame_datasets, traced_advance, traced_init
 from .progress import Progress
 from .simulate import failure_message, prepare
 from .validity import Watch
@@ -60,9 +60,7 @@ def run_to_file(scene: Scene, out: str, *, progress: bool = True,
             stop.check()
             bar.phase("compile", "compiling the step")
             bc = core(b)
-            carry, f0 = start.lower(bc, solver).compile(compiler_options=compiler_options("start"))(bc, solver)
-            chunk = advance.lower(bc, solver, carry, chunk_frames, se).compile(
-                compiler_options=compiler_options("advance"))
+            carry, f0, chunk = compile_run(bc, solver, chunk_frames, se)
             stop.check()
             bar.phase("stepping", "stepping", total=setup.n_steps)
             pending = jax.tree_util.tree_map(lambda x: np.asarray(x)[None], f0)
@@ -114,17 +112,11 @@ def _reason(e: BaseException) -> str:
     return e.strerror if isinstance(e, OSError) and e.strerror else str(e).splitlines()[0]
 
 
-#: JAXSLOSH_FAST_COMPILE=1: the loop too with XLA's classic CPU loop emitters (about half its compile
-#: time; the results then differ at round-off from the default program)
-FAST_COMPILE_ENV = "JAXSLOSH_FAST_COMPILE"
-
-
-def compiler_options(which: str):
-    """XLA options of the run's two programs (CPU only). `start` runs once: XLA's classic loop
-    emitters compile it in about half the time with the same results bit for bit. The loop keeps
-    XLA's defaults unless JAXSLOSH_FAST_COMPILE=1."""
-    if jax.default_backend() != "cpu":
-        return None
-    if which == "start" or os.environ.get(FAST_COMPILE_ENV) == "1":
-        return {"xla_cpu_use_fusion_emitters": False}
-    return None
+def compile_run(bc, solver, chunk_frames: int, save_every: int):
+    """The run's two programs compiled ahead of time (from the exported programs' folder where a
+    process compiled them before, programs.py): runs `start`; returns its carry and frame, and the
+    compiled chunk, called as `chunk(bc, solver, carry, chunk_frames, save_every)`."""
+    start, _ = compile_program("start", traced_init, (bc, solver), XLA_OPTIONS)
+    carry, f0 = start(bc, solver)
+    chunk, _ = compile_program("advance", traced_advance, (bc, solver, carry, chunk_frames, save_every), XLA_OPTIONS)
+    return carry, f0, chunk

@@ -1,0 +1,147 @@
+"""Compiled programs kept across processes: what a second `jaxslosh run` of a scene skips.
+
+JAX's persistent compilation cache (set up by the CLI, cli/common.setup_jax) saves XLA's work, but
+a new process still traces and lowers every program to find its cache entry: for the paper example
+that is seconds, more than the XLA work the cache saves. Here a program is exported once
+(`jax.export`: its StableHLO and the trees of its inputs and outputs) to a file named by everything
+the trace depends on; a later process reads the file instead of tracing, and XLA's cache serves the
+compilation.
+
+What the trace depends on, hence the file's name: jaxslosh's source (every module, hashed), the JAX
+version and backend, the program's name, the structure of its arguments with every static value
+(the pickled tree definition: equinox's static fields, Python numbers and strings among the leaves)
+and the shape and type of each array. Arrays (JAX or NumPy) are the program's inputs, as under
+`eqx.filter_jit`. Where the structure does not pickle, or the folder is off or not writable, the
+program is traced and compiled as usual, without a file.
+"""
+from __future__ import annotations
+
+import functools
+import hashlib
+import os
+import pickle
+import tempfile
+
+import jax
+import numpy as np
+from jax import export
+
+#: XLA options of `jaxslosh run`'s programs (compile_program; JAX takes options only for a top-level
+#: jit, so `js.simulate`, which a user may call inside a jit, keeps XLA's defaults and agrees with
+#: the run to round-off). XLA's classic CPU loop emitters compile the step's many small fusions in
+#: 30-40 % less time than its default fusion emitters, and the step runs as fast (README
+#: "Compilation"). A field of XLA's shared debug options: other backends accept it and leave it unused.
+XLA_OPTIONS = {"xla_cpu_use_fusion_emitters": False}
+
+_FOLDER: list = [None]
+
+
+def use(folder: str | None):
+    """Keep exported programs in `folder` (None: off, the default)."""
+    _FOLDER[0] = folder
+
+
+def folder() -> str | None:
+    return _FOLDER[0]
+
+
+@functools.cache
+def _code_hash() -> bytes:
+    root = os.path.dirname(os.path.abspath(__file__))
+    h = hashlib.sha256(f"{jax.__version__} {jax.lib.__version__}".encode())
+    for dirpath, dirs, files in sorted(os.walk(root)):
+        dirs.sort()
+        for f in sorted(files):
+            if f.endswith(".py"):
+                h.update(f.encode())
+                with open(os.path.join(dirpath, f), "rb") as fh:
+                    h.update(fh.read())
+    return h.digest()
+
+
+def _is_input(x) -> bool:
+    return isinstance(x, (jax.Array, np.ndarray, np.generic))
+
+
+def _aval(x):
+    """Shape and type; never weakly typed: an exported program's outputs come back strongly typed,
+    and a carry passed on from one program to the next must give the same name (with float64
+    throughout, weak typing changes no result)."""
+    return jax.ShapeDtypeStruct(np.shape(x), jax.dtypes.canonicalize_dtype(x.dtype))
+
+
+def _key(name, treedef, leaves, options) -> str | None:
+    try:
+        tree = pickle.dumps(treedef)
+        static = pickle.dumps([None if _is_input(x) else x for x in leaves])
+    except Exception:        # a static value that does not pickle (a function made inside a call)
+        return None
+    h = hashlib.sha256(_code_hash())
+    h.update(repr((name, jax.default_backend(), jax.config.jax_enable_x64, sorted((options or {}).items()))).encode())
+    h.update(tree)
+    h.update(static)
+    h.update(repr([(a.shape, str(a.dtype)) for a in map(_aval, filter(_is_input, leaves))]).encode())
+    return h.hexdigest()
+
+
+def _read(path):
+    try:
+        with open(path, "rb") as f:
+            blob, out_tree = pickle.load(f)
+        return export.deserialize(blob), out_tree
+    except Exception:        # absent, written by another version, cut short: traced again
+        return None
+
+
+def _write(path, exported, out_tree):
+    try:
+        os.makedirs(os.path.dirname(path), exist_ok=True)
+        fd, tmp = tempfile.mkstemp(dir=os.path.dirname(path), suffix=".tmp")
+        with os.fdopen(fd, "wb") as f:
+            pickle.dump((exported.serialize(), out_tree), f)
+        os.replace(tmp, path)      # whole or absent, for a process that reads it meanwhile
+    except Exception:
+        pass                       # a cache that cannot be written is no cache, not an error
+
+
+def compile_program(name: str, fn, args: tuple, compiler_options=None):
+    """`fn(*args)` compiled for arguments of this structure, shapes and static values; returns the
+    compiled callable (it takes arguments like `args`) and whether it came from the folder."""
+    leaves, treedef = jax.tree_util.tree_flatten(args)
+    where = [i for i, x in enumerate(leaves) if _is_input(x)]
+    avals = [_aval(leaves[i]) for i in where]
+    base = folder()
+    key = _key(name, treedef, leaves, compiler_options) if base else None
+    if key is None:
+        compiled = jax.jit(lambda *xs: fn(*_fill(treedef, leaves, where, xs))).lower(*avals).compile(
+            compiler_options=compiler_options)
+        return (lambda *a: compiled(*_inputs(a, where))), False
+    path = os.path.join(base, f"{name.replace(' ', '_')}-{key[:32]}.jaxexport")
+    found = _read(path)
+    if found is None:
+        out_tree = []
+
+        def flat(*xs):
+            out, tree = jax.tree_util.tree_flatten(fn(*_fill(treedef, leaves, where, xs)))
+            out_tree.append(tree)
+            return out
+        exported = export.export(jax.jit(flat))(*avals)
+        _write(path, exported, out_tree[0])
+        found, loaded = (exported, out_tree[0]), False
+    else:
+        loaded = True
+    exported, out_tree = found
+    compiled = jax.jit(exported.call).lower(*avals).compile(compiler_options=compiler_options)
+    return (lambda *a: jax.tree_util.tree_unflatten(out_tree, compiled(*_inputs(a, where)))), loaded
+
+
+def _fill(treedef, leaves, where, xs):
+    leaves = list(leaves)
+    for i, x in zip(where, xs):
+        leaves[i] = x
+    return jax.tree_util.tree_unflatten(treedef, leaves)
+
+
+def _inputs(args, where):
+    leaves = jax.tree_util.tree_leaves(args)
+    return [leaves[i] for i in where]

@@ -1,0 +1,74 @@
+"""Exported programs kept across processes (jaxslosh/programs.py): a program read back from its file
+computes what the traced one does, and a change of anything the trace depends on (a static value,
+a shape) names another file."""
+import os
+
+import equinox as eqx
+import jax
+import jax.numpy as jnp
+import numpy as np
+import pytest
+
+from jaxslosh import programs
+
+
+class Model(eqx.Module):
+    k: jax.Array
+    power: int = eqx.field(static=True)
+
+
+def energy(m: Model, x, label):
+    assert label in ("a", "b")
+    return {"e": 0.5 * m.k * jnp.sum(x ** m.power), "grad": jax.grad(lambda y: jnp.sum(y ** m.power))(x)}
+
+
+@pytest.fixture
+def folder(tmp_path):
+    programs.use(str(tmp_path))
+    yield tmp_path
+    programs.use(None)
+
+
+def test_a_program_read_back_computes_what_the_traced_one_does(folder):
+    m, x = Model(jnp.asarray(3.0), 3), np.linspace(0.0, 1.0, 7)
+    f1, loaded1 = programs.compile_program("energy", energy, (m, x, "a"))
+    files = os.listdir(folder)
+    f2, loaded2 = programs.compile_program("energy", energy, (m, x, "a"))
+    assert (loaded1, loaded2) == (False, True) and len(files) == 1 and os.listdir(folder) == files
+    ref = jax.jit(energy, static_argnums=2)(m, x, "a")
+    for f in (f1, f2):
+        out = f(Model(jnp.asarray(2.0), 3), x + 1.0, "a")        # new values, the same structure
+        want = jax.jit(energy, static_argnums=2)(Model(jnp.asarray(2.0), 3), x + 1.0, "a")
+        np.testing.assert_array_equal(out["e"], want["e"])
+        np.testing.assert_array_equal(out["grad"], want["grad"])
+    np.testing.assert_allclose(ref["e"], 0.5 * 3.0 * np.sum(x ** 3), rtol=1e-15)
+
+
+def test_what_the_trace_depends_on_names_another_file(folder):
+    m, x = Model(jnp.asarray(3.0), 3), np.linspace(0.0, 1.0, 7)
+    programs.compile_program("energy", energy, (m, x, "a"))
+    for args in [(Model(jnp.asarray(3.0), 2), x, "a"),       # a static field
+                 (m, x, "b"),                               # a static leaf
+                 (m, np.linspace(0.0, 1.0, 8), "a"),        # a shape
+                 (m, x.astype(np.float32), "a")]:           # a type
+        _, loaded = programs.compile_program("energy", energy, args)
+        assert not loaded
+    assert len(os.listdir(folder)) == 5
+
+
+def test_a_damaged_file_is_traced_again(folder):
+    m, x = Model(jnp.asarray(3.0), 3), np.linspace(0.0, 1.0, 7)
+    programs.compile_program("energy", energy, (m, x, "a"))
+    (path,) = [folder / f for f in os.listdir(folder)]
+    path.write_bytes(path.read_bytes()[:100])
+    f, loaded = programs.compile_program("energy", energy, (m, x, "a"))
+    assert not loaded
+    np.testing.assert_allclose(f(m, x, "a")["e"], 0.5 * 3.0 * np.sum(x ** 3), rtol=1e-15)
+
+
+def test_without_a_folder_nothing_is_written(tmp_path):
+    programs.use(None)
+    m, x = Model(jnp.asarray(3.0), 3), np.linspace(0.0, 1.0, 7)
+    f, loaded = programs.compile_program("energy", energy, (m, x, "a"))
+    assert not loaded and os.listdir(tmp_path) == []
+    np.testing.assert_allclose(f(m, x, "a")["e"], 0.5 * 3.0 * np.sum(x ** 3), rtol=1e-15)
