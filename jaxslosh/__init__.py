@@ -17,18 +17,27 @@ only campaigns and fits need (a second run of a scene starts in seconds: README 
 """
 from importlib import import_module
 
+# the campaign sub-package (its __init__ imports nothing) is bound now, so that the function
+# `campaign` below keeps its name when a module of the sub-package is imported later
+from . import campaign as _campaign_package  # noqa: F401
 from ._version import __version__
 
 #: public name -> the module that defines it
 _PUBLIC = {
     "sloshing_modes": ".analysis.modes", "structure_modes": ".analysis.modes", "rao": ".analysis.rao",
-    "campaign": ".campaign.run", "identify": ".fit.identify", "Result": ".io.result", "load_result": ".io.result",
+"identify": ".fit.identify", "Result": ".io.result", "load_result": ".io.result",
     "save_result": ".io.result", "Status": ".io.status", "simulate_batch": ".run.batch",
     "NumericalFailure": ".run.simulate", "simulate": ".run.simulate", "Stepper": ".run.stepper", "Scene": ".scene",
     "SceneError": ".scene", "load_scene": ".scene",
 }
 
-__all__ = [*_PUBLIC, "__version__"]
+__all__ = [*_PUBLIC, "campaign", "__version__"]
+
+
+def campaign(*args, **kwargs):
+    """`js.campaign`: jaxslosh.campaign.run.campaign (README "Campaigns"), imported on first call
+    (it loads Dask)."""
+    return import_module(".campaign.run", __name__).campaign(*args, **kwargs)
 
 
 def __getattr__(name):

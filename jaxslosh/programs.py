@@ -16,12 +16,14 @@ program is traced and compiled as usual, without a file.
 """
 from __future__ import annotations
 
+import contextlib
 import functools
 import hashlib
 import os
 import pickle
 import tempfile
 
+import equinox as eqx
 import jax
 import numpy as np
 from jax import export
@@ -145,3 +147,24 @@ def _fill(treedef, leaves, where, xs):
 def _inputs(args, where):
     leaves = jax.tree_util.tree_leaves(args)
     return [leaves[i] for i in where]
+
+
+def no_eager_folding():
+    """A context in which a jit trace stages its operations on constants even inside
+    `jax.ensure_compile_time_eval()` (JAX's eager_constant_folding state; a JAX without it: nothing)."""
+    state = getattr(getattr(jax, "_src", None) and jax._src.config, "eager_constant_folding", None)
+    return state(False) if state is not None else contextlib.nullcontext()
+
+
+def staged(fn):
+    """`fn` under equinox's filter_jit, traced whole even where the build evaluates eagerly
+    (run/simulate.prepare, inside `jax.ensure_compile_time_eval()`): the build's few steps written
+    with jax.numpy become one compiled program each, where op by op every line compiled a tiny XLA
+    program of its own (seconds in a fresh process). Inside an outer trace it is inlined."""
+    jitted = eqx.filter_jit(fn)
+
+    @functools.wraps(fn)
+    def call(*args, **kwargs):
+        with no_eager_folding():
+            return jitted(*args, **kwargs)
+    return call

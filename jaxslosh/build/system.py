@@ -19,6 +19,7 @@ from ..physics.liquid import RotationPenalty, SpinStiffening
 from ..physics.system import System
 from ..physics.terms import Config
 from ..physics.vessel import FreeMotion, Hydrostatics, PrescribedMotion, RigidBody, Weight
+from ..programs import staged
 from ..scene.keys import resolve_params
 from ..scene.types import DOFS, Scene, SceneError
 from ..solve.sparse import hydrostatic_start
@@ -71,7 +72,7 @@ def build(scene: Scene, params: Optional[dict] = None) -> Built:
                                   profile=f.profile, rate=float(f.rate),
                                   duration=float(f.duration) if f.duration else 1.0)
     ini = ves.initial
-    q0 = quat_from_rpy(jnp.asarray(P("vessel.initial.roll_pitch_yaw", ini.roll_pitch_yaw), dtype=float))
+    q0 = staged(quat_from_rpy)(jnp.asarray(P("vessel.initial.roll_pitch_yaw", ini.roll_pitch_yaw), dtype=float))
     if motion.prescribed:
         q0 = jnp.array([1.0, 0.0, 0.0, 0.0])
     sea_terms, memory = build_seakeeping(scene, params) if scene.waves is not None or ves.hydrodynamics is not None \
@@ -139,7 +140,11 @@ def _hull(mass, inertia, parts):
 def _hydrostatic_start(system: System, q0):
     """Discrete hydrostatic equilibrium K d0 = F_g under the initial gravity direction (PHYSICS.md
     item 6), so that the stiff acoustic modes are not excited by the start."""
-    g_b = system.gravity_body(rotation_matrix(q0))
     if system.liquid.sparse:
-        return hydrostatic_start(system.liquid, g_b)
-    return system.liquid.static_start(g_b)
+        return hydrostatic_start(system.liquid, system.gravity_body(rotation_matrix(q0)))
+    return _dense_static_start(system, q0)
+
+
+@staged
+def _dense_static_start(system: System, q0):
+    return system.liquid.static_start(system.gravity_body(rotation_matrix(q0)))

@@ -55,13 +55,12 @@ use >= 2 elements along every direction in which the surface should move.
 """
 from __future__ import annotations
 
-import contextlib
 
 import jax
 import jax.numpy as jnp
 import numpy as np
 
-from ..programs import compile_program
+from ..programs import compile_program, no_eager_folding
 from .linalg import det2, det3, inv3
 from .mesh import GAUSS8, GAUSS_1D, HEX_CORNERS
 
@@ -158,13 +157,6 @@ def _distinct(x, horizontal_only):
     return x[first], inverse.reshape(-1)
 
 _KERNEL_CACHE: dict = {}
-
-
-def _no_eager_folding():
-    """A context in which a jit trace stages its operations on constants even inside
-    `jax.ensure_compile_time_eval()` (JAX's eager_constant_folding state; a JAX without it: nothing)."""
-    state = getattr(getattr(jax, "_src", None) and jax._src.config, "eager_constant_folding", None)
-    return state(False) if state is not None else contextlib.nullcontext()
 
 
 def _kernel_compiler_options():
@@ -282,7 +274,7 @@ def _kernels(form):
                 return out(prm, x)
             key = (x.shape, str(x.dtype), prm.shape)
             if key not in compiled:       # read from the exported programs where a process compiled it before
-                with _no_eager_folding():
+                with no_eager_folding():
                     compiled[key] = compile_program(f"element-{form}-{name}", f, (prm, x),
                                                     _kernel_compiler_options())[0]
             return compiled[key](prm, x)

@@ -13,6 +13,7 @@ import numpy as np
 from ..fem.linalg import inv, solve
 from ..physics.structures import layout
 from ..physics.system import System
+from ..programs import staged
 from .schemes import Scheme
 from .sparse import sparse_solver_blocks
 
@@ -103,12 +104,18 @@ def make_solver(system: System, h: float, scheme: Scheme, tol: float, max_iter: 
         Cs = c_a * M_ff + K_ff
         return inverse(0.5 * (Cs + Cs.T))
 
-    scale = jax.lax.stop_gradient(system.scales()[6:])
-    noise = jnp.finfo(jnp.float64).eps * jnp.max(jnp.sum(jnp.abs(jnp.asarray(K_ff)), axis=1) / scale)
+    noise = _noise(system, K_ff)
     return Solver(damped(step_block_inverse(h), system, scheme, h), inverse(M_ff), jnp.asarray(h, dtype=float),
                   scheme, tol, max_iter, substeps,
                   damped(step_block_inverse(h / substeps), system, scheme, h / substeps) if substeps else None,
                   noise=noise, reuse=reuse, adaptive=adaptive)
+
+
+@staged
+def _noise(system: System, K_ff):
+    """The round-off floor of the scaled residual: eps times the largest row of |K| per unit scale."""
+    scale = jax.lax.stop_gradient(system.scales()[6:])
+    return jnp.finfo(jnp.float64).eps * jnp.max(jnp.sum(jnp.abs(jnp.asarray(K_ff)), axis=1) / scale)
 
 
 class LowRankUpdate(eqx.Module):
