@@ -112,7 +112,7 @@ def build(scene: Scene, params: Optional[dict] = None) -> Built:
         v0 = v0.at[:6].set(motion.rates(jnp.zeros(())))
     alg0 = None
     if flex is not None:
-        c0, v0, alg0 = flex_start(system, c0, v0)
+        c0, v0, alg0 = staged(flex_start)(system, c0, v0)
     probes = build_probes(scene, block.tanks, liquid, blocks, block.vstructs)
     probes = probes._replace(modal=liquid.probe_modal(probes.weights))    # a modal liquid: probes from eta
     surfaces = tuple(jnp.asarray(t.node_offset + np.flatnonzero(np.isclose(t.nodes[:, 2], t.nodes[:, 2].max())))

@@ -27,6 +27,7 @@ import scipy.linalg as sl
 import scipy.sparse as sp
 import scipy.sparse.linalg as spl
 
+from ..programs import compile_program, no_eager_folding
 from .mesh import GAUSS8, HEX_CORNERS, box_mesh
 
 
@@ -43,7 +44,7 @@ def elasticity_matrix(young: float, poisson: float) -> np.ndarray:
 
 @functools.lru_cache(maxsize=1)
 def _element_hessian():
-    """The jitted Hessian of the element energy in (u, a) for given half sizes and C: one
+    """The compiled Hessian of the element energy in (u, a) for given half sizes and C: one
     compilation serves every element size and material."""
     def strain(grad):            # grad[i, j] = d u_i / d x_j
         return jnp.array([grad[0, 0], grad[1, 1], grad[2, 2], grad[1, 2] + grad[2, 1],
@@ -59,7 +60,11 @@ def _element_hessian():
     def energy(z, half, C):
         return jax.vmap(energy_at, in_axes=(0, None, None, None))(jnp.asarray(GAUSS8), z, half, C).sum()
 
-    return jax.jit(jax.hessian(energy))
+    # staged whole even under the build's ensure_compile_time_eval, and read back from the exported
+    # programs where a process compiled it before (programs.py)
+    with jax.enable_x64(True), no_eager_folding():
+        like = (np.zeros(33), np.zeros(3), np.zeros((6, 6)))
+        return compile_program("element-structure", jax.hessian(energy), like)[0]
 
 
 @functools.lru_cache(maxsize=32)
