@@ -13,6 +13,7 @@ import jax
 
 from .. import programs
 from ..io.output import OutputError, check_output
+from ..io.result import ResultFileError
 from ..scene.keys import with_overrides
 from ..scene.load import load_scene
 from ..scene.types import Scene, SceneError
@@ -42,6 +43,15 @@ COMMANDS = {
     "export": ("export", "write a result for ParaView (XDMF 3 time series over one HDF5 file)"),
     "campaign": ("campaign", "run a scatter of sea states x headings x seeds on Dask, write statistics"),
 }
+
+
+def read(load, path):
+    """`load(path)` for a command: a file that is not of the kind asked for, or cannot be read, is
+    bad input (one line naming the file and the fault; exit 2)."""
+    try:
+        return load(path)
+    except ResultFileError as e:
+        raise InputError(str(e)) from None
 
 
 class Parser(argparse.ArgumentParser):

@@ -7,8 +7,8 @@ import time
 
 from ..io.output import OutputError, OutputLock
 from ..io.paraview import export_paraview
-from ..io.result import ResultFileError, load_result
-from .common import COMMANDS, EXIT_OK, InputError, output_folder
+from ..io.result import load_result
+from .common import COMMANDS, EXIT_OK, InputError, read, output_folder
 
 
 def add_parsers(sub):
@@ -29,10 +29,7 @@ def cmd_export(a):
     data = os.path.splitext(a.paraview)[0] + "_paraview.h5"
     if os.path.exists(a.result) and os.path.exists(data) and os.path.samefile(a.result, data):
         raise InputError(f"--paraview: {data} would overwrite the result file; choose another name")
-    try:
-        r = load_result(a.result)
-    except ResultFileError as e:
-        raise InputError(str(e)) from None
+    r = read(load_result, a.result)
     try:
         lock = OutputLock(data)
     except OutputError as e:

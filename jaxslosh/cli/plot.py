@@ -12,7 +12,7 @@ from ..plot.results import plot_result, plot_sweep
 from ..plot.surface import animate_free_surface, plot_free_surface
 from ..run.progress import Progress, wanted
 from .campaign import parse_limits
-from .common import COMMANDS, EXIT_OK, InputError, output_folder, positive
+from .common import COMMANDS, EXIT_OK, InputError, read, output_folder, positive
 
 
 def add_parsers(sub):
@@ -60,10 +60,7 @@ def cmd_plot(a):
     if fmt != FORMAT:
         raise InputError(f"{a.result}: not a jaxslosh result file "
                          f"({'format ' + repr(fmt) if fmt else 'no format attribute'})")
-    try:
-        r = load_result(a.result)
-    except ResultFileError as e:
-        raise InputError(str(e)) from None
+    r = read(load_result, a.result)
     for flag, path in (("--surface", a.surface), ("--animate", a.animate)):
         if path and not r.tanks:
             raise InputError(f"{flag}: {a.result} holds no liquid fields (a scene with tanks, run without --no-fields)")
@@ -90,10 +87,7 @@ def _plot_sweep(a, out):
         if path:
             raise InputError(f"{flag}: {a.result} is a sweep file (format {SWEEP_FORMAT!r}), which keeps no liquid "
                              f"meshes; run one of its scenes with `jaxslosh run` to draw its free surface")
-    try:
-        sw = load_sweep(a.result)
-    except ResultFileError as e:
-        raise InputError(str(e)) from None
+    sw = read(load_sweep, a.result)
     plot_sweep(sw.params, sw.result, sw.statuses, out, sw.scene_text)
     print(f"wrote {out} ({len(sw.statuses)} runs of a sweep)")
     return EXIT_OK
@@ -104,10 +98,7 @@ def _plot_campaign(a, out):
     for flag, path in (("--surface", a.surface), ("--animate", a.animate)):
         if path:
             raise InputError(f"{flag}: {a.result} is a campaign file, which keeps statistics, not liquid fields")
-    try:
-        c = load_campaign(a.result)
-    except ResultFileError as e:
-        raise InputError(str(e)) from None
+    c = read(load_campaign, a.result)
     n = len(c.status)
     if a.case is not None and not 0 <= a.case < n:
         raise InputError(f"--case: {a.case} is not a case of {a.result} (0 to {n - 1})")
