@@ -41,6 +41,11 @@ class Built(NamedTuple):
     surfaces: tuple = ()                 # per tank, the stacked indices of its free-surface nodes (validity)
 
 
+#: the build's jax.numpy steps, each one compiled program (programs.staged), wrapped once per process
+_quat_from_rpy = staged(quat_from_rpy)
+_flex_start = staged(flex_start)
+
+
 def _inertia(value):
     a = jnp.asarray(value, dtype=float)
     return jnp.diag(a) if a.ndim == 1 else a
@@ -72,7 +77,7 @@ def build(scene: Scene, params: Optional[dict] = None) -> Built:
                                   profile=f.profile, rate=float(f.rate),
                                   duration=float(f.duration) if f.duration else 1.0)
     ini = ves.initial
-    q0 = staged(quat_from_rpy)(jnp.asarray(P("vessel.initial.roll_pitch_yaw", ini.roll_pitch_yaw), dtype=float))
+    q0 = _quat_from_rpy(jnp.asarray(P("vessel.initial.roll_pitch_yaw", ini.roll_pitch_yaw), dtype=float))
     if motion.prescribed:
         q0 = jnp.array([1.0, 0.0, 0.0, 0.0])
     sea_terms, memory = build_seakeeping(scene, params) if scene.waves is not None or ves.hydrodynamics is not None \
@@ -112,7 +117,7 @@ def build(scene: Scene, params: Optional[dict] = None) -> Built:
         v0 = v0.at[:6].set(motion.rates(jnp.zeros(())))
     alg0 = None
     if flex is not None:
-        c0, v0, alg0 = staged(flex_start)(system, c0, v0)
+        c0, v0, alg0 = _flex_start(system, c0, v0)
     probes = build_probes(scene, block.tanks, liquid, blocks, block.vstructs)
     probes = probes._replace(modal=liquid.probe_modal(probes.weights))    # a modal liquid: probes from eta
     surfaces = tuple(jnp.asarray(t.node_offset + np.flatnonzero(np.isclose(t.nodes[:, 2], t.nodes[:, 2].max())))
