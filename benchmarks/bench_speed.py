@@ -33,7 +33,7 @@ ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 def naive_step(system, solver, s):
     """The same generalized-alpha step solved the textbook way: full Jacobian, dense solve."""
     scale = system.scales()
-    R, unpack, x0 = step_equations(system, solver, s)
+    R, unpack, x0, _ = step_equations(system, solver, s)
 
     def body(carry):
         x, it, _ = carry

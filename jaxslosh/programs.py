@@ -22,6 +22,7 @@ import hashlib
 import os
 import pickle
 import tempfile
+import threading
 
 import equinox as eqx
 import jax
@@ -62,14 +63,15 @@ def _code_hash() -> bytes:
 
 
 def _is_input(x) -> bool:
-    return isinstance(x, (jax.Array, np.ndarray, np.generic))
+    """An array (or the shape and type of one, to lower a program before its inputs exist)."""
+    return isinstance(x, (jax.Array, np.ndarray, np.generic, jax.ShapeDtypeStruct))
 
 
 def _aval(x):
     """Shape and type; never weakly typed: an exported program's outputs come back strongly typed,
     and a carry passed on from one program to the next must give the same name (with float64
     throughout, weak typing changes no result)."""
-    return jax.ShapeDtypeStruct(np.shape(x), jax.dtypes.canonicalize_dtype(x.dtype))
+    return jax.ShapeDtypeStruct(tuple(x.shape), jax.dtypes.canonicalize_dtype(x.dtype))
 
 
 def _key(name, treedef, leaves, options) -> str | None:
@@ -97,30 +99,74 @@ def _read(path):
 
 def _write(path, exported, out_tree):
     try:
-        os.makedirs(os.path.dirname(path), exist_ok=True)
-        fd, tmp = tempfile.mkstemp(dir=os.path.dirname(path), suffix=".tmp")
-        with os.fdopen(fd, "wb") as f:
-            pickle.dump((exported.serialize(), out_tree), f)
-        os.replace(tmp, path)      # whole or absent, for a process that reads it meanwhile
+        data = pickle.dumps((exported.serialize(), out_tree))
     except Exception:
-        pass                       # a cache that cannot be written is no cache, not an error
+        return
+    _write_bytes(path, data)
 
 
-def compile_program(name: str, fn, args: tuple, compiler_options=None):
-    """`fn(*args)` compiled for arguments of this structure, shapes and static values; returns the
-    compiled callable (it takes arguments like `args`) and whether it came from the folder."""
+class Program:
+    """A program traced (or read from its file) and lowered, whose XLA compilation is still to come:
+    `out` is its output tree of shapes and types (what a following program is lowered with), and
+    `compile()` or `compile_in_background()` then `result()` give the callable, which takes
+    arguments like the `args` it was lowered for. XLA's work runs outside Python (no GIL), so one
+    program compiles in the background while Python traces the next."""
+
+    def __init__(self, lowered, where, out_tree, loaded, options):
+        self._lowered, self._where, self._out_tree, self._options = lowered, where, out_tree, options
+        self.loaded = loaded
+        self._done: list = []
+        self._thread = None
+
+    @property
+    def out(self):
+        info = jax.tree_util.tree_map(lambda a: jax.ShapeDtypeStruct(a.shape, a.dtype), self._lowered.out_info)
+        return info if self._out_tree is None else jax.tree_util.tree_unflatten(self._out_tree, info)
+
+    def _compile(self):
+        try:
+            self._done.append((self._lowered.compile(compiler_options=self._options), None))
+        except BaseException as e:      # handed to the thread that asks for the result
+            self._done.append((None, e))
+
+    def compile_in_background(self) -> "Program":
+        # a daemon thread: an interrupted run exits without waiting for XLA to finish
+        self._thread = threading.Thread(target=self._compile, name="xla-compile", daemon=True)
+        self._thread.start()
+        return self
+
+    def result(self):
+        if self._thread is not None:
+            self._thread.join()
+        elif not self._done:
+            self._compile()
+        compiled, error = self._done[-1]
+        if error is not None:
+            raise error
+        where, out_tree = self._where, self._out_tree
+        if out_tree is None:
+            return lambda *a: compiled(*_inputs(a, where))
+        return lambda *a: jax.tree_util.tree_unflatten(out_tree, compiled(*_inputs(a, where)))
+
+    compile = result
+
+
+def lower_program(name: str, fn, args: tuple, compiler_options=None) -> Program:
+    """`fn(*args)` traced and lowered for arguments of this structure, shapes and static values (from
+    the folder's exported program where a process traced it before), not yet compiled. Arrays among
+    `args` may be jax.ShapeDtypeStruct: only their shapes and types are read."""
     leaves, treedef = jax.tree_util.tree_flatten(args)
     where = [i for i, x in enumerate(leaves) if _is_input(x)]
     avals = [_aval(leaves[i]) for i in where]
     base = folder()
     key = _key(name, treedef, leaves, compiler_options) if base else None
     if key is None:
-        compiled = jax.jit(lambda *xs: fn(*_fill(treedef, leaves, where, xs))).lower(*avals).compile(
-            compiler_options=compiler_options)
-        return (lambda *a: compiled(*_inputs(a, where))), False
+        lowered = jax.jit(lambda *xs: fn(*_fill(treedef, leaves, where, xs))).lower(*avals)
+        return Program(lowered, where, None, False, compiler_options)
     path = os.path.join(base, f"{name.replace(' ', '_')}-{key[:32]}.jaxexport")
     found = _read(path)
-    if found is None:
+    loaded = found is not None
+    if not loaded:
         out_tree = []
 
         def flat(*xs):
@@ -129,12 +175,63 @@ def compile_program(name: str, fn, args: tuple, compiler_options=None):
             return out
         exported = export.export(jax.jit(flat))(*avals)
         _write(path, exported, out_tree[0])
-        found, loaded = (exported, out_tree[0]), False
-    else:
-        loaded = True
+        found = (exported, out_tree[0])
     exported, out_tree = found
-    compiled = jax.jit(exported.call).lower(*avals).compile(compiler_options=compiler_options)
-    return (lambda *a: jax.tree_util.tree_unflatten(out_tree, compiled(*_inputs(a, where)))), loaded
+    return Program(jax.jit(exported.call).lower(*avals), where, out_tree, loaded, compiler_options)
+
+
+def compile_program(name: str, fn, args: tuple, compiler_options=None):
+    """`fn(*args)` compiled for arguments of this structure, shapes and static values; returns the
+    compiled callable (it takes arguments like `args`) and whether it came from the folder."""
+    p = lower_program(name, fn, args, compiler_options)
+    return p.compile(), p.loaded
+
+
+#: a value larger than this, pickled, is not kept (a large mesh's model: its file would cost more to
+#: write and read than the build it saves)
+MAX_VALUE_BYTES = 64 << 20
+
+
+def cached(name: str, key, compute):
+    """`compute()`, kept in the folder under a name made of `key` (pickled: the scene, say), jaxslosh's
+    source, the JAX version and backend, and x64: a later process reads it instead of computing it
+    again. What does not pickle (key or value), is larger than MAX_VALUE_BYTES, or finds no folder is
+    computed as usual and not kept."""
+    base = folder()
+    try:
+        blob = pickle.dumps(key) if base else None
+    except Exception:
+        blob = None
+    if blob is None:
+        return compute()
+    h = hashlib.sha256(_code_hash())
+    h.update(repr((name, jax.default_backend(), jax.config.jax_enable_x64)).encode())
+    h.update(blob)
+    path = os.path.join(base, f"{name.replace(' ', '_')}-{h.hexdigest()[:32]}.pickle")
+    try:
+        with open(path, "rb") as f:
+            return pickle.load(f)
+    except Exception:        # absent, written by another version, cut short: computed again
+        pass
+    value = compute()
+    try:
+        data = pickle.dumps(value)
+    except Exception:
+        return value
+    if len(data) <= MAX_VALUE_BYTES:
+        _write_bytes(path, data)
+    return value
+
+
+def _write_bytes(path, data: bytes):
+    try:
+        os.makedirs(os.path.dirname(path), exist_ok=True)
+        fd, tmp = tempfile.mkstemp(dir=os.path.dirname(path), suffix=".tmp")
+        with os.fdopen(fd, "wb") as f:
+            f.write(data)
+        os.replace(tmp, path)      # whole or absent, for a process that reads it meanwhile
+    except Exception:
+        pass                       # a cache that cannot be written is no cache, not an error
 
 
 def _fill(treedef, leaves, where, xs):

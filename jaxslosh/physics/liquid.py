@@ -153,8 +153,8 @@ class Liquid(AbstractLiquid):
         """Eq. (4): the particle accelerations (body components), their inertia forces on the nodes,
         and what they do on the rigid rows and the liquid's own; the stiffness and the gravity load."""
         c, A, omega = k.c, k.A, k.omega
-        a0, alpha = k.acc[:3], k.acc[3:6]
-        D, Dv, Da = self.full(c.d), self.full(k.d_dot), self.full(k.acc[6:])
+        a0, alpha = k.a6[:3], k.a6[3:6]
+        D, Dv, Da = self.full(c.d), self.full(k.d_dot), self.full(k.d_acc)
         x = self.r + D
         a = tv3(A, a0) + Da + jnp.cross(alpha, x)
         if self.coriolis:

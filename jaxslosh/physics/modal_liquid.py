@@ -67,8 +67,8 @@ class ReducedLiquid(AbstractLiquid):
         """The liquid's share of the residual (liquid.Liquid.rows) at d = V eta: rigid translation
         rows (inertial), rigid rotation rows (body), modal rows."""
         A, omega, g_b, eta_dot = k.A, k.omega, k.g_b, k.d_dot
-        eta, eta_dd = k.c.d, k.acc[6:]
-        a0, alpha = k.acc[:3], k.acc[3:6]
+        eta, eta_dd = k.c.d, k.d_acc
+        a0, alpha = k.a6[:3], k.a6[3:6]
         b = tv3(A, a0)
         W = self._W(eta)
         J = self.second_moment(eta, W)

@@ -100,7 +100,7 @@ class AddedMass(AbstractTerm):
     matrix: jax.Array
 
     def rows(self, k: Kin) -> Rows:
-        return Rows(self.matrix @ k.acc[:6])
+        return Rows(self.matrix @ k.a6)
 
     def kinetic(self, k: Kin):
         v6 = k.v6

@@ -144,13 +144,20 @@ def layout(system) -> Layout:
 
 def advance(system, c: Config, delta) -> Config:
     """Apply a dynamic increment: translations added, rotations on the group (q exp(Theta))."""
+    r = layout(system).n_rigid
+    return advance_parts(system, c, delta[:r], delta[r:])
+
+
+def advance_parts(system, c: Config, y, z) -> Config:
+    """`advance` for the rigid increments y (vessel, structures) and the others z (liquid, modal)
+    apart (see inertia_rows_parts)."""
     L = layout(system)
-    ves, st, dd, de = L.split(delta)
-    out = Config(c.X0 + ves[:3], quat_multiply(c.q, quat_exp(ves[3:6])), c.d + dd)
+    out = Config(c.X0 + y[:3], quat_multiply(c.q, quat_exp(y[3:6])), c.d + z[:L.nf])
     if L.S == 0:
         return out
+    st = y[6:].reshape(L.S, 6)
     qs = jax.vmap(lambda q, th: quat_multiply(q, quat_exp(th)))(c.qs, st[:, 3:])
-    return out._replace(Xs=c.Xs + st[:, :3], qs=qs, eta=c.eta + de)
+    return out._replace(Xs=c.Xs + st[:, :3], qs=qs, eta=c.eta + z[L.nf:])
 
 
 def split_eta(flex: Flex, eta):
@@ -271,10 +278,19 @@ def structure_potential(system, c: Config):
 def inertia_rows(system, c: Config, v, acc, t, mu=None):
     """Dyn rows without the multipliers: the vessel-and-liquid residual of model.py, each structure's
     rigid and elastic inertia rows, and the forces of the structures' potential (elastic, gravity)."""
+    r = layout(system).n_rigid
+    return jnp.concatenate(inertia_rows_parts(system, c, v[:r], v[r:], acc[:r], acc[r:], t, mu))
+
+
+def inertia_rows_parts(system, c: Config, vy, vz, ay, az, t, mu=None):
+    """`inertia_rows` as (rigid rows (n_rigid,), the others (nf + m,)), with the rates of the rigid
+    unknowns (y: vessel, structures) and of the others (z: liquid, modal) passed apart, as
+    System.residual_parts does for the vessel and its liquid (the Newton preconditioner's rigid rows
+    over z are then a transpose in z alone)."""
     L = layout(system)
-    ves_v, st_v, d_v, e_v = L.split(v)
-    ves_a, st_a, d_a, e_a = L.split(acc)
-    core = system.residual(c, ves_v[:3], ves_v[3:], d_v, jnp.concatenate([ves_a, d_a]), t, mu)
+    ves_v, st_v, d_v, e_v = vy[:6], vy[6:].reshape(L.S, 6), vz[:L.nf], vz[L.nf:]
+    ves_a, st_a, d_a, e_a = ay[:6], ay[6:].reshape(L.S, 6), az[:L.nf], az[L.nf:]
+    core_y, core_z = system.residual_parts(c, ves_v[:3], ves_v[3:], d_v, ves_a, d_a, t, mu)
     flex = system.flex
     rigid_s, modal = [], []
     for s, (b, eta, eta_d, eta_dd) in enumerate(zip(flex.bodies, split_eta(flex, c.eta), split_eta(flex, e_v),
@@ -290,11 +306,10 @@ def inertia_rows(system, c: Config, v, acc, t, mu=None):
         if b.Kg is not None:                                        # centrifugal stiffening (structure.py)
             r_eta = r_eta + jnp.einsum("k,kij,j->i", jnp.stack(spin_tensor_components(om)), b.Kg, eta)
         modal.append(r_eta)
-    dyn = jnp.concatenate([core[:6], jnp.concatenate(rigid_s), core[6:], jnp.concatenate(modal)])
-    grad_V = potential_forces(system, c)
+    gy, gz = potential_forces_parts(system, c)
     if system.motion.prescribed:            # the vessel's rows prescribe its motion
-        grad_V = grad_V.at[:6].set(0.0)
-    return dyn + grad_V
+        gy = jnp.concatenate([jnp.zeros(6), gy[6:]])
+    return jnp.concatenate([core_y, *rigid_s]) + gy, jnp.concatenate([core_z, *modal]) + gz
 
 
 def constraint_rows(system, c: Config, alg, g_rows, gscale):
@@ -312,6 +327,11 @@ def potential_forces(system, c: Config):
     """The gradient of `structure_potential` along the increments, by hand (`test_multibody` checks
     it against jax.grad): omega^2 eta on the modal rows, -m_s g on each structure's translation and,
     when balanced, +m_s g on the vessel's translation and c_s x (m_s A_v^T g) on its rotation."""
+    return jnp.concatenate(potential_forces_parts(system, c))
+
+
+def potential_forces_parts(system, c: Config):
+    """`potential_forces` as (rigid rows, the others), as inertia_rows_parts."""
     flex = system.flex
     L = layout(system)
     g_vec = jnp.array([0.0, 0.0, -system.gravity])
@@ -324,7 +344,7 @@ def potential_forces(system, c: Config):
         modal.append(b.omega2 * eta)
         if system.balanced:
             ves = ves + jnp.concatenate([mg, jnp.cross(b.c0, A_v.T @ mg)])
-    return jnp.concatenate([ves, *rig, jnp.zeros(L.nf), *modal])
+    return jnp.concatenate([ves, *rig]), jnp.concatenate([jnp.zeros(L.nf), *modal])
 
 
 def residual(system, c: Config, v, acc, alg, t, gscale):
@@ -367,15 +387,19 @@ def frame_velocities(system, c: Config, v):
 
 
 def initial_residuals(system, c: Config, v, alg0, t, mscale, mu=None):
-    """The initial accelerations as (R_main, R_c) of x = [acc_y, (frame accelerations, multipliers),
-    acc_z]; the constraint rows are d^2 g / dt^2 = 0 times `mscale` (per interface)."""
+    """The initial accelerations as (R_main, R_c, main_parts) of x = [acc_y, (frame accelerations,
+    multipliers), acc_z]; the constraint rows are d^2 g / dt^2 = 0 times `mscale` (per interface);
+    main_parts(acc_y, acc_z): R_main's rows apart (inertia_rows_parts)."""
     L = layout(system)
     pos_mask = position_mask(system.flex)
     Vf = frame_velocities(system, c, v)
+    r = L.n_rigid
+
+    def main_parts(ay, az):
+        return inertia_rows_parts(system, c, v[:r], v[r:], ay, az, t, mu)
 
     def R_main(x):
-        acc, _ = L.from_x(x)
-        return L.to_x(inertia_rows(system, c, v, acc, t, mu), jnp.zeros(L.n_alg))
+        return in_x(L, *main_parts(x[:r], x[L.n_small:]))
 
     def R_c(x):
         acc, alg_a = L.from_x(x)
@@ -383,7 +407,12 @@ def initial_residuals(system, c: Config, v, alg0, t, mscale, mu=None):
         gdd = constraint_acceleration(system, c, v, acc, alg0, Vf, jnp.where(pos_mask, alg_a, 0.0))
         return constraint_rows(system, c, alg, gdd, mscale)
 
-    return R_main, R_c
+    return R_main, R_c, main_parts
+
+
+def in_x(L: Layout, rows_y, rows_z):
+    """Rigid and other dynamic rows in Newton order [y, alg, z], zero on the alg rows."""
+    return jnp.concatenate([rows_y, jnp.zeros(L.n_alg, rows_y.dtype), rows_z])
 
 
 def position_mask(flex):

@@ -61,9 +61,9 @@ class System(eqx.Module):
         g_vec = jnp.array([0.0, 0.0, -self.gravity])
         return tv3(A if self.gravity_turning else rotation_matrix(self.q_ref), g_vec)
 
-    def kin(self, c: Config, V0, omega, d_dot, acc=None, t=0.0, mu=None) -> Kin:
+    def kin(self, c: Config, V0, omega, d_dot, a6=None, d_acc=None, t=0.0, mu=None) -> Kin:
         A = rotation_matrix(c.q)
-        return Kin(c, V0, omega, d_dot, acc, jnp.asarray(t), mu, A, self.gravity_body(A))
+        return Kin(c, V0, omega, d_dot, a6, d_acc, jnp.asarray(t), mu, A, self.gravity_body(A))
 
     # ---------------------------------------------------------------- equations of motion
     def residual(self, c: Config, V0, omega, d_dot, acc, t=0.0, mu=None):
@@ -71,7 +71,15 @@ class System(eqx.Module):
         acc = (dV0/dt (3, inertial), d omega/dt (3, body), d2 d/dt2 (nf)): the sum of the terms' rows.
         Rows: translation (inertial, N), rotation (body, N m), the deformable block's (N).
         `mu` (6,): the radiation memory force at t, from the integrator's states."""
-        k = self.kin(c, V0, omega, d_dot, acc, t, mu)
+        return jnp.concatenate(self.residual_parts(c, V0, omega, d_dot, acc[:6], acc[6:], t, mu))
+
+    def residual_parts(self, c: Config, V0, omega, d_dot, a6, d_acc, t=0.0, mu=None):
+        """`residual` as (rigid rows (6,), deformable rows (nf,)), with the rigid and the deformable
+        unknowns passed apart. Kept apart, JAX sees which rows and unknowns do not touch: the Newton
+        preconditioner's rigid rows over the liquid's unknowns (solve/newton.py) are then a
+        transpose of the liquid's rigid rows alone, where through one stacked vector every term's
+        rows would be linearised and transposed with zero tangents."""
+        k = self.kin(c, V0, omega, d_dot, a6, d_acc, t, mu)
         rigid, d = None, None
         for term in self.all_terms():
             with jax.named_scope(type(term).__name__):
@@ -79,8 +87,8 @@ class System(eqx.Module):
             rigid = r.rigid if rigid is None else rigid + r.rigid
             if r.d is not None:
                 d = r.d if d is None else d + r.d
-        rigid = self.motion.rigid_rows(rigid, acc, k.t, lambda: self.scales()[:6])
-        return jnp.concatenate([rigid, d])
+        rigid = self.motion.rigid_rows(rigid, a6, k.t, lambda: self.scales()[:6])
+        return rigid, d
 
     # ---------------------------------------------------------------- energies
     def kinetic_energy(self, c: Config, v):
@@ -113,7 +121,12 @@ class System(eqx.Module):
 
 def advance_config(c: Config, delta) -> Config:
     """Apply an increment (dX0, Theta, dd): rotations on the group, q_{n+1} = q_n exp(Theta)."""
-    return Config(c.X0 + delta[:3], quat_multiply(c.q, quat_exp(delta[3:6])), c.d + delta[6:])
+    return advance_config_parts(c, delta[:6], delta[6:])
+
+
+def advance_config_parts(c: Config, y, z) -> Config:
+    """`advance_config` for the rigid increment y = (dX0, Theta) and the deformable one z apart."""
+    return Config(c.X0 + y[:3], quat_multiply(c.q, quat_exp(y[3:6])), c.d + z)
 
 
 def omega_from_qdot(q, q_dot):

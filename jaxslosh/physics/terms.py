@@ -46,11 +46,17 @@ class Kin(NamedTuple):
     V0: jax.Array           # (3,) inertial
     omega: jax.Array        # (3,) body frame
     d_dot: jax.Array        # (nf,)
-    acc: Optional[jax.Array]   # (6 + nf,): dV0/dt (inertial), d omega/dt (body), d2 d/dt2
+    a6: Optional[jax.Array]    # (6,) rigid accelerations: dV0/dt (inertial), d omega/dt (body); None for energies
+    d_acc: Optional[jax.Array]  # (nf,) d2 d/dt2 (kept apart from a6: see System.residual_parts)
     t: jax.Array
     mu: Optional[jax.Array]    # (6,) radiation memory force at t, from the integrator's states
     A: jax.Array            # (3, 3) rotation matrix of q
     g_b: jax.Array          # (3,) gravity acceleration in the body frame
+
+    @property
+    def acc(self):
+        """(6 + nf,) all the unknown accelerations."""
+        return jnp.concatenate([self.a6, self.d_acc])
 
     @property
     def v6(self):

@@ -28,7 +28,7 @@ class RigidBody(AbstractTerm):
     S: Optional[jax.Array] = None       # (3,) first moment about the frame origin, kg m (None: zero)
 
     def rows(self, k: Kin) -> Rows:
-        a0, alpha = k.acc[:3], k.acc[3:6]
+        a0, alpha = k.a6[:3], k.a6[3:6]
         w = k.omega
         r_t = self.mass * a0
         r_r = mv3(self.inertia, alpha) + jnp.cross(w, mv3(self.inertia, w))
@@ -135,14 +135,14 @@ class AbstractMotion(eqx.Module):
         """Whether the rigid rows prescribe the motion instead of being equations of motion."""
 
     @abc.abstractmethod
-    def rigid_rows(self, rows, acc, t, scale):
+    def rigid_rows(self, rows, a6, t, scale):
         """The rigid rows of the residual, from the terms' sum `rows` (`scale()`: the rigid rows' masses)."""
 
 
 class FreeMotion(AbstractMotion):
     prescribed = False
 
-    def rigid_rows(self, rows, acc, t, scale):
+    def rigid_rows(self, rows, a6, t, scale):
         return rows
 
 
@@ -180,7 +180,7 @@ class PrescribedMotion(AbstractMotion):
         a = jax.jvp(lambda tt: jax.jvp(self.value, (tt,), (jnp.ones_like(tt),))[1], (t,), (jnp.ones_like(t),))[1]
         return jnp.zeros(6).at[self.dof].set(a)
 
-    def rigid_rows(self, rows, acc, t, scale):
+    def rigid_rows(self, rows, a6, t, scale):
         """The prescribed accelerations (a single-axis rotation has omega_dot = theta_ddot e);
         positions and velocities follow by the scheme from the prescribed initial rates."""
-        return scale() * (acc[:6] - self.accelerations(t))
+        return scale() * (a6 - self.accelerations(t))

@@ -15,7 +15,7 @@ import numpy as np
 from ..io.output import is_disk_full
 from ..io.result import ResultWriter
 from ..io.status import Status
-from ..programs import XLA_OPTIONS, compile_program
+from ..programs import XLA_OPTIONS, lower_program
 from ..scene.types import Scene
 from .guard import Interrupted, interrupts
 from .loop import core, frame_datasets, traced_advance, traced_init
@@ -115,8 +115,14 @@ def _reason(e: BaseException) -> str:
 def compile_run(bc, solver, chunk_frames: int, save_every: int):
     """The run's two programs compiled ahead of time (from the exported programs' folder where a
     process compiled them before, programs.py): runs `start`; returns its carry and frame, and the
-    compiled chunk, called as `chunk(bc, solver, carry, chunk_frames, save_every)`."""
-    start, _ = compile_program("start", traced_init, (bc, solver), XLA_OPTIONS)
-    carry, f0 = start(bc, solver)
-    chunk, _ = compile_program("advance", traced_advance, (bc, solver, carry, chunk_frames, save_every), XLA_OPTIONS)
-    return carry, f0, chunk
+    compiled chunk, called as `chunk(bc, solver, carry, chunk_frames, save_every)`.
+
+    XLA compiles `start` in the background while Python traces the chunk (lowered with the shapes
+    of start's carry), then both at once: on two cores the compile phase is the longer of the two
+    programs' XLA work, not their sum."""
+    start = lower_program("start", traced_init, (bc, solver), XLA_OPTIONS).compile_in_background()
+    carry_like, _ = start.out
+    chunk = lower_program("advance", traced_advance, (bc, solver, carry_like, chunk_frames, save_every),
+                          XLA_OPTIONS).compile_in_background()
+    carry, f0 = start.result()(bc, solver)
+    return carry, f0, chunk.result()

@@ -26,7 +26,7 @@ import jax.numpy as jnp
 
 from ..physics import structures as mb
 from ..physics.kinematics import rotation_matrix
-from ..physics.system import System, advance_config
+from ..physics.system import System, advance_config, advance_config_parts
 from ..physics.terms import Config
 from .linear import Solver, empty_pre
 from .newton import solve_root, solve_root_carried
@@ -72,12 +72,16 @@ def initial_state(system: System, solver: Solver, c0: Config, v0, alg0=None) -> 
     z0 = None if memory is None else memory.init()
     mu0 = None if memory is None else memory.force(z0)
 
+    V0, om, dd = _split(v0)
+
+    def parts(a6, d_acc):
+        return system.residual_parts(c0, V0, om, dd, a6, d_acc, jnp.zeros(()), mu0)
+
     def R(acc):
-        V0, om, dd = _split(v0)
-        return system.residual(c0, V0, om, dd, acc, jnp.zeros(()), mu0)
+        return jnp.concatenate(parts(acc[:6], acc[6:]))
 
     acc0, (it, err, ok) = solve_root(R, jnp.zeros_like(v0), solver.Cinv_mass, scale, solver.tol, solver.max_iter,
-                                     implicit=solver.implicit)
+                                     implicit=solver.implicit, parts=parts)
     pre = empty_pre(system) if solver.reuse else None
     e0 = total_energy(system, c0, v0) if solver.project else None
     return State(c0, v0, acc0, acc0, jnp.zeros(()), pre=pre, z=z0, e0=e0), StepInfo(it, err, ok)
@@ -114,27 +118,46 @@ def memory_next(system: System, solver: Solver, s: State, v_new):
 
 def step_equations(system: System, solver: Solver, s: State):
     """The equations of one step t_n -> t_{n+1} in the increment Delta = (dX0, Theta, dd):
-    returns (R, unpack, x0): the residual R(Delta), the map Delta -> (config, v, acc, a) of the
-    scheme, and the predictor (a_{n+1} = a_n)."""
+    returns (R, unpack, x0, parts): the residual R(Delta), the map Delta -> (config, v, acc, a) of
+    the scheme, the predictor (a_{n+1} = a_n), and the residual in parts for the Newton
+    preconditioner, parts(Delta[:r], Delta[r:]) = (rigid rows, the others) with r the rigid
+    unknowns (System.residual_parts; with structures their inertia rows, without the multipliers:
+    structures.inertia_rows_parts)."""
     h, (am, af, beta, gamma) = solver.h, solver.scheme
     base = h * s.v + h * h * (0.5 - beta) * s.a
 
+    def rates(delta, i):
+        """(v, acc, a) at t_{n+1} of the unknowns i (a slice) for their increments delta."""
+        a_new = (delta - base[i]) / (beta * h * h)
+        v_new = s.v[i] + h * ((1.0 - gamma) * s.a[i] + gamma * a_new)
+        acc_new = ((1.0 - am) * a_new + am * s.a[i] - af * s.acc[i]) / (1.0 - af)
+        return v_new, acc_new, a_new
+
     def unpack(delta):
-        a_new = (delta - base) / (beta * h * h)
-        v_new = s.v + h * ((1.0 - gamma) * s.a + gamma * a_new)
-        acc_new = ((1.0 - am) * a_new + am * s.a - af * s.acc) / (1.0 - af)
-        return _advance(system, s.c, delta), v_new, acc_new, a_new
+        return (_advance(system, s.c, delta),) + rates(delta, slice(None))
 
     memory = system.memory
     coef = None if memory is None else memory.coefficients(h)
 
-    def R(delta):
-        c, v, acc, _ = unpack(delta)
-        V0, om, dd = _split(v)
-        mu = None if memory is None else memory.force(memory.advance(s.z, s.v[:6], v[:6], coef))
-        return system.residual(c, V0, om, dd, acc, s.t + h, mu)
+    r = mb.layout(system).n_rigid
 
-    return R, unpack, base + h * h * beta * s.a
+    def parts(y, z):
+        vy, ay, _ = rates(y, slice(0, r))
+        vz, az, _ = rates(z, slice(r, None))
+        mu = None if memory is None else memory.force(memory.advance(s.z, s.v[:6], vy[:6], coef))
+        if system.flex is not None:
+            return mb.inertia_rows_parts(system, mb.advance_parts(system, s.c, y, z), vy, vz, ay, az, s.t + h, mu)
+        return system.residual_parts(advance_config_parts(s.c, y, z), vy[:3], vy[3:], vz, ay, az, s.t + h, mu)
+
+    def R(delta):
+        if system.flex is not None:
+            c, v, acc, _ = unpack(delta)
+            V0, om, dd = _split(v)
+            mu = None if memory is None else memory.force(memory.advance(s.z, s.v[:6], v[:6], coef))
+            return system.residual(c, V0, om, dd, acc, s.t + h, mu)
+        return jnp.concatenate(parts(delta[:6], delta[6:]))
+
+    return R, unpack, base + h * h * beta * s.a, parts
 
 
 def static_structures(system, solver: Solver, c0: Config, v0, alg0):
@@ -153,10 +176,15 @@ def static_structures(system, solver: Solver, c0: Config, v0, alg0):
     w2 = jax.lax.stop_gradient(jnp.concatenate([b.omega2 for b in system.flex.bodies]))
     Cinv = jnp.zeros((nf + L.m, nf + L.m)).at[:nf, :nf].set(jnp.eye(nf)).at[nf:, nf:].set(jnp.diag(1.0 / w2))
 
+    held_y, held_z = held[:r], held[r:]
+    zy, zz = jnp.zeros(r), jnp.zeros(L.n_dyn - r)
+
+    def Rm_parts(y, w):
+        ry, rw = mb.inertia_rows_parts(system, mb.advance_parts(system, c0, y, w), zy, zz, zy, zz, jnp.zeros(()))
+        return jnp.where(held_y, y * scale[:r], ry), jnp.where(held_z, w * scale[L.n_small:], rw)
+
     def Rm(x):
-        dyn, _ = L.from_x(x)
-        rows = L.to_x(mb.inertia_rows(system, mb.advance(system, c0, dyn), z, z, jnp.zeros(())), jnp.zeros(L.n_alg))
-        return jnp.where(held_x, x * scale, rows)
+        return mb.in_x(L, *Rm_parts(x[:r], x[L.n_small:]))
 
     def Rc(x):
         dyn, alg = L.from_x(x)
@@ -164,7 +192,8 @@ def static_structures(system, solver: Solver, c0: Config, v0, alg0):
         return jnp.where(held_x, 0.0, mb.constraint_rows(system, c, alg, mb.constraint(system, c, alg), gsc))
 
     x, (it, err, ok) = solve_root(lambda x: Rm(x) + Rc(x), L.to_x(z, alg0), Cinv, scale, solver.tol,
-                                  solver.max_iter, L.n_small, split=(Rm, Rc, L.n_rigid), implicit=solver.implicit)
+                                  solver.max_iter, L.n_small, split=(Rm, Rc, L.n_rigid, Rm_parts),
+                                  implicit=solver.implicit)
     dyn, alg = L.from_x(x)
     c = mb.advance(system, c0, dyn)
     # every structure moves rigidly with the vessel: V_s = V + (A omega) x (X_s - X0), omega_s = A_s^T A omega
@@ -183,9 +212,11 @@ def _flex_initial_state(system, solver: Solver, c0: Config, v0, alg0):
     scale = L.to_x(mb.scales(system), alg_sc)
     memory = system.memory
     z0 = None if memory is None else memory.init()
-    Rm, Rc = mb.initial_residuals(system, c0, v0, alg0, jnp.zeros(()), gsc, None if memory is None else memory.force(z0))
+    Rm, Rc, Rm_parts = mb.initial_residuals(system, c0, v0, alg0, jnp.zeros(()), gsc,
+                                            None if memory is None else memory.force(z0))
     x, (it, err, ok) = solve_root(lambda x: Rm(x) + Rc(x), jnp.zeros(L.n), solver.Cinv_mass, scale, solver.tol,
-                                  solver.max_iter, L.n_small, split=(Rm, Rc, L.n_rigid), implicit=solver.implicit)
+                                  solver.max_iter, L.n_small, split=(Rm, Rc, L.n_rigid, Rm_parts),
+                                  implicit=solver.implicit)
     acc0, alg_a = L.from_x(x)
     alg = jnp.where(mb.position_mask(system.flex), alg0, alg_a)
     info = StepInfo(it + info0.iterations, jnp.maximum(err, info0.residual), ok & info0.ok)
@@ -203,16 +234,11 @@ def _flex_step(system, solver: Solver, s: State, fresh=None) -> tuple[State, Ste
     f = 1.0 / (beta * h * h)
     gsc, alg_sc = mb.alg_scales(system, f, lambda itf: jnp.maximum(1.0 / f, 1e-13 * itf.L_ref / solver.tol))
     scale = L.to_x(mb.scales(system), alg_sc)
-    _, unpack, pred = step_equations(system, solver, s)
-
-    memory = system.memory
-    coef = None if memory is None else memory.coefficients(h)
+    _, unpack, pred, Rm_parts = step_equations(system, solver, s)
+    r = L.n_rigid
 
     def Rm(x):
-        dyn, _ = L.from_x(x)
-        c, v, acc, _ = unpack(dyn)
-        mu = None if memory is None else memory.force(memory.advance(s.z, s.v[:6], v[:6], coef))
-        return L.to_x(mb.inertia_rows(system, c, v, acc, s.t + h, mu), jnp.zeros(L.n_alg))
+        return mb.in_x(L, *Rm_parts(x[:r], x[L.n_small:]))
 
     def Rc(x):
         dyn, alg = L.from_x(x)
@@ -223,7 +249,7 @@ def _flex_step(system, solver: Solver, s: State, fresh=None) -> tuple[State, Ste
     pre = s.pre if solver.reuse else None
     x, (it, err, ok), pre_new = solve_root_carried(lambda x: Rm(x) + Rc(x), L.to_x(pred, s.alg), solver.Cinv_step,
                                                    scale, solver.tol, solver.max_iter, pre, floor, solver.adaptive,
-                                                   L.n_small, (Rm, Rc, L.n_rigid), fresh, solver.implicit)
+                                                   L.n_small, (Rm, Rc, L.n_rigid, Rm_parts), fresh, solver.implicit)
     dyn, alg = L.from_x(x)
     c, v, acc, a = unpack(dyn)
     ok = ok & jnp.all(jnp.isfinite(x))
@@ -238,13 +264,13 @@ def step(system: System, solver: Solver, s: State, fresh=None) -> tuple[State, S
         return _flex_step(system, solver, s, fresh)
     with jax.named_scope("predictor"):
         scale = system.scales()            # residual rows / scale: accelerations (m/s^2, rad/s^2)
-        R, unpack, x0 = step_equations(system, solver, s)
+        R, unpack, x0, parts = step_equations(system, solver, s)
         floor = solver.noise * jnp.max(jnp.abs(s.c.d), initial=0.0)
     pre = s.pre if solver.reuse else None
     with jax.named_scope("newton"):
         delta, (it, err, ok), pre_new = solve_root_carried(R, x0, solver.Cinv_step, scale, solver.tol,
                                                            solver.max_iter, pre, floor, solver.adaptive, fresh=fresh,
-                                                           implicit=solver.implicit)
+                                                           implicit=solver.implicit, parts=parts)
     with jax.named_scope("update"):
         c, v, acc, a = unpack(delta)
         ok = ok & jnp.all(jnp.isfinite(delta))

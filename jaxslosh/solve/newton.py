@@ -14,20 +14,42 @@ import jax.numpy as jnp
 from ..fem.linalg import inv
 
 
-def _precond_data_split(Am, Ac, like, Cinv, nr, ns):
+def _precond_data_split(parts_m, Ac, x, Cinv, nr, ns):
     """As _precond_data for A = Am + Ac, when unknowns nr..ns (interface frames and multipliers) enter
     the residual only through the cheap part Ac (the constraints), whose rows nr..ns are all of A's
-    there: the first ns columns and rows of A are Ac's plus, in the first nr, Am's (the expensive Am
-    is applied only nr times each way; each part is linearised and transposed once)."""
-    n = like.shape[0]
-    I = jnp.eye(n, ns, dtype=like.dtype)
+    there: the first ns columns and rows of A are Ac's plus, in the first nr, Am's. Am is the
+    linearisation of the expensive part given in parts, parts_m(x[:nr], x[ns:]) = (its rows nr.., its
+    rows ns..) (zero on rows nr..ns), linearised in x[:nr] alone for its columns and transposed in
+    x[ns:] alone for its rows, as in _precond_data_parts."""
+    n = x.shape[0]
+    y, z = x[:nr], x[ns:]
+    I = jnp.eye(n, ns, dtype=x.dtype)
+    Inr = jnp.eye(nr, dtype=x.dtype)
     cols = jax.vmap(Ac, in_axes=1, out_axes=1)(I)
-    cols = cols.at[:, :nr].add(jax.vmap(Am, in_axes=1, out_axes=1)(I[:, :nr]))
-    AmT = jax.linear_transpose(Am, like)
-    AcT = jax.linear_transpose(Ac, like)
-    rows = jax.vmap(lambda e: AcT(e)[0])(I.T)
-    rows = rows.at[:nr].add(jax.vmap(lambda e: AmT(e)[0])(I[:, :nr].T))
-    Ayz = rows[:, ns:]
+    _, jvp_y = jax.linearize(lambda y_: jnp.concatenate(parts_m(y_, z)), y)
+    cm = jax.vmap(jvp_y, in_axes=1, out_axes=1)(Inr)                    # (nr + nz, nr): Am's rows y and z
+    cols = cols.at[:nr, :nr].add(cm[:nr]).at[ns:, :nr].add(cm[nr:])
+    AcT = jax.linear_transpose(Ac, x)
+    Ayz = jax.vmap(lambda e: AcT(e)[0])(I.T)[:, ns:]
+    _, vjp_z = jax.vjp(lambda z_: parts_m(y, z_)[0], z)
+    Ayz = Ayz.at[:nr].add(jax.vmap(lambda e: vjp_z(e)[0])(Inr))
+    Wz = Cinv @ cols[ns:]
+    return inv(cols[:ns] - Ayz @ Wz), Ayz, Wz
+
+
+def _precond_data_parts(parts, x, Cinv, ns):
+    """As _precond_data for the residual given in parts, parts(y, z) = (R_y, R_z) with y = x[:ns] and
+    z = x[ns:]: the columns by linearising in y alone, the rows R_y over z by a transpose in z alone
+    (the terms that R_y shares with z: the liquid's, not the whole residual; see
+    physics/system.residual_parts)."""
+    y, z = x[:ns], x[ns:]
+    I = jnp.eye(ns, dtype=x.dtype)
+    _, jvp_y = jax.linearize(lambda y_: jnp.concatenate(parts(y_, z)), y)
+    cols = jax.vmap(jvp_y, in_axes=1, out_axes=1)(I)                 # [A_yy; A_zy]
+    if z.shape[0] == 0:
+        return (inv(cols),)
+    _, vjp_z = jax.vjp(lambda z_: parts(y, z_)[0], z)
+    Ayz = jax.vmap(lambda e: vjp_z(e)[0])(I)                           # (ns, nz)
     Wz = Cinv @ cols[ns:]
     return inv(cols[:ns] - Ayz @ Wz), Ayz, Wz
 
@@ -67,7 +89,8 @@ def _preconditioner(A, like, Cinv, ns=6):
 SLOW = 0.01
 
 
-def _newton(R, x0, Cinv, scale, tol, max_iter, pre=None, floor=0.0, adaptive=True, ns=6, split=None, fresh=None):
+def _newton(R, x0, Cinv, scale, tol, max_iter, pre=None, floor=0.0, adaptive=True, ns=6, split=None, fresh=None,
+            parts=None):
     """Quasi-Newton iterations on R(x) = 0 (x: ns rigid and algebraic unknowns, then the liquid's and
     the structures' modal ones) with the
     structured approximate inverse of the Jacobian, formed at the first iteration of the step and
@@ -79,8 +102,9 @@ def _newton(R, x0, Cinv, scale, tol, max_iter, pre=None, floor=0.0, adaptive=Tru
     max(tol, floor). `adaptive=False`: formed once before the iterations, never inside (vmapped
     batches, where a lax.cond computes both branches); then, with `pre` carried, `fresh` (a boolean
     that is the same for every run of a batch) says whether to form it anew or use the carried one
-    through this step. `split` = (Rm, Rc, nr): R = Rm + Rc, and unknowns nr..ns enter R only through
-    the cheap part Rc (see _precond_data_split)."""
+    through this step. `split` = (Rm, Rc, nr, parts_m): R = Rm + Rc, unknowns nr..ns enter R only
+    through the cheap part Rc, and parts_m gives Rm in parts (see _precond_data_split). `parts`: R
+    in parts (see _precond_data_parts), for the preconditioner."""
     tol = jnp.maximum(tol, floor)
 
     def err_of(r):
@@ -89,30 +113,44 @@ def _newton(R, x0, Cinv, scale, tol, max_iter, pre=None, floor=0.0, adaptive=Tru
     @jax.named_scope("preconditioner")
     def refresh(x):
         if split is not None:     # R = Rm + Rc, each part linearised once (not R, then Rc again)
-            Rm, Rc, nr = split
-            _, jvp_m = jax.linearize(Rm, x)
+            _, Rc, nr, parts_m = split
             _, jvp_c = jax.linearize(Rc, x)
-            return _precond_data_split(jvp_m, jvp_c, x, Cinv, nr, ns)
+            return _precond_data_split(parts_m, jvp_c, x, Cinv, nr, ns)
+        if parts is not None:
+            return _precond_data_parts(parts, x, Cinv, ns)
         _, jvp = jax.linearize(R, x)
         return _precond_data(jvp, x, Cinv, ns)
 
-    def body(carry):
-        x, r, it, err_prev, _, need, data = carry
-        if adaptive:
-            data = jax.lax.cond(need, refresh, lambda _: data, x)
-        x = x + _precond_apply(data, Cinv, -r, ns)
-        r = R(x)
-        err = err_of(r)
-        fresh = need | (not adaptive)
-        # a stale preconditioner that slows down is formed again; a fresh one that cannot is a stall
-        slow = err > jnp.where(fresh, 0.1, SLOW) * err_prev
-        return x, r, it + 1, err, fresh & (err > 0.5 * err_prev), slow, data
-
-    def cond(carry):
-        _, _, it, err, stalled, _, _ = carry
+    def going(it, err, stalled):
         return (err > tol) & (it < max_iter) & jnp.isfinite(err) & ~stalled
 
-    r0 = R(x0)
+    # The loop runs over evaluations of R, its first at x0: R appears once in the program (a
+    # residual before the loop would be compiled a second time). Each pass applies the update the
+    # last one prepared, evaluates R, judges the update, and prepares the next (forming the
+    # preconditioner again where the last update was slow).
+    def body(carry):
+        x, dx, it, err_prev, was_fresh, _, need_prev, data = carry
+        x = x + dx
+        r = R(x)
+        err = err_of(r)
+        first = it < 0
+        # a stale preconditioner that slows down is formed again; a fresh one that cannot is a stall
+        stalled = ~first & was_fresh & (err > 0.5 * err_prev)
+        need = jnp.where(first, need_prev, err > jnp.where(was_fresh, 0.1, SLOW) * err_prev)
+        it = it + 1
+
+        def prepare(data):
+            if adaptive:
+                data = jax.lax.cond(need, refresh, lambda _: data, x)
+            return data, _precond_apply(data, Cinv, -r, ns)
+
+        data, dx = jax.lax.cond(going(it, err, stalled), prepare, lambda d: (d, jnp.zeros_like(x)), data)
+        return x, dx, it, err, need | (not adaptive), stalled, need, data
+
+    def cond(carry):
+        _, _, it, err, _, stalled, _, _ = carry
+        return (it < 0) | going(it, err, stalled)
+
     if not adaptive:
         if pre is not None and fresh is not None:
             # `fresh` only, never the carried validity flag, which is per run: the predicate stays
@@ -128,8 +166,9 @@ def _newton(R, x0, Cinv, scale, tol, max_iter, pre=None, floor=0.0, adaptive=Tru
         data0 = ((jnp.zeros((ns, ns), x0.dtype),) if split is None and n == ns else
                  (jnp.zeros((ns, ns), x0.dtype), jnp.zeros((ns, n - ns), x0.dtype), jnp.zeros((n - ns, ns), x0.dtype)))
         need0 = jnp.array(True)
-    init = (x0, r0, jnp.array(0), err_of(r0), jnp.array(False), need0, data0)
-    x, r, it, err, stalled, _, data = jax.lax.while_loop(cond, body, init)
+    init = (x0, jnp.zeros_like(x0), jnp.array(-1), jnp.array(jnp.inf, x0.dtype), jnp.array(False), jnp.array(False),
+            need0, data0)
+    x, _, it, err, _, stalled, _, data = jax.lax.while_loop(cond, body, init)
     # Converged: below the tolerance, or stalled at round-off within a factor 100 of it.
     ok = jnp.isfinite(err) & ((err <= tol) | (stalled & (err <= 100.0 * tol)))
     # aux leaves are floats: custom_root's JVP rule cannot carry integer or boolean aux tangents
@@ -174,22 +213,22 @@ def _root(R, x0, newton, Cinv, ns, implicit):
     return jax.lax.custom_root(R, x0, newton, _tangent_solver(Cinv, ns), has_aux=True)
 
 
-def solve_root(R, x0, Cinv, scale, tol, max_iter, ns=6, split=None, implicit=True):
+def solve_root(R, x0, Cinv, scale, tol, max_iter, ns=6, split=None, implicit=True, parts=None):
     """Root of R near x0; differentiable by the implicit function theorem (lax.custom_root), the
     tangent systems solved with the same structure as the Newton iterations (`implicit=False`: the
     iterations alone, for runs that no gradient goes through)."""
-    x, (it, err, ok) = _root(R, x0, lambda f, x: _newton(f, x, Cinv, scale, tol, max_iter, ns=ns, split=split),
-                             Cinv, ns, implicit)
+    x, (it, err, ok) = _root(R, x0, lambda f, x: _newton(f, x, Cinv, scale, tol, max_iter, ns=ns, split=split,
+                                                         parts=parts), Cinv, ns, implicit)
     it, err, ok = jax.lax.stop_gradient((it, err, ok))
     return x, (it.astype(jnp.int32), err, ok > 0.5)
 
 
 def solve_root_carried(R, x0, Cinv, scale, tol, max_iter, pre=None, floor=0.0, adaptive=True, ns=6, split=None,
-                       fresh=None, implicit=True):
+                       fresh=None, implicit=True, parts=None):
     """`solve_root` with a preconditioner carried in and out (`pre`, see `_newton`; None: formed
     here and not returned), a round-off floor and the batch mode. Returns x, (it, err, ok), pre."""
-    out = _root(R, x0, lambda f, x: _newton(f, x, Cinv, scale, tol, max_iter, pre, floor, adaptive, ns, split, fresh),
-                Cinv, ns, implicit)
+    out = _root(R, x0, lambda f, x: _newton(f, x, Cinv, scale, tol, max_iter, pre, floor, adaptive, ns, split, fresh,
+                                            parts), Cinv, ns, implicit)
     x, aux = out
     it, err, ok = jax.lax.stop_gradient(aux[:3])
     new_pre = jax.lax.stop_gradient(aux[3]) if pre is not None else None
