@@ -1,4 +1,5 @@
-"""Compiled programs kept across processes: what a second `jaxslosh run` of a scene skips.
+"""Compiled programs (and built models) kept across processes: what a second `jaxslosh run` of a
+scene skips.
 
 JAX's persistent compilation cache (set up by the CLI, cli/common.setup_jax) saves XLA's work, but
 a new process still traces and lowers every program to find its cache entry: for the paper example
@@ -13,6 +14,12 @@ version and backend, the program's name, the structure of its arguments with eve
 and the shape and type of each array. Arrays (JAX or NumPy) are the program's inputs, as under
 `eqx.filter_jit`. Where the structure does not pickle, or the folder is off or not writable, the
 program is traced and compiled as usual, without a file.
+
+`cached` keeps a value the same way: `jaxslosh run` keeps the model it built from a scene (meshes,
+element matrices, the Newton matrix's constant blocks), a second run of the scene reads it.
+
+XLA's work on a program runs outside Python: `Program.compile_in_background` lets one program
+compile while Python traces the next (`run/tofile.compile_run`).
 """
 from __future__ import annotations
 

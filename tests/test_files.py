@@ -144,9 +144,9 @@ def test_validity_warnings_reach_the_summary_and_the_file(tmp_path, capsys):
 
 
 def test_a_second_run_takes_its_compiled_programs_from_the_cache(tmp_path):
-    """JAX's persistent compilation cache and the exported programs in JAXSLOSH_CACHE_DIR: the first
-    run fills them, a second process of the same scene finds its programs there (the same files, no
-    new ones) and gives the same result."""
+    """JAX's persistent compilation cache, the exported programs and the built model in
+    JAXSLOSH_CACHE_DIR: the first run fills them, a second process of the same scene finds its
+    programs and its model there (the same files, no new ones) and gives the same result."""
     cache = tmp_path / "cache"
     env = dict(os.environ, JAXSLOSH_CACHE_DIR=str(cache))
     scene = tmp_path / "s.toml"
@@ -162,8 +162,9 @@ def test_a_second_run_takes_its_compiled_programs_from_the_cache(tmp_path):
             first = sorted(os.listdir(cache))
             exported = sorted(os.listdir(cache / "programs"))
     assert len(first) >= 2 and sorted(os.listdir(cache)) == first
-    # the loop's programs were exported by the first process and read, not traced again, by the second
-    assert {f.split("-")[0] for f in exported} >= {"start", "advance"}
+    # the loop's programs were exported, and the model kept, by the first process and read, not
+    # traced or built again, by the second
+    assert {f.split("-")[0] for f in exported} >= {"start", "advance", "model"}
     assert sorted(os.listdir(cache / "programs")) == exported
     with h5py.File(outs[0], "r") as a, h5py.File(outs[1], "r") as b:
         np.testing.assert_array_equal(a["vessel/roll_pitch_yaw"][:], b["vessel/roll_pitch_yaw"][:])

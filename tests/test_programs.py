@@ -72,3 +72,25 @@ def test_without_a_folder_nothing_is_written(tmp_path):
     f, loaded = programs.compile_program("energy", energy, (m, x, "a"))
     assert not loaded and os.listdir(tmp_path) == []
     np.testing.assert_allclose(f(m, x, "a")["e"], 0.5 * 3.0 * np.sum(x ** 3), rtol=1e-15)
+
+
+def test_a_cached_value_is_computed_once_per_key_and_read_back(folder):
+    calls = []
+
+    def compute(k):
+        calls.append(k)
+        return {"k": k, "a": np.arange(3.0) * k, "j": jnp.ones(2) * k}
+
+    first = programs.cached("model", ("scene", 2), lambda: compute(2))
+    again = programs.cached("model", ("scene", 2), lambda: compute(2))
+    other = programs.cached("model", ("scene", 3), lambda: compute(3))
+    assert calls == [2, 3] and len(os.listdir(folder)) == 2
+    np.testing.assert_array_equal(again["a"], first["a"])
+    np.testing.assert_array_equal(np.asarray(again["j"]), [2.0, 2.0])
+    assert other["k"] == 3
+    # a damaged file is computed again; a value that does not pickle is returned, not kept
+    for path in folder.iterdir():
+        path.write_bytes(path.read_bytes()[:10])
+    assert programs.cached("model", ("scene", 2), lambda: compute(2))["k"] == 2 and calls == [2, 3, 2]
+    f = programs.cached("model", ("scene", 4), lambda: (lambda: 4))
+    assert f() == 4 and len(os.listdir(folder)) == 2

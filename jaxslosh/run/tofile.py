@@ -15,7 +15,7 @@ import numpy as np
 from ..io.output import is_disk_full
 from ..io.result import ResultWriter
 from ..io.status import Status
-from ..programs import XLA_OPTIONS, lower_program
+from ..programs import XLA_OPTIONS, cached, lower_program
 from ..scene.types import Scene
 from .guard import Interrupted, interrupts
 from .loop import core, frame_datasets, traced_advance, traced_init
@@ -48,7 +48,8 @@ def run_to_file(scene: Scene, out: str, *, progress: bool = True,
     try:
         with interrupts() as stop:
             bar.phase("build", "building the model")
-            setup = prepare(scene)
+            # a second run of the scene reads the model the first one built (programs.cached)
+            setup = cached("model", scene, lambda: prepare(scene))
             b, solver = setup.built, setup.solver
             se = setup.save_every
             n_frames = setup.n_steps // se
