@@ -130,15 +130,24 @@ def build_liquid_block(scene: Scene, params: Optional[dict] = None, gravity=None
                         K=host_sparse(sp.block_diag(K_list), tuple(zip(meshes, [3] * len(models), free_of))
                                       if boxes else None, layers),
                         free=jnp.asarray(np.concatenate(free_list)), n_nodes=offset,
+                        slot=_slots(np.concatenate(free_list), offset),
                         grids=tuple(m.mesh + (surface_bending_scale(m), m.element) for m in models) if boxes else None,
                         sparse=True, frames=frames)
         return LiquidBlock(liquid, tuple(blocks), (Kdt, jnp.asarray(Ktt)) if coupled else None)
     stack = jax_block_diag if traced else block_diag
     liquid = Liquid(r=jnp.asarray(xp.concatenate(rs)), Ms=jnp.asarray(stack(*Ms_list)),
                     K=jnp.asarray(stack(*K_list)), free=jnp.asarray(np.concatenate(free_list)), n_nodes=offset,
-                    frames=frames)
+                    frames=frames, slot=_slots(np.concatenate(free_list), offset))
     penalty = (jnp.asarray(xp.concatenate(Kdt_list)), jnp.asarray(Ktt)) if coupled else None
     return LiquidBlock(liquid, tuple(blocks), penalty)
+
+
+def _slots(free, n_nodes):
+    """Liquid.slot: the position of each of the 3 n_nodes nodal dofs among the free ones, len(free)
+    where held."""
+    slot = np.full(3 * n_nodes, len(free), dtype=np.int32)
+    slot[np.asarray(free)] = np.arange(len(free), dtype=np.int32)
+    return jnp.asarray(slot)
 
 
 def _liquid_with_walls(tanks, models, structures=()):

@@ -117,6 +117,9 @@ class Liquid(AbstractLiquid):
     # tanks of other shapes (fem/shapes.py): each node's frame (N, 3, 3); the unknowns are the free
     # components in these frames (tangential on a wall). None: the vessel's axes everywhere
     frames: Optional[jax.Array] = None
+    # (3N,) the position of each nodal dof in [d; 0] (nf: held at zero): `full` as a gather, where a
+    # scatter into the nodal vector compiles to a loop on the CPU (None: the scatter)
+    slot: Optional[jax.Array] = None
 
     @property
     def nf(self) -> int:
@@ -127,7 +130,10 @@ class Liquid(AbstractLiquid):
         walls: equal to the wall's there, through `dof_map`)."""
         if self.dof_map is not None:
             return jnp.concatenate([d, jnp.zeros(1, d.dtype)])[self.dof_map].reshape(self.n_nodes, 3)
-        D = jnp.zeros(3 * self.n_nodes, d.dtype).at[self.free].set(d).reshape(self.n_nodes, 3)
+        if self.slot is not None:
+            D = jnp.concatenate([d, jnp.zeros(1, d.dtype)])[self.slot].reshape(self.n_nodes, 3)
+        else:
+            D = jnp.zeros(3 * self.n_nodes, d.dtype).at[self.free].set(d).reshape(self.n_nodes, 3)
         return D if self.frames is None else jnp.einsum("nij,nj->ni", self.frames, D)
 
     def free_part(self, F):

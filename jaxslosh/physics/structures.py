@@ -282,15 +282,19 @@ def inertia_rows(system, c: Config, v, acc, t, mu=None):
     return jnp.concatenate(inertia_rows_parts(system, c, v[:r], v[r:], acc[:r], acc[r:], t, mu))
 
 
-def inertia_rows_parts(system, c: Config, vy, vz, ay, az, t, mu=None):
+def inertia_rows_parts(system, c: Config, vy, vz, ay, az, t, mu=None, core=True):
     """`inertia_rows` as (rigid rows (n_rigid,), the others (nf + m,)), with the rates of the rigid
     unknowns (y: vessel, structures) and of the others (z: liquid, modal) passed apart, as
     System.residual_parts does for the vessel and its liquid (the Newton preconditioner's rigid rows
-    over z are then a transpose in z alone)."""
+    over z are then a transpose in z alone). `core=False`: without the vessel-and-liquid terms (zero
+    on the liquid's rows, the structures' balance alone on the vessel's)."""
     L = layout(system)
     ves_v, st_v, d_v, e_v = vy[:6], vy[6:].reshape(L.S, 6), vz[:L.nf], vz[L.nf:]
     ves_a, st_a, d_a, e_a = ay[:6], ay[6:].reshape(L.S, 6), az[:L.nf], az[L.nf:]
-    core_y, core_z = system.residual_parts(c, ves_v[:3], ves_v[3:], d_v, ves_a, d_a, t, mu)
+    if core:
+        core_y, core_z = system.residual_parts(c, ves_v[:3], ves_v[3:], d_v, ves_a, d_a, t, mu)
+    else:
+        core_y, core_z = jnp.zeros(6), jnp.zeros(L.nf)
     flex = system.flex
     rigid_s, modal = [], []
     for s, (b, eta, eta_d, eta_dd) in enumerate(zip(flex.bodies, split_eta(flex, c.eta), split_eta(flex, e_v),

@@ -179,8 +179,10 @@ def static_structures(system, solver: Solver, c0: Config, v0, alg0):
     held_y, held_z = held[:r], held[r:]
     zy, zz = jnp.zeros(r), jnp.zeros(L.n_dyn - r)
 
+    # the vessel's and the liquid's rows are held: their terms are left out, not computed and dropped
     def Rm_parts(y, w):
-        ry, rw = mb.inertia_rows_parts(system, mb.advance_parts(system, c0, y, w), zy, zz, zy, zz, jnp.zeros(()))
+        ry, rw = mb.inertia_rows_parts(system, mb.advance_parts(system, c0, y, w), zy, zz, zy, zz, jnp.zeros(()),
+                                       core=False)
         return jnp.where(held_y, y * scale[:r], ry), jnp.where(held_z, w * scale[L.n_small:], rw)
 
     def Rm(x):
