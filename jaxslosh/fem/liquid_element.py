@@ -60,7 +60,7 @@ import jax
 import jax.numpy as jnp
 import numpy as np
 
-from ..programs import compile_program, no_eager_folding
+from ..programs import lower_program, no_eager_folding
 from .linalg import det2, det3, inv3
 from .mesh import GAUSS8, GAUSS_1D, HEX_CORNERS
 
@@ -113,36 +113,39 @@ def element_matrices(xe, xf, rho, c, g, h, form, with_parts=True, div_variation=
         else:
             prm = jnp.array([rho, c, g, h, 0.0, xi_h, xi_z], dtype=jnp.float64)
         traced_x = is_traced(xe) or is_traced(prm)
-        kern = _kernels(form)
+        kern = {name: k for name, k in _kernels(form).items()
+                if (with_parts or form != "paper" or name not in ("free_surface", "rotation"))
+                and (name != "div_variation" or div_variation)}
         out = {}
-        for name, (fn, on_faces) in kern.items():
-            if not with_parts and form == "paper" and name in ("free_surface", "rotation"):
-                continue
-            if name == "div_variation" and not div_variation:
-                continue
-            x = xf if on_faces else xe
+        if not traced_x:              # concrete: chunks cut and joined in NumPy (no eager JAX op to compile)
+            # every energy is invariant under horizontal shifts (p0 depends on z only), so each
+            # distinct element shape and height is computed once (a uniform grid: one per layer)
+            distinct = {name: _distinct(np.asarray(xf if on_faces else xe, dtype=np.float64),
+                                        horizontal_only=not on_faces) for name, (_, on_faces) in kern.items()}
+            chunks = {name: [_padded(x[i:i + _CHUNK]) for i in range(0, len(x), _CHUNK)]
+                      for name, (x, _) in distinct.items()}
+            for name, (fn, _) in kern.items():     # every kernel traced, XLA compiling them meanwhile
+                fn.lower(prm, chunks[name][0][0])
+            for name, (fn, _) in kern.items():
+                blocks = [np.asarray(fn(prm, chunk, concrete=True))[:keep] for chunk, keep in chunks[name]]
+                out[name] = np.concatenate(blocks)[distinct[name][1]]
+            return out
+        for name, (fn, on_faces) in kern.items():   # traced: the same fixed-shape chunks, cut by dynamic slices
+            x = jnp.asarray(xf if on_faces else xe, dtype=jnp.float64)
             n = len(x)
-            if not traced_x:          # concrete: chunks cut and joined in NumPy (no eager JAX op to compile)
-                # every energy is invariant under horizontal shifts (p0 depends on z only), so each
-                # distinct element shape and height is computed once (a uniform grid: one per layer)
-                x, expand = _distinct(np.asarray(x, dtype=np.float64), horizontal_only=not on_faces)
-                n = len(x)
-                blocks = []
-                for i in range(0, n, _CHUNK):
-                    chunk = x[i:i + _CHUNK]
-                    pad = _CHUNK - len(chunk)
-                    if pad:
-                        chunk = np.concatenate([chunk, np.repeat(chunk[:1], pad, axis=0)])
-                    blocks.append(np.asarray(fn(prm, jnp.asarray(chunk, dtype=jnp.float64), concrete=True))
-                                  [:_CHUNK - pad])
-                out[name] = np.concatenate(blocks)[expand]
-            else:                     # traced: the same fixed-shape chunks, cut by dynamic slices
-                x = jnp.asarray(x, dtype=jnp.float64)
-                pad = -n % _CHUNK
-                xpad = jnp.concatenate([x, jnp.repeat(x[:1], pad, axis=0)]) if pad else x
-                blocks = [fn(prm, jax.lax.dynamic_slice_in_dim(xpad, i, _CHUNK)) for i in range(0, n, _CHUNK)]
-                out[name] = (blocks[0] if len(blocks) == 1 else jnp.concatenate(blocks))[:n]
+            pad = -n % _CHUNK
+            xpad = jnp.concatenate([x, jnp.repeat(x[:1], pad, axis=0)]) if pad else x
+            blocks = [fn(prm, jax.lax.dynamic_slice_in_dim(xpad, i, _CHUNK)) for i in range(0, n, _CHUNK)]
+            out[name] = (blocks[0] if len(blocks) == 1 else jnp.concatenate(blocks))[:n]
     return out
+
+
+def _padded(chunk):
+    """(a chunk of at most _CHUNK elements padded to _CHUNK with copies of its first, its length)."""
+    pad = _CHUNK - len(chunk)
+    if pad:
+        chunk = np.concatenate([chunk, np.repeat(chunk[:1], pad, axis=0)])
+    return jnp.asarray(chunk, dtype=jnp.float64), _CHUNK - pad
 
 
 def _distinct(x, horizontal_only):
@@ -269,15 +272,21 @@ def _kernels(form):
         out = jax.jit(f)
         compiled = {}
 
+        def lower(prm, x):
+            """Traced (or read from the exported programs where a process compiled it before) and
+            compiling in the background, once per shape."""
+            key = (x.shape, str(x.dtype), prm.shape)
+            if key not in compiled:
+                with no_eager_folding():
+                    compiled[key] = lower_program(f"element-{form}-{name}", f, (prm, x),
+                                                  _kernel_compiler_options()).compile_in_background()
+            return compiled[key]
+
         def call(prm, x, concrete=False):
             if not concrete:
                 return out(prm, x)
-            key = (x.shape, str(x.dtype), prm.shape)
-            if key not in compiled:       # read from the exported programs where a process compiled it before
-                with no_eager_folding():
-                    compiled[key] = compile_program(f"element-{form}-{name}", f, (prm, x),
-                                                    _kernel_compiler_options())[0]
-            return compiled[key](prm, x)
+            return lower(prm, x).result()(prm, x)
+        call.lower = lower
         return call
 
     def batched(fn, size, derivative=jax.hessian):
