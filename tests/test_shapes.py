@@ -258,3 +258,26 @@ def test_shaped_tank_sparse_solver_agrees_with_dense():
     assert dense.status == sparse.status == "ok"
     np.testing.assert_allclose(sparse.vessel.roll_pitch_yaw, dense.vessel.roll_pitch_yaw, rtol=0, atol=1e-9)
     np.testing.assert_allclose(sparse.probes["B"].position, dense.probes["B"].position, rtol=0, atol=1e-8)
+
+
+def test_a_kept_model_is_named_by_the_contents_of_the_mesh_file(tmp_path):
+    """`jaxslosh run` keeps the model it built (programs.cached) under a name that holds the contents
+    of every file the scene names: a mesh that changes after a run gives the next run a new model."""
+    meshio = pytest.importorskip("meshio")
+    from jaxslosh.fem.mesh import box_mesh
+    from jaxslosh.run.tofile import model_key
+    path = tmp_path / "tank.msh"
+
+    def write(height):
+        nodes, elements = box_mesh((5.0, 5.0, height), (5, 5, 5))
+        meshio.write(str(path), meshio.Mesh(nodes, [("hexahedron", elements)]), file_format="gmsh22")
+
+    write(3.0)
+    text = _scene_text(f'shape = "mesh"\nfile = "{path}"').replace("fill_depth = 3.0\n", "").replace("mesh = [5, 5, 5]\n", "")
+    scene = js.load_scene(text)
+    first = model_key(scene)
+    assert model_key(scene) == first and str(path) in dict(first[1])
+    write(2.5)
+    assert model_key(scene) != first
+    path.unlink()
+    assert model_key(scene) is None

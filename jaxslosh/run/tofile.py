@@ -7,6 +7,9 @@ of its own: the first chunk then runs precompiled, so the stepping phase, its ra
 hold steps only, and the compile time is measured apart instead of hiding in the first chunk."""
 from __future__ import annotations
 
+import dataclasses
+import hashlib
+import os
 from typing import NamedTuple, Optional
 
 import jax
@@ -49,7 +52,8 @@ def run_to_file(scene: Scene, out: str, *, progress: bool = True,
         with interrupts() as stop:
             bar.phase("build", "building the model")
             # a second run of the scene reads the model the first one built (programs.cached)
-            setup = cached("model", scene, lambda: prepare(scene))
+            key = model_key(scene)
+            setup = prepare(scene) if key is None else cached("model", key, lambda: prepare(scene))
             b, solver = setup.built, setup.solver
             se = setup.save_every
             n_frames = setup.n_steps // se
@@ -107,6 +111,40 @@ def run_to_file(scene: Scene, out: str, *, progress: bool = True,
                     raise
                 status, code = f"disk full ({_reason(e)})", Status.DISK_FULL
     return RunReport(status, int(code), steps_written, times, warnings)
+
+
+def model_key(scene: Scene):
+    """What a model built from `scene` depends on: the scene and the contents of every file it names
+    (a tank's or the hull's mesh, a hydrodynamic database), so that a model kept from a file that has
+    changed since is not read back; None where such a file cannot be read (the model is not kept)."""
+    files = set()
+
+    def walk(x, base):
+        if dataclasses.is_dataclass(x):
+            base = getattr(x, "base_dir", "") or base
+            for f in dataclasses.fields(x):
+                v = getattr(x, f.name)
+                if f.name == "file" and isinstance(v, str):
+                    if v:
+                        files.add(v if os.path.isabs(v) else os.path.join(base, v))
+                else:
+                    walk(v, base)
+        elif isinstance(x, (tuple, list)):
+            for v in x:
+                walk(v, base)
+        elif isinstance(x, dict):
+            for v in x.values():
+                walk(v, base)
+
+    walk(scene, os.path.dirname(os.path.abspath(scene.path)) if scene.path else os.getcwd())
+    try:
+        contents = []
+        for f in sorted(files):
+            with open(f, "rb") as fh:
+                contents.append((f, hashlib.sha256(fh.read()).hexdigest()))
+    except OSError:
+        return None
+    return scene, tuple(contents)
 
 
 def _reason(e: BaseException) -> str:
