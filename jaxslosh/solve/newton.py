@@ -139,12 +139,14 @@ def _newton(R, x0, Cinv, scale, tol, max_iter, pre=None, floor=0.0, adaptive=Tru
         need = jnp.where(first, need_prev, err > jnp.where(was_fresh, 0.1, SLOW) * err_prev)
         it = it + 1
 
-        def prepare(data):
-            if adaptive:
+        if adaptive:
+            def prepare(data):
                 data = jax.lax.cond(need, refresh, lambda _: data, x)
-            return data, _precond_apply(data, Cinv, -r, ns)
+                return data, _precond_apply(data, Cinv, -r, ns)
 
-        data, dx = jax.lax.cond(going(it, err, stalled), prepare, lambda d: (d, jnp.zeros_like(x)), data)
+            data, dx = jax.lax.cond(going(it, err, stalled), prepare, lambda d: (d, jnp.zeros_like(x)), data)
+        else:    # batches: the preconditioner is fixed through the iterations (a cond on a per-run
+            dx = _precond_apply(data, Cinv, -r, ns)     # test would run both branches under vmap)
         return x, dx, it, err, need | (not adaptive), stalled, need, data
 
     def cond(carry):
