@@ -118,8 +118,9 @@ def memory_next(system: System, solver: Solver, s: State, v_new):
 
 def step_equations(system: System, solver: Solver, s: State):
     """The equations of one step t_n -> t_{n+1} in the increment Delta = (dX0, Theta, dd):
-    returns (R, unpack, x0, parts): the residual R(Delta), the map Delta -> (config, v, acc, a) of
-    the scheme, the predictor (a_{n+1} = a_n), and the residual in parts for the Newton
+    returns (R, unpack, x0, parts): the residual R(Delta) (with structures, of their dynamic
+    unknowns, without the multipliers), the map Delta -> (config, v, acc, a) of the scheme, the
+    predictor (a_{n+1} = a_n), and the residual in parts for the Newton
     preconditioner, parts(Delta[:r], Delta[r:]) = (rigid rows, the others) with r the rigid
     unknowns (System.residual_parts; with structures their inertia rows, without the multipliers:
     structures.inertia_rows_parts)."""
@@ -150,12 +151,7 @@ def step_equations(system: System, solver: Solver, s: State):
         return system.residual_parts(advance_config_parts(s.c, y, z), vy[:3], vy[3:], vz, ay, az, s.t + h, mu)
 
     def R(delta):
-        if system.flex is not None:
-            c, v, acc, _ = unpack(delta)
-            V0, om, dd = _split(v)
-            mu = None if memory is None else memory.force(memory.advance(s.z, s.v[:6], v[:6], coef))
-            return system.residual(c, V0, om, dd, acc, s.t + h, mu)
-        return jnp.concatenate(parts(delta[:6], delta[6:]))
+        return jnp.concatenate(parts(delta[:r], delta[r:]))
 
     return R, unpack, base + h * h * beta * s.a, parts
 

@@ -22,34 +22,35 @@ def _precond_data_split(parts_m, Ac, x, Cinv, nr, ns):
     rows ns..) (zero on rows nr..ns), linearised in x[:nr] alone for its columns and transposed in
     x[ns:] alone for its rows, as in _precond_data_parts."""
     n = x.shape[0]
-    y, z = x[:nr], x[ns:]
     I = jnp.eye(n, ns, dtype=x.dtype)
-    Inr = jnp.eye(nr, dtype=x.dtype)
+    cm, Am_yz = _parts_linearised(parts_m, x[:nr], x[ns:])
     cols = jax.vmap(Ac, in_axes=1, out_axes=1)(I)
-    _, jvp_y = jax.linearize(lambda y_: jnp.concatenate(parts_m(y_, z)), y)
-    cm = jax.vmap(jvp_y, in_axes=1, out_axes=1)(Inr)                    # (nr + nz, nr): Am's rows y and z
     cols = cols.at[:nr, :nr].add(cm[:nr]).at[ns:, :nr].add(cm[nr:])
     AcT = jax.linear_transpose(Ac, x)
-    Ayz = jax.vmap(lambda e: AcT(e)[0])(I.T)[:, ns:]
-    _, vjp_z = jax.vjp(lambda z_: parts_m(y, z_)[0], z)
-    Ayz = Ayz.at[:nr].add(jax.vmap(lambda e: vjp_z(e)[0])(Inr))
+    Ayz = jax.vmap(lambda e: AcT(e)[0])(I.T)[:, ns:].at[:nr].add(Am_yz)
     Wz = Cinv @ cols[ns:]
     return inv(cols[:ns] - Ayz @ Wz), Ayz, Wz
 
 
-def _precond_data_parts(parts, x, Cinv, ns):
-    """As _precond_data for the residual given in parts, parts(y, z) = (R_y, R_z) with y = x[:ns] and
-    z = x[ns:]: the columns by linearising in y alone, the rows R_y over z by a transpose in z alone
-    (the terms that R_y shares with z: the liquid's, not the whole residual; see
-    physics/system.residual_parts)."""
-    y, z = x[:ns], x[ns:]
-    I = jnp.eye(ns, dtype=x.dtype)
+def _parts_linearised(parts, y, z):
+    """For a residual given in parts, parts(y, z) = (R_y, R_z): its columns over y, [A_yy; A_zy]
+    ((ny + nz, ny), by linearising in y alone), and its rows R_y over z, A_yz ((ny, nz), by a
+    transpose in z alone: the terms that R_y shares with z, the liquid's, not the whole residual;
+    see physics/system.residual_parts). None for A_yz when z is empty."""
+    I = jnp.eye(y.shape[0], dtype=y.dtype)
     _, jvp_y = jax.linearize(lambda y_: jnp.concatenate(parts(y_, z)), y)
-    cols = jax.vmap(jvp_y, in_axes=1, out_axes=1)(I)                 # [A_yy; A_zy]
+    cols = jax.vmap(jvp_y, in_axes=1, out_axes=1)(I)
     if z.shape[0] == 0:
-        return (inv(cols),)
+        return cols, None
     _, vjp_z = jax.vjp(lambda z_: parts(y, z_)[0], z)
-    Ayz = jax.vmap(lambda e: vjp_z(e)[0])(I)                           # (ns, nz)
+    return cols, jax.vmap(lambda e: vjp_z(e)[0])(I)
+
+
+def _precond_data_parts(parts, x, Cinv, ns):
+    """As _precond_data for the residual given in parts, parts(x[:ns], x[ns:]) (_parts_linearised)."""
+    cols, Ayz = _parts_linearised(parts, x[:ns], x[ns:])
+    if Ayz is None:
+        return (inv(cols),)
     Wz = Cinv @ cols[ns:]
     return inv(cols[:ns] - Ayz @ Wz), Ayz, Wz
 
