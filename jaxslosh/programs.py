@@ -42,6 +42,9 @@ from jax import export
 #: 30-40 % less time than its default fusion emitters, and the step runs as fast (README
 #: "Compilation"). A field of XLA's shared debug options: other backends accept it and leave it unused.
 XLA_OPTIONS = {"xla_cpu_use_fusion_emitters": False}
+#: XLA options of a program that runs once (the run's initial state): optimisation off, which halves
+#: its compile time, while the time it runs stays well under a step's (README "Compilation")
+START_OPTIONS = {**XLA_OPTIONS, "xla_backend_optimization_level": 0}
 
 _FOLDER: list = [None]
 

@@ -94,3 +94,33 @@ def test_a_cached_value_is_computed_once_per_key_and_read_back(folder):
     assert programs.cached("model", ("scene", 2), lambda: compute(2))["k"] == 2 and calls == [2, 3, 2]
     f = programs.cached("model", ("scene", 4), lambda: (lambda: 4))
     assert f() == 4 and len(os.listdir(folder)) == 2
+
+
+SCENES = os.path.join(os.path.dirname(os.path.dirname(os.path.abspath(__file__))), "scenes")
+
+
+@pytest.mark.parametrize("name, extra", [
+    ("paper_ship_mast.toml", ""),                  # structures: frames and multipliers in the state
+    ("paper_ship_waves.toml", ""),                 # radiation memory states
+    ("anti_roll_tank.toml", ""),                   # a modal liquid
+    ("vessel_only.toml", "energy_projection = true"),     # the initial energy in the state
+])
+def test_the_chunk_is_lowered_for_the_shapes_of_the_initial_state(name, extra):
+    """run/tofile.compile_run lowers the chunk for loop.carry_shapes before `start` is traced: they
+    must be the shapes and types of start's carry (else the chunk is lowered twice)."""
+    from jaxslosh.run.loop import carry_shapes, core, traced_init
+    from jaxslosh.run.simulate import prepare
+    from jaxslosh.run.tofile import _same_shapes
+    from jaxslosh.scene import load_scene
+    with open(os.path.join(SCENES, name)) as f:
+        text = f.read()
+    if extra:      # a conservative scheme, which the projection needs
+        text = text.replace('scheme = "hht"\nalpha = 0.01', f'scheme = "newmark"\nalpha = 0.0\n{extra}', 1)
+    setup = prepare(load_scene(text))
+    b = core(setup.built)
+    like = carry_shapes(b, setup.solver)
+    carry = eqx.filter_eval_shape(traced_init, b, setup.solver)[0]
+    assert (setup.solver.project if extra else True)
+    assert _same_shapes(like, carry)
+    assert jax.tree_util.tree_structure(like) == jax.tree_util.tree_structure(carry)
+    assert len(jax.tree_util.tree_leaves(carry)) >= 12

@@ -15,7 +15,7 @@ from ..io.status import Status
 from ..physics import structures as mb
 from ..physics.kinematics import rotation_matrix, rpy_from_quat
 from ..physics.terms import Config
-from ..solve.integrator import State, initial_state, step_or_retry
+from ..solve.integrator import State, initial_state, initial_state_like, step_or_retry
 from ..solve.linear import Solver
 
 
@@ -95,11 +95,22 @@ def init(b: Built, solver: Solver) -> tuple[Carry, Frame]:
     """The state at t = 0 (consistent accelerations; structures in static equilibrium) and its frame."""
     with jax.named_scope("initial state"):
         s0, info = initial_state(b.system, solver, b.c0, b.v0, b.alg0)
+    carry = _first_carry(s0, info)
+    return carry, observe(b, carry, info.iterations, info.residual)
+
+
+def _first_carry(s0, info) -> Carry:
     failed = ~info.ok
     code = jnp.where(failed, int(Status.INITIAL), int(Status.OK))
-    carry = Carry(s0, jnp.array(0), failed, jnp.where(failed, 0, -1), info.residual, info.iterations, jnp.array(0),
-                  code)
-    return carry, observe(b, carry, info.iterations, info.residual)
+    return Carry(s0, jnp.array(0), failed, jnp.where(failed, 0, -1), info.residual, info.iterations, jnp.array(0),
+                 code)
+
+
+def carry_shapes(b: Built, solver: Solver) -> Carry:
+    """The shapes and types of init's carry, without tracing its Newton solves (what the loop is
+    lowered for while init is still being traced: run/tofile.compile_run)."""
+    return eqx.filter_eval_shape(
+        lambda b_, s_: _first_carry(*initial_state_like(b_.system, s_, b_.c0, b_.v0, b_.alg0)), b, solver)
 
 
 def step(b: Built, solver: Solver, c: Carry) -> tuple[Carry, tuple]:

@@ -87,6 +87,21 @@ def initial_state(system: System, solver: Solver, c0: Config, v0, alg0=None) -> 
     return State(c0, v0, acc0, acc0, jnp.zeros(()), pre=pre, z=z0, e0=e0), StepInfo(it, err, ok)
 
 
+def initial_state_like(system: System, solver: Solver, c0: Config, v0, alg0=None) -> tuple[State, StepInfo]:
+    """What initial_state returns, of the same trees, shapes and types, without solving anything:
+    the shapes the time loop is lowered for while the initial state's own program is still being
+    traced (run/tofile.compile_run; a test keeps the two in step)."""
+    zeros = jnp.zeros_like(v0)
+    memory = system.memory
+    z0 = None if memory is None else memory.init()
+    pre = empty_pre(system) if solver.reuse else None
+    info = StepInfo(jnp.zeros((), jnp.int32), jnp.zeros(()), jnp.array(True))
+    if system.flex is not None:
+        return State(c0, v0, zeros, zeros, jnp.zeros(()), pre, alg0, z0), info
+    e0 = jnp.zeros(()) if solver.project else None
+    return State(c0, v0, zeros, zeros, jnp.zeros(()), pre=pre, z=z0, e0=e0), info
+
+
 def total_energy(system: System, c: Config, v):
     T, V = system.energy(c, v)
     return T + V
