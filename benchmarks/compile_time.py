@@ -1,7 +1,7 @@
 """What a run of a scene costs before its first step, in a fresh process: the first call (empty
 caches) and a second process (the caches the first filled), tracing and XLA apart.
 
-    python benchmarks/compile_time.py [SCENE ...] [--repeat 2] [--equations]
+    python benchmarks/compile_time.py [SCENE ...] [--repeat 2] [--equations] [--api]
 
 Each measurement is one fresh Python process that does what `jaxslosh run` does up to the end of
 its first chunk: import, build the model (`build`; a second process reads the model the first kept),
@@ -13,7 +13,8 @@ tracing (jaxpr_trace_duration), lowering (jaxpr_to_mlir_module_duration) and XLA
 (backend_compile_duration; in a second process, reading XLA's cache). Programs that compile at the
 same time (start and the chunk) are both counted in full: the XLA column can exceed the wall time
 it overlaps. Prints a table; no assertion.
-`--equations` adds the traced programs' sizes. Default scenes: the paper example and the paper ship
+`--equations` adds the traced programs' sizes; `--api` a table of `js.simulate`'s first call (build,
+compile and 50 steps) and second call (build and 50 steps) in a fresh process. Default scenes: the paper example and the paper ship
 with its mast.
 """
 import argparse
@@ -38,7 +39,7 @@ jax.monitoring.register_event_duration_secs_listener(
 from jaxslosh.run.loop import core
 from jaxslosh.run.simulate import prepare
 from jaxslosh.programs import cached
-from jaxslosh.run.tofile import compile_run
+from jaxslosh.run.compiled import compile_run
 from jaxslosh.scene import load_scene
 t_import = time.perf_counter()
 scene = load_scene(sys.argv[1])
@@ -78,6 +79,38 @@ print(json.dumps({**eqns, "import": t_import - T0, "build": t_build - t_import, 
 """
 
 
+API_CHILD = r"""
+import collections, json, sys, time
+T0 = time.perf_counter()
+import jax
+jax.config.update("jax_enable_x64", True)
+events = collections.defaultdict(float)
+jax.monitoring.register_event_duration_secs_listener(
+    lambda name, d, **kw: events.__setitem__(name.split("/")[-1], events[name.split("/")[-1]] + d))
+import jaxslosh as js
+scene = js.load_scene(sys.argv[1])
+t_import = time.perf_counter()
+sim = scene.simulation
+duration = 50 * sim.dt * max(1, sim.save_every or 1)     # 50 steps: the call is its build and compile
+r = js.simulate(scene, duration=duration)
+t_first = time.perf_counter()
+r = js.simulate(scene, duration=duration)
+t_second = time.perf_counter()
+print(json.dumps({"import": t_import - T0, "first": t_first - t_import, "second": t_second - t_first,
+                  "trace": events["jaxpr_trace_duration"], "lower": events["jaxpr_to_mlir_module_duration"],
+                  "xla": events["backend_compile_duration"], "status": r.status}))
+"""
+
+
+def measure_api(scene):
+    """js.simulate's first and second call in a fresh process (50 steps; no cache folder: the Python
+    API keeps its compiled programs in the process only)."""
+    p = subprocess.run([sys.executable, "-c", API_CHILD, scene], capture_output=True, text=True, cwd=ROOT)
+    if p.returncode:
+        raise SystemExit(p.stderr)
+    return json.loads(p.stdout.strip().splitlines()[-1])
+
+
 def measure(scene, cache, equations=False):
     p = subprocess.run([sys.executable, "-c", CHILD, scene, cache, "1" if equations else "0"], capture_output=True, text=True, cwd=ROOT)
     if p.returncode:
@@ -93,6 +126,8 @@ def main():
     ap.add_argument("--equations", action="store_true",
                     help="also count the traced programs' equations (start, chunk): a measure of what tracing "
                          "and XLA work on that does not depend on the machine's load")
+    ap.add_argument("--api", action="store_true",
+                    help="also time js.simulate's first and second call in a fresh process (the Python API)")
     a = ap.parse_args()
     print(f"{'scene':24} {'cache':6} {'import':>7} {'build':>7} {'compile':>8} {'1st step':>9} {'1st chunk':>10} {'trace':>7} "
           f"{'lower':>7} {'XLA':>7}   (seconds, one fresh process each)")
@@ -106,6 +141,15 @@ def main():
                           f"{r['xla']:7.2f}" + (f"   equations: start {r['start_eqns']}, chunk {r['chunk_eqns']}"
                                                  if "start_eqns" in r else ""))
                     sys.stdout.flush()
+    if a.api:
+        print(f"\n{'scene':24} {'import':>7} {'1st call':>9} {'2nd call':>9} {'trace':>7} {'lower':>7} {'XLA':>7}"
+              f"   (js.simulate, 50 steps, build included; seconds, one fresh process each)")
+        for scene in a.scenes:
+            for _ in range(a.repeat):
+                r = measure_api(scene)
+                print(f"{os.path.basename(scene)[:24]:24} {r['import']:7.2f} {r['first']:9.2f} {r['second']:9.2f} "
+                      f"{r['trace']:7.2f} {r['lower']:7.2f} {r['xla']:7.2f}")
+                sys.stdout.flush()
 
 
 if __name__ == "__main__":

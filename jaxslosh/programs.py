@@ -36,14 +36,14 @@ import jax
 import numpy as np
 from jax import export
 
-#: XLA options of `jaxslosh run`'s programs (compile_program; JAX takes options only for a top-level
-#: jit, so `js.simulate`, which a user may call inside a jit, keeps XLA's defaults and agrees with
-#: the run to round-off). XLA's classic CPU loop emitters compile the step's many small fusions in
+#: XLA options of the run's programs compiled ahead of time (run/compiled.py: `jaxslosh run`, and
+#: `js.simulate` called outside any transformation; JAX takes options only for a top-level jit, so
+#: js.simulate inside a user's jit keeps XLA's defaults, and agrees to round-off). XLA's classic CPU loop emitters compile the step's many small fusions in
 #: 30-40 % less time than its default fusion emitters, and the step runs as fast (README
 #: "Compilation"). A field of XLA's shared debug options: other backends accept it and leave it unused.
 XLA_OPTIONS = {"xla_cpu_use_fusion_emitters": False}
-#: XLA options of a program that runs once (the run's initial state): optimisation off, which halves
-#: its compile time, while the time it runs stays well under a step's (README "Compilation")
+#: XLA options of a program that runs once (the run's initial state): its optimisation off, which
+#: halves its XLA work, while it still runs in less time than a few steps (README "Compilation")
 START_OPTIONS = {**XLA_OPTIONS, "xla_backend_optimization_level": 0}
 
 _FOLDER: list = [None]
@@ -96,6 +96,13 @@ def _key(name, treedef, leaves, options) -> str | None:
     h.update(static)
     h.update(repr([(a.shape, str(a.dtype)) for a in map(_aval, filter(_is_input, leaves))]).encode())
     return h.hexdigest()
+
+
+def program_key(name: str, args: tuple, options=None) -> str | None:
+    """The name of `name`'s program for arguments like `args` (what its trace depends on: see the
+    module's docstring); None where a static value does not pickle."""
+    leaves, treedef = jax.tree_util.tree_flatten(args)
+    return _key(name, treedef, leaves, options)
 
 
 def _read(path):

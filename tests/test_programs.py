@@ -110,7 +110,7 @@ def test_the_chunk_is_lowered_for_the_shapes_of_the_initial_state(name, extra):
     must be the shapes and types of start's carry (else the chunk is lowered twice)."""
     from jaxslosh.run.loop import carry_shapes, core, traced_init
     from jaxslosh.run.simulate import prepare
-    from jaxslosh.run.tofile import _same_shapes
+    from jaxslosh.run.compiled import same_shapes
     from jaxslosh.scene import load_scene
     with open(os.path.join(SCENES, name)) as f:
         text = f.read()
@@ -121,6 +121,6 @@ def test_the_chunk_is_lowered_for_the_shapes_of_the_initial_state(name, extra):
     like = carry_shapes(b, setup.solver)
     carry = eqx.filter_eval_shape(traced_init, b, setup.solver)[0]
     assert (setup.solver.project if extra else True)
-    assert _same_shapes(like, carry)
+    assert same_shapes(like, carry)
     assert jax.tree_util.tree_structure(like) == jax.tree_util.tree_structure(carry)
     assert len(jax.tree_util.tree_leaves(carry)) >= 12

@@ -22,6 +22,7 @@ from ..scene.keys import check_values, with_overrides
 from ..scene.types import Scene
 from ..solve.linear import Solver, make_solver
 from ..solve.schemes import make_scheme
+from .compiled import compile_run
 from .loop import Carry, Frame, advance, concat_frames, core, frame_datasets, start
 
 
@@ -75,6 +76,13 @@ def prepare(scene: Scene, params=None, batch: bool = False, check: bool = True) 
     return Setup(b, solver, n_steps, max(1, int(sim.save_every)))
 
 
+def _trace_clean() -> bool:
+    """No JAX transformation (jit, grad, vmap) is tracing the caller (JAX's own test; a JAX without
+    it: taken as traced, the staged path, which is right everywhere)."""
+    clean = getattr(getattr(getattr(jax, "_src", None), "core", None), "trace_state_clean", None)
+    return bool(clean()) if clean is not None else False
+
+
 def is_traced(value) -> bool:
     """Whether a value (or a pytree of them) holds a JAX tracer: no value to check or to convert."""
     return any(isinstance(x, jax.core.Tracer) for x in jax.tree_util.tree_leaves(value))
@@ -109,8 +117,13 @@ def simulate(scene: Scene, params: Optional[dict] = None, *, duration: Optional[
     setup = prepare(scene, params, check=check)
     b, solver = setup.built, setup.solver
     n_frames = setup.n_steps // setup.save_every
-    carry, f0 = start(core(b), solver)
-    carry, frames = advance(core(b), solver, carry, n_frames, setup.save_every)
+    bc = core(b)
+    if is_traced(params or {}) or not _trace_clean():
+        carry, f0 = start(bc, solver)       # inside a JAX transformation: staged into the caller's program
+        carry, frames = advance(bc, solver, carry, n_frames, setup.save_every)
+    else:    # compiled as `jaxslosh run` compiles (XLA options, both programs at once), then run
+        carry, f0, run = compile_run(bc, solver, n_frames, setup.save_every)
+        carry, frames = run(bc, solver, carry, n_frames, setup.save_every)
     fr = concat_frames([jax.tree_util.tree_map(lambda x: x[None], f0), frames])
     traced = isinstance(carry.failed, jax.core.Tracer)
     if traced:

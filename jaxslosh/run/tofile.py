@@ -18,10 +18,11 @@ import numpy as np
 from ..io.output import is_disk_full
 from ..io.result import ResultWriter
 from ..io.status import Status
-from ..programs import START_OPTIONS, XLA_OPTIONS, cached, lower_program
+from ..programs import cached
 from ..scene.types import Scene
 from .guard import Interrupted, interrupts
-from .loop import carry_shapes, core, frame_datasets, traced_advance, traced_init
+from .compiled import compile_run
+from .loop import core, frame_datasets
 from .progress import Progress
 from .simulate import failure_message, prepare
 from .validity import Watch
@@ -149,31 +150,3 @@ def model_key(scene: Scene):
 
 def _reason(e: BaseException) -> str:
     return e.strerror if isinstance(e, OSError) and e.strerror else str(e).splitlines()[0]
-
-
-def compile_run(bc, solver, chunk_frames: int, save_every: int):
-    """The run's two programs compiled ahead of time (from the exported programs' folder where a
-    process compiled them before, programs.py): runs `start`; returns its carry and frame, and the
-    compiled chunk, called as `chunk(bc, solver, carry, chunk_frames, save_every)`.
-
-    The chunk is traced first, for the shapes of start's carry (loop.carry_shapes, which traces no
-    solve); XLA compiles it in the background while Python traces `start`, which XLA then compiles
-    beside it with its optimisation off: `start` runs once, and its two Newton solves (with
-    structures) compiled optimised took as long as the chunk. On two cores the compile phase is then
-    about the chunk's tracing and XLA work alone."""
-    like = carry_shapes(bc, solver)
-    chunk = lower_program("advance", traced_advance, (bc, solver, like, chunk_frames, save_every),
-                          XLA_OPTIONS).compile_in_background()
-    start = lower_program("start", traced_init, (bc, solver), START_OPTIONS).compile_in_background()
-    carry_like = start.out[0]
-    if not _same_shapes(carry_like, like):      # a guard: loop.carry_shapes is tested to agree with init
-        chunk = lower_program("advance", traced_advance, (bc, solver, carry_like, chunk_frames, save_every),
-                              XLA_OPTIONS).compile_in_background()
-    carry, f0 = start.result()(bc, solver)
-    return carry, f0, chunk.result()
-
-
-def _same_shapes(a, b) -> bool:
-    la, ta = jax.tree_util.tree_flatten(a)
-    lb, tb = jax.tree_util.tree_flatten(b)
-    return ta == tb and all(x.shape == y.shape and x.dtype == y.dtype for x, y in zip(la, lb))

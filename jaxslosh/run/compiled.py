@@ -1,0 +1,55 @@
+"""The run's two programs compiled ahead of time, as one phase: the command line's runs
+(run/tofile.py) and `js.simulate` called outside any JAX transformation (run/simulate.py) step with
+them. Compiled ahead of time, a program takes XLA options (programs.XLA_OPTIONS, START_OPTIONS),
+XLA compiles in the background while Python traces the next, and the programs can be read back from
+the exported programs' folder (programs.py)."""
+from __future__ import annotations
+
+import jax
+
+from ..programs import START_OPTIONS, XLA_OPTIONS, lower_program, program_key
+from .loop import carry_shapes, traced_advance, traced_init
+
+
+def compile_run(bc, solver, chunk_frames: int, save_every: int):
+    """The run's two programs compiled ahead of time (from the exported programs' folder where a
+    process compiled them before, programs.py): runs `start`; returns its carry and frame, and the
+    compiled chunk, called as `chunk(bc, solver, carry, chunk_frames, save_every)`.
+
+    The chunk is traced first, for the shapes of start's carry (loop.carry_shapes, which traces no
+    solve); XLA compiles it in the background while Python traces `start`, which XLA then compiles
+    beside it with its optimisation off: `start` runs once, and its two Newton solves (with
+    structures) compiled optimised took as long as the chunk. On two cores the compile phase is then
+    about the chunk's tracing and XLA work alone.
+
+    The compiled pair is kept in the process for the next run of the same structure (a script that
+    calls js.simulate again with other values)."""
+    key = program_key("run", (bc, solver, chunk_frames, save_every))
+    if key in _RUNS:
+        start, chunk = _RUNS[key]
+        carry, f0 = start(bc, solver)
+        return carry, f0, chunk
+    like = carry_shapes(bc, solver)
+    chunk = lower_program("advance", traced_advance, (bc, solver, like, chunk_frames, save_every),
+                          XLA_OPTIONS).compile_in_background()
+    start = lower_program("start", traced_init, (bc, solver), START_OPTIONS).compile_in_background()
+    carry_like = start.out[0]
+    if not same_shapes(carry_like, like):      # a guard: loop.carry_shapes is tested to agree with init
+        chunk = lower_program("advance", traced_advance, (bc, solver, carry_like, chunk_frames, save_every),
+                              XLA_OPTIONS).compile_in_background()
+    start, chunk = start.result(), chunk.result()
+    if key is not None:
+        _RUNS[key] = start, chunk
+    carry, f0 = start(bc, solver)
+    return carry, f0, chunk
+
+
+#: compiled (start, chunk) pairs of this process, by program_key
+_RUNS: dict = {}
+
+
+def same_shapes(a, b) -> bool:
+    """Two trees of arrays (or of their shapes) of the same structure, shapes and types."""
+    la, ta = jax.tree_util.tree_flatten(a)
+    lb, tb = jax.tree_util.tree_flatten(b)
+    return ta == tb and all(x.shape == y.shape and x.dtype == y.dtype for x, y in zip(la, lb))
