@@ -5,7 +5,7 @@ caches) and a second process (the caches the first filled), tracing and XLA apar
 
 Each measurement is one fresh Python process that does what `jaxslosh run` does up to the end of
 its first chunk: import, build the model (`build`; a second process reads the model the first kept),
-compile `start` and the chunk (tofile.compile_run: JAX's persistent compilation cache and the
+compile `start` and the chunk (run/compiled.compile_run: JAX's persistent compilation cache and the
 exported programs, programs.py, in a temporary folder; `start` compiles while the chunk traces) and
 run `start` (`compile`), then the first chunk. `1st step` is the process's time to its first
 step (import + build + compile). JAX's compilation events are summed by kind (jax.monitoring):

@@ -19,7 +19,7 @@ program is traced and compiled as usual, without a file.
 element matrices, the Newton matrix's constant blocks), a second run of the scene reads it.
 
 XLA's work on a program runs outside Python: `Program.compile_in_background` lets one program
-compile while Python traces the next (`run/tofile.compile_run`).
+compile while Python traces the next (`run/compiled.compile_run`).
 """
 from __future__ import annotations
 

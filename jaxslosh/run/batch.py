@@ -53,6 +53,7 @@ def _batch_fn(scene: Scene, keys: tuple, mesh: Optional[Mesh] = None, excited: b
         with jax.ensure_compile_time_eval():     # the liquid's matrices are built on the host, once
             setup = prepare(scene, dict(zip(keys, v)), batch=True)
         b = core(setup.built)
+        b = b._replace(system=eqx.tree_at(lambda s: s.liquid, b.system, b.system.liquid.for_batch()))
         if excited:
             b = _excited(b, exc)
         carry, f0 = start(b, setup.solver)
