@@ -38,9 +38,10 @@ from jax import export
 
 #: XLA options of the run's programs compiled ahead of time (run/compiled.py: `jaxslosh run`, and
 #: `js.simulate` called outside any transformation; JAX takes options only for a top-level jit, so
-#: js.simulate inside a user's jit keeps XLA's defaults, and agrees to round-off). XLA's classic CPU loop emitters compile the step's many small fusions in
-#: 30-40 % less time than its default fusion emitters, and the step runs as fast (README
-#: "Compilation"). A field of XLA's shared debug options: other backends accept it and leave it unused.
+#: js.simulate inside a user's jit keeps XLA's defaults, and agrees to round-off). XLA's classic CPU
+#: loop emitters compile the step's many small fusions in 30-40 % less time than its default fusion
+#: emitters, and the step runs as fast (README "Compilation"). A field of XLA's shared debug options:
+#: other backends accept it and leave it unused.
 XLA_OPTIONS = {"xla_cpu_use_fusion_emitters": False}
 #: XLA options of a program that runs once (the run's initial state): its optimisation off, which
 #: halves its XLA work, while it still runs in less time than a few steps (README "Compilation")

@@ -40,12 +40,15 @@ def compile_run(bc, solver, chunk_frames: int, save_every: int):
     start, chunk = start.result(), chunk.result()
     if key is not None:
         _RUNS[key] = start, chunk
+        while len(_RUNS) > KEEP:       # the oldest first (a script that tries many structures)
+            _RUNS.pop(next(iter(_RUNS)))
     carry, f0 = start(bc, solver)
     return carry, f0, chunk
 
 
-#: compiled (start, chunk) pairs of this process, by program_key
+#: compiled (start, chunk) pairs of this process, by program_key; at most KEEP of them
 _RUNS: dict = {}
+KEEP = 8
 
 
 def same_shapes(a, b) -> bool:
