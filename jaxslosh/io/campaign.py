@@ -12,7 +12,7 @@ import h5py
 import numpy as np
 
 from .._version import __version__
-from .result import ResultFileError, attr_str, expect_format, open_h5
+from .result import ResultFileError, attr_str, open_format
 
 CAMPAIGN_FORMAT = "jaxslosh.campaign"
 CASE_KEYS = ("hs", "tp", "heading", "seed", "weight")
@@ -87,8 +87,7 @@ class Campaign(NamedTuple):
 
 def load_campaign(path) -> Campaign:
     """The campaign file at `path`; one that is not one or cannot be read raises ResultFileError."""
-    with open_h5(path) as f:
-        expect_format(f, path, CAMPAIGN_FORMAT, "campaign")
+    with open_format(path, CAMPAIGN_FORMAT, "campaign") as f:
         try:
             cases = {k: f[f"cases/{k}"][()] for k in f["cases"] if k != "status"}
             status = [attr_str(x) for x in f["cases/status"][()]]

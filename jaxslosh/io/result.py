@@ -230,12 +230,15 @@ def open_h5(path: str):
             pass
 
 
-def expect_format(f: h5py.File, path: str, expected: str, what: str):
-    """Raise ResultFileError unless the file's format (file_format) is `expected` ("sweep",
-    "campaign": what the message calls it)."""
-    fmt = file_format(f, path)
-    if fmt != expected:
-        raise ResultFileError(f"{path}: not a jaxslosh {what} file (format {fmt!r})")
+@contextlib.contextmanager
+def open_format(path: str, expected: str, what: str):
+    """open_h5, for a file whose format (file_format) must be `expected` ("sweep", "campaign": what
+    the message calls it): a ResultFileError otherwise."""
+    with open_h5(path) as f:
+        fmt = file_format(f, path)
+        if fmt != expected:
+            raise ResultFileError(f"{path}: not a jaxslosh {what} file (format {fmt!r})")
+        yield f
 
 
 def file_format(f: h5py.File, path: str) -> str:

@@ -9,7 +9,7 @@ import h5py
 import numpy as np
 
 from .._version import __version__
-from .result import (Result, ResultFileError, attr_str, check_required, expect_format, open_h5, read_frames,
+from .result import (Result, ResultFileError, attr_str, check_required, open_format, read_frames,
                      result_from, result_frames, schema)
 
 
@@ -42,8 +42,7 @@ class Sweep(NamedTuple):
 
 def load_sweep(path) -> Sweep:
     """The sweep file at `path`; a file that is not one or cannot be read raises ResultFileError."""
-    with open_h5(path) as f:
-        expect_format(f, path, SWEEP_FORMAT, "sweep")
+    with open_format(path, SWEEP_FORMAT, "sweep") as f:
         probes = list(f["probes"]) if "probes" in f else []
         params = read_frames(f, [f"sweep/{k}" for k in (f["sweep"] if "sweep" in f else [])])
         d = read_frames(f, schema(probes), axis=1)
