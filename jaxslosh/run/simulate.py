@@ -118,7 +118,7 @@ def simulate(scene: Scene, params: Optional[dict] = None, *, duration: Optional[
     b, solver = setup.built, setup.solver
     n_frames = setup.n_steps // setup.save_every
     bc = core(b)
-    if is_traced(params or {}) or not _trace_clean():
+    if not _trace_clean():      # traced params too: only a transformation makes tracers
         carry, f0 = start(bc, solver)       # inside a JAX transformation: staged into the caller's program
         carry, frames = advance(bc, solver, carry, n_frames, setup.save_every)
     else:    # compiled as `jaxslosh run` compiles (XLA options, both programs at once), then run
