@@ -15,6 +15,13 @@ and the shape and type of each array. Arrays (JAX or NumPy) are the program's in
 `eqx.filter_jit`. Where the structure does not pickle, or the folder is off or not writable, the
 program is traced and compiled as usual, without a file.
 
+Once XLA has compiled the program, its executable is added to the file (`jax.experimental.
+serialize_executable`), marked with the host it was compiled for (backend, processor and its
+instruction set). A later process on that host loads the executable and neither lowers the program
+nor asks XLA's cache: on the mast scene, that lowering and XLA's cache lookup took about half a
+second of a second process's start (README "Compile time"). Another host compiles the exported
+program, through XLA's cache. An executable XLA's cache gave back is not kept (see `_HITS`).
+
 `cached` keeps a value the same way: `jaxslosh run` keeps the model it built from a scene (meshes,
 element matrices, the Newton matrix's constant blocks), a second run of the scene reads it.
 
@@ -35,6 +42,7 @@ import equinox as eqx
 import jax
 import numpy as np
 from jax import export
+from jax.experimental import serialize_executable
 
 #: XLA options of the run's programs compiled ahead of time (run/compiled.py: `jaxslosh run`, and
 #: `js.simulate` called outside any transformation; JAX takes options only for a top-level jit, so
@@ -106,21 +114,70 @@ def program_key(name: str, args: tuple, options=None) -> str | None:
     return _key(name, treedef, leaves, options)
 
 
-def _read(path):
+def _read(path) -> dict | None:
+    """The file's content: the exported program (`export`) and its output tree (`out_tree`); where a
+    process compiled it, the executable (`executable`, with its outputs' shapes `out`) and the host
+    it was compiled for (`host`)."""
     try:
         with open(path, "rb") as f:
-            blob, out_tree = pickle.load(f)
-        return export.deserialize(blob), out_tree
+            saved = pickle.load(f)
     except Exception:        # absent, written by another version, cut short: traced again
         return None
+    _touch(path)
+    return saved if isinstance(saved, dict) and "export" in saved and "out_tree" in saved else None
 
 
-def _write(path, exported, out_tree):
+def _write(path, saved: dict):
     try:
-        data = pickle.dumps((exported.serialize(), out_tree))
+        data = pickle.dumps(saved)
     except Exception:
         return
     _write_bytes(path, data)
+
+
+@functools.cache
+def _host() -> str:
+    """What an executable compiled here needs of the machine that runs it: XLA compiles for this
+    backend and this processor's instruction set (a cache folder shared by several machines, on a
+    cluster's network drive, must not hand one machine's executable to another)."""
+    cpu = ""
+    try:
+        with open("/proc/cpuinfo") as f:
+            cpu = "".join(sorted({ln for ln in f if ln.startswith(("model name", "flags"))}))
+    except OSError:
+        import platform
+        cpu = platform.processor() or platform.machine()
+    return hashlib.sha256(f"{jax.default_backend()} {jax.devices()[0].device_kind} {cpu}".encode()).hexdigest()
+
+
+#: JAX's persistent compilation cache hits, counted by thread: an executable XLA's cache gave back
+#: serialises without its code (a process that loads it fails: "Function ... not found"), so only
+#: what XLA compiled in this process is kept
+_HITS = threading.local()
+
+
+def _count_hit(event: str, **kwargs):
+    if event == "/jax/compilation_cache/cache_hits":
+        _HITS.n = _cache_hits() + 1
+
+
+def _cache_hits() -> int:
+    return getattr(_HITS, "n", 0)
+
+
+jax.monitoring.register_event_listener(_count_hit)
+
+
+@functools.cache
+def _lapack_ready():
+    """jaxlib's LAPACK kernels find LAPACK (SciPy's) when a program that calls them is first lowered;
+    an executable read back is never lowered, and would call through null pointers."""
+    try:
+        from jax._src.lax.linalg import initialize_lapack
+        initialize_lapack()
+    except Exception:       # a JAX that moved it: a lowering does it
+        jax.jit(jax.numpy.linalg.solve).lower(jax.ShapeDtypeStruct((2, 2), np.float64),
+                                              jax.ShapeDtypeStruct((2,), np.float64))
 
 
 class Program:
@@ -128,24 +185,48 @@ class Program:
     `out` is its output tree of shapes and types (what a following program is lowered with), and
     `compile()` or `compile_in_background()` then `result()` give the callable, which takes
     arguments like the `args` it was lowered for. XLA's work runs outside Python (no GIL), so one
-    program compiles in the background while Python traces the next."""
+    program compiles in the background while Python traces the next.
 
-    def __init__(self, lowered, where, out_tree, loaded, options):
+    Where the file holds an executable this host compiled, there is nothing to lower or compile: it
+    is loaded (also outside Python). Where it does not, the executable XLA compiles is added to the
+    file (`saved`), for the next process."""
+
+    def __init__(self, lowered, where, out_tree, loaded, options, saved=None, path=None, retrace=None):
         self._lowered, self._where, self._out_tree, self._options = lowered, where, out_tree, options
+        self._saved, self._path, self._retrace = saved, path, retrace
         self.loaded = loaded
         self._done: list = []
         self._thread = None
 
     @property
     def out(self):
-        info = jax.tree_util.tree_map(lambda a: jax.ShapeDtypeStruct(a.shape, a.dtype), self._lowered.out_info)
+        if self._lowered is None:
+            info = [jax.ShapeDtypeStruct(shape, dtype) for shape, dtype in self._saved["out"]]
+        else:
+            info = jax.tree_util.tree_map(lambda a: jax.ShapeDtypeStruct(a.shape, a.dtype), self._lowered.out_info)
         return info if self._out_tree is None else jax.tree_util.tree_unflatten(self._out_tree, info)
 
     def _compile(self):
         try:
-            self._done.append((self._lowered.compile(compiler_options=self._options), None))
+            if self._lowered is None:
+                _lapack_ready()
+                self._done.append((serialize_executable.deserialize_and_load(*self._saved["executable"]), None))
+                return
+            hits = _cache_hits()
+            compiled = self._lowered.compile(compiler_options=self._options)
+            fresh = _cache_hits() == hits
+            self._done.append((compiled, None))
         except BaseException as e:      # handed to the thread that asks for the result
             self._done.append((None, e))
+            return
+        if self._path is not None and fresh:
+            try:
+                executable = serialize_executable.serialize(compiled)
+            except Exception:           # a backend or program that cannot be serialised: the export alone
+                return
+            _write(self._path, {"export": self._saved["export"], "out_tree": self._out_tree, "host": _host(),
+                                "executable": executable,
+                                "out": [(a.shape, str(a.dtype)) for a in jax.tree_util.tree_leaves(self.out)]})
 
     def compile_in_background(self) -> "Program":
         # a daemon thread: an interrupted run exits without waiting for XLA to finish
@@ -159,6 +240,8 @@ class Program:
         elif not self._done:
             self._compile()
         compiled, error = self._done[-1]
+        if error is not None and self._retrace is not None:     # an executable that did not load
+            return self._retrace().result()
         if error is not None:
             raise error
         where, out_tree = self._where, self._out_tree
@@ -169,10 +252,11 @@ class Program:
     compile = result
 
 
-def lower_program(name: str, fn, args: tuple, compiler_options=None) -> Program:
+def lower_program(name: str, fn, args: tuple, compiler_options=None, executable: bool = True) -> Program:
     """`fn(*args)` traced and lowered for arguments of this structure, shapes and static values (from
-    the folder's exported program where a process traced it before), not yet compiled. Arrays among
-    `args` may be jax.ShapeDtypeStruct: only their shapes and types are read."""
+    the folder's exported program where a process traced it before, or its executable where one was
+    compiled on this host), not yet compiled. Arrays among `args` may be jax.ShapeDtypeStruct: only
+    their shapes and types are read."""
     leaves, treedef = jax.tree_util.tree_flatten(args)
     where = [i for i, x in enumerate(leaves) if _is_input(x)]
     avals = [_aval(leaves[i]) for i in where]
@@ -182,8 +266,17 @@ def lower_program(name: str, fn, args: tuple, compiler_options=None) -> Program:
         lowered = jax.jit(lambda *xs: fn(*_fill(treedef, leaves, where, xs))).lower(*avals)
         return Program(lowered, where, None, False, compiler_options)
     path = os.path.join(base, f"{name.replace(' ', '_')}-{key[:32]}.jaxexport")
-    found = _read(path)
-    loaded = found is not None
+    saved = _read(path)
+    if executable and saved is not None and saved.get("host") == _host() and "executable" in saved:
+        return Program(None, where, saved["out_tree"], True, compiler_options, saved,
+                       retrace=lambda: lower_program(name, fn, args, compiler_options, executable=False))
+    exported = None
+    if saved is not None:
+        try:
+            exported = export.deserialize(saved["export"])
+        except Exception:        # written by another version: traced again
+            pass
+    loaded = exported is not None
     if not loaded:
         out_tree = []
 
@@ -192,10 +285,10 @@ def lower_program(name: str, fn, args: tuple, compiler_options=None) -> Program:
             out_tree.append(tree)
             return out
         exported = export.export(jax.jit(flat))(*avals)
-        _write(path, exported, out_tree[0])
-        found = (exported, out_tree[0])
-    exported, out_tree = found
-    return Program(jax.jit(exported.call).lower(*avals), where, out_tree, loaded, compiler_options)
+        saved = {"export": exported.serialize(), "out_tree": out_tree[0]}
+        _write(path, saved)
+    return Program(jax.jit(exported.call).lower(*avals), where, saved["out_tree"], loaded, compiler_options,
+                   saved, path)
 
 
 def compile_program(name: str, fn, args: tuple, compiler_options=None):
@@ -206,8 +299,9 @@ def compile_program(name: str, fn, args: tuple, compiler_options=None):
 
 
 #: a value larger than this, pickled, is not kept (a large mesh's model: its file would cost more to
-#: write and read than the build it saves)
-MAX_VALUE_BYTES = 64 << 20
+#: write and read than the build it saves; the paper's elastic tank, whose dense liquid blocks make
+#: 75 MB, reads back in a fraction of its build)
+MAX_VALUE_BYTES = 256 << 20
 
 
 def cached(name: str, key, compute):
@@ -228,7 +322,9 @@ def cached(name: str, key, compute):
     path = os.path.join(base, f"{name.replace(' ', '_')}-{h.hexdigest()[:32]}.pickle")
     try:
         with open(path, "rb") as f:
-            return pickle.load(f)
+            value = pickle.load(f)
+        _touch(path)
+        return value
     except Exception:        # absent, written by another version, cut short: computed again
         pass
     value = compute()
@@ -250,6 +346,43 @@ def _write_bytes(path, data: bytes):
         os.replace(tmp, path)      # whole or absent, for a process that reads it meanwhile
     except Exception:
         pass                       # a cache that cannot be written is no cache, not an error
+
+
+def _touch(path):
+    """A file read is a file used: `trim` removes the least recently used first."""
+    try:
+        os.utime(path)
+    except OSError:
+        pass
+
+
+def trim(base: str, max_bytes: int) -> int:
+    """Keep the files under `base` (the exported programs, kept models, XLA's cache entries) within
+    `max_bytes`: where they exceed it, the least recently used (written or read) are removed until
+    three quarters of it remain. Returns the bytes removed. Whatever cannot be listed or removed (a
+    file another process removed meanwhile) is left alone: a cache file removed is only work to
+    redo."""
+    files = []
+    for dirpath, _, names in os.walk(base):
+        for n in names:
+            try:
+                st = os.stat(os.path.join(dirpath, n))
+            except OSError:
+                continue
+            files.append((st.st_mtime, st.st_size, os.path.join(dirpath, n)))
+    total = sum(size for _, size, _ in files)
+    if total <= max_bytes:
+        return 0
+    removed = 0
+    for _, size, path in sorted(files):
+        if total - removed <= 0.75 * max_bytes:
+            break
+        try:
+            os.remove(path)
+            removed += size
+        except OSError:
+            pass
+    return removed
 
 
 def _fill(treedef, leaves, where, xs):

@@ -86,9 +86,13 @@ def test_a_full_disk_ends_the_run_with_one_line_and_a_readable_file(tmp_path):
     assert a["status"].startswith("disk full") and int(a["status_code"]) == 5 and n == int(a["steps_done"]) + 1
 
 
-@pytest.mark.parametrize("case", ["scene", "directory", "foreign", "missing-folder", "duration-inf", "save-every"])
-def test_outputs_and_overrides_are_checked_before_computing(tmp_path, case):
+@pytest.mark.parametrize("case", ["scene", "directory", "foreign", "missing-folder", "duration-inf", "save-every",
+                                  "cache-limit"])
+def test_outputs_and_overrides_are_checked_before_computing(tmp_path, case, monkeypatch, capsys):
     from jaxslosh.cli import main
+    if case == "cache-limit":
+        monkeypatch.setenv("JAXSLOSH_CACHE_DIR", str(tmp_path / "cache"))
+        monkeypatch.setenv("JAXSLOSH_CACHE_MAX_MB", "lots")
     scene = tmp_path / "s.toml"
     scene.write_text(open(PAPER).read().replace("duration = 20.0", "duration = 0.05"))
     out = {"scene": str(scene), "directory": str(tmp_path), "missing-folder": str(tmp_path / "no" / "r.h5")}.get(
@@ -101,6 +105,8 @@ def test_outputs_and_overrides_are_checked_before_computing(tmp_path, case):
         scene.write_text(scene.read_text().replace("[simulation]", "[simulation]\nsave_every = 10"))
     before = scene.read_text()
     assert main(["run", str(scene), "-o", out, "--no-progress", *extra]) == 2
+    if case == "cache-limit":
+        assert "JAXSLOSH_CACHE_MAX_MB" in capsys.readouterr().err and not (tmp_path / "cache").exists()
     assert scene.read_text() == before                     # the scene is never overwritten
     if case == "foreign":
         assert open(out).read() == "not a result\n"

@@ -1,7 +1,11 @@
 """Exported programs kept across processes (jaxslosh/programs.py): a program read back from its file
 computes what the traced one does, and a change of anything the trace depends on (a static value,
 a shape) names another file."""
+import json
 import os
+import pickle
+import subprocess
+import sys
 
 import equinox as eqx
 import jax
@@ -94,6 +98,80 @@ def test_a_cached_value_is_computed_once_per_key_and_read_back(folder):
     assert programs.cached("model", ("scene", 2), lambda: compute(2))["k"] == 2 and calls == [2, 3, 2]
     f = programs.cached("model", ("scene", 4), lambda: (lambda: 4))
     assert f() == 4 and len(os.listdir(folder)) == 2
+
+
+def test_an_executable_compiled_on_another_host_is_not_loaded(folder, monkeypatch):
+    """The file keeps the executable XLA compiled, for this host alone (its instruction set): on
+    another, the exported program is compiled again, and its executable replaces the first."""
+    m, x = Model(jnp.asarray(3.0), 3), np.linspace(0.0, 1.0, 7)
+    programs.compile_program("energy", energy, (m, x, "a"))
+    (path,) = [folder / f for f in os.listdir(folder)]
+    here = pickle.loads(path.read_bytes())["host"]
+    monkeypatch.setattr(programs, "_host", lambda: "another machine")
+    p = programs.lower_program("energy", energy, (m, x, "a"))
+    assert p.loaded and p._lowered is not None          # from the exported program, lowered again
+    f = p.compile()
+    np.testing.assert_allclose(f(m, x, "a")["e"], 0.5 * 3.0 * np.sum(x ** 3), rtol=1e-15)
+    assert pickle.loads(path.read_bytes())["host"] == "another machine" != here
+
+
+def test_the_cache_folder_is_trimmed_to_its_limit_least_recently_used_first(folder):
+    """Past its limit, the folder loses the files least recently written or read (a read marks a
+    file used) until three quarters of the limit remain; under the limit nothing is removed."""
+    sub = folder / "xla"
+    sub.mkdir()
+    paths = [folder / "model-a.pickle", sub / "entry-b", folder / "model-c.pickle", sub / "entry-d"]
+    for t, p in enumerate(paths):
+        p.write_bytes(b"x" * 1000)
+        os.utime(p, (1e9 + t, 1e9 + t))
+    assert programs.trim(str(folder), 4000) == 0 and all(p.exists() for p in paths)
+    calls = []
+    programs.cached("model", "a", lambda: calls.append(1))       # names its own file; written now
+    (kept,) = [f for f in folder.iterdir() if f.name.startswith("model-") and f not in paths]
+    os.utime(kept, (1e9 - 1, 1e9 - 1))          # the oldest ...
+    programs.cached("model", "a", lambda: calls.append(2))       # ... until read
+    assert calls == [1]
+    size = sum(p.stat().st_size for p in paths) + kept.stat().st_size
+    removed = programs.trim(str(folder), 2000)
+    assert [p.exists() for p in paths] == [False, False, False, True] and kept.exists()
+    assert removed == 3000 and size - removed <= 0.75 * 2000
+
+
+CACHED_SOLVE = r"""
+import json, os, sys
+import jax, jax.numpy as jnp, numpy as np
+jax.config.update("jax_enable_x64", True)
+jax.config.update("jax_compilation_cache_dir", os.path.join(sys.argv[1], "xla"))
+jax.config.update("jax_persistent_cache_min_compile_time_secs", 0.0)
+jax.config.update("jax_persistent_cache_min_entry_size_bytes", -1)
+from jaxslosh import programs
+programs.use(os.path.join(sys.argv[1], "programs"))
+a = np.array([[4.0, 1.0, 0.0], [1.0, 3.0, 1.0], [0.0, 1.0, 2.0]])
+p = programs.lower_program("solve", lambda a, b: jnp.linalg.solve(a, b) * 2.0, (a, np.ones(3)))
+x = p.compile()(a, np.arange(3.0))
+print(json.dumps({"from": "executable" if p._lowered is None else "export" if p.loaded else "trace",
+                  "x": np.asarray(x).tolist()}))
+"""
+
+
+def test_an_executable_read_back_runs_and_one_from_xla_cache_is_not_kept(tmp_path):
+    """A fresh process loads the executable the first compiled, and it runs (LAPACK, which jaxlib's
+    kernels find when a program is lowered, is found without). Where JAX's persistent cache gave the
+    executable back (the exported program's file lost), it is not kept: such a one serialises
+    without its code; the next process compiles from the exported program."""
+    def run():
+        p = subprocess.run([sys.executable, "-c", CACHED_SOLVE, str(tmp_path)], capture_output=True, text=True,
+                           timeout=120)
+        assert p.returncode == 0, p.stderr
+        return json.loads(p.stdout.strip().splitlines()[-1])
+    want = 2.0 * np.linalg.solve([[4.0, 1.0, 0.0], [1.0, 3.0, 1.0], [0.0, 1.0, 2.0]], np.arange(3.0))
+    seen = [run(), run()]
+    for f in os.listdir(tmp_path / "programs"):
+        os.remove(tmp_path / "programs" / f)
+    seen += [run(), run()]
+    assert [s["from"] for s in seen] == ["trace", "executable", "trace", "export"]
+    for s in seen:
+        np.testing.assert_allclose(s["x"], want, rtol=1e-14)
 
 
 SCENES = os.path.join(os.path.dirname(os.path.dirname(os.path.abspath(__file__))), "scenes")

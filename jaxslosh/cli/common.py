@@ -62,6 +62,7 @@ class Parser(argparse.ArgumentParser):
 #: the persistent compilation cache's folder: $JAXSLOSH_CACHE_DIR, else $XDG_CACHE_HOME/jaxslosh/xla;
 #: JAXSLOSH_CACHE_DIR="" turns it off (a JAX_COMPILATION_CACHE_DIR of the user's is used as it is)
 CACHE_ENV = "JAXSLOSH_CACHE_DIR"
+CACHE_MAX_ENV = "JAXSLOSH_CACHE_MAX_MB"
 
 
 def setup_jax():
@@ -77,10 +78,26 @@ def setup_jax():
     if not d:
         programs.use(None)
         return
+    limit = cache_max_bytes()
     jax.config.update("jax_compilation_cache_dir", d)
     jax.config.update("jax_persistent_cache_min_compile_time_secs", 0.0)
     jax.config.update("jax_persistent_cache_min_entry_size_bytes", -1)
     programs.use(os.path.join(d, "programs"))
+    programs.trim(d, limit)
+
+
+def cache_max_bytes() -> int:
+    """The cache folder's size limit: $JAXSLOSH_CACHE_MAX_MB megabytes, 2048 by default (a few
+    hundred scenes' programs and models; one program of the mast scene, with its executable, is
+    about 5 MB)."""
+    v = os.environ.get(CACHE_MAX_ENV, "")
+    try:
+        mb = float(v) if v else 2048.0
+    except ValueError:
+        raise InputError(f"{CACHE_MAX_ENV}: must be a number of megabytes, got {v!r}") from None
+    if not mb > 0:
+        raise InputError(f"{CACHE_MAX_ENV}: must be a positive number of megabytes, got {v!r}")
+    return int(mb * (1 << 20))
 
 
 def load(path) -> Scene:
