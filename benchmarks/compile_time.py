@@ -31,6 +31,9 @@ import collections, json, os, sys, time
 T0 = time.perf_counter()
 os.environ["JAXSLOSH_CACHE_DIR"] = sys.argv[2]
 import jax
+from jaxslosh import entry, executables
+# as `jaxslosh run` (jaxslosh/entry.py): the executables its last run used start loading, then the package is imported
+executables.preload(executables.cache_folder()[1], entry.command_hint(["run", sys.argv[1]]))
 from jaxslosh.cli.common import setup_jax
 setup_jax()                 # as `jaxslosh run`: float64, XLA's cache and the exported programs in the folder
 events = collections.defaultdict(float)
@@ -72,6 +75,7 @@ if sys.argv[3] == "1":     # the traced programs' sizes (equations, counted into
     eqns["start_eqns"] = count(eqx.filter_make_jaxpr(traced_init)(b, solver)[0].jaxpr)
     eqns["chunk_eqns"] = count(eqx.filter_make_jaxpr(lambda b_, s_, c_: traced_advance(b_, s_, c_, chunk, se))(
         b, solver, carry)[0].jaxpr)
+executables.settle()        # as `jaxslosh run` does at its end: the executables compiled are kept
 print(json.dumps({**eqns, "import": t_import - T0, "build": t_build - t_import, "compile": t_first - t_build, "first_step": t_first - T0,
                   "first_chunk": t_chunk - T0, "steps": chunk * se,
                   "trace": events["jaxpr_trace_duration"], "lower": events["jaxpr_to_mlir_module_duration"],

@@ -35,7 +35,6 @@ import functools
 import hashlib
 import os
 import pickle
-import tempfile
 import threading
 
 import equinox as eqx
@@ -43,6 +42,9 @@ import jax
 import numpy as np
 from jax import export
 from jax.experimental import serialize_executable
+
+from . import executables
+from .executables import Load, loadable, read, take, touch, write_bytes
 
 #: XLA options of the run's programs compiled ahead of time (run/compiled.py: `jaxslosh run`, and
 #: `js.simulate` called outside any transformation; JAX takes options only for a top-level jit, so
@@ -114,40 +116,12 @@ def program_key(name: str, args: tuple, options=None) -> str | None:
     return _key(name, treedef, leaves, options)
 
 
-def _read(path) -> dict | None:
-    """The file's content: the exported program (`export`) and its output tree (`out_tree`); where a
-    process compiled it, the executable (`executable`, with its outputs' shapes `out`) and the host
-    it was compiled for (`host`)."""
-    try:
-        with open(path, "rb") as f:
-            saved = pickle.load(f)
-    except Exception:        # absent, written by another version, cut short: traced again
-        return None
-    _touch(path)
-    return saved if isinstance(saved, dict) and "export" in saved and "out_tree" in saved else None
-
-
 def _write(path, saved: dict):
     try:
         data = pickle.dumps(saved)
     except Exception:
         return
-    _write_bytes(path, data)
-
-
-@functools.cache
-def _host() -> str:
-    """What an executable compiled here needs of the machine that runs it: XLA compiles for this
-    backend and this processor's instruction set (a cache folder shared by several machines, on a
-    cluster's network drive, must not hand one machine's executable to another)."""
-    cpu = ""
-    try:
-        with open("/proc/cpuinfo") as f:
-            cpu = "".join(sorted({ln for ln in f if ln.startswith(("model name", "flags"))}))
-    except OSError:
-        import platform
-        cpu = platform.processor() or platform.machine()
-    return hashlib.sha256(f"{jax.default_backend()} {jax.devices()[0].device_kind} {cpu}".encode()).hexdigest()
+    write_bytes(path, data)
 
 
 #: JAX's persistent compilation cache hits, counted by thread: an executable XLA's cache gave back
@@ -168,18 +142,6 @@ def _cache_hits() -> int:
 jax.monitoring.register_event_listener(_count_hit)
 
 
-@functools.cache
-def _lapack_ready():
-    """jaxlib's LAPACK kernels find LAPACK (SciPy's) when a program that calls them is first lowered;
-    an executable read back is never lowered, and would call through null pointers."""
-    try:
-        from jax._src.lax.linalg import initialize_lapack
-        initialize_lapack()
-    except Exception:       # a JAX that moved it: a lowering does it
-        jax.jit(jax.numpy.linalg.solve).lower(jax.ShapeDtypeStruct((2, 2), np.float64),
-                                              jax.ShapeDtypeStruct((2,), np.float64))
-
-
 class Program:
     """A program traced (or read from its file) and lowered, whose XLA compilation is still to come:
     `out` is its output tree of shapes and types (what a following program is lowered with), and
@@ -191,12 +153,14 @@ class Program:
     is loaded (also outside Python). Where it does not, the executable XLA compiles is added to the
     file (`saved`), for the next process."""
 
-    def __init__(self, lowered, where, out_tree, loaded, options, saved=None, path=None, retrace=None):
+    def __init__(self, lowered, where, out_tree, loaded, options, saved=None, path=None, retrace=None, loading=None):
         self._lowered, self._where, self._out_tree, self._options = lowered, where, out_tree, options
-        self._saved, self._path, self._retrace = saved, path, retrace
+        self._saved, self._path, self._retrace, self._loading = saved, path, retrace, loading
+        self.path = path
         self.loaded = loaded
         self._done: list = []
         self._thread = None
+        self._ready = threading.Event()
 
     @property
     def out(self):
@@ -209,8 +173,7 @@ class Program:
     def _compile(self):
         try:
             if self._lowered is None:
-                _lapack_ready()
-                self._done.append((serialize_executable.deserialize_and_load(*self._saved["executable"]), None))
+                self._done.append(self._loading.result())
                 return
             hits = _cache_hits()
             compiled = self._lowered.compile(compiler_options=self._options)
@@ -219,24 +182,28 @@ class Program:
         except BaseException as e:      # handed to the thread that asks for the result
             self._done.append((None, e))
             return
+        finally:
+            self._ready.set()           # the executable is kept for the next process after this
         if self._path is not None and fresh:
             try:
                 executable = serialize_executable.serialize(compiled)
             except Exception:           # a backend or program that cannot be serialised: the export alone
                 return
-            _write(self._path, {"export": self._saved["export"], "out_tree": self._out_tree, "host": _host(),
+            _write(self._path, {"export": self._saved["export"], "out_tree": self._saved["out_tree"], "host": executables.host(),
                                 "executable": executable,
                                 "out": [(a.shape, str(a.dtype)) for a in jax.tree_util.tree_leaves(self.out)]})
 
     def compile_in_background(self) -> "Program":
-        # a daemon thread: an interrupted run exits without waiting for XLA to finish
+        # a daemon thread: an interrupted run exits without waiting for XLA to finish; a run that
+        # ends waits for it to keep the executable (executables.settle)
         self._thread = threading.Thread(target=self._compile, name="xla-compile", daemon=True)
         self._thread.start()
+        executables.pending(self._thread)
         return self
 
     def result(self):
         if self._thread is not None:
-            self._thread.join()
+            self._ready.wait()
         elif not self._done:
             self._compile()
         compiled, error = self._done[-1]
@@ -266,10 +233,18 @@ def lower_program(name: str, fn, args: tuple, compiler_options=None, executable:
         lowered = jax.jit(lambda *xs: fn(*_fill(treedef, leaves, where, xs))).lower(*avals)
         return Program(lowered, where, None, False, compiler_options)
     path = os.path.join(base, f"{name.replace(' ', '_')}-{key[:32]}.jaxexport")
-    saved = _read(path)
-    if executable and saved is not None and saved.get("host") == _host() and "executable" in saved:
-        return Program(None, where, saved["out_tree"], True, compiler_options, saved,
-                       retrace=lambda: lower_program(name, fn, args, compiler_options, executable=False))
+    loading = take(path) if executable else None
+    saved = loading.saved if loading is not None else read(path)
+    out_tree = None
+    if saved is not None:
+        try:
+            out_tree = pickle.loads(saved["out_tree"])
+        except Exception:        # written by another version: traced again
+            saved = None
+    if executable and loadable(saved):
+        return Program(None, where, out_tree, True, compiler_options, saved, path,
+                       retrace=lambda: lower_program(name, fn, args, compiler_options, executable=False),
+                       loading=loading or Load(saved))
     exported = None
     if saved is not None:
         try:
@@ -278,17 +253,29 @@ def lower_program(name: str, fn, args: tuple, compiler_options=None, executable:
             pass
     loaded = exported is not None
     if not loaded:
-        out_tree = []
+        trees = []
 
         def flat(*xs):
             out, tree = jax.tree_util.tree_flatten(fn(*_fill(treedef, leaves, where, xs)))
-            out_tree.append(tree)
+            trees.append(tree)
             return out
         exported = export.export(jax.jit(flat))(*avals)
-        saved = {"export": exported.serialize(), "out_tree": out_tree[0]}
+        out_tree = trees[0]
+        try:
+            saved = {"export": exported.serialize(), "out_tree": pickle.dumps(out_tree)}
+        except Exception:        # an output tree that does not pickle: no file
+            return Program(jax.jit(exported.call).lower(*avals), where, out_tree, False, compiler_options)
         _write(path, saved)
-    return Program(jax.jit(exported.call).lower(*avals), where, saved["out_tree"], loaded, compiler_options,
-                   saved, path)
+
+    # The program's name carries its file's: JAX's persistent cache then serves it to this file's
+    # program alone. An executable that cache gives back cannot be kept (see _HITS); named by the
+    # file, the cache misses where the file has no executable for a program it never compiled
+    # (jaxslosh's source changed, hence every file's name, and the programs did not), and XLA's
+    # compile gives one to keep.
+    def call(*xs):
+        return exported.call(*xs)
+    call.__name__ = call.__qualname__ = f"{name}_{key[:16]}".replace("-", "_").replace(" ", "_")
+    return Program(jax.jit(call).lower(*avals), where, out_tree, loaded, compiler_options, saved, path)
 
 
 def compile_program(name: str, fn, args: tuple, compiler_options=None):
@@ -323,7 +310,7 @@ def cached(name: str, key, compute):
     try:
         with open(path, "rb") as f:
             value = pickle.load(f)
-        _touch(path)
+        touch(path)
         return value
     except Exception:        # absent, written by another version, cut short: computed again
         pass
@@ -333,27 +320,8 @@ def cached(name: str, key, compute):
     except Exception:
         return value
     if len(data) <= MAX_VALUE_BYTES:
-        _write_bytes(path, data)
+        write_bytes(path, data)
     return value
-
-
-def _write_bytes(path, data: bytes):
-    try:
-        os.makedirs(os.path.dirname(path), exist_ok=True)
-        fd, tmp = tempfile.mkstemp(dir=os.path.dirname(path), suffix=".tmp")
-        with os.fdopen(fd, "wb") as f:
-            f.write(data)
-        os.replace(tmp, path)      # whole or absent, for a process that reads it meanwhile
-    except Exception:
-        pass                       # a cache that cannot be written is no cache, not an error
-
-
-def _touch(path):
-    """A file read is a file used: `trim` removes the least recently used first."""
-    try:
-        os.utime(path)
-    except OSError:
-        pass
 
 
 def trim(base: str, max_bytes: int) -> int:

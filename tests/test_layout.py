@@ -9,7 +9,8 @@ ROOT = os.path.join(os.path.dirname(os.path.dirname(os.path.abspath(__file__))),
 
 # lowest first; a module may import its own package and the packages on earlier lines
 LAYERS = [
-    {"_version", "programs", "fem.mesh", "fem.slip", "physics.kinematics"},
+    {"_version", "executables"},
+    {"programs", "fem.mesh", "fem.slip", "physics.kinematics"},
     {"fem.shapes"},
     {"hydro", "io"},
     {"scene"},
@@ -21,6 +22,7 @@ LAYERS = [
     {"analysis", "campaign", "fit"},
     {"plot"},
     {"cli"},
+    {"entry"},
     {"__init__", "__main__"},
 ]
 

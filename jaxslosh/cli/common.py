@@ -12,6 +12,7 @@ import tempfile
 import jax
 
 from .. import programs
+from ..executables import cache_folder
 from ..io.output import OutputError, check_output
 from ..io.result import ResultFileError
 from ..scene.keys import with_overrides
@@ -59,9 +60,7 @@ class Parser(argparse.ArgumentParser):
         raise InputError(f"{self.prog}: {message}")
 
 
-#: the persistent compilation cache's folder: $JAXSLOSH_CACHE_DIR, else $XDG_CACHE_HOME/jaxslosh/xla;
-#: JAXSLOSH_CACHE_DIR="" turns it off (a JAX_COMPILATION_CACHE_DIR of the user's is used as it is)
-CACHE_ENV = "JAXSLOSH_CACHE_DIR"
+#: the cache folder's size limit, in megabytes (executables.cache_folder: where the folder is)
 CACHE_MAX_ENV = "JAXSLOSH_CACHE_MAX_MB"
 
 
@@ -69,20 +68,14 @@ def setup_jax():
     """float64, JAX's persistent compilation cache and the exported programs beside it (programs.py):
     a second run of a scene skips tracing and XLA."""
     jax.config.update("jax_enable_x64", True)
-    if os.environ.get("JAX_COMPILATION_CACHE_DIR"):
-        programs.use(os.path.join(os.environ["JAX_COMPILATION_CACHE_DIR"], "jaxslosh-programs"))
-        return
-    d = os.environ.get(CACHE_ENV)
+    d, kept = cache_folder()
+    programs.use(kept)
     if d is None:
-        d = os.path.join(os.environ.get("XDG_CACHE_HOME") or os.path.expanduser("~/.cache"), "jaxslosh", "xla")
-    if not d:
-        programs.use(None)
         return
     limit = cache_max_bytes()
     jax.config.update("jax_compilation_cache_dir", d)
     jax.config.update("jax_persistent_cache_min_compile_time_secs", 0.0)
     jax.config.update("jax_persistent_cache_min_entry_size_bytes", -1)
-    programs.use(os.path.join(d, "programs"))
     programs.trim(d, limit)
 
 

@@ -10,6 +10,7 @@ import sys
 from importlib import import_module
 
 from ..scene.types import SceneError
+from ..executables import settle
 from .common import COMMANDS, EXIT_INPUT, EXIT_INTERRUPTED, InputError, Parser
 
 
@@ -52,6 +53,8 @@ def main(argv=None) -> int:
             sys.stderr.flush()
             os._exit(EXIT_INTERRUPTED)
         return EXIT_INTERRUPTED
+    finally:
+        settle()        # executables loading ahead (jaxslosh/entry.py) that the command did not use
 
 
 if __name__ == "__main__":

@@ -5,9 +5,13 @@ XLA compiles in the background while Python traces the next, and the programs ca
 the exported programs' folder (programs.py)."""
 from __future__ import annotations
 
-import jax
+import hashlib
 
-from ..programs import START_OPTIONS, XLA_OPTIONS, lower_program, program_key
+import jax
+import numpy as np
+
+from ..executables import remember
+from ..programs import START_OPTIONS, XLA_OPTIONS, cached, folder, lower_program, program_key
 from .loop import carry_shapes, traced_advance, traced_init
 
 
@@ -23,7 +27,9 @@ def compile_run(bc, solver, chunk_frames: int, save_every: int):
     about the chunk's tracing and XLA work alone.
 
     The compiled pair is kept in the process for the next run of the same structure (a script that
-    calls js.simulate again with other values)."""
+    calls js.simulate again with other values). Where programs are kept in a folder (the command
+    line), start's result is kept there too, named by the program and the model's values: a second
+    run of the scene reads it and neither loads nor runs `start`."""
     key = program_key("run", (bc, solver, chunk_frames, save_every))
     if key in _RUNS:
         start, chunk = _RUNS[key]
@@ -32,18 +38,49 @@ def compile_run(bc, solver, chunk_frames: int, save_every: int):
     like = carry_shapes(bc, solver)
     chunk = lower_program("advance", traced_advance, (bc, solver, like, chunk_frames, save_every),
                           XLA_OPTIONS).compile_in_background()
-    start = lower_program("start", traced_init, (bc, solver), START_OPTIONS).compile_in_background()
-    carry_like = start.out[0]
-    if not same_shapes(carry_like, like):      # a guard: loop.carry_shapes is tested to agree with init
-        chunk = lower_program("advance", traced_advance, (bc, solver, carry_like, chunk_frames, save_every),
-                              XLA_OPTIONS).compile_in_background()
-    start, chunk = start.result(), chunk.result()
-    if key is not None:
-        _RUNS[key] = start, chunk
+    # the next process given the same command line loads the chunk ahead (executables.preload); not
+    # `start`, whose result that process reads (below)
+    remember([chunk.path])
+    started = []
+
+    def first():
+        nonlocal chunk
+        start = lower_program("start", traced_init, (bc, solver), START_OPTIONS).compile_in_background()
+        carry_like = start.out[0]
+        if not same_shapes(carry_like, like):      # a guard: loop.carry_shapes is tested to agree with init
+            chunk = lower_program("advance", traced_advance, (bc, solver, carry_like, chunk_frames, save_every),
+                                  XLA_OPTIONS).compile_in_background()
+        started.append(start.result())
+        return started[0](bc, solver)
+
+    # The initial state depends on the model's values alone: where the programs are kept in a folder
+    # (the command line), so is it, and a second run of the scene neither loads nor runs `start`.
+    state = None if key is None or folder() is None else (key, _digest((bc, solver)))
+    if state is None:
+        carry, f0 = first()
+    else:
+        carry, f0 = cached("initial-state", state, lambda: jax.device_get(first()))
+        if not same_shapes(carry, like):
+            chunk = lower_program("advance", traced_advance, (bc, solver, carry, chunk_frames, save_every),
+                                  XLA_OPTIONS).compile_in_background()
+    chunk = chunk.result()
+    if key is not None and started:
+        _RUNS[key] = started[0], chunk
         while len(_RUNS) > KEEP:       # the oldest first (a script that tries many structures)
             _RUNS.pop(next(iter(_RUNS)))
-    carry, f0 = start(bc, solver)
     return carry, f0, chunk
+
+
+def _digest(tree) -> str:
+    """A hash of the values of every array in `tree` (its structure and static values are in the
+    program's key)."""
+    h = hashlib.sha256()
+    for x in jax.tree_util.tree_leaves(tree):
+        if isinstance(x, (jax.Array, np.ndarray, np.generic)):
+            a = np.ascontiguousarray(np.asarray(x))
+            h.update(f"{a.dtype}{a.shape}".encode())
+            h.update(a.tobytes())
+    return h.hexdigest()
 
 
 #: compiled (start, chunk) pairs of this process, by program_key; at most KEEP of them
