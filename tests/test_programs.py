@@ -206,3 +206,17 @@ def test_the_chunk_is_lowered_for_the_shapes_of_the_initial_state(name, extra):
     assert same_shapes(like, carry)
     assert jax.tree_util.tree_structure(like) == jax.tree_util.tree_structure(carry)
     assert len(jax.tree_util.tree_leaves(carry)) >= 12
+
+
+def test_the_command_line_hint_names_what_is_computed(tmp_path, monkeypatch):
+    """jaxslosh/entry.py loads ahead what the last run of the same command line used: the output
+    file and the reporting options do not change the name, an override or the scene's text does."""
+    from jaxslosh.entry import command_hint
+    monkeypatch.chdir(tmp_path)
+    (tmp_path / "s.toml").write_text("a = 1\n")
+    h = command_hint(["run", "s.toml", "-o", "a.h5"])
+    assert h == command_hint(["run", "s.toml", "--output", "b.h5", "--no-progress"]) == command_hint(
+        ["run", "--force", "s.toml", "-oc.h5"])
+    assert h != command_hint(["run", "s.toml", "--dt", "0.02"])
+    (tmp_path / "s.toml").write_text("a = 2\n")
+    assert h != command_hint(["run", "s.toml"])
