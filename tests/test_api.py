@@ -53,6 +53,14 @@ def test_a_failure_is_a_code_with_its_text_in_the_result_and_the_file(tmp_path):
     assert back.status == r.status and back.status_code == js.Status.NEWTON
 
 
+def test_a_batch_gives_each_failed_run_the_status_of_its_single_run():
+    scene = _failing()
+    gm = [1.2, 1.7]
+    _, statuses = js.simulate_batch(scene, {"vessel.hydrostatics.gm_t": np.asarray(gm)})
+    singles = [js.simulate(scene, params={"vessel.hydrostatics.gm_t": g}).status for g in gm]
+    assert statuses == singles and all("step 1" in s and "Newton did not converge" in s for s in statuses)
+
+
 def test_throw_raises_inside_jax_jit_and_a_good_run_passes():
     scene = _failing()
     run = jax.jit(lambda gm: js.simulate(scene, params={"vessel.hydrostatics.gm_t": gm}, throw=True).time[-1])

@@ -9,8 +9,10 @@ or, by index, `tanks[0].fill_depth` (the canonical form is the name form). `simu
 """
 from __future__ import annotations
 
+import copy
 import dataclasses
 import difflib
+import functools
 from typing import Any, Iterable, Optional
 
 import numpy as np
@@ -209,7 +211,7 @@ def check_values(scene: Scene, values: dict) -> Scene:
     canon = check_param_keys(scene, values)
     if not scene.text:
         return scene
-    mapping = tomllib.loads(scene.text)
+    mapping = copy.deepcopy(_mapping(scene.text))
     sim = mapping.setdefault("simulation", {})
     sim["duration"], sim["dt"] = float(scene.simulation.duration), float(scene.simulation.dt)
     given = list(values)
@@ -226,6 +228,12 @@ def check_values(scene: Scene, values: dict) -> Scene:
         shown = ", ".join(f"{k} = {show(_plain(values[k]))}" for k in given)
         raise SceneError(given[0] if len(given) == 1 else ", ".join(given),
                          f"with {shown} the scene is not valid: {e}") from None
+
+
+@functools.lru_cache(maxsize=4)
+def _mapping(text: str) -> dict:
+    """The scene's TOML mapping, parsed once for the many runs of a batch (check_values copies it)."""
+    return tomllib.loads(text)
 
 
 def _plain(value):
