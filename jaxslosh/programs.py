@@ -155,8 +155,8 @@ class Program:
 
     def __init__(self, lowered, where, out_tree, loaded, options, saved=None, path=None, retrace=None, loading=None):
         self._lowered, self._where, self._out_tree, self._options = lowered, where, out_tree, options
-        self._saved, self._path, self._retrace, self._loading = saved, path, retrace, loading
-        self.path = path
+        self._saved, self._retrace, self._loading = saved, retrace, loading
+        self.path = path        # the program's file (None: not kept)
         self.loaded = loaded
         self._done: list = []
         self._thread = None
@@ -184,12 +184,12 @@ class Program:
             return
         finally:
             self._ready.set()           # the executable is kept for the next process after this
-        if self._path is not None and fresh:
+        if self.path is not None and fresh:
             try:
                 executable = serialize_executable.serialize(compiled)
             except Exception:           # a backend or program that cannot be serialised: the export alone
                 return
-            _write(self._path, {"export": self._saved["export"], "out_tree": self._saved["out_tree"], "host": executables.host(),
+            _write(self.path, {"export": self._saved["export"], "out_tree": self._saved["out_tree"], "host": executables.host(),
                                 "executable": executable,
                                 "out": [(a.shape, str(a.dtype)) for a in jax.tree_util.tree_leaves(self.out)]})
 

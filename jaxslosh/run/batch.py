@@ -1,6 +1,7 @@
 """A batch of parameter sets in one compiled, vmapped loop (`jaxslosh sweep`)."""
 from __future__ import annotations
 
+import functools
 from typing import Optional
 
 import equinox as eqx
@@ -78,17 +79,12 @@ def _setup0(scene: Scene):
     step, sizes and probes' names from it, and building it again took a twentieth of a 64-run
     batch of the paper example."""
     try:
-        hit = _SETUPS.get(scene)
+        return _kept_setup(scene)
     except TypeError:                 # an unhashable scene: built each time
         return prepare(scene)
-    if hit is None:
-        hit = _SETUPS[scene] = prepare(scene)
-        while len(_SETUPS) > 8:
-            _SETUPS.pop(next(iter(_SETUPS)))
-    return hit
 
 
-_SETUPS: dict = {}
+_kept_setup = functools.lru_cache(maxsize=8)(prepare)
 
 
 def check_runs(scene: Scene, params: dict) -> list:

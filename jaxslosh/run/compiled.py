@@ -36,33 +36,27 @@ def compile_run(bc, solver, chunk_frames: int, save_every: int):
         carry, f0 = start(bc, solver)
         return carry, f0, chunk
     like = carry_shapes(bc, solver)
-    chunk = lower_program("advance", traced_advance, (bc, solver, like, chunk_frames, save_every),
-                          XLA_OPTIONS).compile_in_background()
+
+    def lowered_chunk(carry_like):
+        return lower_program("advance", traced_advance, (bc, solver, carry_like, chunk_frames, save_every),
+                             XLA_OPTIONS).compile_in_background()
+    chunk = lowered_chunk(like)
     # the next process given the same command line loads the chunk ahead (executables.preload); not
     # `start`, whose result that process reads (below)
     remember([chunk.path])
     started = []
 
     def first():
-        nonlocal chunk
-        start = lower_program("start", traced_init, (bc, solver), START_OPTIONS).compile_in_background()
-        carry_like = start.out[0]
-        if not same_shapes(carry_like, like):      # a guard: loop.carry_shapes is tested to agree with init
-            chunk = lower_program("advance", traced_advance, (bc, solver, carry_like, chunk_frames, save_every),
-                                  XLA_OPTIONS).compile_in_background()
-        started.append(start.result())
+        # in the background as well: its executable is written there, after its result is ready
+        started.append(lower_program("start", traced_init, (bc, solver), START_OPTIONS).compile_in_background().result())
         return started[0](bc, solver)
 
     # The initial state depends on the model's values alone: where the programs are kept in a folder
     # (the command line), so is it, and a second run of the scene neither loads nor runs `start`.
     state = None if key is None or folder() is None else (key, _digest((bc, solver)))
-    if state is None:
-        carry, f0 = first()
-    else:
-        carry, f0 = cached("initial-state", state, lambda: jax.device_get(first()))
-        if not same_shapes(carry, like):
-            chunk = lower_program("advance", traced_advance, (bc, solver, carry, chunk_frames, save_every),
-                                  XLA_OPTIONS).compile_in_background()
+    carry, f0 = first() if state is None else cached("initial-state", state, lambda: jax.device_get(first()))
+    if not same_shapes(carry, like):      # a guard: loop.carry_shapes is tested to agree with init
+        chunk = lowered_chunk(carry)
     chunk = chunk.result()
     if key is not None and started:
         _RUNS[key] = started[0], chunk
