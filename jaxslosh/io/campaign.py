@@ -19,7 +19,8 @@ CASE_KEYS = ("hs", "tp", "heading", "seed", "weight")
 STATS = ("std", "significant", "max", "mpm", "tz")
 PENDING = "pending"
 #: how long a write waits for readers: HDF5 locks the file, and a reader that holds it (a plot of
-#: the campaign so far, a script polling it) makes the writer's open fail until it closes the file
+#: the campaign so far, a script polling it; in this process, a thread polling it beside
+#: js.campaign: "already open for read-only") makes the writer's open fail until it closes the file
 WRITE_WAIT = 120.0
 
 
@@ -31,7 +32,7 @@ def _open_for_writing(path):
             return h5py.File(path, "r+")
         except OSError as e:
             busy = isinstance(e, BlockingIOError) or e.errno in (errno.EAGAIN, errno.EWOULDBLOCK) or \
-                "unable to lock file" in str(e)
+                "unable to lock file" in str(e) or "already open for read-only" in str(e)
             if not busy or time.monotonic() > deadline:
                 raise
             time.sleep(0.05)
