@@ -27,6 +27,20 @@ jax.config.update("jax_enable_x64", True)
 threadpool_limits(limits=1, user_api="blas")
 
 
+@pytest.fixture(autouse=True)
+def _cache_folder_off():
+    """A test that calls the command line in process with JAXSLOSH_CACHE_DIR set turns JAX's
+    persistent cache on for the whole worker (jax.config is global): a later test would then be
+    given executables from that folder, which programs.py does not keep. Off again after each."""
+    yield
+    from jax._src import compilation_cache
+    from jaxslosh import programs
+    programs.use(None)
+    if jax.config.jax_compilation_cache_dir is not None:
+        jax.config.update("jax_compilation_cache_dir", None)
+        compilation_cache.reset_cache()
+
+
 @pytest.fixture(autouse=True, scope="module")
 def _free_compiled_code():
     """Each test module compiles its own scenes; dropping the compiled executables after a module

@@ -69,10 +69,10 @@ def setup_jax():
     a second run of a scene skips tracing and XLA."""
     jax.config.update("jax_enable_x64", True)
     d, kept = cache_folder()
+    limit = cache_max_bytes() if d is not None else None     # a bad limit changes nothing
     programs.use(kept)
     if d is None:
         return
-    limit = cache_max_bytes()
     jax.config.update("jax_compilation_cache_dir", d)
     jax.config.update("jax_persistent_cache_min_compile_time_secs", 0.0)
     jax.config.update("jax_persistent_cache_min_entry_size_bytes", -1)
