@@ -1,13 +1,16 @@
 import os
 
-# Four fifths of the suite's time is JAX tracing and XLA compiling programs that then run for
-# seconds at most. LLVM's optimisation passes are most of XLA's CPU compile time; without them
-# (set before jax starts its backend, and inherited by the notebook kernels the tests start)
-# the compile time falls by a third and the suite by a fifth (backend compile 780 -> 508 s of
-# CPU, 1343 -> 1042 s in the tests, two workers). XLA's graph passes are untouched: the tests run the
-# same XLA programs, only as less optimised machine code. The CLI, the notebooks run by users and the
-# benchmarks keep XLA's defaults.
-_FAST_COMPILE = "--xla_backend_optimization_level=0 --xla_llvm_disable_expensive_passes=true"
+# Most of the suite's time is JAX tracing and XLA compiling programs that then run for seconds at
+# most, so the tests ask XLA for quick machine code (set before jax starts its backend, and
+# inherited by the subprocesses and notebook kernels the tests start): LLVM's optimisation passes
+# off; XLA's classic CPU loop emitters, which compile the many small fusions of a step faster than
+# its fusion emitters (as programs.XLA_OPTIONS does for the command line's runs); and one LLVM
+# module per program, not several compiled on threads: the two xdist workers already keep both
+# cores busy. XLA's graph passes are untouched: the tests run the same XLA programs, only as less
+# optimised machine code. The CLI, the notebooks run by users and the benchmarks keep their own
+# settings. (README "Tests" has the suite's times.)
+_FAST_COMPILE = ("--xla_backend_optimization_level=0 --xla_llvm_disable_expensive_passes=true "
+                 "--xla_cpu_use_fusion_emitters=false --xla_cpu_parallel_codegen_split_count=1")
 if "xla_backend_optimization_level" not in os.environ.get("XLA_FLAGS", ""):
     os.environ["XLA_FLAGS"] = (os.environ.get("XLA_FLAGS", "") + " " + _FAST_COMPILE).strip()
 

@@ -106,11 +106,14 @@ sys.exit(main(sys.argv[1:]))
 """
 
 
+@pytest.mark.slow
 def test_density_sweep_finishes_and_equals_single_runs(tmp_path):
     """The reported command on a smaller mesh, in a child process that XLA sees as two host devices
     on two CPUs (the two halves of the batch run side by side on a pool of two threads, where the
     batched inverses deadlocked each time): it must finish, exit 0, and each run must equal a single
-    run with its density."""
+    run with its density. Slow (a fresh process compiles the batch and four single runs); what made
+    the deadlock possible is checked on the compiled program in the default suite (below), and a
+    batch with liquid against its single runs in test_batch_with_liquid_equals_single_runs."""
     import os
     import subprocess
     import sys
