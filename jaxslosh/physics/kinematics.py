@@ -14,14 +14,16 @@ import numpy as np
 
 
 def mv3(A, x):
-    """A @ x for A (k, 3) as three scaled columns: elementwise, so XLA fuses it with its neighbours
-    (a dot is a separate kernel launch, and the small-step loops are launch-bound)."""
-    return A[..., 0] * x[0] + A[..., 1] * x[1] + A[..., 2] * x[2]
+    """A @ x for A (k, 3): a product and a sum over the last axis, which XLA fuses with its
+    neighbours (a dot is a separate kernel launch, and the small-step loops are launch-bound), in
+    three operations where the three columns written out are eleven, each repeated by every jvp,
+    vmap and transpose around it."""
+    return jnp.sum(A * x, axis=-1)
 
 
 def tv3(A, x):
     """A.T @ x for A (3, k), as mv3."""
-    return A[0] * x[0] + A[1] * x[1] + A[2] * x[2]
+    return jnp.sum(A * jnp.reshape(x, (3,) + (1,) * (jnp.ndim(A) - 1)), axis=0)
 
 
 #: gather indices and signs of the cross-product matrix of v, read from (0, v0, v1, v2): one gather
@@ -40,16 +42,23 @@ def skew(v):
     return jnp.concatenate([jnp.zeros((1,), v.dtype), v])[_SKEW_INDEX] * _SKEW_SIGN
 
 
+#: A(q) read from the outer product q q^T (entry 4 i + j: q_i q_j): each of A's nine entries is a
+#: signed sum of four of its products (the off-diagonal factor 2 as the two symmetric entries)
+_A_INDEX = np.array([[[0, 5, 10, 15], [6, 9, 3, 12], [7, 13, 2, 8]],
+                     [[6, 9, 3, 12], [0, 5, 10, 15], [11, 14, 1, 4]],
+                     [[7, 13, 2, 8], [11, 14, 1, 4], [0, 5, 10, 15]]])
+_A_SIGN = np.array([[[1.0, 1.0, -1.0, -1.0], [1.0, 1.0, -1.0, -1.0], [1.0, 1.0, 1.0, 1.0]],
+                    [[1.0, 1.0, 1.0, 1.0], [1.0, -1.0, 1.0, -1.0], [1.0, 1.0, -1.0, -1.0]],
+                    [[1.0, 1.0, -1.0, -1.0], [1.0, 1.0, 1.0, 1.0], [1.0, -1.0, -1.0, 1.0]]])
+
+
 def rotation_matrix(q):
-    """A(q): body to inertial. Entry by entry: XLA fuses the nine products into one loop; the
-    compact (q0^2 - v.v) I + 2 v v^T + 2 q0 skew(v) traces to fewer operations but runs slower in
-    the step (benchmarks/bench_paper.py), as the loops it becomes are not fused into one."""
-    q0, q1, q2, q3 = q
-    return jnp.array([
-        [q0 * q0 + q1 * q1 - q2 * q2 - q3 * q3, 2 * (q1 * q2 - q0 * q3), 2 * (q1 * q3 + q0 * q2)],
-        [2 * (q1 * q2 + q0 * q3), q0 * q0 - q1 * q1 + q2 * q2 - q3 * q3, 2 * (q2 * q3 - q0 * q1)],
-        [2 * (q1 * q3 - q0 * q2), 2 * (q2 * q3 + q0 * q1), q0 * q0 - q1 * q1 - q2 * q2 + q3 * q3],
-    ])
+    """A(q): body to inertial, as one outer product, one gather and one signed sum: a few
+    operations, where the nine entries written out are some sixty, each repeated by every jvp, vmap
+    and transpose around it (the step linearises the residual for its preconditioner): written
+    out, A was a third of the operations of the mast scene's step."""
+    q = jnp.asarray(q)
+    return jnp.sum(jnp.outer(q, q)[_A_INDEX // 4, _A_INDEX % 4] * _A_SIGN, axis=-1)
 
 
 def G_matrix(q):
@@ -57,10 +66,13 @@ def G_matrix(q):
     return jnp.asarray(q)[_G_INDEX] * _G_SIGN
 
 
+#: the Hamilton product p q read from the outer product p q^T as rotation_matrix does
+_QM_INDEX = np.array([[0, 5, 10, 15], [1, 4, 11, 14], [2, 7, 8, 13], [3, 6, 9, 12]])
+_QM_SIGN = np.array([[1.0, -1.0, -1.0, -1.0], [1.0, 1.0, 1.0, -1.0], [1.0, -1.0, 1.0, 1.0], [1.0, 1.0, -1.0, 1.0]])
+
+
 def quat_multiply(p, q):
-    p0, pv = p[0], p[1:]
-    q0, qv = q[0], q[1:]
-    return jnp.concatenate([jnp.array([p0 * q0 - pv @ qv]), p0 * qv + q0 * pv + jnp.cross(pv, qv)])
+    return jnp.sum(jnp.outer(p, q)[_QM_INDEX // 4, _QM_INDEX % 4] * _QM_SIGN, axis=-1)
 
 
 def quat_exp(theta):
