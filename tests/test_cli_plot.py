@@ -6,7 +6,7 @@ import importlib.util
 import io
 import os
 import re
-import time
+import threading
 import types
 
 import h5py
@@ -59,21 +59,38 @@ def test_progress_is_drawn_on_a_terminal_or_when_forced(monkeypatch):
     assert not wanted(False, _Tty(True))
 
 
-def test_progress_phases_share_one_clock_and_estimate_only_after_units_are_done():
+class _Clock:
+    """A clock that moves only when the test moves it (for progress.py's `_time`): the phases'
+    bookkeeping is then checked exactly, whatever the machine's speed."""
+
+    def __init__(self, t=100.0):
+        self.t = t
+
+    def perf_counter(self):
+        return self.t
+
+
+def test_progress_phases_share_one_clock_and_estimate_only_after_units_are_done(monkeypatch):
+    import jaxslosh.run.progress as progress
+    clock = _Clock()
+    monkeypatch.setattr(progress, "_time", clock)
     out = io.StringIO()
     bar = Progress(enabled=True, stream=out, tick=0.01)
     bar.phase("compile", "compiling the step")
+    clock.t += 7.25
     bar.phase("stepping", "stepping", total=10)
     first = out.getvalue().split("\r")[-1]
     assert "0/10" in first and "estimating" in first and "left" not in first
-    time.sleep(0.05)                                  # past the redraw interval: update draws
+    clock.t += 0.05                                   # past the redraw interval: update draws
     bar.update(5)
     assert "5/10" in out.getvalue() and "left" in out.getvalue().split("\r")[-1]
+    clock.t += 0.05
     bar.update(10)
     times = bar.close()
     assert list(times) == ["compile", "stepping"] and all(t >= 0 for t in times.values())
-    # contiguous phases: their sum is the elapsed time since the bar was made, up to the calls between
-    assert abs(sum(times.values()) - bar.elapsed()) < 0.5
+    # contiguous phases: their sum is the elapsed time since the bar was made
+    assert times == pytest.approx({"compile": 7.25, "stepping": 0.1}, abs=1e-12)
+    assert abs(sum(times.values()) - bar.elapsed()) < 1e-12
     assert "compiling the step ... " in out.getvalue() and "100.0%" in out.getvalue()
     quiet = io.StringIO()
     q = Progress(enabled=False, stream=quiet)
@@ -81,7 +98,20 @@ def test_progress_phases_share_one_clock_and_estimate_only_after_units_are_done(
     assert list(q.close()) == ["a"] and quiet.getvalue() == ""     # timed, not drawn
 
 
+class _StepClock(_Clock):
+    """Moves 1 ms each time the command's own thread reads it (the redrawing thread reads it as it
+    is): the run's phases then take as many clock steps as the calls between them, whatever the
+    machine's speed."""
+
+    def perf_counter(self):
+        if threading.current_thread() is threading.main_thread():
+            self.t += 1e-3
+        return self.t
+
+
 def test_run_shows_the_compile_phase_and_a_summary_on_the_bar_clock(tmp_path, capsys, monkeypatch):
+    import jaxslosh.run.progress as progress
+    monkeypatch.setattr(progress, "_time", _StepClock())
     monkeypatch.setenv(ENV, "1")                      # capsys' stderr is no terminal: forced on
     scene = tmp_path / "v.toml"
     scene.write_text(GOOD)

@@ -14,10 +14,9 @@ import numpy as np
 
 
 def mv3(A, x):
-    """A @ x for A (k, 3): a product and a sum over the last axis, which XLA fuses with its
-    neighbours (a dot is a separate kernel launch, and the small-step loops are launch-bound), in
-    three operations where the three columns written out are eleven, each repeated by every jvp,
-    vmap and transpose around it."""
+    """A @ x for A (k, 3): a product and a sum over the last axis, not a dot (a separate kernel
+    launch, and the small-step loops are launch-bound); three operations where the three columns
+    written out are eleven, each repeated by every jvp, vmap and transpose around it."""
     return jnp.sum(A * x, axis=-1)
 
 
@@ -50,6 +49,7 @@ _A_INDEX = np.array([[[0, 5, 10, 15], [6, 9, 3, 12], [7, 13, 2, 8]],
 _A_SIGN = np.array([[[1.0, 1.0, -1.0, -1.0], [1.0, 1.0, -1.0, -1.0], [1.0, 1.0, 1.0, 1.0]],
                     [[1.0, 1.0, 1.0, 1.0], [1.0, -1.0, 1.0, -1.0], [1.0, 1.0, -1.0, -1.0]],
                     [[1.0, 1.0, -1.0, -1.0], [1.0, 1.0, 1.0, 1.0], [1.0, -1.0, -1.0, 1.0]]])
+_A_ROW, _A_COL = np.divmod(_A_INDEX, 4)
 
 
 def rotation_matrix(q):
@@ -58,7 +58,7 @@ def rotation_matrix(q):
     and transpose around it (the step linearises the residual for its preconditioner): written
     out, A was a third of the operations of the mast scene's step."""
     q = jnp.asarray(q)
-    return jnp.sum(jnp.outer(q, q)[_A_INDEX // 4, _A_INDEX % 4] * _A_SIGN, axis=-1)
+    return jnp.sum(jnp.outer(q, q)[_A_ROW, _A_COL] * _A_SIGN, axis=-1)
 
 
 def G_matrix(q):
@@ -69,10 +69,11 @@ def G_matrix(q):
 #: the Hamilton product p q read from the outer product p q^T as rotation_matrix does
 _QM_INDEX = np.array([[0, 5, 10, 15], [1, 4, 11, 14], [2, 7, 8, 13], [3, 6, 9, 12]])
 _QM_SIGN = np.array([[1.0, -1.0, -1.0, -1.0], [1.0, 1.0, 1.0, -1.0], [1.0, -1.0, 1.0, 1.0], [1.0, 1.0, -1.0, 1.0]])
+_QM_ROW, _QM_COL = np.divmod(_QM_INDEX, 4)
 
 
 def quat_multiply(p, q):
-    return jnp.sum(jnp.outer(p, q)[_QM_INDEX // 4, _QM_INDEX % 4] * _QM_SIGN, axis=-1)
+    return jnp.sum(jnp.outer(p, q)[_QM_ROW, _QM_COL] * _QM_SIGN, axis=-1)
 
 
 def quat_exp(theta):
