@@ -3,6 +3,9 @@ calls for: the model is assembled from the scene, so an effect the scene lacks, 
 `[effects]`, is never traced) and its unknowns."""
 from __future__ import annotations
 
+import os
+
+from ..fem.meshfile import read_mesh_file
 from ..fem.shapes import free_count
 from ..fem.walls import shell_mesh
 from ..hydro.source import excitation_source
@@ -24,6 +27,7 @@ def describe(scene: Scene) -> str:
         lines.append(f"tank {t.name!r}: {shape_words(t)}{t.size[0]:g} x {t.size[1]:g} x {t.size[2]:g} m filled to "
                      f"{t.fill_depth:g} m, liquid {t.liquid_mass:.4g} kg ({t.liquid_volume:.4g} m^3), "
                      f"mesh {nx} x {ny} x {nz} = {nx * ny * nz} hexahedra, walls {walls}")
+        lines += tank_notes(t)
     for s in scene.structures:
         nx, ny, nz = s.mesh
         mass = s.material.density * s.size[0] * s.size[1] * s.size[2]
@@ -163,6 +167,25 @@ def shape_words(t) -> str:
     if t.baffles:
         words += f" with {len(t.baffles)} baffle{'s' if len(t.baffles) > 1 else ''}"
     return words + ", "
+
+
+def tank_notes(t) -> list[str]:
+    """Indented lines under a tank: each baffle as the model reads it (its plane, side and edge), and
+    how many hexahedra of a mesh file were re-oriented (numbered left-handed in the file)."""
+    out = []
+    H = t.size[2]
+    for i, b in enumerate(t.baffles):
+        edge = b.height if b.mount == "bottom" else H - b.height
+        side = ("standing on the bottom, its upper edge" if b.mount == "bottom"
+                else "hanging from the roof, its lower edge")
+        out.append(f"  baffle {i}: the plane {b.normal} = {b.at:g} m from the tank's origin, {side} {edge:g} m above "
+                   f"the tank bottom ({b.height:g} m of plate)")
+    if t.shape == "mesh":
+        m = read_mesh_file(t.file)
+        if m.reoriented:
+            out.append(f"  note: {m.reoriented} of the {len(m.elements)} hexahedra in {os.path.basename(t.file)} are "
+                       f"numbered left-handed (inverted) in the file; they are re-oriented")
+    return out
 
 
 def free_liquid_dofs(tank) -> int:
