@@ -53,8 +53,16 @@ def scene_effects(scene: Scene) -> list[tuple[str, str]]:
         if f.profile == "spin-up":
             eff.append(("prescribed motion", f"{f.dof} rate spun up to {f.rate:g} rad/s over {f.duration:g} s, "
                                              "other rigid dofs held"))
+        elif f.profile == "record":
+            dofs = ", ".join(name for name, _ in f.columns)
+            eff.append(("prescribed motion", f"{dofs} from {os.path.basename(f.file)} ({len(f.times)} samples, t = "
+                                             f"{f.times[0]:g} to {f.times[-1]:g} s) by a natural cubic spline "
+                                             f"(continuous acceleration), other rigid dofs held"))
         else:
-            eff.append(("prescribed motion", f"{f.dof} = {f.amplitude:g} sin({f.frequency:g} t), other rigid dofs held"))
+            phase = f" + {f.phase:g}" if f.phase else ""
+            ramp = f", faded in over {f.ramp:g} s" if f.ramp else ""
+            eff.append(("prescribed motion", f"{f.dof} = {f.amplitude:g} sin({f.frequency:g} t{phase}){ramp}, "
+                                             f"other rigid dofs held"))
     if scene.vessel.hydrostatics is not None and e.buoyancy:
         eff.append(("buoyancy", "restoring force and moments of eqs. (33)-(36), "
                                 f"moment form {scene.vessel.hydrostatics.moment!r}"))
