@@ -18,8 +18,8 @@ from ..physics.kinematics import quat_from_rpy, rotation_matrix
 from ..physics.liquid import RotationPenalty, SpinStiffening
 from ..physics.system import System
 from ..physics.terms import Config
-from ..physics.vessel import (FreeMotion, Hydrostatics, PrescribedMotion, RecordedMotion, RigidBody, Weight,
-                              record_coefficients)
+from ..physics.vessel import (FreeMotion, HarmonicMotion, Hydrostatics, RecordedMotion, RigidBody, SpinUpMotion,
+                              Weight, record_coefficients)
 from ..programs import staged
 from ..scene.keys import resolve_params
 from ..scene.types import DOFS, Scene, SceneError
@@ -124,14 +124,14 @@ def build(scene: Scene, params: Optional[dict] = None) -> Built:
 
 
 def _prescribed(f):
-    """The motion class of a `[vessel.forced]` table: one dof's profile, or a record's spline."""
+    """The motion of a `[vessel.forced]` table: one dof's profile, or a record's spline."""
     if f.profile == "record":
         knots, coef = record_coefficients(f.times, f.columns, DOFS)
         return RecordedMotion(knots=jnp.asarray(knots), coef=jnp.asarray(coef))
-    return PrescribedMotion(dof=DOFS.index(f.dof), amplitude=jnp.asarray(f.amplitude, dtype=float),
-                            frequency=jnp.asarray(f.frequency, dtype=float), ramp=float(f.ramp), profile=f.profile,
-                            rate=float(f.rate), duration=float(f.duration) if f.duration else 1.0,
-                            phase=float(f.phase))
+    if f.profile == "spin-up":
+        return SpinUpMotion(dof=DOFS.index(f.dof), rate=float(f.rate), duration=float(f.duration))
+    return HarmonicMotion(dof=DOFS.index(f.dof), amplitude=jnp.asarray(f.amplitude, dtype=float),
+                          frequency=jnp.asarray(f.frequency, dtype=float), ramp=float(f.ramp), phase=float(f.phase))
 
 
 def _hull(mass, inertia, parts):

@@ -176,32 +176,34 @@ class AbstractPrescribedMotion(AbstractMotion):
         return scale() * (a6 - self.accelerations(t))
 
 
-class PrescribedMotion(AbstractPrescribedMotion):
-    """Prescribed motion of one rigid dof (the others held at zero). "harmonic": amplitude
-    sin(frequency t + phase) faded in over `ramp` by `smooth_ramp` (C2: no jump in the
-    acceleration); "spin-up": a rate growing smoothly to `rate` over `duration`."""
+class HarmonicMotion(AbstractPrescribedMotion):
+    """One rigid dof at amplitude sin(frequency t + phase), faded in over `ramp` by `smooth_ramp`
+    (C2: no jump in the acceleration); the others held at zero."""
     dof: int = eqx.field(static=True)      # 0-2 surge, sway, heave; 3-5 roll, pitch, yaw
     amplitude: jax.Array
     frequency: jax.Array
     ramp: float = eqx.field(static=True, default=0.0)
-    profile: str = eqx.field(static=True, default="harmonic")
-    rate: float = eqx.field(static=True, default=0.0)      # spin-up: final rate, rad/s
-    duration: float = eqx.field(static=True, default=1.0)  # spin-up: its time, s
-    phase: float = eqx.field(static=True, default=0.0)     # harmonic, rad
+    phase: float = eqx.field(static=True, default=0.0)     # rad
 
-    def value(self, t):
-        if self.profile == "spin-up":
-            T, W = self.duration, self.rate
-            c = T / (2.0 * jnp.pi)
-            up = W / T * (0.5 * t * t + c * c * (jnp.cos(t / c) - 1.0))
-            return jnp.where(t < T, up, W * (0.5 * T) + W * (t - T))
+    def coordinates(self, t):
         x = self.amplitude * jnp.sin(self.frequency * t + self.phase)
         if self.ramp > 0:
             x = x * smooth_ramp(t / self.ramp)
-        return x
+        return jnp.zeros(6).at[self.dof].set(x)
+
+
+class SpinUpMotion(AbstractPrescribedMotion):
+    """One rotation whose rate grows smoothly to `rate` over `duration` (rate r(t / duration), the
+    harmonic form's ramp), then stays: the Kane-Ryan-Banerjee hub; the others held at zero."""
+    dof: int = eqx.field(static=True)      # 3-5 roll, pitch, yaw
+    rate: float = eqx.field(static=True)   # final rate, rad/s
+    duration: float = eqx.field(static=True)   # its time, s
 
     def coordinates(self, t):
-        return jnp.zeros(6).at[self.dof].set(self.value(t))
+        T, W = self.duration, self.rate
+        c = T / (2.0 * jnp.pi)
+        up = W / T * (0.5 * t * t + c * c * (jnp.cos(t / c) - 1.0))
+        return jnp.zeros(6).at[self.dof].set(jnp.where(t < T, up, W * (0.5 * T) + W * (t - T)))
 
 
 class RecordedMotion(AbstractPrescribedMotion):
