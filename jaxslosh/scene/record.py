@@ -9,7 +9,9 @@ names the file's line, and the column where one is at fault. NumPy only; no JAX.
 from __future__ import annotations
 
 import csv
+import functools
 import math
+import os
 
 from .types import DOFS, SceneError
 
@@ -18,7 +20,17 @@ MIN_ROWS = 4
 
 def read_record(path: str, where: str, shown: str) -> tuple[tuple[float, ...], tuple[tuple[str, tuple], ...]]:
     """(times, ((dof, values), ...)) of a record, the dofs in the file's column order; SceneError at
-    `where` naming the line and column at fault (`shown`: the file's name as the scene writes it)."""
+    `where` naming the line and column at fault (`shown`: the file's name as the scene writes it).
+    Read once per version of the file (a sweep parses its scene again for every run)."""
+    try:
+        st = os.stat(path)
+    except OSError:
+        raise SceneError(where, f"no such file: {path}") from None
+    return _read_record(path, where, shown, st.st_mtime_ns, st.st_size)
+
+
+@functools.lru_cache(maxsize=8)
+def _read_record(path, where, shown, mtime_ns, size):
     try:
         with open(path, newline="", encoding="utf-8") as fh:
             lines = [(n, row) for n, row in enumerate(csv.reader(fh), start=1)
