@@ -23,6 +23,7 @@ except ModuleNotFoundError:  # Python 3.10
     import tomli as tomllib  # type: ignore[no-redef]
 
 from .fields import show
+from .keydocs import KEYS as KEY_DOCS, TABLES as KEY_TABLES  # noqa: F401  default, unit, meaning (docs)
 from .load import forced_span, parse_scene, step_warnings
 from .types import Material, Scene, SceneError
 
