@@ -19,7 +19,7 @@ import jaxslosh as js
 from jaxslosh.cli.main import main
 from jaxslosh.physics.kinematics import quat_from_rpy, rotation_matrix
 from jaxslosh.physics.vessel import RecordedMotion, record_coefficients
-from jaxslosh.scene.keys import scene_values, with_overrides
+from jaxslosh.scene.keys import KEY_DOCS, scene_values, with_overrides
 from jaxslosh.scene.types import DOFS, SceneError
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
@@ -170,5 +170,7 @@ def test_check_describes_the_record_and_the_registry_lists_the_forced_keys(tmp_p
     values = scene_values(harm)
     for key, v in (("amplitude", A), ("frequency", W), ("phase", PHASE), ("ramp", 0.0)):
         assert values[f"vessel.forced.{key}"] == v
+    documented = {k for k, *_ in KEY_DOCS}
+    assert {"vessel.forced.file", "vessel.forced.phase"} <= documented     # the scene reference's rows
     spin = js.load_scene(_scene(tmp_path, 'profile = "spin-up"\ndof = "yaw"\nrate = 1.0\nduration = 2.0'))
     assert scene_values(spin)["vessel.forced.rate"] == 1.0 and "vessel.forced.phase" not in scene_values(spin)

@@ -17,7 +17,8 @@ TABLES = (
                "y to port, z up."),
     ("vessel.hydrostatics", "Linear restoring about the initial equilibrium (paper eqs. 33-38)."),
     ("vessel.initial", "The initial state; every key optional, zero by default."),
-    ("vessel.forced", "A prescribed motion of one rigid dof (tank tests); the other five are held."),
+    ("vessel.forced", "A prescribed motion of one rigid dof, or of any of them from a record (tank tests); "
+                      "the others are held."),
     ("vessel.hull", "The hull's geometry: Froude-Krylov forces, Capytaine, closed-form box hydrostatics."),
     ("vessel.hydrodynamics", "Radiation (added mass, damping, memory) and excitation tables, a database "
                              "file, or Capytaine."),
@@ -82,12 +83,18 @@ KEYS = (
     ("vessel.initial.velocity", "[0, 0, 0]", "m/s", "Inertial velocity of the COG."),
     ("vessel.initial.angular_velocity", "[0, 0, 0]", "rad/s", "Body frame."),
     ("vessel.initial.roll_pitch_yaw", "[0, 0, 0]", "rad", "Initial attitude (yaw, then pitch, then roll)."),
-    ("vessel.forced.dof", _REQ, "", '"surge", "sway", "heave", "roll", "pitch" or "yaw".'),
-    ("vessel.forced.profile", '"harmonic"', "", '"harmonic": amplitude sin(frequency t), faded in over ramp; '
-     '"spin-up": a rotation whose rate grows smoothly to rate over duration, then stays.'),
+    ("vessel.forced.dof", "required (harmonic, spin-up)", "",
+     '"surge", "sway", "heave", "roll", "pitch" or "yaw".'),
+    ("vessel.forced.profile", '"harmonic" ("record" with file)', "", '"harmonic": amplitude sin(frequency t + '
+     'phase), faded in over ramp; "spin-up": a rotation whose rate grows smoothly to rate over duration, then '
+     'stays; "record": the motion of file.'),
     ("vessel.forced.amplitude", "required (harmonic)", "m or rad", "Harmonic amplitude."),
     ("vessel.forced.frequency", "required (harmonic)", "rad/s", "Harmonic frequency."),
+    ("vessel.forced.phase", "0", "rad", "Harmonic phase: x = amplitude sin(frequency t + phase) r(t / ramp)."),
     ("vessel.forced.ramp", "0", "s", "Fade-in time of the harmonic motion (continuous acceleration)."),
+    ("vessel.forced.file", "required (record)", "", "A motion record (CSV, relative to the scene): a header "
+     "row with t and any of surge, sway, heave (m), roll, pitch, yaw (rad); interpolated by a natural cubic "
+     "spline (continuous acceleration), the dofs not given held."),
     ("vessel.forced.rate", "required (spin-up)", "rad/s", "The final rate of a spin-up."),
     ("vessel.forced.duration", "required (spin-up)", "s", "The spin-up time."),
     ("vessel.hull.type", '"box"', "", '"box" or "mesh" (a hull mesh file for Capytaine).'),
