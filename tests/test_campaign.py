@@ -449,3 +449,29 @@ def test_plot_of_a_campaign_file(tmp_path, capsys):
     assert main(["plot", str(out), "-o", str(png), "--limits", "heave=0.5"]) == 0
     assert main(["plot", str(out), "-o", str(png), "--case", "9"]) == 2
     assert "--case" in capsys.readouterr().err
+
+
+# --------------------------------------------------------------------------------------------
+# issue 31: what a new user met
+
+
+def test_headings_in_degrees_are_refused(tmp_path, capsys):
+    """Headings beyond 2 pi are degrees typed where radians are asked for: exit 2 saying so, on
+    campaign's and rao's --headings, in [campaign] headings, and from js.campaign."""
+    from jaxslosh.campaign.run import CampaignError
+    p, s = files(tmp_path)
+    out = str(tmp_path / "c.h5")
+    for argv in (["campaign", str(p), "--scatter", str(s), "-o", out, "--headings", "45,90"],
+                 ["rao", str(p), "--headings", "0,90", "-o", str(tmp_path / "r.h5")]):
+        assert main(argv) == 2
+        err = capsys.readouterr().err
+        assert "--headings" in err and "headings are in radians" in err and len(err.strip().splitlines()) == 1
+    p.write_text(scene_text() + "[campaign]\nheadings = [90]\n")
+    assert main(["check", str(p)]) == 2
+    err = capsys.readouterr().err
+    assert "campaign.headings" in err and "headings are in radians" in err
+    with pytest.raises(CampaignError, match="headings are in radians"):
+        js.campaign(js.load_scene(scene_text()), str(s), headings=[0.0, 180.0])
+    assert not os.path.exists(out)
+    # 2 pi itself, and negative headings within a turn, stay radians
+    assert js.load_scene(scene_text() + f"[campaign]\nheadings = [-3.0, {2 * np.pi!r}]\n").campaign.headings[1] > 6

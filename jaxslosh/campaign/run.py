@@ -20,7 +20,7 @@ from ..io.output import OutputLock
 from ..run.guard import interrupts
 from ..run.progress import Progress, wanted
 from ..scene.load import load_scene
-from ..scene.campaign import channels
+from ..scene.campaign import channels, not_radians
 from ..scene.types import CampaignTable, Scene, SceneError
 from .cases import Cases, Scatter, case_scene, case_values, make_cases, read_scatter
 from .stats import STATISTICS, frequencies, operability
@@ -131,6 +131,9 @@ def campaign(scene, scatter, headings=None, seeds: int | None = None, duration: 
     sc = scatter if isinstance(scatter, Scatter) else read_scatter(scatter)
     headings, seeds, duration, limits = settings(template, headings, seeds, duration, limits)
     heads = [template.waves.heading] if headings is None else headings
+    bad = not_radians(headings or [])
+    if bad:
+        raise CampaignError(f"headings: {bad}")
     if seeds < 1:
         raise CampaignError(f"--seeds: must be at least 1, got {seeds}")
     cases = make_cases(sc, heads, seeds, template.waves.seed)

@@ -13,6 +13,7 @@ from ..campaign.cases import ScatterError
 from ..campaign.run import CampaignError, campaign, channel_names
 from ..io.output import OutputError
 from ..io.result import ResultFileError
+from ..scene.campaign import not_radians
 from .common import COMMANDS, InputError, load, positive, setup_jax, writable_output
 
 
@@ -66,6 +67,9 @@ def parse_headings(text):
         raise InputError(f"--headings: expected numbers in rad separated by commas, got {text!r}") from None
     if not heads or not all(math.isfinite(h) for h in heads):
         raise InputError(f"--headings: expected finite numbers in rad, got {text!r}")
+    bad = not_radians(heads)
+    if bad:
+        raise InputError(f"--headings: {bad}")
     return heads
 
 

@@ -7,6 +7,7 @@ import numpy as np
 
 from ..hydro.capytaine import (CAPYTAINE_MISSING, capytaine_dataset, capytaine_version, have_capytaine,
                                hull_hydrodynamics, save_capytaine_dataset, to_toml)
+from ..scene.campaign import not_radians
 from .common import COMMANDS, EXIT_OK, InputError, load, output_folder
 
 
@@ -41,6 +42,9 @@ def cmd_hydro(a):
             heads = tuple(float(x) for x in a.headings.split(","))
         except ValueError:
             raise InputError(f"--headings: expected comma-separated numbers, got {a.headings!r}") from None
+        bad = not_radians(heads)
+        if bad:
+            raise InputError(f"--headings: {bad}")
     else:
         heads = (scene.waves.heading if scene.waves is not None else 0.0,)
     if not have_capytaine():
