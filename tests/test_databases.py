@@ -237,3 +237,25 @@ def test_the_netcdf_stiffness_mismatch_is_one_warning(dataset, tmp_path, capsys)
     assert main(["check", str(p)]) == 0
     err = [ln for ln in capsys.readouterr().err.splitlines() if "stiffness" in ln]
     assert len(err) == 1 and "C_44" in err[0] and "C_55" in err[0] and "C_33" not in err[0], err
+
+
+def test_hydro_shows_capytaines_progress_per_frequency(tmp_path, capsys, monkeypatch):
+    """`jaxslosh hydro`: Capytaine's solve counted per frequency on stderr (the infinite one last),
+    as the project's progress display draws it; none with --no-progress or JAXSLOSH_PROGRESS=0."""
+    scene = tmp_path / "hull.toml"
+    scene.write_text(scene_text())
+    argv = ["hydro", str(scene), "--frequencies", "0.5:1.4:4", "--headings", "0", "--panel-size", "5.0",
+            "-o", str(tmp_path / "t.toml")]
+    monkeypatch.setenv("JAXSLOSH_PROGRESS", "1")
+    assert main(argv) == 0
+    err = capsys.readouterr().err
+    bars = [x for x in err.replace("\r", "\n").splitlines() if x.startswith("Capytaine: 7 problems per frequency [")]
+    assert bars and "frequency 5/5" in bars[-1] and "100.0%" in bars[-1], err
+    assert "Capytaine: hydrostatics ..." in err
+    from jaxslosh.hydro import capytaine
+    capytaine._CACHE.clear()                  # solved again, silently
+    assert main(argv + ["--no-progress"]) == 0
+    assert "Capytaine" not in capsys.readouterr().err
+    monkeypatch.setenv("JAXSLOSH_PROGRESS", "0")
+    assert main(argv) == 0
+    assert "Capytaine" not in capsys.readouterr().err

@@ -11,6 +11,7 @@ from dask.distributed import Client
 
 from ..campaign.cases import ScatterError
 from ..campaign.run import CampaignError, campaign, channel_names
+from ..io.campaign import PENDING
 from ..io.output import OutputError
 from ..io.result import ResultFileError
 from ..scene.campaign import not_radians
@@ -110,11 +111,38 @@ def cmd_campaign(a):
     finally:
         if client is not None:
             client.close()
-    print(f"{'channel':>12} {'limit':>10} {'P(exceed)':>10}")
-    for ch, lim in r.limits.items():
-        print(f"{ch:>12} {lim:10.4g} {r.exceedance[ch]:10.4g}")
-    if r.limits:
-        print(f"operability: {r.operability:.2f} % of the scatter's weight within every limit")
+    report_failures(r.cases, r.status)
+    if r.limits:         # none (--limits "", or none in the scene): no table, no operability
+        print(f"{'channel':>12} {'limit':>10} {'P(exceed)':>10}")
+        for ch, lim in r.limits.items():
+            print(f"{ch:>12} {lim:10.4g} {r.exceedance.get(ch, math.nan):10.4g}")
+        judged = "" if not r.failed_weight > 0 else \
+            f"; {r.failed_weight:.2f} % of it in failed cases, counted as not operable"
+        print(f"operability: {r.operability:.2f} % of the scatter's weight within every limit{judged}")
     print(f"done: {r.run_now} cases run now, {r.done_before} already done, {r.failed} failed, "
           f"{r.wall:.1f} s wall -> {out}")
     return 0 if r.failed == 0 else 3
+
+
+#: failed cases listed one by one up to this many per reason; beyond, their count and the first ones
+SHOW_CASES = 8
+
+
+def report_failures(cases, status, stream=None):
+    """Each failed case's reason on stderr, the cases that share a reason on one line:
+    `failed: case 3 (hs 6 m, tp 8 s, heading 1.571 rad, seed 0): step 78 (t = 7.8 s): Newton ...`."""
+    stream = sys.stderr if stream is None else stream
+    by_reason: dict = {}
+    for i, s in enumerate(status):
+        if s not in ("ok", PENDING):
+            by_reason.setdefault(s, []).append(i)
+    for reason, idx in by_reason.items():
+        def one(i):
+            return (f"case {i} (hs {cases.hs[i]:g} m, tp {cases.tp[i]:g} s, heading {cases.heading[i]:.4g} rad, "
+                    f"seed {int(cases.seed[i])})")
+        if len(idx) == 1:
+            who = one(idx[0])
+        else:
+            shown = ", ".join(str(i) for i in idx[:SHOW_CASES]) + (", ..." if len(idx) > SHOW_CASES else "")
+            who = f"{len(idx)} cases ({shown}; the first: {one(idx[0])})"
+        print(f"failed: {who}: {reason}", file=stream)
