@@ -124,8 +124,9 @@ def cmd_campaign(a):
     return 0 if r.failed == 0 else 3
 
 
-#: failed cases listed one by one up to this many per reason; beyond, their count and the first ones
-SHOW_CASES = 8
+#: failed cases named one by one up to this many per reason; reasons printed up to SHOW_REASONS
+#: (the file's /cases/status holds every one)
+SHOW_CASES, SHOW_REASONS = 8, 20
 
 
 def report_failures(cases, status, stream=None):
@@ -136,13 +137,18 @@ def report_failures(cases, status, stream=None):
     for i, s in enumerate(status):
         if s not in ("ok", PENDING):
             by_reason.setdefault(s, []).append(i)
-    for reason, idx in by_reason.items():
-        def one(i):
-            return (f"case {i} (hs {cases.hs[i]:g} m, tp {cases.tp[i]:g} s, heading {cases.heading[i]:.4g} rad, "
-                    f"seed {int(cases.seed[i])})")
+
+    def one(i):
+        return (f"case {i} (hs {cases.hs[i]:g} m, tp {cases.tp[i]:g} s, heading {cases.heading[i]:.4g} rad, "
+                f"seed {int(cases.seed[i])})")
+    reasons = list(by_reason.items())
+    for reason, idx in reasons[:SHOW_REASONS]:
         if len(idx) == 1:
             who = one(idx[0])
         else:
             shown = ", ".join(str(i) for i in idx[:SHOW_CASES]) + (", ..." if len(idx) > SHOW_CASES else "")
             who = f"{len(idx)} cases ({shown}; the first: {one(idx[0])})"
         print(f"failed: {who}: {reason}", file=stream)
+    if len(reasons) > SHOW_REASONS:
+        rest = sum(len(idx) for _, idx in reasons[SHOW_REASONS:])
+        print(f"failed: {rest} more cases, each reason in the campaign file's /cases/status", file=stream)
