@@ -219,7 +219,9 @@ def test_an_interrupted_campaign_resumes_without_recomputing_finished_cases(env)
     out = env / "c.h5"
     args = [sys.executable, "-m", "jaxslosh", "campaign", str(p), "--scatter", str(s), "--headings", f"1.2,{BEAM}",
             "--seeds", "6", "--workers", "1", "--batch", "1", "-o", str(out)]
-    proc = subprocess.Popen(args, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, cwd=env)
+    # its own process group, as a terminal's: Ctrl-C reaches the campaign and its cluster's workers
+    proc = subprocess.Popen(args, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, cwd=env,
+                            start_new_session=True)
     children = []
     try:
         deadline = time.time() + 300
@@ -235,8 +237,8 @@ def test_an_interrupted_campaign_resumes_without_recomputing_finished_cases(env)
                 break
             time.sleep(0.05)
         assert proc.poll() is None, proc.communicate()[1][-2000:]
-        proc.send_signal(signal.SIGINT)
-        proc.communicate(timeout=120)
+        os.killpg(proc.pid, signal.SIGINT)
+        _, err = proc.communicate(timeout=120)
     finally:
         if proc.poll() is None:
             proc.kill()
@@ -248,8 +250,13 @@ def test_an_interrupted_campaign_resumes_without_recomputing_finished_cases(env)
     before = load_campaign(str(out))
     n_ok = sum(x == "ok" for x in before.status)
     assert 1 <= n_ok < N and all(x in ("ok", "pending") for x in before.status)
+    # one line that says what is kept and how to go on; nothing of Dask's shutdown
+    assert proc.returncode == 130
+    assert err.strip() == (f"interrupted (SIGINT): {n_ok} of {N} cases done ({n_ok} in this run), kept in {out}; "
+                           f"the same command with --resume runs the other {N - n_ok}"), err[-3000:]
     res = subprocess.run(args + ["--resume"], capture_output=True, text=True, cwd=env, timeout=600)
     assert res.returncode == 0, res.stderr[-2000:]
+    assert res.stderr == "", res.stderr[-2000:]           # the cluster closed without Dask's warnings
     assert f"{N - n_ok} cases run now, {n_ok} already done, 0 failed" in res.stdout
     after = load_campaign(str(out))
     assert after.status == ["ok"] * N
@@ -449,3 +456,171 @@ def test_plot_of_a_campaign_file(tmp_path, capsys):
     assert main(["plot", str(out), "-o", str(png), "--limits", "heave=0.5"]) == 0
     assert main(["plot", str(out), "-o", str(png), "--case", "9"]) == 2
     assert "--case" in capsys.readouterr().err
+
+
+# --------------------------------------------------------------------------------------------
+# issue 31: what a new user met
+
+
+def test_headings_in_degrees_are_refused(tmp_path, capsys):
+    """Headings beyond 2 pi are degrees typed where radians are asked for: exit 2 saying so, on
+    campaign's and rao's --headings, in [campaign] headings, and from js.campaign."""
+    from jaxslosh.campaign.run import CampaignError
+    p, s = files(tmp_path)
+    out = str(tmp_path / "c.h5")
+    for argv in (["campaign", str(p), "--scatter", str(s), "-o", out, "--headings", "45,90"],
+                 ["rao", str(p), "--headings", "0,90", "-o", str(tmp_path / "r.h5")]):
+        assert main(argv) == 2
+        err = capsys.readouterr().err
+        assert "--headings" in err and "headings are in radians" in err and len(err.strip().splitlines()) == 1
+    p.write_text(scene_text() + "[campaign]\nheadings = [90]\n")
+    assert main(["check", str(p)]) == 2
+    err = capsys.readouterr().err
+    assert "campaign.headings" in err and "headings are in radians" in err
+    with pytest.raises(CampaignError, match="headings are in radians"):
+        js.campaign(js.load_scene(scene_text()), str(s), headings=[0.0, 180.0])
+    assert not os.path.exists(out)
+    # 2 pi itself, and negative headings within a turn, stay radians
+    assert js.load_scene(scene_text() + f"[campaign]\nheadings = [-3.0, {2 * np.pi!r}]\n").campaign.headings[1] > 6
+
+
+FAILING_SCATTER = "hs,tp,probability\n0.3,7.0,0.5\n100.0,7.0,0.5\n"     # Hs 100 m: Newton gives up near t = 8 s
+LIMITS = "[campaign]\nheadings = [1.5707963267948966]\n[campaign.limits]\nroll = 1.0\nheave = 5.0\n"
+
+
+def _main(argv):
+    """main(argv) -> (exit status, stdout, stderr)."""
+    import contextlib
+    import io
+    out, err = io.StringIO(), io.StringIO()
+    with contextlib.redirect_stdout(out), contextlib.redirect_stderr(err):
+        try:
+            code = main(argv)
+        except Exception as e:          # noqa: BLE001 - a traceback is an outcome the tests look at
+            code, _ = f"{type(e).__name__}: {e}", print(f"Traceback: {type(e).__name__}: {e}", file=sys.stderr)
+    return code, out.getvalue(), err.getvalue()
+
+
+@pytest.fixture(scope="module")
+def failing(tmp_path_factory):
+    """Three small campaigns of the box in beam seas, one process each, limits roll 1 rad and heave
+    5 m from the scene: `mixed`, Hs 0.3 m and Hs 100 m at 50 % each (the second fails); `resumed`,
+    that file resumed with --limits "" (the failed case run again); `lost`, Hs 100 m alone."""
+    d = tmp_path_factory.mktemp("failing")
+    with pytest.MonkeyPatch.context() as mp:
+        mp.setenv("PYTHONPATH", os.pathsep.join([str(ROOT), str(ROOT / "tests"), os.environ.get("PYTHONPATH", "")]))
+        mp.setenv("JAXSLOSH_CACHE_DIR", str(CACHE))
+        mp.setenv("JAXSLOSH_PROGRESS", "0")
+        p = d / "box.toml"
+        p.write_text(scene_text(40.0).replace('title = "box alone in irregular seas"',
+                                              'title = "box alone (Hs 0.3 m, Tp 7 s)"') + LIMITS)
+        (d / "mixed.csv").write_text(FAILING_SCATTER)
+        (d / "lost.csv").write_text("hs,tp,probability\n100.0,7.0,1.0\n")
+        common = ["--workers", "1", "--batch", "2", "--no-progress"]
+        runs = {"mixed": _main(["campaign", str(p), "--scatter", str(d / "mixed.csv"), "-o", str(d / "mixed.h5")]
+                               + common)}
+        import shutil
+        shutil.copy(d / "mixed.h5", d / "resumed.h5")
+        runs["resumed"] = _main(["campaign", str(p), "--scatter", str(d / "mixed.csv"), "-o", str(d / "resumed.h5"),
+                                 "--resume", "--limits", ""] + common)
+        runs["lost"] = _main(["campaign", str(p), "--scatter", str(d / "lost.csv"), "-o", str(d / "lost.h5")] + common)
+    return d, runs
+
+
+def test_a_failed_case_is_not_operable_in_the_summary_the_file_and_the_figure(failing):
+    d, runs = failing
+    code, out, err = runs["mixed"]
+    assert code == 3, err[-2000:]
+    c = load_campaign(str(d / "mixed.h5"))
+    assert c.status[0] == "ok" and "Newton" in c.status[1]
+    assert "operability: 50.00 % of the scatter's weight within every limit; 50.00 % of it in failed cases" in out
+    np.testing.assert_allclose(c.attrs["operability"], 50.0, rtol=1e-12)
+    np.testing.assert_allclose(c.attrs["failed_weight"], 50.0, rtol=1e-12)
+    import json
+    exc = json.loads(c.attrs["exceedance"])
+    assert exc["roll"] >= 0.5 and exc["heave"] >= 0.5                 # the failed half counts as exceeding
+    from jaxslosh.plot.campaign import heading_operability
+    heads, per, share = heading_operability(c, {"roll": 1.0, "heave": 5.0})
+    np.testing.assert_allclose(per, [50.0], rtol=1e-12)
+    assert share == 50.0
+
+
+def test_a_failed_cases_reason_is_printed(failing):
+    _, runs = failing
+    code, out, err = runs["mixed"]
+    line = [ln for ln in err.splitlines() if ln.startswith("failed:")]
+    assert len(line) == 1 and line[0].startswith("failed: case 1 (hs 100 m, tp 7 s, heading 1.571 rad, seed 0): step ")
+    assert "Newton did not converge" in line[0]
+    assert out.splitlines()[-1].startswith("done: 2 cases run now, 0 already done, 1 failed")
+
+
+def test_no_limits_print_no_table(failing):
+    _, runs = failing
+    code, out, err = runs["resumed"]
+    assert code == 3
+    assert out.splitlines() == [out.splitlines()[-1]] and out.startswith("done: 1 cases run now, 1 already done, 1 failed")
+    assert "failed: case 1" in err
+
+
+def test_a_campaign_whose_every_case_fails_exits_3_with_its_summary_and_reasons(failing):
+    d, runs = failing
+    code, out, err = runs["lost"]
+    assert code == 3 and "Traceback" not in err and "KeyError" not in err
+    assert "operability: 0.00 % of the scatter's weight within every limit; 100.00 % of it in failed cases" in out
+    assert out.splitlines()[-1].startswith("done: 1 cases run now, 0 already done, 1 failed")
+    assert "failed: case 0 (hs 100 m" in err and "Newton" in err
+
+
+def test_the_figure_of_a_campaign_with_failures(failing, tmp_path):
+    """Failed cells said, operability as the summary's, spectra on one axis per unit over the
+    frequencies that hold energy with their resolution said, a title of the campaign's own seas
+    clear of the subplots, no warning from matplotlib (an all-failed campaign included)."""
+    import warnings
+    from jaxslosh.plot.campaign import plot_campaign
+    d, _ = failing
+    c = load_campaign(str(d / "mixed.h5"))
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        fig = plot_campaign(c, str(tmp_path / "m.png"), limits={"roll": 1.0, "heave": 5.0})
+        plot_campaign(load_campaign(str(d / "lost.h5")), str(tmp_path / "l.png"), limits={"roll": 1.0})
+        assert _main(["plot", str(d / "lost.h5"), "-o", str(tmp_path / "l2.png")])[0] == 0
+    texts = [t.get_text() for ax in fig.axes for t in ax.texts]
+    assert "failed" in texts
+    polar = [ax for ax in fig.axes if ax.name == "polar"][0]
+    np.testing.assert_allclose(polar.lines[0].get_ydata(), [50.0])
+    assert "count as not operable" in polar.get_title()
+    by_unit = {ax.get_ylabel(): ax for ax in fig.axes if ax.get_ylabel().startswith("S (")}
+    # beam seas on a box: pitch at round-off, below the roll peak by far more than the axis shows
+    assert {ln.get_label() for ln in by_unit["S (rad^2 s/rad)"].lines} == {"roll"}
+    assert np.nanmax(c.spectra["pitch"][0]) < 1e-5 * np.nanmax(c.spectra["roll"][0])
+    assert {ln.get_label() for ln in by_unit["S (m^2 s/rad)"].lines} == {"heave"}
+    w = np.asarray(c.frequency)
+    for ax in by_unit.values():
+        lo, hi = ax.get_xlim()
+        assert hi < 0.5 * w[-1]                                  # not to Nyquist's 15.7 rad/s
+        top = max(ln.get_ydata().max() for ln in ax.lines)
+        assert ax.get_ylim()[0] >= 1e-6 * top                   # not down to round-off
+    assert any(f"resolution {w[1] - w[0]:.3g} rad/s" in ax.get_title() for ax in fig.axes)
+    sup = fig._suptitle.get_text()
+    assert "Hs 0.3 to 100 m, Tp 7 s" in sup and "(Hs 0.3 m, Tp 7 s)" not in sup
+    r = fig.canvas.get_renderer()
+    box = fig._suptitle.get_window_extent(r)
+    assert all(not box.overlaps(ax.get_tightbbox(r)) for ax in fig.axes)
+
+
+def test_cell_labels_are_dark_on_light_cells():
+    from matplotlib import colormaps
+    from jaxslosh.plot.campaign import _label_colour
+    cmap = colormaps["viridis"]
+    assert _label_colour(cmap, 1.0) == "k" and _label_colour(cmap, 0.9) == "k"     # yellow, light green
+    assert _label_colour(cmap, 0.0) == "w" and _label_colour(cmap, 0.3) == "w"     # purple, blue
+
+
+def test_a_channel_that_does_not_respond_has_no_period():
+    """A record at round-off level (the roll of a symmetric box in head seas) has no zero-crossing
+    period or most probable maximum; a small real response keeps them."""
+    t = np.arange(0.0, 200.0, 0.1)
+    st = statistics(t, 1e-17 * np.sin(2 * np.pi * t / 8.0) + 0.02)
+    assert np.isnan(st["tz"]) and np.isnan(st["mpm"]) and st["std"] < 1e-16
+    st = statistics(t, 1e-6 * np.sin(2 * np.pi * t / 8.0))
+    assert abs(st["tz"] - 8.0) < 0.01

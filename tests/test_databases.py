@@ -165,3 +165,97 @@ def test_tables_written_as_a_netcdf_dataset_read_back(dataset, tmp_path):
     ref = tables_from_dataset(dataset)
     write_netcdf(str(tmp_path / "t.nc"), ref, RHO, G, stiffness=dataset["hydrostatic_stiffness"].values)
     same(scene_tables(js.load_scene(scene_text(f'file = "{tmp_path / "t.nc"}"')).vessel.hydrodynamics), ref, 1e-12)
+
+
+# --------------------------------------------------------------------------------------------
+# a database checked against the scene (issue 31)
+
+
+def _file_warnings(scene):
+    return [w for w in scene.warnings if w.startswith("vessel.hydrodynamics.file")]
+
+
+@pytest.mark.parametrize("fault, word", [("cut", "lacks"), ("cut_line", "numbers where"), ("swap", "monotone"),
+                                         ("again", "appears again"), ("pair", "lacks")])
+def test_a_cut_or_disordered_wamit_file_is_refused_naming_the_line(dataset, tmp_path, capsys, fault, word):
+    """A .1 cut in the middle of a frequency block (or of a line), a block without one (I, J) pair,
+    periods out of order or given twice: exit 2 naming the file and the line, not zeros."""
+    write_wamit(str(tmp_path / "box"), tables_from_dataset(dataset), RHO, G, length=10.0)
+    lines = (tmp_path / "box.1").read_text().splitlines()
+    head, blocks = lines[:36], [lines[36 + 36 * k:72 + 36 * k] for k in range(W.size)]   # A_inf, then per period
+    text = {"cut": lines[:-7], "cut_line": lines[:-1] + [lines[-1][:40]],
+            "swap": head + blocks[0] + blocks[2] + blocks[1] + sum(blocks[3:], []),
+            "again": head + sum(blocks, []) + blocks[0],
+            "pair": head + sum(blocks[:2], []) + blocks[2][:14] + blocks[2][15:] + sum(blocks[3:], [])}[fault]
+    (tmp_path / "box.1").write_text("\n".join(text) + "\n")
+    p = tmp_path / "s.toml"
+    p.write_text(scene_text('file = "box.1"\nlength_scale = 10.0'))
+    assert main(["check", str(p)]) == 2
+    err = capsys.readouterr().err
+    assert "box.1, line " in err and word in err and err.count("\n") == 1, err
+    line = int(err.split(", line ")[1].split(":")[0])
+    assert 1 <= line <= len(text)
+
+
+def test_a_wamit_file_read_without_its_length_scale_is_warned_with_the_likely_ulen(dataset, tmp_path):
+    """WAMIT files written with ULEN = 10 m, read with the default length_scale 1 m: the hydrostatic
+    stiffness (.hst) 100 times too small names length_scale = 10 m; without the .hst, the heave RAO
+    at the lowest frequency (0.3 rad/s, k L = 0.18: a long wave) far from its limit 1 does; read with
+    length_scale = 10 m, or from Capytaine's own NetCDF, neither check speaks."""
+    ref = tables_from_dataset(dataset)
+    write_wamit(str(tmp_path / "box"), ref, RHO, G, length=10.0, stiffness=dataset["hydrostatic_stiffness"].values)
+    p = tmp_path / "s.toml"
+    p.write_text(scene_text('file = "box.1"'))
+    warned = _file_warnings(js.load_scene(p))
+    assert len(warned) == 1 and "length_scale = 10 m would make them agree" in warned[0], warned
+    (tmp_path / "box.hst").unlink()
+    warned = _file_warnings(js.load_scene(p))
+    assert len(warned) == 1 and "heave RAO" in warned[0] and "length_scale" in warned[0], warned
+    rao = float(warned[0].split(" is ")[1].split(" m/m")[0])
+    assert rao < 0.05                                          # ~ 1 / ULEN^2
+    est = float(warned[0].split("length_scale = ")[2].split(" m")[0])
+    assert abs(est - 10.0) < 0.5                               # X_3 ~ rho g A_w e^{-k T} at k T = 0.02
+    p.write_text(scene_text('file = "box.1"\nlength_scale = 10.0'))
+    assert _file_warnings(js.load_scene(p)) == []
+    cpt.io.xarray.export_dataset(str(tmp_path / "box.nc"), dataset)
+    assert _file_warnings(js.load_scene(scene_text(f'file = "{tmp_path / "box.nc"}"'))) == []
+    # the RAO the warning speaks of, from js.rao: the scene read right tends to 1
+    ok = js.load_scene(scene_text(f'file = "{tmp_path / "box.nc"}"', '[waves]\ntype = "regular"\namplitude = 1.0\n'
+                                  'frequency = 0.5\nheading = 0.0\n'))
+    assert abs(abs(np.asarray(js.rao(ok, [0.3], [0.0]).vessel)[0, 0, 2]) - 1) < 0.1
+
+
+def test_the_netcdf_stiffness_mismatch_is_one_warning(dataset, tmp_path, capsys):
+    """A dataset whose roll and pitch stiffness differ from the scene's: one warning naming both."""
+    from jaxslosh.hydro.database import write_netcdf
+    C = np.array(dataset["hydrostatic_stiffness"].values, dtype=float)
+    C[3, 3] *= 0.9
+    C[4, 4] *= 0.95
+    write_netcdf(str(tmp_path / "t.nc"), tables_from_dataset(dataset), RHO, G, stiffness=C)
+    p = tmp_path / "s.toml"
+    p.write_text(scene_text('file = "t.nc"'))
+    assert main(["check", str(p)]) == 0
+    err = [ln for ln in capsys.readouterr().err.splitlines() if "stiffness" in ln]
+    assert len(err) == 1 and "C_44" in err[0] and "C_55" in err[0] and "C_33" not in err[0], err
+
+
+def test_hydro_shows_capytaines_progress_per_frequency(tmp_path, capsys, monkeypatch):
+    """`jaxslosh hydro`: Capytaine's solve counted per frequency on stderr (the infinite one last),
+    as the project's progress display draws it; none with --no-progress or JAXSLOSH_PROGRESS=0."""
+    scene = tmp_path / "hull.toml"
+    scene.write_text(scene_text())
+    argv = ["hydro", str(scene), "--frequencies", "0.5:1.4:4", "--headings", "0", "--panel-size", "5.0",
+            "-o", str(tmp_path / "t.toml")]
+    monkeypatch.setenv("JAXSLOSH_PROGRESS", "1")
+    assert main(argv) == 0
+    err = capsys.readouterr().err
+    bars = [x for x in err.replace("\r", "\n").splitlines() if x.startswith("Capytaine: 7 problems per frequency [")]
+    assert bars and "frequency 5/5" in bars[-1] and "100.0%" in bars[-1], err
+    assert "Capytaine: hydrostatics ..." in err
+    from jaxslosh.hydro import capytaine
+    capytaine._CACHE.clear()                  # solved again, silently
+    assert main(argv + ["--no-progress"]) == 0
+    assert "Capytaine" not in capsys.readouterr().err
+    monkeypatch.setenv("JAXSLOSH_PROGRESS", "0")
+    assert main(argv) == 0
+    assert "Capytaine" not in capsys.readouterr().err

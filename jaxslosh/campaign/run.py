@@ -6,7 +6,11 @@ A worker that dies takes its running batch with it; Dask's scheduler then runs t
 another worker (its `distributed.scheduler.allowed-failures` bounds how often)."""
 from __future__ import annotations
 
+import contextlib
+import logging
 import os
+import signal
+import threading
 import time
 import warnings
 from typing import NamedTuple, Optional
@@ -17,10 +21,10 @@ from dask.distributed import Client, LocalCluster, as_completed
 
 from ..io.campaign import PENDING, create_campaign, load_campaign, write_cases, write_summary
 from ..io.output import OutputLock
-from ..run.guard import interrupts
+from ..run.guard import Interrupted, interrupts
 from ..run.progress import Progress, wanted
 from ..scene.load import load_scene
-from ..scene.campaign import channels
+from ..scene.campaign import channels, not_radians
 from ..scene.types import CampaignTable, Scene, SceneError
 from .cases import Cases, Scatter, case_scene, case_values, make_cases, read_scatter
 from .stats import STATISTICS, frequencies, operability
@@ -48,6 +52,19 @@ class CampaignResult(NamedTuple):
     limits: dict                 # {channel: limit}
     exceedance: dict             # {channel: scatter-weighted probability of exceeding its limit}
     operability: float           # % of the scatter's weight whose cases stay within every limit
+    failed_weight: float = float("nan")   # % of the judged weight whose cases failed (not operable)
+
+
+class CampaignInterrupted(Interrupted):
+    """A campaign stopped by SIGINT or SIGTERM after a finished batch: the cases done so far are in
+    its file (`output`), and `--resume` (resume=True) runs the others. `report`: one line saying so."""
+
+    def __init__(self, how: str, done: int, total: int, run_now: int, output: Optional[str]):
+        super().__init__(how)
+        self.done, self.total, self.run_now, self.output = done, total, run_now, output
+        kept = (f", kept in {output}; the same command with --resume runs the other {total - done}"
+                if output else "")
+        self.report = f"interrupted ({how}): {done} of {total} cases done ({run_now} in this run){kept}"
 
 
 def channel_names(scene: Scene) -> list:
@@ -131,6 +148,9 @@ def campaign(scene, scatter, headings=None, seeds: int | None = None, duration: 
     sc = scatter if isinstance(scatter, Scatter) else read_scatter(scatter)
     headings, seeds, duration, limits = settings(template, headings, seeds, duration, limits)
     heads = [template.waves.heading] if headings is None else headings
+    bad = not_radians(headings or [])
+    if bad:
+        raise CampaignError(f"headings: {bad}")
     if seeds < 1:
         raise CampaignError(f"--seeds: must be at least 1, got {seeds}")
     cases = make_cases(sc, heads, seeds, template.waves.seed)
@@ -164,17 +184,24 @@ def campaign(scene, scatter, headings=None, seeds: int | None = None, duration: 
         elif output:
             create_campaign(output, template.text, _case_table(cases), chans, freq, attrs)
         todo = [i for i in range(n) if status[i] != "ok"]
-        run_now, failed = _run(template, duration, cases, scenes, todo, client, workers, batch, output, status,
-                               stats, spectra, progress, cache_dir or jax.config.jax_compilation_cache_dir or None)
+        counts = [0, 0]
+        try:
+            _run(template, duration, cases, scenes, todo, client, workers, batch, output, status, stats, spectra,
+                 progress, cache_dir or jax.config.jax_compilation_cache_dir or None, counts)
+        except Interrupted as e:
+            raise CampaignInterrupted(str(e), sum(x == "ok" for x in status), n, counts[0], output) from None
+        run_now, failed = counts
     finally:
         if lock is not None:
             lock.release()
     ok = np.array([s == "ok" for s in status])
-    ops = operability(stats, cases.weight, ok, lim, float(scenes[0].simulation.duration - scenes[0].waves.ramp))
+    bad = np.array([s not in ("ok", PENDING) for s in status])
+    ops = operability(stats, cases.weight, ok, lim, float(scenes[0].simulation.duration - scenes[0].waves.ramp),
+                      failed=bad)
     if output and lim:
-        write_summary(output, lim, ops["exceedance"], ops["operability"])
+        write_summary(output, lim, ops["exceedance"], ops["operability"], ops["failed"])
     return CampaignResult(cases, status, stats, freq, spectra, run_now, done_before, failed,
-                          time.perf_counter() - t_start, lim, ops["exceedance"], ops["operability"])
+                          time.perf_counter() - t_start, lim, ops["exceedance"], ops["operability"], ops["failed"])
 
 
 def _check_resume(old, template, cases, chans, attrs, path):
@@ -201,18 +228,56 @@ def _batches(scenes, todo, batch):
     return [idx[k:k + batch] for idx in groups.values() for k in range(0, len(idx), batch)]
 
 
+@contextlib.contextmanager
+def _sigint_ignored():
+    """SIGINT ignored while the local cluster starts its worker processes, which inherit that: a
+    Ctrl-C at the terminal reaches the whole process group, and workers that took it would die
+    with tracebacks while this process closes them in order (their batches are cancelled here)."""
+    if threading.current_thread() is not threading.main_thread():
+        yield
+        return
+    old = signal.signal(signal.SIGINT, signal.SIG_IGN)
+    try:
+        yield
+    finally:
+        signal.signal(signal.SIGINT, old)
+
+
+def _quiet_cancellations():
+    """On a worker: a batch cancelled by an interrupted campaign is expected, not a warning."""
+    logging.getLogger("distributed.worker.state_machine").setLevel(logging.ERROR)
+
+
+@contextlib.contextmanager
+def _quiet_dask():
+    """Dask's loggers in this process silenced while a campaign closes its cluster: after an
+    interruption, the lost and cancelled batches it reports are the ones the interruption stopped."""
+    names = ["distributed"] + [n for n in logging.root.manager.loggerDict if n.startswith("distributed.")]
+    levels = {n: logging.getLogger(n).level for n in names}
+    for n in names:
+        logging.getLogger(n).setLevel(logging.CRITICAL + 1)
+    try:
+        yield
+    finally:
+        for n, lv in levels.items():
+            logging.getLogger(n).setLevel(lv)
+
+
 def _run(template, duration, cases, scenes, todo, client, workers, batch, output, status, stats, spectra, progress,
-         cache_dir):
+         cache_dir, counts):
+    """Run the cases `todo`, storing each batch's outcomes as it finishes; counts[:] = [cases run,
+    cases failed] as they go (read after an interruption too)."""
     if not todo:
-        return 0, 0
+        return
     own = client is None
     cluster = None
     if own:
-        with warnings.catch_warnings():     # its HTTP server moves to a free port when 8787 is taken: say nothing
+        with warnings.catch_warnings(), _sigint_ignored():   # the dashboard moves off a taken 8787: say nothing
             warnings.filterwarnings("ignore", message=".*already in use.*")
             cluster = LocalCluster(n_workers=int(workers), threads_per_worker=1, processes=True,
                                    dashboard_address=None)
         client = Client(cluster)
+        client.run(_quiet_cancellations)
     bar = Progress(enabled=wanted() if progress is None else progress)
     bar.phase("cases", "cases", total=len(todo), unit="case")
     run_now = failed = 0
@@ -221,8 +286,9 @@ def _run(template, duration, cases, scenes, todo, client, workers, batch, output
     # there, and the campaign went on to its end
     guard = interrupts()
     stop = guard.__enter__()
+    futures: dict = {}
+    stopped = False
     try:
-        futures = {}
         for idx in _batches(scenes, todo, batch):
             values = [case_values(cases, i) for i in idx]
             fut = client.submit(run_batch, template.text, template.path, duration, values, batch, cache_dir,
@@ -246,12 +312,21 @@ def _run(template, duration, cases, scenes, todo, client, workers, batch, output
             if output:
                 write_cases(output, idx, outcomes)
             run_now += len(idx)
+            counts[:] = [run_now, failed]
             bar.update(run_now)
             stop.check()
+    except KeyboardInterrupt:
+        stopped = True
+        raise
     finally:
         guard.__exit__(None, None, None)
         bar.close()
-        if own:
-            client.close()
-            cluster.close()
-    return run_now, failed
+        # our own cluster closes quietly: its nanny kills a worker that XLA's threads keep alive past
+        # its grace time ("still alive after 4.0 seconds, killing"), which loses nothing here
+        with _quiet_dask() if stopped or own else contextlib.nullcontext():
+            if stopped:
+                with contextlib.suppress(Exception):
+                    client.cancel(list(futures))
+            if own:
+                client.close()
+                cluster.close()

@@ -9,6 +9,10 @@ import numpy as np
 from scipy import signal
 
 STATISTICS = ("std", "significant", "max", "mpm", "tz")
+#: a channel whose standard deviation is below this (m or rad, plus 1e-12 of its largest value) has
+#: no response: what varies is round-off (the roll of a symmetric ship in head seas), and its
+#: zero crossings would give a period tz of nothing; its tz and mpm are NaN
+RESPONSE_FLOOR = 1e-9
 
 
 def channels(result, run=None) -> dict:
@@ -39,10 +43,11 @@ def statistics(t, x) -> dict:
     t, x = np.asarray(t, dtype=float), np.asarray(x, dtype=float)
     y = x - x.mean()
     std = float(y.std())
+    silent = std <= RESPONSE_FLOOR + 1e-12 * float(np.abs(x).max())    # round-off about a constant
     duration = float(t[-1] - t[0]) + float(t[1] - t[0])
     # the mean period between the first and last upcrossings (interpolated between frames): a count
     # over the whole record would be off by the part-cycles at its ends
-    k = np.flatnonzero((y[:-1] < 0) & (y[1:] >= 0))
+    k = np.flatnonzero((y[:-1] < 0) & (y[1:] >= 0)) if not silent else np.zeros(0, dtype=int)
     tc = t[k] + (t[k + 1] - t[k]) * (-y[k]) / (y[k + 1] - y[k])
     tz = float(tc[-1] - tc[0]) / (k.size - 1) if k.size >= 2 else math.nan
     n_cycles = duration / tz if k.size >= 2 else 0.0
@@ -74,20 +79,28 @@ def exceedance(std, tz, duration: float, limit: float):
     return 1.0 - np.exp(-n * q)
 
 
-def operability(stats: dict, weight, ok, limits: dict, duration: float) -> dict:
+def operability(stats: dict, weight, ok, limits: dict, duration: float, failed=None) -> dict:
     """Per limited channel the scatter-weighted probability of exceeding its limit in `duration`
     (Rayleigh, from each case's std and tz), and the operability: the weighted share (%) of the
-    cases whose every limited channel's largest |x - mean| stayed within its limit. Only cases
-    that finished (`ok`) count; their weights are renormalised."""
-    w = np.where(ok, np.asarray(weight, dtype=float), 0.0)
-    total = w.sum()
-    out = {"exceedance": {}, "operability": math.nan}
+    cases whose every limited channel's largest |x - mean| stayed within its limit. The cases
+    judged are those that finished (`ok`) and those that `failed`: a failed case is not operable
+    and counts as exceeding every limit (a run that broke down is not one a ship rides out);
+    cases still pending are left out, the weights of the judged renormalised. "failed": the share
+    (%) of the judged weight that failed."""
+    ok = np.asarray(ok, dtype=bool)
+    bad = np.zeros_like(ok) if failed is None else np.asarray(failed, dtype=bool) & ~ok
+    weight = np.asarray(weight, dtype=float)
+    w = np.where(ok, weight, 0.0)
+    w_bad = np.where(bad, weight, 0.0)
+    total = w.sum() + w_bad.sum()
+    out = {"exceedance": {ch: math.nan for ch in limits}, "operability": math.nan, "failed": math.nan}
     if total <= 0:
         return out
     within = np.ones(w.shape, dtype=bool)
     for ch, lim in limits.items():
         p = exceedance(stats[ch]["std"], stats[ch]["tz"], duration, lim)
-        out["exceedance"][ch] = float(np.sum(w * np.nan_to_num(p)) / total)
+        out["exceedance"][ch] = float((np.sum(w * np.nan_to_num(p)) + w_bad.sum()) / total)
         within &= np.asarray(stats[ch]["max"]) <= lim
     out["operability"] = float(100.0 * np.sum(w * within) / total)
+    out["failed"] = float(100.0 * w_bad.sum() / total)
     return out

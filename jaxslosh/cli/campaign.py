@@ -11,8 +11,10 @@ from dask.distributed import Client
 
 from ..campaign.cases import ScatterError
 from ..campaign.run import CampaignError, campaign, channel_names
+from ..io.campaign import PENDING
 from ..io.output import OutputError
 from ..io.result import ResultFileError
+from ..scene.campaign import not_radians
 from .common import COMMANDS, InputError, load, positive, setup_jax, writable_output
 
 
@@ -66,6 +68,9 @@ def parse_headings(text):
         raise InputError(f"--headings: expected numbers in rad separated by commas, got {text!r}") from None
     if not heads or not all(math.isfinite(h) for h in heads):
         raise InputError(f"--headings: expected finite numbers in rad, got {text!r}")
+    bad = not_radians(heads)
+    if bad:
+        raise InputError(f"--headings: {bad}")
     return heads
 
 
@@ -106,11 +111,44 @@ def cmd_campaign(a):
     finally:
         if client is not None:
             client.close()
-    print(f"{'channel':>12} {'limit':>10} {'P(exceed)':>10}")
-    for ch, lim in r.limits.items():
-        print(f"{ch:>12} {lim:10.4g} {r.exceedance[ch]:10.4g}")
-    if r.limits:
-        print(f"operability: {r.operability:.2f} % of the scatter's weight within every limit")
+    report_failures(r.cases, r.status)
+    if r.limits:         # none (--limits "", or none in the scene): no table, no operability
+        print(f"{'channel':>12} {'limit':>10} {'P(exceed)':>10}")
+        for ch, lim in r.limits.items():
+            print(f"{ch:>12} {lim:10.4g} {r.exceedance.get(ch, math.nan):10.4g}")
+        judged = "" if not r.failed_weight > 0 else \
+            f"; {r.failed_weight:.2f} % of it in failed cases, counted as not operable"
+        print(f"operability: {r.operability:.2f} % of the scatter's weight within every limit{judged}")
     print(f"done: {r.run_now} cases run now, {r.done_before} already done, {r.failed} failed, "
           f"{r.wall:.1f} s wall -> {out}")
     return 0 if r.failed == 0 else 3
+
+
+#: failed cases named one by one up to this many per reason; reasons printed up to SHOW_REASONS
+#: (the file's /cases/status holds every one)
+SHOW_CASES, SHOW_REASONS = 8, 20
+
+
+def report_failures(cases, status, stream=None):
+    """Each failed case's reason on stderr, the cases that share a reason on one line:
+    `failed: case 3 (hs 6 m, tp 8 s, heading 1.571 rad, seed 0): step 78 (t = 7.8 s): Newton ...`."""
+    stream = sys.stderr if stream is None else stream
+    by_reason: dict = {}
+    for i, s in enumerate(status):
+        if s not in ("ok", PENDING):
+            by_reason.setdefault(s, []).append(i)
+
+    def one(i):
+        return (f"case {i} (hs {cases.hs[i]:g} m, tp {cases.tp[i]:g} s, heading {cases.heading[i]:.4g} rad, "
+                f"seed {int(cases.seed[i])})")
+    reasons = list(by_reason.items())
+    for reason, idx in reasons[:SHOW_REASONS]:
+        if len(idx) == 1:
+            who = one(idx[0])
+        else:
+            shown = ", ".join(str(i) for i in idx[:SHOW_CASES]) + (", ..." if len(idx) > SHOW_CASES else "")
+            who = f"{len(idx)} cases ({shown}; the first: {one(idx[0])})"
+        print(f"failed: {who}: {reason}", file=stream)
+    if len(reasons) > SHOW_REASONS:
+        rest = sum(len(idx) for _, idx in reasons[SHOW_REASONS:])
+        print(f"failed: {rest} more cases, each reason in the campaign file's /cases/status", file=stream)

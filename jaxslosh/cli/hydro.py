@@ -7,6 +7,8 @@ import numpy as np
 
 from ..hydro.capytaine import (CAPYTAINE_MISSING, capytaine_dataset, capytaine_version, have_capytaine,
                                hull_hydrodynamics, save_capytaine_dataset, to_toml)
+from ..run.progress import Progress, wanted
+from ..scene.campaign import not_radians
 from .common import COMMANDS, EXIT_OK, InputError, load, output_folder
 
 
@@ -20,6 +22,7 @@ def add_parsers(sub):
     hy.add_argument("--netcdf", metavar="OUT.nc",
                     help="also write Capytaine's dataset as Capytaine exports it (NetCDF), for "
                          "[vessel.hydrodynamics] file = ... or other tools")
+    hy.add_argument("--no-progress", action="store_true", help="no progress display on stderr")
 
 
 def cmd_hydro(a):
@@ -41,6 +44,9 @@ def cmd_hydro(a):
             heads = tuple(float(x) for x in a.headings.split(","))
         except ValueError:
             raise InputError(f"--headings: expected comma-separated numbers, got {a.headings!r}") from None
+        bad = not_radians(heads)
+        if bad:
+            raise InputError(f"--headings: {bad}")
     else:
         heads = (scene.waves.heading if scene.waves is not None else 0.0,)
     if not have_capytaine():
@@ -53,7 +59,11 @@ def cmd_hydro(a):
               depth=scene.waves.depth if scene.waves is not None else None, frequencies=tuple(np.linspace(lo, hi, n)),
               headings=heads, panel_size=a.panel_size,
               base_dir=hd.base_dir if hd is not None else os.path.dirname(os.path.abspath(a.scene)))
-    data = hull_hydrodynamics(hull, **kw)
+    bar = Progress(enabled=wanted(a.no_progress))     # Capytaine's solve: per frequency, on stderr
+    try:
+        data = hull_hydrodynamics(hull, progress=bar, **kw)
+    finally:
+        bar.close()
     if a.netcdf:       # the same (cached) solve, as Capytaine's own dataset
         save_capytaine_dataset(capytaine_dataset(hull, **kw), a.netcdf)
         print(f"wrote {a.netcdf}")

@@ -46,8 +46,9 @@ def main(argv=None) -> int:
         # one line, whatever a library's message held (h5py's and the OS's carry newlines)
         print("error: " + " ".join(str(e).split()), file=sys.stderr)
         return EXIT_INPUT
-    except KeyboardInterrupt:
-        print("interrupted", file=sys.stderr)
+    except KeyboardInterrupt as e:
+        # a command that knows what an interruption leaves says it (a campaign: cases done, --resume)
+        print(getattr(e, "report", None) or "interrupted", file=sys.stderr)
         if argv is None:
             sys.stdout.flush()
             sys.stderr.flush()

@@ -11,6 +11,7 @@ from ..analysis.rao import rao
 from ..io.output import OutputError, check_output
 from ..io.rao import RAO_FORMAT, write_rao
 from ..plot.rao import plot_rao
+from ..scene.campaign import not_radians
 from ..scene.types import DOFS
 from .common import COMMANDS, EXIT_OK, InputError, load, output_folder, setup_jax
 
@@ -49,6 +50,9 @@ def parse_headings(text):
         raise InputError(f"--headings: expected comma-separated numbers (rad), got {text!r}") from None
     if not np.all(np.isfinite(heads)):
         raise InputError(f"--headings: must be finite numbers (rad), got {text!r}")
+    bad = not_radians(heads.tolist())
+    if bad:
+        raise InputError(f"--headings: {bad}")
     return heads
 
 

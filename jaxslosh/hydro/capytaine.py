@@ -5,7 +5,6 @@ Capytaine is imported inside the functions that need it: it is optional, and a s
 `capytaine = true` never loads it."""
 from __future__ import annotations
 
-import functools
 import importlib.util
 import inspect
 import logging
@@ -118,10 +117,16 @@ def capytaine_hydrostatics(hull, rho=1025.0, g=9.81, panel_size=None, base_dir="
             "gm_t": bmt + zb - zg, "gm_l": bml + zb - zg, "z_b": zb - zg}
 
 
-@functools.lru_cache(maxsize=16)
-def _capytaine_cached(hull, rho, g, depth, frequencies, headings, panel_size, base_dir):
+#: Capytaine's datasets solved in this process, by hull and settings (the most recent CACHE_SIZE)
+_CACHE: dict = {}
+CACHE_SIZE = 16
+
+
+def _capytaine_solve(hull, rho, g, depth, frequencies, headings, panel_size, base_dir, progress=None):
     """Capytaine's dataset (assemble_dataset) of the hull's radiation at the frequencies and at
-    infinite frequency (A_inf), and its diffraction for the headings, about the COG."""
+    infinite frequency (A_inf), and its diffraction for the headings, about the COG. Solved one
+    frequency at a time (all of its radiation and diffraction problems together, as Capytaine
+    groups them to reuse its matrices), so that `progress` (run/progress.Progress) counts them."""
     cpt = _import_capytaine()
     w = np.asarray(frequencies if frequencies else default_frequencies(), dtype=float)
     body = _box_body(cpt, hull, panel_size, omega_max=w.max()) if hull.type == "box" else \
@@ -131,26 +136,41 @@ def _capytaine_cached(hull, rho, g, depth, frequencies, headings, panel_size, ba
         kw["water_depth"] = depth
     solver = cpt.BEMSolver()
     dofs = list(body.dofs)
-    probs = [cpt.RadiationProblem(body=body, radiating_dof=d, omega=float(x), **kw) for d in dofs for x in w]
-    probs += [cpt.DiffractionProblem(body=body, wave_direction=float(b), omega=float(x), **kw)
-              for b in headings for x in w]
     solve = (lambda ps: solver.solve_all(ps, progress_bar=False)) if _accepts(solver.solve_all, "progress_bar") \
         else solver.solve_all
-    results = solve(probs)
+    if progress is not None:
+        progress.phase("bem", f"Capytaine: {len(dofs) + len(headings)} problems per frequency",
+                       total=w.size + 1, unit="frequency")
+    results = []
+    for m, x in enumerate(w):
+        probs = [cpt.RadiationProblem(body=body, radiating_dof=d, omega=float(x), **kw) for d in dofs]
+        probs += [cpt.DiffractionProblem(body=body, wave_direction=float(b), omega=float(x), **kw) for b in headings]
+        results += solve(probs)
+        if progress is not None:
+            progress.update(m + 1)
     try:
         results += solve([cpt.RadiationProblem(body=body, radiating_dof=d, omega=np.inf, **kw) for d in dofs])
     except Exception:   # noqa: BLE001 - an older Capytaine without infinite frequency: A_inf fitted instead
         pass
+    if progress is not None:
+        progress.update(w.size + 1)
     return cpt.assemble_dataset(results)
 
 
 def capytaine_dataset(hull, rho=1025.0, g=9.81, depth=None, frequencies=None, headings=(), panel_size=None,
-                      base_dir=""):
+                      base_dir="", progress=None):
     """Capytaine's own dataset of the hull (what `capytaine.io.xarray.save_dataset_as_netcdf` saves):
-    cached, one solve per hull and settings in a process."""
-    return _capytaine_cached(hull, float(rho), float(g), None if depth is None else float(depth),
-                             tuple(float(x) for x in frequencies) if frequencies else None,
-                             tuple(float(x) for x in headings), panel_size, base_dir)
+    cached, one solve per hull and settings in a process. `progress`: a run/progress.Progress whose
+    phase counts the frequencies solved (nothing is drawn for a dataset already solved)."""
+    key = (hull, float(rho), float(g), None if depth is None else float(depth),
+           tuple(float(x) for x in frequencies) if frequencies else None, tuple(float(x) for x in headings),
+           panel_size, base_dir)
+    if key not in _CACHE:
+        ds = _capytaine_solve(*key, progress=progress)
+        while len(_CACHE) >= CACHE_SIZE:
+            _CACHE.pop(next(iter(_CACHE)))
+        _CACHE[key] = ds
+    return _CACHE[key]
 
 
 def save_capytaine_dataset(ds, path: str) -> None:
@@ -170,20 +190,23 @@ def _accepts(fn, name):
 
 
 def capytaine_tables(hull, rho=1025.0, g=9.81, depth=None, frequencies=None, headings=(), panel_size=None,
-                     base_dir="") -> Tables:
+                     base_dir="", progress=None) -> Tables:
     """Added mass, damping (n, 6, 6), A_inf and excitation (FK + diffraction) for the headings, from a
     Capytaine BEM solve of the hull's wetted surface (with a lid against irregular frequencies),
     about the COG. Cached: one solve per hull and settings in a process."""
-    return tables_from_dataset(capytaine_dataset(hull, rho, g, depth, frequencies, headings, panel_size, base_dir))
+    return tables_from_dataset(capytaine_dataset(hull, rho, g, depth, frequencies, headings, panel_size, base_dir,
+                                                 progress))
 
 
 def hull_hydrodynamics(hull, *, rho=1025.0, g=9.81, depth=None, frequencies=None, headings=(0.0,),
-                       panel_size=None, base_dir=""):
+                       panel_size=None, base_dir="", progress=None):
     """Hydrostatics and hydrodynamic tables of a hull (scene_types.Hull) from Capytaine, as a dict
     in the form of a scene's `[vessel.hydrostatics]` and `[vessel.hydrodynamics]` tables (see
     `to_toml`): the way to feed a scene without Capytaine at run time."""
+    if progress is not None:
+        progress.phase("hydrostatics", "Capytaine: hydrostatics")
     hs = capytaine_hydrostatics(hull, rho, g, None, base_dir)     # its own fine mesh (no BEM)
-    t = capytaine_tables(hull, rho, g, depth, frequencies, headings, panel_size, base_dir)
+    t = capytaine_tables(hull, rho, g, depth, frequencies, headings, panel_size, base_dir, progress)
     hydro = {"frequencies": t.omega.tolist(), "added_mass": t.added_mass.tolist(), "damping": t.damping.tolist()}
     if t.added_mass_infinite is not None:
         hydro["added_mass_infinite"] = t.added_mass_infinite.tolist()

@@ -228,33 +228,99 @@ def save_netcdf(ds, path: str) -> None:
 # WAMIT
 
 
-def _rows(path, min_cols):
+def _rows(path, cols, what):
+    """[(line number, numbers)] of a WAMIT file: every non-blank line holds `cols` numbers (a pair
+    (min, max) where the count may vary), finite. A line that does not is a DatabaseError naming
+    the file and the line: a file cut in the middle of a line, or not a WAMIT file."""
+    lo, hi = (cols, cols) if isinstance(cols, int) else cols
+    out = []
     try:
         with open(path) as f:
-            lines = [ln.replace("D", "E").replace("d", "e").split() for ln in f if ln.strip()]
-        return [[float(x) for x in ln] for ln in lines if len(ln) >= min_cols]
-    except ValueError as e:
-        raise DatabaseError(f"{path}: not a WAMIT output file ({e})") from None
+            for n, line in enumerate(f, start=1):
+                words = line.replace("D", "E").replace("d", "e").split()
+                if not words:
+                    continue
+                try:
+                    x = [float(w) for w in words]
+                except ValueError:
+                    raise DatabaseError(f"{path}, line {n}: not a WAMIT {what} line ({line.strip()[:60]!r})") from None
+                if not lo <= len(x) <= hi:
+                    want = f"{lo}" if lo == hi else f"{lo} or {hi}"
+                    raise DatabaseError(f"{path}, line {n}: {len(x)} numbers where a WAMIT {what} line has {want} "
+                                        f"(the file is cut, or not a WAMIT file)")
+                if not all(np.isfinite(x)):
+                    raise DatabaseError(f"{path}, line {n}: a value is not finite ({line.strip()[:60]!r})")
+                out.append((n, x))
     except OSError as e:
         raise DatabaseError(f"{path}: cannot be read ({e.strerror})") from None
+    return out
+
+
+def _blocks(path, rows, key, entry, names):
+    """The rows of a WAMIT file grouped into blocks of one period (`key(row)`: the block's key,
+    None for rows outside the check), in file order. Refused, naming the file and the line: a
+    block's entry (`entry(row)`) given twice, a block that lacks entries the others have (a file
+    cut in the middle of a block), a period given in two separate places, finite periods that are
+    not monotone."""
+    blocks: list = []            # [(key, first line, {entry: row})]
+    for n, r in rows:
+        k = key(r)
+        if not blocks or blocks[-1][0] != k:
+            if any(b[0] == k for b in blocks):
+                raise DatabaseError(f"{path}, line {n}: period {k[0]:g} s appears again after other periods: the "
+                                    f"lines of one period belong together")
+            blocks.append((k, n, {}))
+        e = entry(r)
+        if e in blocks[-1][2]:
+            raise DatabaseError(f"{path}, line {n}: {_show_entry(e)} is given twice for period {k[0]:g} s")
+        blocks[-1][2][e] = r
+    union = set().union(*(b[2] for b in blocks)) if blocks else set()
+    for k, n, got in blocks:
+        missing = sorted(union - set(got))
+        if missing:
+            shown = ", ".join(_show_entry(e) for e in missing[:4]) + (", ..." if len(missing) > 4 else "")
+            raise DatabaseError(f"{path}, line {n}: the block of period {k[0]:g} s from this line lacks "
+                                f"{len(missing)} of the {len(union)} {names} the other periods have ({shown}): the "
+                                f"file is cut or incomplete")
+    per = [k[0] for k, _, _ in blocks if k[0] > 0]
+    lines = [n for k, n, _ in blocks if k[0] > 0]
+    if len(per) > 2:
+        up = per[1] > per[0]
+        for a, b, n in zip(per[1:], per[2:], lines[2:]):
+            if (b > a) != up:
+                raise DatabaseError(f"{path}, line {n}: period {b:g} s after {a:g} s: the periods must be monotone "
+                                    f"({'ascending' if up else 'descending'} until this line)")
+    return blocks
+
+
+def _show_entry(e):
+    return "(" + ", ".join(f"{x:g}" for x in e) + ")"
 
 
 def read_wamit(path: str, rho: float, g: float, length: float = 1.0, cog=(0.0, 0.0, 0.0), depth=None) -> Database:
     """WAMIT's `.1` at `path` with the `.3` and `.hst` of the same stem where they exist, made
     dimensional with `rho`, `g` and the length ULEN, moved from WAMIT's origin to the COG at `cog`
-    (its position in WAMIT's coordinates)."""
+    (its position in WAMIT's coordinates). A file cut in the middle of a block, a block missing
+    (I, J) pairs the others have, or periods out of order is refused (DatabaseError, with the line)."""
     stem = os.path.splitext(path)[0]
-    rows = _rows(path, 4)
+    rows = _rows(path, (4, 5), ".1 (PER I J A B)")
     if not rows:
         raise DatabaseError(f"{path}: no coefficients (lines PER I J A B)")
-    per = np.array([r[0] for r in rows])
+    for n, r in rows:
+        if r[0] > 0 and len(r) < 5:
+            raise DatabaseError(f"{path}, line {n}: 4 numbers where a finite period's line has 5 (PER I J A B): "
+                                f"the file is cut, or not a WAMIT .1 file")
+    _blocks(path, rows, lambda r: (r[0],), lambda r: (int(r[1]), int(r[2])), "(I, J) pairs")
+    per = np.array([r[0] for _, r in rows])
     fin = per > 0
     periods = np.unique(per[fin])
+    if periods.size == 0:
+        raise DatabaseError(f"{path}: no finite period (lines PER I J A B with PER > 0)")
     w = np.sort(2 * np.pi / periods)
     n = w.size
     A, B = np.zeros((n, 6, 6)), np.zeros((n, 6, 6))
     Ainf = None
-    for r in rows:
+    for _, r in rows:
         p, i, j = r[0], int(r[1]) - 1, int(r[2]) - 1
         if not (0 <= i < 6 and 0 <= j < 6):
             continue                                   # generalized modes: not ours
@@ -268,13 +334,15 @@ def read_wamit(path: str, rho: float, g: float, length: float = 1.0, cog=(0.0, 0
             B[m, i, j] = r[4] * rho * length ** k * w[m]
     X = heads = None
     if os.path.exists(stem + ".3"):
-        r3 = _rows(stem + ".3", 7)
-        heads_deg = np.unique(np.round([r[1] for r in r3], 9))
+        r3 = [(ln, r) for ln, r in _rows(stem + ".3", 7, ".3 (PER BETA I |X| phase Re Im)") if r[0] > 0]
+        _blocks(stem + ".3", r3, lambda r: (r[0],), lambda r: (r[1], int(r[2])), "(BETA, I) entries")
+        heads_deg = np.unique(np.round([r[1] for _, r in r3], 9))
         heads = np.radians(heads_deg)
+        p3 = np.unique([r[0] for _, r in r3])
+        if p3.size != periods.size or not np.allclose(np.sort(p3), periods, rtol=1e-6):
+            raise DatabaseError(f"{stem}.3: its periods ({p3.size}) are not those of {path} ({periods.size})")
         X = np.zeros((n, heads.size, 6), dtype=complex)
-        for r in r3:
-            if r[0] <= 0:
-                continue
+        for _, r in r3:
             m = int(np.argmin(np.abs(w - 2 * np.pi / r[0])))
             h = int(np.argmin(np.abs(heads_deg - r[1])))
             i = int(r[2]) - 1
@@ -283,7 +351,7 @@ def read_wamit(path: str, rho: float, g: float, length: float = 1.0, cog=(0.0, 0
     C = None
     if os.path.exists(stem + ".hst"):
         C = np.zeros((6, 6))
-        for r in _rows(stem + ".hst", 3):
+        for _, r in _rows(stem + ".hst", 3, ".hst (I J C)"):
             i, j = int(r[0]) - 1, int(r[1]) - 1
             if 0 <= i < 6 and 0 <= j < 6:
                 k = 2 if (i, j) == (2, 2) else (3 if 2 in (i, j) else 4)

@@ -102,12 +102,14 @@ def load_campaign(path) -> Campaign:
     return Campaign(cases, status, stats, freq, spectra, attrs.get("scene", ""), attrs)
 
 
-def write_summary(path, limits: dict, exceedance: dict, operability: float):
-    """The limits a campaign was judged by, each one's exceedance probability and the operability."""
+def write_summary(path, limits: dict, exceedance: dict, operability: float, failed: float = 0.0):
+    """The limits a campaign was judged by, each one's exceedance probability, the operability and
+    the share (%) of the judged weight whose cases failed (counted as not operable, as exceeding)."""
     with _open_for_writing(path) as f:
         f.attrs["limits"] = json.dumps(limits)
         f.attrs["exceedance"] = json.dumps(exceedance)
         f.attrs["operability"] = float(operability)
+        f.attrs["failed_weight"] = float(failed)
 
 
 def file_limits(c: Campaign) -> dict:

@@ -56,7 +56,18 @@ def read_campaign(table, probes: tuple[Probe, ...], waves: Waves | None, simulat
 
 
 def _headings(v):
-    return flat_list(v, "a heading in rad")[1]
+    return flat_list(v, "a heading in rad")[1] or not_radians(v if isinstance(v, list) else [v])
+
+
+def not_radians(headings) -> str | None:
+    """None, or the message for headings beyond 2 pi: degrees typed where radians are asked for
+    (90 would be taken as 90 rad, 14.3 turns)."""
+    big = [h for h in headings if isinstance(h, (int, float)) and abs(h) > 2.0 * math.pi + 1e-9]
+    if not big:
+        return None
+    shown = ", ".join(f"{h:g}" for h in big)
+    return (f"{shown} {'is' if len(big) == 1 else 'are'} beyond 2 pi: headings are in radians "
+            f"({big[0]:g} deg = {math.radians(big[0]):.6g} rad)")
 
 
 def _limits(table, where: str, chans: list[str]) -> tuple[tuple[str, float], ...]:

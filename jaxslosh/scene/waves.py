@@ -17,6 +17,7 @@ import numpy as np
 from ..hydro.box import box_hydrostatics
 from ..hydro.capytaine import CAPYTAINE_MISSING, have_capytaine
 from ..hydro.database import DatabaseError, read_database
+from ..hydro.spectra import wavenumber
 from .fields import at_least, non_negative, one_of, positive, read, show
 from .types import Hull, Hydrodynamics, Hydrostatics, Scene, SceneError, Waves
 
@@ -140,7 +141,7 @@ FILE_TABLES = ("frequencies", "added_mass", "damping", "added_mass_infinite", "h
                "excitation_phase", "capytaine", "panel_size")
 
 
-def _from_file(v: dict, where: str, files: Optional[FileContext], hydrostatics, warnings: list[str]) -> dict:
+def _from_file(v: dict, where: str, files: Optional[FileContext], hydrostatics, hull, warnings: list[str]) -> dict:
     """The tables of `file` (hydro/database.py) as the table's own keys would hold them."""
     for k in FILE_TABLES:
         if k in v:
@@ -164,18 +165,72 @@ def _from_file(v: dict, where: str, files: Optional[FileContext], hydrostatics, 
     if db.rho is not None and abs(db.rho / files.rho - 1) > 1e-9:
         warnings.append(f"{where}.file: the dataset was computed with water density {db.rho:.6g} kg/m^3, the scene "
                         f"has {files.rho:.6g}: its coefficients are used as they are")
-    C = db.stiffness
-    if hydrostatics is not None and C is not None and np.abs(C).max() > 0:
-        rg = files.rho * files.g
-        h = hydrostatics
-        pairs = [("waterplane_area", 2, rg * h.waterplane_area)]
-        if db.point_is_cog:     # roll and pitch restoring depend on the point they are about
-            pairs += [("gm_t", 3, rg * h.displaced_volume * h.gm_t), ("gm_l", 4, rg * h.displaced_volume * h.gm_l)]
-        for key, i, mine in pairs:
-            if abs(C[i, i] - mine) > HULL_MISMATCH_TOLERANCE * abs(mine):
-                warnings.append(f"vessel.hydrostatics.{key} gives C_{i + 1}{i + 1} = {mine:.6g}, the file's hydrostatic "
-                                f"stiffness {C[i, i]:.6g}: the restoring uses the table")
+    _check_database(where, path, db, files, hydrostatics, hull, v.get("length_scale", 1.0), warnings)
     return out
+
+
+#: a database's heave RAO is checked at its lowest frequency where that is a long wave (k L below
+#: this) well below heave resonance (w^2 (m + A_33) below this share of rho g A_w): there its
+#: modulus lies within about 0.75 and 1.4 of the limit 1, and outside RAO_LIMIT_BAND it cannot
+LONG_WAVE_KL, QUASI_STATIC, RAO_LIMIT_BAND = 0.5, 0.25, (0.5, 2.0)
+#: a file's C_33 this far from rho g A_w is not a hull detail: units or a length scale
+GROSS_MISMATCH = (0.5, 2.0)
+
+
+def _check_database(where, path, db, files, hydrostatics, hull, length, warnings):
+    """What a database can be checked against in the scene: its hydrostatic stiffness against the
+    scene's restoring (rho g A_w, rho g V GM about the COG), and its heave RAO at the lowest frequency
+    against the long-wave limit 1. One warning each at most, with the likely cause: for WAMIT's
+    non-dimensional files a length_scale (ULEN) other than the run's, estimated from the ratio."""
+    if hydrostatics is None:
+        return
+    h, rg = hydrostatics, files.rho * files.g
+    wamit = os.path.splitext(path)[1].lower() == ".1"
+    rgA = rg * h.waterplane_area
+
+    def cause(ratio, what):             # ratio: file / scene of a quantity scaling as ULEN^2
+        if wamit:
+            est = length / math.sqrt(ratio)
+            return (f"WAMIT's files are non-dimensional, and the scene reads them with length_scale = {length:g} m: "
+                    f"length_scale = {est:.3g} m would make {what} agree (give the ULEN of the WAMIT run)")
+        return f"the file was computed for another hull, draft or units than the scene's [vessel.hydrostatics]"
+
+    C = db.stiffness
+    gross = False
+    if C is not None and np.abs(C).max() > 0:
+        r33 = C[2, 2] / rgA
+        if r33 > 0 and not GROSS_MISMATCH[0] <= r33 <= GROSS_MISMATCH[1]:
+            gross = True
+            warnings.append(f"{where}.file: the file's hydrostatic stiffness C_33 = {C[2, 2]:.6g} N/m is {r33:.3g} "
+                            f"times the scene's rho g A_w = {rgA:.6g} N/m: {cause(r33, 'them')}")
+        else:
+            pairs = [("waterplane_area", 2, rgA)]
+            if db.point_is_cog:     # roll and pitch restoring depend on the point they are about
+                pairs += [("gm_t", 3, rg * h.displaced_volume * h.gm_t), ("gm_l", 4, rg * h.displaced_volume * h.gm_l)]
+            off = [f"C_{i + 1}{i + 1} {C[i, i]:.6g} against {mine:.6g} ({key})" for key, i, mine in pairs
+                   if abs(C[i, i] - mine) > HULL_MISMATCH_TOLERANCE * abs(mine)]
+            if off:
+                warnings.append(f"{where}.file: the file's hydrostatic stiffness differs from the scene's "
+                                f"[vessel.hydrostatics] by more than {100 * HULL_MISMATCH_TOLERANCE:g} %: "
+                                f"{'; '.join(off)}; the restoring uses [vessel.hydrostatics]")
+    t = db.tables
+    if gross or t.excitation is None or t.added_mass is None or not t.headings.size:
+        return
+    w0 = float(t.omega[0])
+    span = max(hull.length, hull.beam) if hull is not None and hull.type == "box" else 3.5 * math.sqrt(h.waterplane_area)
+    k0 = float(wavenumber(w0, files.g, files.depth))
+    mass = files.rho * h.displaced_volume          # afloat: the whole mass is the displacement's
+    inertia = w0 ** 2 * (mass + t.added_mass[0, 2, 2])
+    if k0 * span > LONG_WAVE_KL or not 0 <= inertia <= QUASI_STATIC * rgA:
+        return                                      # not a long, quasi-static wave: the limit says nothing
+    x3 = np.abs(t.excitation[0, :, 2])
+    H = float(np.median(x3 / np.abs(rgA - inertia + 1j * w0 * t.damping[0, 2, 2])))
+    if not RAO_LIMIT_BAND[0] <= H <= RAO_LIMIT_BAND[1]:
+        ratio = float(np.median(x3)) / rgA
+        warnings.append(f"{where}.file: the heave RAO at the lowest frequency {w0:.4g} rad/s (a long wave: k L = "
+                        f"{k0 * span:.2g}) is {H:.3g} m/m, where it tends to 1; the file's heave excitation "
+                        f"{float(np.median(x3)):.6g} N/m against rho g A_w = {rgA:.6g} N/m: "
+                        + (cause(ratio, "them") if ratio > 0 else "the excitation is zero"))
 
 
 def read_hydrodynamics(table, hull: Optional[Hull], files: Optional[FileContext] = None,
@@ -193,7 +248,7 @@ def read_hydrodynamics(table, hull: Optional[Hull], files: Optional[FileContext]
         if k in v and "file" not in v:
             raise SceneError(f"{where}.{k}", "only goes with `file` (a hydrodynamic database)")
     if "file" in v:
-        v = _from_file(v, where, files, hydrostatics, warnings if warnings is not None else [])
+        v = _from_file(v, where, files, hydrostatics, hull, warnings if warnings is not None else [])
     capy = v.get("capytaine", False)
     out = {"capytaine": capy, "panel_size": v.get("panel_size"), "memory_order": v.get("memory_order", 0),
            "excitation": v.get("excitation", "auto"), "file": v.get("file", ""),
