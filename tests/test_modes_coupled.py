@@ -111,9 +111,14 @@ def test_modes_coupled_command(capsys):
     # the yaw mode: the stabilized element's rotation penalty holds the liquid's absolute rotation, so a
     # yawed tank pulls back (README, Frequency domain)
     assert d["dominant"] == ["yaw", "roll", "pitch", "heave", "liquid"]
+    # issue 31, item 19: that yaw mode is labelled for what it is, by the share of its potential
+    # energy in the penalty (all of it: no hydrostatics acts on yaw); the other modes hold none
+    assert d["label"] == ["liquid rotation penalty (numerical)", "roll", "pitch", "heave", "liquid"]
+    assert abs(d["penalty_share"][0] - 1) < 1e-3 and max(d["penalty_share"][1:]) < 1e-3
     assert main(["modes", str(ROOT / "scenes" / "paper_ship_tank.toml"), "--coupled", "-n", "3"]) == 0
     out = capsys.readouterr().out
     assert "roll" in out and "damping" in out
+    assert "<- liquid rotation penalty (numerical)" in out.splitlines()[2] and "mode 1: liquid rotation penalty" in out
     assert main(["modes", str(ROOT / "scenes" / "paper_ship_tank.toml"), "--coupled", "--tank", "tank"]) == 2
     assert capsys.readouterr().err.count("\n") == 1
 

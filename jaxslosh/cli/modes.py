@@ -4,7 +4,7 @@ from __future__ import annotations
 import json
 import math
 
-from ..analysis.coupled import coupled_modes
+from ..analysis.coupled import PENALTY_LABEL, coupled_modes
 from ..analysis.modes import sloshing_modes, structure_modes
 from .common import COMMANDS, EXIT_OK, InputError, setup_jax, load
 
@@ -84,7 +84,8 @@ def _coupled_modes(scene, a):
                           "damped_omega": [float(w) for w in m.damped],
                           "damping_ratio": [float(z) for z in m.damping_ratio], "dominant": list(m.dominant),
                           "shares": [{k: float(v) for k, v in s.items()} for s in m.shares],
-                          "radiation": list(m.radiation), "not_oscillating": m.not_oscillating}))
+                          "radiation": list(m.radiation), "not_oscillating": m.not_oscillating,
+                          "label": list(m.label), "penalty_share": [float(p) for p in m.penalty_share]}))
         return EXIT_OK
     print("coupled modes (vessel, liquid and structures, linearised about rest; radiation A(w), B(w) at each "
           "mode's frequency where the tables reach it):")
@@ -93,7 +94,11 @@ def _coupled_modes(scene, a):
     for i in range(len(m.omega)):
         w, wd, z, dom = m.omega[i], m.damped[i], m.damping_ratio[i], m.dominant[i]
         print(f"{i + 1:>3} {w:12.5f} {wd:13.5f} {2 * math.pi / wd:10.4f} {z:9.5f}  {dom:<18} {m.shares[i][dom]:6.3f}  "
-              f"{m.radiation[i]}")
+              f"{m.radiation[i]}" + (f"  <- {m.label[i]}" if m.label[i] != dom else ""))
+    for i in (i for i, lb in enumerate(m.label) if lb == PENALTY_LABEL):
+        print(f"(mode {i + 1}: {PENALTY_LABEL}: {m.penalty_share[i]:.1%} of its potential energy is the liquid "
+              f"element's rotation penalty, which holds the liquid's absolute rotation; an inviscid liquid has no "
+              f"such stiffness: a numerical mode of the element, not one of the ship)")
     if m.not_oscillating:
         print(f"({m.not_oscillating} non-oscillating modes left out: rigid-body modes without restoring, such as "
               f"surge and sway, or overdamped ones)")
