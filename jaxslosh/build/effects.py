@@ -3,7 +3,9 @@ calls for: the model is assembled from the scene, so an effect the scene lacks, 
 `[effects]`, is never traced) and its unknowns."""
 from __future__ import annotations
 
-from ..fem.shapes import free_count
+import numpy as np
+
+from ..fem.shapes import free_count, grid_counts, read_mesh, tank_mesh
 from ..fem.walls import shell_mesh
 from ..hydro.source import excitation_source
 from ..scene.types import EFFECTS, Scene
@@ -19,11 +21,10 @@ def describe(scene: Scene) -> str:
              if h is not None else "no hydrostatics (free body)")
     lines.append(f"vessel: mass {ves.mass:.4g} kg, inertia diagonal [{diag}] kg m^2; {hydro}")
     for t in scene.tanks:
-        nx, ny, nz = t.mesh
         walls = t.walls if t.wall_spec is None else f"elastic, {t.wall_spec.thickness:g} m thick"
         lines.append(f"tank {t.name!r}: {shape_words(t)}{t.size[0]:g} x {t.size[1]:g} x {t.size[2]:g} m filled to "
                      f"{t.fill_depth:g} m, liquid {t.liquid_mass:.4g} kg ({t.liquid_volume:.4g} m^3), "
-                     f"mesh {nx} x {ny} x {nz} = {nx * ny * nz} hexahedra, walls {walls}")
+                     f"{mesh_words(t)}, walls {walls}")
     for s in scene.structures:
         nx, ny, nz = s.mesh
         mass = s.material.density * s.size[0] * s.size[1] * s.size[2]
@@ -59,7 +60,7 @@ def scene_effects(scene: Scene) -> list[tuple[str, str]]:
     liquid = bool(scene.tanks) and e.liquid
     if liquid:
         for t in scene.tanks:
-            eff.append((f"liquid in tank {t.name!r}", f"{shape_words(t)}{t.mesh[0]}x{t.mesh[1]}x{t.mesh[2]} hexahedra, "
+            eff.append((f"liquid in tank {t.name!r}", f"{shape_words(t)}{mesh_words(t, short=True)}, "
                         f"{t.liquid_mass:.6g} kg, element {t.fluid.element!r}, {t.walls} walls (slip)"))
             if t.damping is not None:
                 d = t.damping
@@ -146,6 +147,52 @@ def _wave_effects(scene: Scene) -> list[tuple[str, str]]:
 
 def switched_off(scene: Scene) -> list[str]:
     return [k for k in EFFECTS if not getattr(scene.effects, k)]
+
+
+def mesh_words(t, short: bool = False) -> str:
+    """"mesh 5 x 5 x 5 = 125 hexahedra" (a grid, of any shape, or a mesh file that is one), or
+    "mesh file of 12 hexahedra on 30 nodes" (a mesh tank's file that is not a grid: its counts
+    along x, y, z mean nothing)."""
+    nx, ny, nz = t.mesh
+    if t.shape == "mesh":
+        try:
+            nodes, elements = read_mesh(t.file)
+        except (OSError, ValueError):
+            nodes = elements = None
+        if elements is not None and grid_counts(nodes, elements) is None:
+            return f"mesh file of {len(elements)} hexahedra on {len(nodes)} nodes"
+    return f"{nx}x{ny}x{nz} hexahedra" if short else f"mesh {nx} x {ny} x {nz} = {nx * ny * nz} hexahedra"
+
+
+#: a horizontal cylinder's surface elements this many times taller than wide (a nearly full tank:
+#: its free surface a narrow strip) carry no sloshing mode the mesh resolves: `check` says so
+SLIVER_ASPECT = 8.0
+
+
+def tank_notes(scene: Scene) -> list[str]:
+    """Notes on tanks whose mesh cannot resolve what the scene asks of it (printed by `check`)."""
+    out = []
+    for i, t in enumerate(scene.tanks):
+        if t.shape != "cylinder" or t.axis == "z":
+            continue
+        tm = tank_mesh(t.geometry, t.fill_depth, tuple(t.mesh))
+        top = np.isclose(tm.nodes[:, 2], tm.depth)
+        E = tm.elements[top[tm.elements].sum(axis=1) >= 4]         # the elements under the free surface
+        if not len(E):
+            continue
+        across = 1 if t.axis == "x" else 0
+        X = tm.nodes[E]
+        height = np.ptp(X[:, :, 2], axis=1)
+        width = np.array([np.ptp(x[np.isclose(x[:, 2], tm.depth), across]) for x in X])
+        aspect = float(np.max(height / np.maximum(width, 1e-300)))
+        if aspect > SLIVER_ASPECT:
+            D = t.size[2]
+            w = float(np.ptp(tm.nodes[top, across]))
+            out.append(f"note: tanks[{i}] ({t.name!r}): the horizontal cylinder is nearly full ({t.fill_depth:g} of "
+                       f"{D:g} m): its free surface is a strip {w:.3g} m wide ({100 * w / D:.2g} % of the diameter), "
+                       f"over elements {aspect:.0f} times taller than wide, which resolve no sloshing mode: the "
+                       f"lowest modes found there (`jaxslosh modes`) are spurious")
+    return out
 
 
 def shape_words(t) -> str:
