@@ -209,3 +209,36 @@ def test_the_shipped_anti_roll_tank_runs_without_a_warning(tmp_path, capsys):
     assert "warning" not in capsys.readouterr().err
     a, _ = attrs(out)
     assert len(np.atleast_1d(a.get("warnings", []))) == 0
+
+
+def test_every_dataset_carries_its_units_and_time_is_counted_in_steps(tmp_path, capsys):
+    """Issue 31, item 18: each dataset of a result file has a `units` attribute (UDUNITS strings that
+    xarray and ParaView users read), the RAO file's too; the time of frame k is k dt exactly (2000
+    steps of 0.01 s end at 20.0, not 20.000000000000327 as a running sum of dt gave)."""
+    from jaxslosh.cli import main
+    from jaxslosh.io.rao import write_rao
+    text = open(PAPER).read().replace("mesh = [5, 5, 5]", "mesh = [2, 2, 2]")
+    scene = tmp_path / "s.toml"
+    scene.write_text(text)
+    out = str(tmp_path / "r.h5")
+    assert main(["run", str(scene), "-o", out, "--no-progress"]) == 0
+    expect = {"time": "s", "vessel/position": "m", "vessel/quaternion": "1", "vessel/angular_velocity": "rad/s",
+              "vessel/roll_pitch_yaw": "rad", "energy/kinetic": "J", "energy/potential": "J",
+              "solver/iterations": "1", "solver/residual": "m/s^2", "probes/A/position": "m",
+              "probes/B/displacement": "m", "tanks/tank/displacement": "m", "tanks/tank/nodes": "m",
+              "tanks/tank/elements": "1"}
+    seen = []
+    with h5py.File(out, "r") as f:
+        f.visititems(lambda k, v: seen.append(k) if isinstance(v, h5py.Dataset) else None)
+        for k in seen:
+            assert "units" in f[k].attrs, k
+        for k, u in expect.items():
+            assert f[k].attrs["units"] == u, (k, f[k].attrs["units"])
+        t = f["time"][:]
+    assert t.size == 2001 and t[-1] == 20.0 and np.array_equal(t, np.arange(2001) * 0.01)
+    rao = str(tmp_path / "rao.h5")
+    write_rao(rao, [0.5, 1.0], [0.0], np.zeros((2, 1, 6), complex), {"A": np.zeros((2, 1, 3), complex)})
+    with h5py.File(rao, "r") as f:
+        assert f["frequency"].attrs["units"] == "rad/s" and f["heading"].attrs["units"] == "rad"
+        assert f["rao/vessel"].attrs["units"] == "m/m, m/m, m/m, rad/m, rad/m, rad/m"
+        assert f["rao/probes/A"].attrs["units"] == "m/m"
