@@ -72,7 +72,8 @@ class Watch:
                            f"below the floor ({t.fill_depth:.3g} m deep): the linear liquid is outside its validity")
         tol = self.scene.simulation.tolerance
         if self.residual > RESIDUAL_FACTOR * self.level:
-            floor = "" if self.level <= tol else f" and the round-off floor {self.level:.3g} of the liquid's displacement"
+            floor = "" if self.level <= tol else \
+                f" and the round-off floor {self.level:.3g} of the liquid's displacement"
             out.append(f"the Newton residual reached {self.residual:.3g} at t = {self.t_residual:.4g} s, "
                        f"{self.residual / self.level:.3g} times what the iterations aim at (the tolerance {tol:.3g}"
                        f"{floor}): they stalled there, and the steps near that time are less accurate than asked "
