@@ -1,4 +1,4 @@
-"""The liquid damping's validation figures (README "Validation"): the logarithmic decrement of a
+"""The liquid damping's validation figures (docs/validation.md): the logarithmic decrement of a
 free decay of the first sloshing mode against 2 pi zeta / sqrt(1 - zeta^2), and the laminar
 boundary-layer ratio against the rectangular tank's closed form (fem/damping.py).
 

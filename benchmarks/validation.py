@@ -1,4 +1,4 @@
-"""Print the validation table of the README: what was checked against what, with measured numbers.
+"""Print the validation tables (docs/validation.md): what was checked against what, with measured numbers.
 
     python benchmarks/validation.py
 

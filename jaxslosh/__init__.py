@@ -7,13 +7,13 @@ sloshing" (2013). Entry points switch on float64 (`jax_enable_x64`); a library u
     import jaxslosh as js
     result = js.simulate(js.load_scene("scenes/paper_ship_tank.toml"))
 
-The package's layers, lowest first (README "Design"): scene/ (TOML to a Scene), fem/ and hydro/
+The package's layers, lowest first (docs/design.md): scene/ (TOML to a Scene), fem/ and hydro/
 (host-side models), physics/ (traced terms), solve/ (schemes, Newton, linear solvers), build/
 (scene to System), run/ (time loop), io/ (files), analysis/, campaign/, fit/, plot/, cli/.
 
 The public names below are imported on first use (PEP 562): `import jaxslosh` stays light, and a
 command such as `jaxslosh run` loads neither Dask nor SciPy's signal and statistics modules, which
-only campaigns and fits need (a second run of a scene starts in seconds: README "Compilation").
+only campaigns and fits need (a second run of a scene starts in seconds: docs/guide/compilation-cache.md).
 """
 from importlib import import_module
 
@@ -35,7 +35,7 @@ __all__ = [*_PUBLIC, "campaign", "__version__"]
 
 
 def campaign(*args, **kwargs):
-    """`js.campaign`: jaxslosh.campaign.run.campaign (README "Campaigns"), imported on first call
+    """`js.campaign`: jaxslosh.campaign.run.campaign (docs/guide/campaigns.md), imported on first call
     (it loads Dask)."""
     return import_module(".campaign.run", __name__).campaign(*args, **kwargs)
 

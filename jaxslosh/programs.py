@@ -46,13 +46,16 @@ from jax.experimental import serialize_executable
 from . import executables
 from .executables import Load, loadable, read, take, touch, write_bytes
 
+_JAXLIB = tuple(int(p) for p in jax.lib.__version__.split(".")[:2] if p.isdigit())
+
 #: XLA options of the run's programs compiled ahead of time (run/compiled.py: `jaxslosh run`, and
 #: `js.simulate` called outside any transformation; JAX takes options only for a top-level jit, so
 #: js.simulate inside a user's jit keeps XLA's defaults, and agrees to round-off). XLA's classic CPU
 #: loop emitters compile the step's many small fusions in 30-40 % less time than its default fusion
 #: emitters, and the step runs as fast (README "Compilation"). A field of XLA's shared debug options:
-#: other backends accept it and leave it unused.
-XLA_OPTIONS = {"xla_cpu_use_fusion_emitters": False}
+#: other backends accept it and leave it unused. jaxlib 0.11 removed the field (its CPU backend has
+#: only the fusion emitters left) and refuses every compilation that names it: no options there.
+XLA_OPTIONS = {"xla_cpu_use_fusion_emitters": False} if _JAXLIB < (0, 11) else {}
 #: XLA options of a program that runs once (the run's initial state): its optimisation off, which
 #: halves its XLA work, while it still runs in less time than a few steps (README "Compilation")
 START_OPTIONS = {**XLA_OPTIONS, "xla_backend_optimization_level": 0}

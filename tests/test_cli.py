@@ -194,7 +194,10 @@ def test_check_describes_a_mesh_file_by_its_counts_and_notes_a_nearly_full_horiz
            'axis = "x"\nfill_depth = {fill}\nmesh = [5, 6, 6]\n')
     assert main(["check", _write(tmp_path, GOOD + cyl.format(fill=2.999))]) == 0
     out = capsys.readouterr().out
-    notes = [line for line in out.splitlines() if line.startswith("note:")]
-    assert len(notes) == 1 and "tanks[0] ('cyl')" in notes[0] and "0.11 m wide" in notes[0] and "spurious" in notes[0]
+    lines = out.splitlines()
+    notes = [i for i, line in enumerate(lines) if line.strip().startswith("note:")]
+    assert len(notes) == 1 and lines[notes[0] - 1].startswith("tank 'cyl'")     # under its tank
+    assert "nearly full (2.999 of 3 m)" in lines[notes[0]] and "0.11 m wide" in lines[notes[0]]
+    assert "spurious" in lines[notes[0]]
     assert main(["check", _write(tmp_path, GOOD + cyl.format(fill=2.5))]) == 0
     assert "note:" not in capsys.readouterr().out

@@ -3,8 +3,11 @@ calls for: the model is assembled from the scene, so an effect the scene lacks, 
 `[effects]`, is never traced) and its unknowns."""
 from __future__ import annotations
 
+import os
+
 import numpy as np
 
+from ..fem.meshfile import read_mesh_file
 from ..fem.shapes import free_count, grid_counts, read_mesh, tank_mesh
 from ..fem.walls import shell_mesh
 from ..hydro.source import excitation_source
@@ -25,6 +28,7 @@ def describe(scene: Scene) -> str:
         lines.append(f"tank {t.name!r}: {shape_words(t)}{t.size[0]:g} x {t.size[1]:g} x {t.size[2]:g} m filled to "
                      f"{t.fill_depth:g} m, liquid {t.liquid_mass:.4g} kg ({t.liquid_volume:.4g} m^3), "
                      f"{mesh_words(t)}, walls {walls}")
+        lines += tank_notes(t)
     for s in scene.structures:
         nx, ny, nz = s.mesh
         mass = s.material.density * s.size[0] * s.size[1] * s.size[2]
@@ -50,8 +54,16 @@ def scene_effects(scene: Scene) -> list[tuple[str, str]]:
         if f.profile == "spin-up":
             eff.append(("prescribed motion", f"{f.dof} rate spun up to {f.rate:g} rad/s over {f.duration:g} s, "
                                              "other rigid dofs held"))
+        elif f.profile == "record":
+            dofs = ", ".join(name for name, _ in f.columns)
+            eff.append(("prescribed motion", f"{dofs} from {os.path.basename(f.file)} ({len(f.times)} samples, t = "
+                                             f"{f.times[0]:g} to {f.times[-1]:g} s) by a natural cubic spline "
+                                             f"(continuous acceleration), other rigid dofs held"))
         else:
-            eff.append(("prescribed motion", f"{f.dof} = {f.amplitude:g} sin({f.frequency:g} t), other rigid dofs held"))
+            phase = f" + {f.phase:g}" if f.phase else ""
+            ramp = f", faded in over {f.ramp:g} s" if f.ramp else ""
+            eff.append(("prescribed motion", f"{f.dof} = {f.amplitude:g} sin({f.frequency:g} t{phase}){ramp}, "
+                                             f"other rigid dofs held"))
     if scene.vessel.hydrostatics is not None and e.buoyancy:
         eff.append(("buoyancy", "restoring force and moments of eqs. (33)-(36), "
                                 f"moment form {scene.vessel.hydrostatics.moment!r}"))
@@ -169,30 +181,28 @@ def mesh_words(t, short: bool = False) -> str:
 SLIVER_ASPECT = 8.0
 
 
-def tank_notes(scene: Scene) -> list[str]:
-    """Notes on tanks whose mesh cannot resolve what the scene asks of it (printed by `check`)."""
-    out = []
-    for i, t in enumerate(scene.tanks):
-        if t.shape != "cylinder" or t.axis == "z":
-            continue
-        tm = tank_mesh(t.geometry, t.fill_depth, tuple(t.mesh))
-        top = np.isclose(tm.nodes[:, 2], tm.depth)
-        E = tm.elements[top[tm.elements].sum(axis=1) >= 4]         # the elements under the free surface
-        if not len(E):
-            continue
-        across = 1 if t.axis == "x" else 0
-        X = tm.nodes[E]
-        height = np.ptp(X[:, :, 2], axis=1)
-        width = np.array([np.ptp(x[np.isclose(x[:, 2], tm.depth), across]) for x in X])
-        aspect = float(np.max(height / np.maximum(width, 1e-300)))
-        if aspect > SLIVER_ASPECT:
-            D = t.size[2]
-            w = float(np.ptp(tm.nodes[top, across]))
-            out.append(f"note: tanks[{i}] ({t.name!r}): the horizontal cylinder is nearly full ({t.fill_depth:g} of "
-                       f"{D:g} m): its free surface is a strip {w:.3g} m wide ({100 * w / D:.2g} % of the diameter), "
-                       f"over elements {aspect:.0f} times taller than wide, which resolve no sloshing mode: the "
-                       f"lowest modes found there (`jaxslosh modes`) are spurious")
-    return out
+def sliver_note(t) -> list[str]:
+    """A note on a horizontal cylinder filled so near its top that its mesh resolves no sloshing."""
+    if t.shape != "cylinder" or t.axis == "z":
+        return []
+    tm = tank_mesh(t.geometry, t.fill_depth, tuple(t.mesh))
+    top = np.isclose(tm.nodes[:, 2], tm.depth)
+    E = tm.elements[top[tm.elements].sum(axis=1) >= 4]             # the elements under the free surface
+    if not len(E):
+        return []
+    across = 1 if t.axis == "x" else 0
+    X = tm.nodes[E]
+    height = np.ptp(X[:, :, 2], axis=1)
+    width = np.array([np.ptp(x[np.isclose(x[:, 2], tm.depth), across]) for x in X])
+    aspect = float(np.max(height / np.maximum(width, 1e-300)))
+    if aspect <= SLIVER_ASPECT:
+        return []
+    D = t.size[2]
+    w = float(np.ptp(tm.nodes[top, across]))
+    return [f"  note: the horizontal cylinder is nearly full ({t.fill_depth:g} of {D:g} m): its free surface is a "
+            f"strip {w:.3g} m wide ({100 * w / D:.2g} % of the diameter), over elements {aspect:.0f} times taller "
+            f"than wide, which resolve no sloshing mode: the lowest modes found there (`jaxslosh modes`) are "
+            f"spurious"]
 
 
 def shape_words(t) -> str:
@@ -210,6 +220,27 @@ def shape_words(t) -> str:
     if t.baffles:
         words += f" with {len(t.baffles)} baffle{'s' if len(t.baffles) > 1 else ''}"
     return words + ", "
+
+
+def tank_notes(t) -> list[str]:
+    """Indented lines under a tank: each baffle as the model reads it (its plane, side and edge), a
+    nearly full horizontal cylinder's unresolved free surface (sliver_note), and how many hexahedra
+    of a mesh file were re-oriented (numbered left-handed in the file)."""
+    out = []
+    H = t.size[2]
+    for i, b in enumerate(t.baffles):
+        edge = b.height if b.mount == "bottom" else H - b.height
+        side = ("standing on the bottom, its upper edge" if b.mount == "bottom"
+                else "hanging from the roof, its lower edge")
+        out.append(f"  baffle {i}: the plane {b.normal} = {b.at:g} m from the tank's origin, {side} {edge:g} m above "
+                   f"the tank bottom ({b.height:g} m of plate)")
+    out += sliver_note(t)
+    if t.shape == "mesh":
+        m = read_mesh_file(t.file)
+        if m.reoriented:
+            out.append(f"  note: {m.reoriented} of the {len(m.elements)} hexahedra in {os.path.basename(t.file)} are "
+                       f"numbered left-handed (inverted) in the file; they are re-oriented")
+    return out
 
 
 def free_liquid_dofs(tank) -> int:

@@ -18,7 +18,8 @@ from ..physics.kinematics import quat_from_rpy, rotation_matrix
 from ..physics.liquid import RotationPenalty, SpinStiffening
 from ..physics.system import System
 from ..physics.terms import Config
-from ..physics.vessel import FreeMotion, Hydrostatics, PrescribedMotion, RigidBody, Weight
+from ..physics.vessel import (FreeMotion, HarmonicMotion, Hydrostatics, RecordedMotion, RigidBody, SpinUpMotion,
+                              Weight, record_coefficients)
 from ..programs import staged
 from ..scene.keys import resolve_params
 from ..scene.types import DOFS, Scene, SceneError
@@ -71,15 +72,12 @@ def build(scene: Scene, params: Optional[dict] = None) -> Built:
         if block.liquid.nf else block.liquid
     motion = FreeMotion()
     if ves.forced is not None:
-        f = ves.forced
-        motion = PrescribedMotion(dof=DOFS.index(f.dof), amplitude=jnp.asarray(f.amplitude, dtype=float),
-                                  frequency=jnp.asarray(f.frequency, dtype=float), ramp=float(f.ramp),
-                                  profile=f.profile, rate=float(f.rate),
-                                  duration=float(f.duration) if f.duration else 1.0)
+        motion = _prescribed(ves.forced)
     ini = ves.initial
     q0 = _quat_from_rpy(jnp.asarray(P("vessel.initial.roll_pitch_yaw", ini.roll_pitch_yaw), dtype=float))
-    if motion.prescribed:
-        q0 = jnp.array([1.0, 0.0, 0.0, 0.0])
+    if motion.prescribed:     # the prescribed attitude at t = 0 (upright unless a phase or a record tilts it)
+        x0 = motion.coordinates(jnp.zeros(()))
+        q0 = _quat_from_rpy(x0[3:])
     sea_terms, memory = build_seakeeping(scene, params) if scene.waves is not None or ves.hydrodynamics is not None \
         else ((), None)
     terms += sea_terms
@@ -113,7 +111,7 @@ def build(scene: Scene, params: Optional[dict] = None) -> Built:
                           jnp.asarray(P("vessel.initial.angular_velocity", ini.angular_velocity), dtype=float),
                           jnp.zeros(nf)])
     if motion.prescribed:   # the prescribed motion sets the rigid state at t = 0
-        c0 = Config(jnp.zeros(3), q0, c0.d)
+        c0 = Config(x0[:3], q0, c0.d)
         v0 = v0.at[:6].set(motion.rates(jnp.zeros(())))
     alg0 = None
     if flex is not None:
@@ -123,6 +121,17 @@ def build(scene: Scene, params: Optional[dict] = None) -> Built:
     surfaces = tuple(jnp.asarray(t.node_offset + np.flatnonzero(np.isclose(t.nodes[:, 2], t.nodes[:, 2].max())))
                      for t in block.tanks)
     return Built(system, c0, v0, probes, block.tanks, alg0, blocks, surfaces)
+
+
+def _prescribed(f):
+    """The motion of a `[vessel.forced]` table: one dof's profile, or a record's spline."""
+    if f.profile == "record":
+        knots, coef = record_coefficients(f.times, f.columns, DOFS)
+        return RecordedMotion(knots=jnp.asarray(knots), coef=jnp.asarray(coef))
+    if f.profile == "spin-up":
+        return SpinUpMotion(dof=DOFS.index(f.dof), rate=float(f.rate), duration=float(f.duration))
+    return HarmonicMotion(dof=DOFS.index(f.dof), amplitude=jnp.asarray(f.amplitude, dtype=float),
+                          frequency=jnp.asarray(f.frequency, dtype=float), ramp=float(f.ramp), phase=float(f.phase))
 
 
 def _hull(mass, inertia, parts):

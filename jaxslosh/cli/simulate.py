@@ -7,7 +7,7 @@ import sys
 
 from ..build.cost import check_cost, describe_cost, estimate
 from ..build.damping import describe_damping
-from ..build.effects import describe, effects_summary, tank_notes
+from ..build.effects import describe, effects_summary
 from ..io.output import OutputError
 from ..io.status import Status
 from ..run.progress import wanted
@@ -72,8 +72,6 @@ def timing(times: dict) -> str:
 def cmd_check(a):
     scene = load(a.scene)
     print(describe(scene))
-    for line in tank_notes(scene):
-        print(line)
     for line in describe_damping(scene):
         print(line)
     print(effects_summary(scene))

@@ -60,7 +60,7 @@ import jax
 import jax.numpy as jnp
 import numpy as np
 
-from ..programs import lower_program, no_eager_folding
+from ..programs import XLA_OPTIONS, lower_program, no_eager_folding
 from .linalg import det2, det3, inv3
 from .mesh import GAUSS8, GAUSS_1D, HEX_CORNERS
 
@@ -167,7 +167,7 @@ def _kernel_compiler_options():
     which run once per build; None elsewhere (the options are the CPU backend's)."""
     if jax.default_backend() != "cpu":
         return None
-    return {"xla_backend_optimization_level": 0, "xla_cpu_use_fusion_emitters": False}
+    return {"xla_backend_optimization_level": 0, **XLA_OPTIONS}
 
 
 def _kernels(form):

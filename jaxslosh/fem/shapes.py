@@ -29,13 +29,13 @@ NumPy only (the scene loader uses it to check shapes and to compute their volume
 from __future__ import annotations
 
 import functools
-import os
 from dataclasses import dataclass
 from typing import NamedTuple, Optional
 
 import numpy as np
 
 from .mesh import HEX_CORNERS, box_elements, grid_index, grid_nodes
+from .meshfile import read_mesh_file
 from .slip import boundary
 
 SHAPES = ("box", "prismatic", "cylinder", "mesh")
@@ -361,46 +361,10 @@ def _merge_coincident(nodes, elements, n_grid=None):
 
 
 def read_mesh(path):
-    """(nodes, elements) of the hexahedra of a mesh file (meshio), oriented positively. Read once per
-    file version (the loader, the volume, the build and `check` all ask); shared arrays: read only."""
-    try:
-        st = os.stat(path)
-    except OSError as e:
-        raise ValueError(f"cannot read the mesh file {path!r}: {e}") from e
-    return _read_mesh(str(path), st.st_mtime_ns, st.st_size)
-
-
-@functools.lru_cache(maxsize=8)
-def _read_mesh(path, mtime_ns, size):
-    try:
-        import meshio
-    except ImportError as e:                        # an optional dependency: say how to get it
-        raise ValueError("reading a tank mesh needs meshio: pip install meshio") from e
-    try:
-        m = meshio.read(path)
-    except Exception as e:                           # meshio raises many kinds; the message names the file
-        raise ValueError(f"cannot read the mesh file {path!r}: {e}") from e
-    hexes = [c.data for c in m.cells if c.type == "hexahedron"]
-    other = sorted({c.type for c in m.cells if c.type in ("tetra", "wedge", "pyramid", "hexahedron20",
-                                                          "hexahedron27", "tetra10")})
-    if not hexes:
-        raise ValueError(f"the mesh file {path!r} holds no 8-node hexahedra" + (f" (it has {other})" if other else ""))
-    if other:
-        raise ValueError(f"the mesh file {path!r} mixes hexahedra with {other}: give 8-node hexahedra only")
-    elements = np.concatenate(hexes).astype(int)
-    nodes = np.asarray(m.points, dtype=float)
-    if nodes.shape[1] == 2:
-        raise ValueError(f"the mesh file {path!r} is two-dimensional")
-    used = np.unique(elements)
-    remap = np.full(nodes.shape[0], -1)
-    remap[used] = np.arange(used.size)
-    nodes, elements = nodes[used], remap[elements]
-    vol = _jacobian_det(nodes[elements], np.zeros(3))
-    flip = vol < 0
-    elements[flip] = elements[flip][:, [0, 3, 2, 1, 4, 7, 6, 5]]
-    if np.any(np.abs(vol) <= 1e-14 * np.abs(vol).max()):
-        raise ValueError(f"the mesh file {path!r} has degenerate hexahedra (zero volume)")
-    return nodes, elements
+    """(nodes, elements) of the hexahedra of a mesh file (meshio), checked and oriented positively
+    (fem/meshfile.py); shared arrays: read only."""
+    m = read_mesh_file(path)
+    return m.nodes, m.elements
 
 
 def grid_counts(nodes, elements):

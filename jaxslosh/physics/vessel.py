@@ -146,41 +146,87 @@ class FreeMotion(AbstractMotion):
         return rows
 
 
-class PrescribedMotion(AbstractMotion):
-    """Prescribed motion of one rigid dof (the others held at zero): the rigid rows prescribe the
-    accelerations, scaled by the rigid masses like the free rows. "harmonic": amplitude
-    sin(frequency t) faded in over `ramp` by `smooth_ramp` (C2: no jump in the acceleration);
-    "spin-up": a rate growing smoothly to `rate` over `duration`."""
+class AbstractPrescribedMotion(AbstractMotion):
+    """A hull whose six rigid coordinates are given functions of time: the rigid rows prescribe their
+    accelerations, scaled by the rigid masses like the free rows; positions and velocities follow by
+    the scheme from the prescribed initial state. The coordinates are surge, sway, heave (the COG's
+    inertial position, m) and roll, pitch, yaw (Z-Y-X angles, rad); the body angular velocity is
+    their rates turned into the body frame."""
+    prescribed = True
+
+    @abc.abstractmethod
+    def coordinates(self, t):
+        """(6,) surge, sway, heave, roll, pitch, yaw at time t."""
+
+    def rates(self, t):
+        """Prescribed (dX0/dt inertial, omega body) at time t: omega = E(roll, pitch) (roll, pitch,
+        yaw)' for A = Rz(yaw) Ry(pitch) Rx(roll); one angle alone gives its own rate exactly."""
+        x, v = jax.jvp(self.coordinates, (t,), (jnp.ones_like(t),))
+        phi, theta = x[3], x[4]
+        dphi, dtheta, dpsi = v[3], v[4], v[5]
+        sp, cp, st, ct = jnp.sin(phi), jnp.cos(phi), jnp.sin(theta), jnp.cos(theta)
+        omega = jnp.stack([dphi - dpsi * st, dtheta * cp + dpsi * ct * sp, -dtheta * sp + dpsi * ct * cp])
+        return jnp.concatenate([v[:3], omega])
+
+    def accelerations(self, t):
+        """(d2X0/dt2, d omega/dt) at time t: the time derivative of `rates`."""
+        return jax.jvp(self.rates, (t,), (jnp.ones_like(t),))[1]
+
+    def rigid_rows(self, rows, a6, t, scale):
+        return scale() * (a6 - self.accelerations(t))
+
+
+class HarmonicMotion(AbstractPrescribedMotion):
+    """One rigid dof at amplitude sin(frequency t + phase), faded in over `ramp` by `smooth_ramp`
+    (C2: no jump in the acceleration); the others held at zero."""
     dof: int = eqx.field(static=True)      # 0-2 surge, sway, heave; 3-5 roll, pitch, yaw
     amplitude: jax.Array
     frequency: jax.Array
     ramp: float = eqx.field(static=True, default=0.0)
-    profile: str = eqx.field(static=True, default="harmonic")
-    rate: float = eqx.field(static=True, default=0.0)      # spin-up: final rate, rad/s
-    duration: float = eqx.field(static=True, default=1.0)  # spin-up: its time, s
-    prescribed = True
+    phase: float = eqx.field(static=True, default=0.0)     # rad
 
-    def value(self, t):
-        if self.profile == "spin-up":
-            T, W = self.duration, self.rate
-            c = T / (2.0 * jnp.pi)
-            up = W / T * (0.5 * t * t + c * c * (jnp.cos(t / c) - 1.0))
-            return jnp.where(t < T, up, W * (0.5 * T) + W * (t - T))
-        x = self.amplitude * jnp.sin(self.frequency * t)
+    def coordinates(self, t):
+        x = self.amplitude * jnp.sin(self.frequency * t + self.phase)
         if self.ramp > 0:
             x = x * smooth_ramp(t / self.ramp)
-        return x
+        return jnp.zeros(6).at[self.dof].set(x)
 
-    def rates(self, t):
-        """Prescribed (dX0/dt, omega) at time t."""
-        v = jax.jvp(self.value, (t,), (jnp.ones_like(t),))[1]
-        return jnp.zeros(6).at[self.dof].set(v)
 
-    def accelerations(self, t):
-        a = jax.jvp(lambda tt: jax.jvp(self.value, (tt,), (jnp.ones_like(tt),))[1], (t,), (jnp.ones_like(t),))[1]
-        return jnp.zeros(6).at[self.dof].set(a)
+class SpinUpMotion(AbstractPrescribedMotion):
+    """One rotation whose rate grows smoothly to `rate` over `duration` (rate r(t / duration), the
+    harmonic form's ramp), then stays: the Kane-Ryan-Banerjee hub; the others held at zero."""
+    dof: int = eqx.field(static=True)      # 3-5 roll, pitch, yaw
+    rate: float = eqx.field(static=True)   # final rate, rad/s
+    duration: float = eqx.field(static=True)   # its time, s
 
-    def rigid_rows(self, rows, a6, t, scale):
-        """The prescribed accelerations (a single-axis rotation has omega_dot = theta_ddot e);
-        positions and velocities follow by the scheme from the prescribed initial rates."""
-        return scale() * (a6 - self.accelerations(t))
+    def coordinates(self, t):
+        T, W = self.duration, self.rate
+        c = T / (2.0 * jnp.pi)
+        up = W / T * (0.5 * t * t + c * c * (jnp.cos(t / c) - 1.0))
+        return jnp.zeros(6).at[self.dof].set(jnp.where(t < T, up, W * (0.5 * T) + W * (t - T)))
+
+
+class RecordedMotion(AbstractPrescribedMotion):
+    """Coordinates from a record (`[vessel.forced] file`): a natural cubic spline through the samples
+    of each recorded dof (value, slope and curvature continuous: the prescribed acceleration has no
+    jump), zero for the dofs the record does not give. Piece i on [t_i, t_i+1] is
+    ((c0 s + c1) s + c2) s + c3, s = t - t_i; found by a binary search, not a loop."""
+    knots: jax.Array        # (n,) sample times, increasing
+    coef: jax.Array         # (n - 1, 4, 6) the pieces' coefficients, highest power first
+
+    def coordinates(self, t):
+        i = jnp.clip(jnp.searchsorted(self.knots, t, side="right") - 1, 0, self.knots.shape[0] - 2)
+        s = t - self.knots[i]
+        c = self.coef[i]
+        return ((c[0] * s + c[1]) * s + c[2]) * s + c[3]
+
+
+def record_coefficients(times, columns, dofs):
+    """(knots, coef) of `RecordedMotion` from a scene's record: `columns` ((dof name, samples), ...),
+    `dofs` the six names in order. NumPy and SciPy, once per build."""
+    from scipy.interpolate import CubicSpline
+    t = np.asarray(times, dtype=float)
+    coef = np.zeros((len(t) - 1, 4, 6))
+    for name, values in columns:
+        coef[:, :, dofs.index(name)] = CubicSpline(t, np.asarray(values, dtype=float), bc_type="natural").c.T
+    return t, coef

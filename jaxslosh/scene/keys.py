@@ -23,7 +23,8 @@ except ModuleNotFoundError:  # Python 3.10
     import tomli as tomllib  # type: ignore[no-redef]
 
 from .fields import show
-from .load import parse_scene, step_warnings
+from .keydocs import KEYS as KEY_DOCS, TABLES as KEY_TABLES  # noqa: F401  default, unit, meaning (docs)
+from .load import forced_span, parse_scene, step_warnings
 from .types import Material, Scene, SceneError
 
 
@@ -83,6 +84,11 @@ def scene_values(scene: Scene) -> dict[str, Any]:
             v[f"vessel.hydrostatics.{key}"] = getattr(ves.hydrostatics, key)
     for key in ("position", "velocity", "angular_velocity", "roll_pitch_yaw"):
         v[f"vessel.initial.{key}"] = getattr(ves.initial, key)
+    f = ves.forced
+    if f is not None and f.profile != "record":   # a record's samples are its file's, not values of the scene
+        own = ("amplitude", "frequency", "phase", "ramp") if f.profile == "harmonic" else ("rate", "duration")
+        for key in own:
+            v[f"vessel.forced.{key}"] = getattr(f, key)
     if scene.waves is not None:   # the wave forces are linear in these (waves.py)
         v["waves.amplitude" if scene.waves.type == "regular" else "waves.hs"] = scene.waves.height
 
@@ -196,6 +202,7 @@ def with_overrides(scene: Scene, *, duration: Optional[float] = None, dt: Option
                               dt=float(dt if dt is not None else sim.dt))
     if sim.dt > sim.duration:
         raise SceneError("simulation.dt", f"{show(sim.dt)} s is longer than the duration {show(sim.duration)} s")
+    forced_span(scene.vessel, sim)
     warnings = [w for w in scene.warnings if not w.startswith(("simulation.duration", "simulation.save_every"))]
     return dataclasses.replace(scene, simulation=sim, warnings=tuple(warnings + step_warnings(sim)))
 

@@ -30,6 +30,7 @@ from ..fem.shapes import AXES, SHAPES
 from .campaign import read_campaign
 from .fields import (at_least, counts, flat_list, non_negative, one_of, poisson_ratio, positive, read, show, sizes,
                      valid_name)
+from .record import read_record
 from .shape import fill_and_mesh, read_shape
 from .types import (DOFS, EFFECTS, ELEMENT_FORMS, FACES, Damping, Effects, Environment, Forced, Fluid, Hydrostatics,
                     Initial, Material, Probe, Reduction, Scene, SceneError, Simulation, Structure, Tank, Vessel, Walls)
@@ -98,6 +99,7 @@ def parse_scene(mapping: Mapping[str, Any], text: str = "", path: str = "") -> S
     files = FileContext(os.path.dirname(os.path.abspath(path)) if path else os.getcwd(), environment.water_density,
                         environment.gravity, depth if isinstance(depth, (int, float)) and depth > 0 else None)
     vessel = _vessel(mapping["vessel"], environment, warnings, files)
+    forced_span(vessel, simulation)
     tanks = tuple(_tank(t, f"tanks[{i}]", files.base_dir) for i, t in enumerate(mapping.get("tanks", [])))
     structures = tuple(_structure(s, f"structures[{i}]") for i, s in enumerate(mapping.get("structures", [])))
     probes = tuple(_probe(p, f"probes[{i}]") for i, p in enumerate(mapping.get("probes", [])))
@@ -248,29 +250,60 @@ def _vessel(table, environment: Environment, warnings: list[str], files=None) ->
         "position": ("vec3", None), "velocity": ("vec3", None), "angular_velocity": ("vec3", None),
         "roll_pitch_yaw": ("vec3", None),
     }))
-    forced = None
-    if "forced" in table:
-        f = read(table["forced"], "vessel.forced", {
-            "dof": ("str", one_of(DOFS)), "profile": ("str", one_of(("harmonic", "spin-up"))),
-            "amplitude": ("float", None), "frequency": ("float", positive), "ramp": ("float", non_negative),
-            "rate": ("float", None), "duration": ("float", positive),
-        }, required=("dof",))
-        profile = f.get("profile", "harmonic")
-        need = ("amplitude", "frequency") if profile == "harmonic" else ("rate", "duration")
-        for k in need:
-            if k not in f:
-                raise SceneError(f"vessel.forced.{k}", f"is required for the {profile} profile")
-        other = ("rate", "duration") if profile == "harmonic" else ("amplitude", "frequency", "ramp")
-        for k in other:
-            if k in f:
-                raise SceneError(f"vessel.forced.{k}", f"does not belong to the {profile} profile "
-                                                       f"(it takes {', '.join(need)})")
-        if profile == "spin-up" and f["dof"] not in ("roll", "pitch", "yaw"):
-            raise SceneError("vessel.forced.dof", f"the spin-up profile turns a rotation (roll, pitch or yaw), "
-                                                  f"not {f['dof']!r}")
-        forced = Forced(**f)
+    forced = _forced(table["forced"], files.base_dir if files is not None else os.getcwd()) \
+        if "forced" in table else None
     return Vessel(mass=v["mass"], inertia=inertia, hydrostatics=hydrostatics, initial=initial, forced=forced,
                   hull=hull, hydrodynamics=hydrodynamics)
+
+
+#: the keys of each [vessel.forced] profile (dof for the two of one dof; a record's columns name its dofs)
+FORCED_PROFILES = {"harmonic": ("dof", "amplitude", "frequency", "ramp", "phase"),
+                   "spin-up": ("dof", "rate", "duration"), "record": ("file",)}
+FORCED_REQUIRED = {"harmonic": ("dof", "amplitude", "frequency"), "spin-up": ("dof", "rate", "duration"),
+                   "record": ("file",)}
+
+
+def _forced(table, base_dir: str) -> Forced:
+    """`[vessel.forced]`: a harmonic or spin-up profile of one dof, or a record (`file`) of any dofs."""
+    where = "vessel.forced"
+    f = read(table, where, {
+        "dof": ("str", one_of(DOFS)), "profile": ("str", one_of(tuple(FORCED_PROFILES))),
+        "amplitude": ("float", None), "frequency": ("float", positive), "ramp": ("float", non_negative),
+        "rate": ("float", None), "duration": ("float", positive), "phase": ("float", None), "file": ("str", None),
+    })
+    profile = f.get("profile", "record" if "file" in f else "harmonic")
+    f["profile"] = profile
+    for k in FORCED_REQUIRED[profile]:
+        if k not in f:
+            raise SceneError(f"{where}.{k}", "a required key is missing" if k == "dof"
+                             else f"is required for the {profile} profile")
+    for k in f:
+        if k != "profile" and k not in FORCED_PROFILES[profile]:
+            takes = ", ".join(FORCED_PROFILES[profile])
+            why = " (the record's columns name the dofs it prescribes)" if profile == "record" and k == "dof" else ""
+            raise SceneError(f"{where}.{k}", f"does not belong to the {profile} profile (it takes {takes}){why}")
+    if profile == "spin-up" and f["dof"] not in ("roll", "pitch", "yaw"):
+        raise SceneError(f"{where}.dof", f"the spin-up profile turns a rotation (roll, pitch or yaw), not {f['dof']!r}")
+    if profile == "record":
+        shown = f["file"]
+        f["file"] = shown if os.path.isabs(shown) else os.path.join(base_dir, shown)
+        f["times"], f["columns"] = read_record(f["file"], f"{where}.file", shown)
+    return Forced(**f)
+
+
+def forced_span(vessel: Vessel, sim: Simulation) -> None:
+    """A record must cover the run, from t = 0 to the duration: the motion is not guessed outside it."""
+    f = vessel.forced
+    if f is None or f.profile != "record":
+        return
+    t0, t1 = f.times[0], f.times[-1]
+    name = os.path.basename(f.file)
+    if t0 > 0.0:
+        raise SceneError("vessel.forced.file", f"{name}: the record starts at t = {t0:g} s; it must cover the run "
+                                               f"from t = 0")
+    if sim.n_steps * sim.dt > t1 * (1 + 1e-12) + 1e-12:
+        raise SceneError("vessel.forced.file", f"{name}: the record ends at t = {t1:g} s, before the run's end "
+                                               f"t = {sim.n_steps * sim.dt:g} s (simulation.duration)")
 
 
 def _hydrostatics(table, warnings: list[str]) -> Hydrostatics:

@@ -33,6 +33,7 @@ def read_shape(table, v, where: str, base_dir: str, elastic: bool = False) -> di
     baffles = []
     for i, b in enumerate(table.get("baffles", [])):
         bw = f"{where}.baffles[{i}]"
+        _old_baffle_keys(b, bw, H)
         bv = read(b, bw, {"normal": ("str", one_of(("x", "y"))), "position": ("float", None),
                           "from": ("str", one_of(("bottom", "top"))), "height": ("float", None)},
                   required=("position", "height"))
@@ -59,6 +60,30 @@ def read_shape(table, v, where: str, base_dir: str, elastic: bool = False) -> di
     if bad:
         raise SceneError(f"{where}.{bad[0]}", bad[1])
     return out
+
+
+def _old_baffle_keys(b, bw: str, H: float) -> None:
+    """An earlier form (`at`, `mount`, `height` as the plate's extent from the bottom or the roof) is
+    refused with its translation to SPEC's keys: its `height` means another length, so reading it
+    silently either way would put the edge where the user did not mean it."""
+    if not isinstance(b, dict) or not ({"at", "mount"} & set(b)):
+        return
+    key = "at" if "at" in b else "mount"
+    mount = b.get("mount", b.get("from", "bottom"))
+    parts = []
+    if "at" in b:
+        parts.append(f"position = {show(b['at'])} (for at)")
+    if "mount" in b:
+        parts.append(f'from = "{mount}" (for mount)')
+    extent = b.get("height")
+    if isinstance(extent, (int, float)) and not isinstance(extent, bool) and mount in ("bottom", "top"):
+        edge = extent if mount == "bottom" else H - extent
+        which = "upper" if mount == "bottom" else "lower"
+        parts.append(f"height = {edge:g} (the plate's {which} edge above the tank bottom; the old height "
+                     f"{show(extent)} was the plate's extent from the {'bottom' if mount == 'bottom' else 'roof'})")
+    else:
+        parts.append("height = the edge's height above the tank bottom (the old height was the plate's extent)")
+    raise SceneError(f"{bw}.{key}", "an old form of the baffle keys; write " + ", ".join(parts))
 
 
 def fill_and_mesh(table, v, where: str, base_dir: str) -> None:

@@ -76,20 +76,26 @@ class Initial:
 
 @dataclass(frozen=True)
 class Forced:
-    """Prescribed motion of the vessel (tank tests, rotating hubs): one rigid dof follows a profile,
-    the other five are held at zero.
-    "harmonic": amplitude * sin(frequency * t), faded in over `ramp` seconds by the C2 ramp
+    """Prescribed motion of the vessel (tank tests, rotating hubs). One rigid dof follows a profile,
+    the other five are held at zero, or a record prescribes any of them:
+    "harmonic": amplitude * sin(frequency * t + phase), faded in over `ramp` seconds by the C2 ramp
     s - sin(2 pi s) / (2 pi), s = t / ramp (physics/vessel.py smooth_ramp);
     "spin-up" (a rotation dof): the rate grows smoothly from 0 to `rate` over `duration` seconds,
     omega(t) = rate / duration (t - duration / (2 pi) sin(2 pi t / duration)), then stays (the
-    Kane-Ryan-Banerjee profile)."""
-    dof: str                         # "surge" | "sway" | "heave" | "roll" | "pitch" | "yaw"
+    Kane-Ryan-Banerjee profile);
+    "record" (`file`): sampled surge, sway, heave, roll, pitch, yaw (any of them; scene/record.py),
+    interpolated by a natural cubic spline (continuous acceleration); the dofs not given held."""
+    dof: str = ""                    # "surge" | "sway" | "heave" | "roll" | "pitch" | "yaw" ("" for a record)
     amplitude: float = 0.0           # m or rad (harmonic)
     frequency: float = 1.0           # rad/s, > 0 (harmonic)
     ramp: float = 0.0                # s, >= 0: the amplitude grows as s - sin(2 pi s) / (2 pi), s = t / ramp
-    profile: str = "harmonic"        # "harmonic" | "spin-up"
+    profile: str = "harmonic"        # "harmonic" | "spin-up" | "record"
     rate: float = 0.0                # rad/s (spin-up: final rate)
     duration: float = 0.0            # s, > 0 (spin-up time)
+    phase: float = 0.0               # rad (harmonic)
+    file: str = ""                   # record: the file (absolute path)
+    times: tuple = ()                # record: the sample times, s, increasing
+    columns: tuple = ()              # record: ((dof, samples), ...) in the file's column order
 
 
 @dataclass(frozen=True)

@@ -1,0 +1,99 @@
+"""The step on whatever device JAX has (a GPU where one is lent), in one run: the paper example, a
+20 x 20 x 12 box tank, a vmapped batch of the paper example, and one campaign batch (the worker's
+`run_batch`: JONSWAP seas of the waves scene, statistics included).
+
+    python benchmarks/gpu.py [--steps 200] [--batch 64] [--cases 64] [--duration 60]
+
+Prints one table: compile (first call less the second) or the first call, the run (second call,
+the same shapes) per case, and the microseconds per step (per run-step for batches). No assertion; tests never time anything.
+"""
+import argparse
+import os
+import sys
+import time
+
+import jax
+
+jax.config.update("jax_enable_x64", True)
+
+import numpy as np  # noqa: E402
+
+import jaxslosh as js  # noqa: E402
+from jaxslosh.scene.keys import with_overrides  # noqa: E402
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from bench_paper import time_scene  # noqa: E402  (the loop alone: compile apart from the run)
+
+ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+
+
+def twice(f):
+    """(first call's wall time, second call's wall time, output): compile plus run, then run."""
+    t0 = time.perf_counter()
+    out = f()
+    jax.block_until_ready(jax.tree_util.tree_leaves(out))
+    t1 = time.perf_counter()
+    out = f()
+    jax.block_until_ready(jax.tree_util.tree_leaves(out))
+    return t1 - t0, time.perf_counter() - t1, out
+
+
+def main():
+    ap = argparse.ArgumentParser()
+    ap.add_argument("--steps", type=int, default=2000, help="steps of the paper example (its 20 s)")
+    ap.add_argument("--tank-steps", type=int, default=200, help="steps of the 20 x 20 x 12 tank")
+    ap.add_argument("--batch-steps", type=int, default=200, help="steps of each run of the batch")
+    ap.add_argument("--batch", type=int, default=64)
+    ap.add_argument("--cases", type=int, default=64)
+    ap.add_argument("--duration", type=float, default=60.0, help="s of each campaign case")
+    ap.add_argument("--only", default="paper,tank20,batch,campaign")
+    a = ap.parse_args()
+    only = a.only.split(",")
+    dev = jax.devices()[0]
+    print(f"device: {dev.platform} {getattr(dev, 'device_kind', '')}, jax {jax.__version__}", flush=True)
+    rows = []
+    paper = js.load_scene(os.path.join(ROOT, "scenes/paper_ship_tank.toml"))
+    dt = paper.simulation.dt
+    base = paper
+    if "paper" in only:
+        t = time_scene(base, a.steps)
+        rows.append(("paper example (125 hexahedra)", t["steps"], t["compile"], t["run"], t["us"],
+                     f"ok, {t['iters']:.2f} Newton its/step" if t["ok"] else "failed"))
+        print(rows[-1], flush=True)
+    if "tank20" in only:
+        import dataclasses
+        t0 = paper.tanks[0]
+        big = dataclasses.replace(base, tanks=(dataclasses.replace(t0, mesh=(20, 20, 12)),) + base.tanks[1:])
+        t = time_scene(big, a.tank_steps)
+        rows.append((f"paper ship, 20x20x12 tank ({t['unknowns']} unknowns)", t["steps"], t["compile"], t["run"],
+                     t["us"], f"ok, {t['iters']:.2f} Newton its/step" if t["ok"] else "failed"))
+        print(rows[-1], flush=True)
+    if "batch" in only:
+        gm = np.linspace(1.0, 2.0, a.batch)
+        short = with_overrides(base, duration=a.batch_steps * dt)
+        c, r, (res, st) = twice(lambda: js.simulate_batch(short, {"vessel.hydrostatics.gm_t": gm}))
+        n = a.batch_steps * a.batch
+        rows.append((f"paper example, batch of {a.batch}", n, c, r, 1e6 * r / n, f"{st.count('ok')}/{a.batch} ok"))
+        print(rows[-1], flush=True)
+    if "campaign" in only:
+        from jaxslosh.campaign.worker import run_batch
+        path = os.path.join(ROOT, "scenes/paper_ship_waves.toml")
+        text = open(path).read()
+        hs = np.linspace(0.5, 2.0, a.cases)
+        values = [{"hs": float(h), "tp": 6.0, "heading": float(np.pi / 2), "seed": i} for i, h in enumerate(hs)]
+        steps = int(round(a.duration / 0.05))
+        c, r, out = twice(lambda: run_batch(text, path, a.duration, values, a.cases))
+        ok = sum(o["status"] == "ok" for o in out)
+        rows.append((f"campaign batch, {a.cases} cases x {a.duration:g} s", steps * a.cases, c, r,
+                     1e6 * r / (steps * a.cases), f"{ok}/{a.cases} ok"))
+        print(rows[-1], flush=True)
+    print()
+    print(f"| case ({dev.platform}) | run-steps | compile or first call (s) | second call (s) | us per run-step | status |")
+    print("| --- | --- | --- | --- | --- | --- |")
+    for name, n, c, r, us, st in rows:
+        print(f"| {name} | {n} | {c:.2f} | {r:.3f} | {us:.1f} | {st} |")
+    sys.stdout.flush()
+
+
+if __name__ == "__main__":
+    main()
