@@ -87,3 +87,36 @@ def test_a_scene_compiles_once_for_runs_and_batches():
     assert eqx.debug.get_num_traces(loop.traced_advance) == n_batch
     assert np.asarray(r.time).shape == (4, 11)
     assert jnp.all(jnp.isfinite(r.vessel.roll_pitch_yaw))
+
+
+def test_api_messages_name_what_the_caller_can_give(tmp_path):
+    """Issue 31, item 16: an unknown probe names the scene's probes; js.campaign's errors name its
+    keyword arguments (limits=, seeds=), not the command line's flags (which `jaxslosh campaign` keeps);
+    a damping ratio list longer than a sparse mesh's sloshing modes says how many were searched."""
+    from test_campaign import SCATTER, scene_text
+    from helpers import VESSEL
+    tank = ('\n[[tanks]]\nname = "t"\norigin = [-1.0, -1.0, -1.0]\nsize = [2.0, 2.0, 2.0]\nfill_depth = 1.0\n'
+            'mesh = [2, 2, 2]\n[[probes]]\nname = "A"\ntank = "t"\npoint = [2.0, 1.0, 0.0]\n'
+            '[[probes]]\nname = "B"\ntank = "t"\npoint = [2.0, 1.0, 1.0]\n')
+    scene = js.load_scene(VESSEL.format(duration=0.1, dt=0.05, scheme="hht", alpha=0.01, omega=[0.0, 0.0, 0.0],
+                                        position=[0.0, 0.0, 0.0]) + tank)
+    stepper = js.Stepper(scene)
+    state = stepper.init()
+    assert np.asarray(stepper.probe(state, "B")).shape == (3,)
+    with pytest.raises(ValueError, match=r"no probe named 'nope'; the scene's probes: A, B"):
+        stepper.probe(state, "nope")
+    from jaxslosh.campaign.run import CampaignError
+    template = js.load_scene(scene_text())
+    for kw, msg in (({"limits": {"yaw": 0.1}}, r"^limits\['yaw'\]: not a channel"),
+                    ({"limits": {"roll": -1.0}}, r"^limits\['roll'\]: must be a positive number"),
+                    ({"seeds": 0}, r"^seeds: must be at least 1")):
+        with pytest.raises(CampaignError, match=msg) as e:
+            js.campaign(template, SCATTER, **kw)
+        assert "--" not in str(e.value) and e.value.cli.startswith("--")
+    from jaxslosh.run.simulate import prepare
+    text = open(js.__file__.replace("jaxslosh/__init__.py", "scenes/paper_ship_tank.toml")).read()
+    text = text.replace("save_every = 1", 'save_every = 1\nlinear_solver = "sparse"').replace(
+        'walls = "rigid"\n', 'walls = "rigid"\n[tanks.damping]\nratio = [' + ", ".join(["0.01"] * 60) + ']\n')
+    with pytest.raises(js.SceneError, match=r"gives 60 damping ratios, but the 48 lowest modes searched on this "
+                                            r"mesh hold \d+ sloshing modes"):
+        prepare(js.load_scene(text))

@@ -170,3 +170,34 @@ def test_failing_steps_retried_as_substeps_get_further():
     n = plain.steps_done + 1
     np.testing.assert_allclose(np.asarray(retried.vessel.quaternion[:n]), np.asarray(plain.vessel.quaternion[:n]),
                                atol=1e-14)
+
+
+def test_check_describes_a_mesh_file_by_its_counts_and_notes_a_nearly_full_horizontal_cylinder(tmp_path, capsys):
+    """Issue 31, item 15: a mesh tank whose file is not a grid is described by its elements and nodes
+    (not "mesh 3 x 1 x 1"); a horizontal cylinder filled to 2.999 of 3 m gets a note that its
+    sloshing is not resolved (surface elements 13 times taller than wide), one filled to 2.5 m none."""
+    meshio = pytest.importorskip("meshio")
+    from jaxslosh.fem.mesh import box_mesh
+    nodes, elements = box_mesh((2.0, 2.0, 1.0), (2, 2, 1))
+    elements = elements[:3]                                   # an L: no grid
+    used = np.unique(elements)
+    renum = np.full(len(nodes), -1)
+    renum[used] = np.arange(used.size)
+    path = tmp_path / "ell.msh"
+    meshio.write(str(path), meshio.Mesh(nodes[used], [("hexahedron", renum[elements])]), file_format="gmsh22")
+    tank = (f'\n[[tanks]]\nname = "ell"\norigin = [-1.0, -1.0, -1.0]\nsize = [2.0, 2.0, 1.0]\nshape = "mesh"\n'
+            f'file = "{path}"\n')
+    assert main(["check", _write(tmp_path, GOOD + tank)]) == 0
+    out = capsys.readouterr().out
+    assert f"mesh file of 3 hexahedra on {used.size} nodes" in out and "3 x 1 x 1" not in out and "3x1x1" not in out
+    cyl = ('\n[[tanks]]\nname = "cyl"\norigin = [-2.5, -1.5, -1.0]\nsize = [5.0, 3.0, 3.0]\nshape = "cylinder"\n'
+           'axis = "x"\nfill_depth = {fill}\nmesh = [5, 6, 6]\n')
+    assert main(["check", _write(tmp_path, GOOD + cyl.format(fill=2.999))]) == 0
+    out = capsys.readouterr().out
+    lines = out.splitlines()
+    notes = [i for i, line in enumerate(lines) if line.strip().startswith("note:")]
+    assert len(notes) == 1 and lines[notes[0] - 1].startswith("tank 'cyl'")     # under its tank
+    assert "nearly full (2.999 of 3 m)" in lines[notes[0]] and "0.11 m wide" in lines[notes[0]]
+    assert "spurious" in lines[notes[0]]
+    assert main(["check", _write(tmp_path, GOOD + cyl.format(fill=2.5))]) == 0
+    assert "note:" not in capsys.readouterr().out

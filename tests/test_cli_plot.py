@@ -173,6 +173,33 @@ def test_a_folder_is_refused_in_one_line(tmp_path, capsys):
     _one_line_error(capsys, "-o", "folder")
 
 
+def test_a_figure_name_that_is_no_image_is_refused_before_drawing(tmp_path, capsys, monkeypatch):
+    """Issue 31, item 7: `-o fig.txt` (or .toml) exits 2 at once, naming the flag and the formats,
+    before any figure is drawn; the same for --surface."""
+    import jaxslosh.cli.plot as cli_plot
+    drawn = []
+    monkeypatch.setattr(cli_plot, "plot_result", lambda *a: drawn.append(a))
+    h5 = _saved(tmp_path)
+    for flag, name in (("-o", "fig.txt"), ("-o", "fig.toml"), ("--surface", "s.h5")):
+        assert main(["plot", str(h5), flag, str(tmp_path / name)]) == 2
+        _one_line_error(capsys, flag, name, ".png", ".pdf")
+        assert not (tmp_path / name).exists()
+    assert drawn == []
+
+
+def test_a_figure_name_without_extension_gets_png_and_is_said(tmp_path, capsys):
+    """Issue 31, item 13: `-o figure_noext` writes figure_noext.png and says so (not "wrote
+    figure_noext"); an upper-case extension is an image too."""
+    h5 = _saved(tmp_path)
+    assert main(["plot", str(h5), "-o", str(tmp_path / "figure_noext"), "--surface", str(tmp_path / "surf")]) == 0
+    out = capsys.readouterr().out
+    assert f"wrote {tmp_path / 'figure_noext.png'}\n" in out and f"wrote {tmp_path / 'surf.png'}\n" in out
+    assert (tmp_path / "figure_noext.png").stat().st_size > 1000 and not (tmp_path / "figure_noext").exists()
+    assert (tmp_path / "surf.png").exists()
+    assert main(["plot", str(h5), "-o", str(tmp_path / "fig.PDF")]) == 0
+    assert (tmp_path / "fig.PDF").read_bytes()[:4] == b"%PDF"
+
+
 # -- unreadable result files -----------------------------------------------------------------------
 
 def _saved(tmp_path, name="r.h5"):

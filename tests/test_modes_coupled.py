@@ -111,8 +111,52 @@ def test_modes_coupled_command(capsys):
     # the yaw mode: the stabilized element's rotation penalty holds the liquid's absolute rotation, so a
     # yawed tank pulls back (README, Frequency domain)
     assert d["dominant"] == ["yaw", "roll", "pitch", "heave", "liquid"]
+    # issue 31, item 19: that yaw mode is labelled for what it is, by the share of its potential
+    # energy in the penalty (all of it: no hydrostatics acts on yaw); the other modes hold none
+    assert d["label"] == ["liquid rotation penalty (numerical)", "roll", "pitch", "heave", "liquid"]
+    assert abs(d["penalty_share"][0] - 1) < 1e-3 and max(d["penalty_share"][1:]) < 1e-3
     assert main(["modes", str(ROOT / "scenes" / "paper_ship_tank.toml"), "--coupled", "-n", "3"]) == 0
     out = capsys.readouterr().out
     assert "roll" in out and "damping" in out
+    assert "<- liquid rotation penalty (numerical)" in out.splitlines()[2] and "mode 1: liquid rotation penalty" in out
     assert main(["modes", str(ROOT / "scenes" / "paper_ship_tank.toml"), "--coupled", "--tank", "tank"]) == 2
     assert capsys.readouterr().err.count("\n") == 1
+
+
+TWO_TANKS = """
+[[tanks]]
+name = "fore"
+origin = [2.0, -1.0, -1.0]
+size = [2.0, 2.0, 2.0]
+fill_depth = 1.0
+mesh = [3, 3, 2]
+[[tanks]]
+name = "aft"
+origin = [-6.0, -2.0, -1.0]
+size = [4.0, 4.0, 2.0]
+fill_depth = 1.0
+mesh = [3, 3, 2]
+"""
+
+
+def test_modes_of_a_scene_with_several_tanks_shows_each_tank_labelled(tmp_path, capsys):
+    """Issue 31, item 9: without --tank every tank is shown, each under its name (its first mode the
+    one `--tank` gives alone); --json keeps the first tank's fields at the top and adds "tanks"."""
+    from helpers import VESSEL
+    path = tmp_path / "two.toml"
+    path.write_text(VESSEL.format(duration=1.0, dt=0.01, scheme="hht", alpha=0.01, omega=[0.0, 0.0, 0.0],
+                                  position=[0.0, 0.0, 0.0]) + TWO_TANKS)
+    assert main(["modes", str(path), "-n", "2"]) == 0
+    out = capsys.readouterr().out
+    assert "tank 'fore' (1 of 2)" in out and "tank 'aft' (2 of 2)" in out
+    assert main(["modes", str(path), "-n", "2", "--json"]) == 0
+    d = json.loads(capsys.readouterr().out)
+    assert d["tank"] == "fore" and [t["tank"] for t in d["tanks"]] == ["fore", "aft"]
+    assert d["omega"] == d["tanks"][0]["omega"]
+    assert main(["modes", str(path), "-n", "2", "--json", "--tank", "aft"]) == 0
+    aft = json.loads(capsys.readouterr().out)
+    assert aft["omega"] == d["tanks"][1]["omega"] and "tanks" not in aft
+    # a 4 m wide tank sloshes slower than a 2 m one (omega^2 = g k tanh(k h), k = pi / width)
+    assert aft["omega"][0] < d["omega"][0]
+    assert main(["modes", str(path), "--tank", "mid"]) == 2
+    assert "--tank: no tank named 'mid' (tanks: fore, aft)" in capsys.readouterr().err

@@ -3,6 +3,8 @@
 The result here is written by hand (a first sloshing mode standing in the small tank of a gently
 rolling ship), so the figures are tested in seconds without compiling a run; the notebook test
 animates a real run of the paper example."""
+import dataclasses
+
 import numpy as np
 import pytest
 from PIL import Image, ImageSequence
@@ -10,7 +12,7 @@ from PIL import Image, ImageSequence
 from jaxslosh.cli import main
 from jaxslosh.fem.mesh import box_elements as _box_elements
 from jaxslosh.plot.surface import animate_free_surface, plot_free_surface
-from jaxslosh.io.result import Energy, Result, SolverHistory, TankField, VesselHistory, save_result
+from jaxslosh.io.result import Energy, Result, SolverHistory, TankField, VesselHistory, load_result, save_result
 
 from helpers import VESSEL
 
@@ -117,9 +119,34 @@ def test_surface_figures_need_liquid_fields(tmp_path, capsys):
 
 def test_surface_axes_are_labelled_in_metres(tmp_path):
     fig = plot_free_surface(hand_result(), str(tmp_path / "s.png"))
-    assert len(fig.axes) == 4
-    for ax in fig.axes:
+    assert len(fig.axes) == 5                            # four instants and the elevation's colour bar
+    for ax in fig.axes[:4]:
         assert (ax.get_xlabel(), ax.get_ylabel(), ax.get_zlabel()) == ("X (m)", "Y (m)", "Z (m)")
+    assert fig.axes[4].get_ylabel() == "free-surface elevation (m)"
+
+
+def _faces(ax):
+    """The surface's triangles drawn on a 3D axes and their colours."""
+    (coll,) = [c for c in ax.collections if c.get_array() is not None]
+    return coll
+
+
+def test_a_flat_surface_is_one_colour_and_the_colour_scale_is_symmetric_with_a_floor(tmp_path):
+    """Issue 31, item 12: round-off on the surface at rest (1e-13 m here) is not a checkerboard; the
+    colour bar spans the record's largest elevation either side of rest, with a floor for a still
+    surface, and says its unit."""
+    r = hand_result()                                    # the surface flat at t = 0, 0.05 m later
+    D = np.array(r.tanks["tank"].displacement)
+    D[0, :, 2] += 1e-13 * np.random.default_rng(0).standard_normal(D.shape[1])
+    r = dataclasses.replace(r, tanks={"tank": TankField(r.tanks["tank"].nodes, r.tanks["tank"].elements, D)})
+    fig = plot_free_surface(r, str(tmp_path / "s.png"))
+    first = _faces(fig.axes[0])
+    assert np.unique(np.round(first.get_facecolor(), 6), axis=0).shape[0] == 1      # one colour at rest
+    assert len(np.unique(np.round(_faces(fig.axes[1]).get_facecolor(), 6), axis=0)) > 1   # sloshing: several
+    high = np.abs(D[:, :, 2]).max()
+    assert first.norm.vmin == -first.norm.vmax and abs(first.norm.vmax - high) <= 1e-12
+    still = plot_free_surface(hand_result(sloshing=0.0), str(tmp_path / "still.png"))
+    assert _faces(still.axes[0]).norm.vmax == pytest.approx(1e-4 * max(SIZE))       # the floor
 
 
 def test_animation_reports_the_frames_written(tmp_path):
@@ -129,3 +156,60 @@ def test_animation_reports_the_frames_written(tmp_path):
     assert n == 4
     # one call as each frame is drawn (frames written before it), then the last: all of them
     assert calls == [(0, 4), (1, 4), (2, 4), (3, 4), (4, 4)]
+
+
+def _shaped_result(tank_toml, nodes, elements, n=5, dt=0.1):
+    """A hand result of a tank of any shape: its liquid mesh `nodes`, `elements`, the free surface
+    (nodes on the highest plane) rising at one end while the ship rolls."""
+    t = dt * np.arange(n)
+    D = np.zeros((n, len(nodes), 3))
+    top = np.isclose(nodes[:, 2], nodes[:, 2].max())
+    x = (nodes[:, 0] - nodes[:, 0].min()) / np.ptp(nodes[:, 0])
+    D[:, top, 2] = 0.02 * np.sin(2.0 * t)[:, None] * np.cos(np.pi * x[top])[None, :]
+    phi = 0.05 * np.sin(t)
+    q = np.stack([np.cos(phi / 2), np.sin(phi / 2), 0 * t, 0 * t], axis=1)
+    z3 = np.zeros((n, 3))
+    scene = VESSEL.format(duration=dt * (n - 1), dt=dt, scheme="hht", alpha=0.01, omega=[0.0, 0.0, 0.0],
+                          position=[0.0, 0.0, 0.0]) + tank_toml
+    return Result(time=t, vessel=VesselHistory(z3, q, z3, np.stack([phi, 0 * t, 0 * t], axis=1)), probes={},
+                  energy=Energy(0 * t, 0 * t), solver=SolverHistory(0 * t, 0 * t),
+                  tanks={"tank": TankField(nodes, elements, D)}, status="ok", steps_done=n - 1, scene_text=scene)
+
+
+def test_every_tank_shape_plots_its_surface_and_animation(tmp_path, capsys):
+    """Issue 31, item 5: `plot --surface` and `--animate` of a result of every shape (box, prismatic,
+    horizontal and vertical cylinders, and a mesh tank, which gives no fill_depth: KeyError before);
+    the drawn surface is the mesh's highest plane, its triangles cover the surface's nodes."""
+    meshio = pytest.importorskip("meshio")
+    from jaxslosh.fem.mesh import box_mesh
+    from jaxslosh.fem.shapes import TankGeometry, tank_mesh
+    path = tmp_path / "liquid.msh"
+    nodes, elements = box_mesh((3.0, 2.0, 1.5), (3, 2, 2))
+    meshio.write(str(path), meshio.Mesh(nodes, [("hexahedron", elements)]), file_format="gmsh22")
+    head = 'name = "tank"\norigin = [-1.5, -1.0, -1.0]\n'
+    cases = {
+        "mesh": (f'[[tanks]]\n{head}size = [3.0, 2.0, 2.0]\nshape = "mesh"\nfile = "{path}"\n', nodes, elements),
+    }
+    for shape, extra, size, mesh in (
+            ("box", "", (3.0, 2.0, 2.0), (3, 2, 2)),
+            ("prismatic", "chamfers = [[0.5, 0.5], [0.0, 0.0]]\n", (3.0, 2.0, 2.0), (3, 4, 2)),
+            ("cylinder", 'axis = "x"\n', (3.0, 2.0, 2.0), (3, 4, 4)),
+            ("cylinder-z", 'axis = "z"\n', (2.0, 2.0, 2.0), (4, 4, 2))):
+        kind = shape.split("-")[0]
+        geo = TankGeometry(kind=kind, size=size, axis="z" if shape.endswith("-z") else "x",
+                           chamfers=((0.5, 0.5), (0.0, 0.0)) if kind == "prismatic" else ((0.0, 0.0), (0.0, 0.0)))
+        tm = tank_mesh(geo, 1.2, mesh)
+        text = (f'[[tanks]]\n{head}size = [{size[0]}, {size[1]}, {size[2]}]\nshape = "{kind}"\n{extra}'
+                f'fill_depth = 1.2\nmesh = [{mesh[0]}, {mesh[1]}, {mesh[2]}]\n')
+        cases[shape] = (text, tm.nodes, tm.elements)
+    for shape, (text, nd, el) in cases.items():
+        h5, surf, gif = tmp_path / f"{shape}.h5", tmp_path / f"{shape}_s.png", tmp_path / f"{shape}.gif"
+        save_result(_shaped_result(text, np.asarray(nd, float), np.asarray(el)), str(h5))
+        assert main(["plot", str(h5), "-o", str(tmp_path / f"{shape}.png"), "--surface", str(surf),
+                     "--animate", str(gif)]) == 0, (shape, capsys.readouterr().err)
+        assert surf.stat().st_size > 1000 and _frames(gif)[0] == 5, shape
+        fig = plot_free_surface(load_result(str(h5)), str(surf))
+        faces = _faces(fig.axes[0])
+        top = np.isclose(np.asarray(nd)[:, 2], np.asarray(nd)[:, 2].max())
+        # two triangles per surface face, every surface node drawn
+        assert len(faces.get_array()) == 2 * (top[np.asarray(el)][:, 4:].all(axis=1)).sum(), shape

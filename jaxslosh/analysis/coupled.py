@@ -17,21 +17,37 @@ the group of unknowns (a rigid dof, the liquid, a structure) holding the largest
 mode's kinetic energy x^H M x. Rigid-body modes without restoring (lambda = 0: surge and sway of a
 free-floating hull whose radiation damping vanishes at zero frequency) and overdamped ones (real
 lambda) are not oscillations and are counted apart.
+
+A mode whose potential energy lies mostly (PENALTY_SHARE) in the stabilized liquid element's
+rotation penalty (fem/liquid_element.py, term 3: kappa |P curl d + 2 theta|^2, which holds the
+liquid's absolute rotation) is labelled "liquid rotation penalty (numerical)": a slow yaw of the
+hull against the liquid its tank holds still, restored by the penalty alone (no hydrostatics acts on
+yaw). An inviscid liquid has no such stiffness; the mode is an artefact of the element, not of the
+ship. Its share is x^H K_pen x / x^H K x, K_pen the penalty's d-d block (the liquid model's
+"rotation" part) with its d-theta and theta-theta blocks (physics/liquid.RotationPenalty).
 """
 from __future__ import annotations
 
 from typing import NamedTuple
 
+import jax
+import jax.numpy as jnp
 import numpy as np
 import scipy.linalg as sl
 import scipy.sparse.linalg as spla
 
+from ..physics.liquid import RotationPenalty
 from ..scene.types import Scene
 from .linear import Linearisation, linearise
 from .rao import frequency_matrices, hull_tables, solve_equilibrated
 
 #: |lambda| below this (rad/s) is a rigid-body mode without restoring
 ZERO = 1e-6
+
+#: a mode with at least this share of its potential energy in the liquid's rotation penalty is
+#: labelled PENALTY_LABEL (the paper example's slow yaw: 1.0000; every other mode there: < 0.001)
+PENALTY_SHARE = 0.5
+PENALTY_LABEL = "liquid rotation penalty (numerical)"
 
 
 class CoupledModes(NamedTuple):
@@ -43,6 +59,8 @@ class CoupledModes(NamedTuple):
     shapes: np.ndarray         # (n, k) complex mode shapes over the unknowns
     radiation: tuple           # (k,) "table" (A, B at the mode's frequency), "infinite" or "none"
     not_oscillating: int       # rigid-body (lambda = 0) and overdamped modes among those found
+    penalty_share: np.ndarray = np.zeros(0)   # (k,) share of x^H K x in the liquid's rotation penalty
+    label: tuple = ()          # (k,) `dominant`, or PENALTY_LABEL for a mode the penalty holds
 
 
 def _lowest(lin: Linearisation, M, C, k: int):
@@ -130,5 +148,39 @@ def coupled_modes(scene: Scene, n: int = 10, *, params=None, linearisation=None,
     shapes = np.stack([o[1] for o in out], axis=1) if out else np.zeros((lin.n, 0), complex)
     zeta = -lam.real / np.abs(lam)
     zeta = np.where(np.abs(zeta) < 1e-9, 0.0, zeta)      # round-off of undamped modes
+    pshare = penalty_shares(lin, shapes)
+    label = tuple(PENALTY_LABEL if p >= PENALTY_SHARE else d for p, d in zip(pshare, dominant))
     return CoupledModes(np.abs(lam), lam.imag, zeta, dominant, shares, shapes,
-                        tuple(o[2] for o in out), left_out)
+                        tuple(o[2] for o in out), left_out, pshare, label)
+
+
+def penalty_shares(lin: Linearisation, shapes) -> np.ndarray:
+    """(k,) the share of each mode's potential energy x^H K x held by the liquid's rotation penalty
+    (see the module's docstring); zeros where the scene has none (no liquid, the "paper" element,
+    a liquid built without its energy parts)."""
+    b = lin.built
+    k = shapes.shape[1]
+    pen = [t for t in b.system.terms if isinstance(t, RotationPenalty)]
+    parts = [tb.model.parts.get("rotation") if getattr(tb.model, "parts", None) else None for tb in b.tanks]
+    if not pen or k == 0 or any(p is None for p in parts):
+        return np.zeros(k)
+    labels = np.asarray(lin.labels)
+    liq = np.flatnonzero(labels == "liquid")
+    L = b.system.liquid
+    nodal = jax.jit(jax.vmap(lambda d: L.nodal_fields(L.frame_field(d)), in_axes=1))
+    D = np.asarray(nodal(jnp.asarray(shapes[liq].real))) + 1j * np.asarray(nodal(jnp.asarray(shapes[liq].imag)))
+    E = np.zeros(k)
+    for tb, P in zip(b.tanks, parts):
+        n = tb.model.n_nodes
+        Dt = D[:, tb.node_offset:tb.node_offset + n]                 # (k, N_t, 3), tank axes
+        if tb.model.frames is not None:                               # the model's parts: in the nodes' frames
+            Dt = np.einsum("nji,knj->kni", np.asarray(tb.model.frames), Dt)
+        v = Dt.reshape(k, -1)
+        E += np.real(np.einsum("ki,ki->k", v.conj(), (P @ v.T).T))
+    th, d = shapes[3:6], shapes[liq]
+    Kdt, Ktt = np.asarray(pen[0].Kdt), np.asarray(pen[0].Ktt)
+    E += np.real(2 * np.einsum("ik,ik->k", th.conj(), Kdt.T @ d) + np.einsum("ik,ik->k", th.conj(), Ktt @ th))
+    total = np.real(np.einsum("ik,ik->k", shapes.conj(), lin.K @ shapes))
+    with np.errstate(divide="ignore", invalid="ignore"):
+        share = np.where(np.abs(total) > 0, E / total, 0.0)
+    return np.clip(np.nan_to_num(share), 0.0, None)

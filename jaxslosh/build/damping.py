@@ -13,7 +13,7 @@ import jax.numpy as jnp
 import numpy as np
 import scipy.sparse as sp
 
-from ..fem.damping import boundary_layer_ratios, sloshing_modes, sloshing_share
+from ..fem.damping import SPARSE_SEARCH, boundary_layer_ratios, sloshing_modes, sloshing_share
 from ..fem.liquid import build_liquid
 from ..fem.modes import free_matrices
 from ..fem.reduction import tank_basis
@@ -60,7 +60,11 @@ def build_damping(scene: Scene, params: Optional[dict], block) -> tuple[Optional
             n_t = Phi.shape[0]
             Bt = free_matrices(model)[1] @ Phi
             Bt = np.asarray(Bt.todense() if sp.issparse(Bt) else Bt)
-            where = f"the mesh carries {omega.size}"
+            if sp.issparse(model.stiffness):     # a large mesh: only its lowest modes are searched
+                searched = min(n_t - 1, SPARSE_SEARCH)
+                where = f"the {searched} lowest modes searched on this mesh hold {omega.size}"
+            else:
+                where = f"the mesh carries {omega.size}"
         if t.damping is None:
             offset += n_t
             continue

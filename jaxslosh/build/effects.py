@@ -5,8 +5,10 @@ from __future__ import annotations
 
 import os
 
+import numpy as np
+
 from ..fem.meshfile import read_mesh_file
-from ..fem.shapes import free_count
+from ..fem.shapes import free_count, grid_counts, read_mesh, tank_mesh
 from ..fem.walls import shell_mesh
 from ..hydro.source import excitation_source
 from ..scene.types import EFFECTS, Scene
@@ -22,11 +24,10 @@ def describe(scene: Scene) -> str:
              if h is not None else "no hydrostatics (free body)")
     lines.append(f"vessel: mass {ves.mass:.4g} kg, inertia diagonal [{diag}] kg m^2; {hydro}")
     for t in scene.tanks:
-        nx, ny, nz = t.mesh
         walls = t.walls if t.wall_spec is None else f"elastic, {t.wall_spec.thickness:g} m thick"
         lines.append(f"tank {t.name!r}: {shape_words(t)}{t.size[0]:g} x {t.size[1]:g} x {t.size[2]:g} m filled to "
                      f"{t.fill_depth:g} m, liquid {t.liquid_mass:.4g} kg ({t.liquid_volume:.4g} m^3), "
-                     f"mesh {nx} x {ny} x {nz} = {nx * ny * nz} hexahedra, walls {walls}")
+                     f"{mesh_words(t)}, walls {walls}")
         lines += tank_notes(t)
     for s in scene.structures:
         nx, ny, nz = s.mesh
@@ -71,7 +72,7 @@ def scene_effects(scene: Scene) -> list[tuple[str, str]]:
     liquid = bool(scene.tanks) and e.liquid
     if liquid:
         for t in scene.tanks:
-            eff.append((f"liquid in tank {t.name!r}", f"{shape_words(t)}{t.mesh[0]}x{t.mesh[1]}x{t.mesh[2]} hexahedra, "
+            eff.append((f"liquid in tank {t.name!r}", f"{shape_words(t)}{mesh_words(t, short=True)}, "
                         f"{t.liquid_mass:.6g} kg, element {t.fluid.element!r}, {t.walls} walls (slip)"))
             if t.damping is not None:
                 d = t.damping
@@ -160,6 +161,50 @@ def switched_off(scene: Scene) -> list[str]:
     return [k for k in EFFECTS if not getattr(scene.effects, k)]
 
 
+def mesh_words(t, short: bool = False) -> str:
+    """"mesh 5 x 5 x 5 = 125 hexahedra" (a grid, of any shape, or a mesh file that is one), or
+    "mesh file of 12 hexahedra on 30 nodes" (a mesh tank's file that is not a grid: its counts
+    along x, y, z mean nothing)."""
+    nx, ny, nz = t.mesh
+    if t.shape == "mesh":
+        try:
+            nodes, elements = read_mesh(t.file)
+        except (OSError, ValueError):
+            nodes = elements = None
+        if elements is not None and grid_counts(nodes, elements) is None:
+            return f"mesh file of {len(elements)} hexahedra on {len(nodes)} nodes"
+    return f"{nx}x{ny}x{nz} hexahedra" if short else f"mesh {nx} x {ny} x {nz} = {nx * ny * nz} hexahedra"
+
+
+#: a horizontal cylinder's surface elements this many times taller than wide (a nearly full tank:
+#: its free surface a narrow strip) carry no sloshing mode the mesh resolves: `check` says so
+SLIVER_ASPECT = 8.0
+
+
+def sliver_note(t) -> list[str]:
+    """A note on a horizontal cylinder filled so near its top that its mesh resolves no sloshing."""
+    if t.shape != "cylinder" or t.axis == "z":
+        return []
+    tm = tank_mesh(t.geometry, t.fill_depth, tuple(t.mesh))
+    top = np.isclose(tm.nodes[:, 2], tm.depth)
+    E = tm.elements[top[tm.elements].sum(axis=1) >= 4]             # the elements under the free surface
+    if not len(E):
+        return []
+    across = 1 if t.axis == "x" else 0
+    X = tm.nodes[E]
+    height = np.ptp(X[:, :, 2], axis=1)
+    width = np.array([np.ptp(x[np.isclose(x[:, 2], tm.depth), across]) for x in X])
+    aspect = float(np.max(height / np.maximum(width, 1e-300)))
+    if aspect <= SLIVER_ASPECT:
+        return []
+    D = t.size[2]
+    w = float(np.ptp(tm.nodes[top, across]))
+    return [f"  note: the horizontal cylinder is nearly full ({t.fill_depth:g} of {D:g} m): its free surface is a "
+            f"strip {w:.3g} m wide ({100 * w / D:.2g} % of the diameter), over elements {aspect:.0f} times taller "
+            f"than wide, which resolve no sloshing mode: the lowest modes found there (`jaxslosh modes`) are "
+            f"spurious"]
+
+
 def shape_words(t) -> str:
     """"prismatic (chamfers ...) " and the like for a tank that is not a plain box, else ""."""
     if t.geometry.plain_box:
@@ -178,8 +223,9 @@ def shape_words(t) -> str:
 
 
 def tank_notes(t) -> list[str]:
-    """Indented lines under a tank: each baffle as the model reads it (its plane, side and edge), and
-    how many hexahedra of a mesh file were re-oriented (numbered left-handed in the file)."""
+    """Indented lines under a tank: each baffle as the model reads it (its plane, side and edge), a
+    nearly full horizontal cylinder's unresolved free surface (sliver_note), and how many hexahedra
+    of a mesh file were re-oriented (numbered left-handed in the file)."""
     out = []
     H = t.size[2]
     for i, b in enumerate(t.baffles):
@@ -188,6 +234,7 @@ def tank_notes(t) -> list[str]:
                 else "hanging from the roof, its lower edge")
         out.append(f"  baffle {i}: the plane {b.normal} = {b.at:g} m from the tank's origin, {side} {edge:g} m above "
                    f"the tank bottom ({b.height:g} m of plate)")
+    out += sliver_note(t)
     if t.shape == "mesh":
         m = read_mesh_file(t.file)
         if m.reoriented:

@@ -36,7 +36,13 @@ BATCH = 8
 
 class CampaignError(ValueError):
     """Input a campaign cannot take (a file to resume that is another campaign, a bad limit):
-    one line, exit status 2 on the command line."""
+    one line, exit status 2 on the command line. The message names the argument as js.campaign
+    takes it (`limits=`, `seeds=`, `resume=`, `duration=`); `cli` as the command line does
+    (`--limits`, ...), which `jaxslosh campaign` prints."""
+
+    def __init__(self, message: str, cli: Optional[str] = None):
+        super().__init__(message)
+        self.cli = cli if cli is not None else message
 
 
 class CampaignResult(NamedTuple):
@@ -100,8 +106,8 @@ def _frequency_grid(scene: Scene) -> np.ndarray:
     t = np.arange(n_steps // every + 1) * dt_frame
     kept = int(np.count_nonzero(t >= scene.waves.ramp - 1e-9 * max(1.0, scene.waves.ramp)))
     if kept < 16:
-        raise CampaignError(f"the campaign's records keep {kept} frames after waves.ramp = {scene.waves.ramp:g} s: "
-                            f"give a longer --duration")
+        why = f"the campaign's records keep {kept} frames after waves.ramp = {scene.waves.ramp:g} s: give a longer "
+        raise CampaignError(why + "duration", cli=why + "--duration")
     return frequencies(kept, dt_frame)
 
 
@@ -115,9 +121,11 @@ def _check_limits(limits, chans) -> dict:
     out = {}
     for k, v in (limits or {}).items():
         if k not in chans:
-            raise CampaignError(f"--limits {k}: not a channel of this scene ({', '.join(chans)})")
+            why = f"not a channel of this scene ({', '.join(chans)})"
+            raise CampaignError(f"limits[{k!r}]: {why}", cli=f"--limits {k}: {why}")
         if not (isinstance(v, (int, float)) and np.isfinite(v) and v > 0):
-            raise CampaignError(f"--limits {k}: must be a positive number, got {v!r}")
+            raise CampaignError(f"limits[{k!r}]: must be a positive number, got {v!r}",
+                                cli=f"--limits {k}: must be a positive number, got {v!r}")
         out[k] = float(v)
     return out
 
@@ -152,7 +160,7 @@ def campaign(scene, scatter, headings=None, seeds: int | None = None, duration: 
     if bad:
         raise CampaignError(f"headings: {bad}")
     if seeds < 1:
-        raise CampaignError(f"--seeds: must be at least 1, got {seeds}")
+        raise CampaignError(f"seeds: must be at least 1, got {seeds}", cli=f"--seeds: must be at least 1, got {seeds}")
     cases = make_cases(sc, heads, seeds, template.waves.seed)
     scenes = []
     for i in range(cases.n):               # every case checked as its scene file would be, before running
@@ -204,15 +212,19 @@ def campaign(scene, scatter, headings=None, seeds: int | None = None, duration: 
                           time.perf_counter() - t_start, lim, ops["exceedance"], ops["operability"], ops["failed"])
 
 
+def _resume_error(path, why):
+    return CampaignError(f"resume: {path} {why}", cli=f"--resume: {path} {why}")
+
+
 def _check_resume(old, template, cases, chans, attrs, path):
     if old.scene_text != template.text:
-        raise CampaignError(f"--resume: {path} holds a campaign of another scene (its scene text differs)")
+        raise _resume_error(path, "holds a campaign of another scene (its scene text differs)")
     same = all(k in old.cases and np.array_equal(np.asarray(old.cases[k], dtype=float), np.asarray(v, dtype=float))
                for k, v in _case_table(cases).items())
     if not same or len(old.status) != cases.n:
-        raise CampaignError(f"--resume: {path} holds other cases (scatter, headings or seeds differ)")
+        raise _resume_error(path, "holds other cases (scatter, headings or seeds differ)")
     if list(old.statistics) != chans or abs(float(old.attrs.get("record_duration", -1)) - attrs["record_duration"]) > 1e-12:
-        raise CampaignError(f"--resume: {path} was run with another duration or other channels")
+        raise _resume_error(path, "was run with another duration or other channels")
 
 
 def _structure(scene: Scene) -> tuple:

@@ -104,7 +104,9 @@ def cmd_campaign(a):
                      progress=None if not a.no_progress else False)
     except ScatterError as e:
         raise InputError(f"--scatter {a.scatter}: {e}") from None
-    except (CampaignError, ResultFileError) as e:
+    except CampaignError as e:
+        raise InputError(e.cli) from None
+    except ResultFileError as e:
         raise InputError(str(e)) from None
     except OutputError as e:
         raise InputError(f"-o: {e.strerror}") from None

@@ -129,6 +129,31 @@ def output_folder(flag, path, scene=None):
         raise InputError(f"{flag}: {path} exists and cannot be written")
 
 
+#: the image formats a figure is written in (matplotlib's Agg canvas); a name without an extension
+#: gets DEFAULT_FIGURE's (and the command says the name it wrote)
+FIGURE_FORMATS = ("png", "pdf", "svg", "svgz", "jpg", "jpeg", "tif", "tiff", "webp", "eps", "ps", "pgf", "gif",
+                  "avif", "raw", "rgba")
+DEFAULT_FIGURE = "png"
+
+
+def figure_file(flag, path):
+    """The figure file a command is to write, checked before any computing (output_folder): its
+    extension names one of FIGURE_FORMATS (else exit 2 at once: matplotlib would refuse it only once
+    the figure is drawn); a name without one gets ".png", and that is the name returned."""
+    if not path:
+        return path
+    if os.path.isdir(path):
+        output_folder(flag, path)           # a folder is refused as such, not given an extension
+    ext = os.path.splitext(path)[1]
+    if not ext:
+        path = path + "." + DEFAULT_FIGURE
+    elif ext[1:].lower() not in FIGURE_FORMATS:
+        raise InputError(f"{flag}: {path}: {ext!r} is not an image format; name the figure with one of "
+                         f".{', .'.join(FIGURE_FORMATS[:9])} (or no extension for .{DEFAULT_FIGURE})")
+    output_folder(flag, path)
+    return path
+
+
 def writable_output(flag, path, inputs=()) -> bool:
     """Check an output file before any computing (io.output.check_output); True when an existing
     jaxslosh file will be replaced."""

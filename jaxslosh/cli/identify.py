@@ -11,7 +11,7 @@ from ..fit.quality import data_scene_mismatch
 from ..io.result import ResultFileError, load_result
 from ..plot.fit import format_value, plot_fit
 from ..scene.types import SceneError
-from .common import COMMANDS, EXIT_NUMERICAL, EXIT_OK, InputError, load, output_folder, setup_jax
+from .common import COMMANDS, EXIT_NUMERICAL, EXIT_OK, InputError, figure_file, load, output_folder, setup_jax
 
 
 def add_parsers(subparsers):
@@ -60,6 +60,8 @@ def cmd_identify(a) -> int:
     if not a.data or not os.path.exists(a.data):
         raise InputError(f"--data: {a.data}: no such file")
     out = getattr(a, "output", None) or os.path.splitext(os.path.basename(a.scene))[0] + "_fit.json"
+    if getattr(a, "plot", None):
+        a.plot = figure_file("--plot", a.plot)
     for flag, path in (("-o", out), ("--plot", getattr(a, "plot", None))):
         output_folder(flag, path)
         if path and os.path.abspath(path) in (os.path.abspath(a.scene), os.path.abspath(a.data)):

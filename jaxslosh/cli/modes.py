@@ -4,7 +4,7 @@ from __future__ import annotations
 import json
 import math
 
-from ..analysis.coupled import coupled_modes
+from ..analysis.coupled import PENALTY_LABEL, coupled_modes
 from ..analysis.modes import sloshing_modes, structure_modes
 from .common import COMMANDS, EXIT_OK, InputError, setup_jax, load
 
@@ -30,22 +30,34 @@ def cmd_modes(a):
         return _coupled_modes(scene, a)
     if a.structure is not None:
         return _structure_modes(scene, a)
-    tank = a.tank
-    if tank is None:
-        if not scene.tanks:
-            raise InputError(f"{a.scene}: the scene has no tanks")
-        tank = scene.tanks[0].name
-    modes = sloshing_modes(scene, tank=tank, n=a.n)
+    names = [t.name for t in scene.tanks]
+    if a.tank is not None:
+        if a.tank not in names:
+            raise InputError(f"--tank: no tank named {a.tank!r} (tanks: {', '.join(names) or 'none'})")
+        names = [a.tank]
+    elif not names:
+        raise InputError(f"{a.scene}: the scene has no tanks")
+    # without --tank, every tank in the scene's order, each labelled (`--tank NAME` for one)
+    found = [_tank_json(name, sloshing_modes(scene, tank=name, n=a.n)) for name in names]
     if a.json:
-        print(json.dumps({"tank": tank, "omega": [float(w) for w in modes.omega], "kind": list(modes.kind),
-                          "free_surface_share": [float(s) for s in modes.free_surface_share]}))
-    else:
-        print(f"liquid modes of tank {tank!r} (vessel held fixed):")
+        # one object: the first tank's fields at the top (SPEC's form), every tank's under "tanks"
+        print(json.dumps(dict(found[0], tanks=found) if a.tank is None else found[0]))
+        return EXIT_OK
+    for j, m in enumerate(found):
+        if j:
+            print()
+        print(f"liquid modes of tank {m['tank']!r}"
+              + (f" ({j + 1} of {len(found)})" if len(found) > 1 else "") + " (vessel held fixed):")
         print(f"{'#':>3} {'omega rad/s':>12} {'f Hz':>10} {'period s':>10} {'surface share':>14}  kind")
-        for i, (w, k, s) in enumerate(zip(modes.omega, modes.kind, modes.free_surface_share)):
+        for i, (w, k, s) in enumerate(zip(m["omega"], m["kind"], m["free_surface_share"])):
             f = w / (2 * math.pi)
             print(f"{i + 1:>3} {w:12.5f} {f:10.5f} {1 / f if f > 0 else float('inf'):10.4f} {s:14.3f}  {k}")
     return EXIT_OK
+
+
+def _tank_json(name, modes) -> dict:
+    return {"tank": name, "omega": [float(w) for w in modes.omega], "kind": list(modes.kind),
+            "free_surface_share": [float(s) for s in modes.free_surface_share]}
 
 
 def _structure_modes(scene, a):
@@ -72,7 +84,8 @@ def _coupled_modes(scene, a):
                           "damped_omega": [float(w) for w in m.damped],
                           "damping_ratio": [float(z) for z in m.damping_ratio], "dominant": list(m.dominant),
                           "shares": [{k: float(v) for k, v in s.items()} for s in m.shares],
-                          "radiation": list(m.radiation), "not_oscillating": m.not_oscillating}))
+                          "radiation": list(m.radiation), "not_oscillating": m.not_oscillating,
+                          "label": list(m.label), "penalty_share": [float(p) for p in m.penalty_share]}))
         return EXIT_OK
     print("coupled modes (vessel, liquid and structures, linearised about rest; radiation A(w), B(w) at each "
           "mode's frequency where the tables reach it):")
@@ -81,7 +94,11 @@ def _coupled_modes(scene, a):
     for i in range(len(m.omega)):
         w, wd, z, dom = m.omega[i], m.damped[i], m.damping_ratio[i], m.dominant[i]
         print(f"{i + 1:>3} {w:12.5f} {wd:13.5f} {2 * math.pi / wd:10.4f} {z:9.5f}  {dom:<18} {m.shares[i][dom]:6.3f}  "
-              f"{m.radiation[i]}")
+              f"{m.radiation[i]}" + (f"  <- {m.label[i]}" if m.label[i] != dom else ""))
+    for i in (i for i, lb in enumerate(m.label) if lb == PENALTY_LABEL):
+        print(f"(mode {i + 1}: {PENALTY_LABEL}: {m.penalty_share[i]:.1%} of its potential energy is the liquid "
+              f"element's rotation penalty, which holds the liquid's absolute rotation; an inviscid liquid has no "
+              f"such stiffness: a numerical mode of the element, not one of the ship)")
     if m.not_oscillating:
         print(f"({m.not_oscillating} non-oscillating modes left out: rigid-body modes without restoring, such as "
               f"surge and sway, or overdamped ones)")

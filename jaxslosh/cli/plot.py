@@ -12,14 +12,16 @@ from ..plot.results import plot_result, plot_sweep
 from ..plot.surface import animate_free_surface, plot_free_surface
 from ..run.progress import Progress, wanted
 from .campaign import parse_limits
-from .common import COMMANDS, EXIT_OK, InputError, read, output_folder, positive
+from .common import COMMANDS, EXIT_OK, InputError, figure_file, read, output_folder, positive
 
 
 def add_parsers(sub):
     pl = sub.add_parser("plot", help=COMMANDS["plot"][1])
     pl.add_argument("result")
-    pl.add_argument("-o", "--output", help="figure file (default: the result's name with .png)")
-    pl.add_argument("--surface", metavar="FIG", help="also draw the deformed free surface at a few instants to FIG")
+    pl.add_argument("-o", "--output", help="figure file: .png, .pdf, .svg, ... (default: the result's name with "
+                                           ".png; a name without an extension gets .png)")
+    pl.add_argument("--surface", metavar="FIG", help="also draw the deformed free surface at a few instants to FIG "
+                                                     "(an image name, as -o)")
     pl.add_argument("--animate", metavar="GIF", help="also write an animated GIF of the tanks and their free surface")
     pl.add_argument("--scale", type=float, default=1.0,
                     help="magnify liquid displacements in --surface and --animate (default 1)")
@@ -45,11 +47,11 @@ def cmd_plot(a):
     positive("scale", a.scale)
     positive("fps", a.fps)
     positive("every", a.every)
-    out = a.output or os.path.splitext(a.result)[0] + ".png"
-    for flag, path in (("-o", out), ("--surface", a.surface), ("--animate", a.animate)):
-        output_folder(flag, path)
+    out = figure_file("-o", a.output or os.path.splitext(a.result)[0] + ".png")
+    a.surface = figure_file("--surface", a.surface)
     if a.animate and not a.animate.lower().endswith(".gif"):
         raise InputError(f"--animate: writes a GIF, the file name must end in .gif, got {a.animate!r}")
+    output_folder("--animate", a.animate)
     if fmt == SWEEP_FORMAT:
         return _plot_sweep(a, out)
     if fmt == CAMPAIGN_FORMAT:

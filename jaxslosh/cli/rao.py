@@ -13,7 +13,7 @@ from ..io.rao import RAO_FORMAT, write_rao
 from ..plot.rao import plot_rao
 from ..scene.campaign import not_radians
 from ..scene.types import DOFS
-from .common import COMMANDS, EXIT_OK, InputError, load, output_folder, setup_jax
+from .common import COMMANDS, EXIT_OK, InputError, figure_file, load, setup_jax
 
 
 def add_parsers(sub):
@@ -69,8 +69,7 @@ def cmd_rao(a):
     scene = load(a.scene)
     out = a.output or os.path.splitext(os.path.basename(a.scene))[0] + "_rao.h5"
     replaced = checked_output("-o", out, (a.scene,), (RAO_FORMAT,))
-    if a.plot:
-        output_folder("--plot", a.plot)
+    a.plot = figure_file("--plot", a.plot)
     setup_jax()
     t0 = time.perf_counter()
     r = rao(scene, w, heads)

@@ -7,10 +7,11 @@ from .shapes import TankGeometry, read_mesh
 from .slip import boundary
 
 
-def outline(geo: TankGeometry, fill_depth: float):
+def outline(geo: TankGeometry, fill_depth: float, mesh=None):
     """The tank's outline to draw: polylines (k, 3) in tank-local coordinates (the box's 12 edges, a
     prismatic section at both ends and its corner lines, a cylinder's end circles and four lines
-    along it, a mesh's feature edges, each baffle's plate)."""
+    along it, a mesh's feature edges, each baffle's plate). `mesh` = (nodes, elements) of a mesh
+    tank's liquid (a result keeps them), else its file is read."""
     a, b, H = geo.size
     lines = []
     if geo.kind == "prismatic" or geo.plain_box or geo.kind == "box":
@@ -37,7 +38,7 @@ def outline(geo: TankGeometry, fill_depth: float):
                 seg = np.array([[0.0, s_, z], [L, s_, z]])
                 lines.append(seg if geo.axis == "x" else seg[:, [1, 0, 2]])
     elif geo.kind == "mesh":
-        nodes, elements = read_mesh(geo.file)
+        nodes, elements = (np.asarray(mesh[0], float), np.asarray(mesh[1])) if mesh is not None else read_mesh(geo.file)
         bd = boundary(nodes, elements, float(nodes[:, 2].max()))
         faces = np.concatenate([bd.wall_faces, bd.top_faces])
         X = nodes[faces]

@@ -39,12 +39,16 @@ def write_rao(path: str, frequency, heading, vessel, probes: dict, scene_text: s
             f.attrs["format_version"] = 1
             f.attrs["scene"] = scene_text
             f.attrs["jaxslosh_version"] = __version__
-            f.create_dataset("frequency", data=np.asarray(frequency, dtype=float))
-            f.create_dataset("heading", data=np.asarray(heading, dtype=float))
-            f.create_dataset("rao/vessel", data=np.asarray(vessel, dtype=complex))
+            f.create_dataset("frequency", data=np.asarray(frequency, dtype=float)).attrs["units"] = "rad/s"
+            f.create_dataset("heading", data=np.asarray(heading, dtype=float)).attrs["units"] = "rad"
+            ds = f.create_dataset("rao/vessel", data=np.asarray(vessel, dtype=complex))
+            # per unit wave amplitude: surge, sway, heave m/m (a pure number), roll, pitch, yaw rad/m
+            ds.attrs["units"] = "m/m, m/m, m/m, rad/m, rad/m, rad/m"     # along the last axis
+            ds.attrs["description"] = "complex response per unit wave amplitude: surge, sway, heave (m/m), " \
+                                      "roll, pitch, yaw (rad/m)"
             g = f.create_group("rao/probes")
             for name, v in probes.items():
-                g.create_dataset(name, data=np.asarray(v, dtype=complex))
+                g.create_dataset(name, data=np.asarray(v, dtype=complex)).attrs["units"] = "m/m"
     finally:
         lock.release()
 

@@ -83,6 +83,44 @@ def schema(probe_names=(), tank_nodes: Optional[dict] = None) -> dict:
     return spec
 
 
+#: each dataset's `units` attribute (UDUNITS strings, as xarray and CF readers expect; "1": a pure
+#: number), by the dataset's name with probe and tank names taken out
+UNITS = {"time": "s", "vessel/position": "m", "vessel/quaternion": "1", "vessel/angular_velocity": "rad/s",
+         "vessel/roll_pitch_yaw": "rad", "energy/kinetic": "J", "energy/potential": "J", "solver/iterations": "1",
+         "solver/residual": "m/s^2", "solver/constraint": "m", "probes/position": "m", "probes/displacement": "m",
+         "tanks/displacement": "m", "tanks/nodes": "m", "tanks/elements": "1"}
+
+#: a `description` attribute where the unit alone does not say what a dataset holds
+DESCRIPTIONS = {
+    "vessel/quaternion": "Euler parameters of the attitude, scalar first",
+    "vessel/angular_velocity": "angular velocity in the body frame",
+    "vessel/position": "inertial position of the vessel's centre of gravity",
+    "solver/residual": "largest scaled Newton residual of the steps since the last frame: an acceleration "
+                       "error (m/s^2 on translations, rad/s^2 on rotations)",
+    "solver/iterations": "largest Newton iteration count of the steps since the last frame",
+    "solver/constraint": "largest interface constraint violation of flexible structures (0 without them)",
+    "tanks/displacement": "the liquid's deformational displacement at the nodes, tank frame",
+    "tanks/elements": "hexahedra: 8 node indices each (0-based)",
+}
+
+
+def units_of(key: str) -> str:
+    """The `units` attribute of a result dataset (see UNITS)."""
+    parts = key.split("/")
+    if parts[0] in ("probes", "tanks") and len(parts) == 3:
+        key = f"{parts[0]}/{parts[2]}"
+    return UNITS.get(key, "1")
+
+
+def label(ds, key: str) -> None:
+    """Write a dataset's `units` (and `description`, where one is known) attributes."""
+    ds.attrs["units"] = units_of(key)
+    parts = key.split("/")
+    short = f"{parts[0]}/{parts[2]}" if parts[0] in ("probes", "tanks") and len(parts) == 3 else key
+    if short in DESCRIPTIONS:
+        ds.attrs["description"] = DESCRIPTIONS[short]
+
+
 def result_frames(r: Result) -> dict:
     """The flat {dataset: array} view of a Result, as the file stores it."""
     d = {"time": r.time, "vessel/position": r.vessel.position, "vessel/quaternion": r.vessel.quaternion,
@@ -136,12 +174,13 @@ class ResultWriter:
         a["steps_done"] = 0
         self.n = 0
         for t in tanks:
-            self.f.create_dataset(f"tanks/{t.name}/nodes", data=t.nodes)
-            self.f.create_dataset(f"tanks/{t.name}/elements", data=t.elements)
+            label(self.f.create_dataset(f"tanks/{t.name}/nodes", data=t.nodes), f"tanks/{t.name}/nodes")
+            label(self.f.create_dataset(f"tanks/{t.name}/elements", data=t.elements), f"tanks/{t.name}/elements")
         for k, shape in schema(probe_names, {t.name: t.nodes.shape[0] for t in tanks}).items():
             dtype = "i8" if k == "solver/iterations" else "f8"
-            self.f.create_dataset(k, shape=(0, *shape), maxshape=(None, *shape), dtype=dtype,
-                                  chunks=(max(1, min(1024, 2 ** 20 // (8 * max(1, int(np.prod(shape)))))), *shape))
+            label(self.f.create_dataset(k, shape=(0, *shape), maxshape=(None, *shape), dtype=dtype,
+                                        chunks=(max(1, min(1024, 2 ** 20 // (8 * max(1, int(np.prod(shape)))))),
+                                                *shape)), k)
         self.f.flush()
 
     def append(self, frames: dict, steps_done: int):

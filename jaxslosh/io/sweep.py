@@ -9,7 +9,7 @@ import h5py
 import numpy as np
 
 from .._version import __version__
-from .result import (Result, ResultFileError, attr_str, check_required, open_format, read_frames,
+from .result import (Result, ResultFileError, attr_str, check_required, label, open_format, read_frames,
                      result_from, result_frames, schema)
 
 
@@ -28,7 +28,7 @@ def write_sweep(path, scene, params, result, statuses):
         for k, v in params.items():
             f.create_dataset(f"sweep/{k}", data=np.asarray(v))
         for k, v in result_frames(result).items():
-            f.create_dataset(k, data=v)
+            label(f.create_dataset(k, data=v), k)
 
 
 class Sweep(NamedTuple):

@@ -3,7 +3,11 @@
 from __future__ import annotations
 
 import numpy as np
+from matplotlib import colormaps
 from matplotlib.animation import FuncAnimation, PillowWriter
+from matplotlib.cm import ScalarMappable
+from matplotlib.colors import Normalize
+from mpl_toolkits.mplot3d.art3d import Poly3DCollection
 
 from ..fem.outline import outline
 from ..fem.shapes import TankGeometry
@@ -14,9 +18,18 @@ from ..scene.types import SceneError
 from .results import figure
 
 
+#: the colour scale of the surface's elevation spans at least this share of the largest tank
+#: dimension either side of rest: a surface that stays flat (round-off only) is drawn in one colour
+ELEVATION_FLOOR = 1e-4
+#: the colour map of the elevation: troughs blue, crests red, rest white; an odd number of colours
+#: puts rest in the middle of one (with an even number, round-off either side of 0 flips between two)
+ELEVATION_CMAP = colormaps["RdBu_r"].resampled(255)
+
+
 class _Tanks:
     """What drawing the tanks of a result needs, computed once: each tank's origin, size, free-surface
-    nodes (those at the fill depth) and their triangulation, and the plot's half-width."""
+    nodes (those at the fill depth) and their triangulation, the plot's half-width and the colour
+    scale of the surface's elevation (symmetric about rest, one for the whole record)."""
 
     def __init__(self, r):
         if not r.tanks:
@@ -29,33 +42,57 @@ class _Tanks:
         self.r = r
         self.time = np.asarray(r.time)
         self.tanks = []
+        high = 0.0
         for name, tf in r.tanks.items():
             if name not in scene:
                 raise ValueError(f"the result's scene has no tank named {name!r}")
-            origin = np.asarray(scene[name]["origin"], float)
-            depth = float(scene[name]["fill_depth"])
-            geo = shapes[name].geometry if name in shapes else TankGeometry(size=tuple(scene[name]["size"]))
+            t = scene[name]
+            origin = np.asarray(t["origin"], float)
             nodes = np.asarray(tf.nodes)
-            s, tri = _surface_triangles(nodes, np.asarray(tf.elements), depth)
-            lines = [origin + line for line in outline(geo, depth)]
+            elements = np.asarray(tf.elements)
+            if name in shapes:
+                depth, geo = float(shapes[name].fill_depth), shapes[name].geometry
+            else:
+                # a mesh tank gives no fill_depth: its free surface is its mesh's highest plane (SPEC 5)
+                depth = float(t["fill_depth"]) if "fill_depth" in t else float(nodes[:, 2].max())
+                geo = TankGeometry(kind=t.get("shape", "box"), size=tuple(t["size"]), axis=t.get("axis", "x"))
+            s, tri = _surface_triangles(nodes, elements, depth)
+            # a mesh tank's outline from the liquid mesh the result keeps (its file may be elsewhere now)
+            mesh = (nodes, elements) if geo.kind == "mesh" else None
+            lines = [origin + line for line in outline(geo, depth, mesh)]
             self.tanks.append((name, origin, nodes[s], s, tri, lines))
-        self.span = max(float(np.max(scene[name]["size"])) for name in r.tanks) * 0.75
+            if s.size:
+                high = max(high, float(np.nanmax(np.abs(np.asarray(tf.displacement)[:, s, 2]), initial=0.0)))
+        size = max(float(np.max(scene[name]["size"])) for name in r.tanks)
+        self.span = size * 0.75
+        self.elevation = Normalize(-max(high, ELEVATION_FLOOR * size), max(high, ELEVATION_FLOOR * size))
 
     def index(self, t) -> int:
         """The saved frame nearest to time t."""
         return int(np.argmin(np.abs(self.time - t)))
 
+    def colour_bar(self, fig, scale: float):
+        """The colour bar of the elevation, in its own axes at the figure's right edge."""
+        cax = fig.add_axes((0.92, 0.18, 0.015, 0.64))
+        label = "free-surface elevation (m)" + (", true (not magnified)" if scale != 1 else "")
+        fig.colorbar(ScalarMappable(norm=self.elevation, cmap=ELEVATION_CMAP), cax=cax, label=label)
+        return cax
+
     def draw(self, ax, i: int, scale: float) -> None:
         """Frame i on a 3D axes: the tanks' edges turned and moved with the hull, and each deformed
-        free surface (displacements magnified by `scale`), in the inertial frame around the COG."""
+        free surface (displacements magnified by `scale`), in the inertial frame around the COG,
+        coloured by its elevation above rest (the tank frame's vertical displacement, in metres)."""
         r = self.r
         A = np.asarray(rotation_matrix(np.asarray(r.vessel.quaternion[i])))
         X0 = np.asarray(r.vessel.position[i])
         for name, origin, surface, s, tri, lines in self.tanks:
             D = np.asarray(r.tanks[name].displacement[i])[s]
             p = X0 + (origin + surface + scale * D) @ A.T
-            ax.plot_trisurf(p[:, 0], p[:, 1], p[:, 2], triangles=tri, cmap="Blues", alpha=0.9, linewidth=0.2,
-                            edgecolor="k")
+            if len(tri):
+                faces = Poly3DCollection(p[tri], cmap=ELEVATION_CMAP, norm=self.elevation, alpha=0.9,
+                                         linewidth=0.2, edgecolor="k")
+                faces.set_array(D[:, 2][tri].mean(axis=1))
+                ax.add_collection3d(faces)
             for line in lines:
                 seg = X0 + line @ A.T
                 ax.plot(seg[:, 0], seg[:, 1], seg[:, 2], color="0.3", lw=0.8)
@@ -98,7 +135,8 @@ def plot_free_surface(r, out: str, times=None, scale: float = 1.0):
     for j, i in enumerate(idx):
         tanks.draw(fig.add_subplot(1, len(idx), j + 1, projection="3d"), i, scale)
     fig.suptitle(_surface_title(scale), fontsize=10)
-    fig.tight_layout()
+    fig.tight_layout(rect=(0, 0, 0.9, 1))
+    tanks.colour_bar(fig, scale)
     fig.savefig(out, dpi=100)
     return fig
 
@@ -119,9 +157,10 @@ def animate_free_surface(r, out: str, scale: float = 1.0, fps: float = 10.0, eve
     if not fps > 0:
         raise ValueError(f"fps: must be positive, got {fps}")
     idx = list(range(0, n, int(every)))
-    fig = figure(5.0, 5.0)
-    ax = fig.add_subplot(projection="3d")
+    fig = figure(5.6, 5.0)
+    ax = fig.add_axes((0.0, 0.0, 0.88, 0.92), projection="3d")
     fig.suptitle(_surface_title(scale), fontsize=10)
+    tanks.colour_bar(fig, scale)
 
     def frame(i):
         ax.cla()

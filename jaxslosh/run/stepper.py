@@ -71,7 +71,11 @@ class Stepper(eqx.Module):
         return rpy_from_quat(state.s.c.q)
 
     def probe(self, state: Carry, name: str):
-        """The inertial position of a probe's material point."""
+        """The inertial position of a probe's material point. An unknown name: ValueError naming the
+        scene's probes."""
+        if name not in self.probe_names:
+            raise ValueError(f"no probe named {name!r}; the scene's probes: "
+                             f"{', '.join(self.probe_names) if self.probe_names else 'none'}")
         return self.observe(state).probes[self.probe_names.index(name)]
 
     def status(self, state: Carry) -> str:

@@ -47,7 +47,7 @@ def run_to_file(scene: Scene, out: str, *, progress: bool = True,
     the phases on stderr."""
     bar = Progress(enabled=progress)
     status, code, steps_written = "ok", Status.OK, 0
-    watch = Watch(scene)
+    watch = None
     writer = None
     try:
         with interrupts() as stop:
@@ -56,6 +56,7 @@ def run_to_file(scene: Scene, out: str, *, progress: bool = True,
             key = model_key(scene)
             setup = prepare(scene) if key is None else cached("model", key, lambda: prepare(scene))
             b, solver = setup.built, setup.solver
+            watch = Watch(scene, np.asarray(solver.noise))
             se = setup.save_every
             n_frames = setup.n_steps // se
             N = b.system.liquid.n_nodes
@@ -76,7 +77,7 @@ def run_to_file(scene: Scene, out: str, *, progress: bool = True,
                 ok = ~np.asarray(pending.failed)
                 n_ok = int(ok.sum()) if ok.all() else int(np.argmin(ok))
                 rows = jax.tree_util.tree_map(lambda x: x[:n_ok], pending)
-                watch.update(rows.t, rows.surface, rows.residual)
+                watch.update(rows.t, rows.surface, rows.residual, rows.D)
                 steps = min(int(carry.k), setup.n_steps)
                 writer.append({k: np.asarray(v) for k, v in frame_datasets(b, rows, p0, save_fields).items()}, steps)
                 steps_written = steps
@@ -103,7 +104,7 @@ def run_to_file(scene: Scene, out: str, *, progress: bool = True,
         status, code = f"disk full ({_reason(e)})", Status.DISK_FULL
     finally:
         times = bar.close()
-        warnings = tuple(watch.warnings())
+        warnings = tuple(watch.warnings()) if watch is not None else ()
         if writer is not None:
             try:
                 writer.close(status, steps_written, code, warnings)
