@@ -242,6 +242,7 @@ class Hull:
     kg: float = 0.0                  # m, COG above the keel (box)
     file: str = ""                   # mesh file (type = "mesh"), relative to the scene's folder
     cog: tuple[float, float, float] = (0.0, 0.0, 0.0)   # the COG in the mesh's coordinates (type = "mesh")
+    depth: Optional[float] = None    # m, keel to deck (box; SPEC section 8): large angles immerse the deck edge
 
 
 @dataclass(frozen=True)

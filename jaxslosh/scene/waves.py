@@ -85,6 +85,7 @@ def read_hull(table) -> Hull:
     v = read(table, where, {
         "type": ("str", one_of(HULL_TYPES)), "length": ("float", positive), "beam": ("float", positive),
         "draft": ("float", positive), "kg": ("float", None), "file": ("str", None), "cog": ("vec3", None),
+        "depth": ("float", positive),
     })
     kind = v.get("type", "box")
     if kind == "box":
@@ -96,8 +97,12 @@ def read_hull(table) -> Hull:
                 raise SceneError(f"{where}.{k}", 'is a key of type = "mesh" hulls, not of a box')
         if v["kg"] <= 0:
             raise SceneError(f"{where}.kg", f"the COG must lie above the keel (kg > 0), got {show(v['kg'])}")
-        return Hull(type="box", length=v["length"], beam=v["beam"], draft=v["draft"], kg=v["kg"])
-    for k in ("length", "beam", "draft", "kg"):
+        if "depth" in v and v["depth"] <= v["draft"]:
+            raise SceneError(f"{where}.depth", f"the deck must lie above the waterline: depth {show(v['depth'])} m "
+                                               f"is not above the draft {show(v['draft'])} m")
+        return Hull(type="box", length=v["length"], beam=v["beam"], draft=v["draft"], kg=v["kg"],
+                    depth=v.get("depth"))
+    for k in ("length", "beam", "draft", "kg", "depth"):
         if k in v:
             raise SceneError(f"{where}.{k}", 'is a key of box hulls, not of type = "mesh"')
     if "file" not in v:
