@@ -14,7 +14,7 @@ LAYERS = [
     {"fem.shapes"},
     {"hydro", "io"},
     {"scene"},
-    {"fem"},
+    {"fem", "hull"},
     {"physics"},
     {"solve"},
     {"build"},
