@@ -65,7 +65,9 @@ def cmd_stability(a):
     if s.criteria:
         print("IS Code 2008 Part A 2.2 (liquids level):")
         for c in s.criteria:
-            print(f"  {'pass' if c.passed else 'FAIL'}  {c.name:<30} {c.value:10.5f}  (>= {c.limit:.5g})")
+            deg = f"  ({np.degrees(c.value):.2f} deg >= {np.degrees(c.limit):.0f})" if "(rad)" in c.name and \
+                "angle" in c.name else ""
+            print(f"  {'pass' if c.passed else 'FAIL'}  {c.name:<30} {c.value:10.5f}  (>= {c.limit:.5g}){deg}")
     else:
         print("IS Code 2008 Part A 2.2: criteria for heel about the roll axis only")
     if a.output:
