@@ -17,10 +17,11 @@ def plot_stability(s, out: str, title: str = ""):
     ax.plot([0, np.degrees(1.0)], [0, s.gm0], color="C0", lw=0.7, ls=":", label=f"GM0 = {s.gm0:.3f} m at 1 rad")
     ax.axhline(0.0, color="k", lw=0.6)
     if s.criteria:
-        sel = (deg >= 0) & (deg <= 40)
-        ax.fill_between(deg[sel], 0, np.asarray(s.gz)[sel], where=deg[sel] <= 30, color="C0", alpha=0.12,
+        eps = 1e-9                          # degrees from radians: 30 may come back as 29.999...
+        sel = (deg >= -eps) & (deg <= 40 + eps)
+        ax.fill_between(deg[sel], 0, np.asarray(s.gz)[sel], where=deg[sel] <= 30 + eps, color="C0", alpha=0.12,
                         label="areas 0-30, 30-40 deg")
-        ax.fill_between(deg[sel], 0, np.asarray(s.gz)[sel], where=deg[sel] >= 30, color="C0", alpha=0.25)
+        ax.fill_between(deg[sel], 0, np.asarray(s.gz)[sel], where=deg[sel] >= 30 - eps, color="C0", alpha=0.25)
         ax.plot([30, max(deg.max(), 30)], [0.20, 0.20], color="C3", lw=0.8, label="GZ 0.20 m at >= 30 deg")
         ax.axvline(25, color="C3", lw=0.8, ls=":", label="max GZ at >= 25 deg")
         lines = [f"{'pass' if c.passed else 'FAIL'}  {c.name}\n      {c.value:.4f} (>= {c.limit:.4g})"
@@ -30,10 +31,10 @@ def plot_stability(s, out: str, title: str = ""):
     if s.vanishing_angle is not None:
         ax.axvline(np.degrees(s.vanishing_angle), color="k", lw=0.7, ls="--")
         ax.annotate(f"vanishing {np.degrees(s.vanishing_angle):.1f} deg", (np.degrees(s.vanishing_angle), 0),
-                    xytext=(4, 8), textcoords="offset points", fontsize=8)
+                    xytext=(-4, 8), textcoords="offset points", fontsize=8, ha="right")
     ax.set_xlabel(f"heel about the {s.axis} axis (deg)")
     ax.set_ylabel("GZ (m)")
-    ax.legend(fontsize=7, loc="lower left")
+    fig.legend(*ax.get_legend_handles_labels(), fontsize=7, loc="lower left", bbox_to_anchor=(0.69, 0.02))
     ax.grid(alpha=0.3)
     ax.set_title(title or "righting lever", fontsize=10)
     fig.savefig(out, dpi=100)
