@@ -1,1 +1,2 @@
-"""The hull as a closed surface: its geometry, clipping at a plane, and the large-angle hydrostatics."""
+"""Closed hull and tank surfaces cut by a plane (PHYSICS section 5): exact, differentiable clipping
+of triangulated surfaces (`clip`), the box hull's surface (`box`), the GZ curve (`stability`)."""

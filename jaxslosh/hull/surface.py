@@ -14,41 +14,11 @@ import os
 
 import numpy as np
 
+from .box import box_hull
+
 
 class HullMeshError(ValueError):
     """A hull mesh that cannot serve the large-angle hydrostatics: the message names the fault."""
-
-
-def _grid(a, b, na, nb):
-    """Triangles of the rectangle spanned by vectors a, b (from the origin) in na x nb cells,
-    counter-clockwise about a x b."""
-    s = np.linspace(0.0, 1.0, na + 1)
-    t = np.linspace(0.0, 1.0, nb + 1)
-    P = s[:, None, None] * a + t[None, :, None] * b           # (na+1, nb+1, 3)
-    p00, p10, p01, p11 = P[:-1, :-1], P[1:, :-1], P[:-1, 1:], P[1:, 1:]
-    t1 = np.stack([p00, p10, p11], axis=-2).reshape(-1, 3, 3)
-    t2 = np.stack([p00, p11, p01], axis=-2).reshape(-1, 3, 3)
-    return np.concatenate([t1, t2])
-
-
-def box_surface(length, beam, depth, kg, divisions=(1, 1, 1)):
-    """The closed surface of a box hull L x B x D (keel to deck), centred on the COG in plan, the
-    COG `kg` above the keel: (n, 3, 3) triangles, outward normals. `divisions` (nx, ny, nz) cells
-    along each edge (the still-water force is exact with one; the wave pressure's quadrature wants
-    panels small against the wave length)."""
-    L, B, D = float(length), float(beam), float(depth)
-    nx, ny, nz = (int(n) for n in divisions)
-    lo = np.array([-0.5 * L, -0.5 * B, -float(kg)])
-    ex, ey, ez = np.array([L, 0, 0.0]), np.array([0, B, 0.0]), np.array([0, 0, D])
-    faces = [
-        lo + _grid(ey, ex, ny, nx),                # keel, n = -z
-        lo + ez + _grid(ex, ey, nx, ny),           # deck, n = +z
-        lo + _grid(ex, ez, nx, nz),                # y = -B/2, n = -y
-        lo + ey + _grid(ez, ex, nz, nx),           # y = +B/2, n = +y
-        lo + _grid(ez, ey, nz, ny),                # x = -L/2, n = -x
-        lo + ex + _grid(ey, ez, ny, nz),           # x = +L/2, n = +x
-    ]
-    return np.concatenate(faces)
 
 
 def enclosed_volume(tris):
@@ -159,7 +129,7 @@ def hull_triangles(hull, divisions=(1, 1, 1)):
     the box with its deck (`divisions` cells along its edges), or the mesh file (read once per
     file version). HullMeshError names the file and the fault."""
     if hull.type == "box":
-        return box_surface(hull.length, hull.beam, hull.depth, hull.kg, divisions)
+        return box_hull(hull.length, hull.beam, hull.kg, hull.depth, divisions)
     path = hull.path()
     try:
         mtime = os.path.getmtime(path)

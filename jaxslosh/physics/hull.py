@@ -145,6 +145,7 @@ class HullPressure(AbstractTerm):
         return self.rho_w * self.gravity * (V * (self.z_water - k.c.X0[2]) - k.A[2] @ m)
 
 
+@eqx.filter_jit
 def rest_stiffness(term: HullPressure):
     """The 6 x 6 hydrostatic stiffness of the still-water pressure at the rest pose (X0 = 0, upright):
     minus the derivative of its rows along the step's increments (translations, body rotations)."""
@@ -161,7 +162,7 @@ def rest_hydrostatics(tris, z_water, rho=1025.0, g=9.81) -> dict:
     and the centre of buoyancy (body frame). Host-side floats."""
     term = HullPressure(jnp.asarray(tris, dtype=float), jnp.asarray(rho, dtype=float), jnp.asarray(g, dtype=float),
                         jnp.asarray(z_water, dtype=float))
-    V, m = term.buoyancy(jnp.zeros(3), jnp.eye(3))
+    V, m = eqx.filter_jit(term.buoyancy)(jnp.zeros(3), jnp.eye(3))
     K = rest_stiffness(term)
     V = float(V)
     rg = rho * g

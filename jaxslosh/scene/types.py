@@ -248,7 +248,7 @@ class Hull:
     kg: float = 0.0                  # m, COG above the keel (box)
     file: str = ""                   # mesh file (type = "mesh"), relative to the scene's folder
     cog: tuple[float, float, float] = (0.0, 0.0, 0.0)   # the COG in the mesh's coordinates (type = "mesh")
-    depth: Optional[float] = None    # m, keel to deck (box; required by the nonlinear hydrostatics)
+    depth: Optional[float] = None    # m, keel to deck (box; SPEC section 8): large angles immerse the deck edge
     base_dir: str = ""               # the scene's folder (a mesh file is relative to it)
 
     def path(self) -> str:

@@ -98,10 +98,10 @@ def read_hull(table, base_dir: str = "") -> Hull:
         if v["kg"] <= 0:
             raise SceneError(f"{where}.kg", f"the COG must lie above the keel (kg > 0), got {show(v['kg'])}")
         if "depth" in v and v["depth"] <= v["draft"]:
-            raise SceneError(f"{where}.depth", f"{show(v['depth'])} m (keel to deck) must exceed the draft "
-                                               f"{show(v['draft'])} m: the deck lies above the waterline")
-        return Hull(type="box", length=v["length"], beam=v["beam"], draft=v["draft"], kg=v["kg"], depth=v.get("depth"),
-                    base_dir=base_dir)
+            raise SceneError(f"{where}.depth", f"the deck must lie above the waterline: depth {show(v['depth'])} m "
+                                               f"is not above the draft {show(v['draft'])} m")
+        return Hull(type="box", length=v["length"], beam=v["beam"], draft=v["draft"], kg=v["kg"],
+                    depth=v.get("depth"), base_dir=base_dir)
     for k in ("length", "beam", "draft", "kg", "depth"):
         if k in v:
             raise SceneError(f"{where}.{k}", 'is a key of box hulls, not of type = "mesh"')
