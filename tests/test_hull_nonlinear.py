@@ -317,3 +317,47 @@ def test_small_waves_give_the_linear_froude_krylov_force():
         got = np.concatenate([F - F0, M - M0])
         want = a * np.real(X * np.exp(1j * 2 * math.pi / 5.0 * t))
         np.testing.assert_allclose(got, want, atol=0.02 * a * np.abs(X).max())
+
+
+# ------------------------------------------------------------------------------------------------
+# capsize
+
+def _section_gz(phi):
+    """GZ of the box's section at heel phi, free to sink: bisection on the COG height for the displacement."""
+    c, sn = math.cos(phi), math.sin(phi)
+    corners = np.array([[-B / 2, -KG], [B / 2, -KG], [B / 2, D - KG], [-B / 2, D - KG]])
+    lo, hi = -20.0, 20.0
+    for _ in range(100):
+        z0 = 0.5 * (lo + hi)
+        P = np.stack([c * corners[:, 0] - sn * corners[:, 1], z0 + sn * corners[:, 0] + c * corners[:, 1]], axis=1)
+        Q = _clip_polygon(P, T - KG)
+        A, (yc, _) = _area_centroid(Q) if len(Q) > 2 else (0.0, (0.0, 0.0))
+        lo, hi = (z0, hi) if A > B * T else (lo, z0)
+    return -yc
+
+
+def test_vanishing_angle_of_the_box_equals_the_exact_section():
+    from jaxslosh.analysis.capsize import vanishing_angles
+    roll, _ = vanishing_angles(build(box_scene()).system)
+    phis = np.radians(np.arange(60.0, 90.0, 0.5))
+    gz = np.array([_section_gz(p) for p in phis])
+    i = int(np.flatnonzero(gz <= 0)[0])
+    exact = phis[i - 1] + (phis[i] - phis[i - 1]) * gz[i - 1] / (gz[i - 1] - gz[i])
+    assert abs(roll - exact) < math.radians(0.05)
+
+
+def test_a_run_past_the_vanishing_angle_says_it_capsized(tmp_path):
+    """Released at 70 degrees rolling on at 0.5 rad/s, the box (vanishing angle 75 degrees) goes over;
+    released at 25 degrees it does not."""
+    import h5py
+
+    from jaxslosh.run.tofile import run_to_file
+    extra = "angular_velocity = [0.5, 0.0, 0.0]\n"
+    over = run_to_file(box_scene(duration=4.0, dt=0.05, roll=math.radians(70.0), extra=extra), str(tmp_path / "a.h5"),
+                       progress=False)
+    assert any(w.startswith("capsized: the roll reached") and "vanishing stability 75.1 deg" in w for w in over.warnings)
+    with h5py.File(tmp_path / "a.h5") as f:
+        assert any(w.startswith("capsized") for w in f.attrs["warnings"])
+    upright = run_to_file(box_scene(duration=4.0, dt=0.05, roll=math.radians(25.0)), str(tmp_path / "b.h5"),
+                          progress=False)
+    assert not any("capsized" in w for w in upright.warnings)
