@@ -141,3 +141,38 @@ def hull_triangles(hull, divisions=(1, 1, 1)):
 def water_height(hull) -> float:
     """The still water plane's height in the vessel frame at rest (the COG at the origin)."""
     return hull.draft - hull.kg if hull.type == "box" else -float(hull.cog[2])
+
+
+def prism_surface(section, length, nx=1, nz=1):
+    """A closed prism along x (length centred on x = 0) of a convex section polygon `section` (k, 2):
+    (y, z) counter-clockwise in the (y, z) plane; `nx` cells along the length, each side of the
+    section cut into `nz` cells (`loft_surface` with one section)."""
+    x = np.linspace(-0.5 * length, 0.5 * length, nx + 1)
+    return loft_surface(x, np.broadcast_to(refine_outline(section, nz), (nx + 1,) + refine_outline(section, nz).shape))
+
+
+def refine_outline(section, n):
+    """A polygon (k, 2) with each side cut into n pieces: (k n, 2)."""
+    S = np.asarray(section, dtype=float)
+    return np.array([S[i] + (S[(i + 1) % len(S)] - S[i]) * s for i in range(len(S)) for s in np.arange(n) / n])
+
+
+def loft_surface(x, sections):
+    """A closed hull lofted through stations x (s,) ascending, with the convex sections (s, m, 2)
+    ((y, z), counter-clockwise in the (y, z) plane, the same number of points at each station):
+    quadrilaterals between stations split into triangles, the end faces fanned from their
+    centroids; outward normals. Flared or V-shaped hulls for tests, examples and benchmarks."""
+    x = np.asarray(x, dtype=float)
+    P = np.asarray(sections, dtype=float)
+    s, m = P.shape[:2]
+    Q = np.concatenate([np.broadcast_to(x[:, None, None], (s, m, 1)), P], axis=2)    # (s, m, 3)
+    j = np.arange(m)
+    k = (j + 1) % m
+    a, b, c, d = Q[:-1, j], Q[:-1, k], Q[1:, k], Q[1:, j]
+    sides = np.concatenate([np.stack([a, c, d], axis=-2), np.stack([a, b, c], axis=-2)]).reshape(-1, 3, 3)
+    ends = []
+    for i, sign in ((0, -1), (s - 1, 1)):
+        o = np.broadcast_to(Q[i].mean(axis=0), (m, 3))
+        tri = np.stack([o, Q[i, j], Q[i, k]], axis=1)
+        ends.append(tri if sign > 0 else tri[:, ::-1])
+    return np.concatenate([sides] + ends)
