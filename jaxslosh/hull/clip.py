@@ -25,7 +25,7 @@ from __future__ import annotations
 
 import jax.numpy as jnp
 
-__all__ = ["clip_below", "submerged", "pressure_force_moment", "integrate_pressure",
+__all__ = ["clip_below", "submerged", "submerged_and_cut", "pressure_force_moment", "integrate_pressure",
            "area_vectors", "triangulate_quads", "MIDPOINT_RULE"]
 
 #: barycentric points and weights (summing to 1) of the degree-2 rule on a triangle (edge midpoints)
@@ -101,6 +101,15 @@ def submerged(tris, normal, offset):
 
     `tris` the closed surface (n, 3, 3), outward; the centre of that volume is first_moment /
     volume. Exact (up to rounding) for any pose: see the module's docstring for the fields."""
+    volume, moment, _ = submerged_and_cut(tris, normal, offset)
+    return volume, moment
+
+
+def submerged_and_cut(tris, normal, offset):
+    """(volume, first_moment (3,), cut_area) below the plane: `submerged` and the area of the
+    body's section by the plane (the unmeshed lid), which is d volume / d offset. The lid's area
+    comes from the wetted pieces too: the flux of the constant field n through the closed clipped
+    body vanishes, so the lid's n . N dS (= dS) is minus the wetted pieces' sum."""
     n, off = _unit_plane(normal, offset)
     pieces = clip_below(tris, n, off).reshape(-1, 3, 3)
     an = area_vectors(pieces) @ n                                  # (n . N) dS per piece
@@ -109,7 +118,7 @@ def submerged(tris, normal, offset):
     volume = jnp.sum(an * (zeta @ w))
     m_zeta = jnp.sum(an * ((0.5 * zeta ** 2) @ w))
     m_x = jnp.einsum("m,mq,mqx,q->x", an, zeta, x, w)
-    return volume, m_x - n * m_zeta
+    return volume, m_x - n * m_zeta, -jnp.sum(an)
 
 
 def integrate_pressure(pieces, pressure, point, rule=MIDPOINT_RULE):
