@@ -337,7 +337,7 @@ def _section_gz(phi):
 
 
 def test_vanishing_angle_of_the_box_equals_the_exact_section():
-    from jaxslosh.analysis.capsize import vanishing_angles
+    from jaxslosh.run.capsize import vanishing_angles
     roll, _ = vanishing_angles(build(box_scene()).system)
     phis = np.radians(np.arange(60.0, 90.0, 0.5))
     gz = np.array([_section_gz(p) for p in phis])

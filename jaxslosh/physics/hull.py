@@ -35,8 +35,8 @@ import equinox as eqx
 import jax
 import jax.numpy as jnp
 
-from ..hull.clip import clip_below, integrate_pressure, submerged
-from .kinematics import quat_exp, rotation_matrix
+from ..hull.clip import clip_below, integrate_pressure
+from ..hull.hydrostatics import buoyancy, still_force_moment
 from .terms import AbstractTerm, Kin, Rows
 
 
@@ -100,13 +100,11 @@ class HullPressure(AbstractTerm):
 
     def buoyancy(self, X0, A):
         """(V, m): displaced volume and its first moment about the COG (body frame) in still water."""
-        return submerged(self.tris, A[2], self.z_water - X0[2])
+        return buoyancy(self.tris, self.z_water, X0, A)
 
     def still_force_moment(self, X0, A):
         """F (inertial) and M (body, about the COG) of the still-water pressure."""
-        V, m = self.buoyancy(X0, A)
-        rg = self.rho_w * self.gravity
-        return jnp.array([0.0, 0.0, rg * V]), jnp.cross(m, rg * A[2])
+        return still_force_moment(self.tris, self.z_water, self.rho_w * self.gravity, X0, A)
 
     def wave_force_moment(self, X0, A, t):
         """F (inertial) and M (body) of the total pressure (hydrostatic and incident) on the part of
@@ -144,28 +142,3 @@ class HullPressure(AbstractTerm):
         V, m = self.buoyancy(k.c.X0, k.A)
         return self.rho_w * self.gravity * (V * (self.z_water - k.c.X0[2]) - k.A[2] @ m)
 
-
-@eqx.filter_jit
-def rest_stiffness(term: HullPressure):
-    """The 6 x 6 hydrostatic stiffness of the still-water pressure at the rest pose (X0 = 0, upright):
-    minus the derivative of its rows along the step's increments (translations, body rotations)."""
-    def rows(x):
-        A = rotation_matrix(quat_exp(x[3:]))
-        F, M = term.still_force_moment(x[:3], A)
-        return jnp.concatenate([F, M])
-    return -jax.jacfwd(rows)(jnp.zeros(6))
-
-
-def rest_hydrostatics(tris, z_water, rho=1025.0, g=9.81) -> dict:
-    """The linear model of the same hull (eqs. 33-38): displaced volume, waterplane area, GM_T and GM_L
-    from the still-water stiffness at rest (K33 = rho g A_w, K44 = rho g V GM_T, K55 = rho g V GM_L),
-    and the centre of buoyancy (body frame). Host-side floats."""
-    term = HullPressure(jnp.asarray(tris, dtype=float), jnp.asarray(rho, dtype=float), jnp.asarray(g, dtype=float),
-                        jnp.asarray(z_water, dtype=float))
-    V, m = eqx.filter_jit(term.buoyancy)(jnp.zeros(3), jnp.eye(3))
-    K = rest_stiffness(term)
-    V = float(V)
-    rg = rho * g
-    return {"waterplane_area": float(K[2, 2]) / rg, "displaced_volume": V,
-            "gm_t": float(K[3, 3]) / (rg * V) if V > 0 else 0.0, "gm_l": float(K[4, 4]) / (rg * V) if V > 0 else 0.0,
-            "centre_of_buoyancy": tuple(float(x) / V if V > 0 else 0.0 for x in m)}

@@ -15,13 +15,13 @@ from typing import NamedTuple, Optional
 import jax
 import numpy as np
 
-from ..analysis.capsize import vanishing_angles
 from ..io.output import is_disk_full
 from ..io.result import ResultWriter
 from ..io.status import Status
 from ..programs import cached
 from ..scene.types import Scene
 from .guard import Interrupted, interrupts
+from .capsize import vanishing_angles
 from .compiled import compile_run
 from .loop import core, frame_datasets
 from .progress import Progress

@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from ..hull.hydrostatics import rest_hydrostatics
 from ..hull.surface import HullMeshError, hull_triangles, water_height
 from ..hydro.box import box_hydrostatics
 from .fields import show
@@ -40,8 +41,6 @@ def nonlinear_hydrostatics(v: dict, hull, environment, warnings: list[str]) -> d
 
 
 def mesh_hydrostatics(hull, environment, warnings: list[str]) -> dict:
-    from ..physics.hull import rest_hydrostatics   # jax: only for a nonlinear mesh hull
-
     try:
         tris = hull_triangles(hull)
     except HullMeshError as e:
