@@ -3,38 +3,40 @@ from __future__ import annotations
 
 import numpy as np
 
-# the 8 corners of the unit cube by bits (x, y, z), and its 6 faces counter-clockwise from outside
-_CORNERS = np.array([[(i >> 0) & 1, (i >> 1) & 1, (i >> 2) & 1] for i in range(8)], dtype=float)
-_FACES = np.array([
-    [0, 2, 3, 1],   # z-
-    [4, 5, 7, 6],   # z+
-    [0, 1, 5, 4],   # y-
-    [2, 6, 7, 3],   # y+
-    [0, 4, 6, 2],   # x-
-    [1, 3, 7, 5],   # x+
-])
+
+def _grid(a, b, na, nb):
+    """Triangles of the rectangle spanned by vectors a, b (from the origin) in na x nb cells,
+    counter-clockwise about a x b."""
+    s = np.linspace(0.0, 1.0, na + 1)
+    t = np.linspace(0.0, 1.0, nb + 1)
+    P = s[:, None, None] * a + t[None, :, None] * b           # (na+1, nb+1, 3)
+    p00, p10, p01, p11 = P[:-1, :-1], P[1:, :-1], P[:-1, 1:], P[1:, 1:]
+    t1 = np.stack([p00, p10, p11], axis=-2).reshape(-1, 3, 3)
+    t2 = np.stack([p00, p11, p01], axis=-2).reshape(-1, 3, 3)
+    return np.concatenate([t1, t2])
 
 
 def box_surface(lo, hi, n=1):
-    """The closed surface of the box [lo, hi] as (12 n^2, 3, 3) triangles, outward normals; each
-    face cut into n x n squares (a finer surface only for tests and figures: the clipping is exact
-    on any)."""
+    """The closed surface of the box [lo, hi] as triangles (m, 3, 3), outward normals, faces in the
+    order z-, z+, y-, y+, x-, x+; `n` cells along every edge, or (nx, ny, nz) along x, y and z (the
+    clipping is exact on any; the wave pressure's quadrature wants panels small against the wave
+    length)."""
     lo, hi = np.asarray(lo, float), np.asarray(hi, float)
-    s = np.linspace(0.0, 1.0, n + 1)
-    tris = []
-    for f in _FACES:
-        c = _CORNERS[f]                        # 4 corners of the face, counter-clockwise
-        o, u, v = c[0], c[1] - c[0], c[3] - c[0]
-        for i in range(n):
-            for j in range(n):
-                p = [o + s[i] * u + s[j] * v, o + s[i + 1] * u + s[j] * v,
-                     o + s[i + 1] * u + s[j + 1] * v, o + s[i] * u + s[j + 1] * v]
-                tris += [[p[0], p[1], p[2]], [p[0], p[2], p[3]]]
-    return lo + np.asarray(tris) * (hi - lo)
+    nx, ny, nz = (int(n),) * 3 if np.ndim(n) == 0 else (int(k) for k in n)
+    e = np.diag(hi - lo)
+    ex, ey, ez = e[0], e[1], e[2]
+    return np.concatenate([
+        lo + _grid(ey, ex, ny, nx),                # z-
+        lo + ez + _grid(ex, ey, nx, ny),           # z+
+        lo + _grid(ex, ez, nx, nz),                # y-
+        lo + ey + _grid(ez, ex, nz, nx),           # y+
+        lo + _grid(ez, ey, nz, ny),                # x-
+        lo + ex + _grid(ey, ez, ny, nz),           # x+
+    ])
 
 
-def box_hull(length, beam, kg, depth):
+def box_hull(length, beam, kg, depth, n=1):
     """The box hull in the vessel frame (origin at the COG): x from -length/2 to length/2 (the COG
-    amidships), y from -beam/2 to beam/2 (on the centre line), z from the keel at -kg to the deck
-    at depth - kg."""
-    return box_surface([-length / 2, -beam / 2, -kg], [length / 2, beam / 2, depth - kg])
+    amidships), y from -beam/2 to beam/2 (on the centre line), z from the keel at -kg up to the deck
+    at depth - kg; `n` as `box_surface`."""
+    return box_surface([-length / 2, -beam / 2, -kg], [length / 2, beam / 2, depth - kg], n)

@@ -1,11 +1,13 @@
 """Whether a run stayed where its model holds: the linear liquid's free surface inside its tank, the
-Newton residual at the tolerance. What is found goes into the summary and the result file's
+Newton residual at the tolerance; and whether the vessel capsized (heeled past its angle of
+vanishing stability, with the nonlinear hydrostatics: analysis/capsize.py). What is found goes into the summary and the result file's
 `warnings` attribute (the run itself is not stopped: its numbers may still be what the user wants
 to see)."""
 from __future__ import annotations
 
 import numpy as np
 
+from ..physics.kinematics import rpy_from_quat
 from ..scene.types import Scene
 
 #: a frame residual this many times the tolerance is reported (the iterations accept a stall at
@@ -24,12 +26,28 @@ class Watch:
         self.t_low = np.zeros(n)
         self.t_high = np.zeros(n)
         self.residual, self.t_residual = 0.0, 0.0
+        self.vanishing = None                    # (roll, pitch) angles of vanishing stability, rad (or None)
+        self.heel = np.zeros(2)                  # largest |roll|, |pitch| seen past them, and when
+        self.t_heel = np.zeros(2)
+        self.capsized = [False, False]
 
-    def update(self, time, surface, residual):
-        """time (k,), surface (k, tanks, 2), residual (k,) of the frames just computed."""
+    def watch_capsize(self, angles) -> None:
+        """Check the frames' roll and pitch against these angles of vanishing stability (rad; None
+        where the hull has none)."""
+        self.vanishing = angles
+
+    def update(self, time, surface, residual, q=None):
+        """time (k,), surface (k, tanks, 2), residual (k,) and the attitudes q (k, 4) of the frames just computed."""
         time = np.asarray(time)
         if time.size == 0:
             return
+        if self.vanishing is not None and q is not None:
+            rp = np.abs(np.asarray(rpy_from_quat(np.asarray(q)))[:, :2])
+            for axis, limit in enumerate(self.vanishing):
+                j = int(np.argmax(rp[:, axis]))
+                if limit is not None and rp[j, axis] > limit and not self.capsized[axis]:
+                    self.capsized[axis] = True
+                    self.heel[axis], self.t_heel[axis] = rp[j, axis], time[j]
         surface = np.asarray(surface).reshape(time.size, -1, 2)
         for i in range(self.low.size):
             j, k = int(np.argmin(surface[:, i, 0])), int(np.argmax(surface[:, i, 1]))
@@ -44,6 +62,12 @@ class Watch:
 
     def warnings(self) -> list[str]:
         out = []
+        for axis, name in enumerate(("roll", "pitch")):
+            if self.capsized[axis]:
+                out.append(f"capsized: the {name} reached {np.degrees(self.heel[axis]):.1f} deg at t = "
+                           f"{self.t_heel[axis]:.4g} s, past the hull's angle of vanishing stability "
+                           f"{np.degrees(self.vanishing[axis]):.1f} deg (its GZ at the ship's displacement, free to "
+                           f"sink, tank liquid frozen): the vessel capsized")
         for i, t in enumerate(self.scene.tanks[:self.low.size]):
             if not np.isfinite(self.low[i]):
                 continue
