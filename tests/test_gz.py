@@ -203,6 +203,45 @@ def test_json_fields_and_figure(tmp_path, capsys):
     assert fine["gm0"] == pytest.approx(out["gm0"], rel=1e-12)
 
 
+def _mesh_scene(path, open_deck=False):
+    """The box of _scene as a mesh hull file: its coordinates with the waterline at z = 0 (draft
+    2.5 m), the COG at kg - 2.5 above it."""
+    from jaxslosh.hull.box import box_hull
+    from jaxslosh.hull.surface import write_hull_mesh
+    cog = np.array([0.0, 0.0, KG - 2.5])
+    tris = box_hull(L, B, KG, D, 2) + cog
+    if open_deck:
+        tris = tris[~np.all(np.isclose(tris[:, :, 2], D - 2.5), axis=1)]
+    write_hull_mesh(str(path), tris)
+    # the loader reads a mesh hull for Capytaine or the nonlinear hydrostatics (it then checks it is closed)
+    text = _scene(hull=False)
+    return text[:text.index("[vessel.hydrostatics]")] + f"""[vessel.hull]
+type = "mesh"
+file = "{path}"
+cog = {cog.tolist()}
+[vessel.hydrostatics]
+model = "nonlinear"
+"""
+
+
+def test_mesh_hull_is_the_box(tmp_path):
+    pytest.importorskip("meshio")
+    angles = np.radians([0.0, 15.0, 35.0, 60.0])
+    mesh = js.stability(_mesh_scene(tmp_path / "box.obj"), angles)
+    box = js.stability(_scene(), angles)
+    np.testing.assert_allclose(mesh.gz, box.gz, atol=1e-9)
+    assert mesh.gm0 == pytest.approx(box.gm0, rel=1e-9)
+
+
+def test_open_mesh_hull_exit_2(tmp_path, capsys):
+    pytest.importorskip("meshio")
+    path = tmp_path / "s.toml"
+    path.write_text(_mesh_scene(tmp_path / "open.obj", open_deck=True))
+    assert main(["stability", str(path)]) == 2
+    err = capsys.readouterr().err.strip().splitlines()[-1]
+    assert err.startswith("error: vessel.hull.file:") and "not closed at the deck" in err
+
+
 @pytest.mark.parametrize("text, key", [
     (_scene(hull=False), "vessel.hull"),
     (_scene(depth=2.0), "vessel.hull.depth"),

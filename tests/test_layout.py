@@ -15,7 +15,7 @@ LAYERS = [
     {"hull"},
     {"hydro", "io"},
     {"scene"},
-    {"fem", "hull"},
+    {"fem"},
     {"physics"},
     {"solve"},
     {"build"},

@@ -24,8 +24,8 @@ import jax
 import jax.numpy as jnp
 import numpy as np
 
-from ..hull.box import box_hull
 from ..hull.clip import submerged, submerged_and_cut
+from ..hull.surface import HullMeshError, hull_triangles
 from ..hull.tanks import tank_surface
 from ..programs import START_OPTIONS
 from ..scene.load import load_scene
@@ -94,18 +94,19 @@ class Stability:
 # ------------------------------------------------------------------------------------- the model
 
 def hull_surface(scene):
-    """The hull's closed surface (n, 3, 3) in the vessel frame; SceneError naming the key when the
-    scene has none this analysis can use."""
+    """The hull's closed surface (n, 3, 3) in the vessel frame: the box with its deck, or a closed
+    mesh (hull/surface.py); SceneError naming the key when the scene has none this analysis can use."""
     hull = scene.vessel.hull
     if hull is None:
         raise SceneError("vessel.hull", "stability needs the hull's geometry: add a [vessel.hull] table "
-                                        "(length, beam, draft, kg and depth)")
-    if hull.type != "box":
-        raise SceneError("vessel.hull.type", 'stability builds box hulls; a "mesh" hull is not read for it yet')
-    if hull.depth is None:
+                                        '(a box: length, beam, draft, kg and depth; or type = "mesh", a closed mesh)')
+    if hull.type == "box" and hull.depth is None:
         raise SceneError("vessel.hull.depth", "stability needs the box's depth from keel to deck (m): at large "
                                               "heels the deck edge immerses")
-    return box_hull(hull.length, hull.beam, hull.kg, hull.depth)
+    try:
+        return np.asarray(hull_triangles(hull))
+    except HullMeshError as e:
+        raise SceneError("vessel.hull.file", str(e)) from None
 
 
 @dataclass(frozen=True)
