@@ -144,6 +144,21 @@ def test_horizontal_cylinder_liquid_acts_at_the_axis():
     np.testing.assert_allclose(s.gz_frozen - s.gz, m_l / (410000.0 + m_l) * r_c * np.sin(phi), rtol=2e-3, atol=1e-7)
 
 
+def test_cylinders_along_y_and_z_lose_their_free_surfaces_inertia():
+    """GM0's free-surface loss of a vertical cylinder (i = pi D^4 / 64) and of a horizontal one
+    along y, heeled across its axis (its surface a rectangle: chord x length, i = c Ly^3 / 12)."""
+    rho_l, D, R, Ly, h = 1000.0, 2.0, 1.0, 6.0, 0.6
+    tanks = _tank('shape = "cylinder"\naxis = "z"\n', (-5.0, -3.0, -1.0), (D, D, 2.0), fill=1.0, density=rho_l)
+    tanks += _tank('shape = "cylinder"\naxis = "y"\n', (2.0, -3.0, -1.5), (2 * R, Ly, 2 * R), fill=h, density=rho_l)
+    s = js.stability(_scene(tanks=tanks), np.radians([0.0, 2.0]), criteria=False)
+    t = (h - R) / R
+    seg = R * R * (np.arccos(-t) + t * np.sqrt(1 - t * t))
+    V = (410000.0 + rho_l * (np.pi * D * D / 4 * 1.0 + Ly * seg)) / RHO
+    chord = 2 * np.sqrt(R * R - (h - R) ** 2)
+    i_t = np.pi * D ** 4 / 64 + chord * Ly ** 3 / 12
+    assert s.gm0_frozen - s.gm0 == pytest.approx(rho_l * i_t / (RHO * V), rel=2e-3)
+
+
 def test_prismatic_and_mesh_tanks():
     """A prismatic tank filled into its straight part loses (at small heels) the free surface's own
     i = l b^3 / 12; a mesh tank that is a box grid of the liquid (walls continued up to its
@@ -193,7 +208,7 @@ def test_json_fields_and_figure(tmp_path, capsys):
     assert [c["limit"] for c in out["criteria"]] == pytest.approx([0.055, 0.09, 0.03, 0.2, np.radians(25), 0.15])
     assert out["criteria"][5]["value"] == out["gm0"]
     # the areas against the trapezoidal rule on a fine curve of their own
-    fine = js.stability(str(path), np.radians(np.linspace(0, 40, 401)), criteria=False)
+    fine = js.stability(str(path), np.radians(np.linspace(0, 40, 81)), criteria=False)
     a = np.asarray(fine.angle)
     area = lambda lo, hi: np.trapezoid(fine.gz[(a >= lo - 1e-12) & (a <= hi + 1e-12)],
                                        a[(a >= lo - 1e-12) & (a <= hi + 1e-12)])
