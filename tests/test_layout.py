@@ -12,6 +12,7 @@ LAYERS = [
     {"_version", "executables"},
     {"programs", "fem.mesh", "fem.slip", "physics.kinematics"},
     {"fem.shapes"},
+    {"hull"},
     {"hydro", "io"},
     {"scene"},
     {"fem"},

@@ -21,6 +21,7 @@ def describe(scene: Scene) -> str:
     diag = ", ".join(f"{ves.inertia[i][i]:.4g}" for i in range(3))
     h = ves.hydrostatics
     hydro = (f"A_w {h.waterplane_area:g} m^2, V {h.displaced_volume:g} m^3, GM_T {h.gm_t:g} m, GM_L {h.gm_l:g} m"
+             + (" (the hull's at rest; the restoring is nonlinear)" if h.nonlinear else "")
              if h is not None else "no hydrostatics (free body)")
     lines.append(f"vessel: mass {ves.mass:.4g} kg, inertia diagonal [{diag}] kg m^2; {hydro}")
     for t in scene.tanks:
@@ -64,7 +65,14 @@ def scene_effects(scene: Scene) -> list[tuple[str, str]]:
             ramp = f", faded in over {f.ramp:g} s" if f.ramp else ""
             eff.append(("prescribed motion", f"{f.dof} = {f.amplitude:g} sin({f.frequency:g} t{phase}){ramp}, "
                                              f"other rigid dofs held"))
-    if scene.vessel.hydrostatics is not None and e.buoyancy:
+    if scene.vessel.hydrostatics is not None and e.buoyancy and scene.vessel.hydrostatics.nonlinear:
+        hull = scene.vessel.hull
+        what = (f"box {hull.length:g} x {hull.beam:g} x {hull.depth:g} m (deck included)" if hull.type == "box"
+                else f"mesh {hull.file}")
+        waves = " and the incident waves' (Wheeler-stretched Froude-Krylov)" if scene.waves is not None and e.waves else ""
+        eff.append(("buoyancy", f"nonlinear: the still-water pressure{waves} on the instantaneous wetted surface of "
+                                f"the {what}, clipped exactly at the water; the weight of the ship and its liquid"))
+    elif scene.vessel.hydrostatics is not None and e.buoyancy:
         eff.append(("buoyancy", "restoring force and moments of eqs. (33)-(36), "
                                 f"moment form {scene.vessel.hydrostatics.moment!r}"))
     elif scene.vessel.hydrostatics is None and scene.environment.gravity > 0:
@@ -137,7 +145,11 @@ def _wave_effects(scene: Scene) -> list[tuple[str, str]]:
     out = []
     if w is not None and e.waves:
         src = excitation_source(scene)
-        src = ("Froude-Krylov on the box hull" if src == "froude-krylov" else
+        nl = ves.hydrostatics is not None and ves.hydrostatics.nonlinear and e.buoyancy
+        src = ("Froude-Krylov on the wetted hull (nonlinear)" if nl and src == "froude-krylov" else
+               "the tables less the hull's linear Froude-Krylov (diffraction), and Froude-Krylov on the wetted hull "
+               "(nonlinear)" if nl else
+               "Froude-Krylov on the box hull" if src == "froude-krylov" else
                "Capytaine (Froude-Krylov + diffraction)" if ves.hydrodynamics.capytaine else "excitation tables")
         sea = (f"regular, amplitude {w.amplitude:g} m, {w.omega:.4g} rad/s" if w.type == "regular" else
                (f"JONSWAP Hs {w.hs:g} m, Tp {w.tp:g} s, gamma {w.gamma:g}" if w.type == "jonswap" else

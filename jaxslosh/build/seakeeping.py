@@ -8,7 +8,8 @@ import jax.numpy as jnp
 import numpy as np
 
 from ..hydro.radiation import RadiationFit
-from ..hydro.source import excitation_rao, radiation_fit
+from ..hydro.source import excitation_rao, excitation_source, radiation_fit
+from .hull import froude_krylov_hull
 from ..hydro.spectra import components
 from ..hydro.tables import matrix6
 from ..physics.seakeeping import AddedMass, Excitation, LinearDamping, Memory, RadiationMemory, WaveExcitation
@@ -41,10 +42,16 @@ def build_seakeeping(scene, params: dict) -> tuple:
     hydrodynamic coefficients); `waves.amplitude` / `waves.hs` may be traced."""
     eff, ves, waves = scene.effects, scene.vessel, scene.waves
     terms, memory = [], None
-    if waves is not None and eff.waves:
+    hs = ves.hydrostatics
+    # the nonlinear hydrostatics integrate the incident pressure on the wetted hull (physics/hull.py):
+    # the linear excitation keeps only what that does not hold (diffraction, from the tables)
+    on_hull = hs is not None and hs.nonlinear and eff.buoyancy
+    if waves is not None and eff.waves and not (on_hull and excitation_source(scene) == "froude-krylov"):
         key = "waves.amplitude" if waves.type == "regular" else "waves.hs"
         c = components(waves)
         X = excitation_rao(scene, c.omega, c.headings)
+        if on_hull:
+            X = X - froude_krylov_hull(scene, c.omega, c.headings)
         terms.append(WaveExcitation(make_excitation(waves, X, params.get(key, waves.height))))
     hd = ves.hydrodynamics
     if hd is not None and eff.radiation:

@@ -25,6 +25,7 @@ from ..scene.keys import resolve_params
 from ..scene.types import DOFS, Scene, SceneError
 from ..solve.sparse import hydrostatic_start
 from .damping import build_damping
+from .hull import build_hull_pressure
 from .liquid import build_liquid_block, rigid_part
 from .probes import Probes, build_probes
 from .seakeeping import build_seakeeping
@@ -58,7 +59,10 @@ def build(scene: Scene, params: Optional[dict] = None) -> Built:
     env, ves, eff = scene.environment, scene.vessel, scene.effects
     g = jnp.asarray(P("environment.gravity", env.gravity), dtype=float)
     terms = []
-    if ves.hydrostatics is not None and eff.buoyancy:
+    nonlinear = ves.hydrostatics is not None and ves.hydrostatics.nonlinear and eff.buoyancy
+    if nonlinear:              # the hull's wetted surface (build/hull.py); the weight below
+        terms.append(build_hull_pressure(scene, params, g))
+    elif ves.hydrostatics is not None and eff.buoyancy:
         h = ves.hydrostatics
         f = lambda k, v: jnp.asarray(P(k, v), dtype=float)  # noqa: E731
         terms.append(Hydrostatics(
@@ -90,8 +94,8 @@ def build(scene: Scene, params: Optional[dict] = None) -> Built:
     if carried:       # the ship's mass and inertia include these parts: the hull is the rest (SPEC)
         mass, inertia, hull_S = _hull(mass, inertia, carried)
     body = RigidBody(mass=mass, inertia=inertia, S=hull_S)
-    balanced = ves.hydrostatics is not None
-    if not balanced:           # nothing holds the vessel up: its weight, liquid included
+    balanced = ves.hydrostatics is not None and not nonlinear
+    if not balanced:           # nothing holds the vessel up, or the hull's pressure does: its weight, liquid included
         S = liquid.rigid_first_moment() if hull_S is None else hull_S + liquid.rigid_first_moment()
         terms.append(Weight(mass=mass + liquid.total_mass(), S=S, gravity=g))
     if block.penalty is not None:

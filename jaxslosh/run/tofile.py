@@ -21,6 +21,7 @@ from ..io.status import Status
 from ..programs import cached
 from ..scene.types import Scene
 from .guard import Interrupted, interrupts
+from .capsize import vanishing_angles
 from .compiled import compile_run
 from .loop import core, frame_datasets
 from .progress import Progress
@@ -57,6 +58,7 @@ def run_to_file(scene: Scene, out: str, *, progress: bool = True,
             setup = prepare(scene) if key is None else cached("model", key, lambda: prepare(scene))
             b, solver = setup.built, setup.solver
             watch = Watch(scene, np.asarray(solver.noise))
+            watch.watch_capsize(vanishing_angles(b.system))
             se = setup.save_every
             n_frames = setup.n_steps // se
             N = b.system.liquid.n_nodes
@@ -77,7 +79,7 @@ def run_to_file(scene: Scene, out: str, *, progress: bool = True,
                 ok = ~np.asarray(pending.failed)
                 n_ok = int(ok.sum()) if ok.all() else int(np.argmin(ok))
                 rows = jax.tree_util.tree_map(lambda x: x[:n_ok], pending)
-                watch.update(rows.t, rows.surface, rows.residual, rows.D)
+                watch.update(rows.t, rows.surface, rows.residual, rows.D, rows.q)
                 steps = min(int(carry.k), setup.n_steps)
                 writer.append({k: np.asarray(v) for k, v in frame_datasets(b, rows, p0, save_fields).items()}, steps)
                 steps_written = steps

@@ -1,7 +1,8 @@
 """Whether a run stayed where its model holds: the linear liquid's free surface inside its tank, the
-Newton residual at what its iterations can reach. What is found goes into the summary and the result
-file's `warnings` attribute (the run itself is not stopped: its numbers may still be what the user
-wants to see).
+Newton residual at what its iterations can reach; and whether the vessel capsized (heeled past its
+angle of vanishing stability, with the nonlinear hydrostatics: run/capsize.py). What is found goes
+into the summary and the result file's `warnings` attribute (the run itself is not stopped: its
+numbers may still be what the user wants to see).
 
 The residual is judged against the level the Newton iterations themselves aim at, max(tolerance,
 round-off floor), not the tolerance alone: the floor (solve/linear.Solver.noise times the largest
@@ -13,6 +14,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from ..physics.kinematics import rpy_from_quat
 from ..scene.types import Scene
 
 #: a frame residual this many times its level, max(tolerance, round-off floor), is reported (the
@@ -33,13 +35,30 @@ class Watch:
         self.t_low = np.zeros(n)
         self.t_high = np.zeros(n)
         self.residual, self.t_residual, self.level = 0.0, 0.0, self.scene.simulation.tolerance
+        self.vanishing = None                    # (roll, pitch) angles of vanishing stability, rad (or None)
+        self.heel = np.zeros(2)                  # largest |roll|, |pitch| seen past them, and when
+        self.t_heel = np.zeros(2)
+        self.capsized = [False, False]
 
-    def update(self, time, surface, residual, field=None):
+    def watch_capsize(self, angles) -> None:
+        """Check the frames' roll and pitch against these angles of vanishing stability (rad; None
+        where the hull has none)."""
+        self.vanishing = angles
+
+    def update(self, time, surface, residual, field=None, q=None):
         """time (k,), surface (k, tanks, 2), residual (k,) of the frames just computed; `field`
-        (k, ...): their liquid unknowns (Frame.D), whose size sets each frame's round-off floor."""
+        (k, ...): their liquid unknowns (Frame.D), whose size sets each frame's round-off floor;
+        `q` (k, 4): their attitudes."""
         time = np.asarray(time)
         if time.size == 0:
             return
+        if self.vanishing is not None and q is not None:
+            rp = np.abs(np.asarray(rpy_from_quat(np.asarray(q)))[:, :2])
+            for axis, limit in enumerate(self.vanishing):
+                j = int(np.argmax(rp[:, axis]))
+                if limit is not None and rp[j, axis] > limit and not self.capsized[axis]:
+                    self.capsized[axis] = True
+                    self.heel[axis], self.t_heel[axis] = rp[j, axis], time[j]
         surface = np.asarray(surface).reshape(time.size, -1, 2)
         for i in range(self.low.size):
             j, k = int(np.argmin(surface[:, i, 0])), int(np.argmax(surface[:, i, 1]))
@@ -59,6 +78,12 @@ class Watch:
 
     def warnings(self) -> list[str]:
         out = []
+        for axis, name in enumerate(("roll", "pitch")):
+            if self.capsized[axis]:
+                out.append(f"capsized: the {name} reached {np.degrees(self.heel[axis]):.1f} deg at t = "
+                           f"{self.t_heel[axis]:.4g} s, past the hull's angle of vanishing stability "
+                           f"{np.degrees(self.vanishing[axis]):.1f} deg (its GZ at the ship's displacement, free to "
+                           f"sink, tank liquid frozen): the vessel capsized")
         for i, t in enumerate(self.scene.tanks[:self.low.size]):
             if not np.isfinite(self.low[i]):
                 continue

@@ -31,6 +31,8 @@ from .campaign import read_campaign
 from .fields import (at_least, counts, flat_list, non_negative, one_of, poisson_ratio, positive, read, show, sizes,
                      valid_name)
 from .record import read_record
+from ..hydro.box import box_hydrostatics
+from .hull import nonlinear_hydrostatics
 from .shape import fill_and_mesh, read_shape
 from .types import (DOFS, EFFECTS, ELEMENT_FORMS, FACES, Damping, Effects, Environment, Forced, Fluid, Hydrostatics,
                     Initial, Material, Probe, Reduction, Scene, SceneError, Simulation, Structure, Tank, Vessel, Walls)
@@ -40,6 +42,7 @@ SCHEMES = ("newmark", "hht", "generalized-alpha")
 LINEAR_SOLVERS = ("auto", "dense", "sparse")      # [simulation] linear_solver (sparse.py)
 WALLS = ("rigid", "elastic")
 MOMENTS = ("paper", "conservative")
+HYDROSTATIC_MODELS = ("linear", "nonlinear")
 PROBE_TOLERANCE = 1e-9                           # m: how far outside its owner a probe may lie
 MASS_BALANCE_TOLERANCE = 0.01                    # relative mismatch of weight and buoyancy that warns
 HHT_ALPHA_MAX = 1.0 / 3.0
@@ -234,11 +237,11 @@ def _vessel(table, environment: Environment, warnings: list[str], files=None) ->
     }, required=("mass", "inertia"))
     inertia = v["inertia"]
     _inertia_warnings(inertia, warnings)
-    hydrostatics = _hydrostatics(table["hydrostatics"], warnings) if "hydrostatics" in table else None
-    hull = hydrodynamics = None
+    hull = read_hull(table["hull"], files.base_dir if files is not None else "") if "hull" in table else None
+    hydrostatics = _hydrostatics(table["hydrostatics"], warnings, hull, environment) if "hydrostatics" in table else None
+    hydrodynamics = None
     if "hull" in table or "hydrodynamics" in table:   # hull and its hydrodynamics (waves.py)
-        hull = read_hull(table["hull"]) if "hull" in table else None
-        if hull is not None:
+        if hull is not None and not (hydrostatics is not None and hydrostatics.nonlinear):
             hydrostatics = hull_hydrostatics(hull, hydrostatics, warnings)
         hydrodynamics = read_hydrodynamics(table["hydrodynamics"], hull, files, warnings, hydrostatics) \
             if "hydrodynamics" in table else None
@@ -306,12 +309,20 @@ def forced_span(vessel: Vessel, sim: Simulation) -> None:
                                                f"t = {sim.n_steps * sim.dt:g} s (simulation.duration)")
 
 
-def _hydrostatics(table, warnings: list[str]) -> Hydrostatics:
+def _hydrostatics(table, warnings: list[str], hull=None, environment: Environment = Environment()) -> Hydrostatics:
     where = "vessel.hydrostatics"
-    h = Hydrostatics(**read(table, where, {
+    v = read(table, where, {
         "waterplane_area": ("float", positive), "displaced_volume": ("float", positive), "gm_t": ("float", None),
-        "gm_l": ("float", None), "moment": ("str", one_of(MOMENTS)),
-    }, required=("waterplane_area", "displaced_volume", "gm_t", "gm_l")))
+        "gm_l": ("float", None), "moment": ("str", one_of(MOMENTS)), "model": ("str", one_of(HYDROSTATIC_MODELS)),
+    })
+    if v.get("model", "linear") == "nonlinear":   # the values are the hull's (scene/hull.py)
+        v = nonlinear_hydrostatics(v, hull, environment, warnings)
+    elif hull is not None and hull.type == "box":   # what the table leaves out is the box's (as with no table)
+        v = box_hydrostatics(hull.length, hull.beam, hull.draft, hull.kg) | v
+    for k in ("waterplane_area", "displaced_volume", "gm_t", "gm_l"):
+        if k not in v:
+            raise SceneError(f"{where}.{k}", "a required key is missing")
+    h = Hydrostatics(**v)
     for key, value, motion in (("gm_t", h.gm_t, "roll"), ("gm_l", h.gm_l, "pitch")):
         if value <= 0:
             warnings.append(f"{where}.{key} = {show(value)} m <= 0: the vessel is statically unstable in "
@@ -488,7 +499,14 @@ def _mass_balance(vessel: Vessel, tanks, environment: Environment, warnings: lis
     liquid = sum(t.liquid_mass for t in tanks)
     total = vessel.mass + liquid        # vessel.mass: the whole ship without its liquid (structures included)
     buoyant = environment.water_density * h.displaced_volume
-    if abs(total - buoyant) > MASS_BALANCE_TOLERANCE * buoyant:
+    if abs(total - buoyant) > MASS_BALANCE_TOLERANCE * buoyant and h.nonlinear:
+        # the restoring is the hull's own: the vessel is simply released out of equilibrium
+        warnings.append(
+            f"vessel.mass: the total mass {total:.6g} kg (vessel {vessel.mass:.6g} kg + tank liquid {liquid:.6g} kg) "
+            f"differs from the water the hull displaces at rest, {buoyant:.6g} kg, by "
+            f"{100 * (total - buoyant) / buoyant:+.2f} %: the vessel starts out of equilibrium and "
+            f"{'sinks' if total > buoyant else 'rises'} to its own draft (heaving about it) from t = 0")
+    elif abs(total - buoyant) > MASS_BALANCE_TOLERANCE * buoyant:
         imbalance = (total - buoyant) * environment.gravity
         warnings.append(
             f"vessel.hydrostatics.displaced_volume: the total mass {total:.6g} kg (vessel {vessel.mass:.6g} kg + "

@@ -7,6 +7,7 @@ Values that `simulate(scene, params=...)` may override are looked up by their do
 """
 from __future__ import annotations
 
+import os
 from dataclasses import dataclass, field
 from typing import Optional, Union
 
@@ -64,6 +65,11 @@ class Hydrostatics:
     gm_t: float                      # m (<= 0 legal, warned)
     gm_l: float                      # m (<= 0 legal, warned)
     moment: str = "conservative"     # "conservative": gradient of a restoring potential | "paper": eq. (36) literally
+    model: str = "linear"            # "linear": GM springs (eqs. 33-38) | "nonlinear": pressure on the hull's wetted surface
+
+    @property
+    def nonlinear(self) -> bool:
+        return self.model == "nonlinear"
 
 
 @dataclass(frozen=True)
@@ -248,6 +254,11 @@ class Hull:
     kg: float = 0.0                  # m, COG above the keel (box)
     file: str = ""                   # mesh file (type = "mesh"), relative to the scene's folder
     cog: tuple[float, float, float] = (0.0, 0.0, 0.0)   # the COG in the mesh's coordinates (type = "mesh")
+    depth: Optional[float] = None    # m, keel to deck (box; SPEC section 8): large angles immerse the deck edge
+    base_dir: str = ""               # the scene's folder (a mesh file is relative to it)
+
+    def path(self) -> str:
+        return self.file if os.path.isabs(self.file) else os.path.join(self.base_dir, self.file)
 
 
 @dataclass(frozen=True)

@@ -81,11 +81,12 @@ def _at_least_one(v):
     return None if v >= 1.0 else f"must be >= 1, got {v}"
 
 
-def read_hull(table) -> Hull:
+def read_hull(table, base_dir: str = "") -> Hull:
     where = "vessel.hull"
     v = read(table, where, {
         "type": ("str", one_of(HULL_TYPES)), "length": ("float", positive), "beam": ("float", positive),
         "draft": ("float", positive), "kg": ("float", None), "file": ("str", None), "cog": ("vec3", None),
+        "depth": ("float", positive),
     })
     kind = v.get("type", "box")
     if kind == "box":
@@ -97,13 +98,17 @@ def read_hull(table) -> Hull:
                 raise SceneError(f"{where}.{k}", 'is a key of type = "mesh" hulls, not of a box')
         if v["kg"] <= 0:
             raise SceneError(f"{where}.kg", f"the COG must lie above the keel (kg > 0), got {show(v['kg'])}")
-        return Hull(type="box", length=v["length"], beam=v["beam"], draft=v["draft"], kg=v["kg"])
-    for k in ("length", "beam", "draft", "kg"):
+        if "depth" in v and v["depth"] <= v["draft"]:
+            raise SceneError(f"{where}.depth", f"the deck must lie above the waterline: depth {show(v['depth'])} m "
+                                               f"is not above the draft {show(v['draft'])} m")
+        return Hull(type="box", length=v["length"], beam=v["beam"], draft=v["draft"], kg=v["kg"],
+                    depth=v.get("depth"), base_dir=base_dir)
+    for k in ("length", "beam", "draft", "kg", "depth"):
         if k in v:
             raise SceneError(f"{where}.{k}", 'is a key of box hulls, not of type = "mesh"')
     if "file" not in v:
         raise SceneError(f"{where}.file", "a required key is missing (mesh hull)")
-    return Hull(type="mesh", file=v["file"], cog=v.get("cog", (0.0, 0.0, 0.0)))
+    return Hull(type="mesh", file=v["file"], cog=v.get("cog", (0.0, 0.0, 0.0)), base_dir=base_dir)
 
 
 def _shape(x):
@@ -359,9 +364,11 @@ def check_waves(scene: Scene, path: str, warnings: list[str]) -> Scene:
         scene = dataclasses.replace(scene, vessel=dataclasses.replace(
             ves, hydrodynamics=dataclasses.replace(hd, base_dir=os.path.dirname(os.path.abspath(path)))))
         ves, hd = scene.vessel, scene.vessel.hydrodynamics
-    if ves.hull is not None and ves.hull.type == "mesh" and not (hd is not None and hd.capytaine):
-        raise SceneError("vessel.hull.type", 'a "mesh" hull is only read by Capytaine: add '
-                                             "[vessel.hydrodynamics] capytaine = true (or use a box)")
+    nonlinear = ves.hydrostatics is not None and ves.hydrostatics.nonlinear
+    if ves.hull is not None and ves.hull.type == "mesh" and not (hd is not None and hd.capytaine) and not nonlinear:
+        raise SceneError("vessel.hull.type", 'a "mesh" hull is read by Capytaine or by the nonlinear hydrostatics: '
+                                             'add [vessel.hydrodynamics] capytaine = true or [vessel.hydrostatics] '
+                                             'model = "nonlinear" (or use a box)')
     if waves is None:
         return scene
     tables = hd is not None and (hd.capytaine or hd.excitation_amplitude is not None)
@@ -372,7 +379,7 @@ def check_waves(scene: Scene, path: str, warnings: list[str]) -> Scene:
                                                             "(or capytaine = true)")
     if source == "froude-krylov" and not box:
         raise SceneError("vessel.hydrodynamics.excitation", '"froude-krylov" needs a box [vessel.hull]')
-    if not tables and not box:
+    if not tables and not box and not nonlinear:
         raise SceneError("waves", "nothing turns the waves into forces: give a box [vessel.hull] (Froude-Krylov) "
                                   "or excitation tables in [vessel.hydrodynamics] (or capytaine = true)")
     if ves.forced is not None:
@@ -400,6 +407,6 @@ def check_waves(scene: Scene, path: str, warnings: list[str]) -> Scene:
                                                     f"frequencies [{lo:.6g}, {hi:.6g}] rad/s")
             warnings.append(f"waves.frequency_range [{wl:.4g}, {wh:.4g}] rad/s reaches beyond the excitation tables' "
                             f"[{lo:.4g}, {hi:.4g}] rad/s: components outside them exert no force")
-    if not box and not uses_table:
+    if not box and not uses_table and not nonlinear:
         raise SceneError("waves", "no excitation source")
     return scene

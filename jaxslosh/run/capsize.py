@@ -1,0 +1,33 @@
+"""The angles of vanishing stability a run's capsize check holds its roll and pitch against
+(validity.py), for a vessel with the nonlinear hydrostatics: the righting lever GZ of its hull at
+fixed heels from 0 to 180 degrees, free to sink to the ship's displacement (tank liquid frozen at
+rest, its weight in the centre of gravity), the trim held (hull/hydrostatics.gz_curve), and the
+first heel where GZ turns from righting to capsizing. `js.stability` (analysis/stability.py) draws
+the full curve with the trim free and the liquids level; this is the quick bound a run needs, for
+any closed hull it has."""
+from __future__ import annotations
+
+from typing import Optional
+
+import jax.numpy as jnp
+import numpy as np
+
+from ..hull.hydrostatics import first_vanishing, gz_curve
+from ..physics.hull import HullPressure
+from ..physics.vessel import Weight
+
+#: heels at which GZ is evaluated before the crossing is interpolated, 0 to 180 degrees
+HEELS = 361
+
+
+def vanishing_angles(system) -> Optional[tuple]:
+    """(roll, pitch) angles of vanishing stability (rad; None where GZ stays positive) of a built
+    System with the nonlinear hydrostatics; None for other systems."""
+    hull = [t for t in system.terms if isinstance(t, HullPressure)]
+    weight = [t for t in system.terms if isinstance(t, Weight)]
+    if not hull or not weight:
+        return None
+    h, w = hull[0], weight[0]
+    angles = np.linspace(0.0, np.pi, HEELS)
+    return tuple(first_vanishing(angles, gz_curve(h.tris, h.z_water, w.mass / h.rho_w, w.S / w.mass,
+                                                  jnp.asarray(angles), axis)) for axis in (0, 1))
