@@ -17,7 +17,7 @@ from ..fem.mesh import box_mesh, face_nodes, grid_nodes
 from ..fem.structure import assemble, box_element, centrifugal_stiffness
 from ..fem.walls import build_tank_with_walls
 from ..physics.liquid import AbstractLiquid, Liquid, NoLiquid
-from ..scene.types import Scene, SceneError
+from ..scene.types import MODES_ONLY_FORMS, Scene, SceneError
 from ..solve.sparse import SPARSE_AUTO, host_sparse
 from .effects import liquid_unknowns
 from .reduced import reduce_liquid
@@ -62,6 +62,10 @@ def build_liquid_block(scene: Scene, params: Optional[dict] = None, gravity=None
     sparse = wants_sparse(scene)
     models = []
     for i, t in enumerate(rigid):
+        if t.fluid.element in MODES_ONLY_FORMS:
+            raise SceneError(f"tanks[{i}].fluid.element", f"{t.fluid.element!r} (face-normal) gives natural modes "
+                                                          "only so far (jaxslosh modes); runs take \"stabilized\" "
+                                                          "or \"paper\"")
         P = lambda k, d: params.get(f"tanks.{t.name}.{k}", d)  # noqa: E731
         if not t.geometry.plain_box and isinstance(P("fill_depth", t.fill_depth), jax.core.Tracer):
             raise SceneError(f"tanks[{i}].fill_depth", f"the fill depth of a {t.shape} tank (or one with baffles) "

@@ -38,13 +38,17 @@ def cmd_modes(a):
     modes = sloshing_modes(scene, tank=tank, n=a.n)
     if a.json:
         print(json.dumps({"tank": tank, "omega": [float(w) for w in modes.omega], "kind": list(modes.kind),
-                          "free_surface_share": [float(s) for s in modes.free_surface_share]}))
+                          "free_surface_share": [float(s) for s in modes.free_surface_share],
+                          "circulation_modes_left_out": int(modes.circulation)}))
     else:
         print(f"liquid modes of tank {tank!r} (vessel held fixed):")
         print(f"{'#':>3} {'omega rad/s':>12} {'f Hz':>10} {'period s':>10} {'surface share':>14}  kind")
         for i, (w, k, s) in enumerate(zip(modes.omega, modes.kind, modes.free_surface_share)):
             f = w / (2 * math.pi)
             print(f"{i + 1:>3} {w:12.5f} {f:10.5f} {1 / f if f > 0 else float('inf'):10.4f} {s:14.3f}  {k}")
+        if modes.circulation:
+            print(f"({modes.circulation} circulation modes at zero frequency left out: divergence-free flow with "
+                  f"no free-surface motion, which the face-normal element holds at exactly zero)")
     return EXIT_OK
 
 

@@ -17,7 +17,10 @@ DOFS = ("surge", "sway", "heave", "roll", "pitch", "yaw")
 #: faces of a block ("x-" is x = 0, "z+" is z = size_z)
 FACES = ("x-", "x+", "y-", "y+", "z-", "z+")
 #: liquid element forms (fem/liquid_element.py)
-ELEMENT_FORMS = ("stabilized", "paper")
+ELEMENT_FORMS = ("stabilized", "paper", "rt")
+
+#: element forms whose liquid gives natural modes only (`jaxslosh modes`), not yet runs
+MODES_ONLY_FORMS = ("rt",)
 
 Vec3 = tuple[float, float, float]
 Mat3 = tuple[Vec3, Vec3, Vec3]
