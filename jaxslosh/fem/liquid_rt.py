@@ -68,6 +68,15 @@ class FaceLiquid:
     sound_speed: float
     gravity: float
     depth: float
+    geometry: object = None           # fem/shapes.TankGeometry it was meshed from (probes, outputs)
+
+    traced = False                    # built from concrete values only
+    frames = None                     # no node frames: the walls hold face fluxes
+    rotation_coupling = None
+
+    @property
+    def n_nodes(self) -> int:
+        return int(self.nodes.shape[0])
 
     @property
     def stiffness(self):
@@ -76,13 +85,17 @@ class FaceLiquid:
     @property
     def pools(self) -> int:
         """Separate pools of liquid (elements joined through free faces)."""
+        return int(self.pool_labels().max() + 1)
+
+    def pool_labels(self):
+        """(E,) the pool of each element."""
         from scipy.sparse.csgraph import connected_components
         E = len(self.elements)
         rows = np.repeat(np.arange(E), 6)
         cols = self.element_faces.reshape(-1)
         keep = self.free[cols]
         A = sp.coo_matrix((np.ones(keep.sum()), (rows[keep], cols[keep])), shape=(E, len(self.faces))).tocsr()
-        return int(connected_components(A @ A.T, directed=False)[0])
+        return connected_components(A @ A.T, directed=False)[1]
 
     def displacement_at(self, q, element, xi):
         """Displacements (P, 3) at reference points xi (P, 3) of the given elements (P,), for face
@@ -148,7 +161,7 @@ def face_topology(elements):
     return faces, inv.reshape(E, 6), signs, counts == 1, collapsed
 
 
-def build_face_liquid(nodes, elements, depth, density, sound_speed, gravity) -> FaceLiquid:
+def build_face_liquid(nodes, elements, depth, density, sound_speed, gravity, geometry=None) -> FaceLiquid:
     """The face-normal model of the liquid meshed by hexahedra ``elements`` (positively oriented;
     a collapsed face allowed) at rest below the free surface z = ``depth``."""
     nodes = np.asarray(nodes, dtype=float)
@@ -190,7 +203,7 @@ def build_face_liquid(nodes, elements, depth, density, sound_speed, gravity) -> 
     Ks = sp.coo_matrix((rho * g / top_area, (top, top)), shape=(nF, nF)).tocsr()
     return FaceLiquid(nodes=nodes, elements=elements, faces=faces, element_faces=element_faces, signs=signs,
                       free=free, top=top, top_area=top_area, volume=volume, mass=M, acoustic=Kac, surface=Ks,
-                      density=rho, sound_speed=c, gravity=g, depth=float(depth))
+                      density=rho, sound_speed=c, gravity=g, depth=float(depth), geometry=geometry)
 
 
 @dataclass(frozen=True, eq=False)
@@ -252,3 +265,180 @@ def face_modes(model: FaceLiquid, n: int = 10) -> FaceModes:
     kind = tuple("sloshing" if s > 0.5 else "acoustic" for s in share)
     return FaceModes(omega=np.sqrt(np.maximum(lam, 0.0)), kind=kind, free_surface_share=share,
                      fluxes=fluxes, circulation=int(n_ker))
+
+
+# ------------------------------------------------------------------------------ runs: a modal basis
+
+#: the absolute-rotation penalty's modes at this multiple of the highest sloshing mode kept
+ROTATION_PENALTY_RATIO = 10.0
+
+
+def _gauss(model: FaceLiquid):
+    """(positions (E, P, 3), weights det J (E, P), signed basis fields (E, P, 6, 3)) at the 2x2x2 Gauss points."""
+    X = model.nodes[model.elements]
+    dN = _shape_gradients(GAUSS8)
+    N = np.prod(1.0 + HEX_CORNERS[None] * GAUSS8[:, None, :], axis=2) / 8.0     # (P, 8)
+    J = np.einsum("eai,pak->epik", X, dN)
+    detJ = np.linalg.det(J)
+    phys = np.einsum("epik,pfk->epfi", J, _reference_fields(GAUSS8)) / detJ[:, :, None, None]
+    return np.einsum("pa,eai->epi", N, X), detJ, phys * model.signs[:, None, :, None]
+
+
+def _fields(model, gauss, Q):
+    """Displacements (k, E, P, 3) at the Gauss points of face fluxes Q (k, F)."""
+    return np.einsum("epfi,kef->kepi", gauss[2], Q[:, model.element_faces])
+
+
+def _loads(model, gauss, fields):
+    """Generalized forces (F, k) rho int phi_f . a_k dV of acceleration fields a_k (k, E, P, 3)."""
+    _, w, phys = gauss
+    local = model.density * np.einsum("ep,epfi,kepi->kef", w, phys, fields)
+    out = np.zeros((len(fields), len(model.faces)))
+    for k in range(len(fields)):
+        np.add.at(out[k], model.element_faces.reshape(-1), local[k].reshape(-1))
+    return out.T
+
+
+class _Mixed:
+    """Solves with G = B M^-1 B^T on the free faces (the saddle-point system, a tiny regularisation
+    for the pools' uniform pressures, which every right-hand side here is cleared of)."""
+
+    def __init__(self, model: FaceLiquid):
+        f = np.flatnonzero(model.free)
+        E, T = len(model.elements), len(model.top)
+        D = sp.coo_matrix((model.signs.reshape(-1), (np.repeat(np.arange(E), 6), model.element_faces.reshape(-1))),
+                          shape=(E, len(model.faces))).tocsr()
+        Tsel = sp.coo_matrix((np.ones(T), (np.arange(T), model.top)), shape=(T, len(model.faces))).tocsr()
+        self.B = sp.vstack([D, Tsel]).tocsr()[:, f]
+        self.M = model.mass[f][:, f].tocsc()
+        self.winv = np.concatenate([model.volume / (model.density * model.sound_speed ** 2),
+                                    model.top_area / (model.density * model.gravity)])
+        L = float(np.ptp(model.nodes[:, :2], axis=0).max())
+        eps = 1e-10 * model.gravity * np.pi / L
+        self.lu = spla.splu(sp.bmat([[self.M, -self.B.T], [self.B, sp.diags(eps * self.winv)]], format="csc"))
+        self.Mlu = spla.splu(self.M)
+        labels = model.pool_labels()
+        owner = np.empty(len(model.faces), dtype=int)
+        owner[model.element_faces.reshape(-1)] = np.repeat(np.arange(E), 6)
+        top_owner = labels[owner[model.top]]
+        P = np.zeros((E + T, int(labels.max() + 1)))
+        P[np.arange(E), labels] = 1.0
+        P[E + np.arange(T), top_owner] = -1.0
+        self.P = P / np.linalg.norm(P, axis=0)
+        self.nf, self.f = len(f), f
+
+    def pool_fix(self, z):
+        """z plus the pools' null vectors that make W^-1 z orthogonal to them (a solvable G y = W^-1 z)."""
+        Pw = self.winv[:, None] * self.P
+        return z - self.P @ ((Pw.T @ z) / np.einsum("ij,ij->j", self.P, Pw)[:, None])
+
+    def solve(self, r):
+        """(x, w = M^-1 B^T x) with G x = r (r cleared of the pools' null vectors)."""
+        r = r - self.P @ (self.P.T @ r)
+        out = self.lu.solve(np.concatenate([np.zeros((self.nf,) + r.shape[1:]), r]))
+        return out[self.nf:], out[:self.nf]
+
+
+def face_basis(model: FaceLiquid, origin, n: int, static_correction: bool = True):
+    """A Ritz basis of the face-normal liquid for runs (fem/reduction.py's counterpart).
+
+    Returns (V (F, m) on all faces, omega (m,), n_modes, (K_dt (m, 3), K_tt (3, 3))): the n lowest
+    sloshing modes; with ``static_correction`` the quasi-static responses K^+ F to the loads of a
+    uniform acceleration (3) and of the acceleration fields that are gradients of quadratics (the
+    symmetric parts of a field linear in position: centrifugal, 6), made M-orthonormal to the modes
+    and diagonalised; and the circulation the tank's rotation drives. The last is the kernel part
+    P c_k of each rigid rotation e_k x r: an ideal liquid keeps its absolute flow irrotational, so
+    relative to the tank it turns back by -theta (Kelvin); the basis holds span{P c_k}, and the
+    penalty 1/2 kappa |P (c theta) + V_c zeta|_M^2 ties those coordinates to the body rotation
+    theta through the same K_dt, K_tt terms as the stabilized element's rotation penalty
+    (kappa: the penalty modes at ROTATION_PENALTY_RATIO times the highest mode kept)."""
+    modes = face_modes(model, n)
+    f = np.flatnonzero(model.free)
+    Phi = modes.fluxes[:, f].T                                   # (nf, n), M-orthonormal
+    mixed = _Mixed(model)
+    M = mixed.M
+    gauss = _gauss(model)
+    r = gauss[0] + np.asarray(origin, dtype=float)
+    E, P = r.shape[:2]
+    # the rigid rotations' fluxes: the M-projection onto the faces' space of e_k x r is not needed,
+    # only its kernel part, which the load rho int phi . (e_k x r) determines: c = M^-1 F, and
+    # P c = c - M^-1 B^T G^-1 B c
+    rot = np.stack([np.cross(np.eye(3)[k], r) for k in range(3)])          # (3, E, P, 3)
+    Frot = _loads(model, gauss, rot)[f]
+    c = mixed.Mlu.solve(Frot)
+    _, w = mixed.solve(mixed.B @ c)
+    Pc = c - w
+    Gc = Pc.T @ (M @ Pc)
+    g, Z = np.linalg.eigh(0.5 * (Gc + Gc.T))
+    keep = g > 1e-9 * max(g.max(), 1e-300)
+    Vc = Pc @ (Z[:, keep] / np.sqrt(g[keep]))                   # M-orthonormal kernel vectors
+    cols = [Phi]
+    om = [modes.omega]
+    if static_correction:
+        one = np.ones((E, P))
+        fields = [np.stack([one * (a == k) for k in range(3)], axis=-1) for a in range(3)]
+        for a in range(3):
+            for b in range(a, 3):
+                F = np.zeros((E, P, 3))
+                F[..., a] += r[..., b]
+                F[..., b] += r[..., a]
+                fields.append(F)
+        F = _loads(model, gauss, np.stack(fields))[f]             # (nf, 9)
+        # K Psi = F with Psi = M^-1 B^T y: G W G y = B M^-1 F
+        z, _ = mixed.solve(mixed.B @ mixed.Mlu.solve(F))
+        _, Psi = mixed.solve(mixed.winv[:, None] * mixed.pool_fix(z))
+        for _ in range(2):
+            Psi = Psi - Phi @ (Phi.T @ (M @ Psi))
+        norms = np.sqrt(np.einsum("ij,ij->j", Psi, M @ Psi))
+        Psi = Psi[:, norms > 1e-12 * norms.max()] / norms[norms > 1e-12 * norms.max()]
+        Gp = Psi.T @ (M @ Psi)
+        gp, Wp = np.linalg.eigh(0.5 * (Gp + Gp.T))
+        kp = gp > 1e-9 * gp.max()
+        Bp = Psi @ (Wp[:, kp] / np.sqrt(gp[kp]))
+        Bp = Bp - Phi @ (Phi.T @ (M @ Bp))
+        K = model.stiffness[f][:, f]
+        Kb = Bp.T @ (K @ Bp)
+        mu, Zb = np.linalg.eigh(0.5 * (Kb + Kb.T))
+        cols.append(Bp @ Zb)
+        om.append(np.sqrt(np.abs(mu)))
+    cols.append(Vc)
+    V = np.concatenate(cols, axis=1)
+    Mv = V.T @ (M @ V)
+    Lc = np.linalg.cholesky(0.5 * (Mv + Mv.T))
+    V = np.linalg.solve(Lc, V.T).T                               # V^T M V = I to round-off
+    kappa = (ROTATION_PENALTY_RATIO * max(float(np.max(om[0])), 1e-30)) ** 2
+    m = V.shape[1]
+    nc = Vc.shape[1]
+    # the kernel coordinates are the last nc (the Cholesky pass leaves a triangular mix: project again)
+    Vk = V[:, m - nc:]
+    Kdt = np.zeros((m, 3))
+    Kdt[m - nc:] = kappa * (Vk.T @ (M @ Pc))
+    Ktt = kappa * Gc
+    Vfull = np.zeros((len(model.faces), m))
+    Vfull[f] = V
+    omega = np.concatenate(om + [np.full(nc, np.sqrt(kappa))])
+    return Vfull, omega, len(modes.omega), (Kdt, Ktt, kappa, m - nc)
+
+
+def face_invariants(model: FaceLiquid, V, origin):
+    """The inertia invariants of physics/modal_liquid.py for the basis V (F, m), as integrals of the
+    element fields (2x2x2 Gauss): mass, S0, Q0, U1 (m, 3), Q1 (m, 3, 3), Q2 (m, m, 3, 3), Mr, Kr;
+    and the basis as nodal fields (m, N, 3) for outputs and probes, and lumped nodal masses (N,)."""
+    gauss = _gauss(model)
+    x, w, _ = gauss
+    r = x + np.asarray(origin, dtype=float)
+    rho = model.density
+    u = _fields(model, gauss, V.T)                                # (m, E, P, 3)
+    mass = rho * w.sum()
+    S0 = rho * np.einsum("ep,epa->a", w, r)
+    Q0 = rho * np.einsum("ep,epa,epb->ab", w, r, r)
+    U1 = rho * np.einsum("ep,kepa->ka", w, u)
+    Q1 = rho * np.einsum("ep,epa,kepb->kab", w, r, u)
+    Q2 = rho * np.einsum("ep,kepa,lepb->klab", w, u, u)
+    Mr = np.einsum("klaa->kl", Q2)
+    Kr = V.T @ (model.stiffness @ V)
+    U = np.stack([model.nodal_field(q) for q in V.T])
+    m_nodes = np.zeros(model.n_nodes)
+    np.add.at(m_nodes, model.elements.reshape(-1), np.repeat(rho * model.volume / 8.0, 8))
+    return dict(mass=mass, S0=S0, Q0=Q0, U1=U1, Q1=Q1, Q2=Q2, Mr=0.5 * (Mr + Mr.T), Kr=0.5 * (Kr + Kr.T), U=U,
+                m_nodes=m_nodes, r=model.nodes + np.asarray(origin, dtype=float))
