@@ -42,8 +42,7 @@ def _face_modes(scene: Scene, t, n: int) -> Modes:
     model = build_face_liquid(tm.nodes, tm.elements, tm.depth, t.fluid.density, t.fluid.sound_speed,
                               scene.environment.gravity)
     fm = face_modes(model, n)
-    shapes = np.stack([model.nodal_field(q).reshape(-1) for q in fm.fluxes]) if len(fm.omega) else \
-        np.zeros((0, 3 * len(model.nodes)))
+    shapes = model.nodal_fields(fm.fluxes).reshape(len(fm.omega), -1)
     return Modes(omega=fm.omega, kind=fm.kind, free_surface_share=fm.free_surface_share, shapes=shapes,
                  circulation=fm.circulation)
 

@@ -270,7 +270,7 @@ def _face_model(scene, t, i, params, g):
                                 f"{', '.join(traced) or 'gravity'} cannot be traced with it yet")
     tm = tank_mesh(t.geometry, t.fill_depth, t.mesh)
     return build_face_liquid(tm.nodes, tm.elements, tm.depth, t.fluid.density, t.fluid.sound_speed, g,
-                             geometry=t.geometry)
+                             geometry=None if t.geometry.plain_box else t.geometry)
 
 
 def _host_block(t, m, offset) -> TankBlock:

@@ -108,17 +108,32 @@ class FaceLiquid:
         return np.einsum("pik,pfk,pf->pi", J, ref, ql) / detJ[:, None]
 
     def nodal_field(self, q):
-        """A nodal displacement field (N, 3): each node the mean of its elements' fields there (for
-        plots and probes; the model's own field is the element-wise one)."""
-        E = len(self.elements)
-        xi = np.tile(HEX_CORNERS, (E, 1))
-        element = np.repeat(np.arange(E), 8)
-        u = self.displacement_at(q, element, xi)
-        idx = self.elements.reshape(-1)
-        out = np.zeros((len(self.nodes), 3))
-        np.add.at(out, idx, u)
-        count = np.bincount(idx, minlength=len(self.nodes))
-        return out / np.maximum(count, 1)[:, None]
+        """A nodal displacement field (N, 3) for plots and probes (the model's own field is the
+        element-wise one): at each node the value of the linear field fitted, by least squares, to
+        the Gauss-point values of the elements round it (a patch recovery: at a wall or on the free
+        surface it extrapolates the field to the node rather than averaging it inwards)."""
+        return self.nodal_fields(np.asarray(q)[None])[0]
+
+    def nodal_fields(self, Q):
+        """`nodal_field` of several flux fields Q (k, F) -> (k, N, 3)."""
+        x, _, _ = _gauss(self)
+        u = _fields(self, _gauss(self), np.atleast_2d(Q))                  # (k, E, P, 3)
+        E, P = x.shape[:2]
+        node = np.repeat(self.elements, P, axis=0).reshape(E, P, 8)       # each Gauss point, for every corner
+        rows = self.elements[:, None, :].repeat(P, axis=1)                 # (E, P, 8) node of corner a
+        h = np.cbrt(self.volume)[:, None, None, None]
+        d = (x[:, :, None, :] - self.nodes[rows]) / h                       # (E, P, 8, 3) scaled offsets
+        A = np.concatenate([np.ones(d.shape[:-1] + (1,)), d], axis=-1)     # (E, P, 8, 4)
+        N = len(self.nodes)
+        AtA = np.zeros((N, 4, 4))
+        np.add.at(AtA, rows.reshape(-1), np.einsum("...i,...j->...ij", A, A).reshape(-1, 4, 4))
+        k = u.shape[0]
+        Atb = np.zeros((N, 4, 3 * k))
+        ub = np.broadcast_to(u.transpose(1, 2, 0, 3)[:, :, None], (E, P, 8, k, 3)).reshape(E, P, 8, 3 * k)
+        np.add.at(Atb, rows.reshape(-1), np.einsum("...i,...j->...ij", A, ub).reshape(-1, 4, 3 * k))
+        del node
+        sol = np.linalg.solve(AtA + 1e-12 * np.eye(4), Atb)                # (N, 4, 3k)
+        return sol[:, 0].reshape(N, k, 3).transpose(1, 0, 2)
 
 
 def _shape_gradients(xi):
@@ -437,7 +452,7 @@ def face_invariants(model: FaceLiquid, V, origin):
     Q2 = rho * np.einsum("ep,kepa,lepb->klab", w, u, u)
     Mr = np.einsum("klaa->kl", Q2)
     Kr = V.T @ (model.stiffness @ V)
-    U = np.stack([model.nodal_field(q) for q in V.T])
+    U = model.nodal_fields(V.T)
     m_nodes = np.zeros(model.n_nodes)
     np.add.at(m_nodes, model.elements.reshape(-1), np.repeat(rho * model.volume / 8.0, 8))
     return dict(mass=mass, S0=S0, Q0=Q0, U1=U1, Q1=Q1, Q2=Q2, Mr=0.5 * (Mr + Mr.T), Kr=0.5 * (Kr + Kr.T), U=U,
