@@ -63,6 +63,7 @@ def test_uniform_flow_is_reproduced_on_a_distorted_mesh():
     el = rng.integers(0, len(m.elements), 50)
     xi = rng.uniform(-1, 1, (50, 3))
     np.testing.assert_allclose(m.displacement_at(q, el, xi), np.tile(U, (50, 1)), atol=1e-12)
+    np.testing.assert_allclose(m.nodal_field(q), np.tile(U, (len(m.nodes), 1)), atol=1e-11)   # the recovery too
     assert 0.5 * q @ m.mass @ q == pytest.approx(0.5 * RHO * m.volume.sum() * U @ U, rel=1e-12)
     # a uniform flow is divergence-free: no compression energy
     assert abs(q @ m.acoustic @ q) < 1e-9 * RHO * C * C * m.volume.sum() * U @ U

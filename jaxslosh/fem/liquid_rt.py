@@ -127,13 +127,14 @@ class FaceLiquid:
         N = len(self.nodes)
         AtA = np.zeros((N, 4, 4))
         np.add.at(AtA, rows.reshape(-1), np.einsum("...i,...j->...ij", A, A).reshape(-1, 4, 4))
-        k = u.shape[0]
-        Atb = np.zeros((N, 4, 3 * k))
-        ub = np.broadcast_to(u.transpose(1, 2, 0, 3)[:, :, None], (E, P, 8, k, 3)).reshape(E, P, 8, 3 * k)
-        np.add.at(Atb, rows.reshape(-1), np.einsum("...i,...j->...ij", A, ub).reshape(-1, 4, 3 * k))
         del node
-        sol = np.linalg.solve(AtA + 1e-12 * np.eye(4), Atb)                # (N, 4, 3k)
-        return sol[:, 0].reshape(N, k, 3).transpose(1, 0, 2)
+        # the value at the node is the fit's constant term: row 0 of (A^T A)^-1 applied to A^T b
+        row0 = np.linalg.solve(AtA + 1e-12 * np.eye(4), np.broadcast_to(np.eye(4)[:, :1], (N, 4, 1)))[..., 0]
+        wts = np.einsum("epai,epai->epa", A, row0[rows])                  # (E, P, 8) weight of each point
+        out = np.zeros((u.shape[0], N, 3))
+        for i in range(u.shape[0]):                                        # one field at a time: bounded memory
+            np.add.at(out[i], rows.reshape(-1), (wts[..., None] * u[i][:, :, None, :]).reshape(-1, 3))
+        return out
 
 
 def _shape_gradients(xi):
