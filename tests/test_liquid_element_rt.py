@@ -196,7 +196,8 @@ def test_modes_command_and_runs_refused(tmp_path, capsys):
 def test_static_tilt_keeps_the_surface_level():
     """The static correction holds the response to a uniform lateral acceleration: solved on the
     basis, the free surface's face elevations q_f / A_f lie on the plane normal to the apparent
-    gravity (to 1e-4 of the tilt: the basis holds compression modes 1e6 times stiffer), in a box and in a hopper (sloping walls)."""
+    gravity (to 1e-4 of the tilt: the basis holds compression modes 1e6 times stiffer), in a box and in
+    a hopper (sloping walls)."""
     from jaxslosh.fem.liquid_rt import _gauss, _loads, face_basis
     for geo, mesh in [(TankGeometry(kind="box", size=(3.0, 2.0, 2.0)), (6, 4, 3)),
                       (TankGeometry(kind="prismatic", size=(1.0, 2.0, 2.0), chamfers=((0.5, 0.5), (0.0, 0.0))),
@@ -239,8 +240,10 @@ PAPER = os.path.join(os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 
 def _paper(element_lines):
     text = open(PAPER).read().replace("duration = 20.0", "duration = 2.0").replace("dt = 0.01", "dt = 0.02")
-    text = text.replace('scheme = "hht"', 'scheme = "newmark"').replace("alpha = 0.01\n", "").replace("mesh = [5, 5, 5]", "mesh = [6, 6, 4]")
-    return text.replace("sound_speed = 1500.0", "sound_speed = 1500.0\n" + element_lines + "\n[tanks.reduction]\nmodes = 12")
+    text = text.replace('scheme = "hht"', 'scheme = "newmark"').replace("alpha = 0.01\n", "")
+    text = text.replace("mesh = [5, 5, 5]", "mesh = [6, 6, 4]")
+    return text.replace("sound_speed = 1500.0",
+                        "sound_speed = 1500.0\n" + element_lines + "\n[tanks.reduction]\nmodes = 12")
 
 
 def test_run_on_the_modal_basis_conserves_energy_and_matches_the_stabilized_roll():

@@ -1,8 +1,6 @@
 """Natural modes of a scene's tank liquid or flexible structure, the vessel held fixed (`jaxslosh modes`)."""
 from __future__ import annotations
 
-import numpy as np
-
 from ..build.effects import free_liquid_dofs
 from ..fem.liquid import build_liquid
 from ..fem.liquid_rt import build_face_liquid, face_modes

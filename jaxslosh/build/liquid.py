@@ -19,7 +19,7 @@ from ..fem.shapes import tank_mesh
 from ..fem.structure import assemble, box_element, centrifugal_stiffness
 from ..fem.walls import build_tank_with_walls
 from ..physics.liquid import AbstractLiquid, Liquid, NoLiquid
-from ..scene.types import MODES_ONLY_FORMS, Scene, SceneError
+from ..scene.types import FACE_FORMS, Scene, SceneError
 from ..solve.sparse import SPARSE_AUTO, host_sparse
 from .effects import liquid_unknowns
 from .reduced import reduce_liquid
@@ -64,7 +64,7 @@ def build_liquid_block(scene: Scene, params: Optional[dict] = None, gravity=None
     sparse = wants_sparse(scene)
     models = []
     for i, t in enumerate(rigid):
-        if t.fluid.element in MODES_ONLY_FORMS:
+        if t.fluid.element in FACE_FORMS:
             models.append(_face_model(scene, t, i, params, g))
             continue
         P = lambda k, d: params.get(f"tanks.{t.name}.{k}", d)  # noqa: E731

@@ -17,10 +17,10 @@ DOFS = ("surge", "sway", "heave", "roll", "pitch", "yaw")
 #: faces of a block ("x-" is x = 0, "z+" is z = size_z)
 FACES = ("x-", "x+", "y-", "y+", "z-", "z+")
 #: liquid element forms (fem/liquid_element.py)
-ELEMENT_FORMS = ("stabilized", "paper", "rt")
+ELEMENT_FORMS = ("stabilized", "paper")
 
-#: element forms whose liquid gives natural modes only (`jaxslosh modes`), not yet runs
-MODES_ONLY_FORMS = ("rt",)
+#: the face-normal liquid elements (fem/liquid_rt.py): `tanks.fluid.element` takes these too
+FACE_FORMS = ("rt",)
 
 Vec3 = tuple[float, float, float]
 Mat3 = tuple[Vec3, Vec3, Vec3]
@@ -117,7 +117,7 @@ class Material:
 class Fluid:
     density: float = 1000.0          # kg/m^3, > 0
     sound_speed: float = 1500.0      # m/s, > 0
-    element: str = "stabilized"      # liquid element form, see liquid.py (ELEMENT_FORMS)
+    element: str = "stabilized"      # liquid element form: ELEMENT_FORMS (fem/liquid.py) or FACE_FORMS (fem/liquid_rt.py)
 
 
 @dataclass(frozen=True)
