@@ -259,3 +259,26 @@ def test_run_on_the_modal_basis_conserves_energy_and_matches_the_stabilized_roll
     a, b = np.asarray(rt.vessel.roll_pitch_yaw), np.asarray(st.vessel.roll_pitch_yaw)
     for k in (0, 1):
         assert np.abs(a[:, k] - b[:, k]).max() < 0.01 * np.abs(b[:, k]).max()
+
+
+def test_u_tube_from_a_mesh_file_through_the_command(tmp_path, capsys):
+    """The issue's first case as a user meets it: a U-tube anti-roll tank given as a mesh file,
+    `jaxslosh modes`: the first mode is the U-tube mode, within 0.5 % of the reference."""
+    import meshio
+    nodes, elements = u_tube_hex(8.0, 1.0, 0.3, 1.0, 40, 10, T)
+    meshio.write(str(tmp_path / "u_tube.vtu"), meshio.Mesh(nodes, [("hexahedron", elements)]))
+    scene = tmp_path / "u.toml"
+    scene.write_text(SCENE.split("[[tanks]]")[0] + """
+[[tanks]]
+name = "u"
+origin = [0.0, 0.0, 0.0]
+size = [0.2, 8.0, 2.0]
+shape = "mesh"
+file = "u_tube.vtu"
+[tanks.fluid]
+element = "rt"
+""")
+    assert main(["modes", str(scene), "-n", "3", "--json"]) == 0
+    out = json.loads(capsys.readouterr().out.strip().splitlines()[-1])
+    w_ref = ref.rectilinear_sloshing_omegas(ref.u_tube(8.0, 1.0, 0.3, 2.0), 1.0, G, n=1, h_target=0.05)[0]
+    assert abs(out["omega"][0] / w_ref - 1) < 0.005 and out["kind"][0] == "sloshing"
