@@ -655,3 +655,110 @@ def section_sloshing_omegas(boundary: Section, fill_depth: float, g: float = G, 
     """
     m = section_mesh(boundary, fill_depth, baffles, h_target, tip_refinements)
     return np.sqrt(g * section_sloshing_lambdas(m, n, degree))
+
+
+# ---------------------------------------------------------------------------------------------
+# sections that are not convex: unions of rectangles (a U-tube)
+# ---------------------------------------------------------------------------------------------
+
+
+def u_tube(length: float, reservoir: float, duct: float, height: float) -> tuple:
+    """A U-tube anti-roll tank's section as rectangles (s0, s1, z0, z1): two reservoirs
+    ``reservoir`` wide at the ends of a section ``length`` long and ``height`` high, joined along
+    the bottom by a duct ``duct`` high (closed above). Pass it to
+    :func:`rectilinear_sloshing_omegas`."""
+    if not 0 < 2 * reservoir < length or not 0 < duct < height:
+        raise ValueError("a U-tube needs 2 reservoir < length and 0 < duct < height")
+    return ((0.0, reservoir, 0.0, height), (reservoir, length - reservoir, 0.0, duct),
+            (length - reservoir, length, 0.0, height))
+
+
+def rectilinear_section_mesh(rects, fill_depth: float, h_target: float,
+                             corner_refinements: int = 8) -> SectionMesh:
+    """Triangular mesh of the liquid in a union of axis-parallel rectangles (s0, s1, z0, z1)
+    below z = ``fill_depth`` (it need not be convex: a U-tube).
+
+    A tensor grid through every rectangle's sides and the fill level, spacing <= h, each cell cut
+    into two triangles, the cells outside every rectangle dropped. Re-entrant corners (the liquid's
+    angle 270 degrees: the potential there goes like r^(2/3)) are refined ``corner_refinements``
+    times as the baffles' tips are (red-green, ring radius halved each time). The free surface is
+    every boundary facet at z = fill_depth; it may be in several pieces (both reservoirs)."""
+    from skfem import MeshTri1
+
+    d = float(fill_depth)
+    h = float(h_target)
+    rects = [tuple(float(v) for v in r) for r in rects]
+    wet = [(s0, s1, z0, min(z1, d)) for s0, s1, z0, z1 in rects if z0 < d]
+
+    def lines(values):
+        values = sorted(set(values))
+        out = [values[0]]
+        for a, b in itertools.pairwise(values):
+            n = max(1, math.ceil((b - a) / h - 1e-9))
+            out += list(a + (b - a) * np.arange(1, n + 1) / n)
+        return np.array(out)
+
+    xs = lines([v for r in wet for v in r[:2]])
+    zs = lines([v for r in wet for v in r[2:]])
+    mesh = MeshTri1.init_tensor(xs, zs)
+    scale = max(xs[-1] - xs[0], zs[-1] - zs[0])
+    tol = 1e-9 * scale
+
+    def inside(P):
+        return np.any([(P[0] > s0) & (P[0] < s1) & (P[1] > z0) & (P[1] < z1) for s0, s1, z0, z1 in wet], axis=0)
+
+    centres = mesh.p[:, mesh.t].mean(axis=1)
+    mesh = mesh.remove_elements(np.nonzero(~inside(centres))[0])
+    used = np.unique(mesh.t)
+    remap = np.full(mesh.p.shape[1], -1)
+    remap[used] = np.arange(used.size)
+    mesh = MeshTri1(np.ascontiguousarray(mesh.p[:, used]), np.ascontiguousarray(remap[mesh.t]))
+
+    # re-entrant corners: a rectangle's corner with liquid in three of the four quadrants round it
+    corners = []
+    e = 1e-6 * scale
+    for s0, s1, z0, z1 in wet:
+        for s, z in ((s0, z0), (s0, z1), (s1, z0), (s1, z1)):
+            q = np.array([[s - e, s + e, s - e, s + e], [z - e, z - e, z + e, z + e]])
+            if inside(q).sum() == 3 and (s, z) not in corners:
+                corners.append((s, z))
+    for level in range(corner_refinements):
+        if not corners:
+            break
+        radius = 1.5 * h * 0.5**level
+        c = mesh.p[:, mesh.t].mean(axis=1)
+        near = np.zeros(mesh.t.shape[1], dtype=bool)
+        for s, z in corners:
+            near |= np.hypot(c[0] - s, c[1] - z) < radius
+        mesh = mesh.refined(np.nonzero(near)[0])
+
+    adjacency = sp.coo_matrix((np.ones(3 * mesh.t.shape[1]),
+                               (mesh.t.ravel(), np.roll(mesh.t, 1, axis=0).ravel())),
+                              shape=(mesh.p.shape[1],) * 2)
+    pools = connected_components(adjacency, directed=False)[0]
+    surface = mesh.facets_satisfying(lambda x: np.abs(x[1] - d) < tol, boundaries_only=True)
+    ends = mesh.p[0, mesh.facets[:, surface]]
+    width = float(np.sum(np.abs(ends[1] - ends[0])))
+    return SectionMesh(mesh=mesh, surface=surface, tips=tuple(corners), pools=pools, width=width)
+
+
+def rectilinear_sloshing_omegas(rects, fill_depth: float, g: float = G, n: int = 4,
+                                h_target: float | None = None, degree: int = 2,
+                                corner_refinements: int = 8) -> np.ndarray:
+    """The n lowest sloshing frequencies omega (rad/s) of the liquid in a union of rectangles
+    (:func:`u_tube`), 2-D: the same Steklov problem as :func:`section_sloshing_omegas`.
+    ``h_target``: element size (default: 1/20 of the fill depth)."""
+    h = float(fill_depth) / 20.0 if h_target is None else float(h_target)
+    m = rectilinear_section_mesh(rects, fill_depth, h, corner_refinements)
+    return np.sqrt(g * section_sloshing_lambdas(m, n, degree))
+
+
+def richardson(values, ratio: float = 2.0):
+    """(limit, observed order) from three values on meshes refined by ``ratio`` each time
+    (Richardson extrapolation with the observed order p: e_k ~ C h_k^p)."""
+    f1, f2, f3 = (np.asarray(v, dtype=float) for v in values)
+    d12, d23 = f1 - f2, f2 - f3
+    with np.errstate(divide="ignore", invalid="ignore"):
+        p = np.log(np.abs(d12 / d23)) / math.log(ratio)
+    p = np.where(np.isfinite(p) & (p > 0.5), p, 2.0)
+    return f3 - d23 / (ratio**p - 1.0), p

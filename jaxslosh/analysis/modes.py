@@ -3,17 +3,21 @@ from __future__ import annotations
 
 from ..build.effects import free_liquid_dofs
 from ..fem.liquid import build_liquid
+from ..fem.liquid_rt import build_face_liquid, face_modes
 from ..fem.mesh import face_nodes
-from ..fem.modes import liquid_modes
+from ..fem.modes import Modes, liquid_modes
 from ..fem.structure import build_structure, clamped_modes
 from ..fem.walls import build_tank_with_walls, tank_modes
-from ..scene.types import Scene
+from ..fem.shapes import tank_mesh
+from ..scene.types import Scene, SceneError
 from ..solve.sparse import SPARSE_AUTO
 
 
 def sloshing_modes(scene: Scene, tank=None, n: int = 10):
     """The first n modes of a tank's liquid: `Modes(omega, kind, free_surface_share, shapes)`."""
     t = scene.tank(tank) if tank is not None else scene.tanks[0]
+    if t.fluid.element == "rt":
+        return _face_modes(scene, t, n)
     # large meshes as the simulation takes them: sparse matrices and shift-invert Lanczos (a dense
     # generalized eigh needs every matrix dense, and crashed OpenBLAS at 20 x 20 x 12)
     # (tanks of other shapes too: their walls' frames make the dense mass full, shift-invert is quicker)
@@ -23,6 +27,22 @@ def sloshing_modes(scene: Scene, tank=None, n: int = 10):
     if t.wall_spec is not None:       # the liquid and its elastic walls together (kinds add "wall")
         return tank_modes(build_tank_with_walls(t, model), n=n)
     return liquid_modes(model, n=n)
+
+
+def _face_modes(scene: Scene, t, n: int) -> Modes:
+    """The face-normal element's modes (fem/liquid_rt.py): the circulation modes, all at zero
+    frequency, are left out and counted (`Modes.circulation`); shapes are nodal fields, each node the
+    mean of its elements' displacements there."""
+    if t.wall_spec is not None:
+        i = scene.tanks.index(t)
+        raise SceneError(f"tanks[{i}].fluid.element", '"rt" does not take elastic walls yet; use "stabilized"')
+    tm = tank_mesh(t.geometry, t.fill_depth, t.mesh)
+    model = build_face_liquid(tm.nodes, tm.elements, tm.depth, t.fluid.density, t.fluid.sound_speed,
+                              scene.environment.gravity)
+    fm = face_modes(model, n)
+    shapes = model.nodal_fields(fm.fluxes).reshape(len(fm.omega), -1)
+    return Modes(omega=fm.omega, kind=fm.kind, free_surface_share=fm.free_surface_share, shapes=shapes,
+                 circulation=fm.circulation)
 
 
 def structure_modes(scene: Scene, structure: str, n: int = 10):

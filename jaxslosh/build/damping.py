@@ -36,6 +36,10 @@ def build_damping(scene: Scene, params: Optional[dict], block) -> tuple[Optional
     tanks = scene.tanks
     if not any(t.damping is not None for t in tanks) or not block.liquid.nf or not block.tanks:
         return None, ()
+    for i, t in enumerate(tanks):
+        if t.damping is not None and t.fluid.element == "rt":
+            raise SceneError(f"tanks[{i}].damping", 'is not available with the face-normal element ("rt") yet; '
+                                                    'use "stabilized" for a damped tank')
     if block.vstructs or any(t.wall_spec is not None for t in tanks):
         i = next(i for i, t in enumerate(tanks) if t.damping is not None)
         raise SceneError(f"tanks[{i}].damping", "is not available with elastic tank walls or structures in the "

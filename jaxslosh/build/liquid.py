@@ -13,11 +13,13 @@ from jax.scipy.linalg import block_diag as jax_block_diag
 from scipy.linalg import block_diag
 
 from ..fem.liquid import build_liquid, surface_bending_scale
+from ..fem.liquid_rt import FaceLiquid, build_face_liquid
 from ..fem.mesh import box_mesh, face_nodes, grid_nodes
+from ..fem.shapes import tank_mesh
 from ..fem.structure import assemble, box_element, centrifugal_stiffness
 from ..fem.walls import build_tank_with_walls
 from ..physics.liquid import AbstractLiquid, Liquid, NoLiquid
-from ..scene.types import Scene, SceneError
+from ..scene.types import FACE_FORMS, Scene, SceneError
 from ..solve.sparse import SPARSE_AUTO, host_sparse
 from .effects import liquid_unknowns
 from .reduced import reduce_liquid
@@ -62,6 +64,9 @@ def build_liquid_block(scene: Scene, params: Optional[dict] = None, gravity=None
     sparse = wants_sparse(scene)
     models = []
     for i, t in enumerate(rigid):
+        if t.fluid.element in FACE_FORMS:
+            models.append(_face_model(scene, t, i, params, g))
+            continue
         P = lambda k, d: params.get(f"tanks.{t.name}.{k}", d)  # noqa: E731
         if not t.geometry.plain_box and isinstance(P("fill_depth", t.fill_depth), jax.core.Tracer):
             raise SceneError(f"tanks[{i}].fill_depth", f"the fill depth of a {t.shape} tank (or one with baffles) "
@@ -249,6 +254,25 @@ class VesselFrameStructure(NamedTuple):
     elements: np.ndarray
 
 
+def _face_model(scene, t, i, params, g):
+    """The face-normal liquid of one tank (fem/liquid_rt.py): runs take it on its modal basis only,
+    with the scene's own values."""
+    where = f"tanks[{i}].fluid.element"
+    if t.reduction is None:
+        raise SceneError(where, f"{t.fluid.element!r} (face-normal) runs on its modes: add a [tanks.reduction] "
+                                "table (modes = N), or use \"stabilized\" for the full-order liquid")
+    if t.wall_spec is not None:
+        raise SceneError(where, f"{t.fluid.element!r} does not take elastic walls yet; use \"stabilized\"")
+    traced = [k for k in ("fill_depth", "fluid.density", "fluid.sound_speed")
+              if isinstance(params.get(f"tanks.{t.name}.{k}"), jax.core.Tracer)]
+    if traced or isinstance(g, jax.core.Tracer):
+        raise SceneError(where, f"{t.fluid.element!r} needs the scene's own values: "
+                                f"{', '.join(traced) or 'gravity'} cannot be traced with it yet")
+    tm = tank_mesh(t.geometry, t.fill_depth, t.mesh)
+    return build_face_liquid(tm.nodes, tm.elements, tm.depth, t.fluid.density, t.fluid.sound_speed, g,
+                             geometry=None if t.geometry.plain_box else t.geometry)
+
+
 def _host_block(t, m, offset) -> TankBlock:
     """The tank's block for probes and result fields, with the mesh at the scene's fill depth: a
     probe keeps its place relative to the mesh whatever a traced fill depth says."""
@@ -267,7 +291,7 @@ def _reduced_liquid(scene: Scene, tanks, models, reduced, g):
                                                        "[tanks.reduction] table and this one has not")
     concrete = []
     for t, m in zip(tanks, models):
-        if m.traced or isinstance(g, jax.core.Tracer):
+        if getattr(m, "traced", False) or (isinstance(g, jax.core.Tracer) and not isinstance(m, FaceLiquid)):
             m = build_liquid(t.size, t.fill_depth, t.mesh, t.fluid.density, t.fluid.sound_speed,
                              scene.environment.gravity, element=t.fluid.element, geometry=t.geometry)
         concrete.append(m)

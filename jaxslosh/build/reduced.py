@@ -8,6 +8,7 @@ import scipy.sparse as sp
 from jax.scipy.linalg import block_diag as jax_block_diag
 from scipy.linalg import block_diag
 
+from ..fem.liquid_rt import FaceLiquid, face_basis, face_invariants
 from ..fem.reduction import tank_basis
 from ..physics.modal_liquid import ReducedLiquid
 
@@ -26,8 +27,27 @@ def reduce_liquid(models, concrete_models, origins, offsets, reductions):
     S0, Q0, mass, Ktt = 0.0, 0.0, 0.0, xp.zeros((3, 3))
     U1s, Q1s, Q2_blocks = [], [], []
     rs, ms = [], []
-    coupled = any(m.rotation_coupling is not None for m in models)
+    coupled = any(m.rotation_coupling is not None or isinstance(m, FaceLiquid) for m in models)
     for model, cmodel, origin, off, (n, static) in zip(models, concrete_models, origins, offsets, reductions):
+        if isinstance(model, FaceLiquid):         # the face-normal element: invariants are its fields' integrals
+            V, _, _, (Kdt_t, Ktt_t, kappa, k0) = face_basis(model, origin, n, static)
+            inv = face_invariants(model, V, origin)
+            m = V.shape[1]
+            Kr_t = inv["Kr"].copy()
+            Kr_t[k0:, k0:] += kappa * np.eye(m - k0)               # the absolute-rotation penalty's own block
+            S0, Q0, mass = S0 + inv["S0"], Q0 + inv["Q0"], mass + inv["mass"]
+            U1s.append(xp.asarray(inv["U1"]))
+            Q1s.append(xp.asarray(inv["Q1"]))
+            Q2_blocks.append(xp.asarray(inv["Q2"]))
+            Mr_blocks.append(xp.asarray(inv["Mr"]))
+            Kr_blocks.append(xp.asarray(Kr_t))
+            Kdt_rows.append(xp.asarray(Kdt_t))
+            Ktt = Ktt + xp.asarray(Ktt_t)
+            scales.append(1.0 / np.maximum(np.abs(inv["U"]).max(axis=(1, 2)), 1e-300))
+            Us.append((off, inv["U"]))
+            rs.append(xp.asarray(inv["r"]))
+            ms.append(xp.asarray(inv["m_nodes"]))
+            continue
         basis = tank_basis(cmodel, origin, n, static)
         f = np.flatnonzero(np.asarray(model.free))
         Nt, m = int(model.n_nodes), basis.V.shape[1]

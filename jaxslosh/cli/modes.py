@@ -52,12 +52,17 @@ def cmd_modes(a):
         for i, (w, k, s) in enumerate(zip(m["omega"], m["kind"], m["free_surface_share"])):
             f = w / (2 * math.pi)
             print(f"{i + 1:>3} {w:12.5f} {f:10.5f} {1 / f if f > 0 else float('inf'):10.4f} {s:14.3f}  {k}")
+        if m["circulation_modes_left_out"]:
+            print(f"({m['circulation_modes_left_out']} circulation modes at zero frequency left out: "
+                  f"divergence-free flow with no free-surface motion, which the face-normal element holds at "
+                  f"exactly zero)")
     return EXIT_OK
 
 
 def _tank_json(name, modes) -> dict:
     return {"tank": name, "omega": [float(w) for w in modes.omega], "kind": list(modes.kind),
-            "free_surface_share": [float(s) for s in modes.free_surface_share]}
+            "free_surface_share": [float(s) for s in modes.free_surface_share],
+            "circulation_modes_left_out": int(modes.circulation)}
 
 
 def _structure_modes(scene, a):

@@ -42,7 +42,7 @@ import jax.numpy as jnp
 import numpy as np
 import scipy.sparse as sp
 
-from ..scene.types import ELEMENT_FORMS
+from ..scene.types import ELEMENT_FORMS, FACE_FORMS
 from .liquid_element import FLAT_CORNER_PENALTY, ROTATION_PENALTY, SURFACE_BENDING, element_matrices, is_traced
 from .mesh import box_elements, grid_index, grid_nodes
 from .shapes import box_equivalent, tank_mesh
@@ -150,7 +150,8 @@ def build_liquid(size, fill_depth, mesh, density, sound_speed, gravity, element=
     TankGeometry for other shapes than the plain box (then the fill depth is concrete).
     """
     if element not in ELEMENT_FORMS:
-        raise ValueError(f"element form {element!r} unknown; choose one of {ELEMENT_FORMS}")
+        raise ValueError(f"element form {element!r} unknown; choose one of {ELEMENT_FORMS} (the face-normal "
+                         f"forms {FACE_FORMS} are fem/liquid_rt.py's)")
     if geometry is not None and geometry.kind == "mesh" and not is_traced(fill_depth):
         counts = box_equivalent(geometry, float(fill_depth))
         if counts is not None:                 # a box grid given as a mesh file: the box itself

@@ -37,6 +37,7 @@ class Modes:
     kind: tuple                       # (n,) one of KINDS
     free_surface_share: np.ndarray    # (n,) in [0, 1]
     shapes: np.ndarray                # (n, 3N) mass-normalised (x^T kron(M, I3) x = 1), on the tank's axes
+    circulation: int = 0              # zero-frequency circulation modes left out ("rt": dim ker K)
 
 
 def free_mass(model: LiquidModel) -> np.ndarray:

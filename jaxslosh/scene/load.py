@@ -34,8 +34,9 @@ from .record import read_record
 from ..hydro.box import box_hydrostatics
 from .hull import nonlinear_hydrostatics
 from .shape import fill_and_mesh, read_shape
-from .types import (DOFS, EFFECTS, ELEMENT_FORMS, FACES, Damping, Effects, Environment, Forced, Fluid, Hydrostatics,
-                    Initial, Material, Probe, Reduction, Scene, SceneError, Simulation, Structure, Tank, Vessel, Walls)
+from .types import (DOFS, EFFECTS, ELEMENT_FORMS, FACE_FORMS, FACES, Damping, Effects, Environment, Forced, Fluid,
+                    Hydrostatics, Initial, Material, Probe, Reduction, Scene, SceneError, Simulation, Structure, Tank,
+                    Vessel, Walls)
 from .waves import FileContext, check_waves, hull_hydrostatics, read_hull, read_hydrodynamics, read_waves
 
 SCHEMES = ("newmark", "hht", "generalized-alpha")
@@ -373,7 +374,7 @@ def _tank(table, where: str, base_dir: str = "") -> Tank:
         raise SceneError(f"{where}.fill_depth", f"{show(depth)} m is above the tank height {show(height)} m")
     fluid = Fluid(**read(table.get("fluid", {}), f"{where}.fluid", {
         "density": ("float", positive), "sound_speed": ("float", positive),
-        "element": ("str", one_of(ELEMENT_FORMS)),
+        "element": ("str", one_of(ELEMENT_FORMS + FACE_FORMS)),
     }))
     reduction = None
     if "reduction" in table:

@@ -20,6 +20,9 @@ FACES = ("x-", "x+", "y-", "y+", "z-", "z+")
 #: liquid element forms (fem/liquid_element.py)
 ELEMENT_FORMS = ("stabilized", "paper")
 
+#: the face-normal liquid elements (fem/liquid_rt.py): `tanks.fluid.element` takes these too
+FACE_FORMS = ("rt",)
+
 Vec3 = tuple[float, float, float]
 Mat3 = tuple[Vec3, Vec3, Vec3]
 
@@ -126,7 +129,7 @@ class Material:
 class Fluid:
     density: float = 1000.0          # kg/m^3, > 0
     sound_speed: float = 1500.0      # m/s, > 0
-    element: str = "stabilized"      # liquid element form, see liquid.py (ELEMENT_FORMS)
+    element: str = "stabilized"      # liquid element form: ELEMENT_FORMS (fem/liquid.py) or FACE_FORMS (fem/liquid_rt.py)
 
 
 @dataclass(frozen=True)

@@ -1,0 +1,120 @@
+"""Convergence of the liquid elements on tank sections with re-entrant geometry (issue 30): the
+face-normal element ("rt"), the stabilized one and the paper's, against the project's independent
+2-D potential-flow reference (tests/sloshing_reference.py, P2 triangles, converged), on sections
+meshed two elements thick (tests/section_meshes.py, or the loader's own box-with-baffle and
+prismatic meshes). Prints one table per case: mesh, elements, the first three sloshing
+frequencies' errors (%) per element.
+
+    python benchmarks/liquid_element.py [--elements rt,stabilized] [--cases utube,hanging,...]
+
+Every case is 2-D (modes uniform across the two-element thickness), so the nodal elements' modes
+are taken as the sloshing modes whose free-surface share is > 0.5, and the first three of those
+matched with the reference's.
+"""
+import argparse
+import os
+import sys
+import tempfile
+import time
+
+import jax
+
+jax.config.update("jax_enable_x64", True)
+
+import numpy as np  # noqa: E402
+
+HERE = os.path.dirname(os.path.abspath(__file__))
+sys.path.insert(0, os.path.join(HERE, "..", "tests"))
+
+from section_meshes import hopper_baffle_hex, u_tube_hex  # noqa: E402
+from sloshing_reference import (Baffle as RefBaffle, prismatic, rectangle, rectilinear_sloshing_omegas,  # noqa: E402
+                                section_sloshing_omegas, u_tube)
+
+from jaxslosh.fem.liquid import build_liquid  # noqa: E402
+from jaxslosh.fem.liquid_rt import build_face_liquid, face_modes  # noqa: E402
+from jaxslosh.fem.modes import liquid_modes  # noqa: E402
+from jaxslosh.fem.shapes import Baffle, TankGeometry, tank_mesh  # noqa: E402
+
+G, RHO, C = 9.81, 1000.0, 1500.0
+T = 0.2          # the sections' thickness (x), two elements
+
+
+def reference(case):
+    if case == "utube":
+        return rectilinear_sloshing_omegas(u_tube(8.0, 1.0, 0.3, 2.0), 1.0, G, n=3, h_target=0.025)
+    if case == "hanging":
+        return section_sloshing_omegas(rectangle(1.0, 1.0), 0.5, G, 3, [RefBaffle(0.5, 0.8, hanging=True)], 0.005)
+    if case == "standing":
+        return section_sloshing_omegas(rectangle(1.0, 1.0), 0.5, G, 3, [RefBaffle(0.5, 0.3)], 0.005)
+    if case == "hopper":
+        return section_sloshing_omegas(prismatic(1.0, 1.0, 0.2, 0.2), 0.5, G, 3, [RefBaffle(0.5, 0.3)], 0.005)
+    if case == "lng30":
+        return section_sloshing_omegas(prismatic(1.0, 1.0, 0.2, 0.2, 0.2, 0.2), 0.3, G, 3, (), 0.005)
+    raise ValueError(case)
+
+
+def meshes(case):
+    """[(label, geometry, depth, counts)]: a TankGeometry the loader would build (a mesh file for
+    the sections it cannot describe)."""
+    out = []
+    if case == "utube":
+        for ny, nz in [(40, 10), (80, 20), (160, 40)]:
+            out.append((f"2x{ny}x{nz}", _file(*u_tube_hex(8.0, 1.0, 0.3, 1.0, ny, nz, T)), 1.0, None))
+    elif case in ("hanging", "standing"):
+        bf = Baffle("y", 0.5, "top", 0.8) if case == "hanging" else Baffle("y", 0.5, "bottom", 0.3)
+        for ny, nz in [(20, 10), (40, 20), (80, 40)]:
+            out.append((f"2x{ny}x{nz}", TankGeometry(kind="box", size=(T, 1.0, 1.0), baffles=(bf,)), 0.5, (2, ny, nz)))
+    elif case == "hopper":
+        for ny, nz in [(20, 10), (40, 20), (80, 40)]:
+            out.append((f"2x{ny}x{nz}", _file(*hopper_baffle_hex(1.0, 0.2, 0.5, 0.5, 0.3, ny, nz, T)), 0.5, None))
+    elif case == "lng30":
+        geo = TankGeometry(kind="prismatic", size=(T, 1.0, 1.0), chamfers=((0.2, 0.2), (0.2, 0.2)))
+        for ny, nz in [(24, 8), (24, 16), (48, 16), (48, 32)]:
+            out.append((f"2x{ny}x{nz}", geo, 0.3, (2, ny, nz)))
+    return out
+
+
+_TMP = tempfile.mkdtemp(prefix="jaxslosh-bench-")
+
+
+def _file(nodes, elements):
+    import meshio
+    path = os.path.join(_TMP, f"m{len(os.listdir(_TMP))}.vtu")
+    meshio.write(path, meshio.Mesh(nodes, [("hexahedron", elements)]))
+    return TankGeometry(kind="mesh", size=tuple(np.ptp(nodes, axis=0)), file=path)
+
+
+def omegas(element, geo, depth, counts, n=3):
+    if element == "rt":
+        tm = tank_mesh(geo, depth, counts or (1, 1, 1))
+        m = build_face_liquid(tm.nodes, tm.elements, tm.depth, RHO, C, G)
+        md = face_modes(m, n)
+        return md.omega[:n], len(tm.elements)
+    model = build_liquid(geo.size, depth, counts or (1, 1, 1), RHO, C, G, element=element, sparse=True, geometry=geo)
+    md = liquid_modes(model, n=4 * n + 6)
+    w = md.omega[np.array(md.kind) == "sloshing"]
+    return w[:n], len(model.elements)
+
+
+def main():
+    p = argparse.ArgumentParser()
+    p.add_argument("--elements", default="rt,stabilized")
+    p.add_argument("--cases", default="utube,hanging,standing,hopper,lng30")
+    a = p.parse_args()
+    for case in a.cases.split(","):
+        ref = reference(case)
+        print(f"\n{case}: reference omega = {', '.join(f'{w:.5f}' for w in ref)} rad/s")
+        print(f"| mesh | elements | " + " | ".join(f"{e} err % (modes 1, 2, 3)" for e in a.elements.split(",")) + " |")
+        print("|---|---|" + "---|" * len(a.elements.split(",")))
+        for label, geo, depth, counts in meshes(case):
+            cells = []
+            for element in a.elements.split(","):
+                t0 = time.perf_counter()
+                w, ne = omegas(element, geo, depth, counts)
+                err = (w / ref[:len(w)] - 1) * 100
+                cells.append(", ".join(f"{e:+.2f}" for e in err) + ("" if len(w) == 3 else " (missing)"))
+            print(f"| {label} | {ne} | " + " | ".join(cells) + " |")
+
+
+if __name__ == "__main__":
+    main()
