@@ -147,8 +147,10 @@ KEYS = (
                                           "reads), relative to the scene."),
     ("tanks.fluid.density", "1000.0", "kg/m^3", "Liquid density."),
     ("tanks.fluid.sound_speed", "1500.0", "m/s", "Liquid sound speed."),
-    ("tanks.fluid.element", '"stabilized"', "", 'The liquid element: "stabilized" or the paper\'s literal '
-                                                '"paper".'),
+    ("tanks.fluid.element", '"stabilized"', "", 'The liquid element: "stabilized", the paper\'s literal '
+                                                '"paper", or "rt", the face-normal (Raviart-Thomas) element that '
+                                                'does not lock on re-entrant tanks (U-tubes, baffles, hoppers; '
+                                                'runs need [tanks.reduction]).'),
     ("tanks.walls.thickness", _REQ, "m", "Wall thickness (one element through it)."),
     ("tanks.walls.mesh", "the liquid mesh", "", "Wall elements along the tank's length, breadth and height."),
     ("tanks.walls.material.young", _REQ, "Pa", "Young's modulus."),
