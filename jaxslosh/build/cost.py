@@ -64,7 +64,7 @@ def estimate(scene: Scene) -> Cost:
     frames = steps // max(1, sim.save_every) + 1
     liquid = sum(free_liquid_dofs(t) for t in scene.tanks) if scene.effects.liquid else 0
     choice = sim.linear_solver
-    sparse = choice == "sparse" or (choice == "auto" and liquid > SPARSE_AUTO
+    sparse = choice in ("sparse", "sparse-host") or (choice == "auto" and liquid > SPARSE_AUTO
                                     and not any(t.wall_spec is not None for t in scene.tanks))
     worst, total = ("", 0.0), 0.0
     for i, t in enumerate(scene.tanks if scene.effects.liquid else ()):

@@ -37,6 +37,7 @@ from scipy.sparse.linalg import splu
 
 from ..fem.slip import rotate_matrix
 from .boxsolve import box_inverse, elements, solve, stencil
+from .factored import cached_factored_inverse
 
 #: `linear_solver = "auto"` goes sparse above this many liquid unknowns (free dofs of all tanks):
 #: above it the dense inverses' products cost more than the sparse path and their memory grows as
@@ -175,7 +176,11 @@ def sparse_solver_blocks(liquid, c_a_step, c_a_sub=None):
             if key not in _REGISTRY:
                 _REGISTRY[key] = box_inverse(A, liquid.grids, with_bending)
             box = _REGISTRY[key]
-        return box if box is not None else host_inverse(A)
+        if box is not None:
+            return box
+        # shaped tanks: dense or banded factors applied in JAX (factored.py); the host's sparse LU
+        # only where the scene asks for it (linear_solver = "sparse-host")
+        return host_inverse(A) if liquid.host_lu else cached_factored_inverse(A)
 
     step = inverse(c_a_step * M + K)
     sub = inverse(c_a_sub * M + K) if c_a_sub is not None else None
