@@ -10,6 +10,8 @@ cylinder), and the shapes of benchmarks/shapes.py at full order (prismatic 4x12x
 
 * `jax`: "sparse", the liquid block's solves by the factors of jaxslosh/solve/factored.py;
 * `host`: "sparse-host", SciPy's SuperLU called from the step (the path before issue 35);
+* `dense`: "dense", the whole liquid's dense matrices and inverses (what "auto" gives below 1,500
+  liquid unknowns: the three shapes of benchmarks/shapes.py);
 * `floor`: three solves per step with a pre-factored dense matrix of the scene's unknowns (the
   issue's floor; a solve is a product with the pre-computed inverse), in one compiled loop of as
   many steps; the ratio is the step's time over it.
@@ -40,6 +42,10 @@ from bench_paper import time_scene  # noqa: E402
 from shapes import shape_text  # noqa: E402
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+
+
+#: the rows' names for the values of `simulation.linear_solver`
+SOLVERS = {"jax": "sparse", "host": "sparse-host", "dense": "dense"}
 
 
 def with_solver(text, solver):
@@ -108,6 +114,7 @@ def main():
     ap.add_argument("--repeat", type=int, default=2, help="timings per case; the best is shown (shared machine)")
     ap.add_argument("--no-compile", action="store_true", help="skip the two-process compile rows")
     ap.add_argument("--no-host", action="store_true", help="skip the host LU rows")
+    ap.add_argument("--no-dense", action="store_true", help="skip the dense rows")
     ap.add_argument("--only", help="rows whose name contains this")
     a = ap.parse_args()
     rows = [r for r in scenes() if a.only is None or a.only in r[0]]
@@ -116,8 +123,8 @@ def main():
     print(f"{'scene':28} {'unknowns':>8} {'solver':>6} {'us/step':>9} {'floor us':>9} {'ratio':>6} {'newton it':>9}")
     for name, text in rows:
         floor = None
-        for solver in ("jax",) if a.no_host else ("jax", "host"):
-            scene = js.load_scene(with_solver(text, "sparse" if solver == "jax" else "sparse-host"))
+        for solver in [s for s in SOLVERS if not (a.no_host and s == "host") and not (a.no_dense and s == "dense")]:
+            scene = js.load_scene(with_solver(text, SOLVERS[solver]))
             best = None
             for _ in range(a.repeat):
                 r = time_scene(scene, a.steps)
