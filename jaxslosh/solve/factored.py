@@ -94,6 +94,9 @@ class FactoredInverse(eqx.Module):
     perm: jax.Array          # (n,) A's unknown at each place of the factors' order
     iperm: jax.Array         # (n,) its inverse
     n: int = eqx.field(static=True)
+    # a hash of A and the form: the factors' values follow from it, so a run's initial state kept on
+    # disk is named by it (run/compiled._digest) instead of by hashing the factors' megabytes
+    content_key: str = eqx.field(static=True, default="")
 
     @property
     def shape(self):
@@ -144,6 +147,7 @@ def factored_inverse(A, form: str = "auto") -> FactoredInverse:
     or "banded" for every component (tests and benchmarks)."""
     A = sp.csr_matrix(A)
     A = (0.5 * (A + A.T)).tocsr()
+    A.sort_indices()
     n = A.shape[0]
     ncomp, labels = connected_components(A, directed=False)
     parts, order = [], []
@@ -163,7 +167,8 @@ def factored_inverse(A, form: str = "auto") -> FactoredInverse:
     perm = np.concatenate(order) if order else np.zeros(0, dtype=np.int64)
     iperm = np.empty_like(perm)
     iperm[perm] = np.arange(n)
-    F = FactoredInverse(tuple(parts), jnp.asarray(perm.astype(np.int32)), jnp.asarray(iperm.astype(np.int32)), n)
+    F = FactoredInverse(tuple(parts), jnp.asarray(perm.astype(np.int32)), jnp.asarray(iperm.astype(np.int32)), n,
+                        _matrix_key(A, form))
     _check(A, F)
     return F
 
@@ -210,14 +215,18 @@ _CACHE: dict = {}
 KEEP = 8
 
 
-def cached_factored_inverse(A, form: str = "auto") -> FactoredInverse:
-    """factored_inverse, reused for a matrix of the same content (the same scene built again)."""
+def _matrix_key(A, form: str) -> str:
     A = sp.csr_matrix(A)
     A.sort_indices()
-    h = hashlib.sha1()
+    h = hashlib.sha256(repr((A.shape, form, DENSE_MAX, BANDED_GAIN)).encode())
     for arr in (A.indptr, A.indices, A.data):
         h.update(np.ascontiguousarray(arr).tobytes())
-    key = (A.shape, h.hexdigest(), form)
+    return h.hexdigest()
+
+
+def cached_factored_inverse(A, form: str = "auto") -> FactoredInverse:
+    """factored_inverse, reused for a matrix of the same content (the same scene built again)."""
+    key = _matrix_key(A, form)
     if key not in _CACHE:
         _CACHE[key] = factored_inverse(A, form)
         while len(_CACHE) > KEEP:
