@@ -2,7 +2,8 @@
 solves, the JAX factors against the host's sparse LU, and the compile phase of a first and a second
 `jaxslosh run` in new processes.
 
-    PYTHONPATH=. python benchmarks/shaped_tanks.py [--steps 400] [--repeat 2] [--no-compile] [--only NAME]
+    PYTHONPATH=. python benchmarks/shaped_tanks.py [--steps 400] [--repeat 2] [--only NAME]
+        [--no-compile | --no-steps] [--no-host] [--no-dense]
 
 Rows: the two shaped scenes of scenes/ (lng_carrier: two prismatic tanks; type_c_tank: a horizontal
 cylinder), and the shapes of benchmarks/shapes.py at full order (prismatic 4x12x8, vertical cylinder
@@ -115,13 +116,14 @@ def main():
     ap.add_argument("--no-compile", action="store_true", help="skip the two-process compile rows")
     ap.add_argument("--no-host", action="store_true", help="skip the host LU rows")
     ap.add_argument("--no-dense", action="store_true", help="skip the dense rows")
+    ap.add_argument("--no-steps", action="store_true", help="only the two-process compile rows")
     ap.add_argument("--only", help="rows whose name contains this")
     a = ap.parse_args()
     rows = [r for r in scenes() if a.only is None or a.only in r[0]]
     print(f"jax {jax.__version__} on {jax.devices()[0].platform}, {os.cpu_count()} cpu; {a.steps} steps, "
           f"best of {a.repeat}")
     print(f"{'scene':28} {'unknowns':>8} {'solver':>6} {'us/step':>9} {'floor us':>9} {'ratio':>6} {'newton it':>9}")
-    for name, text in rows:
+    for name, text in [] if a.no_steps else rows:
         floor = None
         for solver in [s for s in SOLVERS if not (a.no_host and s == "host") and not (a.no_dense and s == "dense")]:
             scene = js.load_scene(with_solver(text, SOLVERS[solver]))
