@@ -251,7 +251,8 @@ def test_box_written_by_gmsh_runs_as_the_box(tmp_path):
 
 
 def test_shaped_tank_sparse_solver_agrees_with_dense():
-    """Full order through SciPy's sparse LU (the box's fast diagonalization needs the box grid)."""
+    """Full order through the shaped tank's JAX factors (solve/factored.py; the box's fast
+    diagonalization needs the box grid)."""
     text = _scene_text('shape = "cylinder"\naxis = "z"', mesh="[6, 6, 3]", duration="0.2")
     dense = js.simulate(js.load_scene(text.replace("save_every = 1", 'save_every = 1\nlinear_solver = "dense"')))
     sparse = js.simulate(js.load_scene(text.replace("save_every = 1", 'save_every = 1\nlinear_solver = "sparse"')))

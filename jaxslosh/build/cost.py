@@ -3,8 +3,8 @@ scene this machine cannot hold.
 
 The memory is an estimate of the largest phase, tank by tank, as build/ assembles them: the element
 arrays of the assembly, then the solver's blocks (dense inverses below `SPARSE_AUTO` unknowns; above
-it the sparse matrices and the fast-diagonalization blocks, or the sparse factor that the modal
-basis of a reduced tank needs), plus the result's frames. It is meant to tell 1 GB from 1 TB, not
+it the sparse matrices and the fast-diagonalization blocks, the JAX factors of shaped tanks, or the
+sparse factor that the modal basis of a reduced tank needs), plus the result's frames. It is meant to tell 1 GB from 1 TB, not
 to predict the process's peak to a few per cent.
 """
 from __future__ import annotations
@@ -13,6 +13,7 @@ import os
 from typing import NamedTuple
 
 from ..scene.types import Scene, SceneError
+from ..solve.factored import DENSE_MAX
 from ..solve.sparse import SPARSE_AUTO
 from .effects import count_unknowns, free_liquid_dofs
 
@@ -43,7 +44,17 @@ def machine_memory() -> float:
     return total
 
 
-def _tank_bytes(t, sparse: bool) -> float:
+def _factor_bytes(t, nf: int) -> float:
+    """The liquid block's JAX factors of a tank the fast diagonalization does not take (solve/
+    factored.py): the step's and the mass's, dense inverses or banded block factors, whose RCM
+    bandwidth is about twice the dofs of a cross-section across the two shortest node counts."""
+    if nf <= DENSE_MAX:
+        return 2 * 8.0 * nf * nf
+    a, b, _ = sorted(n + 1 for n in t.mesh)
+    return 2 * 8.0 * 2 * nf * min(nf, 2 * 3 * a * b)
+
+
+def _tank_bytes(t, sparse: bool, host_lu: bool = False) -> float:
     nx, ny, nz = t.mesh
     E = nx * ny * nz
     N = (nx + 1) * (ny + 1) * (nz + 1)
@@ -53,6 +64,8 @@ def _tank_bytes(t, sparse: bool) -> float:
         solver = 8.0 * (N * N + 4.0 * nf * nf)                      # mass, stiffness, two or three inverses
     else:
         solver = 8.0 * 81 * 3 * nf * 2 + 8.0 * nx * ny * (3 * (nz + 1)) ** 2   # sparse products, box blocks
+        if not t.geometry.plain_box and not host_lu and t.reduction is None:
+            solver += _factor_bytes(t, nf)
         if t.reduction is not None:                                  # the basis: a sparse factor of the mesh
             solver = max(solver, 8.0 * nf * 30 * max(nx * ny, ny * nz, nx * nz) ** 0.5)
     return max(assembly, solver)
@@ -64,11 +77,11 @@ def estimate(scene: Scene) -> Cost:
     frames = steps // max(1, sim.save_every) + 1
     liquid = sum(free_liquid_dofs(t) for t in scene.tanks) if scene.effects.liquid else 0
     choice = sim.linear_solver
-    sparse = choice == "sparse" or (choice == "auto" and liquid > SPARSE_AUTO
+    sparse = choice in ("sparse", "sparse-host") or (choice == "auto" and liquid > SPARSE_AUTO
                                     and not any(t.wall_spec is not None for t in scene.tanks))
     worst, total = ("", 0.0), 0.0
     for i, t in enumerate(scene.tanks if scene.effects.liquid else ()):
-        b = _tank_bytes(t, sparse)
+        b = _tank_bytes(t, sparse, choice == "sparse-host")
         total += b
         if b > worst[1]:
             worst = (f"tanks[{i}].mesh", b)

@@ -137,7 +137,7 @@ def build_liquid_block(scene: Scene, params: Optional[dict] = None, gravity=None
                         free=jnp.asarray(np.concatenate(free_list)), n_nodes=offset,
                         slot=_slots(np.concatenate(free_list), offset),
                         grids=tuple(m.mesh + (surface_bending_scale(m), m.element) for m in models) if boxes else None,
-                        sparse=True, frames=frames)
+                        sparse=True, frames=frames, host_lu=scene.simulation.linear_solver == "sparse-host")
         return LiquidBlock(liquid, tuple(blocks), (Kdt, jnp.asarray(Ktt)) if coupled else None)
     stack = jax_block_diag if traced else block_diag
     liquid = Liquid(r=jnp.asarray(xp.concatenate(rs)), Ms=jnp.asarray(stack(*Ms_list)),
@@ -310,7 +310,7 @@ def wants_sparse(scene) -> bool:
     """Whether the scene's liquid goes the sparse way (`simulation.linear_solver`)."""
     choice = scene.simulation.linear_solver
     if choice != "auto":
-        return choice == "sparse"
+        return choice in ("sparse", "sparse-host")
     if any(t.wall_spec is not None for t in scene.tanks):
         return False             # elastic walls have dense blocks of their own
     return liquid_unknowns(scene) > SPARSE_AUTO

@@ -118,6 +118,9 @@ class Liquid(AbstractLiquid):
     # element form), ...) in the stacking order, for the fast-diagonalization inverse (solve/boxsolve.py)
     grids: Optional[tuple] = eqx.field(static=True, default=None)
     sparse: bool = eqx.field(static=True, default=False)
+    # large meshes of other shapes: the constant block's solves by SciPy's sparse LU on the host
+    # (`simulation.linear_solver = "sparse-host"`), not by the JAX factors of solve/factored.py
+    host_lu: bool = eqx.field(static=True, default=False)
     # tanks of other shapes (fem/shapes.py): each node's frame (N, 3, 3); the unknowns are the free
     # components in these frames (tangential on a wall). None: the vessel's axes everywhere
     frames: Optional[jax.Array] = None

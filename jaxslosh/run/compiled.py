@@ -12,6 +12,7 @@ import numpy as np
 
 from ..executables import remember
 from ..programs import START_OPTIONS, XLA_OPTIONS, cached, folder, lower_program, program_key
+from ..solve.factored import FactoredInverse
 from .loop import carry_shapes, traced_advance, traced_init
 
 
@@ -67,10 +68,13 @@ def compile_run(bc, solver, chunk_frames: int, save_every: int):
 
 def _digest(tree) -> str:
     """A hash of the values of every array in `tree` (its structure and static values are in the
-    program's key)."""
+    program's key). The liquid block's factors (solve/factored.py) are named by the hash of the
+    matrix they factor, which they carry: their tens of megabytes are not hashed again."""
     h = hashlib.sha256()
-    for x in jax.tree_util.tree_leaves(tree):
-        if isinstance(x, (jax.Array, np.ndarray, np.generic)):
+    for x in jax.tree_util.tree_leaves(tree, is_leaf=lambda x: isinstance(x, FactoredInverse)):
+        if isinstance(x, FactoredInverse):
+            h.update(f"factored {x.content_key}".encode())
+        elif isinstance(x, (jax.Array, np.ndarray, np.generic)):
             a = np.ascontiguousarray(np.asarray(x))
             h.update(f"{a.dtype}{a.shape}".encode())
             h.update(a.tobytes())

@@ -40,7 +40,7 @@ from .types import (DOFS, EFFECTS, ELEMENT_FORMS, FACE_FORMS, FACES, Damping, Ef
 from .waves import FileContext, check_waves, hull_hydrostatics, read_hull, read_hydrodynamics, read_waves
 
 SCHEMES = ("newmark", "hht", "generalized-alpha")
-LINEAR_SOLVERS = ("auto", "dense", "sparse")      # [simulation] linear_solver (sparse.py)
+LINEAR_SOLVERS = ("auto", "dense", "sparse", "sparse-host")      # [simulation] linear_solver (sparse.py)
 WALLS = ("rigid", "elastic")
 MOMENTS = ("paper", "conservative")
 HYDROSTATIC_MODELS = ("linear", "nonlinear")

@@ -53,7 +53,7 @@ class Simulation:
     max_iterations: int = 25         # Newton iterations per step before the step counts as failed
     chunk: int = 0                   # steps per jitted chunk written to the result (0: automatic)
     substeps: int = 0                # > 1: a step whose Newton iteration fails is retried as this many sub-steps
-    linear_solver: str = "auto"      # liquid block: "dense" inverse | "sparse" factor (sparse.py) | "auto" by size
+    linear_solver: str = "auto"      # liquid block: "dense" inverse | "sparse" (sparse.py, factored.py) | "sparse-host" | "auto" by size
     energy_projection: bool = False  # trapezoidal rule only: scale the velocities after each step to the initial energy
 
     @property

@@ -27,7 +27,8 @@ with S the inverse without it and U the surface's vertical dofs,
 
 which costs one extra transform of the surface layer. Each inverse is checked when it is built
 (residual of random right-hand sides below 1e-8 relative); a mesh it does not fit (an odd number
-of elements along x or y, where the stabilized element pairs its wall elements) keeps the sparse LU.
+of elements along x or y, where the stabilized element pairs its wall elements) is factored instead
+(factored.py).
 
 Pure JAX: the solve is batched by vmap like everything else and runs wherever the loop runs.
 
@@ -184,7 +185,7 @@ def _tank(A, bending, mesh, start, stop, free_grid):
 def box_inverse(A, grids, with_bending=True):
     """BoxInverse of the stacked liquid block A (SciPy, free dofs) for tanks on the box grids
     `grids` = ((nx, ny, nz, bending scale), ...) in the liquid's order, or None where a tank's block
-    is not of the box form (then the caller keeps the sparse LU). `with_bending=False`: A has no
+    is not of the box form (then the caller factors it: factored.py). `with_bending=False`: A has no
     surface bending (the mass matrix)."""
     A = sp.csr_matrix(A)
     tanks, start = [], 0

@@ -82,7 +82,7 @@ def make_solver(system: System, h: float, scheme: Scheme, tol: float, max_iter: 
         return Solver(z, z, jnp.asarray(h, dtype=float), scheme, tol, max_iter, substeps, z if substeps else None,
                       reuse=reuse, adaptive=adaptive)
     L = system.liquid
-    if L.sparse:         # large mesh (sparse.py): fast diagonalization or host-side sparse LU factors
+    if L.sparse:         # large mesh (sparse.py): fast diagonalization, factors in JAX, or the host's LU
         c_a = lambda hh: (1.0 - scheme.alpha_m) / ((1.0 - scheme.alpha_f) * scheme.beta * hh ** 2)  # noqa: E731
         step_inv, mass_inv, sub_inv, K = sparse_solver_blocks(L, c_a(h), c_a(h / substeps) if substeps else None)
         step_inv = damped(step_inv, system, scheme, h)

@@ -1,4 +1,4 @@
-"""Large meshes: the liquid's matrices kept sparse, products and factors on the host (SciPy).
+"""Large meshes: the liquid's matrices kept sparse, their products and solves in JAX.
 
 A dense liquid block stops fitting long before a mesh is fine: 20 x 20 x 12 hexahedra have 15,666
 free unknowns, whose dense stiffness, mass and step-matrix inverses would take 2 GB each. Here:
@@ -13,10 +13,18 @@ free unknowns, whose dense stiffness, mass and step-matrix inverses would take 2
 * the products of `HostSparse` go element by element where every tank's layers are uniform (one
   element matrix per layer, boxsolve.Elements), else as grid stencils (boxsolve.Stencil), else
   as BCOO gathers and scatters;
-* otherwise `HostInverse` applies a sparse LU factor (SuperLU, symmetric mode, minimum-degree
-  ordering on A + A^T): the Newton iterations only need an
-  approximate inverse (lax.custom_root), so a host-side factor is a legitimate preconditioner, and
-  the tangent solves of the gradients reach full precision by Richardson sweeps around it.
+* otherwise (shaped tanks, box meshes the diagonalization does not fit) the block is factored once
+  at build time and applied with JAX ops (factored.py: dense inverses per tank, or banded block
+  factors for tanks too large for one): the step stays pure JAX, so it exports, caches, vmaps and
+  runs on any backend;
+* `HostInverse`, a sparse LU factor on the host (SuperLU, symmetric mode, minimum-degree ordering on
+  A + A^T) called from the step, only where the scene asks for it (`simulation.linear_solver =
+  "sparse-host"`: a mesh whose banded factors would not fit in memory). A host callback is neither
+  exported nor kept by XLA's cache (programs.py finds no name for a program that holds the factor:
+  it does not pickle), so such a run traces and compiles every time. The Newton iterations only
+  need an approximate inverse (lax.custom_root), so a host-side factor is a legitimate
+  preconditioner, and the tangent solves of the gradients reach full precision by Richardson sweeps
+  around it.
 
 The matrices must be concrete: a tank key traced for gradients or a sweep (fill depth, density,
 sound speed, gravity) needs the dense path (`simulation.linear_solver = "dense"`) or a reduced
@@ -37,6 +45,7 @@ from scipy.sparse.linalg import splu
 
 from ..fem.slip import rotate_matrix
 from .boxsolve import box_inverse, elements, solve, stencil
+from .factored import cached_factored_inverse
 
 #: `linear_solver = "auto"` goes sparse above this many liquid unknowns (free dofs of all tanks):
 #: above it the dense inverses' products cost more than the sparse path and their memory grows as
@@ -170,12 +179,16 @@ def sparse_solver_blocks(liquid, c_a_step, c_a_sub=None):
 
     def inverse(A, with_bending=True):
         box = None
-        if liquid.grids is not None:      # box tanks: fast diagonalization (boxsolve.py), else LU
+        if liquid.grids is not None:      # box tanks: fast diagonalization (boxsolve.py) where it fits
             key = _content_key("box", sp.csr_matrix(A), (liquid.grids, with_bending))
             if key not in _REGISTRY:
                 _REGISTRY[key] = box_inverse(A, liquid.grids, with_bending)
             box = _REGISTRY[key]
-        return box if box is not None else host_inverse(A)
+        if box is not None:
+            return box
+        # shaped tanks: dense or banded factors applied in JAX (factored.py); the host's sparse LU
+        # only where the scene asks for it (linear_solver = "sparse-host")
+        return host_inverse(A) if liquid.host_lu else cached_factored_inverse(A)
 
     step = inverse(c_a_step * M + K)
     sub = inverse(c_a_sub * M + K) if c_a_sub is not None else None
