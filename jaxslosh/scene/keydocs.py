@@ -64,7 +64,9 @@ KEYS = (
     ("simulation.substeps", "0", "", "When > 1, a step whose Newton iteration fails is retried as this many "
                                      "sub-steps."),
     ("simulation.linear_solver", '"auto"', "", 'The liquid block of the Newton matrix: "dense" inverses, '
-     '"sparse" (fast diagonalization on box grids, else SuperLU), "auto": sparse above 1,500 liquid unknowns.'),
+     '"sparse" (fast diagonalization on box grids, else factors computed at build time and applied in JAX), '
+     '"sparse-host" (SciPy SuperLU called from the step: very large shaped meshes; no export, batching or '
+     'cache), "auto": sparse above 1,500 liquid unknowns.'),
     ("simulation.energy_projection", "false", "", 'scheme = "newmark" in a conservative scene only: after each '
      "step the velocities are scaled back onto the initial energy."),
     # vessel
