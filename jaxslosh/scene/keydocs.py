@@ -79,6 +79,9 @@ KEYS = (
     ("vessel.hydrostatics.gm_t", _REQ, "m", "Transverse metacentric height, tank liquid frozen (<= 0 runs, "
                                             "with a warning)."),
     ("vessel.hydrostatics.gm_l", _REQ, "m", "Longitudinal metacentric height."),
+    ("vessel.hydrostatics.model", '"linear"', "", '"linear": GM springs (eqs. 33-38); "nonlinear": the still-'
+     "water pressure on the hull's instantaneous wetted surface and the weight; with [waves] the incident-wave "
+     "pressure on that surface too."),
     ("vessel.hydrostatics.moment", '"conservative"', "", '"conservative": the gradient of a restoring '
      'potential, equal to eq. (36) for pure roll or pitch; "paper": eq. (36) literally.'),
     ("vessel.initial.position", "[0, 0, 0]", "m", "Inertial offset of the COG from its equilibrium."),
@@ -107,6 +110,8 @@ KEYS = (
     ("vessel.hull.file", "required (mesh)", "", "The hull mesh (any format Capytaine reads), relative to the "
                                                "scene, waterline at z = 0."),
     ("vessel.hull.cog", "[0, 0, 0]", "m", "The COG in the mesh's coordinates."),
+    ("vessel.hull.depth", "required (box, nonlinear or stability)", "m", "Box hull: keel to deck, above the "
+                                                                          "draft (large angles immerse the deck edge)."),
     ("vessel.hydrodynamics.frequencies", "none", "rad/s", "Ascending, at least 4: the tables below are per "
                                                           "frequency, about the COG."),
     ("vessel.hydrodynamics.added_mass", "none", "kg, kg m, kg m^2", "Radiation added mass per frequency: "
