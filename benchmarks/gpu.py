@@ -1,5 +1,5 @@
 """The step on whatever device JAX has (a GPU where one is lent), in one run: the paper example, a
-20 x 20 x 12 box tank, a vmapped batch of the paper example, and one campaign batch (the worker's
+20 x 20 x 12 box tank, the LNG carrier's shaped tanks, a vmapped batch of the paper example, and one campaign batch (the worker's
 `run_batch`: JONSWAP seas of the waves scene, statistics included).
 
     python benchmarks/gpu.py [--steps 200] [--batch 64] [--cases 64] [--duration 60]
@@ -46,7 +46,7 @@ def main():
     ap.add_argument("--batch", type=int, default=64)
     ap.add_argument("--cases", type=int, default=64)
     ap.add_argument("--duration", type=float, default=60.0, help="s of each campaign case")
-    ap.add_argument("--only", default="paper,tank20,batch,campaign")
+    ap.add_argument("--only", default="paper,tank20,lng,batch,campaign")
     a = ap.parse_args()
     only = a.only.split(",")
     dev = jax.devices()[0]
@@ -67,6 +67,12 @@ def main():
         t = time_scene(big, a.tank_steps)
         rows.append((f"paper ship, 20x20x12 tank ({t['unknowns']} unknowns)", t["steps"], t["compile"], t["run"],
                      t["us"], f"ok, {t['iters']:.2f} Newton its/step" if t["ok"] else "failed"))
+        print(rows[-1], flush=True)
+    if "lng" in only:
+        lng = js.load_scene(os.path.join(ROOT, "scenes/lng_carrier.toml"))
+        t = time_scene(lng, a.tank_steps)
+        rows.append((f"lng_carrier, two prismatic tanks ({t['unknowns']} unknowns)", t["steps"], t["compile"],
+                     t["run"], t["us"], f"ok, {t['iters']:.2f} Newton its/step" if t["ok"] else "failed"))
         print(rows[-1], flush=True)
     if "batch" in only:
         gm = np.linspace(1.0, 2.0, a.batch)
