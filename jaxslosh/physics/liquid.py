@@ -28,6 +28,16 @@ from .kinematics import mv3, quat_multiply, skew, spin_tensor_components, tv3
 from .terms import AbstractTerm, Config, Kin, Rows
 
 
+def nodal_product(Ms, a):
+    """Ms @ a for a nodal field a (N, 3): three matrix-vector products. XLA's CPU product of a dense
+    (N, N) by an (N, 3) takes a general matrix-product path that costs about twice the three
+    products (benchmarks/floor.py: the paper example's residual evaluates it at every Newton
+    iteration). The sparse paths' matrices (solve/sparse.HostSparse) keep their own product."""
+    if not isinstance(Ms, (jax.Array, np.ndarray)) or a.ndim != 2:
+        return Ms @ a
+    return jnp.stack([Ms @ a[:, i] for i in range(a.shape[1])], axis=1)
+
+
 class AbstractLiquid(AbstractTerm):
     """The owner of the deformable unknowns d: what the solver, the build and the frames need of it
     besides its rows and energies."""
@@ -180,7 +190,7 @@ class Liquid(AbstractLiquid):
             a = a + 2.0 * jnp.cross(omega, Dv)
         if self.centrifugal:
             a = a + jnp.cross(omega, jnp.cross(omega, x))
-        F = self.Ms @ a
+        F = nodal_product(self.Ms, a)
         mD = self.m_nodes @ D                                       # first moment of d
         r_t = mv3(A, F.sum(axis=0))
         r_r = jnp.cross(x, F).sum(axis=0) - jnp.cross(mD, k.g_b)
@@ -189,7 +199,7 @@ class Liquid(AbstractLiquid):
 
     def kinetic(self, k: Kin):
         v = k.A.T @ k.V0 + self.full(k.d_dot) + jnp.cross(k.omega, self.r + self.full(k.c.d))
-        return 0.5 * jnp.sum(v * (self.Ms @ v))
+        return 0.5 * jnp.sum(v * nodal_product(self.Ms, v))
 
     def potential(self, k: Kin):
         d = k.c.d
