@@ -420,3 +420,15 @@ def test_parametric_roll_grows_to_a_steady_amplitude_only_with_the_nonlinear_mod
     lin = js.simulate(_linear_twin(scene))
     lroll = np.degrees(np.asarray(lin.vessel.roll_pitch_yaw)[:, 0])
     assert np.max(np.abs(lroll)) <= np.degrees(0.05) * 1.0001
+
+
+def test_small_waves_run_equals_the_linear_model():
+    """Waves of 2 cm on the bow quarter, 12 s: roll, pitch and heave of the nonlinear model follow
+    the linear model's (GM springs, Froude-Krylov on the box) within 3 % of their largest values."""
+    extra = '\n[waves]\ntype = "regular"\namplitude = 0.02\nperiod = 6.0\nheading = 2.3\nramp = 3.0\n'
+    a = js.simulate(box_scene(duration=12.0, dt=0.05, extra=extra))
+    b = js.simulate(box_scene(duration=12.0, dt=0.05, model="linear", extra=extra))
+    for get in (lambda r: r.vessel.roll_pitch_yaw[:, 0], lambda r: r.vessel.roll_pitch_yaw[:, 1],
+                lambda r: r.vessel.position[:, 2]):
+        x, y = np.asarray(get(a)), np.asarray(get(b))
+        assert np.max(np.abs(x - y)) < 0.03 * np.max(np.abs(y)), (np.max(np.abs(x - y)), np.max(np.abs(y)))
