@@ -432,3 +432,23 @@ def test_small_waves_run_equals_the_linear_model():
                 lambda r: r.vessel.position[:, 2]):
         x, y = np.asarray(get(a)), np.asarray(get(b))
         assert np.max(np.abs(x - y)) < 0.03 * np.max(np.abs(y)), (np.max(np.abs(x - y)), np.max(np.abs(y)))
+
+
+def test_the_written_out_tangent_of_the_volume_equals_the_clippings():
+    """hull/hydrostatics.volume_below's derivative in the plane (from the lid's area and moments)
+    against JAX's through the clipping (hull/clip.submerged), forward and reverse; a tangent in the
+    surface itself goes through the clipping."""
+    from jaxslosh.hull.clip import submerged
+    from jaxslosh.hull.hydrostatics import volume_below
+    from jaxslosh.hull.surface import prism_surface
+    tris = jnp.asarray(prism_surface([[-1, 0], [1, 0], [2, 2], [-2, 2]], 10.0, 5, 3))
+    n, c = jnp.array([0.1, 0.3, 1.0]), jnp.asarray(0.4)
+    for dn, dc in ((jnp.array([0.3, -0.2, 0.5]), 0.7), (jnp.zeros(3), 1.0)):
+        (_, a), (_, b) = (jax.jvp(lambda n_, c_: f(tris, n_, c_), (n, c), (dn, jnp.asarray(dc)))
+                          for f in (volume_below, submerged))
+        for x, y in zip(a, b):
+            np.testing.assert_allclose(np.asarray(x), np.asarray(y), rtol=1e-11, atol=1e-11)
+    np.testing.assert_allclose(np.asarray(jax.jacrev(lambda n_: volume_below(tris, n_, c)[1])(n)),
+                               np.asarray(jax.jacrev(lambda n_: submerged(tris, n_, c)[1])(n)), rtol=1e-11, atol=1e-11)
+    np.testing.assert_allclose(np.asarray(jax.grad(lambda t: volume_below(t, n, c)[0])(tris)),
+                               np.asarray(jax.grad(lambda t: submerged(t, n, c)[0])(tris)), atol=1e-12)

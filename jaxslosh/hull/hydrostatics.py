@@ -6,11 +6,12 @@ from __future__ import annotations
 import functools
 
 import jax
+from jax.custom_derivatives import SymbolicZero
 import jax.numpy as jnp
 import numpy as np
 
 from ..physics.kinematics import quat_exp, rotation_matrix
-from .clip import submerged
+from .clip import MIDPOINT_RULE, area_vectors, clip_below, submerged
 
 #: bisection steps of the sinkage at a fixed heel: the bracket (the hull's size) shrinks below round-off
 BISECTIONS = 80
@@ -19,7 +20,57 @@ BISECTIONS = 80
 def buoyancy(tris, z_water, X0, A):
     """(V, m): the displaced volume and its first moment about the COG (body frame) for the pose
     (X0 inertial, A body to inertial): the body's part below n_b . r = z_water - Z0, n_b = A^T e_z."""
-    return submerged(tris, A[2], z_water - X0[2])
+    return volume_below(tris, A[2], z_water - X0[2])
+
+
+def _lid_integrals(tris, n, c):
+    """(V, m, A, s, J): `submerged`'s volume and first moment below n . x <= c, and the area, first
+    moment and second moment (int x x^T dA) of the body's section by the plane (the lid), all from
+    the wetted pieces: the flux of x_a n through the closed clipped body is V n_a, that of
+    x_a x_b n is n_a m_b + n_b m_a, and the lid's share is what the wetted pieces leave."""
+    nn = jnp.linalg.norm(n)
+    u, off = n / nn, c / nn
+    pieces = clip_below(tris, u, off).reshape(-1, 3, 3)
+    an = area_vectors(pieces) @ u                                  # (u . N) dS per piece
+    lam, w = MIDPOINT_RULE
+    x = jnp.einsum("qk,mkx->mqx", lam, pieces)                     # (m, 3, 3) quadrature points
+    zeta = x @ u - off
+    V = jnp.sum(an * (zeta @ w))
+    m = jnp.einsum("m,mq,mqx,q->x", an, zeta, x, w) - u * jnp.sum(an * ((0.5 * zeta ** 2) @ w))
+    area = -jnp.sum(an)
+    s = V * u - jnp.einsum("m,mqx,q->x", an, x, w)
+    J = jnp.outer(u, m) + jnp.outer(m, u) - jnp.einsum("m,mqx,mqy,q->xy", an, x, x, w)
+    return V, m, area, s, J, nn
+
+
+@jax.custom_jvp
+def volume_below(tris, n, c):
+    """(V, m): the volume of the closed surface `tris` below the plane n . x <= c and its first
+    moment (hull/clip.submerged), with the derivative in the plane written out: moving the plane
+    sweeps the lid, so d V = (A dc - s . dn) / |n| and d m = (s dc - J dn) / |n| with the lid's
+    area A, first moment s and second moment J. The Newton preconditioner linearises the rows six
+    times per iteration; through the clipping each is a pass over every panel, from these
+    integrals a 3 x 3 product. A tangent in the surface itself is differentiated through the
+    clipping."""
+    return submerged(tris, n, c)
+
+
+def _volume_below_jvp(primals, tangents):
+    tris, n, c = primals
+    dt, dn, dc = tangents
+    if not isinstance(dt, SymbolicZero):          # the surface moves: differentiate the clipping
+        return jax.jvp(submerged, primals, tuple(jnp.zeros_like(p) if isinstance(t, SymbolicZero) else t
+                                                 for t, p in zip(tangents, primals)))
+    V, m, area, s, J, nn = _lid_integrals(tris, n, c)
+    dn = jnp.zeros_like(n) if isinstance(dn, SymbolicZero) else dn
+    dc = jnp.zeros_like(c) if isinstance(dc, SymbolicZero) else dc
+    # the plane n . x = c moves along its unit normal by (dc - dn . x) / |n| at x
+    dV = (area * dc - s @ dn) / nn
+    dm = (s * dc - J @ dn) / nn
+    return (V, m), (dV, dm)
+
+
+volume_below.defjvp(_volume_below_jvp, symbolic_zeros=True)
 
 
 def still_force_moment(tris, z_water, rho_g, X0, A):
