@@ -16,6 +16,7 @@ rights the vessel. Everything is traced once and vmapped over the angles; the it
 """
 from __future__ import annotations
 
+import functools
 from dataclasses import dataclass, field
 from typing import Optional
 
@@ -23,15 +24,17 @@ import jax
 import jax.numpy as jnp
 import numpy as np
 
-from ..hull.box import box_hull
 from ..hull.clip import submerged, submerged_and_cut
+from ..hull.surface import HullMeshError, hull_triangles
 from ..hull.tanks import tank_surface
 from ..programs import START_OPTIONS
+from ..scene.load import load_scene
 from ..scene.types import SceneError
 
-#: iterations of the bracketed Newton solves of a plane's offset and of the free angle
-LEVEL_ITERATIONS = 40
-TRIM_ITERATIONS = 12
+#: most iterations of the bracketed Newton solves of a plane's offset and of the free angle (each
+#: stops when converged)
+LEVEL_ITERATIONS = 60
+TRIM_ITERATIONS = 20
 #: rad: the step of the free lever's difference quotient (Newton converges to its round-off all the same)
 TRIM_STEP = 1e-6
 #: rad: the half step of GM0's central difference of GZ (its error is GZ''' GM0_STEP^2 / 6)
@@ -42,7 +45,7 @@ TOLERANCE = 1e-8
 #: the default heels, degrees (the command line's 0:80:81)
 DEFAULT_DEGREES = (0.0, 80.0, 81)
 #: Gauss-Legendre points of the criteria's areas on 0-30 and on 30-40 degrees
-_AREA_POINTS = (24, 8)
+_AREA_POINTS = (16, 8)
 AXES = ("roll", "pitch")
 
 
@@ -91,18 +94,19 @@ class Stability:
 # ------------------------------------------------------------------------------------- the model
 
 def hull_surface(scene):
-    """The hull's closed surface (n, 3, 3) in the vessel frame; SceneError naming the key when the
-    scene has none this analysis can use."""
+    """The hull's closed surface (n, 3, 3) in the vessel frame: the box with its deck, or a closed
+    mesh (hull/surface.py); SceneError naming the key when the scene has none this analysis can use."""
     hull = scene.vessel.hull
     if hull is None:
         raise SceneError("vessel.hull", "stability needs the hull's geometry: add a [vessel.hull] table "
-                                        "(length, beam, draft, kg and depth)")
-    if hull.type != "box":
-        raise SceneError("vessel.hull.type", 'stability builds box hulls; a "mesh" hull is not read for it yet')
-    if hull.depth is None:
+                                        '(a box: length, beam, draft, kg and depth; or type = "mesh", a closed mesh)')
+    if hull.type == "box" and hull.depth is None:
         raise SceneError("vessel.hull.depth", "stability needs the box's depth from keel to deck (m): at large "
                                               "heels the deck edge immerses")
-    return box_hull(hull.length, hull.beam, hull.kg, hull.depth)
+    try:
+        return np.asarray(hull_triangles(hull))
+    except HullMeshError as e:
+        raise SceneError("vessel.hull.file", str(e)) from None
 
 
 @dataclass(frozen=True)
@@ -115,6 +119,10 @@ class _Model:
     tank_mass: np.ndarray       # (k,) kg
     rest_centroid: np.ndarray   # (k, 3) vessel frame
     size: float                 # m, the hull's extent: the scale of the lever tolerance
+
+
+#: each tank's liquid at rest: (volume, first moment) under its fill plane
+_rest_state = jax.jit(jax.vmap(submerged, in_axes=(0, None, 0)))
 
 
 def build_model(scene) -> _Model:
@@ -136,8 +144,7 @@ def build_model(scene) -> _Model:
     vol, cen = np.zeros(len(surfaces)), np.zeros((len(surfaces), 3))
     if surfaces:
         fill = np.array([t.origin[2] + t.fill_depth for t in scene.tanks])
-        v, mom = jax.jit(jax.vmap(submerged, in_axes=(0, None, 0)))(jnp.asarray(tanks), jnp.array([0.0, 0.0, 1.0]),
-                                                                     jnp.asarray(fill))
+        v, mom = _rest_state(jnp.asarray(tanks), jnp.array([0.0, 0.0, 1.0]), jnp.asarray(fill))
         vol, cen = np.asarray(v), np.asarray(mom) / np.asarray(v)[:, None]
     return _Model(hull=hull, volume=mass / rho, mass=mass, tanks=tanks, tank_volume=vol, tank_mass=mass_l,
                   rest_centroid=cen, size=float(np.ptp(hull.reshape(-1, 3), axis=0).max()))
@@ -159,8 +166,8 @@ def level(tris, n, volume, iterations=LEVEL_ITERATIONS):
     lo0, hi0 = h.min(), h.max()
     full = submerged(tris, n, hi0)[0]
 
-    def step(_, s):
-        lo, hi, c = s
+    def step(s):
+        i, lo, hi, c, _ = s
         v, _, a = submerged_and_cut(tris, n, c)
         f = v - volume
         lo = jnp.where(f <= 0, c, lo)
@@ -168,26 +175,26 @@ def level(tris, n, volume, iterations=LEVEL_ITERATIONS):
         ok = a > 0
         cn = c - jnp.where(ok, f / jnp.where(ok, a, 1.0), 0.0)
         inside = ok & (cn > lo) & (cn < hi)
-        return lo, hi, jnp.where(inside, cn, 0.5 * (lo + hi))
+        done = jnp.abs(f) <= TOLERANCE * 1e-4 * full
+        return i + 1, lo, hi, jnp.where(done, c, jnp.where(inside, cn, 0.5 * (lo + hi))), done
+
+    def going(s):
+        return (s[0] < iterations) & ~s[4]
 
     c0 = lo0 + (hi0 - lo0) * volume / full
-    _, _, c = jax.lax.fori_loop(0, iterations, step, (lo0, hi0, c0))
+    # until the volume is within round-off (one more step then costs nothing: Newton's is quadratic)
+    _, _, _, c, _ = jax.lax.while_loop(going, step, (0, lo0, hi0, c0, False))
     V, S = submerged(tris, n, c)
     return c, V, S
 
 
-def _levers(model: _Model, axis: str):
+def _levers(arrays, axis: str, has_tanks: bool):
     """(heel, frozen) -> (gz, free angle, offset, volume error, free lever): the equilibrium at one
     heel with the liquids frozen (1.0) or level (0.0). Frozen and level share one program; the
     slope of the free lever for Newton's steps is a difference of two states computed side by side
     (vmapped: no second copy of the program, as a jvp through the plane solves would make)."""
-    hull = jnp.asarray(model.hull)
-    tanks = jnp.asarray(model.tanks)
-    m_l = jnp.asarray(model.tank_mass)
-    v_l = jnp.asarray(model.tank_volume)
-    rest = jnp.asarray(model.rest_centroid)
+    hull, tanks, m_l, v_l, rest, mass, volume, size = arrays
     free = 0 if axis == "roll" else 1          # the world component of B - G the free angle zeroes
-    has_tanks = len(model.tank_mass) > 0
 
     def attitude(heel, psi):
         return _rotation(heel, psi) if axis == "roll" else _rotation(psi, heel)
@@ -197,30 +204,45 @@ def _levers(model: _Model, axis: str):
         if has_tanks:
             _, V, S = jax.vmap(level, in_axes=(0, None, 0))(tanks, n, v_l)
             c = jnp.where(frozen > 0.5, rest, S / V[:, None])
-        return (m_l @ c) / model.mass       # the ship's own COG is the origin
+        return (m_l @ c) / mass             # the ship's own COG is the origin
 
     def state(heel, psi, frozen):
         R = attitude(heel, psi)
         n = R[2]                            # the sea's up direction in the vessel frame
-        off, V, S = level(hull, n, model.volume)
+        off, V, S = level(hull, n, volume)
         d = R @ (S / V - centre_of_gravity(n, frozen))
         return d, off, V
 
     pair = jax.vmap(state, in_axes=(None, 0, None))
 
     def solve(heel, frozen):
-        def newton(_, psi):
+        def newton(s):
+            i, psi, _ = s
             d, _, _ = pair(heel, psi + jnp.array([0.0, TRIM_STEP]), frozen)
             g, dg = d[0, free], (d[1, free] - d[0, free]) / TRIM_STEP
             ok = jnp.abs(dg) > 0
-            return psi - jnp.where(ok, g / jnp.where(ok, dg, 1.0), 0.0)
+            return i + 1, psi - jnp.where(ok, g / jnp.where(ok, dg, 1.0), 0.0), jnp.abs(g) <= 1e-3 * TOLERANCE * size
 
-        psi = jax.lax.fori_loop(0, TRIM_ITERATIONS, newton, jnp.zeros_like(heel))
+        _, psi, _ = jax.lax.while_loop(lambda s: (s[0] < TRIM_ITERATIONS) & ~s[2], newton,
+                                       (0, jnp.zeros_like(heel), False))
         d, off, V = state(heel, psi, frozen)
         gz = -d[1] if axis == "roll" else d[0]
-        return gz, psi, off, V / model.volume - 1.0, d[free]
+        return gz, psi, off, V / volume - 1.0, d[free]
 
     return solve
+
+
+# The model's numbers are arguments, not constants of the program: scenes whose hull and tanks have
+# the same counts of triangles share it (and the heels are padded to a multiple of _PAD). It runs
+# once per call: XLA's optimisation off halves its compile and costs little at run time.
+_PAD = 64
+
+
+@functools.partial(jax.jit, static_argnames=("axis", "has_tanks"), compiler_options=START_OPTIONS)
+def _curves(arrays, heels, *, axis, has_tanks):
+    """Both equilibria (level, frozen) at every heel: arrays (heels, 2)."""
+    solve = _levers(arrays, axis, has_tanks)
+    return jax.vmap(jax.vmap(solve, in_axes=(None, 0)), in_axes=(0, None))(heels, jnp.array([0.0, 1.0]))
 
 
 def _check(what, angles, verr, lever, size):
@@ -276,8 +298,7 @@ def stability(scene, angles=None, axis: str = "roll") -> Stability:
     the IS Code 2008 Part A 2.2 criteria (roll only) on the level curve. `scene`: a Scene or the
     path of a scene file. Raises SceneError for a scene without what it needs (naming the key),
     StabilityFailure where an equilibrium does not converge."""
-    if isinstance(scene, (str, bytes)) or hasattr(scene, "__fspath__"):
-        from ..scene import load_scene
+    if isinstance(scene, str) or hasattr(scene, "__fspath__"):
         scene = load_scene(scene)
     if axis not in AXES:
         raise ValueError(f"axis must be one of {AXES}, got {axis!r}")
@@ -290,26 +311,31 @@ def stability(scene, angles=None, axis: str = "roll") -> Stability:
     grid = np.radians(np.linspace(*DEFAULT_DEGREES))
     x30, w30 = _gauss(0.0, np.radians(30.0), _AREA_POINTS[0])
     x40, w40 = _gauss(np.radians(30.0), np.radians(40.0), _AREA_POINTS[1])
-    # the angles asked for, upright (the sinkage's zero), and the criteria's own points (roll)
-    every = np.concatenate([angles, [0.0]] + ([grid, x30, x40] if axis == "roll" else []))
-    every = np.concatenate([every, [-GM0_STEP, GM0_STEP]])
-    solve = jax.jit(jax.vmap(jax.vmap(_levers(model, axis), in_axes=(None, 0)), in_axes=(0, None)))
-    args = (jnp.asarray(every), jnp.array([0.0, 1.0]))
-    # a program that runs once: XLA's optimisation off halves its compile and costs little at run time
-    solve = solve.lower(*args).compile(compiler_options=START_OPTIONS)
-    gz2, psi2, off2, verr2, lever2 = (np.asarray(x) for x in solve(*args))
+    # the angles asked for, upright (the sinkage's zero), GM0's two points and the criteria's own
+    # (roll: the default grid and the areas' Gauss points), each distinct heel solved once
+    parts = [angles, [0.0, -GM0_STEP, GM0_STEP]] + ([grid, x30, x40] if axis == "roll" else [])
+    every, where = np.unique(np.concatenate(parts), return_inverse=True)
+    where = np.split(where.reshape(-1), np.cumsum([len(p) for p in parts])[:-1])
+    k = len(every)
+    heels = np.concatenate([every, np.zeros(-k % _PAD)])
+    tanks = len(model.tank_mass) > 0
+    arrays = tuple(jnp.asarray(x, dtype=float) for x in (
+        model.hull, model.tanks if tanks else np.zeros((1, 1, 3, 3)), model.tank_mass if tanks else np.zeros(1),
+        model.tank_volume if tanks else np.ones(1), model.rest_centroid if tanks else np.zeros((1, 3)),
+        model.mass, model.volume, model.size))
+    gz2, psi2, off2, verr2, lever2 = (np.asarray(x)[:k] for x in _curves(arrays, jnp.asarray(heels), axis=axis,
+                                                                         has_tanks=tanks))
     for j, what in enumerate(("level", "frozen")):
         _check(what, every, verr2[:, j], lever2[:, j], model.size)
-    gm0, gm0_f = (gz2[-1] - gz2[-2]) / (2 * GM0_STEP)
-    gz, gz_f, psi, off = gz2[:-2, 0], gz2[:-2, 1], psi2[:-2, 0], off2[:-2, 0]
-    gm0, gm0_f = float(gm0), float(gm0_f)
-    n = len(angles)
+    at = where[0]
+    up, minus, plus = where[1]
+    gm0, gm0_f = ((gz2[plus] - gz2[minus]) / (2 * GM0_STEP)).tolist()
+    gz, gz_f = gz2[at, 0] + 0.0, gz2[at, 1] + 0.0         # + 0.0: no -0.0 upright
     crit = ()
     if axis == "roll":
-        k = n + 1 + len(grid)
-        a30 = float(w30 @ gz[k:k + len(x30)])
-        a3040 = float(w40 @ gz[k + len(x30):])
-        crit = criteria(grid, gz[n + 1:k], gm0, a30, a30 + a3040, a3040)
-    return Stability(angle=angles, gz=gz[:n], gz_frozen=gz_f[:n], gm0=gm0, gm0_frozen=gm0_f,
-                     vanishing_angle=vanishing_angle(angles, gz[:n]), criteria=crit, axis=axis,
-                     sinkage=off[:n] - off[n], trim=psi[:n])
+        a30 = float(w30 @ gz2[where[3], 0])
+        a3040 = float(w40 @ gz2[where[4], 0])
+        crit = criteria(grid, gz2[where[2], 0], gm0, a30, a30 + a3040, a3040)
+    return Stability(angle=angles, gz=gz, gz_frozen=gz_f, gm0=gm0, gm0_frozen=gm0_f,
+                     vanishing_angle=vanishing_angle(angles, gz), criteria=crit, axis=axis,
+                     sinkage=off2[at, 0] - off2[up, 0], trim=psi2[at, 0])
