@@ -11,6 +11,7 @@ from jaxslosh.hull.box import box_surface
 from jaxslosh.hull.clip import clip_below, pressure_force_moment, submerged
 
 SIZE = np.array([3.0, 2.0, 1.5])
+_submerged = jax.jit(submerged)
 
 
 def _rotation(rng):
@@ -35,25 +36,23 @@ def _box_halfspace_closed_form(size, n, t):
     return V / p, W / p
 
 
-def _convex_clip(corners, n, t):
+def _convex_clip(corners, n, t, edges=None):
     """Independent: the convex polytope (corners below) + (edge crossings), its volume and
-    centroid from scipy's hull, split into tetrahedra about an inner point."""
+    centroid from scipy's hull, split into tetrahedra about an inner point. `edges` (k, 2) index
+    pairs (default: every pair, which adds points inside the cut but none outside it)."""
     d = corners @ n - t
-    pts = [c for c, di in zip(corners, d) if di <= 0]
-    for i in range(len(corners)):
-        for j in range(i + 1, len(corners)):
-            if d[i] * d[j] < 0:
-                pts.append(corners[i] + d[i] / (d[i] - d[j]) * (corners[j] - corners[i]))
-    pts = np.array(pts)
+    if edges is None:
+        edges = np.array([(i, j) for i in range(len(corners)) for j in range(i + 1, len(corners))])
+    i, j = edges[:, 0], edges[:, 1]
+    cross = d[i] * d[j] < 0
+    i, j = i[cross], j[cross]
+    cuts = corners[i] + (d[i] / (d[i] - d[j]))[:, None] * (corners[j] - corners[i])
+    pts = np.concatenate([corners[d <= 0], cuts])
     h = ConvexHull(pts)
     o = pts.mean(axis=0)
-    V, M = 0.0, np.zeros(3)
-    for s in h.simplices:
-        a, b, c = pts[s]
-        v = abs(np.linalg.det(np.array([a - o, b - o, c - o]))) / 6.0
-        V += v
-        M += v * (a + b + c + o) / 4.0
-    return V, M
+    T = pts[h.simplices]                                       # (f, 3, 3): tetrahedra (o, a, b, c)
+    v = np.abs(np.linalg.det(T - o)) / 6.0
+    return v.sum(), (v[:, None] * (T.sum(axis=1) + o) / 4.0).sum(axis=0)
 
 
 def _icosphere(level):
@@ -81,7 +80,7 @@ def test_box_at_random_poses_matches_closed_form_and_convex_hull():
         corners = np.array([[(e >> i) & 1 for i in range(3)] for e in range(8)]) * SIZE
         h = corners @ n
         t = rng.uniform(h.min() + 0.05, h.max() - 0.05)
-        V, M = (np.asarray(x) for x in submerged(jnp.asarray(tris), jnp.asarray(n), t))
+        V, M = (np.asarray(x) for x in _submerged(jnp.asarray(tris), jnp.asarray(n), t))
         # the closed form needs n_i > 0: mirror the box (x -> size - x) along negative components
         flip = n < 0
         n_pos = np.abs(n)
@@ -94,7 +93,7 @@ def test_box_at_random_poses_matches_closed_form_and_convex_hull():
         np.testing.assert_allclose(M / V, Mh / Vh, atol=1e-10)
         # after a rigid motion of both the body and the plane, the same volume, the centroid moved
         R, p = _rotation(rng), rng.normal(size=3)
-        V2, M2 = submerged(jnp.asarray(tris @ R.T + p), jnp.asarray(R @ n), t + (R @ n) @ p)
+        V2, M2 = _submerged(jnp.asarray(tris @ R.T + p), jnp.asarray(R @ n), t + (R @ n) @ p)
         assert float(V2) == pytest.approx(V, rel=1e-12)
         np.testing.assert_allclose(np.asarray(M2) / float(V2), R @ (M / V) + p, atol=1e-10)
 
@@ -103,15 +102,17 @@ def test_sphere_caps():
     """A fine icosphere (the polyhedron, so against its convex hull exactly, and against the sphere's
     caps to the polyhedron's own error)."""
     tris = _icosphere(4)
-    verts = np.unique(tris.reshape(-1, 3).round(14), axis=0)
+    verts, idx = np.unique(tris.reshape(-1, 3).round(14), axis=0, return_inverse=True)
+    idx = idx.reshape(-1, 3)
+    edges = np.unique(np.sort(np.concatenate([idx[:, [0, 1]], idx[:, [1, 2]], idx[:, [2, 0]]]), axis=1), axis=0)
     rng = np.random.default_rng(1)
     c = np.array([0.3, -0.2, 0.5])
     for h in (-0.7, 0.0, 0.45):
         n = rng.normal(size=3)
         n /= np.linalg.norm(n)
         t = n @ c + h
-        V, M = (np.asarray(x) for x in submerged(jnp.asarray(tris + c), jnp.asarray(n), t))
-        Vh, Mh = _convex_clip(verts + c, n, t)
+        V, M = (np.asarray(x) for x in _submerged(jnp.asarray(tris + c), jnp.asarray(n), t))
+        Vh, Mh = _convex_clip(verts + c, n, t, edges)
         assert V == pytest.approx(Vh, rel=1e-10)
         np.testing.assert_allclose(M / V, Mh / Vh, atol=1e-10)
         # the cap of height a = 1 + h below the plane: V = pi a^2 (3 - a) / 3, centroid on the axis
@@ -158,6 +159,7 @@ def test_gradients_agree_with_finite_differences_and_are_finite_on_the_plane():
     R = _rotation(rng)
     tris = jnp.asarray(box_surface([-1.5, -1, -0.75], [1.5, 1, 0.75]) @ R.T)
 
+    @jax.jit
     def f(x):                       # a scalar of the pose: plane normal (3), offset, a shift of the body
         V, M = submerged(tris + x[4:7], x[:3], x[3])
         return V + 0.3 * M[0] - 0.7 * M[2]

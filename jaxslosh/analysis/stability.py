@@ -269,7 +269,7 @@ def vanishing_angle(angle, gz) -> Optional[float]:
     return None
 
 
-def criteria(angle, gz, gm0, area_30, area_40, area_30_40):
+def is_code_criteria(angle, gz, gm0, area_30, area_40, area_30_40):
     """IS Code 2008 Part A 2.2 on a GZ curve (rad, m) that covers 0-40 degrees and beyond."""
     a, g = np.asarray(angle), np.asarray(gz)
     i = int(np.argmax(g))
@@ -292,12 +292,13 @@ def _gauss(lo, hi, n):
     return 0.5 * (hi - lo) * x + 0.5 * (hi + lo), 0.5 * (hi - lo) * w
 
 
-def stability(scene, angles=None, axis: str = "roll") -> Stability:
+def stability(scene, angles=None, axis: str = "roll", *, criteria: bool = True) -> Stability:
     """GZ (m) at the heels `angles` (rad; default 0 to 80 degrees by 1) about the `axis` "roll" or
     "pitch", with the liquids level and frozen; GM0 both ways; the angle of vanishing stability;
     the IS Code 2008 Part A 2.2 criteria (roll only) on the level curve. `scene`: a Scene or the
     path of a scene file. Raises SceneError for a scene without what it needs (naming the key),
-    StabilityFailure where an equilibrium does not converge."""
+    StabilityFailure where an equilibrium does not converge. `criteria=False` skips the criteria
+    and the heels they are computed at (`criteria` is then empty)."""
     if isinstance(scene, str) or hasattr(scene, "__fspath__"):
         scene = load_scene(scene)
     if axis not in AXES:
@@ -313,7 +314,8 @@ def stability(scene, angles=None, axis: str = "roll") -> Stability:
     x40, w40 = _gauss(np.radians(30.0), np.radians(40.0), _AREA_POINTS[1])
     # the angles asked for, upright (the sinkage's zero), GM0's two points and the criteria's own
     # (roll: the default grid and the areas' Gauss points), each distinct heel solved once
-    parts = [angles, [0.0, -GM0_STEP, GM0_STEP]] + ([grid, x30, x40] if axis == "roll" else [])
+    judged = criteria and axis == "roll"
+    parts = [angles, [0.0, -GM0_STEP, GM0_STEP]] + ([grid, x30, x40] if judged else [])
     every, where = np.unique(np.concatenate(parts), return_inverse=True)
     where = np.split(where.reshape(-1), np.cumsum([len(p) for p in parts])[:-1])
     k = len(every)
@@ -332,10 +334,10 @@ def stability(scene, angles=None, axis: str = "roll") -> Stability:
     gm0, gm0_f = ((gz2[plus] - gz2[minus]) / (2 * GM0_STEP)).tolist()
     gz, gz_f = gz2[at, 0] + 0.0, gz2[at, 1] + 0.0         # + 0.0: no -0.0 upright
     crit = ()
-    if axis == "roll":
+    if judged:
         a30 = float(w30 @ gz2[where[3], 0])
         a3040 = float(w40 @ gz2[where[4], 0])
-        crit = criteria(grid, gz2[where[2], 0], gm0, a30, a30 + a3040, a3040)
+        crit = is_code_criteria(grid, gz2[where[2], 0], gm0, a30, a30 + a3040, a3040)
     return Stability(angle=angles, gz=gz, gz_frozen=gz_f, gm0=gm0, gm0_frozen=gm0_f,
                      vanishing_angle=vanishing_angle(angles, gz), criteria=crit, axis=axis,
                      sinkage=off2[at, 0] - off2[up, 0], trim=psi2[at, 0])

@@ -21,7 +21,7 @@ from .box import box_surface
 
 #: sides of the polygon that stands for a cylinder's circle (area kept exact; the centroid of a
 #: level segment is within (pi / sides)^2 / 3 of the circle's, relative)
-CYLINDER_SIDES = 256
+CYLINDER_SIDES = 128
 
 
 def prism_surface(polygon, length):
