@@ -10,11 +10,10 @@ from jax.custom_derivatives import SymbolicZero
 import jax.numpy as jnp
 import numpy as np
 
-from ..physics.kinematics import quat_exp, rotation_matrix
 from .clip import MIDPOINT_RULE, area_vectors, clip_below, submerged
 
 #: bisection steps of the sinkage at a fixed heel: the bracket (the hull's size) shrinks below round-off
-BISECTIONS = 80
+BISECTIONS = 52
 
 
 def buoyancy(tris, z_water, X0, A):
@@ -80,24 +79,20 @@ def still_force_moment(tris, z_water, rho_g, X0, A):
     return jnp.array([0.0, 0.0, rho_g * V]), jnp.cross(m, rho_g * A[2])
 
 
-@jax.jit
-def _rest(tris, z_water, rho_g):
-    def rows(x):
-        F, M = still_force_moment(tris, z_water, rho_g, x[:3], rotation_matrix(quat_exp(x[3:])))
-        return jnp.concatenate([F, M])
-    V, m = buoyancy(tris, z_water, jnp.zeros(3), jnp.eye(3))
-    return V, m, -jax.jacfwd(rows)(jnp.zeros(6))
-
-
 def rest_hydrostatics(tris, z_water, rho=1025.0, g=9.81) -> dict:
-    """The linear model of the same hull (eqs. 33-38) from the still-water stiffness K at rest
-    (K33 = rho g A_w, K44 = rho g V GM_T, K55 = rho g V GM_L; the weight adds nothing there, the
-    frame being at the COG), and the centre of buoyancy (body frame). Host-side floats."""
-    V, m, K = _rest(jnp.asarray(tris, dtype=float), jnp.asarray(z_water, dtype=float), jnp.asarray(rho * g))
-    V, rg = float(V), rho * g
+    """The linear model of the same hull (eqs. 33-38) from the still-water stiffness at rest, written
+    with the lid's (waterplane's) integrals: K33 = rho g A_w, K44 = rho g (int y^2 dA + V z_B) =
+    rho g V GM_T, K55 = rho g (int x^2 dA + V z_B) = rho g V GM_L (the frame at the COG), and the
+    centre of buoyancy (body frame). Host-side floats, in float64 whatever the session's setting:
+    the loader calls it before the command line switches JAX to float64, so it uses no program
+    that the run traces again (a constant cached in float32 would then meet float64 indices)."""
+    with jax.enable_x64(True):
+        V, m, area, s, J, _ = (np.asarray(x) for x in _lid_integrals(
+            jnp.asarray(np.asarray(tris, dtype=np.float64)), jnp.array([0.0, 0.0, 1.0]), jnp.asarray(float(z_water))))
+    V = float(V)
     safe = V if V > 0 else 1.0
-    return {"waterplane_area": float(K[2, 2]) / rg, "displaced_volume": V,
-            "gm_t": float(K[3, 3]) / (rg * safe), "gm_l": float(K[4, 4]) / (rg * safe),
+    return {"waterplane_area": float(area), "displaced_volume": V,
+            "gm_t": (float(J[1, 1]) + float(m[2])) / safe, "gm_l": (float(J[0, 0]) + float(m[2])) / safe,
             "centre_of_buoyancy": tuple(float(x) / safe for x in m)}
 
 
@@ -109,17 +104,19 @@ def gz_curve(tris, z_water, volume, S_over_mass, angles, axis: int = 0):
     reach = jnp.max(jnp.abs(tris)) + jnp.abs(z_water) + 1.0
 
     def one(phi):
-        A = rotation_matrix(quat_exp(jnp.zeros(3).at[axis].set(phi)))
+        # the body's up direction n_b = A^T e_z after a rotation phi about body x (roll) or y (pitch)
+        c, sn = jnp.cos(phi), jnp.sin(phi)
+        up = jnp.stack([jnp.zeros_like(phi), sn, c]) if axis == 0 else jnp.stack([-sn, jnp.zeros_like(phi), c])
 
         def halve(_, bracket):
             lo, hi = bracket
             mid = 0.5 * (lo + hi)
-            V, _m = buoyancy(tris, z_water, jnp.array([0.0, 0.0, mid]), A)
+            V, _m = volume_below(tris, up, z_water - mid)
             return jnp.where(V > volume, mid, lo), jnp.where(V > volume, hi, mid)
         lo, hi = jax.lax.fori_loop(0, BISECTIONS, halve, (-reach, reach))
-        V, m = buoyancy(tris, z_water, jnp.array([0.0, 0.0, 0.5 * (lo + hi)]), A)
+        V, m = volume_below(tris, up, z_water - 0.5 * (lo + hi))
         # the moment of buoyancy and weight about the COG over the weight: (x_B - x_G) x n_b
-        lever = jnp.cross(m / V - S_over_mass, A[2])
+        lever = jnp.cross(m / V - S_over_mass, up)
         return -lever[axis]
     return jax.vmap(one)(angles)
 
