@@ -153,8 +153,8 @@ def test_small_motion_stiffness_equals_the_linear_model_of_the_same_hull():
         X0, q = _pose(x)
         return -jnp.concatenate([lin.force(X0), lin.moment(q)])
 
-    Knl, Klin = jax.jacfwd(rows_nl)(jnp.zeros(6)), jax.jacfwd(rows_lin)(jnp.zeros(6))
-    np.testing.assert_allclose(np.asarray(rows_nl(jnp.zeros(6))), 0.0, atol=1e-6 * MASS * G)
+    Knl, Klin = jax.jit(jax.jacfwd(rows_nl))(jnp.zeros(6)), jax.jit(jax.jacfwd(rows_lin))(jnp.zeros(6))
+    np.testing.assert_allclose(np.asarray(jax.jit(rows_nl)(jnp.zeros(6))), 0.0, atol=1e-6 * MASS * G)
     np.testing.assert_allclose(np.asarray(Knl), np.asarray(Klin), atol=1e-9 * float(jnp.abs(Klin).max()))
 
 
@@ -174,8 +174,10 @@ def test_rows_are_the_gradient_of_the_potential():
     c = Config(X0, q, jnp.zeros(0))
     sysm = build(scene).system
     k = sysm.kin(c, jnp.zeros(3), jnp.zeros(3), jnp.zeros(0), jnp.zeros(6), jnp.zeros(0))
-    grad = potential_rows(lambda cc: term.potential(sysm.kin(cc, jnp.zeros(3), jnp.zeros(3), jnp.zeros(0))), c)
-    np.testing.assert_allclose(np.asarray(term.rows(k).rigid), np.asarray(grad), rtol=1e-9, atol=1e-6)
+    grad = jax.jit(lambda cc: potential_rows(
+        lambda c_: term.potential(sysm.kin(c_, jnp.zeros(3), jnp.zeros(3), jnp.zeros(0))), cc))(c)
+    np.testing.assert_allclose(np.asarray(jax.jit(lambda k_: term.rows(k_).rigid)(k)), np.asarray(grad),
+                               rtol=1e-9, atol=1e-6)
 
 
 # ------------------------------------------------------------------------------------------------
@@ -311,9 +313,11 @@ def test_small_waves_give_the_linear_froude_krylov_force():
     term = build_hull_pressure(scene, {}, jnp.asarray(G))
     still = HullPressure(term.tris, term.rho_w, term.gravity, term.z_water)
     X = froude_krylov_box(2 * math.pi / 5.0, 2.5, L, B, T, KG, RHO, G)[0]
+    wave = jax.jit(lambda X0, A, t: term.force_moment(X0, A, t))
+    calm = jax.jit(lambda X0, A, t: still.force_moment(X0, A, t))
     for t in (0.0, 1.1, 2.7):
-        F, M = term.force_moment(jnp.zeros(3), jnp.eye(3), t)
-        F0, M0 = still.force_moment(jnp.zeros(3), jnp.eye(3), t)
+        F, M = wave(jnp.zeros(3), jnp.eye(3), t)
+        F0, M0 = calm(jnp.zeros(3), jnp.eye(3), t)
         got = np.concatenate([F - F0, M - M0])
         want = a * np.real(X * np.exp(1j * 2 * math.pi / 5.0 * t))
         np.testing.assert_allclose(got, want, atol=0.02 * a * np.abs(X).max())
@@ -420,3 +424,36 @@ def test_parametric_roll_grows_to_a_steady_amplitude_only_with_the_nonlinear_mod
     lin = js.simulate(_linear_twin(scene))
     lroll = np.degrees(np.asarray(lin.vessel.roll_pitch_yaw)[:, 0])
     assert np.max(np.abs(lroll)) <= np.degrees(0.05) * 1.0001
+
+
+def test_small_waves_run_equals_the_linear_model():
+    """Waves of 2 cm on the bow quarter, 12 s: roll, pitch and heave of the nonlinear model follow
+    the linear model's (GM springs, Froude-Krylov on the box) within 3 % of their largest values."""
+    extra = '\n[waves]\ntype = "regular"\namplitude = 0.02\nperiod = 6.0\nheading = 2.3\nramp = 3.0\n'
+    a = js.simulate(box_scene(duration=12.0, dt=0.05, extra=extra))
+    b = js.simulate(box_scene(duration=12.0, dt=0.05, model="linear", extra=extra))
+    for get in (lambda r: r.vessel.roll_pitch_yaw[:, 0], lambda r: r.vessel.roll_pitch_yaw[:, 1],
+                lambda r: r.vessel.position[:, 2]):
+        x, y = np.asarray(get(a)), np.asarray(get(b))
+        assert np.max(np.abs(x - y)) < 0.03 * np.max(np.abs(y)), (np.max(np.abs(x - y)), np.max(np.abs(y)))
+
+
+def test_the_written_out_tangent_of_the_volume_equals_the_clippings():
+    """hull/hydrostatics.volume_below's derivative in the plane (from the lid's area and moments)
+    against JAX's through the clipping (hull/clip.submerged), forward and reverse; a tangent in the
+    surface itself goes through the clipping."""
+    from jaxslosh.hull.clip import submerged
+    from jaxslosh.hull.hydrostatics import volume_below
+    from jaxslosh.hull.surface import prism_surface
+    tris = jnp.asarray(prism_surface([[-1, 0], [1, 0], [2, 2], [-2, 2]], 10.0, 5, 3))
+    n, c = jnp.array([0.1, 0.3, 1.0]), jnp.asarray(0.4)
+    for dn, dc in ((jnp.array([0.3, -0.2, 0.5]), 0.7), (jnp.zeros(3), 1.0)):
+        (_, a), (_, b) = (jax.jit(lambda n_, c_, dn_, dc_: jax.jvp(lambda x, y: f(tris, x, y), (n_, c_), (dn_, dc_)))(
+            n, c, dn, jnp.asarray(dc)) for f in (volume_below, submerged))
+        for x, y in zip(a, b):
+            np.testing.assert_allclose(np.asarray(x), np.asarray(y), rtol=1e-11, atol=1e-11)
+    np.testing.assert_allclose(np.asarray(jax.jit(jax.jacrev(lambda n_: volume_below(tris, n_, c)[1]))(n)),
+                               np.asarray(jax.jit(jax.jacrev(lambda n_: submerged(tris, n_, c)[1]))(n)),
+                               rtol=1e-11, atol=1e-11)
+    np.testing.assert_allclose(np.asarray(jax.jit(jax.grad(lambda t: volume_below(t, n, c)[0]))(tris)),
+                               np.asarray(jax.jit(jax.grad(lambda t: submerged(t, n, c)[0]))(tris)), atol=1e-12)

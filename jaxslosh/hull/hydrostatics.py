@@ -6,20 +6,70 @@ from __future__ import annotations
 import functools
 
 import jax
+from jax.custom_derivatives import SymbolicZero
 import jax.numpy as jnp
 import numpy as np
 
-from ..physics.kinematics import quat_exp, rotation_matrix
-from .clip import submerged
+from .clip import MIDPOINT_RULE, area_vectors, clip_below, submerged
 
 #: bisection steps of the sinkage at a fixed heel: the bracket (the hull's size) shrinks below round-off
-BISECTIONS = 80
+BISECTIONS = 52
 
 
 def buoyancy(tris, z_water, X0, A):
     """(V, m): the displaced volume and its first moment about the COG (body frame) for the pose
     (X0 inertial, A body to inertial): the body's part below n_b . r = z_water - Z0, n_b = A^T e_z."""
-    return submerged(tris, A[2], z_water - X0[2])
+    return volume_below(tris, A[2], z_water - X0[2])
+
+
+def _lid_integrals(tris, n, c):
+    """(V, m, A, s, J): `submerged`'s volume and first moment below n . x <= c, and the area, first
+    moment and second moment (int x x^T dA) of the body's section by the plane (the lid), all from
+    the wetted pieces: the flux of x_a n through the closed clipped body is V n_a, that of
+    x_a x_b n is n_a m_b + n_b m_a, and the lid's share is what the wetted pieces leave."""
+    nn = jnp.linalg.norm(n)
+    u, off = n / nn, c / nn
+    pieces = clip_below(tris, u, off).reshape(-1, 3, 3)
+    an = area_vectors(pieces) @ u                                  # (u . N) dS per piece
+    lam, w = MIDPOINT_RULE
+    x = jnp.einsum("qk,mkx->mqx", lam, pieces)                     # (m, 3, 3) quadrature points
+    zeta = x @ u - off
+    V = jnp.sum(an * (zeta @ w))
+    m = jnp.einsum("m,mq,mqx,q->x", an, zeta, x, w) - u * jnp.sum(an * ((0.5 * zeta ** 2) @ w))
+    area = -jnp.sum(an)
+    s = V * u - jnp.einsum("m,mqx,q->x", an, x, w)
+    J = jnp.outer(u, m) + jnp.outer(m, u) - jnp.einsum("m,mqx,mqy,q->xy", an, x, x, w)
+    return V, m, area, s, J, nn
+
+
+@jax.custom_jvp
+def volume_below(tris, n, c):
+    """(V, m): the volume of the closed surface `tris` below the plane n . x <= c and its first
+    moment (hull/clip.submerged), with the derivative in the plane written out: moving the plane
+    sweeps the lid, so d V = (A dc - s . dn) / |n| and d m = (s dc - J dn) / |n| with the lid's
+    area A, first moment s and second moment J. The Newton preconditioner linearises the rows six
+    times per iteration; through the clipping each is a pass over every panel, from these
+    integrals a 3 x 3 product. A tangent in the surface itself is differentiated through the
+    clipping."""
+    return submerged(tris, n, c)
+
+
+def _volume_below_jvp(primals, tangents):
+    tris, n, c = primals
+    dt, dn, dc = tangents
+    if not isinstance(dt, SymbolicZero):          # the surface moves: differentiate the clipping
+        return jax.jvp(submerged, primals, tuple(jnp.zeros_like(p) if isinstance(t, SymbolicZero) else t
+                                                 for t, p in zip(tangents, primals)))
+    V, m, area, s, J, nn = _lid_integrals(tris, n, c)
+    dn = jnp.zeros_like(n) if isinstance(dn, SymbolicZero) else dn
+    dc = jnp.zeros_like(c) if isinstance(dc, SymbolicZero) else dc
+    # the plane n . x = c moves along its unit normal by (dc - dn . x) / |n| at x
+    dV = (area * dc - s @ dn) / nn
+    dm = (s * dc - J @ dn) / nn
+    return (V, m), (dV, dm)
+
+
+volume_below.defjvp(_volume_below_jvp, symbolic_zeros=True)
 
 
 def still_force_moment(tris, z_water, rho_g, X0, A):
@@ -29,24 +79,20 @@ def still_force_moment(tris, z_water, rho_g, X0, A):
     return jnp.array([0.0, 0.0, rho_g * V]), jnp.cross(m, rho_g * A[2])
 
 
-@jax.jit
-def _rest(tris, z_water, rho_g):
-    def rows(x):
-        F, M = still_force_moment(tris, z_water, rho_g, x[:3], rotation_matrix(quat_exp(x[3:])))
-        return jnp.concatenate([F, M])
-    V, m = buoyancy(tris, z_water, jnp.zeros(3), jnp.eye(3))
-    return V, m, -jax.jacfwd(rows)(jnp.zeros(6))
-
-
 def rest_hydrostatics(tris, z_water, rho=1025.0, g=9.81) -> dict:
-    """The linear model of the same hull (eqs. 33-38) from the still-water stiffness K at rest
-    (K33 = rho g A_w, K44 = rho g V GM_T, K55 = rho g V GM_L; the weight adds nothing there, the
-    frame being at the COG), and the centre of buoyancy (body frame). Host-side floats."""
-    V, m, K = _rest(jnp.asarray(tris, dtype=float), jnp.asarray(z_water, dtype=float), jnp.asarray(rho * g))
-    V, rg = float(V), rho * g
+    """The linear model of the same hull (eqs. 33-38) from the still-water stiffness at rest, written
+    with the lid's (waterplane's) integrals: K33 = rho g A_w, K44 = rho g (int y^2 dA + V z_B) =
+    rho g V GM_T, K55 = rho g (int x^2 dA + V z_B) = rho g V GM_L (the frame at the COG), and the
+    centre of buoyancy (body frame). Host-side floats, in float64 whatever the session's setting:
+    the loader calls it before the command line switches JAX to float64, so it uses no program
+    that the run traces again (a constant cached in float32 would then meet float64 indices)."""
+    with jax.enable_x64(True):
+        V, m, area, s, J, _ = (np.asarray(x) for x in _lid_integrals(
+            jnp.asarray(np.asarray(tris, dtype=np.float64)), jnp.array([0.0, 0.0, 1.0]), jnp.asarray(float(z_water))))
+    V = float(V)
     safe = V if V > 0 else 1.0
-    return {"waterplane_area": float(K[2, 2]) / rg, "displaced_volume": V,
-            "gm_t": float(K[3, 3]) / (rg * safe), "gm_l": float(K[4, 4]) / (rg * safe),
+    return {"waterplane_area": float(area), "displaced_volume": V,
+            "gm_t": (float(J[1, 1]) + float(m[2])) / safe, "gm_l": (float(J[0, 0]) + float(m[2])) / safe,
             "centre_of_buoyancy": tuple(float(x) / safe for x in m)}
 
 
@@ -58,17 +104,19 @@ def gz_curve(tris, z_water, volume, S_over_mass, angles, axis: int = 0):
     reach = jnp.max(jnp.abs(tris)) + jnp.abs(z_water) + 1.0
 
     def one(phi):
-        A = rotation_matrix(quat_exp(jnp.zeros(3).at[axis].set(phi)))
+        # the body's up direction n_b = A^T e_z after a rotation phi about body x (roll) or y (pitch)
+        c, sn = jnp.cos(phi), jnp.sin(phi)
+        up = jnp.stack([jnp.zeros_like(phi), sn, c]) if axis == 0 else jnp.stack([-sn, jnp.zeros_like(phi), c])
 
         def halve(_, bracket):
             lo, hi = bracket
             mid = 0.5 * (lo + hi)
-            V, _m = buoyancy(tris, z_water, jnp.array([0.0, 0.0, mid]), A)
+            V, _m = volume_below(tris, up, z_water - mid)
             return jnp.where(V > volume, mid, lo), jnp.where(V > volume, hi, mid)
         lo, hi = jax.lax.fori_loop(0, BISECTIONS, halve, (-reach, reach))
-        V, m = buoyancy(tris, z_water, jnp.array([0.0, 0.0, 0.5 * (lo + hi)]), A)
+        V, m = volume_below(tris, up, z_water - 0.5 * (lo + hi))
         # the moment of buoyancy and weight about the COG over the weight: (x_B - x_G) x n_b
-        lever = jnp.cross(m / V - S_over_mass, A[2])
+        lever = jnp.cross(m / V - S_over_mass, up)
         return -lever[axis]
     return jax.vmap(one)(angles)
 

@@ -16,8 +16,8 @@ from ..hull.hydrostatics import first_vanishing, gz_curve
 from ..physics.hull import HullPressure
 from ..physics.vessel import Weight
 
-#: heels at which GZ is evaluated before the crossing is interpolated, 0 to 180 degrees
-HEELS = 361
+#: heels at which GZ is evaluated before the crossing is interpolated, 0 to 180 degrees by 2
+HEELS = 91
 
 
 def vanishing_angles(system) -> Optional[tuple]:
