@@ -24,13 +24,16 @@ polynomials of degree <= 2 on each flat piece; the three-edge-midpoint rule inte
 from __future__ import annotations
 
 import jax.numpy as jnp
+import numpy as np
 
 __all__ = ["clip_below", "submerged", "submerged_and_cut", "pressure_force_moment", "integrate_pressure",
            "area_vectors", "triangulate_quads", "MIDPOINT_RULE"]
 
-#: barycentric points and weights (summing to 1) of the degree-2 rule on a triangle (edge midpoints)
-MIDPOINT_RULE = (jnp.array([[0.5, 0.5, 0.0], [0.0, 0.5, 0.5], [0.5, 0.0, 0.5]]),
-                 jnp.array([1.0, 1.0, 1.0]) / 3.0)
+#: barycentric points and weights (summing to 1) of the degree-2 rule on a triangle (edge midpoints);
+#: NumPy constants, not jnp arrays: a module imported before the entry point switches on float64
+#: would otherwise keep them float32 (1e-8 relative error in every clipped integral)
+MIDPOINT_RULE = (np.array([[0.5, 0.5, 0.0], [0.0, 0.5, 0.5], [0.5, 0.0, 0.5]]),
+                 np.array([1.0, 1.0, 1.0]) / 3.0)
 
 
 def _unit_plane(normal, offset):
