@@ -102,13 +102,14 @@ KEYS = (
      "spline (continuous acceleration), the dofs not given held."),
     ("vessel.forced.rate", "required (spin-up)", "rad/s", "The final rate of a spin-up."),
     ("vessel.forced.duration", "required (spin-up)", "s", "The spin-up time."),
-    ("vessel.hull.type", '"box"', "", '"box" or "mesh" (a hull mesh file for Capytaine).'),
+    ("vessel.hull.type", '"box"', "", '"box" or "mesh": a hull mesh file, for Capytaine and, closed (deck '
+                                      'included), for the nonlinear hydrostatics and stability.'),
     ("vessel.hull.length", "required (box)", "m", "Box hull length, centred on the COG in plan."),
     ("vessel.hull.beam", "required (box)", "m", "Box hull beam."),
     ("vessel.hull.draft", "required (box)", "m", "Box hull draft."),
     ("vessel.hull.kg", "required (box)", "m", "The COG's height above the keel."),
-    ("vessel.hull.file", "required (mesh)", "", "The hull mesh (any format Capytaine reads), relative to the "
-                                               "scene, waterline at z = 0."),
+    ("vessel.hull.file", "required (mesh)", "", "The hull mesh (any format meshio or Capytaine reads; triangles "
+                                               "and quads), relative to the scene, waterline at z = 0."),
     ("vessel.hull.cog", "[0, 0, 0]", "m", "The COG in the mesh's coordinates."),
     ("vessel.hull.depth", "required (box, nonlinear or stability)", "m", "Box hull: keel to deck, above the "
                                                                           "draft (large angles immerse the deck edge)."),
