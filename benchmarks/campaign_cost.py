@@ -11,7 +11,8 @@ headings x 2 seeds. In one process, compilation excluded from both (each is call
   stepping alone (the initial state and the result's assembly left out);
 * a campaign batch: `campaign.worker.run_batch` of `--batch` cases as a Dask worker runs it (the
   cases' scenes, their seas drawn on the host, the vmapped loop, the result, the statistics),
-  each phase timed.
+  each phase timed; each repeat runs the campaign's next `--batch` cases in its order (the first
+  batch is the warm-up), as a worker meets them.
 
 Printed: each phase per case, the per-case cost / plain-run stepping ratio (wall and this process's
 CPU time: on a busy machine the wall clock counts other jobs' time, the CPU time much less of it),
@@ -122,7 +123,11 @@ def main(argv=None):
     scene = js.load_scene(scene_path)
     heads = np.linspace(0.0, np.pi, 5)
     cases = make_cases(read_scatter(csv_path), heads, 2, scene.waves.seed)
-    values = [case_values(cases, i) for i in np.linspace(0, cases.n - 1, a.batch).round().astype(int)]
+    # batch k holds cases k B .. (k + 1) B - 1, as a campaign's batches do (cell-major: a batch's
+    # cases share a few sea states); the first is the warm-up, each repeat runs the next
+    batches = [[case_values(cases, i % cases.n) for i in range(k * a.batch, (k + 1) * a.batch)]
+               for k in range(a.repeat + 1)]
+    values = batches[0]
     steps = int(round(a.duration / scene.simulation.dt))
     print(f"{os.cpu_count()} cores, load average {' '.join(f'{x:.1f}' for x in os.getloadavg())}; "
           f"{a.batch} cases of {a.duration:g} s ({steps} steps) per batch")
@@ -144,7 +149,7 @@ def main(argv=None):
         plain = Clock()
         plain("stepping", lambda: run(bc, st.solver, carry, n_frames, st.save_every))
         clock = Clock()
-        statuses = batch(scene, values, a.duration, a.batch, clock)
+        statuses = batch(scene, batches[rep + 1], a.duration, a.batch, clock)
         pw, pc = plain.wall["stepping"], plain.cpu["stepping"]
         bw, bcpu = sum(clock.wall.values()) / a.batch, sum(clock.cpu.values()) / a.batch
         print(f"repeat {rep + 1}: plain run stepping {pw:.3f} s wall, {pc:.3f} s CPU "

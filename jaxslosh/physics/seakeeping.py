@@ -77,8 +77,8 @@ class Excitation(eqx.Module):
 
     The sum is evaluated as amp cos(phase) . cos(w t) - amp sin(phase) . sin(w t), the two
     (6, N) products formed once where the excitation is made: the force is evaluated in every
-    Newton iteration, and a cosine per row and component (6 N) cost a third of the paper ship's
-    step in a 200-component sea, where N cosines and N sines do not."""
+    Newton iteration, and N cosines and N sines there cost a third of a cosine per row and
+    component (6 N)."""
     omega: jax.Array      # (N,)
     amp: jax.Array        # (6, N) per unit `height`
     phase: jax.Array      # (6, N)
