@@ -11,11 +11,11 @@ import numpy as np
 from jax.sharding import Mesh, NamedSharding, PartitionSpec
 
 from ..io.result import Result, result_from
-from ..programs import START_OPTIONS, XLA_OPTIONS
+from ..programs import XLA_OPTIONS
 from ..physics.seakeeping import Excitation, WaveExcitation
 from ..scene.keys import check_values, with_overrides
 from ..scene.types import Scene, SceneError
-from .loop import advance, core, frame_datasets, start
+from .loop import advance, concat_frames, core, frame_datasets, start
 from .simulate import failure_message, is_traced, prepare
 
 
@@ -49,7 +49,7 @@ def _batch_fn(scene: Scene, keys: tuple, mesh: Optional[Mesh] = None, excited: b
     setup0 = _setup0(scene)
     n_frames = setup0.n_steps // setup0.save_every
 
-    def model(v):
+    def one(*v):
         if excited:
             exc, v = v[:4], v[4:]
         with jax.ensure_compile_time_eval():     # the liquid's matrices are built on the host, once
@@ -58,66 +58,23 @@ def _batch_fn(scene: Scene, keys: tuple, mesh: Optional[Mesh] = None, excited: b
         b = b._replace(system=eqx.tree_at(lambda s: s.liquid, b.system, b.system.liquid.for_batch()))
         if excited:
             b = _excited(b, exc)
-        return b, setup
+        carry, f0 = start(b, setup.solver)
+        carry, frames = advance(b, setup.solver, carry, n_frames, setup.save_every)
+        fr = concat_frames([jax.tree_util.tree_map(lambda x: x[None], f0), frames])
+        return carry, fr
 
-    def first(*v):
-        b, setup = model(v)
-        return start(b, setup.solver)
-
-    def rest(carry, *v):
-        b, setup = model(v)
-        return advance(b, setup.solver, carry, n_frames, setup.save_every)
-
-    def mapped(f):
-        f = jax.vmap(f)
-        if mesh is not None:
-            f = jax.shard_map(f, mesh=mesh, in_specs=PartitionSpec("batch"), out_specs=PartitionSpec("batch"),
-                              check_vma=False)
-        return f
-
-    # Two programs, as a single run's (run/compiled.py): the initial state, which runs once, with
-    # XLA's optimisation off (START_OPTIONS), and the loop with the run's options (XLA_OPTIONS: the
-    # classic CPU emitters compile the step's many small fusions in less time, and it runs as fast).
-    # One program of both compiled the initial state's Newton solves optimised, as long as the loop.
-    first_fn = jax.jit(mapped(first), compiler_options=START_OPTIONS or None)
-    rest_fn = jax.jit(mapped(rest), compiler_options=XLA_OPTIONS or None)
-    join = jax.jit(lambda f0, frames: jax.tree_util.tree_map(
-        lambda a, b: jnp.concatenate([a[:, None], b], axis=1), f0, frames))
-
-    fn = _BatchRun(first_fn, rest_fn, join)
+    fn = jax.vmap(one)
+    if mesh is not None:
+        fn = jax.shard_map(fn, mesh=mesh, in_specs=PartitionSpec("batch"), out_specs=PartitionSpec("batch"),
+                           check_vma=False)
+    # XLA's options of the single run's loop (programs.XLA_OPTIONS: its classic CPU emitters compile
+    # the step's many small fusions in less time, and the loop runs as fast)
+    fn = jax.jit(fn, compiler_options=XLA_OPTIONS or None)
     if cache_key is not None:
         _BATCH_FNS[cache_key] = fn
         while len(_BATCH_FNS) > 8:
             _BATCH_FNS.pop(next(iter(_BATCH_FNS)))
     return fn
-
-
-class _BatchRun:
-    """A batch's two programs called as one: (carry, frames with the initial one first). `lower`
-    lowers both (their compiled texts joined), for tests that read the compiled program."""
-
-    def __init__(self, first, rest, join):
-        self.first, self.rest, self.join = first, rest, join
-
-    def __call__(self, *v):
-        carry, f0 = self.first(*v)
-        carry, frames = self.rest(carry, *v)
-        return carry, self.join(f0, frames)
-
-    def lower(self, *v):
-        carry, _ = jax.eval_shape(self.first, *v)
-        return _Lowered([self.first.lower(*v), self.rest.lower(carry, *v)])
-
-
-class _Lowered:
-    def __init__(self, parts):
-        self.parts = parts
-
-    def compile(self):
-        return _Lowered([p.compile() for p in self.parts])
-
-    def as_text(self):
-        return "\n".join(p.as_text() for p in self.parts)
 
 
 def _setup0(scene: Scene):
