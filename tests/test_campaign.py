@@ -624,3 +624,20 @@ def test_a_channel_that_does_not_respond_has_no_period():
     assert np.isnan(st["tz"]) and np.isnan(st["mpm"]) and st["std"] < 1e-16
     st = statistics(t, 1e-6 * np.sin(2 * np.pi * t / 8.0))
     assert abs(st["tz"] - 8.0) < 0.01
+
+
+def test_a_case_scene_is_the_scene_its_text_parses_to():
+    """case_scene reads a case from the template's parsed mapping: the same Scene as parsing the
+    case's own text (as `jaxslosh run` of it does), duration and extra sea columns included."""
+    import tomllib
+    from jaxslosh.scene.load import parse_scene
+    template = parse_scene(tomllib.loads(scene_text()), text=scene_text(), path="box.toml")
+    for values, duration in (({"hs": 0.6, "tp": 7.0, "heading": BEAM, "seed": 1}, None),
+                             ({"hs": 0.9, "tp": 8.5, "heading": 0.3, "seed": 4, "depth": 30.0}, 33.0),
+                             ({"hs": 0.3, "tp": 6.0, "heading": 3.0, "seed": 0, "spreading": 4.0, "directions": 3}, 20.5)):
+        case = case_scene(template, values, duration)
+        again = parse_scene(tomllib.loads(case.text), text=case.text, path="box.toml")
+        assert case == again
+        assert case.waves.hs == values["hs"] and case.waves.seed == values["seed"]
+        assert case.simulation.duration == (duration if duration is not None else 60.0)
+    assert template == parse_scene(tomllib.loads(scene_text()), text=scene_text(), path="box.toml")

@@ -3,6 +3,7 @@ scene (the template's TOML with its `[waves]` keys set: `jaxslosh run` of that t
 from __future__ import annotations
 
 import csv
+import functools
 import io
 import math
 import os
@@ -152,18 +153,36 @@ def case_text(template_text: str, values: dict) -> str:
 
 
 def case_scene(template: Scene, values: dict, duration: Optional[float] = None) -> Scene:
-    """The scene of a case (its text is case_text's; `duration` replaces the simulation's)."""
+    """The scene of a case (its text is case_text's; `duration` replaces the simulation's).
+
+    The scene is read from the template's TOML mapping (parsed once per template, kept) with the
+    case's [waves] keys and duration set: the mapping that parsing the case's text gives (floats
+    written with repr read back exactly), without parsing its large hydrodynamic tables again for
+    every case (two TOML parses a case took longer than drawing its sea)."""
     text = template.text
+    base = _mapping(text)
     if duration is not None:
+        if "simulation" not in base:
+            raise SceneError("simulation", "a campaign needs the scene's [simulation] table")
         text = _set_duration(text, duration)
     text = case_text(text, values)
-    return parse_scene(tomllib.loads(text), text=text, path=template.path)
+    mapping = dict(base)
+    if duration is not None:
+        mapping["simulation"] = {**base["simulation"], "duration": float(duration)}
+    if not isinstance(base.get("waves"), dict):
+        return parse_scene(tomllib.loads(text), text=text, path=template.path)
+    waves = {k: v for k, v in base["waves"].items() if k not in values}
+    mapping["waves"] = {**values, **waves}
+    return parse_scene(mapping, text=text, path=template.path)
+
+
+@functools.lru_cache(maxsize=4)
+def _mapping(text: str) -> dict:
+    """The template's parsed TOML (read only: a case's mapping copies the tables it changes)."""
+    return tomllib.loads(text)
 
 
 def _set_duration(text: str, duration: float) -> str:
-    mapping = tomllib.loads(text)
-    if "simulation" not in mapping:
-        raise SceneError("simulation", "a campaign needs the scene's [simulation] table")
     lines = text.splitlines()
     start = next(i for i, ln in enumerate(lines) if re.match(r"^\s*\[\s*simulation\s*\]", ln))
     end = next((i for i in range(start + 1, len(lines)) if _ANY_HEADER.match(lines[i])), len(lines))
