@@ -1,0 +1,295 @@
+"""The multimodal liquid: nonlinear sloshing of a box tank's liquid in two-dimensional flow along the
+tank's length (x), after the Bateman-Luke variational principle with the free surface and the
+velocity potential both expanded in the tank's natural modes (Miles 1976, J. Fluid Mech. 75;
+Faltinsen, Rognebakke, Lukovsky & Timokha 2000, J. Fluid Mech. 407, section 2, the general modal
+system; Faltinsen & Timokha, Sloshing, 2009, chapter 7).
+
+Tank-local coordinates: x in [0, L] along the length, u in [0, H(x)] above the bottom, the free
+surface
+
+    H(x, t) = h + zeta(x, t),   zeta = sum_i beta_i(t) cos(k_i x),   k_i = i pi / L,  i = 1..N
+
+(each cosine has zero mean: the volume is conserved exactly), and the potential of the liquid's
+velocity relative to the tank
+
+    phi = sum_n R_n(t) phi_n,   phi_n = cos(k_n x) cosh(k_n u) / cosh(k_n h)
+
+(the natural modes: phi_n has no normal flux through the walls and the bottom). The kinematic free
+surface condition, projected on each phi_n, is Faltinsen et al.'s  dA_n/dt = sum_k A_nk R_k  with
+A_n = integral of phi_n over the liquid and A_nk = integral of grad phi_n . grad phi_k; so
+R = A_nk^-1 (dA_n / d beta) beta_dot, and the liquid's kinetic energy is a function of beta,
+beta_dot and the tank's velocities. The modal system used here is that Lagrangian's, the general
+(Lukovsky-type) system truncated at N modes with no ordering of the amplitudes: it holds the
+third-order (Moiseev-type) system of Faltinsen et al. 2000 and goes beyond it. The integrals are
+evaluated exactly in beta at every step, by Gauss quadrature over the instantaneous liquid.
+
+The tank moves with the vessel: a particle's velocity is V_b + omega x r + grad phi (body frame),
+the liquid's rotation that of the tank, as the finite-element liquid's (physics/liquid.py), so the
+two models share their rigid-body part. The equations are Kirchhoff's for the body's velocities
+(V_b = A^T V0, omega) with the modal coordinates as internal unknowns:
+
+    d/dt dT/dV_b + omega x dT/dV_b                           = F_b   (translation rows, then A F_b)
+    d/dt dT/domega + omega x dT/domega + V_b x dT/dV_b       = M_b   (rotation rows)
+    d/dt dT/dbeta_dot - dT/dbeta + dV/dbeta                  = 0     (modal rows)
+
+with V = -g_b . (S(beta) - S0) (the frozen liquid's weight and its moment are the vessel's: the
+same convention as the finite-element liquid). The force and moment on the tank follow from the
+liquid's momentum: they are the rigid rows.
+"""
+from __future__ import annotations
+
+from typing import NamedTuple
+
+import equinox as eqx
+import jax
+import jax.numpy as jnp
+import numpy as np
+
+from .kinematics import mv3, tv3
+from .liquid import AbstractLiquid
+from .terms import Kin, Rows
+
+#: quadrature points along the tank and through the depth (Gauss-Legendre)
+NX, NZ = 48, 20
+
+
+class Integrals(NamedTuple):
+    """The liquid's geometric integrals at one beta (per unit breadth and density where not said)."""
+    An: jax.Array      # (N,) integral of phi_n
+    Jn: jax.Array      # (N, N) dA_n / dbeta_j
+    Ank: jax.Array     # (N, N) integral of grad phi_n . grad phi_k
+    grad: jax.Array    # (N, 2) integral of grad phi_n (x, u components)
+    Zux: jax.Array     # (N,) integral of u dphi_n/dx
+    Xuz: jax.Array     # (N,) integral of x dphi_n/du
+    area: jax.Array    # integral of 1
+    mx: jax.Array      # integral of x
+    mz: jax.Array      # integral of u
+    mxx: jax.Array
+    mzz: jax.Array
+    mxz: jax.Array
+    dmx: jax.Array     # (N,) d(integral of x) / dbeta
+    dmz: jax.Array     # (N,) d(integral of u) / dbeta
+
+
+class ModalTank(eqx.Module):
+    """One tank's liquid in two-dimensional flow along its length, on N modes (module docstring)."""
+    L: jax.Array          # tank length (x), m
+    b: jax.Array          # tank breadth (y), m
+    h: jax.Array          # fill depth, m
+    rho: jax.Array        # liquid density, kg/m^3
+    origin: jax.Array     # (3,) the tank's inner min corner in the vessel frame
+    k: jax.Array          # (N,) k_n = n pi / L
+    xq: jax.Array         # (NX,) quadrature points on [0, L]
+    wq: jax.Array         # (NX,) their weights
+    sq: jax.Array         # (NZ,) points on [0, 1] through the depth
+    ws: jax.Array         # (NZ,) their weights
+
+    @property
+    def n(self) -> int:
+        return int(self.k.shape[0])
+
+    @property
+    def mass(self):
+        return self.rho * self.b * self.L * self.h
+
+    def zeta(self, beta, x):
+        """The free-surface elevation above the fill depth at tank-local x (any shape)."""
+        x = jnp.asarray(x)
+        return jnp.cos(x[..., None] * self.k) @ beta
+
+    def omega_linear(self, g):
+        """(N,) the linear natural frequencies sqrt(g k tanh(k h)), rad/s."""
+        return jnp.sqrt(g * self.k * jnp.tanh(self.k * self.h))
+
+    def modal_mass(self):
+        """(N,) rho b (L/2) / (k tanh kh): each modal row's mass at rest (kg per m of beta)."""
+        return self.rho * self.b * 0.5 * self.L / (self.k * jnp.tanh(self.k * self.h))
+
+    # ------------------------------------------------------------------ integrals
+    def integrals(self, beta) -> Integrals:
+        k, x, w = self.k, self.xq, self.wq
+        H = self.h + jnp.cos(x[:, None] * k) @ beta                       # (NX,)
+        ch = jnp.cosh(k * self.h)
+        cx, sx = jnp.cos(x[:, None] * k), jnp.sin(x[:, None] * k)         # (NX, N)
+        # phi_n at the surface and the closed-form depth integral of cosh
+        An = jnp.einsum("q,qn->n", w, cx * jnp.sinh(H[:, None] * k) / (k * ch))
+        phis = cx * jnp.cosh(H[:, None] * k) / ch                          # (NX, N)
+        Jn = jnp.einsum("q,qn,qj->nj", w, phis, cx)
+        # through the depth: u = H s, weight H ws
+        u = H[:, None] * self.sq[None, :]                                  # (NX, NZ)
+        wu = w[:, None] * H[:, None] * self.ws[None, :]
+        C = jnp.cosh(u[..., None] * k) / ch                               # (NX, NZ, N)
+        S = jnp.sinh(u[..., None] * k) / ch
+        gx = -k * sx[:, None, :] * C                                        # dphi/dx
+        gz = k * cx[:, None, :] * S                                         # dphi/du
+        Ank = jnp.einsum("qs,qsn,qsm->nm", wu, gx, gx) + jnp.einsum("qs,qsn,qsm->nm", wu, gz, gz)
+        grad = jnp.stack([jnp.einsum("qs,qsn->n", wu, gx), jnp.einsum("qs,qsn->n", wu, gz)], axis=-1)
+        Zux = jnp.einsum("qs,qs,qsn->n", wu, u, gx)
+        Xuz = jnp.einsum("qs,q,qsn->n", wu, x, gz)
+        return Integrals(An, Jn, Ank, grad, Zux, Xuz, w @ H, w @ (x * H), w @ (0.5 * H ** 2), w @ (x * x * H),
+                         w @ (H ** 3 / 3.0), w @ (x * 0.5 * H ** 2),
+                         (w * x) @ cx, (w * H) @ cx)
+
+    def moments(self, I: Integrals):
+        """(first moment S (3,), second moment J = sum m x x^T (3, 3)) of the liquid in the vessel frame."""
+        rb, o, bb = self.rho * self.b, self.origin, self.b
+        yc = o[1] + 0.5 * bb
+        Sl = rb * jnp.array([I.mx, 0.5 * bb * I.area, I.mz])            # tank-local, from the corner
+        yy = self.rho * (bb ** 3 / 3.0) * I.area
+        xy = self.rho * 0.5 * bb ** 2 * I.mx
+        yz = self.rho * 0.5 * bb ** 2 * I.mz
+        Jl = jnp.array([[rb * I.mxx, xy, rb * I.mxz], [xy, yy, yz], [rb * I.mxz, yz, rb * I.mzz]])
+        m = rb * I.area
+        J = Jl + jnp.outer(o, Sl) + jnp.outer(Sl, o) + m * jnp.outer(o, o)
+        del yc
+        return Sl + m * o, J
+
+    def rates(self, I: Integrals, beta_dot):
+        """The potential's amplitudes R from the projected kinematic condition dA_n/dt = A_nk R_k."""
+        return jnp.linalg.solve(I.Ank, I.Jn @ beta_dot)
+
+    def relative_momenta(self, I: Integrals, R, beta_dot):
+        """(linear, angular about the vessel's origin) momentum of the flow relative to the tank (body
+        frame). The linear one is the mass centre's rate dS/dt, which the true flow's momentum equals
+        (Reynolds): unlike the truncated potential's integral of grad phi it is an exact time
+        derivative, so that a tank in uniform motion sloshes as one at rest (Galilean invariance)."""
+        rb, o = self.rho * self.b, self.origin
+        yc = o[1] + 0.5 * self.b
+        ux, uz = I.grad[:, 0] @ R, I.grad[:, 1] @ R
+        P = rb * jnp.array([I.dmx @ beta_dot, 0.0, I.dmz @ beta_dot])
+        # integral of r x (ux, 0, uz) with r = o + (x, y, u), uniform in y
+        Zux = (I.Zux @ R) + o[2] * ux
+        Xuz = (I.Xuz @ R) + o[0] * uz
+        H = rb * jnp.array([yc * uz, Zux - Xuz, -yc * ux])
+        return P, H
+
+    def kinetic(self, Vb, omega, beta, beta_dot):
+        """The liquid's kinetic energy (J) for the body-frame velocity V_b of the vessel's origin and omega."""
+        I = self.integrals(beta)
+        S, J = self.moments(I)
+        R = self.rates(I, beta_dot)
+        P, H = self.relative_momenta(I, R, beta_dot)
+        m = self.rho * self.b * I.area
+        Iw = jnp.trace(J) * omega - J @ omega
+        return (0.5 * m * Vb @ Vb + Vb @ jnp.cross(omega, S) + 0.5 * omega @ Iw + Vb @ P + omega @ H
+                + 0.5 * self.rho * self.b * R @ (I.Ank @ R))
+
+    def first_moment(self, beta):
+        return self.moments(self.integrals(beta))[0]
+
+    def rest_moment(self):
+        return self.first_moment(jnp.zeros(self.n))
+
+    def potential(self, beta, g_b):
+        """The gravity potential of the liquid's displacement from rest: -g_b . (S(beta) - S0)."""
+        return -g_b @ (self.first_moment(beta) - self.rest_moment())
+
+    def rows(self, Vb, omega, beta, beta_dot, Vb_dot, alpha, beta_dd, g_b):
+        """Kirchhoff's equations (module docstring): (translation rows (body), rotation rows (body),
+        modal rows)."""
+        def momenta(Vb, omega, beta, beta_dot):
+            return jax.grad(self.kinetic, argnums=(0, 1, 3))(Vb, omega, beta, beta_dot)
+        (P, H, pb), (dP, dH, dpb) = jax.jvp(momenta, (Vb, omega, beta, beta_dot), (Vb_dot, alpha, beta_dot, beta_dd))
+        dT = jax.grad(self.kinetic, argnums=2)(Vb, omega, beta, beta_dot)
+        dS = self.first_moment(beta) - self.rest_moment()
+        dV = jax.grad(self.potential)(beta, g_b)
+        f = dP + jnp.cross(omega, P)
+        m = dH + jnp.cross(omega, H) + jnp.cross(Vb, P) - jnp.cross(dS, g_b)
+        return f, m, dpb - dT + dV
+
+
+def modal_tank(L, b, h, rho, origin, n_modes: int) -> ModalTank:
+    xg, wg = np.polynomial.legendre.leggauss(NX)
+    sg, sw = np.polynomial.legendre.leggauss(NZ)
+    L = jnp.asarray(L, dtype=float)
+    return ModalTank(L=L, b=jnp.asarray(b, dtype=float), h=jnp.asarray(h, dtype=float),
+                     rho=jnp.asarray(rho, dtype=float), origin=jnp.asarray(origin, dtype=float),
+                     k=jnp.arange(1, n_modes + 1) * jnp.pi / L,
+                     xq=0.5 * L * (jnp.asarray(xg) + 1.0), wq=0.5 * L * jnp.asarray(wg),
+                     sq=0.5 * (jnp.asarray(sg) + 1.0), ws=0.5 * jnp.asarray(sw))
+
+
+class MultimodalLiquid(AbstractLiquid):
+    """Every tank's liquid as a multimodal tank (ModalTank), the modal coordinates stacked."""
+    tanks: tuple                      # ModalTank per tank
+    sizes: tuple = eqx.field(static=True)     # modes per tank
+    samples: jax.Array                # (Ns, nf) surface elevation at sample points of every tank (validity)
+    gravity: jax.Array                # m/s^2, for the rest stiffness
+    sparse = False
+    n_nodes = 0
+
+    @property
+    def nf(self) -> int:
+        return int(sum(self.sizes))
+
+    def _split(self, v):
+        out, i = [], 0
+        for n in self.sizes:
+            out.append(v[i:i + n])
+            i += n
+        return out
+
+    def rows(self, k: Kin) -> Rows:
+        A, omega = k.A, k.omega
+        Vb = tv3(A, k.V0)
+        Vb_dot = tv3(A, k.a6[:3]) - jnp.cross(omega, Vb)
+        f, m, rd = jnp.zeros(3), jnp.zeros(3), []
+        for t, be, bd, bdd in zip(self.tanks, self._split(k.c.d), self._split(k.d_dot), self._split(k.d_acc)):
+            ft, mt, rt = t.rows(Vb, omega, be, bd, Vb_dot, k.a6[3:6], bdd, k.g_b)
+            f, m = f + ft, m + mt
+            rd.append(rt)
+        return Rows(jnp.concatenate([mv3(A, f), m]), jnp.concatenate(rd))
+
+    def kinetic(self, k: Kin):
+        Vb = tv3(k.A, k.V0)
+        return sum((t.kinetic(Vb, k.omega, be, bd) for t, be, bd in
+                    zip(self.tanks, self._split(k.c.d), self._split(k.d_dot))), jnp.zeros(()))
+
+    def potential(self, k: Kin):
+        return self._potential(k.c.d, k.g_b)
+
+    def _potential(self, d, g_b):
+        return sum((t.potential(be, g_b) for t, be in zip(self.tanks, self._split(d))), jnp.zeros(()))
+
+    def mass_scale(self):
+        m = sum(t.mass for t in self.tanks)
+        I = jnp.zeros(3)
+        for t in self.tanks:
+            J = t.moments(t.integrals(jnp.zeros(t.n)))[1]
+            I = I + jnp.trace(J) - jnp.diag(J)
+        return jnp.concatenate([jnp.full(3, m), I])
+
+    def d_scale(self):
+        return jnp.concatenate([t.modal_mass() for t in self.tanks])
+
+    def total_mass(self):
+        return sum((t.mass for t in self.tanks), jnp.zeros(()))
+
+    def rigid_first_moment(self):
+        return sum((t.rest_moment() for t in self.tanks), jnp.zeros(3))
+
+    def constant_blocks(self):
+        """The modal rows' mass and stiffness at rest (they precondition Newton; the rows are exact)."""
+        M = jnp.diag(self.d_scale())
+        Kd = jnp.concatenate([t.modal_mass() * t.omega_linear(self.gravity) ** 2 for t in self.tanks])
+        return M, jnp.diag(Kd)
+
+    def frame_field(self, d):
+        return d
+
+    def nodal_fields(self, D):
+        return D
+
+    def probe_displacements(self, weights, modal, d):
+        return jnp.einsum("pkc,k->pc", modal, d)
+
+    def surface_heave(self, d, nodes):
+        return (self.samples @ d)[nodes]
+
+    def static_start(self, g_b):
+        """The level surface under the initial gravity direction: the minimum of the potential (Newton)."""
+        beta = jnp.zeros(self.nf)
+        grad = jax.grad(self._potential)
+        for _ in range(4):
+            beta = beta - jnp.linalg.solve(jax.jacfwd(grad)(beta, g_b), grad(beta, g_b))
+        return beta
