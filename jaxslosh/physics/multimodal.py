@@ -148,31 +148,38 @@ class ModalTank(eqx.Module):
         """The potential's amplitudes R from the projected kinematic condition dA_n/dt = A_nk R_k."""
         return jnp.linalg.solve(I.Ank, I.Jn @ beta_dot)
 
-    def relative_momenta(self, I: Integrals, R, beta_dot):
-        """(linear, angular about the vessel's origin) momentum of the flow relative to the tank (body
-        frame). The linear one is the mass centre's rate dS/dt, which the true flow's momentum equals
-        (Reynolds): unlike the truncated potential's integral of grad phi it is an exact time
-        derivative, so that a tank in uniform motion sloshes as one at rest (Galilean invariance)."""
+    def coupling(self, I: Integrals):
+        """(3, N), (3, N): the liquid's linear and angular momentum (body frame, about the vessel's
+        origin) per unit beta_dot, of the flow relative to the tank. The linear one is the mass
+        centre's rate dS/dt, which the true flow's momentum equals (Reynolds): unlike the truncated
+        potential's integral of grad phi it is an exact time derivative, so that a tank in uniform
+        motion sloshes as one at rest (Galilean invariance). The angular one is the potential's
+        integral of r x grad phi, r = origin + (x, y, u), uniform in y."""
         rb, o = self.rho * self.b, self.origin
         yc = o[1] + 0.5 * self.b
-        ux, uz = I.grad[:, 0] @ R, I.grad[:, 1] @ R
-        P = rb * jnp.array([I.dmx @ beta_dot, 0.0, I.dmz @ beta_dot])
-        # integral of r x (ux, 0, uz) with r = o + (x, y, u), uniform in y
-        Zux = (I.Zux @ R) + o[2] * ux
-        Xuz = (I.Xuz @ R) + o[0] * uz
-        H = rb * jnp.array([yc * uz, Zux - Xuz, -yc * ux])
-        return P, H
+        P = rb * jnp.stack([I.dmx, jnp.zeros_like(I.dmx), I.dmz])
+        gx, gz = I.grad[:, 0], I.grad[:, 1]
+        Hn = rb * jnp.stack([yc * gz, I.Zux + o[2] * gx - I.Xuz - o[0] * gz, -yc * gx])
+        return P, Hn @ jnp.linalg.solve(I.Ank, I.Jn)
+
+    def mass_matrix(self, beta):
+        """(6 + N, 6 + N): the kinetic energy is exactly 1/2 v^T M(beta) v in v = (V_b, omega, beta_dot)."""
+        I = self.integrals(beta)
+        S, J = self.moments(I)
+        P, Hb = self.coupling(I)
+        m = self.rho * self.b * I.area
+        Sx = jnp.array([[0.0, -S[2], S[1]], [S[2], 0.0, -S[0]], [-S[1], S[0], 0.0]])
+        Iw = jnp.trace(J) * jnp.eye(3) - J
+        Mbb = self.rho * self.b * I.Jn.T @ jnp.linalg.solve(I.Ank, I.Jn)
+        top = jnp.concatenate([m * jnp.eye(3), -Sx, P], axis=1)
+        mid = jnp.concatenate([Sx, Iw, Hb], axis=1)
+        bot = jnp.concatenate([P.T, Hb.T, 0.5 * (Mbb + Mbb.T)], axis=1)
+        return jnp.concatenate([top, mid, bot], axis=0)
 
     def kinetic(self, Vb, omega, beta, beta_dot):
         """The liquid's kinetic energy (J) for the body-frame velocity V_b of the vessel's origin and omega."""
-        I = self.integrals(beta)
-        S, J = self.moments(I)
-        R = self.rates(I, beta_dot)
-        P, H = self.relative_momenta(I, R, beta_dot)
-        m = self.rho * self.b * I.area
-        Iw = jnp.trace(J) * omega - J @ omega
-        return (0.5 * m * Vb @ Vb + Vb @ jnp.cross(omega, S) + 0.5 * omega @ Iw + Vb @ P + omega @ H
-                + 0.5 * self.rho * self.b * R @ (I.Ank @ R))
+        v = jnp.concatenate([Vb, omega, beta_dot])
+        return 0.5 * v @ (self.mass_matrix(beta) @ v)
 
     def first_moment(self, beta):
         return self.moments(self.integrals(beta))[0]
@@ -186,16 +193,19 @@ class ModalTank(eqx.Module):
 
     def rows(self, Vb, omega, beta, beta_dot, Vb_dot, alpha, beta_dd, g_b):
         """Kirchhoff's equations (module docstring): (translation rows (body), rotation rows (body),
-        modal rows)."""
-        def momenta(Vb, omega, beta, beta_dot):
-            return jax.grad(self.kinetic, argnums=(0, 1, 3))(Vb, omega, beta, beta_dot)
-        (P, H, pb), (dP, dH, dpb) = jax.jvp(momenta, (Vb, omega, beta, beta_dot), (Vb_dot, alpha, beta_dot, beta_dd))
-        dT = jax.grad(self.kinetic, argnums=2)(Vb, omega, beta, beta_dot)
-        dS = self.first_moment(beta) - self.rest_moment()
-        dV = jax.grad(self.potential)(beta, g_b)
-        f = dP + jnp.cross(omega, P)
-        m = dH + jnp.cross(omega, H) + jnp.cross(Vb, P) - jnp.cross(dS, g_b)
-        return f, m, dpb - dT + dV
+        modal rows), from the momenta p = M(beta) v and their rates M v_dot + (dM/dt) v."""
+        v = jnp.concatenate([Vb, omega, beta_dot])
+        M, dM = jax.jvp(self.mass_matrix, (beta,), (beta_dot,))
+        p = M @ v
+        dp = M @ jnp.concatenate([Vb_dot, alpha, beta_dd]) + dM @ v
+        dT = jax.grad(lambda be: 0.5 * v @ (self.mass_matrix(be) @ v))(beta)
+        I = self.integrals(beta)
+        P = self.coupling(I)[0]
+        dS = self.moments(I)[0] - self.rest_moment()
+        P_lin, H = p[:3], p[3:6]
+        f = dp[:3] + jnp.cross(omega, P_lin)
+        m = dp[3:6] + jnp.cross(omega, H) + jnp.cross(Vb, P_lin) - jnp.cross(dS, g_b)
+        return f, m, dp[6:] - dT - g_b @ P          # dV/dbeta = -g_b . dS/dbeta
 
 
 def modal_tank(L, b, h, rho, origin, n_modes: int) -> ModalTank:
@@ -217,6 +227,7 @@ class MultimodalLiquid(AbstractLiquid):
     gravity: jax.Array                # m/s^2, for the rest stiffness
     sparse = False
     n_nodes = 0
+    nonlinear = True
 
     @property
     def nf(self) -> int:
