@@ -164,3 +164,14 @@ def test_keys_and_warnings(tmp_path, capsys):
     assert main(["run", str(p), "-o", str(tmp_path / "o.h5")]) == 0
     err = capsys.readouterr().err
     assert "roof" in err and "multimodal" in err, err
+
+
+def test_batch_of_fill_depths_matches_single_runs():
+    """simulate_batch takes a multimodal tank: each run of a batch is the single run's."""
+    scene = js.load_scene(FORCED.format(duration=1.0, amplitude=0.005, w=5.0, ratio=0.02))
+    depths = np.array([0.45, 0.5])
+    r, statuses = js.simulate_batch(scene, {"tanks.tank.fill_depth": depths})
+    assert statuses == ["ok", "ok"]
+    one = js.simulate(scene, params={"tanks.tank.fill_depth": 0.45})
+    np.testing.assert_allclose(np.asarray(r.probes["wall"].displacement)[0], np.asarray(one.probes["wall"].displacement),
+                               rtol=1e-7, atol=1e-10)
