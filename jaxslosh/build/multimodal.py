@@ -26,7 +26,7 @@ def build_multimodal(scene: Scene, params: Optional[dict], gravity) -> Multimoda
     for t in scene.tanks:
         P = lambda k, d: params.get(f"tanks.{t.name}.{k}", d)  # noqa: E731
         tanks.append(modal_tank(t.size[0], t.size[1], P("fill_depth", t.fill_depth), P("fluid.density", t.fluid.density),
-                                t.origin, t.modes))
+                                t.origin, t.modes, D=t.size[2]))
         rows.append(np.cos(np.outer(np.linspace(0.0, t.size[0], SAMPLES), np.arange(1, t.modes + 1) * np.pi / t.size[0])))
     nf = sum(t.modes for t in scene.tanks)
     samples = np.zeros((SAMPLES * len(tanks), nf))

@@ -23,9 +23,13 @@ beta_dot and the tank's velocities. The modal system used here is that Lagrangia
 third-order (Moiseev-type) system of Faltinsen et al. 2000 and goes beyond it. The integrals are
 evaluated exactly in beta at every step, by Gauss quadrature over the instantaneous liquid.
 
-The tank moves with the vessel: a particle's velocity is V_b + omega x r + grad phi (body frame),
-the liquid's rotation that of the tank, as the finite-element liquid's (physics/liquid.py), so the
-two models share their rigid-body part. The equations are Kirchhoff's for the body's velocities
+The tank moves with the vessel: a particle's velocity is V_b + omega x r + grad phi + q w (body
+frame), with q = omega_y the pitch rate and w the vortical flow relative to the tank that keeps the
+liquid's absolute motion irrotational (Kelvin; `ModalTank.vortical`, the Stokes-Joukowski potential
+of the tank's section less its rigid rotation), as the finite-element liquid's rotation penalty keeps
+it. Across the tank (roll, yaw) the liquid turns with the tank.
+
+The equations are Kirchhoff's for the body's velocities
 (V_b = A^T V0, omega) with the modal coordinates as internal unknowns:
 
     d/dt dT/dV_b + omega x dT/dV_b                           = F_b   (translation rows, then A F_b)
@@ -51,6 +55,8 @@ from .terms import Kin, Rows
 
 #: quadrature points along the tank and through the depth (Gauss-Legendre)
 NX, NZ = 48, 20
+#: terms of the vortical flow's series (`ModalTank.vortical`)
+SJ_TERMS = 40
 
 
 class Integrals(NamedTuple):
@@ -69,6 +75,11 @@ class Integrals(NamedTuple):
     mxz: jax.Array
     dmx: jax.Array     # (N,) d(integral of x) / dbeta
     dmz: jax.Array     # (N,) d(integral of u) / dbeta
+    Bw: jax.Array      # (N,) integral of grad phi_n . w (w: the rotation's vortical flow, `vortical`)
+    W: jax.Array       # integral of |w|^2
+    wint: jax.Array    # (2,) integral of w
+    Zwx: jax.Array     # integral of u w_x
+    Xwz: jax.Array     # integral of x w_z
 
 
 class ModalTank(eqx.Module):
@@ -76,6 +87,7 @@ class ModalTank(eqx.Module):
     L: jax.Array          # tank length (x), m
     b: jax.Array          # tank breadth (y), m
     h: jax.Array          # fill depth, m
+    D: jax.Array          # tank height, m (the vortical flow's section)
     rho: jax.Array        # liquid density, kg/m^3
     origin: jax.Array     # (3,) the tank's inner min corner in the vessel frame
     k: jax.Array          # (N,) k_n = n pi / L
@@ -126,9 +138,34 @@ class ModalTank(eqx.Module):
         grad = jnp.stack([jnp.einsum("qs,qsn->n", wu, gx), jnp.einsum("qs,qsn->n", wu, gz)], axis=-1)
         Zux = jnp.einsum("qs,qs,qsn->n", wu, u, gx)
         Xuz = jnp.einsum("qs,q,qsn->n", wu, x, gz)
+        wx, wz = self.vortical(jnp.broadcast_to(x[:, None], u.shape), u)
+        Bw = jnp.einsum("qs,qsn->n", wu, gx * wx[..., None] + gz * wz[..., None])
+        vort = (Bw, jnp.sum(wu * (wx ** 2 + wz ** 2)), jnp.array([jnp.sum(wu * wx), jnp.sum(wu * wz)]),
+                jnp.sum(wu * u * wx), jnp.sum(wu * x[:, None] * wz))
         return Integrals(An, Jn, Ank, grad, Zux, Xuz, w @ H, w @ (x * H), w @ (0.5 * H ** 2), w @ (x * x * H),
                          w @ (H ** 3 / 3.0), w @ (x * 0.5 * H ** 2),
-                         (w * x) @ cx, (w * H) @ cx)
+                         (w * x) @ cx, (w * H) @ cx, *vort)
+
+    def vortical(self, x, u):
+        """w (x and u components) at tank-local points: the flow relative to the tank that a unit pitch
+        rate (about y) adds so that the liquid's absolute motion stays irrotational (Kelvin): curl w =
+        -2 e_y, no flux through the walls, the bottom and the roof. With xi, eta from the centre of the
+        L x D section, w = grad(chi) + (0, 2 xi), chi = sum_m c_m sin(k_m xi) sinh(k_m eta) /
+        (k_m cosh(k_m D / 2)), k_m = (2m + 1) pi / L, c_m the sine series of -2 xi (the
+        Stokes-Joukowski potential of the rectangle less the rigid rotation)."""
+        a, d = 0.5 * self.L, 0.5 * self.D
+        xi, eta = x - a, u - d
+        m = jnp.arange(SJ_TERMS)
+        k = (2 * m + 1) * jnp.pi / (2 * a)
+        c = -2.0 * (2.0 / a) * (-1.0) ** m / k ** 2
+        # sinh(k eta) / cosh(k d) and cosh(k eta) / cosh(k d) without overflow (|eta| <= d)
+        e = jnp.exp(-k * (d - eta[..., None]))
+        f = jnp.exp(-k * (d + eta[..., None]))
+        den = 1.0 + jnp.exp(-2.0 * k * d)
+        sh, ch = (e - f) / den, (e + f) / den
+        wx = jnp.sum(c * jnp.cos(k * xi[..., None]) * sh, axis=-1)
+        wz = 2.0 * xi + jnp.sum(c * jnp.sin(k * xi[..., None]) * ch, axis=-1)
+        return wx, wz
 
     def moments(self, I: Integrals):
         """(first moment S (3,), second moment J = sum m x x^T (3, 3)) of the liquid in the vessel frame."""
@@ -162,6 +199,21 @@ class ModalTank(eqx.Module):
         Hn = rb * jnp.stack([yc * gz, I.Zux + o[2] * gx - I.Xuz - o[0] * gz, -yc * gx])
         return P, Hn @ jnp.linalg.solve(I.Ank, I.Jn)
 
+    def pitch_block(self, I: Integrals):
+        """The vortical flow's share of the kinetic energy, in omega: with R = A^-1 (J beta_dot - q Bw)
+        (the kinematic condition with w's flux through the surface) the cross terms in q beta_dot
+        cancel, leaving the (3, 3) block rho b (e_y c^T + c e_y^T + (W - Bw A^-1 Bw) e_y e_y^T),
+        c = integral of r x w less the potential's share integral of r x grad phi A^-1 Bw."""
+        rb, o = self.rho * self.b, self.origin
+        yc = o[1] + 0.5 * self.b
+        gx, gz = I.grad[:, 0], I.grad[:, 1]
+        Hn = jnp.stack([yc * gz, I.Zux + o[2] * gx - I.Xuz - o[0] * gz, -yc * gx])
+        Hw = jnp.array([yc * I.wint[1], I.Zwx + o[2] * I.wint[0] - I.Xwz - o[0] * I.wint[1], -yc * I.wint[0]])
+        gw = jnp.linalg.solve(I.Ank, I.Bw)
+        c = Hw - Hn @ gw
+        ey = jnp.array([0.0, 1.0, 0.0])
+        return rb * (jnp.outer(ey, c) + jnp.outer(c, ey) + (I.W - I.Bw @ gw) * jnp.outer(ey, ey))
+
     def mass_matrix(self, beta):
         """(6 + N, 6 + N): the kinetic energy is exactly 1/2 v^T M(beta) v in v = (V_b, omega, beta_dot)."""
         I = self.integrals(beta)
@@ -169,7 +221,7 @@ class ModalTank(eqx.Module):
         P, Hb = self.coupling(I)
         m = self.rho * self.b * I.area
         Sx = jnp.array([[0.0, -S[2], S[1]], [S[2], 0.0, -S[0]], [-S[1], S[0], 0.0]])
-        Iw = jnp.trace(J) * jnp.eye(3) - J
+        Iw = jnp.trace(J) * jnp.eye(3) - J + self.pitch_block(I)
         Mbb = self.rho * self.b * I.Jn.T @ jnp.linalg.solve(I.Ank, I.Jn)
         top = jnp.concatenate([m * jnp.eye(3), -Sx, P], axis=1)
         mid = jnp.concatenate([Sx, Iw, Hb], axis=1)
@@ -208,11 +260,12 @@ class ModalTank(eqx.Module):
         return f, m, dp[6:] - dT - g_b @ P          # dV/dbeta = -g_b . dS/dbeta
 
 
-def modal_tank(L, b, h, rho, origin, n_modes: int) -> ModalTank:
+def modal_tank(L, b, h, rho, origin, n_modes: int, D=None) -> ModalTank:
     xg, wg = np.polynomial.legendre.leggauss(NX)
     sg, sw = np.polynomial.legendre.leggauss(NZ)
     L = jnp.asarray(L, dtype=float)
-    return ModalTank(L=L, b=jnp.asarray(b, dtype=float), h=jnp.asarray(h, dtype=float),
+    D = 2.0 * jnp.asarray(h, dtype=float) if D is None else jnp.asarray(D, dtype=float)
+    return ModalTank(L=L, b=jnp.asarray(b, dtype=float), h=jnp.asarray(h, dtype=float), D=D,
                      rho=jnp.asarray(rho, dtype=float), origin=jnp.asarray(origin, dtype=float),
                      k=jnp.arange(1, n_modes + 1) * jnp.pi / L,
                      xq=0.5 * L * (jnp.asarray(xg) + 1.0), wq=0.5 * L * jnp.asarray(wg),
