@@ -26,7 +26,8 @@ from ..scene.types import DOFS, Scene, SceneError
 from ..solve.sparse import hydrostatic_start
 from .damping import build_damping
 from .hull import build_hull_pressure
-from .liquid import build_liquid_block, rigid_part
+from .liquid import LiquidBlock, build_liquid_block, rigid_part
+from .multimodal import build_multimodal, multimodal_damping, multimodal_scene, probe_modal, surfaces
 from .probes import Probes, build_probes
 from .seakeeping import build_seakeeping
 from .structures import build_flex, flex_start
@@ -71,9 +72,11 @@ def build(scene: Scene, params: Optional[dict] = None) -> Built:
             displaced_volume=f("vessel.hydrostatics.displaced_volume", h.displaced_volume),
             gm_t=f("vessel.hydrostatics.gm_t", h.gm_t), gm_l=f("vessel.hydrostatics.gm_l", h.gm_l),
             moment_form=h.moment))
-    block = build_liquid_block(scene, params, g, include_liquid=eff.liquid)
+    multimodal = eff.liquid and multimodal_scene(scene)
+    block = LiquidBlock(build_multimodal(scene, params, g)) if multimodal else \
+        build_liquid_block(scene, params, g, include_liquid=eff.liquid)
     liquid = dataclasses.replace(block.liquid, coriolis=eff.coriolis, centrifugal=eff.centrifugal) \
-        if block.liquid.nf else block.liquid
+        if block.liquid.nf and not multimodal else block.liquid
     motion = FreeMotion()
     if ves.forced is not None:
         motion = _prescribed(ves.forced)
@@ -102,7 +105,10 @@ def build(scene: Scene, params: Optional[dict] = None) -> Built:
         terms.append(RotationPenalty(Kdt=block.penalty[0], Ktt=block.penalty[1], q_ref=q0))
     if block.Kg is not None:
         terms.append(SpinStiffening(block.Kg))
-    damping, _ = build_damping(scene, params, block) if eff.liquid else (None, ())
+    if multimodal:
+        damping = multimodal_damping(scene, params, liquid)
+    else:
+        damping, _ = build_damping(scene, params, block) if eff.liquid else (None, ())
     system = System(body=body, terms=tuple(terms), liquid=liquid, gravity=g, q_ref=q0, motion=motion, memory=memory,
                     flex=flex, gravity_turning=eff.gravity_turning or not liquid.nf, balanced=balanced,
                     damping=damping)
@@ -122,9 +128,13 @@ def build(scene: Scene, params: Optional[dict] = None) -> Built:
         c0, v0, alg0 = _flex_start(system, c0, v0)
     probes = build_probes(scene, block.tanks, liquid, blocks, block.vstructs)
     probes = probes._replace(modal=liquid.probe_modal(probes.weights))    # a modal liquid: probes from eta
-    surfaces = tuple(jnp.asarray(t.node_offset + np.flatnonzero(np.isclose(t.nodes[:, 2], t.nodes[:, 2].max())))
+    if multimodal:
+        probes = probes._replace(modal=probe_modal(scene))
+        tops = surfaces(scene)
+    else:
+        tops = tuple(jnp.asarray(t.node_offset + np.flatnonzero(np.isclose(t.nodes[:, 2], t.nodes[:, 2].max())))
                      for t in block.tanks)
-    return Built(system, c0, v0, probes, block.tanks, alg0, blocks, surfaces)
+    return Built(system, c0, v0, probes, block.tanks, alg0, blocks, tops)
 
 
 def _prescribed(f):

@@ -41,6 +41,9 @@ def nodal_product(Ms, a):
 class AbstractLiquid(AbstractTerm):
     """The owner of the deformable unknowns d: what the solver, the build and the frames need of it
     besides its rows and energies."""
+    #: its rows are nonlinear in d (physics/multimodal.py): Newton linearises its few unknowns with the
+    #: rigid ones instead of using a constant block (solve/linear.py)
+    nonlinear = False
 
     @property
     @abc.abstractmethod

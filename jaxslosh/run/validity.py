@@ -89,12 +89,13 @@ class Watch:
                 continue
             roof = t.size[2] - t.fill_depth
             where = f"tanks[{i}] ({t.name!r})"
+            model = "the multimodal liquid" if t.model == "multimodal" else "the linear liquid"
             if self.high[i] > roof:
                 out.append(f"{where}: the free surface rose {self.high[i]:.3g} m at t = {self.t_high[i]:.4g} s, "
-                           f"above the roof ({roof:.3g} m of freeboard): the linear liquid is outside its validity")
+                           f"above the roof ({roof:.3g} m of freeboard): {model} is outside its validity")
             if self.low[i] < -t.fill_depth:
                 out.append(f"{where}: the free surface fell {-self.low[i]:.3g} m at t = {self.t_low[i]:.4g} s, "
-                           f"below the floor ({t.fill_depth:.3g} m deep): the linear liquid is outside its validity")
+                           f"below the floor ({t.fill_depth:.3g} m deep): {model} is outside its validity")
         tol = self.scene.simulation.tolerance
         if self.residual > RESIDUAL_FACTOR * self.level:
             floor = "" if self.level <= tol else \

@@ -153,6 +153,9 @@ KEYS = (
     ("tanks.axis", '"x"', "", 'Cylinder: "x" or "y" (horizontal) or "z" (vertical).'),
     ("tanks.file", "required (mesh)", "", "Mesh tank: the liquid at rest as hexahedra (any format meshio "
                                           "reads), relative to the scene."),
+    ("tanks.model", '"fem"', "", '"fem" (the linear finite elements) or "multimodal": nonlinear sloshing '
+                                 "along the length of a box tank (every tank of the scene the same)."),
+    ("tanks.modes", "6", "", "Multimodal: the free-surface modes along the tank's length."),
     ("tanks.fluid.density", "1000.0", "kg/m^3", "Liquid density."),
     ("tanks.fluid.sound_speed", "1500.0", "m/s", "Liquid sound speed."),
     ("tanks.fluid.element", '"stabilized"', "", 'The liquid element: "stabilized", the paper\'s literal '

@@ -42,6 +42,9 @@ from .waves import FileContext, check_waves, hull_hydrostatics, read_hull, read_
 SCHEMES = ("newmark", "hht", "generalized-alpha")
 LINEAR_SOLVERS = ("auto", "dense", "sparse", "sparse-host")      # [simulation] linear_solver (sparse.py)
 WALLS = ("rigid", "elastic")
+TANK_MODELS = ("fem", "multimodal")
+#: below this fill depth over length the multimodal method's ordering fails (shallow water, bores)
+MULTIMODAL_SHALLOW = 0.1
 MOMENTS = ("paper", "conservative")
 HYDROSTATIC_MODELS = ("linear", "nonlinear")
 PROBE_TOLERANCE = 1e-9                           # m: how far outside its owner a probe may lie
@@ -108,6 +111,7 @@ def parse_scene(mapping: Mapping[str, Any], text: str = "", path: str = "") -> S
     structures = tuple(_structure(s, f"structures[{i}]") for i, s in enumerate(mapping.get("structures", [])))
     probes = tuple(_probe(p, f"probes[{i}]") for i, p in enumerate(mapping.get("probes", [])))
     _unique_names(tanks, "tanks", "tank")
+    _multimodal_scene(tanks, warnings)
     _overlapping_tanks(tanks, warnings)
     _unique_names(structures, "structures", "structure")
     _attachments(structures)
@@ -131,6 +135,23 @@ def parse_scene(mapping: Mapping[str, Any], text: str = "", path: str = "") -> S
     if simulation.energy_projection:
         _conservative(scene)
     return scene
+
+
+def _multimodal_scene(tanks, warnings: list[str]) -> None:
+    """Every tank multimodal or none (the stacked liquid is of one kind); the method's validity."""
+    kinds = {t.model for t in tanks}
+    if len(kinds) > 1:
+        i = next(i for i, t in enumerate(tanks) if t.model != tanks[0].model)
+        raise SceneError(f"tanks[{i}].model", f'is "{tanks[i].model}" but tanks[0] is "{tanks[0].model}": all '
+                                              "tanks of a scene take the same model")
+    for i, t in enumerate(tanks):
+        if t.model != "multimodal":
+            continue
+        ratio = t.fill_depth / t.size[0]
+        if ratio < MULTIMODAL_SHALLOW:
+            warnings.append(f"tanks[{i}] ({t.name!r}): fill depth / length = {ratio:.3g} is below "
+                            f"{MULTIMODAL_SHALLOW}: shallow-water sloshing (bores, hydraulic jumps), outside the "
+                            "multimodal method's validity")
 
 
 def _conservative(scene: Scene) -> None:
@@ -350,8 +371,15 @@ def _tank(table, where: str, base_dir: str = "") -> Tank:
         "fill_depth": ("float", None), "mesh": ("mesh", counts), "walls": ("str_or_table", None),
         "fluid": ("table", None), "reduction": ("table", None), "damping": ("table", None),
         "shape": ("str", one_of(SHAPES)), "chamfers": ("any", None), "axis": ("str", one_of(AXES)),
-        "file": ("str", None), "baffles": ("tables", None),
+        "file": ("str", None), "baffles": ("tables", None), "model": ("str", one_of(TANK_MODELS)),
+        "modes": ("int", at_least(1)),
     }, required=("name", "origin", "size"))
+    model = v.get("model", "fem")
+    if model == "multimodal":
+        _multimodal_tank(table, where)
+        v.setdefault("mesh", (1, 1, 1))          # the multimodal tank has no mesh
+    elif "modes" in table:
+        raise SceneError(f"{where}.modes", 'is the multimodal tank\'s: it needs model = "multimodal"')
     fill_and_mesh(table, v, where, base_dir)
     # SPEC writes `walls = "elastic"` and a `[tanks.walls]` table, but TOML cannot hold both under
     # one key: `walls` is either the string "rigid" or the table, which makes the walls elastic.
@@ -384,7 +412,21 @@ def _tank(table, where: str, base_dir: str = "") -> Tank:
     damping = _damping(table["damping"], f"{where}.damping") if "damping" in table else None
     shape = read_shape(table, v, where, base_dir, elastic=wall_spec is not None)
     return Tank(name=v["name"], origin=v["origin"], size=v["size"], fill_depth=depth, mesh=v["mesh"],
-                walls=walls, fluid=fluid, wall_spec=wall_spec, reduction=reduction, damping=damping, **shape)
+                walls=walls, fluid=fluid, wall_spec=wall_spec, reduction=reduction, damping=damping,
+                model=model, modes=v.get("modes", 6), **shape)
+
+
+def _multimodal_tank(table, where: str) -> None:
+    """A multimodal tank is a plain box with rigid walls (physics/multimodal.py)."""
+    for key, why in (("shape", "a box"), ("baffles", "a box without baffles"), ("walls", "rigid walls"),
+                     ("reduction", "its own modes"), ("file", "a box")):
+        if key in table and not (key == "shape" and table[key] == "box") and \
+                not (key == "walls" and table[key] == "rigid"):
+            raise SceneError(f"{where}.{key}", f'a model = "multimodal" tank is {why}: leave {key} out')
+    visc = table.get("damping", {}).get("viscosity", 0.0) if isinstance(table.get("damping"), dict) else 0.0
+    if visc:
+        raise SceneError(f"{where}.damping.viscosity", 'the boundary-layer damping needs the finite-element modes: '
+                                                      'give the multimodal tank damping ratios')
 
 
 def _damping(table, where: str) -> Damping:

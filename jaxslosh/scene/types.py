@@ -171,6 +171,8 @@ class Tank:
     axis: str = "x"                         # cylinder: "x", "y" (horizontal) or "z" (vertical)
     file: str = ""                          # mesh: the mesh file (absolute path)
     baffles: tuple = ()                     # fem/shapes.Baffle per [[tanks.baffles]]
+    model: str = "fem"                      # "fem" | "multimodal" (physics/multimodal.py)
+    modes: int = 6                          # multimodal: free-surface modes along the tank's length
 
     @property
     def geometry(self) -> TankGeometry:

@@ -80,8 +80,9 @@ def initial_state(system: System, solver: Solver, c0: Config, v0, alg0=None) -> 
     def R(acc):
         return jnp.concatenate(parts(acc[:6], acc[6:]))
 
+    exact = system.liquid.nonlinear    # every unknown in the exact block: R's parts are not needed
     acc0, (it, err, ok) = solve_root(R, jnp.zeros_like(v0), solver.Cinv_mass, scale, solver.tol, solver.max_iter,
-                                     implicit=solver.implicit, parts=parts)
+                                     ns=solver.ns, implicit=solver.implicit, parts=None if exact else parts)
     pre = empty_pre(system) if solver.reuse else None
     e0 = total_energy(system, c0, v0) if solver.project else None
     return State(c0, v0, acc0, acc0, jnp.zeros(()), pre=pre, z=z0, e0=e0), StepInfo(it, err, ok)
@@ -281,9 +282,11 @@ def step(system: System, solver: Solver, s: State, fresh=None) -> tuple[State, S
         floor = solver.noise * jnp.max(jnp.abs(s.c.d), initial=0.0)
     pre = s.pre if solver.reuse else None
     with jax.named_scope("newton"):
+        exact = system.liquid.nonlinear    # every unknown in the exact block: R's parts are not needed
         delta, (it, err, ok), pre_new = solve_root_carried(R, x0, solver.Cinv_step, scale, solver.tol,
-                                                           solver.max_iter, pre, floor, solver.adaptive, fresh=fresh,
-                                                           implicit=solver.implicit, parts=parts)
+                                                           solver.max_iter, pre, floor, solver.adaptive, ns=solver.ns,
+                                                           fresh=fresh, implicit=solver.implicit,
+                                                           parts=None if exact else parts)
     with jax.named_scope("update"):
         c, v, acc, a = unpack(delta)
         ok = ok & jnp.all(jnp.isfinite(delta))

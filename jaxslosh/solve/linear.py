@@ -77,10 +77,10 @@ def make_solver(system: System, h: float, scheme: Scheme, tol: float, max_iter: 
     substeps = int(substeps) if substeps and substeps > 1 else 0
     if system.flex is not None:
         return _flex_solver(system, h, scheme, tol, max_iter, substeps, reuse, adaptive)
-    if nf == 0:
+    if nf == 0 or system.liquid.nonlinear:      # a nonlinear liquid's few unknowns: linearised exactly
         z = jnp.zeros((0, 0))
         return Solver(z, z, jnp.asarray(h, dtype=float), scheme, tol, max_iter, substeps, z if substeps else None,
-                      reuse=reuse, adaptive=adaptive)
+                      reuse=reuse, adaptive=adaptive, ns=6 + nf)
     L = system.liquid
     if L.sparse:         # large mesh (sparse.py): fast diagonalization, factors in JAX, or the host's LU
         c_a = lambda hh: (1.0 - scheme.alpha_m) / ((1.0 - scheme.alpha_f) * scheme.beta * hh ** 2)  # noqa: E731
@@ -187,7 +187,7 @@ def _flex_solver(system: System, h, scheme: Scheme, tol, max_iter, substeps, reu
 
 def empty_pre(system: System):
     """A carried preconditioner of the right shapes, marked not valid (formed at the first step)."""
-    ns, nz = 6, system.nf
+    ns, nz = (6 + system.nf, 0) if system.liquid.nonlinear else (6, system.nf)
     if system.flex is not None:
         L = layout(system)
         ns, nz = L.n_small, L.nf + L.m

@@ -1,0 +1,359 @@
+"""The multimodal liquid: nonlinear sloshing of a box tank's liquid in two-dimensional flow along the
+tank's length (x), after the Bateman-Luke variational principle with the free surface and the
+velocity potential both expanded in the tank's natural modes (Miles 1976, J. Fluid Mech. 75;
+Faltinsen, Rognebakke, Lukovsky & Timokha 2000, J. Fluid Mech. 407, section 2, the general modal
+system; Faltinsen & Timokha, Sloshing, 2009, chapter 7).
+
+Tank-local coordinates: x in [0, L] along the length, u in [0, H(x)] above the bottom, the free
+surface
+
+    H(x, t) = h + zeta(x, t),   zeta = sum_i beta_i(t) cos(k_i x),   k_i = i pi / L,  i = 1..N
+
+(each cosine has zero mean: the volume is conserved exactly), and the potential of the liquid's
+velocity relative to the tank
+
+    phi = sum_n R_n(t) phi_n,   phi_n = cos(k_n x) cosh(k_n u) / cosh(k_n h)
+
+(the natural modes: phi_n has no normal flux through the walls and the bottom). The kinematic free
+surface condition, projected on each phi_n, is Faltinsen et al.'s  dA_n/dt = sum_k A_nk R_k  with
+A_n = integral of phi_n over the liquid and A_nk = integral of grad phi_n . grad phi_k; so
+R = A_nk^-1 (dA_n / d beta) beta_dot, and the liquid's kinetic energy is a function of beta,
+beta_dot and the tank's velocities. The modal system used here is that Lagrangian's, the general
+(Lukovsky-type) system truncated at N modes with no ordering of the amplitudes: it holds the
+third-order (Moiseev-type) system of Faltinsen et al. 2000 and goes beyond it. The integrals are
+evaluated exactly in beta at every step, by Gauss quadrature over the instantaneous liquid.
+
+The tank moves with the vessel: a particle's velocity is V_b + omega x r + grad phi + q w (body
+frame), with q = omega_y the pitch rate and w the vortical flow relative to the tank that keeps the
+liquid's absolute motion irrotational (Kelvin; `ModalTank.vortical`, the Stokes-Joukowski potential
+of the tank's section less its rigid rotation), as the finite-element liquid's rotation penalty keeps
+it. Across the tank (roll, yaw) the liquid turns with the tank.
+
+The equations are Kirchhoff's for the body's velocities
+(V_b = A^T V0, omega) with the modal coordinates as internal unknowns:
+
+    d/dt dT/dV_b + omega x dT/dV_b                           = F_b   (translation rows, then A F_b)
+    d/dt dT/domega + omega x dT/domega + V_b x dT/dV_b       = M_b   (rotation rows)
+    d/dt dT/dbeta_dot - dT/dbeta + dV/dbeta                  = 0     (modal rows)
+
+with V = -g_b . (S(beta) - S0) (the frozen liquid's weight and its moment are the vessel's: the
+same convention as the finite-element liquid). The force and moment on the tank follow from the
+liquid's momentum: they are the rigid rows.
+"""
+from __future__ import annotations
+
+from typing import NamedTuple
+
+import equinox as eqx
+import jax
+import jax.numpy as jnp
+import numpy as np
+
+from .kinematics import mv3, tv3
+from .liquid import AbstractLiquid
+from .terms import Kin, Rows
+
+#: quadrature points along the tank and through the depth (Gauss-Legendre)
+NX, NZ = 48, 20
+#: terms of the vortical flow's series (`ModalTank.vortical`)
+SJ_TERMS = 40
+
+
+class Integrals(NamedTuple):
+    """The liquid's geometric integrals at one beta (per unit breadth and density where not said)."""
+    An: jax.Array      # (N,) integral of phi_n
+    Jn: jax.Array      # (N, N) dA_n / dbeta_j
+    Ank: jax.Array     # (N, N) integral of grad phi_n . grad phi_k
+    grad: jax.Array    # (N, 2) integral of grad phi_n (x, u components)
+    Zux: jax.Array     # (N,) integral of u dphi_n/dx
+    Xuz: jax.Array     # (N,) integral of x dphi_n/du
+    area: jax.Array    # integral of 1
+    mx: jax.Array      # integral of x
+    mz: jax.Array      # integral of u
+    mxx: jax.Array
+    mzz: jax.Array
+    mxz: jax.Array
+    dmx: jax.Array     # (N,) d(integral of x) / dbeta
+    dmz: jax.Array     # (N,) d(integral of u) / dbeta
+    Bw: jax.Array      # (N,) integral of grad phi_n . w (w: the rotation's vortical flow, `vortical`)
+    W: jax.Array       # integral of |w|^2
+    wint: jax.Array    # (2,) integral of w
+    Zwx: jax.Array     # integral of u w_x
+    Xwz: jax.Array     # integral of x w_z
+
+
+class ModalTank(eqx.Module):
+    """One tank's liquid in two-dimensional flow along its length, on N modes (module docstring)."""
+    L: jax.Array          # tank length (x), m
+    b: jax.Array          # tank breadth (y), m
+    h: jax.Array          # fill depth, m
+    D: jax.Array          # tank height, m (the vortical flow's section)
+    rho: jax.Array        # liquid density, kg/m^3
+    origin: jax.Array     # (3,) the tank's inner min corner in the vessel frame
+    k: jax.Array          # (N,) k_n = n pi / L
+    xq: jax.Array         # (NX,) quadrature points on [0, L]
+    wq: jax.Array         # (NX,) their weights
+    sq: jax.Array         # (NZ,) points on [0, 1] through the depth
+    ws: jax.Array         # (NZ,) their weights
+
+    @property
+    def n(self) -> int:
+        return int(self.k.shape[0])
+
+    @property
+    def mass(self):
+        return self.rho * self.b * self.L * self.h
+
+    def zeta(self, beta, x):
+        """The free-surface elevation above the fill depth at tank-local x (any shape)."""
+        x = jnp.asarray(x)
+        return jnp.cos(x[..., None] * self.k) @ beta
+
+    def omega_linear(self, g):
+        """(N,) the linear natural frequencies sqrt(g k tanh(k h)), rad/s."""
+        return jnp.sqrt(g * self.k * jnp.tanh(self.k * self.h))
+
+    def modal_mass(self):
+        """(N,) rho b (L/2) / (k tanh kh): each modal row's mass at rest (kg per m of beta)."""
+        return self.rho * self.b * 0.5 * self.L / (self.k * jnp.tanh(self.k * self.h))
+
+    # ------------------------------------------------------------------ integrals
+    def integrals(self, beta) -> Integrals:
+        k, x, w = self.k, self.xq, self.wq
+        H = self.h + jnp.cos(x[:, None] * k) @ beta                       # (NX,)
+        ch = jnp.cosh(k * self.h)
+        cx, sx = jnp.cos(x[:, None] * k), jnp.sin(x[:, None] * k)         # (NX, N)
+        # phi_n at the surface and the closed-form depth integral of cosh
+        An = jnp.einsum("q,qn->n", w, cx * jnp.sinh(H[:, None] * k) / (k * ch))
+        phis = cx * jnp.cosh(H[:, None] * k) / ch                          # (NX, N)
+        Jn = jnp.einsum("q,qn,qj->nj", w, phis, cx)
+        # through the depth: u = H s, weight H ws
+        u = H[:, None] * self.sq[None, :]                                  # (NX, NZ)
+        wu = w[:, None] * H[:, None] * self.ws[None, :]
+        C = jnp.cosh(u[..., None] * k) / ch                               # (NX, NZ, N)
+        S = jnp.sinh(u[..., None] * k) / ch
+        gx = -k * sx[:, None, :] * C                                        # dphi/dx
+        gz = k * cx[:, None, :] * S                                         # dphi/du
+        Ank = jnp.einsum("qs,qsn,qsm->nm", wu, gx, gx) + jnp.einsum("qs,qsn,qsm->nm", wu, gz, gz)
+        grad = jnp.stack([jnp.einsum("qs,qsn->n", wu, gx), jnp.einsum("qs,qsn->n", wu, gz)], axis=-1)
+        Zux = jnp.einsum("qs,qs,qsn->n", wu, u, gx)
+        Xuz = jnp.einsum("qs,q,qsn->n", wu, x, gz)
+        wx, wz = self.vortical(jnp.broadcast_to(x[:, None], u.shape), u)
+        Bw = jnp.einsum("qs,qsn->n", wu, gx * wx[..., None] + gz * wz[..., None])
+        vort = (Bw, jnp.sum(wu * (wx ** 2 + wz ** 2)), jnp.array([jnp.sum(wu * wx), jnp.sum(wu * wz)]),
+                jnp.sum(wu * u * wx), jnp.sum(wu * x[:, None] * wz))
+        return Integrals(An, Jn, Ank, grad, Zux, Xuz, w @ H, w @ (x * H), w @ (0.5 * H ** 2), w @ (x * x * H),
+                         w @ (H ** 3 / 3.0), w @ (x * 0.5 * H ** 2),
+                         (w * x) @ cx, (w * H) @ cx, *vort)
+
+    def vortical(self, x, u):
+        """w (x and u components) at tank-local points: the flow relative to the tank that a unit pitch
+        rate (about y) adds so that the liquid's absolute motion stays irrotational (Kelvin): curl w =
+        -2 e_y, no flux through the walls, the bottom and the roof. With xi, eta from the centre of the
+        L x D section, w = grad(chi) + (0, 2 xi), chi = sum_m c_m sin(k_m xi) sinh(k_m eta) /
+        (k_m cosh(k_m D / 2)), k_m = (2m + 1) pi / L, c_m the sine series of -2 xi (the
+        Stokes-Joukowski potential of the rectangle less the rigid rotation)."""
+        a, d = 0.5 * self.L, 0.5 * self.D
+        xi, eta = x - a, u - d
+        m = jnp.arange(SJ_TERMS)
+        k = (2 * m + 1) * jnp.pi / (2 * a)
+        c = -2.0 * (2.0 / a) * (-1.0) ** m / k ** 2
+        # sinh(k eta) / cosh(k d) and cosh(k eta) / cosh(k d) without overflow (|eta| <= d)
+        e = jnp.exp(-k * (d - eta[..., None]))
+        f = jnp.exp(-k * (d + eta[..., None]))
+        den = 1.0 + jnp.exp(-2.0 * k * d)
+        sh, ch = (e - f) / den, (e + f) / den
+        wx = jnp.sum(c * jnp.cos(k * xi[..., None]) * sh, axis=-1)
+        wz = 2.0 * xi + jnp.sum(c * jnp.sin(k * xi[..., None]) * ch, axis=-1)
+        return wx, wz
+
+    def moments(self, I: Integrals):
+        """(first moment S (3,), second moment J = sum m x x^T (3, 3)) of the liquid in the vessel frame."""
+        rb, o, bb = self.rho * self.b, self.origin, self.b
+        yc = o[1] + 0.5 * bb
+        Sl = rb * jnp.array([I.mx, 0.5 * bb * I.area, I.mz])            # tank-local, from the corner
+        yy = self.rho * (bb ** 3 / 3.0) * I.area
+        xy = self.rho * 0.5 * bb ** 2 * I.mx
+        yz = self.rho * 0.5 * bb ** 2 * I.mz
+        Jl = jnp.array([[rb * I.mxx, xy, rb * I.mxz], [xy, yy, yz], [rb * I.mxz, yz, rb * I.mzz]])
+        m = rb * I.area
+        J = Jl + jnp.outer(o, Sl) + jnp.outer(Sl, o) + m * jnp.outer(o, o)
+        del yc
+        return Sl + m * o, J
+
+    def rates(self, I: Integrals, beta_dot):
+        """The potential's amplitudes R from the projected kinematic condition dA_n/dt = A_nk R_k."""
+        return jnp.linalg.solve(I.Ank, I.Jn @ beta_dot)
+
+    def coupling(self, I: Integrals):
+        """(3, N), (3, N): the liquid's linear and angular momentum (body frame, about the vessel's
+        origin) per unit beta_dot, of the flow relative to the tank. The linear one is the mass
+        centre's rate dS/dt, which the true flow's momentum equals (Reynolds): unlike the truncated
+        potential's integral of grad phi it is an exact time derivative, so that a tank in uniform
+        motion sloshes as one at rest (Galilean invariance). The angular one is the potential's
+        integral of r x grad phi, r = origin + (x, y, u), uniform in y."""
+        rb, o = self.rho * self.b, self.origin
+        yc = o[1] + 0.5 * self.b
+        P = rb * jnp.stack([I.dmx, jnp.zeros_like(I.dmx), I.dmz])
+        gx, gz = I.grad[:, 0], I.grad[:, 1]
+        Hn = rb * jnp.stack([yc * gz, I.Zux + o[2] * gx - I.Xuz - o[0] * gz, -yc * gx])
+        return P, Hn @ jnp.linalg.solve(I.Ank, I.Jn)
+
+    def pitch_block(self, I: Integrals):
+        """The vortical flow's share of the kinetic energy, in omega: with R = A^-1 (J beta_dot - q Bw)
+        (the kinematic condition with w's flux through the surface) the cross terms in q beta_dot
+        cancel, leaving the (3, 3) block rho b (e_y c^T + c e_y^T + (W - Bw A^-1 Bw) e_y e_y^T),
+        c = integral of r x w less the potential's share integral of r x grad phi A^-1 Bw."""
+        rb, o = self.rho * self.b, self.origin
+        yc = o[1] + 0.5 * self.b
+        gx, gz = I.grad[:, 0], I.grad[:, 1]
+        Hn = jnp.stack([yc * gz, I.Zux + o[2] * gx - I.Xuz - o[0] * gz, -yc * gx])
+        Hw = jnp.array([yc * I.wint[1], I.Zwx + o[2] * I.wint[0] - I.Xwz - o[0] * I.wint[1], -yc * I.wint[0]])
+        gw = jnp.linalg.solve(I.Ank, I.Bw)
+        c = Hw - Hn @ gw
+        ey = jnp.array([0.0, 1.0, 0.0])
+        return rb * (jnp.outer(ey, c) + jnp.outer(c, ey) + (I.W - I.Bw @ gw) * jnp.outer(ey, ey))
+
+    def mass_matrix(self, beta):
+        """(6 + N, 6 + N): the kinetic energy is exactly 1/2 v^T M(beta) v in v = (V_b, omega, beta_dot)."""
+        I = self.integrals(beta)
+        S, J = self.moments(I)
+        P, Hb = self.coupling(I)
+        m = self.rho * self.b * I.area
+        Sx = jnp.array([[0.0, -S[2], S[1]], [S[2], 0.0, -S[0]], [-S[1], S[0], 0.0]])
+        Iw = jnp.trace(J) * jnp.eye(3) - J + self.pitch_block(I)
+        Mbb = self.rho * self.b * I.Jn.T @ jnp.linalg.solve(I.Ank, I.Jn)
+        top = jnp.concatenate([m * jnp.eye(3), -Sx, P], axis=1)
+        mid = jnp.concatenate([Sx, Iw, Hb], axis=1)
+        bot = jnp.concatenate([P.T, Hb.T, 0.5 * (Mbb + Mbb.T)], axis=1)
+        return jnp.concatenate([top, mid, bot], axis=0)
+
+    def kinetic(self, Vb, omega, beta, beta_dot):
+        """The liquid's kinetic energy (J) for the body-frame velocity V_b of the vessel's origin and omega."""
+        v = jnp.concatenate([Vb, omega, beta_dot])
+        return 0.5 * v @ (self.mass_matrix(beta) @ v)
+
+    def first_moment(self, beta):
+        return self.moments(self.integrals(beta))[0]
+
+    def rest_moment(self):
+        return self.first_moment(jnp.zeros(self.n))
+
+    def potential(self, beta, g_b):
+        """The gravity potential of the liquid's displacement from rest: -g_b . (S(beta) - S0)."""
+        return -g_b @ (self.first_moment(beta) - self.rest_moment())
+
+    def rows(self, Vb, omega, beta, beta_dot, Vb_dot, alpha, beta_dd, g_b):
+        """Kirchhoff's equations (module docstring): (translation rows (body), rotation rows (body),
+        modal rows), from the momenta p = M(beta) v and their rates M v_dot + (dM/dt) v."""
+        v = jnp.concatenate([Vb, omega, beta_dot])
+        M, dM = jax.jvp(self.mass_matrix, (beta,), (beta_dot,))
+        p = M @ v
+        dp = M @ jnp.concatenate([Vb_dot, alpha, beta_dd]) + dM @ v
+        dT = jax.grad(lambda be: 0.5 * v @ (self.mass_matrix(be) @ v))(beta)
+        I = self.integrals(beta)
+        P = self.coupling(I)[0]
+        dS = self.moments(I)[0] - self.rest_moment()
+        P_lin, H = p[:3], p[3:6]
+        f = dp[:3] + jnp.cross(omega, P_lin)
+        m = dp[3:6] + jnp.cross(omega, H) + jnp.cross(Vb, P_lin) - jnp.cross(dS, g_b)
+        return f, m, dp[6:] - dT - g_b @ P          # dV/dbeta = -g_b . dS/dbeta
+
+
+def modal_tank(L, b, h, rho, origin, n_modes: int, D=None) -> ModalTank:
+    xg, wg = np.polynomial.legendre.leggauss(NX)
+    sg, sw = np.polynomial.legendre.leggauss(NZ)
+    L = jnp.asarray(L, dtype=float)
+    D = 2.0 * jnp.asarray(h, dtype=float) if D is None else jnp.asarray(D, dtype=float)
+    return ModalTank(L=L, b=jnp.asarray(b, dtype=float), h=jnp.asarray(h, dtype=float), D=D,
+                     rho=jnp.asarray(rho, dtype=float), origin=jnp.asarray(origin, dtype=float),
+                     k=jnp.arange(1, n_modes + 1) * jnp.pi / L,
+                     xq=0.5 * L * (jnp.asarray(xg) + 1.0), wq=0.5 * L * jnp.asarray(wg),
+                     sq=0.5 * (jnp.asarray(sg) + 1.0), ws=0.5 * jnp.asarray(sw))
+
+
+class MultimodalLiquid(AbstractLiquid):
+    """Every tank's liquid as a multimodal tank (ModalTank), the modal coordinates stacked."""
+    tanks: tuple                      # ModalTank per tank
+    sizes: tuple = eqx.field(static=True)     # modes per tank
+    samples: jax.Array                # (Ns, nf) surface elevation at sample points of every tank (validity)
+    gravity: jax.Array                # m/s^2, for the rest stiffness
+    sparse = False
+    n_nodes = 0
+    nonlinear = True
+
+    @property
+    def nf(self) -> int:
+        return int(sum(self.sizes))
+
+    def _split(self, v):
+        out, i = [], 0
+        for n in self.sizes:
+            out.append(v[i:i + n])
+            i += n
+        return out
+
+    def rows(self, k: Kin) -> Rows:
+        A, omega = k.A, k.omega
+        Vb = tv3(A, k.V0)
+        Vb_dot = tv3(A, k.a6[:3]) - jnp.cross(omega, Vb)
+        f, m, rd = jnp.zeros(3), jnp.zeros(3), []
+        for t, be, bd, bdd in zip(self.tanks, self._split(k.c.d), self._split(k.d_dot), self._split(k.d_acc)):
+            ft, mt, rt = t.rows(Vb, omega, be, bd, Vb_dot, k.a6[3:6], bdd, k.g_b)
+            f, m = f + ft, m + mt
+            rd.append(rt)
+        return Rows(jnp.concatenate([mv3(A, f), m]), jnp.concatenate(rd))
+
+    def kinetic(self, k: Kin):
+        Vb = tv3(k.A, k.V0)
+        return sum((t.kinetic(Vb, k.omega, be, bd) for t, be, bd in
+                    zip(self.tanks, self._split(k.c.d), self._split(k.d_dot))), jnp.zeros(()))
+
+    def potential(self, k: Kin):
+        return self._potential(k.c.d, k.g_b)
+
+    def _potential(self, d, g_b):
+        return sum((t.potential(be, g_b) for t, be in zip(self.tanks, self._split(d))), jnp.zeros(()))
+
+    def mass_scale(self):
+        m = sum(t.mass for t in self.tanks)
+        I = jnp.zeros(3)
+        for t in self.tanks:
+            J = t.moments(t.integrals(jnp.zeros(t.n)))[1]
+            I = I + jnp.trace(J) - jnp.diag(J)
+        return jnp.concatenate([jnp.full(3, m), I])
+
+    def d_scale(self):
+        return jnp.concatenate([t.modal_mass() for t in self.tanks])
+
+    def total_mass(self):
+        return sum((t.mass for t in self.tanks), jnp.zeros(()))
+
+    def rigid_first_moment(self):
+        return sum((t.rest_moment() for t in self.tanks), jnp.zeros(3))
+
+    def constant_blocks(self):
+        """The modal rows' mass and stiffness at rest (they precondition Newton; the rows are exact)."""
+        M = jnp.diag(self.d_scale())
+        Kd = jnp.concatenate([t.modal_mass() * t.omega_linear(self.gravity) ** 2 for t in self.tanks])
+        return M, jnp.diag(Kd)
+
+    def frame_field(self, d):
+        return d
+
+    def nodal_fields(self, D):
+        return D
+
+    def probe_displacements(self, weights, modal, d):
+        return jnp.einsum("pkc,k->pc", modal, d)
+
+    def surface_heave(self, d, nodes):
+        return (self.samples @ d)[nodes]
+
+    def static_start(self, g_b):
+        """The level surface under the initial gravity direction: the minimum of the potential (Newton)."""
+        beta = jnp.zeros(self.nf)
+        grad = jax.grad(self._potential)
+        for _ in range(4):
+            beta = beta - jnp.linalg.solve(jax.jacfwd(grad)(beta, g_b), grad(beta, g_b))
+        return beta
