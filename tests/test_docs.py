@@ -63,7 +63,12 @@ def _accepted_keys() -> set:
             seen[(where + "." if where else "") + key] = kind
         return original(table, where, spec, required)
 
-    modules = (load, waves, shape, scene_campaign)
+    # every scene module that reads tables with fields.read (its own binding of the name)
+    import importlib
+    import pkgutil
+    import jaxslosh.scene as scene_pkg
+    modules = [m for m in (importlib.import_module(f"jaxslosh.scene.{i.name}")
+                           for i in pkgutil.iter_modules(scene_pkg.__path__)) if getattr(m, "read", None) is original]
     saved = [m.read for m in modules]
     try:
         for m in modules:

@@ -10,7 +10,7 @@ ROOT = os.path.join(os.path.dirname(os.path.dirname(os.path.abspath(__file__))),
 # lowest first; a module may import its own package and the packages on earlier lines
 LAYERS = [
     {"_version", "executables"},
-    {"programs", "fem.mesh", "fem.slip", "physics.kinematics"},
+    {"programs", "fem.mesh", "fem.meshfile", "fem.slip", "physics.kinematics"},
     {"fem.shapes"},
     {"hull"},
     {"hydro", "io"},

@@ -8,8 +8,11 @@ import numpy as np
 from ..hull.hydrostatics import rest_hydrostatics
 from ..hull.surface import HullMeshError, hull_triangles, water_height
 from ..hydro.box import box_hydrostatics
-from .fields import show
-from .types import SceneError
+from .fields import one_of, positive, read, show
+from .types import Environment, Hydrostatics, SceneError
+
+MOMENTS = ("paper", "conservative")
+HYDROSTATIC_MODELS = ("linear", "nonlinear")
 
 #: relative difference of a value given in [vessel.hydrostatics] from the hull's that warns
 HULL_VALUE_TOLERANCE = 0.01
@@ -55,4 +58,26 @@ def mesh_hydrostatics(hull, environment, warnings: list[str]) -> dict:
         warnings.append(f"vessel.hull.cog: the centre of buoyancy at rest lies {xb:.4g} m forward and {yb:.4g} m to "
                         "port of the COG: the vessel is not in equilibrium at its mesh's waterline and trims or "
                         "heels from the start")
+    return h
+
+
+def read_hydrostatics(table, warnings: list[str], hull=None, environment: Environment = Environment()) -> Hydrostatics:
+    """`[vessel.hydrostatics]`: the GM springs' values, or the hull's own for the nonlinear model."""
+    where = "vessel.hydrostatics"
+    v = read(table, where, {
+        "waterplane_area": ("float", positive), "displaced_volume": ("float", positive), "gm_t": ("float", None),
+        "gm_l": ("float", None), "moment": ("str", one_of(MOMENTS)), "model": ("str", one_of(HYDROSTATIC_MODELS)),
+    })
+    if v.get("model", "linear") == "nonlinear":   # the values are the hull's (scene/hull.py)
+        v = nonlinear_hydrostatics(v, hull, environment, warnings)
+    elif hull is not None and hull.type == "box":   # what the table leaves out is the box's (as with no table)
+        v = box_hydrostatics(hull.length, hull.beam, hull.draft, hull.kg) | v
+    for k in ("waterplane_area", "displaced_volume", "gm_t", "gm_l"):
+        if k not in v:
+            raise SceneError(f"{where}.{k}", "a required key is missing")
+    h = Hydrostatics(**v)
+    for key, value, motion in (("gm_t", h.gm_t, "roll"), ("gm_l", h.gm_l, "pitch")):
+        if value <= 0:
+            warnings.append(f"{where}.{key} = {show(value)} m <= 0: the vessel is statically unstable in "
+                            f"{motion}; it will capsize or loll")
     return h

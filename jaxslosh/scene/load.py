@@ -30,12 +30,11 @@ from ..fem.shapes import AXES, SHAPES
 from .campaign import read_campaign
 from .fields import (at_least, counts, flat_list, non_negative, one_of, poisson_ratio, positive, read, show, sizes,
                      valid_name)
-from .record import read_record
-from ..hydro.box import box_hydrostatics
-from .hull import nonlinear_hydrostatics
+from .record import forced_span, read_forced
+from .hull import read_hydrostatics
 from .shape import fill_and_mesh, read_shape
-from .types import (DOFS, EFFECTS, ELEMENT_FORMS, FACE_FORMS, FACES, Damping, Effects, Environment, Forced, Fluid,
-                    Hydrostatics, Initial, Material, Probe, Reduction, Scene, SceneError, Simulation, Structure, Tank,
+from .types import (EFFECTS, ELEMENT_FORMS, FACE_FORMS, FACES, Damping, Effects, Environment, Fluid,
+                    Initial, Material, Probe, Reduction, Scene, SceneError, Simulation, Structure, Tank,
                     Vessel, Walls)
 from .waves import FileContext, check_waves, hull_hydrostatics, read_hull, read_hydrodynamics, read_waves
 
@@ -45,8 +44,6 @@ WALLS = ("rigid", "elastic")
 TANK_MODELS = ("fem", "multimodal")
 #: below this fill depth over length the multimodal method's ordering fails (shallow water, bores)
 MULTIMODAL_SHALLOW = 0.1
-MOMENTS = ("paper", "conservative")
-HYDROSTATIC_MODELS = ("linear", "nonlinear")
 PROBE_TOLERANCE = 1e-9                           # m: how far outside its owner a probe may lie
 MASS_BALANCE_TOLERANCE = 0.01                    # relative mismatch of weight and buoyancy that warns
 HHT_ALPHA_MAX = 1.0 / 3.0
@@ -260,7 +257,7 @@ def _vessel(table, environment: Environment, warnings: list[str], files=None) ->
     inertia = v["inertia"]
     _inertia_warnings(inertia, warnings)
     hull = read_hull(table["hull"], files.base_dir if files is not None else "") if "hull" in table else None
-    hydrostatics = _hydrostatics(table["hydrostatics"], warnings, hull, environment) if "hydrostatics" in table else None
+    hydrostatics = read_hydrostatics(table["hydrostatics"], warnings, hull, environment) if "hydrostatics" in table else None
     hydrodynamics = None
     if "hull" in table or "hydrodynamics" in table:   # hull and its hydrodynamics (waves.py)
         if hull is not None and not (hydrostatics is not None and hydrostatics.nonlinear):
@@ -275,81 +272,10 @@ def _vessel(table, environment: Environment, warnings: list[str], files=None) ->
         "position": ("vec3", None), "velocity": ("vec3", None), "angular_velocity": ("vec3", None),
         "roll_pitch_yaw": ("vec3", None),
     }))
-    forced = _forced(table["forced"], files.base_dir if files is not None else os.getcwd()) \
+    forced = read_forced(table["forced"], files.base_dir if files is not None else os.getcwd()) \
         if "forced" in table else None
     return Vessel(mass=v["mass"], inertia=inertia, hydrostatics=hydrostatics, initial=initial, forced=forced,
                   hull=hull, hydrodynamics=hydrodynamics)
-
-
-#: the keys of each [vessel.forced] profile (dof for the two of one dof; a record's columns name its dofs)
-FORCED_PROFILES = {"harmonic": ("dof", "amplitude", "frequency", "ramp", "phase"),
-                   "spin-up": ("dof", "rate", "duration"), "record": ("file",)}
-FORCED_REQUIRED = {"harmonic": ("dof", "amplitude", "frequency"), "spin-up": ("dof", "rate", "duration"),
-                   "record": ("file",)}
-
-
-def _forced(table, base_dir: str) -> Forced:
-    """`[vessel.forced]`: a harmonic or spin-up profile of one dof, or a record (`file`) of any dofs."""
-    where = "vessel.forced"
-    f = read(table, where, {
-        "dof": ("str", one_of(DOFS)), "profile": ("str", one_of(tuple(FORCED_PROFILES))),
-        "amplitude": ("float", None), "frequency": ("float", positive), "ramp": ("float", non_negative),
-        "rate": ("float", None), "duration": ("float", positive), "phase": ("float", None), "file": ("str", None),
-    })
-    profile = f.get("profile", "record" if "file" in f else "harmonic")
-    f["profile"] = profile
-    for k in FORCED_REQUIRED[profile]:
-        if k not in f:
-            raise SceneError(f"{where}.{k}", "a required key is missing" if k == "dof"
-                             else f"is required for the {profile} profile")
-    for k in f:
-        if k != "profile" and k not in FORCED_PROFILES[profile]:
-            takes = ", ".join(FORCED_PROFILES[profile])
-            why = " (the record's columns name the dofs it prescribes)" if profile == "record" and k == "dof" else ""
-            raise SceneError(f"{where}.{k}", f"does not belong to the {profile} profile (it takes {takes}){why}")
-    if profile == "spin-up" and f["dof"] not in ("roll", "pitch", "yaw"):
-        raise SceneError(f"{where}.dof", f"the spin-up profile turns a rotation (roll, pitch or yaw), not {f['dof']!r}")
-    if profile == "record":
-        shown = f["file"]
-        f["file"] = shown if os.path.isabs(shown) else os.path.join(base_dir, shown)
-        f["times"], f["columns"] = read_record(f["file"], f"{where}.file", shown)
-    return Forced(**f)
-
-
-def forced_span(vessel: Vessel, sim: Simulation) -> None:
-    """A record must cover the run, from t = 0 to the duration: the motion is not guessed outside it."""
-    f = vessel.forced
-    if f is None or f.profile != "record":
-        return
-    t0, t1 = f.times[0], f.times[-1]
-    name = os.path.basename(f.file)
-    if t0 > 0.0:
-        raise SceneError("vessel.forced.file", f"{name}: the record starts at t = {t0:g} s; it must cover the run "
-                                               f"from t = 0")
-    if sim.n_steps * sim.dt > t1 * (1 + 1e-12) + 1e-12:
-        raise SceneError("vessel.forced.file", f"{name}: the record ends at t = {t1:g} s, before the run's end "
-                                               f"t = {sim.n_steps * sim.dt:g} s (simulation.duration)")
-
-
-def _hydrostatics(table, warnings: list[str], hull=None, environment: Environment = Environment()) -> Hydrostatics:
-    where = "vessel.hydrostatics"
-    v = read(table, where, {
-        "waterplane_area": ("float", positive), "displaced_volume": ("float", positive), "gm_t": ("float", None),
-        "gm_l": ("float", None), "moment": ("str", one_of(MOMENTS)), "model": ("str", one_of(HYDROSTATIC_MODELS)),
-    })
-    if v.get("model", "linear") == "nonlinear":   # the values are the hull's (scene/hull.py)
-        v = nonlinear_hydrostatics(v, hull, environment, warnings)
-    elif hull is not None and hull.type == "box":   # what the table leaves out is the box's (as with no table)
-        v = box_hydrostatics(hull.length, hull.beam, hull.draft, hull.kg) | v
-    for k in ("waterplane_area", "displaced_volume", "gm_t", "gm_l"):
-        if k not in v:
-            raise SceneError(f"{where}.{k}", "a required key is missing")
-    h = Hydrostatics(**v)
-    for key, value, motion in (("gm_t", h.gm_t, "roll"), ("gm_l", h.gm_l, "pitch")):
-        if value <= 0:
-            warnings.append(f"{where}.{key} = {show(value)} m <= 0: the vessel is statically unstable in "
-                            f"{motion}; it will capsize or loll")
-    return h
 
 
 def _inertia_warnings(inertia, warnings: list[str]) -> None:

@@ -1,4 +1,5 @@
-"""A motion record for `[vessel.forced] file = "motion.csv"` (SPEC section 9): read and checked.
+"""`[vessel.forced]` read and checked: the harmonic and spin-up profiles' keys, and a motion record
+(`file = "motion.csv"`, SPEC section 9).
 
 The file is comma-separated text: a header row with `t` and any of surge, sway, heave (m), roll,
 pitch, yaw (rad), then one row per sample. Blank lines and lines starting with `#` are skipped.
@@ -13,7 +14,8 @@ import functools
 import math
 import os
 
-from .types import DOFS, SceneError
+from .fields import non_negative, one_of, positive, read
+from .types import DOFS, Forced, SceneError, Simulation, Vessel
 
 MIN_ROWS = 4
 
@@ -79,3 +81,53 @@ def _read_record(path, where, shown, mtime_ns, size):
     times = tuple(v[it] for _, v in values)
     cols = tuple((name, tuple(v[k] for _, v in values)) for k, name in enumerate(names) if name != "t")
     return times, cols
+
+
+#: the keys of each [vessel.forced] profile (dof for the two of one dof; a record's columns name its dofs)
+FORCED_PROFILES = {"harmonic": ("dof", "amplitude", "frequency", "ramp", "phase"),
+                   "spin-up": ("dof", "rate", "duration"), "record": ("file",)}
+FORCED_REQUIRED = {"harmonic": ("dof", "amplitude", "frequency"), "spin-up": ("dof", "rate", "duration"),
+                   "record": ("file",)}
+
+
+def read_forced(table, base_dir: str) -> Forced:
+    """`[vessel.forced]`: a harmonic or spin-up profile of one dof, or a record (`file`) of any dofs."""
+    where = "vessel.forced"
+    f = read(table, where, {
+        "dof": ("str", one_of(DOFS)), "profile": ("str", one_of(tuple(FORCED_PROFILES))),
+        "amplitude": ("float", None), "frequency": ("float", positive), "ramp": ("float", non_negative),
+        "rate": ("float", None), "duration": ("float", positive), "phase": ("float", None), "file": ("str", None),
+    })
+    profile = f.get("profile", "record" if "file" in f else "harmonic")
+    f["profile"] = profile
+    for k in FORCED_REQUIRED[profile]:
+        if k not in f:
+            raise SceneError(f"{where}.{k}", "a required key is missing" if k == "dof"
+                             else f"is required for the {profile} profile")
+    for k in f:
+        if k != "profile" and k not in FORCED_PROFILES[profile]:
+            takes = ", ".join(FORCED_PROFILES[profile])
+            why = " (the record's columns name the dofs it prescribes)" if profile == "record" and k == "dof" else ""
+            raise SceneError(f"{where}.{k}", f"does not belong to the {profile} profile (it takes {takes}){why}")
+    if profile == "spin-up" and f["dof"] not in ("roll", "pitch", "yaw"):
+        raise SceneError(f"{where}.dof", f"the spin-up profile turns a rotation (roll, pitch or yaw), not {f['dof']!r}")
+    if profile == "record":
+        shown = f["file"]
+        f["file"] = shown if os.path.isabs(shown) else os.path.join(base_dir, shown)
+        f["times"], f["columns"] = read_record(f["file"], f"{where}.file", shown)
+    return Forced(**f)
+
+
+def forced_span(vessel: Vessel, sim: Simulation) -> None:
+    """A record must cover the run, from t = 0 to the duration: the motion is not guessed outside it."""
+    f = vessel.forced
+    if f is None or f.profile != "record":
+        return
+    t0, t1 = f.times[0], f.times[-1]
+    name = os.path.basename(f.file)
+    if t0 > 0.0:
+        raise SceneError("vessel.forced.file", f"{name}: the record starts at t = {t0:g} s; it must cover the run "
+                                               f"from t = 0")
+    if sim.n_steps * sim.dt > t1 * (1 + 1e-12) + 1e-12:
+        raise SceneError("vessel.forced.file", f"{name}: the record ends at t = {t1:g} s, before the run's end "
+                                               f"t = {sim.n_steps * sim.dt:g} s (simulation.duration)")
