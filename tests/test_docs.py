@@ -12,8 +12,7 @@ import re
 
 import pytest
 
-from jaxslosh.scene import campaign as scene_campaign
-from jaxslosh.scene import fields, load, shape, waves
+from jaxslosh.scene import fields, load
 from jaxslosh.scene.keydocs import KEYS, TABLES
 from jaxslosh.scene.types import SceneError
 
