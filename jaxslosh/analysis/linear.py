@@ -32,7 +32,7 @@ from ..physics import structures as mb
 from ..physics.seakeeping import AddedMass
 from ..physics.system import advance_config
 from ..run.loop import probe_positions
-from ..run.simulate import prepare
+from ..run.simulate import is_traced, prepare
 from ..scene.types import DOFS, Initial, Scene, SceneError
 from ..solve.integrator import static_structures
 
@@ -86,7 +86,9 @@ def _labels(b: Built, L: mb.Layout) -> tuple:
 
 
 def linearise(scene: Scene, params=None) -> Linearisation:
-    """M, C, K of the scene about its rest state (see the module's docstring)."""
+    """M, C, K of the scene about its rest state (see the module's docstring). With traced
+    `params` (under jax.grad or jax.jit) M, C, K and the probes' rows are JAX values that carry
+    the gradient; otherwise NumPy arrays."""
     setup = prepare(rest_scene(scene), params)
     b, solver = setup.built, setup.solver
     sysm = b.system
@@ -131,13 +133,21 @@ def linearise(scene: Scene, params=None) -> Linearisation:
         P = jax.jacfwd(position)(zx) if b.probes.names else jnp.zeros((0, 3, n))
         return M, C, K, P
 
-    M_d, C_d, K, P = (np.asarray(m) for m in matrices())
     # velocities and accelerations are the dynamic unknowns: their columns go where those sit in x
-    where = np.asarray(L.to_x(jnp.arange(L.n_dyn), -jnp.ones(L.n_alg, dtype=int)))
+    with jax.ensure_compile_time_eval():
+        where = np.asarray(L.to_x(jnp.arange(L.n_dyn), -jnp.ones(L.n_alg, dtype=int)))
     dynamic = where >= 0
-    M, C = np.zeros((n, n)), np.zeros((n, n))
-    M[:, dynamic] = M_d[:, where[dynamic]]
-    C[:, dynamic] = C_d[:, where[dynamic]]
+    if is_traced(params or {}):
+        # traced params (jax.grad of a function of the RAOs): the matrices stay JAX values
+        M_d, C_d, K, P = matrices()
+        cols = np.flatnonzero(dynamic)
+        M = jnp.zeros((n, n), dtype=M_d.dtype).at[:, cols].set(M_d[:, where[cols]])
+        C = jnp.zeros((n, n), dtype=C_d.dtype).at[:, cols].set(C_d[:, where[cols]])
+    else:
+        M_d, C_d, K, P = (np.asarray(m) for m in matrices())
+        M, C = np.zeros((n, n)), np.zeros((n, n))
+        M[:, dynamic] = M_d[:, where[dynamic]]
+        C[:, dynamic] = C_d[:, where[dynamic]]
     Ainf = np.zeros((6, 6))
     for term in sysm.terms:
         if isinstance(term, AddedMass):

@@ -15,11 +15,14 @@ from __future__ import annotations
 
 from typing import NamedTuple, Optional
 
+import jax
+import jax.numpy as jnp
 import numpy as np
 
 from ..hydro.source import excitation_at, tables_of
 from ..hydro.tables import interpolate_radiation
 from ..scene.types import Scene, SceneError
+from ..run.simulate import is_traced
 from .linear import Linearisation, linearise
 
 #: the default frequencies without radiation tables (rad/s): the band of ship motions and of the
@@ -90,7 +93,14 @@ def default_frequencies(scene: Scene, tables=None, radiation=None, count: int = 
 
 def solve_equilibrated(Z, F):
     """Z X = F with rows and columns scaled to unit max norm first: the acoustic rows of the liquid
-    are 1e10 times the vessel's, and the interface rows of structures carry no inertia."""
+    are 1e10 times the vessel's, and the interface rows of structures carry no inertia. A traced Z
+    (a gradient through the RAOs) is solved by JAX; the scaling, which leaves X as it is, carries
+    no gradient."""
+    if is_traced(Z):
+        r = jax.lax.stop_gradient(1.0 / jnp.maximum(jnp.abs(Z).max(axis=1), 1e-300))
+        Zr = Z * r[:, None]
+        c = jax.lax.stop_gradient(1.0 / jnp.maximum(jnp.abs(Zr).max(axis=0), 1e-300))
+        return c[:, None] * jnp.linalg.solve(Zr * c[None, :], F * r[:, None])
     r = 1.0 / np.maximum(np.abs(Z).max(axis=1), 1e-300)
     Zr = Z * r[:, None]
     c = 1.0 / np.maximum(np.abs(Zr).max(axis=0), 1e-300)
@@ -99,13 +109,14 @@ def solve_equilibrated(Z, F):
 
 def frequency_matrices(lin: Linearisation, tables, radiation: bool, w):
     """(M(w), C(w)) of the coupled system at frequency w: the radiation tables' A(w) in place of
-    the A_inf the residual carries, B(w) added, on the vessel's rows and columns."""
-    M, C = lin.M.copy(), lin.C.copy()
-    if radiation:
-        A, B = interpolate_radiation(tables, [w])
-        M[:6, :6] += A[0] - lin.added_mass_infinite
-        C[:6, :6] += B[0]
-    return M, C
+    the A_inf the residual carries, B(w) added, on the vessel's rows and columns (new arrays)."""
+    if not radiation:
+        return lin.M.copy(), lin.C.copy()
+    A, B = interpolate_radiation(tables, [w])
+    dM, dC = np.zeros(lin.M.shape), np.zeros(lin.C.shape)
+    dM[:6, :6] = A[0] - lin.added_mass_infinite
+    dC[:6, :6] = B[0]
+    return lin.M + dM, lin.C + dC
 
 
 def rao(scene: Scene, frequencies=None, headings=None, *, params=None,
@@ -113,7 +124,9 @@ def rao(scene: Scene, frequencies=None, headings=None, *, params=None,
     """Complex RAOs of the vessel's six dofs and every probe over `frequencies` (rad/s; default:
     the radiation tables' range, else 0.1 to 4 rad/s) and `headings` (rad, the direction the waves
     travel to; default the scene's wave heading, else the excitation tables', else 0, pi/2, pi).
-    Input the frequency domain cannot take raises SceneError naming it."""
+    Input the frequency domain cannot take raises SceneError naming it. With traced `params`
+    (traceable scene keys, under jax.grad or jax.jit) the RAOs are JAX values: a function of them
+    can be differentiated with respect to those params."""
     env, ves = scene.environment, scene.vessel
     heads = None if headings is None else np.atleast_1d(np.asarray(headings, dtype=float))
     tables = hull_tables(scene, heads if heads is not None else
@@ -133,12 +146,32 @@ def rao(scene: Scene, frequencies=None, headings=None, *, params=None,
     X = np.stack(X, axis=1)                                  # (f, h, 6)
     lin = linearisation if linearisation is not None else linearise(scene, params)
     n = lin.n
-    out = np.zeros((w.size, heads.size, n), dtype=complex)
-    for i, wi in enumerate(w):
-        M, C = frequency_matrices(lin, tables, radiation, wi)
-        Z = lin.K - wi * wi * M + 1j * wi * C
-        F = np.zeros((n, heads.size), dtype=complex)
-        F[:6] = X[i].T
-        out[i] = solve_equilibrated(Z, F).T
-    probes = {name: np.einsum("cn,fhn->fhc", lin.probes[k], out) for k, name in enumerate(lin.probe_names)}
+    F = np.zeros((w.size, n, heads.size), dtype=complex)
+    F[:, :6] = X.transpose(0, 2, 1)
+    if is_traced((lin.M, lin.C, lin.K)):
+        out, xp = _traced_solves(lin, tables, radiation, w, F), jnp
+    else:
+        out, xp = np.zeros((w.size, heads.size, n), dtype=complex), np
+        for i, wi in enumerate(w):
+            M, C = frequency_matrices(lin, tables, radiation, wi)
+            out[i] = solve_equilibrated(lin.K - wi * wi * M + 1j * wi * C, F[i]).T
+    probes = {name: xp.einsum("cn,fhn->fhc", lin.probes[k], out) for k, name in enumerate(lin.probe_names)}
     return RAO(w, heads, out[:, :, :6], probes, scene.text)
+
+
+def _traced_solves(lin: Linearisation, tables, radiation: bool, w, F):
+    """The RAOs (f, h, n) of a linearisation whose matrices are traced (a gradient through them):
+    one solve per frequency in a lax.map, so that the compiled program does not grow with the
+    number of frequencies."""
+    dA, dB = np.zeros((w.size, 6, 6)), np.zeros((w.size, 6, 6))
+    if radiation:
+        A, B = interpolate_radiation(tables, w)
+        dA, dB = np.asarray(A) - lin.added_mass_infinite[None], np.asarray(B)
+
+    def one(args):
+        wi, dAi, dBi, Fi = args
+        Z = lin.K - wi * wi * lin.M + 1j * wi * lin.C
+        Z = Z.at[:6, :6].add(-wi * wi * dAi + 1j * wi * dBi)
+        return solve_equilibrated(Z, Fi).T
+
+    return jax.lax.map(one, (jnp.asarray(w), jnp.asarray(dA), jnp.asarray(dB), jnp.asarray(F)))
