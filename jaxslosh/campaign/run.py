@@ -260,6 +260,13 @@ def _quiet_cancellations():
     logging.getLogger("distributed.worker.state_machine").setLevel(logging.ERROR)
 
 
+def _quiet_closing():
+    """On a worker or its nanny, as our own cluster closes: the heartbeats that race with the
+    scheduler's shutdown ("Failed to communicate with scheduler during heartbeat") lose nothing."""
+    for n in ["distributed"] + [n for n in logging.root.manager.loggerDict if n.startswith("distributed.")]:
+        logging.getLogger(n).setLevel(logging.CRITICAL + 1)
+
+
 @contextlib.contextmanager
 def _quiet_dask():
     """Dask's loggers in this process silenced while a campaign closes its cluster: after an
@@ -340,5 +347,8 @@ def _run(template, duration, cases, scenes, todo, client, workers, batch, output
                 with contextlib.suppress(Exception):
                     client.cancel(list(futures))
             if own:
+                with contextlib.suppress(Exception):
+                    client.run(_quiet_closing)
+                    client.run(_quiet_closing, nanny=True)
                 client.close()
                 cluster.close()
