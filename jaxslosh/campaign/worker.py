@@ -19,7 +19,8 @@ try:
 except ModuleNotFoundError:  # Python 3.10
     import tomli as tomllib  # type: ignore[no-redef]
 
-from ..run.batch import simulate_seas
+from ..run.batch import capsize_angles, simulate_seas
+from ..run.capsize import capsize_reason
 from ..scene.load import parse_scene
 from ..scene.types import Scene
 from .cases import case_scene, sea_arrays
@@ -69,10 +70,15 @@ def run_batch(text: str, path: str, duration: Optional[float], values: list, bat
     seas = [sea_arrays(s) for s in scenes]
     seas += [seas[-1]] * (batch - len(seas))
     omega, amp, phase, hs = (np.stack([s[k] for s in seas]) for k in range(4))
-    result, statuses = simulate_seas(structure_scene(template, scenes[0]), omega, amp, phase, hs)
+    structure = structure_scene(template, scenes[0])
+    result, statuses = simulate_seas(structure, omega, amp, phase, hs)
     t = np.asarray(result.time)
+    angles = capsize_angles(structure)
     out = []
     for i, s in enumerate(scenes):
+        if statuses[i] == "ok" and angles is not None:
+            rpy = np.asarray(result.vessel.roll_pitch_yaw[i])
+            statuses[i] = capsize_reason(rpy[:, 0], rpy[:, 1], angles) or "ok"
         st = case_statistics(t[i], channels(result, i), s.waves.ramp) if statuses[i] == "ok" else None
         out.append({"status": statuses[i], "stats": st, "pid": os.getpid()})
     return out

@@ -15,6 +15,7 @@ from ..programs import XLA_OPTIONS
 from ..physics.seakeeping import Excitation, WaveExcitation
 from ..scene.keys import check_values, with_overrides
 from ..scene.types import Scene, SceneError
+from .capsize import vanishing_angles
 from .loop import advance, concat_frames, core, frame_datasets, start
 from .simulate import failure_message, is_traced, prepare
 
@@ -167,3 +168,9 @@ def simulate_batch(scene: Scene, params: dict, *, duration: Optional[float] = No
     setup0 = _setup0(scene)
     carry, fr = _batch_fn(scene, tuple(keys), mesh)(*vals)
     return _batch_result(scene, setup0, carry, fr, B)
+
+
+def capsize_angles(scene: Scene):
+    """The (roll, pitch) angles of vanishing stability of a scene with the nonlinear hydrostatics
+    (run/capsize.py), None for other scenes; from the model its batches are built on (kept)."""
+    return vanishing_angles(_setup0(scene).built.system)

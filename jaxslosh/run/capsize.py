@@ -31,3 +31,18 @@ def vanishing_angles(system) -> Optional[tuple]:
     angles = np.linspace(0.0, np.pi, HEELS)
     return tuple(first_vanishing(angles, gz_curve(h.tris, h.z_water, w.mass / h.rho_w, w.S / w.mass,
                                                   jnp.asarray(angles), axis)) for axis in (0, 1))
+
+
+def capsize_reason(roll, pitch, angles) -> Optional[str]:
+    """Why a run's record (roll and pitch series, rad) counts as capsized against its angles of
+    vanishing stability (vanishing_angles), or None: the first axis whose largest |angle| passes
+    its angle. A campaign gives this as the case's status, so the case counts as not operable and
+    as exceeding every limit."""
+    if angles is None:
+        return None
+    for name, x, limit in (("roll", roll, angles[0]), ("pitch", pitch, angles[1])):
+        peak = float(np.max(np.abs(np.asarray(x)))) if np.size(x) else 0.0
+        if limit is not None and peak > limit:
+            return (f"capsized: the {name} reached {np.degrees(peak):.1f} deg, past the hull's angle of vanishing "
+                    f"stability {np.degrees(limit):.1f} deg")
+    return None

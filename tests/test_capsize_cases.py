@@ -1,0 +1,34 @@
+"""A capsized campaign case (issue 32 item 4): its status says so, and it counts as not operable
+and as exceeding every limit, as a failed case does."""
+import math
+
+import numpy as np
+
+from jaxslosh.campaign.stats import operability
+from jaxslosh.run.capsize import capsize_reason
+
+
+def test_a_record_past_the_angle_of_vanishing_stability_is_capsized():
+    t = np.linspace(0.0, 10.0, 201)
+    roll = np.radians(80.0) * np.sin(t)           # peaks at 80 deg
+    pitch = np.radians(2.0) * np.sin(t)
+    angles = (np.radians(75.0), np.radians(60.0))
+    why = capsize_reason(roll, pitch, angles)
+    assert why is not None and why.startswith("capsized: the roll reached 80.0 deg") and "75.0 deg" in why
+    # within both angles, or a hull whose GZ never vanishes on an axis, or no nonlinear hull: not capsized
+    assert capsize_reason(0.5 * roll, pitch, angles) is None
+    assert capsize_reason(roll, pitch, (None, np.radians(60.0))) is None
+    assert capsize_reason(roll, pitch, None) is None
+    assert capsize_reason(0.5 * roll, np.radians(61.0) * np.sin(t), angles).startswith("capsized: the pitch")
+
+
+def test_a_capsized_case_is_not_operable_and_exceeds_every_limit():
+    # two cases of equal weight: one rode out the sea well within the limit, one capsized (no statistics)
+    stats = {"roll": {"std": np.array([0.01, np.nan]), "tz": np.array([8.0, np.nan]),
+                      "max": np.array([0.03, np.nan])}}
+    status = ["ok", capsize_reason(np.array([1.5]), np.array([0.0]), (1.3, None))]
+    ok = np.array([s == "ok" for s in status])
+    out = operability(stats, [0.5, 0.5], ok, {"roll": 0.2}, 3600.0, failed=~ok)
+    assert math.isclose(out["operability"], 50.0, rel_tol=1e-12)
+    assert math.isclose(out["failed"], 50.0, rel_tol=1e-12)
+    assert 0.5 <= out["exceedance"]["roll"] < 0.5 + 1e-6
