@@ -121,3 +121,27 @@ def run_notebook(name: str, env: dict | None = None, timeout: int = 900) -> list
 
 def printed(outputs: list) -> str:
     return "".join(o.get("text", "") for o in outputs)
+
+
+# independent section geometry for the large-angle references (tests of GZ and of the free roll)
+
+def clip_polygon(P, level):
+    """Sutherland-Hodgman: the part of polygon P (k, 2: y, z) with z <= level."""
+    out = []
+    for i in range(len(P)):
+        a, b = P[i], P[(i + 1) % len(P)]
+        ina, inb = a[1] <= level, b[1] <= level
+        if ina:
+            out.append(a)
+        if ina != inb:
+            s = (level - a[1]) / (b[1] - a[1])
+            out.append(a + s * (b - a))
+    return np.array(out)
+
+
+def area_centroid(P):
+    y, z = P[:, 0], P[:, 1]
+    y1, z1 = np.roll(y, -1), np.roll(z, -1)
+    c = y * z1 - y1 * z
+    A = 0.5 * c.sum()
+    return A, np.array([((y + y1) * c).sum(), ((z + z1) * c).sum()]) / (6.0 * A)

@@ -11,6 +11,8 @@ from scipy.optimize import brentq
 import jaxslosh as js
 from jaxslosh.cli.main import main
 
+from helpers import area_centroid, clip_polygon
+
 RHO = 1025.0
 L, B, D, KG = 16.0, 10.0, 5.0, 2.9
 
@@ -50,27 +52,9 @@ def _section_gz(phi, T, kg, depth, beam):
     rect = np.array([[-beam / 2, -kg], [beam / 2, -kg], [beam / 2, depth - kg], [-beam / 2, depth - kg]])
     world = rect @ np.array([[c, s], [-s, c]])            # rotate by phi (y, z)
 
-    def clip(poly, h):
-        out = []
-        for i in range(len(poly)):
-            p, q = poly[i], poly[(i + 1) % len(poly)]
-            ip, iq = p[1] <= h, q[1] <= h
-            if ip:
-                out.append(p)
-            if ip != iq:
-                out.append(p + (h - p[1]) / (q[1] - p[1]) * (q - p))
-        return np.array(out)
-
-    def shoelace(poly):
-        x, y = poly[:, 0], poly[:, 1]
-        xn, yn = np.roll(x, -1), np.roll(y, -1)
-        cr = x * yn - xn * y
-        return cr.sum() / 2, np.array([((x + xn) * cr).sum(), ((y + yn) * cr).sum()]) / 6
-
-    h = brentq(lambda h: shoelace(clip(world, h))[0] - beam * T, world[:, 1].min() + 1e-9,
+    h = brentq(lambda h: area_centroid(clip_polygon(world, h))[0] - beam * T, world[:, 1].min() + 1e-9,
                world[:, 1].max() - 1e-9, xtol=1e-14)
-    a, first = shoelace(clip(world, h))
-    cb = first / a
+    _, cb = area_centroid(clip_polygon(world, h))
     return 0.0 - cb[0]                                     # G at the origin
 
 

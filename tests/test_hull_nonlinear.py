@@ -20,6 +20,8 @@ from jaxslosh.physics.kinematics import quat_exp, quat_from_rpy, quat_multiply, 
 from jaxslosh.physics.terms import Config, potential_rows
 from jaxslosh.physics.vessel import Hydrostatics
 
+from helpers import area_centroid, clip_polygon
+
 RHO, G = 1025.0, 9.81
 L, B, T, D, KG = 20.0, 10.0, 3.0, 6.0, 3.5
 MASS = RHO * L * B * T
@@ -57,28 +59,6 @@ def box_scene(duration=10.0, dt=0.02, model="nonlinear", roll=0.0, mass=MASS, ex
 # ------------------------------------------------------------------------------------------------
 # the independent reference: the box's 2-D section, roll and heave, buoyancy by polygon clipping
 
-def _clip_polygon(P, level):
-    """Sutherland-Hodgman: the part of polygon P (k, 2: y, z) with z <= level."""
-    out = []
-    for i in range(len(P)):
-        a, b = P[i], P[(i + 1) % len(P)]
-        ina, inb = a[1] <= level, b[1] <= level
-        if ina:
-            out.append(a)
-        if ina != inb:
-            s = (level - a[1]) / (b[1] - a[1])
-            out.append(a + s * (b - a))
-    return np.array(out)
-
-
-def _area_centroid(P):
-    y, z = P[:, 0], P[:, 1]
-    y1, z1 = np.roll(y, -1), np.roll(z, -1)
-    c = y * z1 - y1 * z
-    A = 0.5 * c.sum()
-    return A, np.array([((y + y1) * c).sum(), ((z + z1) * c).sum()]) / (6.0 * A)
-
-
 def section_rhs(t, s):
     """s = (z0, phi, z0_dot, phi_dot): the rectangle B x D about its COG, KG above the keel, rolled by
     phi about the COG at height z0; water at z = T - KG."""
@@ -86,7 +66,7 @@ def section_rhs(t, s):
     c, sn = math.cos(phi), math.sin(phi)
     corners = np.array([[-B / 2, -KG], [B / 2, -KG], [B / 2, D - KG], [-B / 2, D - KG]])
     P = np.stack([c * corners[:, 0] - sn * corners[:, 1], z0 + sn * corners[:, 0] + c * corners[:, 1]], axis=1)
-    A, (yc, _) = _area_centroid(_clip_polygon(P, T - KG))
+    A, (yc, _) = area_centroid(clip_polygon(P, T - KG))
     Fz = RHO * G * L * A
     return [s[2], s[3], (Fz - MASS * G) / MASS, Fz * yc / IXX]
 
@@ -334,8 +314,8 @@ def _section_gz(phi):
     for _ in range(100):
         z0 = 0.5 * (lo + hi)
         P = np.stack([c * corners[:, 0] - sn * corners[:, 1], z0 + sn * corners[:, 0] + c * corners[:, 1]], axis=1)
-        Q = _clip_polygon(P, T - KG)
-        A, (yc, _) = _area_centroid(Q) if len(Q) > 2 else (0.0, (0.0, 0.0))
+        Q = clip_polygon(P, T - KG)
+        A, (yc, _) = area_centroid(Q) if len(Q) > 2 else (0.0, (0.0, 0.0))
         lo, hi = (z0, hi) if A > B * T else (lo, z0)
     return -yc
 
