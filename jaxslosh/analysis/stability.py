@@ -25,6 +25,7 @@ import jax.numpy as jnp
 import numpy as np
 
 from ..hull.clip import submerged, submerged_and_cut
+from ..hull.hydrostatics import first_vanishing
 from ..hull.surface import HullMeshError, hull_triangles
 from ..hull.tanks import tank_surface
 from ..programs import START_OPTIONS
@@ -253,22 +254,6 @@ def _check(what, angles, verr, lever, size):
                                f"not converge (volume off by {verr[i]:.3g}, free lever {lever[i]:.3g} m)")
 
 
-def vanishing_angle(angle, gz) -> Optional[float]:
-    """The first positive angle where GZ goes from positive to <= 0 (linear between the two samples
-    that bracket it); 0 where GZ is <= 0 at every positive angle; None when it stays positive."""
-    a, g = np.asarray(angle), np.asarray(gz)
-    keep = a > 0
-    a, g = a[keep], g[keep]
-    if len(a) == 0:
-        return None
-    if np.all(g <= 0):
-        return 0.0
-    for i in range(int(np.argmax(g > 0)), len(a) - 1):
-        if g[i] > 0 >= g[i + 1]:
-            return float(a[i] + (a[i + 1] - a[i]) * g[i] / (g[i] - g[i + 1]))
-    return None
-
-
 def is_code_criteria(angle, gz, gm0, area_30, area_40, area_30_40):
     """IS Code 2008 Part A 2.2 on a GZ curve (rad, m) that covers 0-40 degrees and beyond."""
     a, g = np.asarray(angle), np.asarray(gz)
@@ -339,5 +324,5 @@ def stability(scene, angles=None, axis: str = "roll", *, criteria: bool = True) 
         a3040 = float(w40 @ gz2[where[4], 0])
         crit = is_code_criteria(grid, gz2[where[2], 0], gm0, a30, a30 + a3040, a3040)
     return Stability(angle=angles, gz=gz, gz_frozen=gz_f, gm0=gm0, gm0_frozen=gm0_f,
-                     vanishing_angle=vanishing_angle(angles, gz), criteria=crit, axis=axis,
+                     vanishing_angle=first_vanishing(angles, gz), criteria=crit, axis=axis,
                      sinkage=off2[at, 0] - off2[up, 0], trim=psi2[at, 0])

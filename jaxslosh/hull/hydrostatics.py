@@ -123,8 +123,8 @@ def gz_curve(tris, z_water, volume, S_over_mass, angles, axis: int = 0):
 
 def first_vanishing(angles, gz):
     """The first positive angle where GZ goes from positive to <= 0 (linear between the samples), 0
-    where it is <= 0 at every positive angle, None where it stays positive (the convention of
-    analysis/stability.vanishing_angle, which this layer cannot import)."""
+    where it is <= 0 at every positive angle, None where it stays positive (a run's capsize check
+    and `js.stability` both)."""
     a, g = np.asarray(angles), np.asarray(gz)
     a, g = a[a > 0], g[a > 0]
     if len(a) == 0:
