@@ -140,8 +140,14 @@ def clip_polygon(P, level):
 
 
 def area_centroid(P):
+    """Shoelace area and centroid of polygon P (k, 2); a polygon of no area (the section clear of
+    the water line) has no centroid: NaN."""
+    if len(P) < 3:
+        return 0.0, np.full(2, np.nan)
     y, z = P[:, 0], P[:, 1]
     y1, z1 = np.roll(y, -1), np.roll(z, -1)
     c = y * z1 - y1 * z
     A = 0.5 * c.sum()
+    if A == 0.0:
+        return 0.0, np.full(2, np.nan)
     return A, np.array([((y + y1) * c).sum(), ((z + z1) * c).sum()]) / (6.0 * A)
