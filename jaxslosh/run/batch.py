@@ -172,5 +172,14 @@ def simulate_batch(scene: Scene, params: dict, *, duration: Optional[float] = No
 
 def capsize_angles(scene: Scene):
     """The (roll, pitch) angles of vanishing stability of a scene with the nonlinear hydrostatics
-    (run/capsize.py), None for other scenes; from the model its batches are built on (kept)."""
+    (run/capsize.py), None for other scenes; from the model its batches are built on. Kept per
+    scene, as that model is: a campaign asks once per batch, and the GZ curves do not change."""
+    try:
+        return _kept_angles(scene)
+    except TypeError:                 # an unhashable scene: computed each time
+        return vanishing_angles(_setup0(scene).built.system)
+
+
+@functools.lru_cache(maxsize=8)
+def _kept_angles(scene: Scene):
     return vanishing_angles(_setup0(scene).built.system)
