@@ -9,7 +9,7 @@ import equinox as eqx
 
 from jaxslosh.build.system import build
 from jaxslosh.solve.integrator import State, step
-from jaxslosh.solve.schemes import make_scheme
+from jaxslosh.solve.schemes import Scheme, make_scheme
 from jaxslosh.solve.linear import make_solver
 from jaxslosh.physics.terms import Config
 
@@ -42,7 +42,7 @@ def measured_amplification(scheme, Om):
 def theory_amplification(sch, Om):
     """Chung & Hulbert (1993): (1-am) a1 + am a0 = -w^2 ((1-af) z1 + af z0) with Newmark's updates;
     written in the scaled state (z, h v, h^2 a)."""
-    am, af, beta, gamma = sch
+    am, af, beta, gamma = sch.alpha_m, sch.alpha_f, sch.beta, sch.gamma
     w2 = Om ** 2
     D = (1 - am) + w2 * (1 - af) * beta
     # a1 h^2 = (-w2 z0 - w2 (1-af) (h v0) - (am + w2 (1-af) (0.5 - beta)) h^2 a0) / D
@@ -112,6 +112,6 @@ def test_hht_with_alpha_001_never_amplifies():
 def test_literal_paper_parameters_amplify():
     """gamma = 1/2, beta = 1/4 with alpha = 0.01 (a literal reading of the paper) amplifies; this is
     why the loader refuses alpha != 0 with scheme = "newmark" (PHYSICS.md item 7)."""
-    sch = (0.0, 0.01, 0.25, 0.5)
+    sch = Scheme(0.0, 0.01, 0.25, 0.5)
     radii = [spectral_radius(theory_amplification(sch, Om)) for Om in np.logspace(-1, 3, 30)]
     assert max(radii) > 1.004

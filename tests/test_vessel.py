@@ -153,8 +153,7 @@ def test_paper_moment_is_the_restoring_moment_for_pure_roll_and_pitch():
 
 def test_conservative_moment_is_minus_gradient_of_potential_and_matches_paper_when_gm_equal():
     f = lambda x: jnp.asarray(x, dtype=float)  # noqa: E731
-    h = Hydro(rho_w=f(RHO), gravity=f(G), waterplane_area=f(AW), displaced_volume=f(V), gm_t=f(2.0), gm_l=f(2.0),
-              moment_form="conservative")
+    h = Hydro(rho_w=f(RHO), gravity=f(G), waterplane_area=f(AW), displaced_volume=f(V), gm_t=f(2.0), gm_l=f(2.0))
     for _, q in _random_states(5, seed=3):
         if rotation_matrix(q)[2, 2] < -0.5:
             continue    # far past capsize the potential's (1 + g_z) denominator is near zero

@@ -18,8 +18,8 @@ from ..physics.kinematics import quat_from_rpy, rotation_matrix
 from ..physics.liquid import RotationPenalty, SpinStiffening
 from ..physics.system import System
 from ..physics.terms import Config
-from ..physics.vessel import (FreeMotion, HarmonicMotion, Hydrostatics, RecordedMotion, RigidBody, SpinUpMotion,
-                              Weight, record_coefficients)
+from ..physics.vessel import (FreeMotion, HarmonicMotion, Hydrostatics, PaperHydrostatics, RecordedMotion, RigidBody,
+                              SpinUpMotion, Weight, record_coefficients)
 from ..programs import staged
 from ..scene.keys import resolve_params
 from ..scene.types import DOFS, Scene, SceneError
@@ -66,12 +66,12 @@ def build(scene: Scene, params: Optional[dict] = None) -> Built:
     elif ves.hydrostatics is not None and eff.buoyancy:
         h = ves.hydrostatics
         f = lambda k, v: jnp.asarray(P(k, v), dtype=float)  # noqa: E731
-        terms.append(Hydrostatics(
+        form = PaperHydrostatics if h.moment == "paper" else Hydrostatics
+        terms.append(form(
             rho_w=f("environment.water_density", env.water_density), gravity=g,
             waterplane_area=f("vessel.hydrostatics.waterplane_area", h.waterplane_area),
             displaced_volume=f("vessel.hydrostatics.displaced_volume", h.displaced_volume),
-            gm_t=f("vessel.hydrostatics.gm_t", h.gm_t), gm_l=f("vessel.hydrostatics.gm_l", h.gm_l),
-            moment_form=h.moment))
+            gm_t=f("vessel.hydrostatics.gm_t", h.gm_t), gm_l=f("vessel.hydrostatics.gm_l", h.gm_l)))
     multimodal = eff.liquid and multimodal_scene(scene)
     block = LiquidBlock(build_multimodal(scene, params, g)) if multimodal else \
         build_liquid_block(scene, params, g, include_liquid=eff.liquid)
