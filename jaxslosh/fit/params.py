@@ -9,14 +9,14 @@ import jax
 import jax.numpy as jnp
 import numpy as np
 
-from ..scene.keys import canonical_key, scene_values, traceable
+from ..scene.keys import SPRING_KEYS, canonical_key, scene_values, traceable
 from ..scene.types import Scene, SceneError
 
 
 # keys whose values are positive by nature: fitted in log by default
 POSITIVE = ("environment.gravity", "environment.water_density", "vessel.mass", "vessel.inertia",
             "vessel.hydrostatics.waterplane_area", "vessel.hydrostatics.displaced_volume",
-            "vessel.hydrostatics.gm_t", "vessel.hydrostatics.gm_l")
+            "vessel.hydrostatics.gm_t", "vessel.hydrostatics.gm_l", "vessel.hull.kg")
 
 
 class Param:
@@ -92,7 +92,36 @@ def fit_keys(scene: Scene, fit: Sequence[str]) -> tuple:
     fit = list(fit)
     if not fit:
         raise SceneError("fit", "give at least one key to fit")
-    return traceable(scene, fit)
+    keys = traceable(scene, fit)
+    h = scene.vessel.hydrostatics
+    if h is not None and h.nonlinear:
+        for given, key in zip(fit, keys):
+            if key in SPRING_KEYS:
+                raise SceneError(given, 'model = "nonlinear" takes its restoring from the hull, which this value '
+                                        "does not enter: fit vessel.hull.kg (the fit reports the implied GM0 = KM - KG)")
+    return keys
+
+
+# GM0 = KB + BM - KG of the hull at rest (the box's closed form, at the scene's draft): what a
+# fitted KG implies for the small-angle springs, reported beside it
+IMPLIED_BY_KG = ("vessel.hydrostatics.gm_t", "vessel.hydrostatics.gm_l")
+
+
+def implied_keys(keys) -> tuple:
+    """The scene values that follow from the fitted keys (the GM0s of a fitted KG): a record made
+    with another KG differs in them too, and the fit reports them."""
+    return IMPLIED_BY_KG if "vessel.hull.kg" in keys else ()
+
+
+def implied_values(scene: Scene, values: dict, errors: dict) -> tuple[dict, dict]:
+    """({key: value}, {key: standard error}) of the implied keys: GM0 = KM - KG with the hull's KM
+    (the scene's GM0 plus its KG) for a fitted KG, whose standard error it shares (dGM0/dKG = -1)."""
+    if "vessel.hull.kg" not in values:
+        return {}, {}
+    h, kg0 = scene.vessel.hydrostatics, scene.vessel.hull.kg
+    kg = values["vessel.hull.kg"]
+    out = {"vessel.hydrostatics.gm_t": h.gm_t + kg0 - kg, "vessel.hydrostatics.gm_l": h.gm_l + kg0 - kg}
+    return out, {k: errors["vessel.hull.kg"] for k in out}
 
 
 def make_params(scene: Scene, keys, x0, bounds) -> list:
