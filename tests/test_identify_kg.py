@@ -212,3 +212,69 @@ def test_cli_bad_keys_exit_2_naming_the_key(decay, tmp_path, capsys, change, key
     assert not out.exists()
     with pytest.raises(js.SceneError, match=named.replace(".", r"\.")):
         identify(js.load_scene(str(path)), data, [named])
+
+
+# ------------------------------------------------------------------------------------------------
+# the traced COG is the scene's COG: the hull's term, no run
+
+WAVES = """
+[waves]
+type = "regular"
+amplitude = 0.5
+period = 6.0
+heading = 1.0
+"""
+
+
+def _poses():
+    from jaxslosh.physics.kinematics import quat_from_rpy, rotation_matrix
+    import jax.numpy as jnp
+    for X0, rpy in (((0.0, 0.0, 0.0), (0.0, 0.0, 0.0)), ((0.3, -0.2, 0.4), (0.5, 0.2, 0.1)),
+                    ((0.0, 0.0, -0.3), (0.6, -0.1, 0.0))):
+        yield jnp.asarray(X0), rotation_matrix(quat_from_rpy(jnp.asarray(rpy)))
+
+
+def _same_term(a, b):
+    import jax
+    fm = jax.jit(lambda term, X0, A, t: term.force_moment(X0, A, t))
+    for X0, A in _poses():
+        for t in (0.0, 2.0):
+            Fa, Ma = fm(a, X0, A, t)
+            Fb, Mb = fm(b, X0, A, t)
+            np.testing.assert_allclose(np.asarray(Fb), np.asarray(Fa), rtol=1e-10, atol=1e-6)
+            np.testing.assert_allclose(np.asarray(Mb), np.asarray(Ma), rtol=1e-10, atol=1e-6)
+
+
+@pytest.mark.parametrize("waves", [False, True])
+def test_a_traced_kg_is_the_scene_with_that_kg(waves):
+    """The still-water and the wave pressure's force and moment at several poses."""
+    import jax.numpy as jnp
+    from jaxslosh.build.hull import build_hull_pressure
+    extra = WAVES if waves else ""
+    g = jnp.asarray(G)
+    a = build_hull_pressure(js.load_scene(barge(TRUE_KG) + extra), {}, g)
+    b = build_hull_pressure(js.load_scene(barge(SCENE_KG) + extra), {"vessel.hull.kg": jnp.asarray(TRUE_KG)}, g)
+    assert b.shift is not None and float(b.z_water) == pytest.approx(T - TRUE_KG)
+    _same_term(a, b)
+
+
+def test_a_mesh_hulls_traced_cog_is_the_scene_with_that_cog(tmp_path):
+    """`vessel.hull.cog` of a mesh hull (the box as a file, waterline at z = 0), moved up and to
+    port; the implied GM0 is the box's KM - KG."""
+    import jax.numpy as jnp
+    from jaxslosh.build.hull import build_hull_pressure
+    from jaxslosh.fit.params import implied_values
+    from jaxslosh.hull.box import box_hull
+    from jaxslosh.hull.surface import write_hull_mesh
+    path = tmp_path / "hull.obj"
+    write_hull_mesh(str(path), box_hull(L, B, T, D, 2))          # keel at z = -T: the file's waterline is z = 0
+    text = barge(SCENE_KG).replace("[vessel.hull]\nlength = 20.0\nbeam = 10.0\ndraft = 3.0\nkg = 3.5\ndepth = 6.0\n",
+                                   f'[vessel.hull]\ntype = "mesh"\nfile = "{path}"\ncog = [{{cog}}]\n')
+    cog = (0.0, 0.1, TRUE_KG - T)
+    a = build_hull_pressure(js.load_scene(text.format(cog="0.0, 0.1, 0.6")), {}, jnp.asarray(G))
+    scene = js.load_scene(text.format(cog="0.0, 0.0, 0.5"))
+    b = build_hull_pressure(scene, {"vessel.hull.cog": jnp.asarray(cog)}, jnp.asarray(G))
+    _same_term(a, b)
+    implied, se = implied_values(scene, {"vessel.hull.cog": [0.0, 0.0, 0.6]}, {"vessel.hull.cog": [1.0, 2.0, 3.0]})
+    assert implied["vessel.hydrostatics.gm_t"] == pytest.approx(KM - TRUE_KG, rel=1e-9)
+    assert se["vessel.hydrostatics.gm_t"] == 3.0

@@ -48,7 +48,8 @@ def build_hull_pressure(scene, params: dict, g) -> HullPressure:
 
     A traced `vessel.hull.kg` moves the COG against the hull: in the vessel frame (origin at the
     COG) the surface shifts by kg0 - kg along z and the still water plane, `draft` above the keel,
-    lies at draft - kg. The triangles stay the scene's (constants) and carry the shift as a vector
+    lies at draft - kg; a mesh's traced `vessel.hull.cog` shifts it by cog0 - cog, the water at
+    -cog_z (the file's z = 0). The triangles stay the scene's (constants) and carry the shift as a vector
     (HullPressure.shift), so the clipping's tangent stays the water plane's. The vessel's mass and
     inertia about the COG are the scene's (`vessel.mass`, `vessel.inertia`): KG moves the hull
     against them, not their distribution."""
@@ -63,6 +64,10 @@ def build_hull_pressure(scene, params: dict, g) -> HullPressure:
         kg = jnp.asarray(params["vessel.hull.kg"], dtype=float)
         z_water = jnp.asarray(hull.draft, dtype=float) - kg
         shift = jnp.stack([jnp.zeros_like(kg), jnp.zeros_like(kg), hull.kg - kg])
+    elif "vessel.hull.cog" in params:       # a mesh: its waterline is z = 0 of the file's coordinates
+        cog = jnp.asarray(params["vessel.hull.cog"], dtype=float)
+        z_water = -cog[2]
+        shift = jnp.asarray(hull.cog, dtype=float) - cog
     return HullPressure(jnp.asarray(tris), rho, g, z_water, inc, shift)
 
 

@@ -39,7 +39,8 @@ KG and GM0 with the nonlinear hydrostatics
     number. GM0 is then not a parameter of its own: the fit reports the implied GM0 = KM - KG of
     the hull at rest (`implied`), and fitting the springs' values (GM_T, GM_L, A_w, V), which the
     nonlinear model does not read, is refused naming the key. With the linear model KG cannot be
-    traced (the springs were derived from it when the scene was loaded): fit GM_T there.
+    traced (the springs were derived from it when the scene was loaded): fit GM_T there. A mesh
+    hull's analogue is `vessel.hull.cog` (the COG in the file's coordinates).
 
 Methods (`method=`)
     "gauss-newton": Levenberg-Marquardt damped Gauss-Newton. J = d r / d theta by forward mode

@@ -111,7 +111,8 @@ KEYS = (
                                               "hydrostatics only (`identify --fit vessel.hull.kg`)."),
     ("vessel.hull.file", "required (mesh)", "", "The hull mesh (any format meshio or Capytaine reads; triangles "
                                                "and quads), relative to the scene, waterline at z = 0."),
-    ("vessel.hull.cog", "[0, 0, 0]", "m", "The COG in the mesh's coordinates."),
+    ("vessel.hull.cog", "[0, 0, 0]", "m", "The COG in the mesh's coordinates. Traced by the nonlinear "
+                                          "hydrostatics only (`identify --fit vessel.hull.cog`)."),
     ("vessel.hull.depth", "required (box, nonlinear or stability)", "m", "Box hull: keel to deck, above the "
                                                                           "draft (large angles immerse the deck edge)."),
     ("vessel.hydrodynamics.frequencies", "none", "rad/s", "Ascending, at least 4: the tables below are per "

@@ -58,12 +58,12 @@ TRACEABLE = _Keys((
     "vessel.hydrostatics.waterplane_area", "vessel.hydrostatics.displaced_volume",
     "vessel.hydrostatics.gm_t", "vessel.hydrostatics.gm_l",
     "vessel.initial.position", "vessel.initial.velocity", "vessel.initial.angular_velocity",
-    "vessel.initial.roll_pitch_yaw", "vessel.hull.kg",
+    "vessel.initial.roll_pitch_yaw", "vessel.hull.kg", "vessel.hull.cog",
 ) + tuple(f"tanks.<name>.{k}" for k in TANK_TRACEABLE) + ("waves.amplitude", "waves.hs"))
 
 # keys traced by the nonlinear hydrostatics alone (build/hull.py moves the hull's surface against the
 # COG); the linear model's GM springs were derived from them when the scene was loaded
-HULL_TRACEABLE = ("vessel.hull.kg",)
+HULL_TRACEABLE = ("vessel.hull.kg", "vessel.hull.cog")
 # keys the nonlinear hydrostatics does not read (the restoring is the hull's): tracing them would
 # change nothing
 SPRING_KEYS = ("vessel.hydrostatics.waterplane_area", "vessel.hydrostatics.displaced_volume",
@@ -92,8 +92,11 @@ def scene_values(scene: Scene) -> dict[str, Any]:
             v[f"vessel.hydrostatics.{key}"] = getattr(ves.hydrostatics, key)
     for key in ("position", "velocity", "angular_velocity", "roll_pitch_yaw"):
         v[f"vessel.initial.{key}"] = getattr(ves.initial, key)
-    if ves.hull is not None and ves.hull.type == "box":
-        v["vessel.hull.kg"] = ves.hull.kg
+    if ves.hull is not None:      # the COG against the hull: a box's KG, a mesh's COG in its file's coordinates
+        if ves.hull.type == "box":
+            v["vessel.hull.kg"] = ves.hull.kg
+        else:
+            v["vessel.hull.cog"] = ves.hull.cog
     f = ves.forced
     if f is not None and f.profile != "record":   # a record's samples are its file's, not values of the scene
         own = ("amplitude", "frequency", "phase", "ramp") if f.profile == "harmonic" else ("rate", "duration")
