@@ -44,14 +44,31 @@ def incident_waves(scene, params: dict) -> IncidentWaves:
 
 
 def build_hull_pressure(scene, params: dict, g) -> HullPressure:
-    """The term: still water, and the incident waves where the scene has them and `[effects] waves` is on."""
+    """The term: still water, and the incident waves where the scene has them and `[effects] waves` is on.
+
+    A traced `vessel.hull.kg` moves the COG against the hull: in the vessel frame (origin at the
+    COG) the surface shifts by kg0 - kg along z and the still water plane, `draft` above the keel,
+    lies at draft - kg; a mesh's traced `vessel.hull.cog` shifts it by cog0 - cog, the water at
+    -cog_z (the file's z = 0). The triangles stay the scene's (constants) and carry the shift as a vector
+    (HullPressure.shift), so the clipping's tangent stays the water plane's. The vessel's mass and
+    inertia about the COG are the scene's (`vessel.mass`, `vessel.inertia`): KG moves the hull
+    against them, not their distribution."""
     hull, env = scene.vessel.hull, scene.environment
     waves = scene.waves if scene.waves is not None and scene.effects.waves else None
     divisions = box_divisions(hull, waves) if hull.type == "box" else (1, 1, 1)
     tris = hull_triangles(hull, divisions)
     rho = jnp.asarray(params.get("environment.water_density", env.water_density), dtype=float)
     inc: Optional[IncidentWaves] = incident_waves(scene, params) if waves is not None else None
-    return HullPressure(jnp.asarray(tris), rho, g, jnp.asarray(water_height(hull), dtype=float), inc)
+    z_water, shift = jnp.asarray(water_height(hull), dtype=float), None
+    if "vessel.hull.kg" in params:
+        kg = jnp.asarray(params["vessel.hull.kg"], dtype=float)
+        z_water = jnp.asarray(hull.draft, dtype=float) - kg
+        shift = jnp.stack([jnp.zeros_like(kg), jnp.zeros_like(kg), hull.kg - kg])
+    elif "vessel.hull.cog" in params:       # a mesh: its waterline is z = 0 of the file's coordinates
+        cog = jnp.asarray(params["vessel.hull.cog"], dtype=float)
+        z_water = -cog[2]
+        shift = jnp.asarray(hull.cog, dtype=float) - cog
+    return HullPressure(jnp.asarray(tris), rho, g, z_water, inc, shift)
 
 
 def froude_krylov_surface(tris, z_water, omega, headings, rho=1025.0, g=9.81, depth=None):
