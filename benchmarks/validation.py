@@ -17,7 +17,7 @@ from scipy.integrate import solve_ivp  # noqa: E402
 
 import jaxslosh as js  # noqa: E402
 from jaxslosh.fem.modes import effective_roll_inertia  # noqa: E402
-from jaxslosh.build.system import build  # noqa: E402
+from jaxslosh.assemble.system import build  # noqa: E402
 from jaxslosh.physics.kinematics import rotation_matrix  # noqa: E402
 from jaxslosh.fem.liquid import build_liquid  # noqa: E402
 from jaxslosh.fem.modes import analytic_sloshing_omegas, liquid_modes  # noqa: E402

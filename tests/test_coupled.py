@@ -3,7 +3,7 @@ import numpy as np
 import pytest
 
 import jaxslosh as js
-from jaxslosh.build.system import build
+from jaxslosh.assemble.system import build
 from jaxslosh.physics.kinematics import rotation_matrix
 
 from helpers import zero_crossing_period

@@ -7,9 +7,9 @@ import numpy as np
 import pytest
 
 import jaxslosh as js
-from jaxslosh.build.damping import build_damping
-from jaxslosh.build.liquid import build_liquid_block
-from jaxslosh.build.system import build
+from jaxslosh.assemble.damping import build_damping
+from jaxslosh.assemble.liquid import build_liquid_block
+from jaxslosh.assemble.system import build
 from jaxslosh.cli.main import main
 from jaxslosh.fem.damping import rectangular_ratio
 from jaxslosh.fit.identify import identify

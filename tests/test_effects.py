@@ -3,7 +3,7 @@ import jax
 import numpy as np
 
 import jaxslosh as js
-from jaxslosh.build.system import build
+from jaxslosh.assemble.system import build
 from jaxslosh.cli import main
 from jaxslosh.solve.integrator import initial_state, step
 from jaxslosh.solve.schemes import make_scheme

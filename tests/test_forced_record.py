@@ -111,7 +111,7 @@ def test_the_body_angular_velocity_of_recorded_angles():
 
 
 def test_a_phase_without_ramp_starts_the_motion_where_the_law_is(tmp_path):
-    from jaxslosh.build.system import build
+    from jaxslosh.assemble.system import build
     b = build(js.load_scene(_scene(tmp_path, f'dof = "surge"\namplitude = {A}\nfrequency = {W}\nphase = {PHASE}')))
     assert abs(float(b.c0.X0[0]) - A * np.sin(PHASE)) < 1e-15
     assert abs(float(b.v0[0]) - A * W * np.cos(PHASE)) < 1e-15

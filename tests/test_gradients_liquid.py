@@ -8,7 +8,7 @@ import pytest
 
 import jaxslosh as js
 from jaxslosh.scene.keys import TRACEABLE
-from jaxslosh.build.system import build
+from jaxslosh.assemble.system import build
 from jaxslosh.solve.schemes import make_scheme
 from jaxslosh.solve.linear import make_solver
 from jaxslosh.fem.liquid import build_liquid

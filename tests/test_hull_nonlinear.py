@@ -10,8 +10,8 @@ import pytest
 from scipy.integrate import solve_ivp
 
 import jaxslosh as js
-from jaxslosh.build.hull import build_hull_pressure, froude_krylov_surface
-from jaxslosh.build.system import build
+from jaxslosh.assemble.hull import build_hull_pressure, froude_krylov_surface
+from jaxslosh.assemble.system import build
 from jaxslosh.hull.box import box_hull
 from jaxslosh.hull.surface import write_hull_mesh
 from jaxslosh.hydro.box import froude_krylov_box
@@ -360,7 +360,7 @@ def _peaks(t, roll, lo, hi):
 def _linear_twin(scene):
     """The same hull and waves in the linear model: GM springs of the hull at rest, the linear
     Froude-Krylov force of its wetted surface at rest as excitation tables, the same damping."""
-    from jaxslosh.build.hull import froude_krylov_hull
+    from jaxslosh.assemble.hull import froude_krylov_hull
     h, w = scene.vessel.hydrostatics, scene.waves
     freqs = [w.omega - 0.2, w.omega - 0.1, w.omega, w.omega + 0.1]
     X = froude_krylov_hull(scene, np.array(freqs))

@@ -249,7 +249,7 @@ def _same_term(a, b):
 def test_a_traced_kg_is_the_scene_with_that_kg(waves):
     """The still-water and the wave pressure's force and moment at several poses."""
     import jax.numpy as jnp
-    from jaxslosh.build.hull import build_hull_pressure
+    from jaxslosh.assemble.hull import build_hull_pressure
     extra = WAVES if waves else ""
     g = jnp.asarray(G)
     a = build_hull_pressure(js.load_scene(barge(TRUE_KG) + extra), {}, g)
@@ -262,7 +262,7 @@ def test_a_mesh_hulls_traced_cog_is_the_scene_with_that_cog(tmp_path):
     """`vessel.hull.cog` of a mesh hull (the box as a file, waterline at z = 0), moved up and to
     port; the implied GM0 is the box's KM - KG."""
     import jax.numpy as jnp
-    from jaxslosh.build.hull import build_hull_pressure
+    from jaxslosh.assemble.hull import build_hull_pressure
     from jaxslosh.fit.params import implied_values
     from jaxslosh.hull.box import box_hull
     from jaxslosh.hull.surface import write_hull_mesh

@@ -7,7 +7,7 @@ import pytest
 
 import equinox as eqx
 
-from jaxslosh.build.system import build
+from jaxslosh.assemble.system import build
 from jaxslosh.solve.integrator import State, step
 from jaxslosh.solve.schemes import Scheme, make_scheme
 from jaxslosh.solve.linear import make_solver

@@ -18,7 +18,7 @@ LAYERS = [
     {"fem"},
     {"physics"},
     {"solve"},
-    {"build"},
+    {"assemble"},
     {"run"},
     {"analysis", "campaign", "fit"},
     {"plot"},

@@ -5,7 +5,7 @@ import jax.numpy as jnp
 import numpy as np
 import pytest
 
-from jaxslosh.build.system import build
+from jaxslosh.assemble.system import build
 from jaxslosh.physics.kinematics import quat_exp, quat_from_rpy, quat_multiply
 from jaxslosh.physics.terms import Config
 

@@ -9,7 +9,7 @@ import numpy as np
 
 import jaxslosh as js
 from jaxslosh.physics import structures as mb
-from jaxslosh.build.system import build
+from jaxslosh.assemble.system import build
 
 from helpers import MULTIBODY_TANK as TANK, mast, multibody_vessel as vessel, zero_crossing_period
 

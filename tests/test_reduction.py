@@ -11,7 +11,7 @@ import pytest
 import scipy.linalg
 
 import jaxslosh as js
-from jaxslosh.build.system import build
+from jaxslosh.assemble.system import build
 from jaxslosh.physics.kinematics import quat_exp
 from jaxslosh.fem.liquid import build_liquid
 from jaxslosh.physics.terms import Config

@@ -7,7 +7,7 @@ import pytest
 
 from jaxslosh.scene.types import ELEMENT_FORMS
 from jaxslosh.scene.keys import canonical_key, check_param_keys, scene_values
-from jaxslosh.build.effects import describe
+from jaxslosh.assemble.effects import describe
 from jaxslosh.scene.load import load_scene, parse_scene
 from jaxslosh.scene.types import SceneError
 

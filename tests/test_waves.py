@@ -11,7 +11,7 @@ import numpy as np
 import pytest
 
 import jaxslosh as js
-from jaxslosh.build.system import build
+from jaxslosh.assemble.system import build
 from jaxslosh.cli import main
 from jaxslosh.hydro.radiation import linear_response, restoring_matrix, rigid_mass_matrix
 from jaxslosh.hydro.source import radiation_fit

@@ -25,7 +25,7 @@ crest's share by the factor 1 / f(0) - 1 of the dynamic part that Wheeler remove
 first order. Each hull triangle is cut by the plane tangent to eta at its centroid: the wetted
 pieces then follow the wave without centroid switching, with an error of the order of the
 triangle's size squared times the surface curvature (k a / panel^2), so panels must be small
-against the wave length (build/hull.py divides the box accordingly).
+against the wave length (assemble/hull.py divides the box accordingly).
 """
 from __future__ import annotations
 
@@ -97,7 +97,7 @@ class HullPressure(AbstractTerm):
     gravity: jax.Array
     z_water: jax.Array                      # inertial height of the still water plane
     waves: Optional[IncidentWaves] = None
-    # (3,) body frame: the surface is tris + shift (a traced KG: build/hull.py); None: tris itself
+    # (3,) body frame: the surface is tris + shift (a traced KG: assemble/hull.py); None: tris itself
     shift: Optional[jax.Array] = None
 
     def surface(self):

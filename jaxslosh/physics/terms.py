@@ -1,7 +1,7 @@
 """The one interface of the physics: a term of the virtual work (eq. 26) and what every term reads.
 
 A System (system.py) is the sum of its terms: each is an equinox module, abstract or final (STYLE.md),
-built once from the scene with only what the scene has (build/), and evaluated inside the jitted
+built once from the scene with only what the scene has (assemble/), and evaluated inside the jitted
 step. A term gives
 
 * `rows(k)`: its share of the residual, inertia minus applied forces, for the unknown accelerations

@@ -61,7 +61,7 @@ TRACEABLE = _Keys((
     "vessel.initial.roll_pitch_yaw", "vessel.hull.kg", "vessel.hull.cog",
 ) + tuple(f"tanks.<name>.{k}" for k in TANK_TRACEABLE) + ("waves.amplitude", "waves.hs"))
 
-# keys traced by the nonlinear hydrostatics alone (build/hull.py moves the hull's surface against the
+# keys traced by the nonlinear hydrostatics alone (assemble/hull.py moves the hull's surface against the
 # COG); the linear model's GM springs were derived from them when the scene was loaded
 HULL_TRACEABLE = ("vessel.hull.kg", "vessel.hull.cog")
 # keys the nonlinear hydrostatics does not read (the restoring is the hull's): tracing them would

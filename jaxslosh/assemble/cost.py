@@ -1,7 +1,7 @@
 """What a scene will cost before anything is built: unknowns, memory, steps; and the refusal of a
 scene this machine cannot hold.
 
-The memory is an estimate of the largest phase, tank by tank, as build/ assembles them: the element
+The memory is an estimate of the largest phase, tank by tank, as assemble/ assembles them: the element
 arrays of the assembly, then the solver's blocks (dense inverses below `SPARSE_AUTO` unknowns; above
 it the sparse matrices and the fast-diagonalization blocks, the JAX factors of shaped tanks, or the
 sparse factor that the modal basis of a reduced tank needs), plus the result's frames. It is meant to tell 1 GB from 1 TB, not

@@ -1,6 +1,6 @@
 """The stacked liquid block of a scene's tanks (physics/system.py `Liquid`), from their finite-element
 models (fem/liquid.py): dense, sparse (large meshes, solve/sparse.py), reduced to modes
-(build/reduced.py), or extended by elastic walls and structures in the vessel's frame."""
+(assemble/reduced.py), or extended by elastic walls and structures in the vessel's frame."""
 from __future__ import annotations
 
 from typing import NamedTuple, Optional

@@ -61,7 +61,7 @@ def build(scene: Scene, params: Optional[dict] = None) -> Built:
     g = jnp.asarray(P("environment.gravity", env.gravity), dtype=float)
     terms = []
     nonlinear = ves.hydrostatics is not None and ves.hydrostatics.nonlinear and eff.buoyancy
-    if nonlinear:              # the hull's wetted surface (build/hull.py); the weight below
+    if nonlinear:              # the hull's wetted surface (assemble/hull.py); the weight below
         terms.append(build_hull_pressure(scene, params, g))
     elif ves.hydrostatics is not None and eff.buoyancy:
         h = ves.hydrostatics

@@ -1,6 +1,6 @@
 """The liquid's modal damping of a scene (`[tanks.damping]`, physics/damping.py) from its tanks'
 sloshing modes (fem/damping.py): full order on the stacked free dofs, or on the modal basis of a
-reduced liquid (build/reduced.py).
+reduced liquid (assemble/reduced.py).
 
 The modes come from the scene's values (as a reduced basis does): a traced fill depth or density
 leaves them as they are, and a traced `tanks.<name>.damping.ratio` scales the damping of each.
@@ -32,7 +32,7 @@ class TankDamping(NamedTuple):
 
 def build_damping(scene: Scene, params: Optional[dict], block) -> tuple[Optional[ModalDamping], tuple]:
     """(ModalDamping or None, TankDamping per damped tank) for the liquid block `block`
-    (build/liquid.py LiquidBlock); None where no tank has a `[tanks.damping]` table."""
+    (assemble/liquid.py LiquidBlock); None where no tank has a `[tanks.damping]` table."""
     tanks = scene.tanks
     if not any(t.damping is not None for t in tanks) or not block.liquid.nf or not block.tanks:
         return None, ()
