@@ -107,7 +107,7 @@ def inertia():
 
 
 def waves():
-    """The rows of tests/test_waves.py: the regular-wave RAO and the Cummins memory, Capytaine's box."""
+    """The rows of tests/hydro/test_waves.py: the regular-wave RAO and the Cummins memory, Capytaine's box."""
     import test_waves as tw
     from jaxslosh.hydro.capytaine import capytaine_hydrostatics
     from jaxslosh.scene.types import Hull

@@ -15,7 +15,7 @@ A term's rows are written out. Where the term has a potential, a test checks its
 the potential's gradient along the step's increments (`potential_rows`, by JAX): a gradient inside
 the residual would be linearised and transposed again in every Newton preconditioner, which
 lengthens compilation; the liquid's rows must also stay linear and sparse for large meshes
-(tests/test_model.py checks them against the gradient and the Hessian of its energies).
+(tests/physics/test_model.py checks them against the gradient and the Hessian of its energies).
 """
 from __future__ import annotations
 

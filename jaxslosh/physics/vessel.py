@@ -97,7 +97,7 @@ class Hydrostatics(AbstractTerm):
         derivative of the potential along body-frame rotations, written out (a JAX gradient inside
         the residual would be linearised and transposed again in every Newton preconditioner):
         with g = A^T e_z, a body rotation d theta changes g by g x d theta, so M = g x dV/dg.
-        tests/test_vessel.py checks it against the gradient of `restoring_potential`."""
+        tests/physics/test_vessel.py checks it against the gradient of `restoring_potential`."""
         k = self.rho_w * self.gravity * self.displaced_volume
         g = rotation_matrix(q)[2]
         D = 1.0 + g[2]

@@ -1,5 +1,5 @@
 """What every scene key means: its default, unit and meaning, for the scene reference of the
-documentation (docs/hooks.py writes the page from these rows; tests/test_docs.py holds them to the
+documentation (docs/hooks.py writes the page from these rows; tests/docs/test_docs.py holds them to the
 keys the loader accepts).
 
 A key is written as the scene file writes it, without indices: `tanks.fluid.density` is the

@@ -23,7 +23,7 @@ from jaxslosh.fem.modes import analytic_sloshing_table, liquid_modes
 from helpers import zero_crossing_period
 from test_coupled import ship_with_tank
 
-ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 G = 9.81
 N_STEPS = 2000              # every paper-scene run below: one compilation per scheme
 MESH = (3, 3, 2)            # coarse version of the paper's 5 x 5 x 5 liquid mesh

@@ -5,7 +5,7 @@ import os
 
 import pytest
 
-ROOT = os.path.join(os.path.dirname(os.path.dirname(os.path.abspath(__file__))), "jaxslosh")
+ROOT = os.path.join(os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__)))), "jaxslosh")
 
 # lowest first; a module may import its own package and the packages on earlier lines
 LAYERS = [

@@ -16,7 +16,7 @@ from jaxslosh.physics.kinematics import rotation_matrix
 meshio = pytest.importorskip("meshio")
 from meshio.xdmf import TimeSeriesReader  # noqa: E402
 
-ROOT = Path(__file__).resolve().parents[1]
+ROOT = Path(__file__).resolve().parents[2]
 
 
 @pytest.fixture(scope="module")

@@ -18,7 +18,7 @@ from jaxslosh.fem.shapes import TankGeometry, tank_mesh
 
 meshio = pytest.importorskip("meshio")
 
-ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 FLIP = [0, 3, 2, 1, 4, 7, 6, 5]
 
 

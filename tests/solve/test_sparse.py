@@ -12,7 +12,7 @@ import jaxslosh as js
 from jaxslosh.solve.boxsolve import box_inverse, elements, stencil
 from jaxslosh.fem.liquid import build_liquid, surface_bending_scale
 
-ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 C_A = 1.0 / (0.25 * 1.01 ** 2 * 0.01 ** 2)        # the paper scene's step: HHT alpha 0.01, dt 0.01
 
 

@@ -17,7 +17,7 @@ from jaxslosh.fem.liquid import build_liquid
 from jaxslosh.physics.terms import Config
 from jaxslosh.fem.modes import liquid_modes
 
-ROOT = Path(__file__).resolve().parents[1]
+ROOT = Path(__file__).resolve().parents[2]
 PAPER = (ROOT / "scenes" / "paper_ship_tank.toml").read_text()
 
 

@@ -13,10 +13,10 @@ from jaxslosh.fem.liquid import build_liquid
 from jaxslosh.fem.modes import free_matrices, liquid_modes
 from jaxslosh.fem.shapes import Baffle, TankGeometry
 
-sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+sys.path.insert(0, os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 import sloshing_reference as ref  # noqa: E402
 
-ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 G = 9.81
 
 

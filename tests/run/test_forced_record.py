@@ -22,7 +22,7 @@ from jaxslosh.physics.vessel import RecordedMotion, record_coefficients
 from jaxslosh.scene.keys import KEY_DOCS, scene_values, with_overrides
 from jaxslosh.scene.types import DOFS, SceneError
 
-ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 A, W, RAMP, PHASE = 0.02, 2.4, 1.5, 0.3
 
 

@@ -20,7 +20,7 @@ from jaxslosh.fem.liquid import build_liquid
 from jaxslosh.fem.shapes import TankGeometry
 from jaxslosh.solve.factored import Banded, Dense, factored_inverse
 
-ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 C_A = 1.0 / (0.25 * 1.01 ** 2 * 0.01 ** 2)        # the paper scene's step: HHT alpha 0.01, dt 0.01
 CHAMFERS = 'shape = "prismatic"\nchamfers = [[1.5, 1.0], [1.0, 0.8]]'
 
@@ -76,7 +76,7 @@ def _scene_text(solver, duration="0.15", extra=""):
 def test_a_prismatic_tank_moves_as_with_the_host_lu():
     """The same scene through the JAX factors and SciPy's SuperLU on the host (the path before): the
     Newton iterations see the same preconditioner to round-off, so the motion is the same to
-    round-off. (Against the dense inverses: tests/test_shapes.py, a cylinder.)"""
+    round-off. (Against the dense inverses: tests/fem/test_shapes.py, a cylinder.)"""
     runs = {s: js.simulate(js.load_scene(_scene_text(s))) for s in ("sparse", "sparse-host")}
     jx, host = runs["sparse"], runs["sparse-host"]
     assert jx.status == host.status == "ok"

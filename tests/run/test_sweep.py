@@ -10,7 +10,7 @@ from jaxslosh.cli import main
 
 from helpers import vessel_scene
 
-ROOT = Path(__file__).resolve().parents[1]
+ROOT = Path(__file__).resolve().parents[2]
 
 
 def test_batch_equals_single_runs():
@@ -80,7 +80,7 @@ print(len(q.sharding.device_set), st == ["ok"] * 4)
 np.save(%r, np.asarray(q))
 """ % str(tmp_path / "q.npy")
     env = dict(os.environ, XLA_FLAGS="--xla_force_host_platform_device_count=2", JAX_PLATFORMS="cpu",
-               PYTHONPATH=os.path.dirname(os.path.abspath(__file__)))
+               PYTHONPATH=os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, env=env, timeout=600)
     assert out.returncode == 0, out.stderr[-2000:]
     assert out.stdout.split()[-2:] == ["2", "True"]

@@ -15,7 +15,7 @@ from jaxslosh.fit.quality import data_scene_mismatch
 
 from helpers import run_notebook, vessel_scene
 
-ROOT = Path(__file__).resolve().parents[1]
+ROOT = Path(__file__).resolve().parents[2]
 GM = ["vessel.hydrostatics.gm_t", "vessel.hydrostatics.gm_l"]
 
 DECAY = dict(duration=10.0, omega=(0.1, 0.05, 0.0))   # 10 s of free roll and pitch decay

@@ -12,7 +12,7 @@ from jaxslosh.scene.types import Fluid, Material, Tank, Walls
 from jaxslosh.fem.walls import build_walls
 from jaxslosh.fem.walls import build_tank_with_walls, tank_modes
 
-ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 SIZE, FILL, MESH = (5.0, 5.0, 4.0), 3.0, (5, 5, 5)
 
 

@@ -15,7 +15,7 @@ from jaxslosh.hydro.tables import interpolate_radiation, scene_tables
 
 from helpers import vessel_scene
 
-ROOT = Path(__file__).resolve().parents[1]
+ROOT = Path(__file__).resolve().parents[2]
 
 
 def spectrum_peak(t, x, lo, hi):
@@ -80,7 +80,7 @@ def test_radiation_at_the_modes_own_frequency():
     """The test box with its Capytaine tables: each mode is a fixed point, its frequency the root of
     the 6-dof determinant with A(w), B(w) at that same frequency (the residual's A_inf alone puts
     the roll elsewhere); heave, the most damped, about 10 % of critical."""
-    data = Path(__file__).resolve().parent / "data"
+    data = Path(__file__).resolve().parents[1] / "data"
     text = (data / "box_20x10x2_hydro.toml").read_text()
     text = text[text.index("[vessel.hydrostatics]"):]
     scene = js.load_scene('title = "box"\n[environment]\ngravity = 9.81\nwater_density = 1025.0\n'

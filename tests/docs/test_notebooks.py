@@ -1,5 +1,5 @@
 """Every notebook runs clean, at a small size (JAXSLOSH_NOTEBOOK_SMALL=1).
-(notebooks/identify_metacentric_heights.ipynb runs in tests/test_identify.py.)"""
+(notebooks/identify_metacentric_heights.ipynb runs in tests/fit/test_identify.py.)"""
 import re
 from pathlib import Path
 
@@ -7,7 +7,7 @@ import pytest
 
 from helpers import printed, run_notebook
 
-ROOT = Path(__file__).resolve().parents[1]
+ROOT = Path(__file__).resolve().parents[2]
 
 
 def test_quickstart_notebook_runs():

@@ -23,7 +23,7 @@ from jaxslosh.hydro.spectra import spectrum
 from jaxslosh.io.campaign import load_campaign
 from jaxslosh.io.output import OutputLock
 
-ROOT = Path(__file__).resolve().parents[1]
+ROOT = Path(__file__).resolve().parents[2]
 BEAM = 1.5707963267948966
 
 SCENE = """

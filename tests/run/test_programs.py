@@ -178,7 +178,7 @@ def test_an_executable_read_back_runs_and_one_from_xla_cache_is_not_kept(tmp_pat
         np.testing.assert_allclose(s["x"], want, rtol=1e-14)
 
 
-SCENES = os.path.join(os.path.dirname(os.path.dirname(os.path.abspath(__file__))), "scenes")
+SCENES = os.path.join(os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__)))), "scenes")
 
 
 @pytest.mark.parametrize("name, extra", [

@@ -26,8 +26,8 @@ from jaxslosh.physics.system import advance_config
 
 from helpers import mast, multibody_vessel
 
-ROOT = Path(__file__).resolve().parents[1]
-DATA = Path(__file__).resolve().parent / "data"
+ROOT = Path(__file__).resolve().parents[2]
+DATA = Path(__file__).resolve().parents[1] / "data"
 RHO, G = 1025.0, 9.81
 L, B, T, KG = 20.0, 10.0, 2.0, 2.5
 MASS, INERTIA = 4.1e5, (6.0e6, 1.6e7, 2.0e7)
@@ -137,7 +137,7 @@ def paper():
 def test_linearisation_is_the_hessian_of_the_energies(paper):
     """At rest the mass matrix is the Hessian of the kinetic energy in the velocities and the
     stiffness the Hessian of the potential along the step's increments (rotations on the group):
-    the residual is Lagrangian (tests/test_model.py), so its linearisation is symmetric too."""
+    the residual is Lagrangian (tests/physics/test_model.py), so its linearisation is symmetric too."""
     scene, lin = paper
     sysm, c0 = lin.built.system, lin.built.c0
     n = lin.n

@@ -18,7 +18,7 @@ from jaxslosh.fem.liquid_rt import build_face_liquid, face_modes
 from jaxslosh.fem.modes import analytic_sloshing_omegas
 from jaxslosh.fem.shapes import Baffle, TankGeometry, tank_mesh
 
-sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+sys.path.insert(0, os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 import sloshing_reference as ref  # noqa: E402
 from section_meshes import hopper_baffle_hex, u_tube_hex  # noqa: E402
 
@@ -235,7 +235,7 @@ def test_rotation_penalty_blocks():
     np.testing.assert_allclose(inv["S0"] / inv["mass"], [3.5, 4.5, 2.0], rtol=1e-12)
 
 
-PAPER = os.path.join(os.path.dirname(os.path.dirname(os.path.abspath(__file__))), "scenes", "paper_ship_tank.toml")
+PAPER = os.path.join(os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__)))), "scenes", "paper_ship_tank.toml")
 
 
 def _paper(element_lines):

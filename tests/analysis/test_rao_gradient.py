@@ -2,7 +2,7 @@
 derivative of the response with respect to traceable scene keys (the linearisation's matrices
 stay JAX values), equal to central finite differences of the concrete RAOs, and its value equals
 the concrete one. (The anti-roll tank's fill depth and damping ratio: notebooks/anti_roll_tank.ipynb,
-run by tests/test_notebooks.py.)"""
+run by tests/docs/test_notebooks.py.)"""
 import jax
 import jax.numpy as jnp
 import numpy as np

@@ -16,7 +16,7 @@ from jaxslosh.scene import fields, load
 from jaxslosh.scene.keydocs import KEYS, TABLES
 from jaxslosh.scene.types import SceneError
 
-ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 
 
 def _hooks():

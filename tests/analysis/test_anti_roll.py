@@ -6,7 +6,7 @@ Frozen: the same scene with `[effects] liquid = false`, which drops the liquid a
 mass and its inertia about the COG are added to the vessel's (params), as notebooks/waves.ipynb
 does. Steady amplitudes: a least-squares fit of cos, sin and a constant at the wave frequency over
 the last PERIODS wave periods; the PERIODS before them must give the same amplitude (the transient
-is gone). `pytest tests/test_anti_roll.py -s` prints the amplitudes and their ratio."""
+is gone). `pytest tests/analysis/test_anti_roll.py -s` prints the amplitudes and their ratio."""
 import time
 from pathlib import Path
 
@@ -14,7 +14,7 @@ import numpy as np
 
 import jaxslosh as js
 
-ROOT = Path(__file__).resolve().parents[1]
+ROOT = Path(__file__).resolve().parents[2]
 SCENE = ROOT / "scenes" / "anti_roll_tank.toml"
 PERIODS = 5
 

@@ -22,7 +22,7 @@ from jaxslosh.solve.linear import make_solver
 from jaxslosh.hydro.box import box_hydrostatics, froude_krylov_box
 from jaxslosh.hydro.spectra import components, elevation, jonswap, wavenumber
 
-DATA = Path(__file__).resolve().parent / "data"
+DATA = Path(__file__).resolve().parents[1] / "data"
 RHO, G = 1025.0, 9.81
 L, B, T, KG = 20.0, 10.0, 2.0, 2.5
 MASS, INERTIA = 4.1e5, (6.0e6, 1.6e7, 2.0e7)

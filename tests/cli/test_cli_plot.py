@@ -26,7 +26,7 @@ from helpers import VESSEL
 from test_plot import hand_result
 
 GOOD = VESSEL.format(duration=1.0, dt=0.01, scheme="hht", alpha=0.01, omega=[0.02, 0.01, 0.0], position=[0, 0, 0])
-ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 
 
 def _one_line_error(capsys, *needles):
