@@ -7,7 +7,7 @@ The scene is benchmarks/campaign.py's (scenes/paper_ship_waves.toml: the paper s
 modes, Froude-Krylov forces on its box, a yaw damping), its cases that benchmark's scatter x 5
 headings x 2 seeds. In one process, compilation excluded from both (each is called once first):
 
-* the plain run: the compiled loop of `js.simulate` (run/compiled.compile_run) of the first case,
+* the plain run: the compiled loop of `js.simulate` (cache/compiled.compile_run) of the first case,
   stepping alone (the initial state and the result's assembly left out);
 * a campaign batch: `campaign.worker.run_batch` of `--batch` cases as a Dask worker runs it (the
   cases' scenes, their seas drawn on the host, the vmapped loop, the result, the statistics),
@@ -47,7 +47,7 @@ from jaxslosh.campaign import worker  # noqa: E402
 from jaxslosh.campaign.cases import case_scene, case_values, make_cases, read_scatter, sea_arrays  # noqa: E402
 from jaxslosh.campaign.stats import case_statistics, channels  # noqa: E402
 from jaxslosh.run.batch import _batch_fn, _batch_result, _setup0  # noqa: E402
-from jaxslosh.run.compiled import compile_run  # noqa: E402
+from jaxslosh.cache.compiled import compile_run  # noqa: E402
 from jaxslosh.run.loop import core  # noqa: E402
 from jaxslosh.run.simulate import prepare  # noqa: E402
 

@@ -5,8 +5,8 @@ caches) and a second process (the caches the first filled), tracing and XLA apar
 
 Each measurement is one fresh Python process that does what `jaxslosh run` does up to the end of
 its first chunk: import, build the model (`build`; a second process reads the model the first kept),
-compile `start` and the chunk (run/compiled.compile_run: JAX's persistent compilation cache and the
-exported programs, programs.py, in a temporary folder; `start` compiles while the chunk traces) and
+compile `start` and the chunk (cache/compiled.compile_run: JAX's persistent compilation cache and the
+exported programs, cache/programs.py, in a temporary folder; `start` compiles while the chunk traces) and
 run `start` (`compile`), then the first chunk. `1st step` is the process's time to its first
 step (import + build + compile). JAX's compilation events are summed by kind (jax.monitoring):
 tracing (jaxpr_trace_duration), lowering (jaxpr_to_mlir_module_duration) and XLA
@@ -31,7 +31,8 @@ import collections, json, os, sys, time
 T0 = time.perf_counter()
 os.environ["JAXSLOSH_CACHE_DIR"] = sys.argv[2]
 import jax
-from jaxslosh import entry, executables
+from jaxslosh import entry
+from jaxslosh.cache import executables
 # as `jaxslosh run` (jaxslosh/entry.py): the executables its last run used start loading, then the package is imported
 executables.preload(executables.cache_folder()[1], entry.command_hint(["run", sys.argv[1]]))
 from jaxslosh.cli.common import setup_jax
@@ -41,8 +42,8 @@ jax.monitoring.register_event_duration_secs_listener(
     lambda name, d, **kw: events.__setitem__(name.split("/")[-1], events[name.split("/")[-1]] + d))
 from jaxslosh.run.loop import core
 from jaxslosh.run.simulate import prepare
-from jaxslosh.programs import cached
-from jaxslosh.run.compiled import compile_run
+from jaxslosh.cache.programs import cached
+from jaxslosh.cache.compiled import compile_run
 from jaxslosh.scene import load_scene
 t_import = time.perf_counter()
 scene = load_scene(sys.argv[1])

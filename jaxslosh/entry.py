@@ -11,7 +11,7 @@ import os
 import sys
 from importlib import import_module
 
-from . import executables
+from .cache import executables
 
 
 def main() -> int:

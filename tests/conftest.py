@@ -1,10 +1,22 @@
 import os
+import sys
+
+# The tests live in folders by sub-package (tests/fem, tests/hull, ...); their shared helpers
+# (helpers.py, sloshing_reference.py, section_meshes.py) here, and a few test files import another's
+# scenes: every folder is on the path, as pytest's default import mode puts a test file's own
+# (test file names are unique across the folders).
+_HERE = os.path.dirname(os.path.abspath(__file__))
+for _d in sorted(os.listdir(_HERE)):
+    if os.path.isdir(os.path.join(_HERE, _d)) and _d not in ("data", "__pycache__"):
+        sys.path.append(os.path.join(_HERE, _d))
+if _HERE not in sys.path:
+    sys.path.insert(0, _HERE)
 
 # Most of the suite's time is JAX tracing and XLA compiling programs that then run for seconds at
 # most, so the tests ask XLA for quick machine code (set before jax starts its backend, and
 # inherited by the subprocesses and notebook kernels the tests start): LLVM's optimisation passes
 # off; XLA's classic CPU loop emitters, which compile the many small fusions of a step faster than
-# its fusion emitters (as programs.XLA_OPTIONS does for the command line's runs); and one LLVM
+# its fusion emitters (as staging.XLA_OPTIONS does for the command line's runs); and one LLVM
 # module per program, not several compiled on threads: the two xdist workers already keep both
 # cores busy. XLA's graph passes are untouched: the tests run the same XLA programs, only as less
 # optimised machine code. The CLI, the notebooks run by users and the benchmarks keep their own
@@ -34,10 +46,10 @@ threadpool_limits(limits=1, user_api="blas")
 def _cache_folder_off():
     """A test that calls the command line in process with JAXSLOSH_CACHE_DIR set turns JAX's
     persistent cache on for the whole worker (jax.config is global): a later test would then be
-    given executables from that folder, which programs.py does not keep. Off again after each."""
+    given executables from that folder, which cache/programs.py does not keep. Off again after each."""
     yield
     from jax._src import compilation_cache
-    from jaxslosh import programs
+    from jaxslosh.cache import programs
     programs.use(None)
     if jax.config.jax_compilation_cache_dir is not None:
         jax.config.update("jax_compilation_cache_dir", None)

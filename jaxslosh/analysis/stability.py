@@ -28,7 +28,7 @@ from ..hull.clip import submerged, submerged_and_cut
 from ..hull.hydrostatics import first_vanishing
 from ..hull.surface import HullMeshError, hull_triangles
 from ..hull.tanks import tank_surface
-from ..programs import START_OPTIONS
+from ..staging import START_OPTIONS
 from ..scene.load import load_scene
 from ..scene.types import SceneError
 

@@ -20,7 +20,7 @@ from ..physics.system import System
 from ..physics.terms import Config
 from ..physics.vessel import (FreeMotion, HarmonicMotion, Hydrostatics, PaperHydrostatics, RecordedMotion, RigidBody,
                               SpinUpMotion, Weight, record_coefficients)
-from ..programs import staged
+from ..staging import staged
 from ..scene.keys import resolve_params
 from ..scene.types import DOFS, Scene, SceneError
 from ..solve.sparse import hydrostatic_start
@@ -44,7 +44,7 @@ class Built(NamedTuple):
     surfaces: tuple = ()                 # per tank, the stacked indices of its free-surface nodes (validity)
 
 
-#: the build's jax.numpy steps, each one compiled program (programs.staged), wrapped once per process
+#: the build's jax.numpy steps, each one compiled program (staging.staged), wrapped once per process
 _quat_from_rpy = staged(quat_from_rpy)
 _flex_start = staged(flex_start)
 

@@ -11,8 +11,8 @@ import tempfile
 
 import jax
 
-from .. import programs
-from ..executables import cache_folder
+from ..cache import programs
+from ..cache.executables import cache_folder
 from ..io.output import OutputError, check_output
 from ..io.result import ResultFileError
 from ..scene.keys import with_overrides
@@ -66,7 +66,7 @@ CACHE_MAX_ENV = "JAXSLOSH_CACHE_MAX_MB"
 
 
 def setup_jax():
-    """float64, JAX's persistent compilation cache and the exported programs beside it (programs.py):
+    """float64, JAX's persistent compilation cache and the exported programs beside it (cache/programs.py):
     a second run of a scene skips tracing and XLA."""
     jax.config.update("jax_enable_x64", True)
     d, kept = cache_folder()

@@ -10,7 +10,7 @@ import sys
 from importlib import import_module
 
 from ..scene.types import SceneError
-from ..executables import settle
+from ..cache.executables import settle
 from .common import COMMANDS, EXIT_INPUT, EXIT_INTERRUPTED, InputError, Parser
 
 

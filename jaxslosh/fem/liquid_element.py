@@ -60,7 +60,7 @@ import jax
 import jax.numpy as jnp
 import numpy as np
 
-from ..programs import XLA_OPTIONS, lower_program, no_eager_folding
+from ..staging import XLA_OPTIONS, lower_program, no_eager_folding
 from .linalg import det2, det3, inv3
 from .mesh import GAUSS8, GAUSS_1D, HEX_CORNERS
 

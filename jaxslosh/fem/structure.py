@@ -27,7 +27,7 @@ import scipy.linalg as sl
 import scipy.sparse as sp
 import scipy.sparse.linalg as spl
 
-from ..programs import compile_program, no_eager_folding
+from ..staging import compile_program, no_eager_folding
 from .mesh import GAUSS8, HEX_CORNERS, box_mesh
 
 
@@ -61,7 +61,7 @@ def _element_hessian():
         return jax.vmap(energy_at, in_axes=(0, None, None, None))(jnp.asarray(GAUSS8), z, half, C).sum()
 
     # staged whole even under the build's ensure_compile_time_eval, and read back from the exported
-    # programs where a process compiled it before (programs.py)
+    # programs where a process compiled it before (cache/programs.py)
     with jax.enable_x64(True), no_eager_folding():
         like = (np.zeros(33), np.zeros(3), np.zeros((6, 6)))
         return compile_program("element-structure", jax.hessian(energy), like)[0]

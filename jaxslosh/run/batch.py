@@ -11,7 +11,7 @@ import numpy as np
 from jax.sharding import Mesh, NamedSharding, PartitionSpec
 
 from ..io.result import Result, result_from
-from ..programs import XLA_OPTIONS
+from ..staging import XLA_OPTIONS
 from ..physics.seakeeping import Excitation, WaveExcitation
 from ..scene.keys import check_values, with_overrides
 from ..scene.types import Scene, SceneError
@@ -68,10 +68,10 @@ def _batch_fn(scene: Scene, keys: tuple, mesh: Optional[Mesh] = None, excited: b
     if mesh is not None:
         fn = jax.shard_map(fn, mesh=mesh, in_specs=PartitionSpec("batch"), out_specs=PartitionSpec("batch"),
                            check_vma=False)
-    # XLA's options of the single run's loop (programs.XLA_OPTIONS: its classic CPU emitters compile
+    # XLA's options of the single run's loop (staging.XLA_OPTIONS: its classic CPU emitters compile
     # the step's many small fusions in less time, and the loop runs as fast). One program, the
     # initial state in it: compiled apart with its optimisation off, as a single run's is
-    # (run/compiled.py), the vmapped loop that takes its carry ran markedly slower (docs/benchmarks.md)
+    # (cache/compiled.py), the vmapped loop that takes its carry ran markedly slower (docs/benchmarks.md)
     fn = jax.jit(fn, compiler_options=XLA_OPTIONS or None)
     if cache_key is not None:
         _BATCH_FNS[cache_key] = fn

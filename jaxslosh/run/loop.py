@@ -108,7 +108,7 @@ def _first_carry(s0, info) -> Carry:
 
 def carry_shapes(b: Built, solver: Solver) -> Carry:
     """The shapes and types of init's carry, without tracing its Newton solves (what the loop is
-    lowered for while init is still being traced: run/compiled.compile_run)."""
+    lowered for while init is still being traced: cache/compiled.compile_run)."""
     return eqx.filter_eval_shape(
         lambda b_, s_: _first_carry(*initial_state_like(b_.system, s_, b_.c0, b_.v0, b_.alg0)), b, solver)
 

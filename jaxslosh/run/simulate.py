@@ -22,7 +22,7 @@ from ..scene.keys import check_values, with_overrides
 from ..scene.types import Scene
 from ..solve.linear import Solver, make_solver
 from ..solve.schemes import make_scheme
-from .compiled import compile_run
+from ..cache.compiled import compile_run
 from .loop import Carry, Frame, advance, concat_frames, core, frame_datasets, start
 
 

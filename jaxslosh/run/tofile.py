@@ -2,7 +2,7 @@
 with its progress on stderr, so that long runs show progress and a killed run leaves a readable file
 that says how it ended.
 
-The chunk is compiled ahead of time (compile_run: traced once and exported, programs.py), as a phase
+The chunk is compiled ahead of time (compile_run: traced once and exported, cache/programs.py), as a phase
 of its own: the first chunk then runs precompiled, so the stepping phase, its rate and its estimate
 hold steps only, and the compile time is measured apart instead of hiding in the first chunk."""
 from __future__ import annotations
@@ -18,11 +18,11 @@ import numpy as np
 from ..io.output import is_disk_full
 from ..io.result import ResultWriter
 from ..io.status import Status
-from ..programs import cached
+from ..cache.programs import cached
 from ..scene.types import Scene
 from .guard import Interrupted, interrupts
 from .capsize import vanishing_angles
-from .compiled import compile_run
+from ..cache.compiled import compile_run
 from .loop import core, frame_datasets
 from .progress import Progress
 from .simulate import failure_message, prepare

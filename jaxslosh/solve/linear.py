@@ -13,7 +13,7 @@ import numpy as np
 from ..fem.linalg import inv, solve
 from ..physics.structures import layout
 from ..physics.system import System
-from ..programs import staged
+from ..staging import staged
 from .schemes import Scheme
 from .sparse import sparse_solver_blocks
 

@@ -20,7 +20,7 @@ free unknowns, whose dense stiffness, mass and step-matrix inverses would take 2
 * `HostInverse`, a sparse LU factor on the host (SuperLU, symmetric mode, minimum-degree ordering on
   A + A^T) called from the step, only where the scene asks for it (`simulation.linear_solver =
   "sparse-host"`: a mesh whose banded factors would not fit in memory). A host callback is neither
-  exported nor kept by XLA's cache (programs.py finds no name for a program that holds the factor:
+  exported nor kept by XLA's cache (cache/programs.py finds no name for a program that holds the factor:
   it does not pickle), so such a run traces and compiles every time. The Newton iterations only
   need an approximate inverse (lax.custom_root), so a host-side factor is a legitimate
   preconditioner, and the tangent solves of the gradients reach full precision by Richardson sweeps

@@ -1,4 +1,4 @@
-"""Exported programs kept across processes (jaxslosh/programs.py): a program read back from its file
+"""Exported programs kept across processes (jaxslosh/cache/programs.py): a program read back from its file
 computes what the traced one does, and a change of anything the trace depends on (a static value,
 a shape) names another file."""
 import json
@@ -13,7 +13,7 @@ import jax.numpy as jnp
 import numpy as np
 import pytest
 
-from jaxslosh import executables, programs
+from jaxslosh.cache import executables, programs
 
 
 class Model(eqx.Module):
@@ -144,7 +144,7 @@ jax.config.update("jax_enable_x64", True)
 jax.config.update("jax_compilation_cache_dir", os.path.join(sys.argv[1], "xla"))
 jax.config.update("jax_persistent_cache_min_compile_time_secs", 0.0)
 jax.config.update("jax_persistent_cache_min_entry_size_bytes", -1)
-from jaxslosh import programs
+from jaxslosh.cache import programs
 if sys.argv[2:] == ["new"]:           # another version of jaxslosh: every file's name changes
     programs._code_hash = lambda: b"another version"
 programs.use(os.path.join(sys.argv[1], "programs"))
@@ -188,11 +188,11 @@ SCENES = os.path.join(os.path.dirname(os.path.dirname(os.path.dirname(os.path.ab
     ("vessel_only.toml", "energy_projection = true"),     # the initial energy in the state
 ])
 def test_the_chunk_is_lowered_for_the_shapes_of_the_initial_state(name, extra):
-    """run/compiled.compile_run lowers the chunk for loop.carry_shapes before `start` is traced: they
+    """cache/compiled.compile_run lowers the chunk for loop.carry_shapes before `start` is traced: they
     must be the shapes and types of start's carry (else the chunk is lowered twice)."""
     from jaxslosh.run.loop import carry_shapes, core, traced_init
     from jaxslosh.run.simulate import prepare
-    from jaxslosh.run.compiled import same_shapes
+    from jaxslosh.cache.compiled import same_shapes
     from jaxslosh.scene import load_scene
     with open(os.path.join(SCENES, name)) as f:
         text = f.read()

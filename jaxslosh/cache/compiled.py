@@ -1,8 +1,8 @@
 """The run's two programs compiled ahead of time, as one phase: the command line's runs
 (run/tofile.py) and `js.simulate` called outside any JAX transformation (run/simulate.py) step with
-them. Compiled ahead of time, a program takes XLA options (programs.XLA_OPTIONS, START_OPTIONS),
+them. Compiled ahead of time, a program takes XLA options (staging.XLA_OPTIONS, START_OPTIONS),
 XLA compiles in the background while Python traces the next, and the programs can be read back from
-the exported programs' folder (programs.py)."""
+the exported programs' folder (cache/programs.py)."""
 from __future__ import annotations
 
 import hashlib
@@ -10,15 +10,16 @@ import hashlib
 import jax
 import numpy as np
 
-from ..executables import remember
-from ..programs import START_OPTIONS, XLA_OPTIONS, cached, folder, lower_program, program_key
+from ..run.loop import carry_shapes, traced_advance, traced_init
 from ..solve.factored import FactoredInverse
-from .loop import carry_shapes, traced_advance, traced_init
+from ..staging import START_OPTIONS, XLA_OPTIONS
+from .executables import remember
+from .programs import cached, folder, lower_program, program_key
 
 
 def compile_run(bc, solver, chunk_frames: int, save_every: int):
     """The run's two programs compiled ahead of time (from the exported programs' folder where a
-    process compiled them before, programs.py): runs `start`; returns its carry and frame, and the
+    process compiled them before, cache/programs.py): runs `start`; returns its carry and frame, and the
     compiled chunk, called as `chunk(bc, solver, carry, chunk_frames, save_every)`.
 
     The chunk is traced first, for the shapes of start's carry (loop.carry_shapes, which traces no

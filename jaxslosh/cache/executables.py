@@ -1,6 +1,6 @@
-"""Executables kept in the programs' folder (programs.py), and their loading ahead of use.
+"""Executables kept in the programs' folder (cache/programs.py), and their loading ahead of use.
 
-A program's file (programs.py) keeps, beside the exported program, the executable XLA compiled for
+A program's file (cache/programs.py) keeps, beside the exported program, the executable XLA compiled for
 this host. Loading it is XLA's work, outside Python's lock, and the largest part of what a second
 `jaxslosh run` of a scene does before its first step (README "Compile time"). So the command line
 starts loading the executables its last run of the same command line used (`preload`, called by

@@ -26,7 +26,7 @@ program, through XLA's cache. An executable XLA's cache gave back is not kept (s
 element matrices, the Newton matrix's constant blocks), a second run of the scene reads it.
 
 XLA's work on a program runs outside Python: `Program.compile_in_background` lets one program
-compile while Python traces the next (`run/compiled.compile_run`).
+compile while Python traces the next (`cache/compiled.compile_run`).
 """
 from __future__ import annotations
 
@@ -37,28 +37,14 @@ import os
 import pickle
 import threading
 
-import equinox as eqx
 import jax
 import numpy as np
 from jax import export
 from jax.experimental import serialize_executable
 
+from .. import staging
 from . import executables
 from .executables import Load, loadable, read, take, touch, write_bytes
-
-_JAXLIB = tuple(int(p) for p in jax.lib.__version__.split(".")[:2] if p.isdigit())
-
-#: XLA options of the run's programs compiled ahead of time (run/compiled.py: `jaxslosh run`, and
-#: `js.simulate` called outside any transformation; JAX takes options only for a top-level jit, so
-#: js.simulate inside a user's jit keeps XLA's defaults, and agrees to round-off). XLA's classic CPU
-#: loop emitters compile the step's many small fusions in 30-40 % less time than its default fusion
-#: emitters, and the step runs as fast (README "Compilation"). A field of XLA's shared debug options:
-#: other backends accept it and leave it unused. jaxlib 0.11 removed the field (its CPU backend has
-#: only the fusion emitters left) and refuses every compilation that names it: no options there.
-XLA_OPTIONS = {"xla_cpu_use_fusion_emitters": False} if _JAXLIB < (0, 11) else {}
-#: XLA options of a program that runs once (the run's initial state): its optimisation off, which
-#: halves its XLA work, while it still runs in less time than a few steps (README "Compilation")
-START_OPTIONS = {**XLA_OPTIONS, "xla_backend_optimization_level": 0}
 
 _FOLDER: list = [None]
 
@@ -74,7 +60,7 @@ def folder() -> str | None:
 
 @functools.cache
 def _code_hash() -> bytes:
-    root = os.path.dirname(os.path.abspath(__file__))
+    root = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))   # the package
     h = hashlib.sha256(f"{jax.__version__} {jax.lib.__version__}".encode())
     for dirpath, dirs, files in sorted(os.walk(root)):
         dirs.sort()
@@ -375,15 +361,4 @@ def no_eager_folding():
     return state(False) if state is not None else contextlib.nullcontext()
 
 
-def staged(fn):
-    """`fn` under equinox's filter_jit, traced whole even where the build evaluates eagerly
-    (run/simulate.prepare, inside `jax.ensure_compile_time_eval()`): the build's few steps written
-    with jax.numpy become one compiled program each, where op by op every line compiled a tiny XLA
-    program of its own (seconds in a fresh process). Inside an outer trace it is inlined."""
-    jitted = eqx.filter_jit(fn)
-
-    @functools.wraps(fn)
-    def call(*args, **kwargs):
-        with no_eager_folding():
-            return jitted(*args, **kwargs)
-    return call
+staging.install(lower_program, no_eager_folding)

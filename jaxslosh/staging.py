@@ -1,0 +1,100 @@
+"""How jaxslosh's programs are staged for XLA, below everything that stages them: the XLA options of
+the run's programs, `staged` for the build's jax.numpy steps, and the compiled kernels of the finite
+elements.
+
+The compile cache (jaxslosh/cache: programs exported and kept across processes, their executables,
+the preload) sits in a wing above the modules that compile: they call `lower_program`,
+`compile_program` and `no_eager_folding` here, and the cache installs its own when it is imported
+(`install`; `jaxslosh run`, `js.simulate` and the campaign workers import it). Without it the same
+calls trace and compile in the process, with the same options and results, and keep nothing.
+"""
+from __future__ import annotations
+
+import contextlib
+import functools
+
+import equinox as eqx
+import jax
+
+_JAXLIB = tuple(int(p) for p in jax.lib.__version__.split(".")[:2] if p.isdigit())
+
+#: XLA options of the run's programs compiled ahead of time (cache/compiled.py: `jaxslosh run`, and
+#: `js.simulate` called outside any transformation; JAX takes options only for a top-level jit, so
+#: js.simulate inside a user's jit keeps XLA's defaults, and agrees to round-off). XLA's classic CPU
+#: loop emitters compile the step's many small fusions in 30-40 % less time than its default fusion
+#: emitters, and the step runs as fast (docs/guide/compilation-cache.md). A field of XLA's shared
+#: debug options: other backends accept it and leave it unused. jaxlib 0.11 removed the field (its
+#: CPU backend has only the fusion emitters left) and refuses every compilation that names it.
+XLA_OPTIONS = {"xla_cpu_use_fusion_emitters": False} if _JAXLIB < (0, 11) else {}
+#: XLA options of a program that runs once (the run's initial state): its optimisation off, which
+#: halves its XLA work, while it still runs in less time than a few steps
+START_OPTIONS = {**XLA_OPTIONS, "xla_backend_optimization_level": 0}
+
+
+class _Done:
+    """A compilation already finished, in the shape of a background one (`result()`)."""
+
+    def __init__(self, value):
+        self.value = value
+
+    def result(self):
+        return self.value
+
+
+class PlainProgram:
+    """`fn(*args)` traced and lowered in this process, nothing kept: the programs of a process that
+    has not imported the compile cache."""
+
+    def __init__(self, fn, args, compiler_options=None):
+        self.lowered = jax.jit(fn).lower(*args)
+        self.options = compiler_options
+        self.loaded = False
+
+    def compile(self):
+        return self.lowered.compile(self.options)
+
+    def compile_in_background(self):
+        return _Done(self.compile())
+
+
+_IMPL = {"lower": lambda name, fn, args, compiler_options=None: PlainProgram(fn, args, compiler_options),
+         "no_folding": contextlib.nullcontext}
+
+
+def install(lower, no_folding):
+    """The compile cache's `lower_program(name, fn, args, compiler_options)` and its context in
+    which a jit trace stages its operations on constants (cache/programs.py)."""
+    _IMPL["lower"], _IMPL["no_folding"] = lower, no_folding
+
+
+def lower_program(name: str, fn, args: tuple, compiler_options=None):
+    """`fn(*args)` lowered for arguments of this structure (a program with `compile()` and
+    `compile_in_background()`; from the compile cache where it is imported)."""
+    return _IMPL["lower"](name, fn, args, compiler_options)
+
+
+def compile_program(name: str, fn, args: tuple, compiler_options=None):
+    """`fn(*args)` compiled for arguments of this structure, shapes and static values; returns the
+    compiled callable (it takes arguments like `args`) and whether it came from the cache's folder."""
+    p = lower_program(name, fn, args, compiler_options)
+    return p.compile(), p.loaded
+
+
+def no_eager_folding():
+    """A context in which a jit trace stages its operations on constants even inside
+    `jax.ensure_compile_time_eval()` (nothing where the compile cache is not imported)."""
+    return _IMPL["no_folding"]()
+
+
+def staged(fn):
+    """`fn` under equinox's filter_jit, traced whole even where the build evaluates eagerly
+    (run/simulate.prepare, inside `jax.ensure_compile_time_eval()`): the build's few steps written
+    with jax.numpy become one compiled program each, where op by op every line compiled a tiny XLA
+    program of its own (seconds in a fresh process). Inside an outer trace it is inlined."""
+    jitted = eqx.filter_jit(fn)
+
+    @functools.wraps(fn)
+    def call(*args, **kwargs):
+        with no_eager_folding():
+            return jitted(*args, **kwargs)
+    return call
