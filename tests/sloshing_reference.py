@@ -667,14 +667,19 @@ def section_sloshing_omegas(boundary: Section, fill_depth: float, g: float = G, 
     return np.sqrt(g * section_sloshing_lambdas(m, n, degree))
 
 
-def prism_sloshing_omegas(boundary: Section, fill_depth: float, length: float, g: float = G, n: int = 6,
-                          h_target: float | None = None, degree: int = 2) -> tuple[np.ndarray, np.ndarray]:
+def prism_sloshing_omegas(boundary, fill_depth: float, length: float, g: float = G, n: int = 6,
+                          h_target: float | None = None, degree: int = 2, baffles=()) -> tuple[np.ndarray, np.ndarray]:
     """The n lowest sloshing frequencies (rad/s) of the prism of the section over 0 <= x <= ``length``
     (end walls), 3-D: separated as phi(s, z) cos(m pi x / length), each m a section problem with
     wavenumber m pi / length (:func:`section_sloshing_lambdas`). Returns (omega (n,), m (n,)), the
     longitudinal order of each mode: m = 0 are the section's own modes, m > 0 vary along the length
-    (along a sloping wall they include edge waves, omega^2 ~ g k sin(slope), lower than a box's)."""
-    m = section_mesh(boundary, fill_depth, (), h_target)
+    (along a sloping wall they include edge waves, omega^2 ~ g k sin(slope), lower than a box's).
+    ``boundary``: a :class:`Section` (with ``baffles``: plates along the whole length), or the
+    rectangles of a union (:func:`u_tube`; ``h_target`` then required)."""
+    if isinstance(boundary, Section):
+        m = section_mesh(boundary, fill_depth, baffles, h_target)
+    else:
+        m = rectilinear_section_mesh(boundary, fill_depth, float(h_target))
     out, order = [], []
     for j in range(n + 1):
         lam = section_sloshing_lambdas(m, n, degree, wavenumber=j * math.pi / length)
