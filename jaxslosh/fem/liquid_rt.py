@@ -131,10 +131,9 @@ class FaceLiquid:
         # the value at the node is the fit's constant term: row 0 of (A^T A)^-1 applied to A^T b
         row0 = np.linalg.solve(AtA + 1e-12 * np.eye(4), np.broadcast_to(np.eye(4)[:, :1], (N, 4, 1)))[..., 0]
         wts = np.einsum("epai,epai->epa", A, row0[rows])                  # (E, P, 8) weight of each point
-        out = np.zeros((u.shape[0], N, 3))
-        for i in range(u.shape[0]):                                        # one field at a time: bounded memory
-            np.add.at(out[i], rows.reshape(-1), (wts[..., None] * u[i][:, :, None, :]).reshape(-1, 3))
-        return out
+        k = u.shape[0]                                                     # the sums as one sparse product
+        S = sp.csr_matrix((wts.reshape(-1), (rows.reshape(-1), np.repeat(np.arange(E * P), 8))), shape=(N, E * P))
+        return (S @ u.reshape(k, E * P, 3).transpose(1, 0, 2).reshape(E * P, 3 * k)).reshape(N, k, 3).transpose(1, 0, 2)
 
 
 def _shape_gradients(xi):
@@ -489,7 +488,8 @@ def face_invariants(model: FaceLiquid, V, origin):
     Q0 = rho * np.einsum("ep,epa,epb->ab", w, r, r)
     U1 = rho * np.einsum("ep,kepa->ka", w, u)
     Q1 = rho * np.einsum("ep,epa,kepb->kab", w, r, u)
-    Q2 = rho * np.einsum("ep,kepa,lepb->klab", w, u, u)
+    uf = u.reshape(len(u), -1, 3).transpose(1, 0, 2).reshape(-1, 3 * len(u))   # (E P, 3 m): one product
+    Q2 = (rho * (uf * w.reshape(-1, 1)).T @ uf).reshape(len(u), 3, len(u), 3).transpose(0, 2, 1, 3)
     Mr = np.einsum("klaa->kl", Q2)
     Kr = V.T @ (model.stiffness @ V)
     U = model.nodal_fields(V.T)
