@@ -6,6 +6,14 @@ prismatic meshes). Prints one table per case: mesh, elements, the first three sl
 frequencies' errors (%) per element.
 
     python benchmarks/liquid_element.py [--elements rt,stabilized] [--cases utube,hanging,...]
+    python benchmarks/liquid_element.py --cases shapes
+    python benchmarks/liquid_element.py --cases cost [--meshes 10x10x6,20x20x12]
+
+``cost``: rt's times (s) on a 5x5x3 m box: build, face_modes (10), face_basis (20 modes and the
+static correction), face_invariants.
+``shapes``: every tank shape on about 1,000 elements (tests/shape_cases.py), 3-D, the first six
+sloshing modes' errors (%) against closed forms or the reference's prism modes, per element, and
+the non-sloshing modes the nodal elements put among them.
 
 Every case is 2-D (modes uniform across the two-element thickness), so the nodal elements' modes
 are taken as the sloshing modes whose free-surface share is > 0.5, and the first three of those
@@ -96,11 +104,51 @@ def omegas(element, geo, depth, counts, n=3):
     return w[:n], len(model.elements)
 
 
+def shapes(elements):
+    import shape_cases
+    print("| tank | elements | " + " | ".join(f"{e}, modes 1-6 (%)" for e in elements) + " |")
+    print("|---|---|" + "---|" * len(elements))
+    for name in shape_cases.CASES:
+        geo, depth, mesh, _, ref_w = shape_cases.case(name)
+        cells = []
+        for element in elements:
+            w, ne, kinds = shape_cases.sloshing_omegas(geo, depth, mesh, element)
+            other = sum(k != "sloshing" for k in kinds)
+            cells.append(", ".join(f"{e:+.2f}" for e in (w / ref_w[:len(w)] - 1) * 100)
+                         + (f" ({other} other modes among them)" if other else ""))
+        print(f"| {name} | {ne} | " + " | ".join(cells) + " |", flush=True)
+
+
+def cost(meshes):
+    from jaxslosh.fem.liquid_rt import face_basis, face_invariants
+    print("| mesh | face unknowns | build | face_modes (10) | face_basis (20 + correction) | invariants |")
+    print("|---|---|---|---|---|---|")
+    for mesh in meshes:
+        counts = tuple(int(v) for v in mesh.split("x"))
+        t = [time.perf_counter()]
+        tm = tank_mesh(TankGeometry(kind="box", size=(5.0, 5.0, 4.0)), 3.0, counts)
+        m = build_face_liquid(tm.nodes, tm.elements, 3.0, RHO, C, G)
+        t.append(time.perf_counter())
+        face_modes(m, 10)
+        t.append(time.perf_counter())
+        V = face_basis(m, (0.0, 0.0, 0.0), 20)[0]
+        t.append(time.perf_counter())
+        face_invariants(m, V, (0.0, 0.0, 0.0))
+        t.append(time.perf_counter())
+        dt = np.diff(t)
+        print(f"| {mesh} | {int(m.free.sum()):,} | " + " | ".join(f"{v:.1f}" for v in dt) + " |", flush=True)
+
+
 def main():
     p = argparse.ArgumentParser()
     p.add_argument("--elements", default="rt,stabilized")
     p.add_argument("--cases", default="utube,hanging,standing,hopper,lng30")
+    p.add_argument("--meshes", default="10x10x6,20x20x12,30x30x16")
     a = p.parse_args()
+    if a.cases == "cost":
+        return cost(a.meshes.split(","))
+    if a.cases == "shapes":
+        return shapes(a.elements.split(","))
     for case in a.cases.split(","):
         ref = reference(case)
         print(f"\n{case}: reference omega = {', '.join(f'{w:.5f}' for w in ref)} rad/s")

@@ -32,6 +32,10 @@ S phi_F = lambda B_FF phi_F on the surface nodes, solved by shift-invert Lanczos
 the surface block of (K + c B)^-1 = (S + c B_FF)^-1, to machine precision. lambda = 0 (phi
 constant) is the trivial mode, one per separate pool of liquid; it is dropped.
 
+A prism of the section with end walls at x = 0 and x = L (a prismatic tank, a horizontal
+cylinder) has the modes phi(s, z) cos(m pi x / L): for each m the same problem with k^2 phi added
+to the Laplacian, k = m pi / L (prism_sloshing_omegas), m = 0 being the section's own modes.
+
 Discretisation: quadratic (P2) triangles. The liquid (convex: a convex tank section below a
 level) is meshed by Delaunay triangulation (scipy.spatial.Delaunay) of its boundary sampled
 every h, of each baffle sampled every h, and of an equilateral lattice of spacing h kept clear of
@@ -597,22 +601,28 @@ def _surface_mass(m: SectionMesh, basis, degree: int):
     return B.tocsr()
 
 
-def section_sloshing_lambdas(m: SectionMesh, n: int = 4, degree: int = 2) -> np.ndarray:
-    """The n lowest nonzero lambda = omega^2 / g of the Steklov problem on a meshed section."""
+def section_sloshing_lambdas(m: SectionMesh, n: int = 4, degree: int = 2, wavenumber: float = 0.0) -> np.ndarray:
+    """The n lowest nonzero lambda = omega^2 / g of the Steklov problem on a meshed section.
+
+    ``wavenumber`` k > 0: the modes phi(s, z) cos(k x) of the prism over the section (walls at
+    the ends), for which the section's potential solves Laplace's equation less k^2 phi: the
+    stiffness gets k^2 int phi psi, and no mode is trivial."""
     from skfem import Basis, BilinearForm, ElementTriP1, ElementTriP2
     from skfem.helpers import dot, grad
 
     elem = {1: ElementTriP1(), 2: ElementTriP2()}[degree]
+    k2 = float(wavenumber) ** 2
 
     @BilinearForm
     def laplace(u, v, _):
-        return dot(grad(u), grad(v))
+        return dot(grad(u), grad(v)) + k2 * u * v
 
     basis = Basis(m.mesh, elem)
     K = laplace.assemble(basis).tocsr()
+    pools = m.pools if k2 == 0.0 else 0
     B = _surface_mass(m, basis, degree)
     F = basis.get_dofs(m.surface).all()
-    k = n + m.pools
+    k = n + pools
     if F.size < 2 * k + 1:
         raise ValueError("too few surface nodes for n modes; refine")
     # Shift-invert Lanczos on the surface unknowns, about -c < 0. A = K + c B is positive
@@ -633,8 +643,8 @@ def section_sloshing_lambdas(m: SectionMesh, n: int = 4, degree: int = 2) -> np.
     lam = spla.eigsh(op, k=k, M=BFF, sigma=-c, which="LM", OPinv=op, ncv=max(2 * k + 1, 20),
                      v0=v0, return_eigenvectors=False)
     lam = np.sort(lam)
-    zero, rest = lam[:m.pools], lam[m.pools:]
-    if np.max(np.abs(zero)) > 1e-6 * rest[0]:
+    zero, rest = lam[:pools], lam[pools:]
+    if pools and np.max(np.abs(zero)) > 1e-6 * rest[0]:
         raise RuntimeError(f"trivial modes not found near zero: {lam}")
     return rest
 
@@ -655,6 +665,31 @@ def section_sloshing_omegas(boundary: Section, fill_depth: float, g: float = G, 
     """
     m = section_mesh(boundary, fill_depth, baffles, h_target, tip_refinements)
     return np.sqrt(g * section_sloshing_lambdas(m, n, degree))
+
+
+def prism_sloshing_omegas(boundary, fill_depth: float, length: float, g: float = G, n: int = 6,
+                          h_target: float | None = None, degree: int = 2, baffles=()) -> tuple[np.ndarray, np.ndarray]:
+    """The n lowest sloshing frequencies (rad/s) of the prism of the section over 0 <= x <= ``length``
+    (end walls), 3-D: separated as phi(s, z) cos(m pi x / length), each m a section problem with
+    wavenumber m pi / length (:func:`section_sloshing_lambdas`). Returns (omega (n,), m (n,)), the
+    longitudinal order of each mode: m = 0 are the section's own modes, m > 0 vary along the length
+    (along a sloping wall they include edge waves, omega^2 ~ g k sin(slope), lower than a box's).
+    ``boundary``: a :class:`Section` (with ``baffles``: plates along the whole length), or the
+    rectangles of a union (:func:`u_tube`; ``h_target`` then required)."""
+    if isinstance(boundary, Section):
+        m = section_mesh(boundary, fill_depth, baffles, h_target)
+    else:
+        m = rectilinear_section_mesh(boundary, fill_depth, float(h_target))
+    out, order = [], []
+    for j in range(n + 1):
+        lam = section_sloshing_lambdas(m, n, degree, wavenumber=j * math.pi / length)
+        out.append(lam)
+        order.append(np.full(len(lam), j))
+        if j and lam[0] > np.sort(np.concatenate(out))[n - 1]:
+            break
+    lam, order = np.concatenate(out), np.concatenate(order)
+    keep = np.argsort(lam, kind="stable")[:n]
+    return np.sqrt(g * lam[keep]), order[keep]
 
 
 # ---------------------------------------------------------------------------------------------

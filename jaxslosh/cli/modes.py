@@ -6,6 +6,7 @@ import math
 
 from ..analysis.coupled import PENALTY_LABEL, coupled_modes
 from ..analysis.modes import sloshing_modes, structure_modes
+from ..fem.modes import KIND_NOTES, others_in_band
 from .common import COMMANDS, EXIT_OK, InputError, setup_jax, load
 
 
@@ -48,10 +49,17 @@ def cmd_modes(a):
             print()
         print(f"liquid modes of tank {m['tank']!r}"
               + (f" ({j + 1} of {len(found)})" if len(found) > 1 else "") + " (vessel held fixed):")
-        print(f"{'#':>3} {'omega rad/s':>12} {'f Hz':>10} {'period s':>10} {'surface share':>14}  kind")
-        for i, (w, k, s) in enumerate(zip(m["omega"], m["kind"], m["free_surface_share"])):
-            f = w / (2 * math.pi)
-            print(f"{i + 1:>3} {w:12.5f} {f:10.5f} {1 / f if f > 0 else float('inf'):10.4f} {s:14.3f}  {k}")
+        # the sloshing modes first; any other mode among them (below the highest sloshing one listed)
+        # apart, labelled; the rest, above the band, after them. '#' is the place in frequency order.
+        band = set(m["others_in_sloshing_band"])
+        rows = list(zip(range(len(m["omega"])), m["omega"], m["kind"], m["free_surface_share"]))
+        _rows([r for r in rows if r[0] not in band])
+        if band:
+            kinds = sorted({m["kind"][i] for i in band})
+            print(f"not sloshing, among the sloshing modes above ({len(band)}):")
+            _rows([r for r in rows if r[0] in band])
+            for k in kinds:
+                print(f"  {k}: {KIND_NOTES.get(k, k)}")
         if m["circulation_modes_left_out"]:
             print(f"({m['circulation_modes_left_out']} circulation modes at zero frequency left out: "
                   f"divergence-free flow with no free-surface motion, which the face-normal element holds at "
@@ -59,10 +67,19 @@ def cmd_modes(a):
     return EXIT_OK
 
 
+def _rows(rows):
+    print(f"{'#':>3} {'omega rad/s':>12} {'f Hz':>10} {'period s':>10} {'surface share':>14}  kind")
+    for i, w, k, s in rows:
+        f = w / (2 * math.pi)
+        print(f"{i + 1:>3} {w:12.5f} {f:10.5f} {1 / f if f > 0 else float('inf'):10.4f} {s:14.3f}  {k}")
+
+
 def _tank_json(name, modes) -> dict:
     return {"tank": name, "omega": [float(w) for w in modes.omega], "kind": list(modes.kind),
             "free_surface_share": [float(s) for s in modes.free_surface_share],
-            "circulation_modes_left_out": int(modes.circulation)}
+            # (a tank with elastic walls has no such count: its liquid element is a nodal one)
+            "circulation_modes_left_out": int(getattr(modes, "circulation", 0)),
+            "others_in_sloshing_band": others_in_band(modes.kind)}
 
 
 def _structure_modes(scene, a):

@@ -117,6 +117,27 @@ def classify(model: LiquidModel, shapes: np.ndarray):
     return s["free_surface"], tuple(kinds)
 
 
+#: what each kind of mode but sloshing is, for the listing that sets them apart (`jaxslosh modes`)
+KIND_NOTES = {
+    "acoustic": "compression of the liquid",
+    "circulation": "a numerical mode: vortical flow held by the element's rotation penalty (an ideal liquid "
+                   "has it at zero frequency)",
+    "spurious": "a numerical mode: a surface pattern about two elements long that the mesh cannot carry as a "
+                "wave (its energy is in the element's surface hourglass and bending terms)",
+    "wall": "the tank's elastic walls (a mode of the walls and the liquid together)",
+}
+
+
+def others_in_band(kinds) -> list:
+    """Indices of the modes (ascending frequency) that are not sloshing and lie below the highest
+    sloshing mode listed: the numerical modes among the sloshing band."""
+    kinds = list(kinds)
+    slosh = [i for i, k in enumerate(kinds) if k == "sloshing"]
+    if not slosh:
+        return []
+    return [i for i in range(slosh[-1]) if kinds[i] != "sloshing"]
+
+
 def analytic_sloshing_table(a: float, b: float, h: float, g: float, n: int):
     """The n lowest (omega, m, n) of a rigid a x b tank filled to h: omega^2 = g k tanh(k h),
     k = pi sqrt((m/a)^2 + (n/b)^2), m, n >= 0 not both zero (PHYSICS.md section 3)."""

@@ -36,7 +36,7 @@ import numpy as np
 
 from .mesh import HEX_CORNERS, box_elements, grid_index, grid_nodes
 from .meshfile import read_mesh_file
-from .slip import boundary
+from .slip import FEATURE_ANGLE, boundary
 
 SHAPES = ("box", "prismatic", "cylinder", "mesh")
 AXES = ("x", "y", "z")
@@ -255,7 +255,44 @@ def _prismatic(geo, h, mesh):
         y = ys_rest[g[:, 1]]
     else:
         y = lo + t * (hi - lo)
-    return np.stack([xs[g[:, 0]], y, zs[g[:, 2]]], axis=1)
+    z = zs[g[:, 2]]
+    if _low_hopper(geo, h):
+        # the layers up to the top chamfer's kink (else the surface) follow the bottom: columns
+        # between the vertical walls, each from the bottom up (see _low_hopper)
+        th = geo.chamfers[1][1]
+        zt = H - th if 0 < th and H - th < h else h
+        below = z <= zt * (1.0 + 1e-12)
+        y = np.where(below, t * b, y)
+        zb = _hopper_bottom(geo, y)
+        z = np.where(below, zb + (zt - zb) * z / zt, z)
+    return np.stack([xs[g[:, 0]], y, z], axis=1)
+
+
+def _hopper_bottom(geo, y):
+    """The height of the bottom (the hopper chamfers' floor) at y."""
+    a, b, H = geo.size
+    cw, ch = geo.chamfers[0]
+    return ch * np.clip(np.maximum(1.0 - y / cw, (y - (b - cw)) / cw), 0.0, None)
+
+
+def _low_hopper(geo, h) -> bool:
+    """A bottom chamfer flatter than slip.FEATURE_ANGLE, filled above its top, meshed with its layers
+    following the bottom. Layered as a steeper hopper is (the bottom layer between the chamfers,
+    its corner node on the kink), the element at the kink would have its floor and its chamfer face
+    on one smooth wall (fem/slip.py), a node there sliding with no energy of the stabilized element,
+    and the penalty that holds it (liquid_element.FLAT_CORNER_PENALTY) locks the liquid: an 8 m
+    section with (1.0, 0.3) chamfers filled to 1.2 m had its first mode 41 % high on 2x16x4. With
+    the layers following the bottom the kink's node is shared by two elements' floors, and the
+    corner at the wall is a box's corner (no extra constraint: `_extra_pairs` adds none); a flat V
+    bottom (chamfers meeting) is meshed the same way, with no collapsed row at its apex. Not with
+    baffles (their edges lie on flat layers), nor filled to within the hopper (the surface would
+    meet the floor in a collapsed column): those keep the layers flat."""
+    if geo.kind != "prismatic":
+        return False
+    cw, ch = geo.chamfers[0]
+    a, b, H = geo.size
+    return (0 < cw <= b / 2 * (1 + 1e-12) and 0 < ch < h and np.degrees(np.arctan2(ch, cw)) < FEATURE_ANGLE
+            and ch < H - geo.chamfers[1][1] and not geo.baffles)
 
 
 def _vertical_cylinder(size, h, mesh):
@@ -430,7 +467,7 @@ def _extra_pairs(geo, h, mesh, nodes):
         a, b, H = geo.size
         (cw, ch), (tw, th) = geo.chamfers
         zs = nodes[: nz + 1, 2]
-        kinks = [ch] if 0 < cw < b / 2 * (1 - 1e-12) and ch < h else []
+        kinks = [ch] if 0 < cw < b / 2 * (1 - 1e-12) and ch < h and not _low_hopper(geo, h) else []
         for z in kinks:
             k = int(np.argmin(np.abs(zs - z)))
             if 0 < k < nz:

@@ -18,6 +18,7 @@ from sloshing_reference import (
     cylinder_bessel_roots,
     horizontal_cylinder_half_full_first,
     polygon,
+    prism_sloshing_omegas,
     prismatic,
     rectangle,
     rectangular_omegas,
@@ -81,6 +82,23 @@ def test_rectangle_first_three_modes(a, d):
     exact = rectangular_omegas(a, d, G, 3)
     assert np.all(rel(w, exact) < 1e-3), (w, exact)
     assert np.all(rel(w, exact) < 1e-5), (w, exact)
+
+
+def test_prism_modes_box_closed_form_and_stokes_edge_waves():
+    """The 3-D modes of a prism (section x length, end walls): a box's, g kappa tanh(kappa d) with
+    kappa = pi sqrt((m / L)^2 + (n / b)^2), every (m, n) in order; in a 90-degree V the lowest mode
+    of wavenumber k along the length is Stokes' edge wave on each 45-degree wall, omega^2 = g k
+    sin(45 deg), twice (one per wall; they decay as exp(-k r) away from their wall)."""
+    b, d, length = 1.0, 0.5, 1.3
+    w, order = prism_sloshing_omegas(rectangle(b), d, length, G, n=6, h_target=0.05)
+    kappa = sorted((math.pi * math.hypot(m / length, n / b), m) for m in range(8) for n in range(8) if m + n)
+    exact = np.array([math.sqrt(G * k * math.tanh(k * d)) for k, _ in kappa[:6]])
+    assert np.all(rel(w, exact) < 1e-4), (w, exact)
+    assert list(order) == [m for _, m in kappa[:6]]
+    k = math.pi / 0.2
+    w, order = prism_sloshing_omegas(prismatic(2.0, 1.0, 1.0, 1.0), 0.8, 0.2, G, n=8, h_target=0.04)
+    edge = math.sqrt(G * k * math.sin(math.pi / 4))
+    assert list(order[6:]) == [1, 1] and np.all(rel(w[6:], edge) < 1e-3), (w, edge)
 
 
 def test_half_full_circle_mciver():
