@@ -70,7 +70,7 @@ def test_a_spurious_mode_among_the_sloshing_ones_is_printed_apart(tmp_path, caps
 def test_a_tank_with_elastic_walls_lists_its_modes(capsys):
     """scenes/paper_ship_elastic_tank.toml: its modes are the liquid's and the walls' together
     (`jaxslosh modes --json` failed on them: no circulation count)."""
-    path = os.path.join(os.path.dirname(os.path.dirname(os.path.abspath(__file__))), "scenes",
+    path = os.path.join(os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__)))), "scenes",
                         "paper_ship_elastic_tank.toml")
     assert main(["modes", path, "-n", "3", "--json"]) == 0
     out = json.loads(capsys.readouterr().out.strip().splitlines()[-1])

@@ -14,7 +14,7 @@ import pytest
 from jaxslosh.fem.liquid_rt import build_face_liquid, face_modes
 from jaxslosh.fem.shapes import TankGeometry, tank_mesh
 
-sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+sys.path.insert(0, os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 import shape_cases  # noqa: E402
 import sloshing_reference as ref  # noqa: E402
 
