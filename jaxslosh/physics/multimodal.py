@@ -54,7 +54,8 @@ from .kinematics import mv3, tv3
 from .liquid import AbstractLiquid
 from .terms import Kin, Rows
 
-#: quadrature points along the tank and through the depth (Gauss-Legendre)
+#: quadrature points along the tank (Gauss-Legendre; at least, and 8 per mode: the integrands hold
+#: cos(k_2N x) exp(k_2N zeta)) and through the depth (the reference quadrature over the liquid)
 NX, NZ = 48, 20
 #: terms of the vortical flow's series (`ModalTank.vortical`)
 SJ_TERMS = 40
@@ -107,6 +108,11 @@ class ModalTank(eqx.Module):
     k: jax.Array          # (N,) k_n = n pi / L
     xq: jax.Array         # (NX,) quadrature points on [0, L]
     wq: jax.Array         # (NX,) their weights
+    cx: jax.Array         # (NX, N) cos(k_n x_q), sin(k_n x_q): the tables of the integrals
+    sx: jax.Array
+    cj: jax.Array         # (NX, 2N + 1) cos(j pi x_q / L)
+    cm: jax.Array         # (NX, SJ_TERMS) cos(kappa_m xi_q), sin(kappa_m xi_q) (`vortical`)
+    sm: jax.Array
     vort0: tuple          # the vortical integrals (Bw, W, wint, Zwx, Xwz) at rest less their surface terms
     S0: jax.Array         # (3,) the first moment at rest (vessel frame)
 
@@ -139,8 +145,7 @@ class ModalTank(eqx.Module):
         integrands are divergences of fields with no flux through the walls), all along x by Gauss
         quadrature over the instantaneous surface H(x) = h + zeta(x)."""
         k, x, w, ch = self.k, self.xq, self.wq, jnp.cosh(self.k * self.h)
-        n = self.n
-        cx, sx = jnp.cos(x[:, None] * k), jnp.sin(x[:, None] * k)         # (NX, N)
+        n, cx, sx = self.n, self.cx, self.sx
         H = self.h + cx @ beta                                             # (NX,)
         Hp = -(sx * k) @ beta                                               # dH/dx
         shH, chH = jnp.sinh(H[:, None] * k), jnp.cosh(H[:, None] * k)
@@ -151,7 +156,7 @@ class ModalTank(eqx.Module):
         kj = jnp.arange(2 * n + 1) * jnp.pi / self.L
         kj_ = jnp.where(kj > 0, kj, 1.0)
         Sj = jnp.where(kj > 0, jnp.sinh(H[:, None] * kj) / kj_, H[:, None])
-        Cj = jnp.cos(x[:, None] * kj)
+        Cj = self.cj
         i = np.arange(1, n + 1)
         P, M = i[:, None] + i[None, :], np.abs(i[:, None] - i[None, :])
         Ank = 0.5 * jnp.outer(k / ch, k / ch) * jnp.einsum("q,qnm->nm", w, Sj[:, P] * Cj[:, M] - Sj[:, M] * Cj[:, P])
@@ -180,7 +185,7 @@ class ModalTank(eqx.Module):
         f = jnp.exp(-kap * (d + eta[:, None]))
         den = 1.0 + jnp.exp(-2.0 * kap * d)
         sh, chh = (e - f) / den, (e + f) / den
-        Cm, Sm = jnp.cos(kap * xi[:, None]), jnp.sin(kap * xi[:, None])
+        Cm, Sm = self.cm, self.sm
         chi = (Sm * sh) @ (c / kap)
         wx = (Cm * sh) @ c
         wz = 2.0 * xi + (Sm * chh) @ c
@@ -340,18 +345,23 @@ class ModalTank(eqx.Module):
 def modal_tank(L, b, h, rho, origin, n_modes: int, D=None) -> ModalTank:
     """The tank, with its rest values (the vortical integrals less their surface terms, the first
     moment) formed once here by quadrature over the liquid at rest (`integrals_quadrature`)."""
-    xg, wg = np.polynomial.legendre.leggauss(NX)
+    nx = max(NX, 8 * n_modes)
+    xg, wg = np.polynomial.legendre.leggauss(nx)
     L = jnp.asarray(L, dtype=float)
     D = 2.0 * jnp.asarray(h, dtype=float) if D is None else jnp.asarray(D, dtype=float)
     z = jnp.zeros(n_modes)
+    x = 0.5 * L * (jnp.asarray(xg) + 1.0)
+    k = jnp.arange(1, n_modes + 1) * jnp.pi / L
+    kap = (2 * jnp.arange(SJ_TERMS) + 1) * jnp.pi / L
     t = ModalTank(L=L, b=jnp.asarray(b, dtype=float), h=jnp.asarray(h, dtype=float), D=D,
                   rho=jnp.asarray(rho, dtype=float), origin=jnp.asarray(origin, dtype=float),
-                  k=jnp.arange(1, n_modes + 1) * jnp.pi / L,
-                  xq=0.5 * L * (jnp.asarray(xg) + 1.0), wq=0.5 * L * jnp.asarray(wg),
+                  k=k, xq=x, wq=0.5 * L * jnp.asarray(wg), cx=jnp.cos(x[:, None] * k), sx=jnp.sin(x[:, None] * k),
+                  cj=jnp.cos(x[:, None] * jnp.arange(2 * n_modes + 1) * jnp.pi / L),
+                  cm=jnp.cos(kap * (x[:, None] - 0.5 * L)), sm=jnp.sin(kap * (x[:, None] - 0.5 * L)),
                   vort0=(z, jnp.zeros(()), jnp.zeros(2), jnp.zeros(()), jnp.zeros(())), S0=jnp.zeros(3))
     I = t.integrals_quadrature(z)
-    w, x, H = t.wq, t.xq, jnp.full(NX, t.h)
-    chi, flux, Gx, Gz, Gux = t._vortical_surface(H, jnp.zeros(NX))
+    w, H = t.wq, jnp.full(nx, t.h)
+    chi, flux, Gx, Gz, Gux = t._vortical_surface(H, jnp.zeros(nx))
     phis = jnp.cos(x[:, None] * t.k)
     vort0 = (I.Bw - (w * flux) @ phis, I.W - w @ (chi * flux + (x - 0.5 * L) * 2.0 * Gz),
              I.wint - jnp.stack([w @ Gx, w @ Gz]), I.Zwx - w @ Gux, I.Xwz - (w * x) @ Gz)
