@@ -175,3 +175,20 @@ def test_batch_of_fill_depths_matches_single_runs():
     one = js.simulate(scene, params={"tanks.tank.fill_depth": 0.45})
     np.testing.assert_allclose(np.asarray(r.probes["wall"].displacement)[0], np.asarray(one.probes["wall"].displacement),
                                rtol=1e-7, atol=1e-10)
+
+
+def test_steep_surface_warns_with_its_time():
+    """The run's validity watch: a multimodal surface steeper than tan 30 deg (breaking) is said with
+    the frame's time; a gentler one is not."""
+    from jaxslosh.run.validity import Watch
+    scene = js.load_scene(FORCED.format(duration=1.0, amplitude=0.001, w=4.0, ratio=0.1))
+    w = Watch(scene)
+    beta = np.zeros((3, 5))
+    beta[1, 0] = 0.5 / np.pi           # slope k_1 beta_1 = 0.5 at mid-tank: steep, not breaking
+    beta[2, 1] = 0.31 / np.pi          # k_2 beta_2 = 0.62
+    surface = np.zeros((3, 1, 2))
+    w.update(np.array([0.1, 0.2, 0.3])[:2], surface[:2], np.zeros(2), beta[:2])
+    assert not any("slope" in m for m in w.warnings())
+    w.update(np.array([0.3]), surface[2:], np.zeros(1), beta[2:])
+    msg = [m for m in w.warnings() if "slope" in m]
+    assert len(msg) == 1 and "t = 0.3 s" in msg[0] and "0.62" in msg[0] and "tanks[0]" in msg[0], msg
