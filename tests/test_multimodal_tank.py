@@ -192,3 +192,15 @@ def test_steep_surface_warns_with_its_time():
     w.update(np.array([0.3]), surface[2:], np.zeros(1), beta[2:])
     msg = [m for m in w.warnings() if "slope" in m]
     assert len(msg) == 1 and "t = 0.3 s" in msg[0] and "0.62" in msg[0] and "tanks[0]" in msg[0], msg
+
+
+def test_modes_command_lists_the_linear_frequencies(tmp_path, capsys):
+    """`jaxslosh modes` on a multimodal tank: its own modes, omega^2 = g k tanh(k h), at most `modes`."""
+    import json
+    p = tmp_path / "s.toml"
+    p.write_text(FORCED.format(duration=1.0, amplitude=0.001, w=4.0, ratio=0.1))
+    assert main(["modes", str(p), "-n", "8", "--json"]) == 0
+    out = json.loads(capsys.readouterr().out)
+    k = np.arange(1, 6) * np.pi / L
+    np.testing.assert_allclose(out["omega"], np.sqrt(G * k * np.tanh(k * H)), rtol=1e-12)
+    assert out["kind"] == ["sloshing"] * 5
