@@ -1,6 +1,8 @@
 """Natural modes of a scene's tank liquid or flexible structure, the vessel held fixed (`jaxslosh modes`)."""
 from __future__ import annotations
 
+import numpy as np
+
 from ..assemble.effects import free_liquid_dofs
 from ..fem.liquid import build_liquid
 from ..fem.liquid_rt import build_face_liquid, face_modes
@@ -16,6 +18,8 @@ from ..solve.sparse import SPARSE_AUTO
 def sloshing_modes(scene: Scene, tank=None, n: int = 10):
     """The first n modes of a tank's liquid: `Modes(omega, kind, free_surface_share, shapes)`."""
     t = scene.tank(tank) if tank is not None else scene.tanks[0]
+    if t.model == "multimodal":
+        return _multimodal_modes(scene, t, n)
     if t.fluid.element == "rt":
         return _face_modes(scene, t, n)
     # large meshes as the simulation takes them: sparse matrices and shift-invert Lanczos (a dense
@@ -27,6 +31,17 @@ def sloshing_modes(scene: Scene, tank=None, n: int = 10):
     if t.wall_spec is not None:       # the liquid and its elastic walls together (kinds add "wall")
         return tank_modes(build_tank_with_walls(t, model), n=n)
     return liquid_modes(model, n=n)
+
+
+def _multimodal_modes(scene: Scene, t, n: int) -> Modes:
+    """A multimodal tank's own modes, at most its `modes`: the standing waves along its length,
+    omega_n^2 = g k_n tanh(k_n h), k_n = n pi / L (physics/multimodal.py), each a free-surface mode; the
+    shapes are the surface elevation cos(k_n x) at the fill depth's sample points."""
+    n = min(n, t.modes)
+    k = np.arange(1, n + 1) * np.pi / t.size[0]
+    x = np.linspace(0.0, t.size[0], 33)
+    return Modes(omega=np.sqrt(scene.environment.gravity * k * np.tanh(k * t.fill_depth)), kind=("sloshing",) * n,
+                 free_surface_share=np.ones(n), shapes=np.cos(np.outer(k, x)))
 
 
 def _face_modes(scene: Scene, t, n: int) -> Modes:

@@ -21,7 +21,8 @@ R = A_nk^-1 (dA_n / d beta) beta_dot, and the liquid's kinetic energy is a funct
 beta_dot and the tank's velocities. The modal system used here is that Lagrangian's, the general
 (Lukovsky-type) system truncated at N modes with no ordering of the amplitudes: it holds the
 third-order (Moiseev-type) system of Faltinsen et al. 2000 and goes beyond it. The integrals are
-evaluated exactly in beta at every step, by Gauss quadrature over the instantaneous liquid.
+evaluated exactly in beta at every step: in closed form through the depth, by Gauss quadrature along
+the tank (`ModalTank.integrals`).
 
 The tank moves with the vessel: a particle's velocity is V_b + omega x r + grad phi + q w (body
 frame), with q = omega_y the pitch rate and w the vortical flow relative to the tank that keeps the
@@ -53,10 +54,24 @@ from .kinematics import mv3, tv3
 from .liquid import AbstractLiquid
 from .terms import Kin, Rows
 
-#: quadrature points along the tank and through the depth (Gauss-Legendre)
+#: quadrature points along the tank (Gauss-Legendre; at least, and 8 per mode: the integrands hold
+#: cos(k_2N x) exp(k_2N zeta)) and through the depth (the reference quadrature over the liquid)
 NX, NZ = 48, 20
 #: terms of the vortical flow's series (`ModalTank.vortical`)
 SJ_TERMS = 40
+
+
+@jax.custom_jvp
+def spd_inverse(A):
+    """A^-1, its derivatives -X dA X in matrix products only: differentiated twice (the rows take
+    the mass matrix's derivative, Newton the rows'), a solve's would factorise batches of matrices."""
+    return jnp.linalg.inv(A)
+
+
+@spd_inverse.defjvp
+def _spd_inverse_jvp(primals, tangents):
+    X = spd_inverse(primals[0])
+    return X, -X @ tangents[0] @ X
 
 
 class Integrals(NamedTuple):
@@ -93,8 +108,13 @@ class ModalTank(eqx.Module):
     k: jax.Array          # (N,) k_n = n pi / L
     xq: jax.Array         # (NX,) quadrature points on [0, L]
     wq: jax.Array         # (NX,) their weights
-    sq: jax.Array         # (NZ,) points on [0, 1] through the depth
-    ws: jax.Array         # (NZ,) their weights
+    cx: jax.Array         # (NX, N) cos(k_n x_q), sin(k_n x_q): the tables of the integrals
+    sx: jax.Array
+    cj: jax.Array         # (NX, 2N + 1) cos(j pi x_q / L)
+    cm: jax.Array         # (NX, SJ_TERMS) cos(kappa_m xi_q), sin(kappa_m xi_q) (`vortical`)
+    sm: jax.Array
+    vort0: tuple          # the vortical integrals (Bw, W, wint, Zwx, Xwz) at rest less their surface terms
+    S0: jax.Array         # (3,) the first moment at rest (vessel frame)
 
     @property
     def n(self) -> int:
@@ -119,17 +139,72 @@ class ModalTank(eqx.Module):
 
     # ------------------------------------------------------------------ integrals
     def integrals(self, beta) -> Integrals:
+        """The integrals at beta, exact through the depth: the potential's in closed form (products of
+        cosh(k_n u) make sinh(k_j H) / k_j with k_j = j pi / L, j = |n - m| or n + m), the vortical
+        flow's from their values at rest (`vort0`) plus the flux through the free surface (Green: the
+        integrands are divergences of fields with no flux through the walls), all along x by Gauss
+        quadrature over the instantaneous surface H(x) = h + zeta(x)."""
+        k, x, w, ch = self.k, self.xq, self.wq, jnp.cosh(self.k * self.h)
+        n, cx, sx = self.n, self.cx, self.sx
+        H = self.h + cx @ beta                                             # (NX,)
+        Hp = -(sx * k) @ beta                                               # dH/dx
+        shH, chH = jnp.sinh(H[:, None] * k), jnp.cosh(H[:, None] * k)
+        An = w @ (cx * shH) / (k * ch)
+        phis = cx * chH / ch                                                # phi_n at the surface
+        Jn = jnp.einsum("q,qn,qj->nj", w, phis, cx)
+        # sinh(k_j H) / k_j (H for j = 0) and cos(k_j x), j = 0..2N
+        kj = jnp.arange(2 * n + 1) * jnp.pi / self.L
+        kj_ = jnp.where(kj > 0, kj, 1.0)
+        Sj = jnp.where(kj > 0, jnp.sinh(H[:, None] * kj) / kj_, H[:, None])
+        Cj = self.cj
+        i = np.arange(1, n + 1)
+        P, M = i[:, None] + i[None, :], np.abs(i[:, None] - i[None, :])
+        Ank = 0.5 * jnp.outer(k / ch, k / ch) * jnp.einsum("q,qnm->nm", w, Sj[:, P] * Cj[:, M] - Sj[:, M] * Cj[:, P])
+        grad = jnp.stack([-(w @ (sx * shH)) / ch, (w @ (cx * (chH - 1.0))) / ch], axis=-1)
+        Zux = -(w @ (sx * (H[:, None] * shH - (chH - 1.0) / k))) / ch
+        Xuz = ((w * x) @ (cx * (chH - 1.0))) / ch
+        chi, flux, Gx, Gz, Gux = self._vortical_surface(H, Hp)
+        xi = x - 0.5 * self.L
+        Bw0, W0, wint0, Zwx0, Xwz0 = self.vort0
+        vort = (Bw0 + (w * flux) @ phis, W0 + w @ (chi * flux + 2.0 * xi * Gz), wint0 + jnp.stack([w @ Gx, w @ Gz]),
+                Zwx0 + w @ Gux, Xwz0 + (w * x) @ Gz)
+        return Integrals(An, Jn, Ank, grad, Zux, Xuz, w @ H, w @ (x * H), w @ (0.5 * H ** 2), w @ (x * x * H),
+                         w @ (H ** 3 / 3.0), w @ (x * 0.5 * H ** 2),
+                         (w * x) @ cx, (w * H) @ cx, *vort)
+
+    def _vortical_surface(self, H, Hp):
+        """At the quadrature points' surface (x_q, H_q), slope Hp: chi, the flux w . (-H', 1) of the
+        vortical flow (`vortical`), and the depth primitives of w_x, w_z and u w_x (their values at
+        u = H; the vortical integrals' differences from rest are sums of these)."""
+        a, d = 0.5 * self.L, 0.5 * self.D
+        xi, eta = self.xq - a, H - d
+        m = jnp.arange(SJ_TERMS)
+        kap = (2 * m + 1) * jnp.pi / (2 * a)
+        c = -2.0 * (2.0 / a) * (-1.0) ** m / kap ** 2
+        e = jnp.exp(-kap * (d - eta[:, None]))
+        f = jnp.exp(-kap * (d + eta[:, None]))
+        den = 1.0 + jnp.exp(-2.0 * kap * d)
+        sh, chh = (e - f) / den, (e + f) / den
+        Cm, Sm = self.cm, self.sm
+        chi = (Sm * sh) @ (c / kap)
+        wx = (Cm * sh) @ c
+        wz = 2.0 * xi + (Sm * chh) @ c
+        Gx = (Cm * chh) @ (c / kap)
+        return chi, wz - Hp * wx, Gx, 2.0 * xi * H + chi, H * Gx - (Cm * sh) @ (c / kap ** 2)
+
+    def integrals_quadrature(self, beta) -> Integrals:
+        """The same integrals by Gauss quadrature over the liquid (NZ points through the depth): the
+        reference of `integrals`, and its vortical values at rest."""
         k, x, w = self.k, self.xq, self.wq
         H = self.h + jnp.cos(x[:, None] * k) @ beta                       # (NX,)
         ch = jnp.cosh(k * self.h)
         cx, sx = jnp.cos(x[:, None] * k), jnp.sin(x[:, None] * k)         # (NX, N)
-        # phi_n at the surface and the closed-form depth integral of cosh
         An = jnp.einsum("q,qn->n", w, cx * jnp.sinh(H[:, None] * k) / (k * ch))
         phis = cx * jnp.cosh(H[:, None] * k) / ch                          # (NX, N)
         Jn = jnp.einsum("q,qn,qj->nj", w, phis, cx)
-        # through the depth: u = H s, weight H ws
-        u = H[:, None] * self.sq[None, :]                                  # (NX, NZ)
-        wu = w[:, None] * H[:, None] * self.ws[None, :]
+        sg, sw = np.polynomial.legendre.leggauss(NZ)
+        u = H[:, None] * (0.5 * (sg[None, :] + 1.0))                      # (NX, NZ)
+        wu = w[:, None] * H[:, None] * (0.5 * sw[None, :])
         C = jnp.cosh(u[..., None] * k) / ch                               # (NX, NZ, N)
         S = jnp.sinh(u[..., None] * k) / ch
         gx = -k * sx[:, None, :] * C                                        # dphi/dx
@@ -185,7 +260,7 @@ class ModalTank(eqx.Module):
         """The potential's amplitudes R from the projected kinematic condition dA_n/dt = A_nk R_k."""
         return jnp.linalg.solve(I.Ank, I.Jn @ beta_dot)
 
-    def coupling(self, I: Integrals):
+    def coupling(self, I: Integrals, AJ=None):
         """(3, N), (3, N): the liquid's linear and angular momentum (body frame, about the vessel's
         origin) per unit beta_dot, of the flow relative to the tank. The linear one is the mass
         centre's rate dS/dt, which the true flow's momentum equals (Reynolds): unlike the truncated
@@ -197,9 +272,9 @@ class ModalTank(eqx.Module):
         P = rb * jnp.stack([I.dmx, jnp.zeros_like(I.dmx), I.dmz])
         gx, gz = I.grad[:, 0], I.grad[:, 1]
         Hn = rb * jnp.stack([yc * gz, I.Zux + o[2] * gx - I.Xuz - o[0] * gz, -yc * gx])
-        return P, Hn @ jnp.linalg.solve(I.Ank, I.Jn)
+        return P, Hn @ (jnp.linalg.solve(I.Ank, I.Jn) if AJ is None else AJ)
 
-    def pitch_block(self, I: Integrals):
+    def pitch_block(self, I: Integrals, gw=None):
         """The vortical flow's share of the kinetic energy, in omega: with R = A^-1 (J beta_dot - q Bw)
         (the kinematic condition with w's flux through the surface) the cross terms in q beta_dot
         cancel, leaving the (3, 3) block rho b (e_y c^T + c e_y^T + (W - Bw A^-1 Bw) e_y e_y^T),
@@ -209,24 +284,31 @@ class ModalTank(eqx.Module):
         gx, gz = I.grad[:, 0], I.grad[:, 1]
         Hn = jnp.stack([yc * gz, I.Zux + o[2] * gx - I.Xuz - o[0] * gz, -yc * gx])
         Hw = jnp.array([yc * I.wint[1], I.Zwx + o[2] * I.wint[0] - I.Xwz - o[0] * I.wint[1], -yc * I.wint[0]])
-        gw = jnp.linalg.solve(I.Ank, I.Bw)
+        gw = jnp.linalg.solve(I.Ank, I.Bw) if gw is None else gw
         c = Hw - Hn @ gw
         ey = jnp.array([0.0, 1.0, 0.0])
         return rb * (jnp.outer(ey, c) + jnp.outer(c, ey) + (I.W - I.Bw @ gw) * jnp.outer(ey, ey))
 
     def mass_matrix(self, beta):
         """(6 + N, 6 + N): the kinetic energy is exactly 1/2 v^T M(beta) v in v = (V_b, omega, beta_dot)."""
+        return self._mass(beta)[0]
+
+    def _mass(self, beta):
+        """(M(beta), (P, S(beta) - S0)): the mass matrix, the linear momentum per beta_dot, the first
+        moment's displacement from rest (one evaluation of the integrals and one solve with A_nk)."""
         I = self.integrals(beta)
         S, J = self.moments(I)
-        P, Hb = self.coupling(I)
+        G = spd_inverse(I.Ank) @ jnp.concatenate([I.Jn, I.Bw[:, None]], axis=1)
+        AJ, gw = G[:, :-1], G[:, -1]
+        P, Hb = self.coupling(I, AJ)
         m = self.rho * self.b * I.area
         Sx = jnp.array([[0.0, -S[2], S[1]], [S[2], 0.0, -S[0]], [-S[1], S[0], 0.0]])
-        Iw = jnp.trace(J) * jnp.eye(3) - J + self.pitch_block(I)
-        Mbb = self.rho * self.b * I.Jn.T @ jnp.linalg.solve(I.Ank, I.Jn)
+        Iw = jnp.trace(J) * jnp.eye(3) - J + self.pitch_block(I, gw)
+        Mbb = self.rho * self.b * I.Jn.T @ AJ
         top = jnp.concatenate([m * jnp.eye(3), -Sx, P], axis=1)
         mid = jnp.concatenate([Sx, Iw, Hb], axis=1)
         bot = jnp.concatenate([P.T, Hb.T, 0.5 * (Mbb + Mbb.T)], axis=1)
-        return jnp.concatenate([top, mid, bot], axis=0)
+        return jnp.concatenate([top, mid, bot], axis=0), (P, S - self.S0)
 
     def kinetic(self, Vb, omega, beta, beta_dot):
         """The liquid's kinetic energy (J) for the body-frame velocity V_b of the vessel's origin and omega."""
@@ -237,23 +319,23 @@ class ModalTank(eqx.Module):
         return self.moments(self.integrals(beta))[0]
 
     def rest_moment(self):
-        return self.first_moment(jnp.zeros(self.n))
+        return self.S0
 
     def potential(self, beta, g_b):
         """The gravity potential of the liquid's displacement from rest: -g_b . (S(beta) - S0)."""
-        return -g_b @ (self.first_moment(beta) - self.rest_moment())
+        return -g_b @ (self.first_moment(beta) - self.S0)
 
     def rows(self, Vb, omega, beta, beta_dot, Vb_dot, alpha, beta_dd, g_b):
         """Kirchhoff's equations (module docstring): (translation rows (body), rotation rows (body),
         modal rows), from the momenta p = M(beta) v and their rates M v_dot + (dM/dt) v."""
         v = jnp.concatenate([Vb, omega, beta_dot])
-        M, dM = jax.jvp(self.mass_matrix, (beta,), (beta_dot,))
+        # M and its derivatives along every beta_j in one forward pass (dM: (N, 6 + N, 6 + N))
+        (M, (P, dS)), (dM, _) = jax.vmap(lambda e: jax.jvp(self._mass, (beta,), (e,)),
+                                         out_axes=((None, (None, None)), 0))(jnp.eye(self.n, dtype=beta.dtype))
+        Mv = dM @ v                                                         # (N, 6 + N)
         p = M @ v
-        dp = M @ jnp.concatenate([Vb_dot, alpha, beta_dd]) + dM @ v
-        dT = jax.grad(lambda be: 0.5 * v @ (self.mass_matrix(be) @ v))(beta)
-        I = self.integrals(beta)
-        P = self.coupling(I)[0]
-        dS = self.moments(I)[0] - self.rest_moment()
+        dp = M @ jnp.concatenate([Vb_dot, alpha, beta_dd]) + beta_dot @ Mv
+        dT = 0.5 * Mv @ v
         P_lin, H = p[:3], p[3:6]
         f = dp[:3] + jnp.cross(omega, P_lin)
         m = dp[3:6] + jnp.cross(omega, H) + jnp.cross(Vb, P_lin) - jnp.cross(dS, g_b)
@@ -261,15 +343,29 @@ class ModalTank(eqx.Module):
 
 
 def modal_tank(L, b, h, rho, origin, n_modes: int, D=None) -> ModalTank:
-    xg, wg = np.polynomial.legendre.leggauss(NX)
-    sg, sw = np.polynomial.legendre.leggauss(NZ)
+    """The tank, with its rest values (the vortical integrals less their surface terms, the first
+    moment) formed once here by quadrature over the liquid at rest (`integrals_quadrature`)."""
+    nx = max(NX, 8 * n_modes)
+    xg, wg = np.polynomial.legendre.leggauss(nx)
     L = jnp.asarray(L, dtype=float)
     D = 2.0 * jnp.asarray(h, dtype=float) if D is None else jnp.asarray(D, dtype=float)
-    return ModalTank(L=L, b=jnp.asarray(b, dtype=float), h=jnp.asarray(h, dtype=float), D=D,
-                     rho=jnp.asarray(rho, dtype=float), origin=jnp.asarray(origin, dtype=float),
-                     k=jnp.arange(1, n_modes + 1) * jnp.pi / L,
-                     xq=0.5 * L * (jnp.asarray(xg) + 1.0), wq=0.5 * L * jnp.asarray(wg),
-                     sq=0.5 * (jnp.asarray(sg) + 1.0), ws=0.5 * jnp.asarray(sw))
+    z = jnp.zeros(n_modes)
+    x = 0.5 * L * (jnp.asarray(xg) + 1.0)
+    k = jnp.arange(1, n_modes + 1) * jnp.pi / L
+    kap = (2 * jnp.arange(SJ_TERMS) + 1) * jnp.pi / L
+    t = ModalTank(L=L, b=jnp.asarray(b, dtype=float), h=jnp.asarray(h, dtype=float), D=D,
+                  rho=jnp.asarray(rho, dtype=float), origin=jnp.asarray(origin, dtype=float),
+                  k=k, xq=x, wq=0.5 * L * jnp.asarray(wg), cx=jnp.cos(x[:, None] * k), sx=jnp.sin(x[:, None] * k),
+                  cj=jnp.cos(x[:, None] * jnp.arange(2 * n_modes + 1) * jnp.pi / L),
+                  cm=jnp.cos(kap * (x[:, None] - 0.5 * L)), sm=jnp.sin(kap * (x[:, None] - 0.5 * L)),
+                  vort0=(z, jnp.zeros(()), jnp.zeros(2), jnp.zeros(()), jnp.zeros(())), S0=jnp.zeros(3))
+    I = t.integrals_quadrature(z)
+    w, H = t.wq, jnp.full(nx, t.h)
+    chi, flux, Gx, Gz, Gux = t._vortical_surface(H, jnp.zeros(nx))
+    phis = jnp.cos(x[:, None] * t.k)
+    vort0 = (I.Bw - (w * flux) @ phis, I.W - w @ (chi * flux + (x - 0.5 * L) * 2.0 * Gz),
+             I.wint - jnp.stack([w @ Gx, w @ Gz]), I.Zwx - w @ Gux, I.Xwz - (w * x) @ Gz)
+    return eqx.tree_at(lambda m: (m.vort0, m.S0), t, (vort0, t.moments(I)[0]))
 
 
 class MultimodalLiquid(AbstractLiquid):

@@ -21,6 +21,24 @@ from ..scene.types import Scene
 #: iterations accept a stall up to 100 times that level; at the floor, residuals come within a few
 #: times of it, as round-off does)
 RESIDUAL_FACTOR = 10.0
+#: the free-surface slope past which a multimodal tank's waves are taken as breaking: tan 30 deg, the
+#: limiting crest of Stokes's wave (120 degrees), where a modal surface z = zeta(x) stops holding
+STEEP_SLOPE = float(np.tan(np.radians(30.0)))
+#: points per multimodal tank where the slope is read (walls included)
+SLOPE_SAMPLES = 65
+
+
+def _slope_rows(scene: Scene):
+    """Per multimodal tank, (offset of its modal amplitudes, (SLOPE_SAMPLES, modes) dzeta/dbeta_n at
+    the points): zeta = sum beta_n cos(k_n x), so its slope is -sum beta_n k_n sin(k_n x)."""
+    out, off = [], 0
+    for t in scene.tanks:
+        if t.model != "multimodal":
+            return []
+        k = np.arange(1, t.modes + 1) * np.pi / t.size[0]
+        out.append((off, -k * np.sin(np.outer(np.linspace(0.0, t.size[0], SLOPE_SAMPLES), k))))
+        off += t.modes
+    return out
 
 
 class Watch:
@@ -39,6 +57,9 @@ class Watch:
         self.heel = np.zeros(2)                  # largest |roll|, |pitch| seen past them, and when
         self.t_heel = np.zeros(2)
         self.capsized = [False, False]
+        self.slope_rows = _slope_rows(scene) if n else []
+        self.slope = np.zeros(len(self.slope_rows))     # steepest free surface of each multimodal tank, and when
+        self.t_slope = np.zeros(len(self.slope_rows))
 
     def watch_capsize(self, angles) -> None:
         """Check the frames' roll and pitch against these angles of vanishing stability (rad; None
@@ -66,6 +87,13 @@ class Watch:
                 self.low[i], self.t_low[i] = surface[j, i, 0], time[j]
             if surface[k, i, 1] > self.high[i]:
                 self.high[i], self.t_high[i] = surface[k, i, 1], time[k]
+        if field is not None and self.slope_rows:
+            d = np.asarray(field, float).reshape(time.size, -1)
+            for i, (off, rows) in enumerate(self.slope_rows):
+                s = np.abs(d[:, off:off + rows.shape[1]] @ rows.T).max(axis=1)
+                j = int(np.argmax(s))
+                if s[j] > self.slope[i]:
+                    self.slope[i], self.t_slope[i] = s[j], time[j]
         residual = np.asarray(residual, float)
         level = np.full(time.size, self.scene.simulation.tolerance)
         if field is not None and self.noise > 0:
@@ -96,6 +124,11 @@ class Watch:
             if self.low[i] < -t.fill_depth:
                 out.append(f"{where}: the free surface fell {-self.low[i]:.3g} m at t = {self.t_low[i]:.4g} s, "
                            f"below the floor ({t.fill_depth:.3g} m deep): {model} is outside its validity")
+        for i, s in enumerate(self.slope):
+            if s > STEEP_SLOPE:
+                out.append(f"tanks[{i}] ({self.scene.tanks[i].name!r}): the free surface's slope reached {s:.3g} at "
+                           f"t = {self.t_slope[i]:.4g} s, steeper than {STEEP_SLOPE:.3g} (the 120 degree crest "
+                           f"where waves break): the multimodal liquid is outside its validity")
         tol = self.scene.simulation.tolerance
         if self.residual > RESIDUAL_FACTOR * self.level:
             floor = "" if self.level <= tol else \

@@ -166,3 +166,15 @@ def test_rotation_keeps_the_liquid_irrotational():
     full = modal_tank(1.0, 1.0, 1.0 - 1e-9, 1000.0, (-0.5, -0.5, -0.5), 3, D=1.0)
     M = full.mass_matrix(jnp.zeros(3))
     assert float(M[4, 4]) / (1000.0 / 6.0) == pytest.approx(0.157, rel=5e-3)
+
+
+def test_closed_form_integrals_are_the_quadrature_over_the_liquid():
+    """`integrals` (closed forms through the depth, the vortical flow's by its flux through the free
+    surface) against Gauss quadrature over the whole deflected liquid, pitch terms included."""
+    t = modal_tank(1.0, 0.4, 0.5, 1000.0, (-0.5, -0.2, -0.3), 5, D=0.8)
+    beta = jnp.array([0.09, -0.03, 0.02, 0.01, -0.005])
+    a, b = t.integrals(beta), t.integrals_quadrature(beta)
+    for name in a._fields:
+        np.testing.assert_allclose(getattr(a, name), getattr(b, name), rtol=1e-9, atol=1e-11, err_msg=name)
+    np.testing.assert_allclose(jax.jacfwd(lambda be: t.integrals(be).W)(beta),
+                               jax.jacfwd(lambda be: t.integrals_quadrature(be).W)(beta), rtol=1e-8, atol=1e-10)
