@@ -213,7 +213,7 @@ def test_rao_of_a_multimodal_tank_is_the_finite_elements_along_its_length():
     (the 5 x 5 x 5 mesh's own first mode is off linear theory there)."""
     from pathlib import Path
     from test_frequency import with_hull
-    text = (Path(__file__).resolve().parents[1] / "scenes" / "paper_ship_tank.toml").read_text()
+    text = (Path(__file__).resolve().parents[2] / "scenes" / "paper_ship_tank.toml").read_text()
     fem = text.replace('walls = "rigid"', 'walls = "rigid"\n[tanks.reduction]\nmodes = 20')
     mm = text.replace('mesh = [5, 5, 5]\nwalls = "rigid"', 'model = "multimodal"\nmodes = 20')
     w = np.array([0.6, 1.0, 1.5, 2.3])
