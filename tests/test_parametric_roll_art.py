@@ -48,7 +48,14 @@ def test_anti_roll_tank_suppresses_parametric_roll(monkeypatch):
     roll_art, roll_frozen = last_peak(sloshing, 10.0), last_peak(solid, 10.0)
     print(f"\nroll peaks over the last 10 s of 50: liquid frozen {roll_frozen:.3f} deg, sloshing "
           f"{roll_art:.3f} deg (start {start:.3f} deg); ratio {roll_art / roll_frozen:.4f}")
-    # measured: frozen 13.3 degrees (4.6 times the start), sloshing 0.04 degrees, ratio 0.003
+    # measured: frozen 13.1 degrees (4.6 times the start), sloshing 0.04 degrees, ratio 0.003
     assert roll_frozen > 3.5 * start
     assert roll_art < 0.1 * start
     assert roll_art < 0.02 * roll_frozen
+    # the shallow liquid stays where its linear model holds: its free surface (the nodes' vertical
+    # displacement in the tank, from the start's level surface in the heeled tank on) never reaches
+    # the floor, 0.082 m below it (measured: 0.066 m, in the first seconds)
+    depth = art.tanks[0].fill_depth
+    rise = float(np.abs(np.asarray(sloshing.tanks["art"].displacement)[..., 2]).max())
+    print(f"free surface: largest |rise| in the tank {rise:.4f} m of the {depth} m depth")
+    assert rise < depth
