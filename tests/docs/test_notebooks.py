@@ -80,3 +80,22 @@ def test_campaign_notebook_runs():
     modes = dict((d, float(w)) for w, d in re.findall(r"^\s*\d+\s+([\d.]+)\s+[\d.]+\s+[\d.]+\s+(\w+) \(", text, re.M))
     assert abs(roll_w - modes["roll"]) < 0.06 and abs(pitch_w - modes["pitch"]) < 0.06, (roll_w, pitch_w, modes)
     assert "liquid" in modes
+
+
+@pytest.mark.slow
+def test_parametric_roll_notebook_runs():
+    """A few minutes at the small size (each wave frequency of the map compiles once)."""
+    text = printed(run_notebook("parametric_roll.ipynb", {"JAXSLOSH_NOTEBOOK_SMALL": "1"}, timeout=1800))
+    (start,) = numbers(r"roll disturbance ([\d.]+) deg", text)
+    peaks = {name: float(v) for name, v in re.findall(
+        r"^(nonlinear|linear|anti-roll tank)\s+ok: roll peak over the last 10 s\s+([\d.]+) deg", text, re.M)}
+    # 20 s: the nonlinear roll has grown, the linear one and the tank's have decayed
+    assert peaks["nonlinear"] > start > peaks["linear"] and peaks["anti-roll tank"] < 0.5 * start, peaks
+    # the tank frozen and added back is the plain ship
+    (d,) = numbers(r"largest difference ([\d.e+-]+) deg", text)
+    assert d < 1e-6, d
+    # the hull's GM on the scene's wave swings about its mean by about 30 %, above the damping's threshold
+    (h,) = numbers(r"mean [\d.]+ m, h = ([\d.]+)", text)
+    (threshold,) = numbers(r"threshold h = 4 lambda / omega_0 = ([\d.]+)", text)
+    assert threshold < 0.2 < h < 0.4, (h, threshold)
+    assert "not ok" not in text
