@@ -6,7 +6,7 @@ parametric_roll.toml's ship) the 3-degree disturbance grows; with the liquid slo
 
 Coarse and short: dt = 0.1 s (25 steps a wave period; the scene's 0.05 s gives the same peaks
 within 2 %) and 50 s, by when the frozen roll has grown more than fourfold.
-`pytest tests/test_parametric_roll_art.py -s` prints the peaks."""
+`pytest tests/hull/test_parametric_roll_art.py -s` prints the peaks."""
 from pathlib import Path
 
 import numpy as np
@@ -15,7 +15,7 @@ import jaxslosh as js
 from jaxslosh.scene.keys import with_overrides
 from test_anti_roll import frozen_params
 
-SCENES = Path(__file__).resolve().parents[1] / "scenes"
+SCENES = Path(__file__).resolve().parents[2] / "scenes"
 
 
 def last_peak(result, window: float) -> float:
