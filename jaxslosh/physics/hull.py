@@ -145,12 +145,13 @@ class HullPressure(AbstractTerm):
         p = rg * (w.head(X, zeta, t) - zeta) / 3.0                     # (6, n), the rule's weight in
         sa = 0.5 * wa * cross3(a[1] - a[0], a[2] - a[0])                # (3, n) area vectors
         sb = 0.5 * wb * cross3(b[1] - b[0], b[2] - b[0])
-        pa, pb = p[:3].sum(axis=0), p[3:].sum(axis=0)
-        ra = (p[:3] * x[:, :3]).sum(axis=1)                            # (3, n) sum of p x per piece
-        rb = (p[3:] * x[:, 3:]).sum(axis=1)
-        F = -(pa * sa + pb * sb).sum(axis=1)
-        M = -(cross3(ra, sa) + cross3(rb, sb)).sum(axis=1)
-        return A @ F, M
+        s6 = jnp.stack([sa] * 3 + [sb] * 3, axis=1)                    # (3, 6, n) each point's piece
+        # force and moment per unit pressure at each point, contracted with the pressures in one
+        # product: p is then computed once (in elementwise sums XLA repeated its cosines and
+        # exponentials in every fusion that reads it)
+        G = jnp.concatenate([s6, cross3(x, s6)])                         # (6, 6, n)
+        FM = -jnp.einsum("oqn,qn->o", G, p)
+        return A @ FM[:3], FM[3:]
 
     def force_moment(self, X0, A, t):
         if self.waves is None:
