@@ -19,6 +19,7 @@ import jax
 import jax.numpy as jnp
 import numpy as np
 
+from ..build.hull import froude_krylov_hull, hull_pressure
 from ..hydro.source import excitation_at, tables_of
 from ..hydro.tables import interpolate_radiation
 from ..scene.types import Scene, SceneError
@@ -140,6 +141,10 @@ def rao(scene: Scene, frequencies=None, headings=None, *, params=None,
     depth = scene.waves.depth if scene.waves is not None else None
     X = [excitation_at(ves.hydrodynamics, ves.hull, tables, w, b, env.water_density, env.gravity, depth)
          for b in heads]
+    if X[0] is None and hull_pressure(scene):
+        # Froude-Krylov on the wetted surface of a mesh hull: the small-wave limit of the incident
+        # pressure that the nonlinear hydrostatics integrate (build/hull.py), as a run takes it
+        X = [froude_krylov_hull(scene, w, np.full(w.shape, b)) for b in heads]
     if X[0] is None:
         raise SceneError("vessel.hull", "the RAO needs the wave forces: a box [vessel.hull] (Froude-Krylov) or "
                                         "excitation tables in [vessel.hydrodynamics] (or capytaine = true)")

@@ -21,15 +21,31 @@ MAX_DIVISIONS = 48
 
 def box_divisions(hull, waves) -> tuple:
     """Cells along the box's length, beam and depth: one in still water (the clipping is exact on
-    any box), else panels of a twelfth of the shortest wave length (or finer vertically, where the
-    pressure decays as exp(k z))."""
+    any box), else panels of a twelfth of the shortest wave length of the sea (or finer
+    vertically, where the pressure decays as exp(k z))."""
     if waves is None:
         return (1, 1, 1)
-    lam = 2.0 * math.pi / float(np.max(wavenumber(components(waves).omega, 9.81, waves.depth)))
+    # the top of an irregular sea's frequency range, not its highest drawn component: the panels
+    # then do not depend on the seed, and a campaign's cases share their model (and its compilation)
+    top = waves.omega if waves.type == "regular" else waves.omega_range[1]
+    lam = 2.0 * math.pi / float(np.max(wavenumber(np.array([top]), 9.81, waves.depth)))
     size = lam / PANELS_PER_WAVELENGTH
     n = [min(MAX_DIVISIONS, max(1, math.ceil(s / size))) for s in (hull.length, hull.beam, hull.depth)]
     n[2] = max(n[2], 4)
     return tuple(n)
+
+
+def hull_pressure(scene) -> bool:
+    """Whether the scene's restoring is the pressure on its wetted hull: the nonlinear
+    hydrostatics with the buoyancy effect on."""
+    hs = scene.vessel.hydrostatics
+    return hs is not None and hs.nonlinear and scene.effects.buoyancy
+
+
+def hull_waves(scene) -> bool:
+    """Whether the scene's incident waves act on its wetted hull: `hull_pressure` with [waves] and
+    the waves effect on."""
+    return hull_pressure(scene) and scene.waves is not None and scene.effects.waves
 
 
 def incident_waves(scene, params: dict) -> IncidentWaves:
@@ -97,8 +113,10 @@ def froude_krylov_surface(tris, z_water, omega, headings, rho=1025.0, g=9.81, de
 
 def froude_krylov_hull(scene, omega, headings=None):
     """`froude_krylov_surface` of the scene's hull at the wave components (the scene's heading
-    where `headings` is None), with the surface the nonlinear model integrates on."""
+    where `headings` is None), with the surface the nonlinear model integrates on (the scene's
+    water depth; deep water without [waves])."""
     hull, env, w = scene.vessel.hull, scene.environment, scene.waves
     divisions = box_divisions(hull, w) if hull.type == "box" else (1, 1, 1)
     return froude_krylov_surface(hull_triangles(hull, divisions), water_height(hull), omega,
-                                 w.heading if headings is None else headings, env.water_density, env.gravity, w.depth)
+                                 w.heading if headings is None else headings, env.water_density, env.gravity,
+                                 None if w is None else w.depth)

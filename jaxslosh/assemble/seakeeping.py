@@ -9,7 +9,7 @@ import numpy as np
 
 from ..hydro.radiation import RadiationFit
 from ..hydro.source import excitation_rao, excitation_source, radiation_fit
-from .hull import froude_krylov_hull
+from .hull import froude_krylov_hull, hull_pressure
 from ..hydro.spectra import components
 from ..hydro.tables import matrix6
 from ..physics.seakeeping import AddedMass, Excitation, LinearDamping, Memory, RadiationMemory, WaveExcitation
@@ -35,6 +35,18 @@ def make_excitation(waves, X, height) -> Excitation:
                       ramp=float(waves.ramp))
 
 
+def linear_excitation_rao(scene, c) -> Optional[np.ndarray]:
+    """X (N, 6) of the scene's linear wave excitation term at the components `c` (hydro/spectra.
+    components), None where it has none: the nonlinear hydrostatics integrate the incident
+    pressure on the wetted hull (physics/hull.py), so the linear term keeps only what that does
+    not hold (diffraction, from the tables), and nothing at all with Froude-Krylov forces alone."""
+    on_hull = hull_pressure(scene)
+    if on_hull and excitation_source(scene) == "froude-krylov":
+        return None
+    X = excitation_rao(scene, c.omega, c.headings)
+    return X - froude_krylov_hull(scene, c.omega, c.headings) if on_hull else X
+
+
 def build_seakeeping(scene, params: dict) -> tuple:
     """(terms, memory): the wave and radiation terms of a scene, with what its effects switch on,
     and the radiation memory whose states the integrator carries (None without). Host-side tables
@@ -42,17 +54,11 @@ def build_seakeeping(scene, params: dict) -> tuple:
     hydrodynamic coefficients); `waves.amplitude` / `waves.hs` may be traced."""
     eff, ves, waves = scene.effects, scene.vessel, scene.waves
     terms, memory = [], None
-    hs = ves.hydrostatics
-    # the nonlinear hydrostatics integrate the incident pressure on the wetted hull (physics/hull.py):
-    # the linear excitation keeps only what that does not hold (diffraction, from the tables)
-    on_hull = hs is not None and hs.nonlinear and eff.buoyancy
-    if waves is not None and eff.waves and not (on_hull and excitation_source(scene) == "froude-krylov"):
-        key = "waves.amplitude" if waves.type == "regular" else "waves.hs"
-        c = components(waves)
-        X = excitation_rao(scene, c.omega, c.headings)
-        if on_hull:
-            X = X - froude_krylov_hull(scene, c.omega, c.headings)
-        terms.append(WaveExcitation(make_excitation(waves, X, params.get(key, waves.height))))
+    if waves is not None and eff.waves:
+        X = linear_excitation_rao(scene, components(waves))
+        if X is not None:
+            key = "waves.amplitude" if waves.type == "regular" else "waves.hs"
+            terms.append(WaveExcitation(make_excitation(waves, X, params.get(key, waves.height))))
     hd = ves.hydrodynamics
     if hd is not None and eff.radiation:
         fit = radiation_fit(scene)

@@ -17,8 +17,8 @@ try:
 except ModuleNotFoundError:  # Python 3.10
     import tomli as tomllib  # type: ignore[no-redef]
 
-from ..assemble.seakeeping import make_excitation
-from ..hydro.source import excitation_rao
+from ..assemble.hull import hull_waves, incident_waves
+from ..assemble.seakeeping import linear_excitation_rao, make_excitation
 from ..hydro.spectra import components
 from ..scene.load import parse_scene
 from ..scene.types import Scene, SceneError
@@ -191,9 +191,17 @@ def _set_duration(text: str, duration: float) -> str:
 
 
 def sea_arrays(scene: Scene) -> tuple:
-    """(omega (N,), amp (6, N) per unit Hs, phase (6, N), Hs): the wave excitation the build of
-    `scene` makes (assemble/seakeeping.py), as the arrays a batch of seas runs on."""
+    """(omega (N,), amp (6, N) per unit Hs, phase (6, N), Hs, incident): the wave excitation the
+    build of `scene` makes (assemble/seakeeping.py), as the arrays a batch of seas runs on (zero
+    amplitudes where the scene has no linear excitation term); `incident` the components that the
+    nonlinear hydrostatics integrate on the wetted hull, (k, amp per unit Hs, phase, cos heading,
+    sin heading) each (N,) (assemble/hull.incident_waves), None for other scenes."""
     waves = scene.waves
     c = components(waves)
-    e = make_excitation(waves, excitation_rao(scene, c.omega, c.headings), waves.hs)
-    return np.asarray(e.omega), np.asarray(e.amp), np.asarray(e.phase), float(waves.hs)
+    X = linear_excitation_rao(scene, c)
+    e = make_excitation(waves, np.zeros((c.omega.size, 6)) if X is None else X, waves.hs)
+    incident = None
+    if hull_waves(scene):
+        w = incident_waves(scene, {})
+        incident = tuple(np.asarray(x) for x in (w.k, w.amp, w.phase, w.cb, w.sb))
+    return np.asarray(e.omega), np.asarray(e.amp), np.asarray(e.phase), float(waves.hs), incident

@@ -19,6 +19,7 @@ import jax
 import numpy as np
 from dask.distributed import Client, LocalCluster, as_completed
 
+from ..build.hull import hull_waves
 from ..io.campaign import PENDING, create_campaign, load_campaign, write_cases, write_summary
 from ..io.output import OutputLock
 from ..run.guard import Interrupted, interrupts
@@ -229,7 +230,9 @@ def _check_resume(old, template, cases, chans, attrs, path):
 
 def _structure(scene: Scene) -> tuple:
     w = scene.waves
-    return (w.components, w.directions if w.spreading > 0 else 1)
+    # the wetted hull's wave pressure is compiled for its depth and frequency range (campaign/worker.structure_scene)
+    return (w.components, w.directions if w.spreading > 0 else 1) + ((w.depth, w.omega_range) if hull_waves(scene)
+                                                                     else ())
 
 
 def _batches(scenes, todo, batch):

@@ -19,6 +19,7 @@ try:
 except ModuleNotFoundError:  # Python 3.10
     import tomli as tomllib  # type: ignore[no-redef]
 
+from ..build.hull import hull_waves
 from ..run.batch import capsize_angles, simulate_seas
 from ..run.capsize import capsize_reason
 from ..scene.load import parse_scene
@@ -53,9 +54,14 @@ def template_scene(text: str, path: str, duration: Optional[float]) -> Scene:
 
 def structure_scene(template: Scene, case: Scene) -> Scene:
     """The scene a batch is compiled for: the template with the case's sea structure (its
-    component count), the sea's values fixed; the runs replace its excitation by their own."""
+    component count; with the nonlinear hydrostatics, its depth and frequency range), the sea's
+    values fixed; the runs replace its excitation by their own."""
     w = dataclasses.replace(template.waves, spreading=case.waves.spreading, directions=case.waves.directions,
                             components=case.waves.components)
+    if hull_waves(template):
+        # the wetted hull's wave pressure is compiled for the depth, and its panels for the top of
+        # the frequency range (build/hull.box_divisions)
+        w = dataclasses.replace(w, depth=case.waves.depth, omega_range=case.waves.omega_range)
     return dataclasses.replace(template, waves=w)
 
 
@@ -70,8 +76,9 @@ def run_batch(text: str, path: str, duration: Optional[float], values: list, bat
     seas = [sea_arrays(s) for s in scenes]
     seas += [seas[-1]] * (batch - len(seas))
     omega, amp, phase, hs = (np.stack([s[k] for s in seas]) for k in range(4))
+    incident = None if seas[0][4] is None else tuple(np.stack([s[4][k] for s in seas]) for k in range(5))
     structure = structure_scene(template, scenes[0])
-    result, statuses = simulate_seas(structure, omega, amp, phase, hs)
+    result, statuses = simulate_seas(structure, omega, amp, phase, hs, incident)
     t = np.asarray(result.time)
     angles = capsize_angles(structure)
     out = []

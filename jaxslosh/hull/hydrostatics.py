@@ -10,63 +10,50 @@ from jax.custom_derivatives import SymbolicZero
 import jax.numpy as jnp
 import numpy as np
 
-from .clip import MIDPOINT_RULE, area_vectors, clip_below, submerged
+from .clip import lid_integrals, panels
 
 #: bisection steps of the sinkage at a fixed heel: the bracket (the hull's size) shrinks below round-off
 BISECTIONS = 52
 
 
-def buoyancy(tris, z_water, X0, A, shift=None):
+def buoyancy(P, z_water, X0, A, shift=None):
     """(V, m): the displaced volume and its first moment about the COG (body frame) for the pose
-    (X0 inertial, A body to inertial): the body's part below n_b . r = z_water - Z0, n_b = A^T e_z.
-    `shift` (3,), body frame: the surface is `tris + shift` (a traced KG moves the hull against the
-    COG); the plane moves the other way over the fixed triangles instead, so the tangent stays the
-    lid's (volume_below) and the triangles stay constants: V is unchanged and m gains shift V."""
+    (X0 inertial, A body to inertial) of the closed surface P (3, 3, n) (hull/clip.panels): the
+    body's part below n_b . r = z_water - Z0, n_b = A^T e_z. `shift` (3,), body frame: the surface
+    is `P + shift` (a traced KG moves the hull against the COG); the plane moves the other way over
+    the fixed triangles instead, so the tangent stays the lid's (volume_below) and the triangles
+    stay constants: V is unchanged and m gains shift V."""
     if shift is None:
-        return volume_below(tris, A[2], z_water - X0[2])
-    V, m = volume_below(tris, A[2], z_water - X0[2] - A[2] @ shift)
+        return volume_below(P, A[2], z_water - X0[2])
+    V, m = volume_below(P, A[2], z_water - X0[2] - A[2] @ shift)
     return V, m + shift * V
 
 
-def _lid_integrals(tris, n, c):
-    """(V, m, A, s, J): `submerged`'s volume and first moment below n . x <= c, and the area, first
-    moment and second moment (int x x^T dA) of the body's section by the plane (the lid), all from
-    the wetted pieces: the flux of x_a n through the closed clipped body is V n_a, that of
-    x_a x_b n is n_a m_b + n_b m_a, and the lid's share is what the wetted pieces leave."""
+def _below(P, n, c, second):
     nn = jnp.linalg.norm(n)
-    u, off = n / nn, c / nn
-    pieces = clip_below(tris, u, off).reshape(-1, 3, 3)
-    an = area_vectors(pieces) @ u                                  # (u . N) dS per piece
-    lam, w = MIDPOINT_RULE
-    x = jnp.einsum("qk,mkx->mqx", lam, pieces)                     # (m, 3, 3) quadrature points
-    zeta = x @ u - off
-    V = jnp.sum(an * (zeta @ w))
-    m = jnp.einsum("m,mq,mqx,q->x", an, zeta, x, w) - u * jnp.sum(an * ((0.5 * zeta ** 2) @ w))
-    area = -jnp.sum(an)
-    s = V * u - jnp.einsum("m,mqx,q->x", an, x, w)
-    J = jnp.outer(u, m) + jnp.outer(m, u) - jnp.einsum("m,mqx,mqy,q->xy", an, x, x, w)
-    return V, m, area, s, J, nn
+    return lid_integrals(P, n / nn, c / nn, second) + (nn,)
 
 
 @jax.custom_jvp
-def volume_below(tris, n, c):
-    """(V, m): the volume of the closed surface `tris` below the plane n . x <= c and its first
-    moment (hull/clip.submerged), with the derivative in the plane written out: moving the plane
-    sweeps the lid, so d V = (A dc - s . dn) / |n| and d m = (s dc - J dn) / |n| with the lid's
-    area A, first moment s and second moment J. The Newton preconditioner linearises the rows six
-    times per iteration; through the clipping each is a pass over every panel, from these
+def volume_below(P, n, c):
+    """(V, m): the volume of the closed surface P (3, 3, n) (hull/clip.panels) below the plane
+    n . x <= c and its first moment, with the derivative in the plane written out: moving the
+    plane sweeps the lid, so d V = (A dc - s . dn) / |n| and d m = (s dc - J dn) / |n| with the
+    lid's area A, first moment s and second moment J. The Newton preconditioner linearises the
+    rows six times per iteration; through the clipping each is a pass over every panel, from these
     integrals a 3 x 3 product. A tangent in the surface itself is differentiated through the
     clipping."""
-    return submerged(tris, n, c)
+    V, m, _, _, _, _ = _below(P, n, c, False)
+    return V, m
 
 
 def _volume_below_jvp(primals, tangents):
-    tris, n, c = primals
-    dt, dn, dc = tangents
-    if not isinstance(dt, SymbolicZero):          # the surface moves: differentiate the clipping
-        return jax.jvp(submerged, primals, tuple(jnp.zeros_like(p) if isinstance(t, SymbolicZero) else t
-                                                 for t, p in zip(tangents, primals)))
-    V, m, area, s, J, nn = _lid_integrals(tris, n, c)
+    P, n, c = primals
+    dP, dn, dc = tangents
+    if not isinstance(dP, SymbolicZero):          # the surface moves: differentiate the clipping
+        return jax.jvp(lambda *a: _below(*a, False)[:2], primals,
+                       tuple(jnp.zeros_like(p) if isinstance(t, SymbolicZero) else t for t, p in zip(tangents, primals)))
+    V, m, area, s, J, nn = _below(P, n, c, True)
     dn = jnp.zeros_like(n) if isinstance(dn, SymbolicZero) else dn
     dc = jnp.zeros_like(c) if isinstance(dc, SymbolicZero) else dc
     # the plane n . x = c moves along its unit normal by (dc - dn . x) / |n| at x
@@ -78,11 +65,11 @@ def _volume_below_jvp(primals, tangents):
 volume_below.defjvp(_volume_below_jvp, symbolic_zeros=True)
 
 
-def still_force_moment(tris, z_water, rho_g, X0, A, shift=None):
-    """F (inertial) and M (body, about the COG) of the still-water pressure: by the divergence
-    theorem rho g V e_z, and m x rho g n_b for the first moment m of the displaced volume (the
-    surface `tris + shift`, as `buoyancy`)."""
-    V, m = buoyancy(tris, z_water, X0, A, shift)
+def still_force_moment(P, z_water, rho_g, X0, A, shift=None):
+    """F (inertial) and M (body, about the COG) of the still-water pressure on the closed surface P
+    (3, 3, n): by the divergence theorem rho g V e_z, and m x rho g n_b for the first moment m of
+    the displaced volume (the surface `P + shift`, as `buoyancy`)."""
+    V, m = buoyancy(P, z_water, X0, A, shift)
     return jnp.array([0.0, 0.0, rho_g * V]), jnp.cross(m, rho_g * A[2])
 
 
@@ -94,8 +81,8 @@ def rest_hydrostatics(tris, z_water, rho=1025.0, g=9.81) -> dict:
     the loader calls it before the command line switches JAX to float64, so it uses no program
     that the run traces again (a constant cached in float32 would then meet float64 indices)."""
     with jax.enable_x64(True):
-        V, m, area, s, J, _ = (np.asarray(x) for x in _lid_integrals(
-            jnp.asarray(np.asarray(tris, dtype=np.float64)), jnp.array([0.0, 0.0, 1.0]), jnp.asarray(float(z_water))))
+        V, m, area, s, J = (np.asarray(x) for x in lid_integrals(
+            panels(np.asarray(tris, dtype=np.float64)), jnp.array([0.0, 0.0, 1.0]), jnp.asarray(float(z_water))))
     V = float(V)
     safe = V if V > 0 else 1.0
     return {"waterplane_area": float(area), "displaced_volume": V,
@@ -109,6 +96,7 @@ def gz_curve(tris, z_water, volume, S_over_mass, angles, axis: int = 0):
     to sink to the displaced `volume`, its trim (or heel) held; positive where the moment rights the
     vessel. `S_over_mass`: the centre of gravity in the frame (the liquid's weight moves it)."""
     reach = jnp.max(jnp.abs(tris)) + jnp.abs(z_water) + 1.0
+    P = panels(tris)
 
     def one(phi):
         # the body's up direction n_b = A^T e_z after a rotation phi about body x (roll) or y (pitch)
@@ -118,10 +106,10 @@ def gz_curve(tris, z_water, volume, S_over_mass, angles, axis: int = 0):
         def halve(_, bracket):
             lo, hi = bracket
             mid = 0.5 * (lo + hi)
-            V, _m = volume_below(tris, up, z_water - mid)
+            V, _m = volume_below(P, up, z_water - mid)
             return jnp.where(V > volume, mid, lo), jnp.where(V > volume, hi, mid)
         lo, hi = jax.lax.fori_loop(0, BISECTIONS, halve, (-reach, reach))
-        V, m = volume_below(tris, up, z_water - 0.5 * (lo + hi))
+        V, m = volume_below(P, up, z_water - 0.5 * (lo + hi))
         # the moment of buoyancy and weight about the COG over the weight: (x_B - x_G) x n_b
         lever = jnp.cross(m / V - S_over_mass, up)
         return -lever[axis]

@@ -35,14 +35,15 @@ import equinox as eqx
 import jax
 import jax.numpy as jnp
 
-from ..hull.clip import clip_below, integrate_pressure
+from ..hull.clip import cross3, cut_pieces, panels as coordinate_major
 from ..hull.hydrostatics import buoyancy, still_force_moment
 from .terms import AbstractTerm, Kin, Rows
 
 
 class IncidentWaves(eqx.Module):
     """Airy components: eta(x, y, t) = r(t) height sum_i amp_i cos(w_i t + eps_i - k_i (x cos b_i + y sin b_i))
-    (hydro/spectra.py's conventions, horizontal coordinates from the rest COG), r the scene's ramp."""
+    (hydro/spectra.py's conventions, horizontal coordinates from the rest COG), r the scene's ramp.
+    Points are coordinate-major: X (3, ...)."""
     omega: jax.Array      # (N,)
     k: jax.Array          # (N,)
     amp: jax.Array        # (N,) per unit `height`
@@ -61,20 +62,20 @@ class IncidentWaves(eqx.Module):
         return a
 
     def phases(self, X, t):
-        """theta (..., N) at inertial points X (..., 3)."""
-        return self.omega * t + self.phase - self.k * (X[..., 0:1] * self.cb + X[..., 1:2] * self.sb)
+        """theta (..., N) at inertial points X (3, ...)."""
+        return self.omega * t + self.phase - self.k * (X[0][..., None] * self.cb + X[1][..., None] * self.sb)
 
     def elevation_and_slope(self, X, t):
-        """eta (...,) and its horizontal gradient (..., 2) at X (..., 3)."""
+        """eta (...,) and its horizontal gradient (2, ...) at X (3, ...)."""
         a = self.factor(t)
         th = self.phases(X, t)
         c, s = jnp.cos(th), jnp.sin(th)
         eta = jnp.sum(a * c, axis=-1)
         aks = a * self.k * s
-        return eta, jnp.stack([jnp.sum(aks * self.cb, axis=-1), jnp.sum(aks * self.sb, axis=-1)], axis=-1)
+        return eta, jnp.stack([jnp.sum(aks * self.cb, axis=-1), jnp.sum(aks * self.sb, axis=-1)])
 
     def head(self, X, zeta, t):
-        """(...,) the dynamic pressure over rho g at X with zeta = Z - z_water, Wheeler-stretched."""
+        """(...,) the dynamic pressure over rho g at X (3, ...) with zeta = Z - z_water, Wheeler-stretched."""
         a = self.factor(t)
         c = a * jnp.cos(self.phases(X, t))
         eta = jnp.sum(c, axis=-1)
@@ -89,10 +90,17 @@ class IncidentWaves(eqx.Module):
         return jnp.sum(c * f, axis=-1)
 
 
+def _to_inertial(X0, A, x):
+    """X0 + A x for body points x (3, ...), coordinate-major, written out (elementwise, fused)."""
+    e = (Ellipsis,) + (None,) * (x.ndim - 1)
+    return X0[e] + A[:, 0][e] * x[0] + A[:, 1][e] * x[1] + A[:, 2][e] * x[2]
+
+
 class HullPressure(AbstractTerm):
     """Still-water pressure (and, with `waves`, the incident-wave pressure) on the instantaneous
-    wetted surface of the closed hull `tris` (n, 3, 3), body frame, outward."""
-    tris: jax.Array
+    wetted surface of the closed hull `tris` (n, 3, 3), body frame, outward; kept coordinate-major
+    (hull/clip.panels), the layout the clipping runs in."""
+    panels: jax.Array                       # (3, 3, n): vertex, coordinate, triangle
     rho_w: jax.Array
     gravity: jax.Array
     z_water: jax.Array                      # inertial height of the still water plane
@@ -100,40 +108,60 @@ class HullPressure(AbstractTerm):
     # (3,) body frame: the surface is tris + shift (a traced KG: assemble/hull.py); None: tris itself
     shift: Optional[jax.Array] = None
 
+    def __init__(self, tris, rho_w, gravity, z_water, waves=None, shift=None):
+        self.panels = coordinate_major(tris)
+        self.rho_w, self.gravity, self.z_water, self.waves, self.shift = rho_w, gravity, z_water, waves, shift
+
     def surface(self):
         """The closed surface (n, 3, 3) in the body frame, the shift applied."""
         return self.tris if self.shift is None else self.tris + self.shift
 
+    def surface_panels(self):
+        """The closed surface coordinate-major (3, 3, n), the shift applied."""
+        return self.panels if self.shift is None else self.panels + self.shift[None, :, None]
+
+    @property
+    def tris(self):
+        """The hull's triangles (n, 3, 3)."""
+        return jnp.moveaxis(self.panels, -1, 0)
+
     def buoyancy(self, X0, A):
         """(V, m): displaced volume and its first moment about the COG (body frame) in still water."""
-        return buoyancy(self.tris, self.z_water, X0, A, self.shift)
+        return buoyancy(self.panels, self.z_water, X0, A, self.shift)
 
     def still_force_moment(self, X0, A):
         """F (inertial) and M (body, about the COG) of the still-water pressure."""
-        return still_force_moment(self.tris, self.z_water, self.rho_w * self.gravity, X0, A, self.shift)
+        return still_force_moment(self.panels, self.z_water, self.rho_w * self.gravity, X0, A, self.shift)
 
     def wave_force_moment(self, X0, A, t):
         """F (inertial) and M (body) of the total pressure (hydrostatic and incident) on the part of
-        each triangle below the plane tangent to the incident surface at its centroid."""
-        w = self.waves
-        tris = self.surface()
-        cen = tris.mean(axis=1)                                      # (n, 3) body
-        C = X0 + cen @ A.T
+        each triangle below the plane tangent to the incident surface at its centroid, by the
+        edge-midpoint rule on each wetted piece (hull/clip.cut_pieces)."""
+        w, P = self.waves, self.surface_panels()
+        C = _to_inertial(X0, A, (P[0] + P[1] + P[2]) / 3.0)          # (3, n) centroids, inertial
         eta, slope = w.elevation_and_slope(C, t)
-        N_in = jnp.concatenate([-slope, jnp.ones_like(eta)[:, None]], axis=1)          # (n, 3)
-        off_in = self.z_water + eta - slope[:, 0] * C[:, 0] - slope[:, 1] * C[:, 1]
-        nb = N_in @ A                                                # A^T N_in, per row
-        ob = off_in - N_in @ X0
-        pieces = jax.vmap(lambda tri, n, o: clip_below(tri[None], n, o)[0])(tris, nb, ob)
+        N_in = jnp.stack([-slope[0], -slope[1], jnp.ones_like(eta)])  # (3, n)
+        off_in = self.z_water + eta - slope[0] * C[0] - slope[1] * C[1]
+        nb = A.T @ N_in                                              # body frame
+        ob = off_in - X0 @ N_in
+        size = jnp.sqrt(nb[0] ** 2 + nb[1] ** 2 + nb[2] ** 2)
+        a, b, wa, wb = cut_pieces(P, nb / size, ob / size)
         rg = self.rho_w * self.gravity
-
-        def pressure(x):
-            X = X0 + x @ A.T
-            zeta = X[..., 2] - self.z_water
-            return rg * (w.head(X, zeta, t) - zeta)
-
-        F, M = integrate_pressure(pieces, pressure, jnp.zeros(3))
-        return A @ F, M
+        # the three edge midpoints of both pieces: (3, 6, n) body points
+        x = jnp.stack([0.5 * (a[0] + a[1]), 0.5 * (a[1] + a[2]), 0.5 * (a[2] + a[0]),
+                       0.5 * (b[0] + b[1]), 0.5 * (b[1] + b[2]), 0.5 * (b[2] + b[0])], axis=1)
+        X = _to_inertial(X0, A, x)
+        zeta = X[2] - self.z_water
+        p = rg * (w.head(X, zeta, t) - zeta) / 3.0                     # (6, n), the rule's weight in
+        sa = 0.5 * wa * cross3(a[1] - a[0], a[2] - a[0])                # (3, n) area vectors
+        sb = 0.5 * wb * cross3(b[1] - b[0], b[2] - b[0])
+        s6 = jnp.stack([sa] * 3 + [sb] * 3, axis=1)                    # (3, 6, n) each point's piece
+        # force and moment per unit pressure at each point, contracted with the pressures in one
+        # product: p is then computed once (in elementwise sums XLA repeated its cosines and
+        # exponentials in every fusion that reads it)
+        G = jnp.concatenate([s6, cross3(x, s6)])                         # (6, 6, n)
+        FM = -jnp.einsum("oqn,qn->o", G, p)
+        return A @ FM[:3], FM[3:]
 
     def force_moment(self, X0, A, t):
         if self.waves is None:

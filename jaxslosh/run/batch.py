@@ -1,6 +1,7 @@
 """A batch of parameter sets in one compiled, vmapped loop (`jaxslosh sweep`)."""
 from __future__ import annotations
 
+import dataclasses
 import functools
 from typing import Optional
 
@@ -11,10 +12,11 @@ import numpy as np
 from jax.sharding import Mesh, NamedSharding, PartitionSpec
 
 from ..io.result import Result, result_from
-from ..staging import XLA_OPTIONS
+from ..physics.hull import HullPressure
 from ..physics.seakeeping import Excitation, WaveExcitation
 from ..scene.keys import check_values, with_overrides
 from ..scene.types import Scene, SceneError
+from ..staging import XLA_OPTIONS
 from .capsize import vanishing_angles
 from .loop import advance, concat_frames, core, frame_datasets, start
 from .simulate import failure_message, is_traced, prepare
@@ -23,24 +25,35 @@ from .simulate import failure_message, is_traced, prepare
 _BATCH_FNS: dict = {}
 
 
-def _excited(b, exc):
-    """The built model with its wave excitation replaced by `exc` (omega, amp, phase, height): the
-    runs of a campaign differ only in their sea, whose components are drawn on the host."""
+def _excited(b, exc, incident=None):
+    """The built model with its wave excitation replaced by `exc` (omega, amp, phase, height), and
+    with `incident` (k, amp, phase, cos heading, sin heading) the incident components that the
+    nonlinear hydrostatics integrate on the wetted hull: the runs of a campaign differ only in
+    their sea, whose components are drawn on the host."""
     omega, amp, phase, height = exc
-    terms = tuple(WaveExcitation(Excitation(omega, amp, phase, height, ramp=t.excitation.ramp))
-                  if isinstance(t, WaveExcitation) else t for t in b.system.terms)
-    if not any(isinstance(t, WaveExcitation) for t in terms):
+
+    def one(t):
+        if isinstance(t, WaveExcitation):
+            return WaveExcitation(Excitation(omega, amp, phase, height, ramp=t.excitation.ramp))
+        if incident is not None and isinstance(t, HullPressure) and t.waves is not None:
+            k, a, eps, cb, sb = incident
+            return eqx.tree_at(lambda h: h.waves, t, dataclasses.replace(t.waves, omega=omega, k=k, amp=a,
+                                                                          phase=eps, cb=cb, sb=sb, height=height))
+        return t
+    terms = tuple(one(t) for t in b.system.terms)
+    if all(x is y for x, y in zip(terms, b.system.terms)):
         raise ValueError("the scene has no wave excitation to replace")
     return b._replace(system=eqx.tree_at(lambda s: s.terms, b.system, terms))
 
 
-def _batch_fn(scene: Scene, keys: tuple, mesh: Optional[Mesh] = None, excited: bool = False):
+def _batch_fn(scene: Scene, keys: tuple, mesh: Optional[Mesh] = None, excited: bool = False,
+              incident: bool = False):
     """The jitted, vmapped run of a batch, kept per scene, keys, times and devices: a second batch
     of the same structure does not compile again. With a device `mesh` each device runs the vmap
     over its own runs (shard_map): the per-run loops of fem/linalg.py then stay on the device's
     share, where the compiler's partitioning of one global vmap gathered every run's matrices on
     every device."""
-    cache_key = (scene, keys, mesh, excited)
+    cache_key = (scene, keys, mesh, excited, incident)
     try:
         hit = _BATCH_FNS.get(cache_key)
     except TypeError:                 # an unhashable scene: no reuse
@@ -53,12 +66,14 @@ def _batch_fn(scene: Scene, keys: tuple, mesh: Optional[Mesh] = None, excited: b
     def one(*v):
         if excited:
             exc, v = v[:4], v[4:]
+        if incident:
+            inc, v = v[:5], v[5:]
         with jax.ensure_compile_time_eval():     # the liquid's matrices are built on the host, once
             setup = prepare(scene, dict(zip(keys, v)), batch=True)
         b = core(setup.built)
         b = b._replace(system=eqx.tree_at(lambda s: s.liquid, b.system, b.system.liquid.for_batch()))
         if excited:
-            b = _excited(b, exc)
+            b = _excited(b, exc, inc if incident else None)
         carry, f0 = start(b, setup.solver)
         carry, frames = advance(b, setup.solver, carry, n_frames, setup.save_every)
         fr = concat_frames([jax.tree_util.tree_map(lambda x: x[None], f0), frames])
@@ -113,14 +128,18 @@ def check_runs(scene: Scene, params: dict) -> list:
     return runs
 
 
-def simulate_seas(scene: Scene, omega, amp, phase, height) -> tuple[Result, list]:
+def simulate_seas(scene: Scene, omega, amp, phase, height, incident=None) -> tuple[Result, list]:
     """Runs of one scene in B seas, one compiled vmapped loop: each run's wave excitation is
     omega (B, N), amp (B, 6, N) per unit height, phase (B, 6, N) and height (B,) (the arrays
-    assemble/seakeeping.make_excitation makes of a scene's sea, all with the same component count).
-    Returns (result with a leading run axis, one status per run), as simulate_batch."""
+    assemble/seakeeping.make_excitation makes of a scene's sea, all with the same component count);
+    with the nonlinear hydrostatics, `incident` (k, amp, phase, cos heading, sin heading), each
+    (B, N), are the components on the wetted hull (campaign/cases.sea_arrays). Returns (result
+    with a leading run axis, one status per run), as simulate_batch."""
     vals = [jnp.asarray(x, dtype=float) for x in (omega, amp, phase, height)]
+    if incident is not None:
+        vals += [jnp.asarray(x, dtype=float) for x in incident]
     setup0 = _setup0(scene)
-    carry, fr = _batch_fn(scene, (), None, excited=True)(*vals)
+    carry, fr = _batch_fn(scene, (), None, excited=True, incident=incident is not None)(*vals)
     return _batch_result(scene, setup0, carry, fr, int(vals[0].shape[0]))
 
 
