@@ -19,7 +19,7 @@ import jax
 import jax.numpy as jnp
 import numpy as np
 
-from ..build.hull import froude_krylov_hull, hull_pressure
+from ..assemble.hull import froude_krylov_hull, hull_pressure
 from ..hydro.source import excitation_at, tables_of
 from ..hydro.tables import interpolate_radiation
 from ..scene.types import Scene, SceneError
@@ -143,7 +143,7 @@ def rao(scene: Scene, frequencies=None, headings=None, *, params=None,
          for b in heads]
     if X[0] is None and hull_pressure(scene):
         # Froude-Krylov on the wetted surface of a mesh hull: the small-wave limit of the incident
-        # pressure that the nonlinear hydrostatics integrate (build/hull.py), as a run takes it
+        # pressure that the nonlinear hydrostatics integrate (assemble/hull.py), as a run takes it
         X = [froude_krylov_hull(scene, w, np.full(w.shape, b)) for b in heads]
     if X[0] is None:
         raise SceneError("vessel.hull", "the RAO needs the wave forces: a box [vessel.hull] (Froude-Krylov) or "

@@ -19,7 +19,7 @@ import jax
 import numpy as np
 from dask.distributed import Client, LocalCluster, as_completed
 
-from ..build.hull import hull_waves
+from ..assemble.hull import hull_waves
 from ..io.campaign import PENDING, create_campaign, load_campaign, write_cases, write_summary
 from ..io.output import OutputLock
 from ..run.guard import Interrupted, interrupts

@@ -19,7 +19,7 @@ try:
 except ModuleNotFoundError:  # Python 3.10
     import tomli as tomllib  # type: ignore[no-redef]
 
-from ..build.hull import hull_waves
+from ..assemble.hull import hull_waves
 from ..run.batch import capsize_angles, simulate_seas
 from ..run.capsize import capsize_reason
 from ..scene.load import parse_scene
@@ -60,7 +60,7 @@ def structure_scene(template: Scene, case: Scene) -> Scene:
                             components=case.waves.components)
     if hull_waves(template):
         # the wetted hull's wave pressure is compiled for the depth, and its panels for the top of
-        # the frequency range (build/hull.box_divisions)
+        # the frequency range (assemble/hull.box_divisions)
         w = dataclasses.replace(w, depth=case.waves.depth, omega_range=case.waves.omega_range)
     return dataclasses.replace(template, waves=w)
 

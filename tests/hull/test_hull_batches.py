@@ -19,7 +19,7 @@ from jaxslosh.hull.surface import write_hull_mesh
 from jaxslosh.io.rao import load_rao
 from jaxslosh.run.batch import simulate_seas
 
-ROOT = Path(__file__).resolve().parents[1]
+ROOT = Path(__file__).resolve().parents[2]
 BOX_HULL = "[vessel.hull]\nlength = 20.0\nbeam = 10.0\ndraft = 3.0\nkg = 3.5\ndepth = 6.0\n"
 
 SCENE = """
