@@ -2,6 +2,8 @@
 invariants of physics/modal_liquid.py, computed once."""
 from __future__ import annotations
 
+import functools
+
 import jax.numpy as jnp
 import numpy as np
 import scipy.sparse as sp
@@ -11,6 +13,26 @@ from scipy.linalg import block_diag
 from ..fem.liquid_rt import FaceLiquid, face_basis, face_invariants
 from ..fem.reduction import tank_basis
 from ..physics.modal_liquid import ReducedLiquid
+
+
+@functools.lru_cache(maxsize=8)
+def _face_basis(model: FaceLiquid, origin: tuple, n: int, static: bool):
+    return face_basis(model, origin, n, static)
+
+
+def face_tank_basis(model: FaceLiquid, origin, n: int, static: bool):
+    """`face_basis` of a face-normal tank, computed once per model (the liquid block and the damping
+    of the same scene take the same basis; FaceLiquid hashes by identity)."""
+    return _face_basis(model, tuple(float(v) for v in origin), int(n), bool(static))
+
+
+def face_sloshing(model: FaceLiquid, V, n_modes: int) -> np.ndarray:
+    """The columns of V[:, :n_modes] (face_basis's modes) that are sloshing modes: most of their
+    energy in the free surface (fem/liquid_rt.py face_modes' rule)."""
+    Vm = V[:, :n_modes]
+    total = np.einsum("fi,fi->i", Vm, model.stiffness @ Vm)
+    surf = np.einsum("fi,fi->i", Vm, model.surface @ Vm)
+    return np.flatnonzero(surf > 0.5 * np.where(total > 0, total, np.inf))
 
 
 def reduce_liquid(models, concrete_models, origins, offsets, reductions):
@@ -30,7 +52,7 @@ def reduce_liquid(models, concrete_models, origins, offsets, reductions):
     coupled = any(m.rotation_coupling is not None or isinstance(m, FaceLiquid) for m in models)
     for model, cmodel, origin, off, (n, static) in zip(models, concrete_models, origins, offsets, reductions):
         if isinstance(model, FaceLiquid):         # the face-normal element: invariants are its fields' integrals
-            V, _, _, (Kdt_t, Ktt_t, kappa, k0) = face_basis(model, origin, n, static)
+            V, _, _, (Kdt_t, Ktt_t, kappa, k0) = face_tank_basis(model, origin, n, static)
             inv = face_invariants(model, V, origin)
             m = V.shape[1]
             Kr_t = inv["Kr"].copy()
