@@ -15,7 +15,7 @@ import scipy.sparse as sp
 
 from ..fem.damping import SPARSE_SEARCH, boundary_layer_ratios, sloshing_modes, sloshing_share
 from ..fem.liquid import build_liquid
-from ..fem.liquid_rt import FaceLiquid
+from ..fem.liquid_rt import FaceLiquid, face_modes
 from ..fem.modes import free_matrices
 from ..fem.reduction import tank_basis
 from ..physics.damping import ModalDamping
@@ -47,7 +47,15 @@ def build_damping(scene: Scene, params: Optional[dict], block) -> tuple[Optional
     parts, cs, table, offset = [], [], [], 0
     for i, (t, tb) in enumerate(zip(tanks, block.tanks)):
         model = tb.model
-        if isinstance(model, FaceLiquid):      # the face-normal element runs on its modal basis only
+        if isinstance(model, FaceLiquid) and not reduced:      # full order: its lowest modes, on the free faces
+            fm = face_modes(model, SPARSE_SEARCH)
+            slosh = np.array([k == "sloshing" for k in fm.kind], dtype=bool)
+            f = np.flatnonzero(model.free)
+            omega, Phi = fm.omega[slosh], fm.fluxes[slosh].T                # Phi on all faces (wall integrals)
+            n_t = f.size
+            Bt = model.mass[f][:, f] @ Phi[f]
+            where = f"the {SPARSE_SEARCH} lowest modes searched on this mesh hold {omega.size}"
+        elif isinstance(model, FaceLiquid):      # on its modal basis
             V, omega_b, n_modes, (_, _, _, k0) = face_tank_basis(model, t.origin, t.reduction.modes,
                                                                  t.reduction.static_correction)
             n_t = V.shape[1]

@@ -22,6 +22,7 @@ from ..physics.liquid import AbstractLiquid, Liquid, NoLiquid
 from ..scene.types import FACE_FORMS, Scene, SceneError
 from ..solve.sparse import SPARSE_AUTO, host_sparse
 from .effects import liquid_unknowns
+from .face_liquid import face_full_liquid
 from .reduced import reduce_liquid
 
 
@@ -84,6 +85,9 @@ def build_liquid_block(scene: Scene, params: Optional[dict] = None, gravity=None
     elastic = [t.wall_spec is not None for t in rigid]
     if any(elastic) or in_vessel_frame:
         for i, t in enumerate(rigid):
+            if isinstance(models[i], FaceLiquid):
+                raise SceneError(f"tanks[{i}].fluid.element", f"{t.fluid.element!r} does not take structures in the "
+                                                              "vessel's frame yet; use \"stabilized\"")
             if models[i].frames is not None:
                 raise SceneError(f"tanks[{i}].shape", "structures in the vessel's frame go with box tanks (and "
                                                       "shapes whose walls are all along the axes) only")
@@ -95,6 +99,8 @@ def build_liquid_block(scene: Scene, params: Optional[dict] = None, gravity=None
         return _liquid_with_walls(rigid, models, in_vessel_frame)
     if any(reduced):
         return _reduced_liquid(scene, rigid, models, reduced, g)
+    if any(isinstance(m, FaceLiquid) for m in models):
+        return _face_full(rigid, models)
 
     blocks, rs, Ms_list, K_list, free_list, Kdt_list, Ktt = [], [], [], [], [], [], xp.zeros((3, 3))
     coupled = False
@@ -255,12 +261,9 @@ class VesselFrameStructure(NamedTuple):
 
 
 def _face_model(scene, t, i, params, g):
-    """The face-normal liquid of one tank (fem/liquid_rt.py): runs take it on its modal basis only,
-    with the scene's own values."""
+    """The face-normal liquid of one tank (fem/liquid_rt.py), with the scene's own values: runs take it
+    on its modal basis (build/reduced.py) or at full order (build/face_liquid.py)."""
     where = f"tanks[{i}].fluid.element"
-    if t.reduction is None:
-        raise SceneError(where, f"{t.fluid.element!r} (face-normal) runs on its modes: add a [tanks.reduction] "
-                                "table (modes = N), or use \"stabilized\" for the full-order liquid")
     if t.wall_spec is not None:
         raise SceneError(where, f"{t.fluid.element!r} does not take elastic walls yet; use \"stabilized\"")
     traced = [k for k in ("fill_depth", "fluid.density", "fluid.sound_speed")
@@ -271,6 +274,21 @@ def _face_model(scene, t, i, params, g):
     tm = tank_mesh(t.geometry, t.fill_depth, t.mesh)
     return build_face_liquid(tm.nodes, tm.elements, tm.depth, t.fluid.density, t.fluid.sound_speed, g,
                              geometry=None if t.geometry.plain_box else t.geometry)
+
+
+def _face_full(tanks, models):
+    """Face-normal tanks at full order (build/face_liquid.py): every tank's, none of the nodal ones."""
+    for i, m in enumerate(models):
+        if not isinstance(m, FaceLiquid):
+            raise SceneError(f"tanks[{i}].fluid.element", "a full-order \"rt\" tank goes with other \"rt\" tanks "
+                                                          "only: give this one element = \"rt\" too, or give every "
+                                                          "tank a [tanks.reduction] table")
+    blocks, offset = [], 0
+    for t, m in zip(tanks, models):
+        blocks.append(_host_block(t, m, offset))
+        offset += m.n_nodes
+    liquid, penalty = face_full_liquid(tanks, models)
+    return LiquidBlock(liquid, tuple(blocks), penalty)
 
 
 def _host_block(t, m, offset) -> TankBlock:
