@@ -178,3 +178,53 @@ def test_full_order_follows_the_reduced_run_and_the_still_tank_stays_still():
     assert np.abs(a - b).max() < 0.01 * np.abs(b).max(), (np.abs(a - b).max(), np.abs(b).max())
     still = js.simulate(js.load_scene(ROLLED.replace("amplitude = 0.02", "amplitude = 0.0")))
     assert np.abs(np.asarray(still.probes["corner"].displacement)).max() < 1e-9
+
+
+# --- the default element ----------------------------------------------------------------------
+
+BAFFLED = """
+title = "baffled"
+[simulation]
+duration = 0.2
+dt = 0.02
+[vessel]
+mass = 4.1e5
+inertia = [6.0e6, 1.6e7, 2.0e7]
+[[tanks]]
+name = "tank"
+origin = [0.0, 0.0, 0.0]
+size = [5.0, 5.0, 4.0]
+fill_depth = 3.0
+mesh = {mesh}
+{extra}
+[[tanks.baffles]]
+normal = "x"
+position = 2.5
+from = "bottom"
+height = 1.0
+"""
+
+
+def test_the_default_element_is_rt_where_the_stabilized_one_locks(tmp_path, capsys):
+    """Left out, the element is "rt" for a tank with baffles (and a mesh file that is not a box grid,
+    tests/test_liquid_element_rt.py's U-tube), "stabilized" for a plain box, a box grid given as a
+    mesh file and a baffled tank too large for rt at full order; `check` says which and why; a given
+    element stays."""
+    from jaxslosh.cli.main import main
+    small = js.load_scene(BAFFLED.format(mesh="[10, 4, 6]", extra=""))
+    assert small.tanks[0].fluid.element == "rt" and "baffles" in small.tanks[0].fluid.element_default
+    big = js.load_scene(BAFFLED.format(mesh="[40, 20, 12]", extra=""))
+    assert big.tanks[0].fluid.element == "stabilized"
+    reduced = js.load_scene(BAFFLED.format(mesh="[40, 20, 12]", extra="[tanks.reduction]\nmodes = 6"))
+    assert reduced.tanks[0].fluid.element == "rt"
+    given = js.load_scene(BAFFLED.format(mesh="[10, 4, 6]", extra='[tanks.fluid]\nelement = "stabilized"'))
+    assert given.tanks[0].fluid.element == "stabilized" and given.tanks[0].fluid.element_default == ""
+    plain = js.load_scene(BAFFLED.format(mesh="[10, 4, 6]", extra="").split("[[tanks.baffles]]")[0])
+    assert plain.tanks[0].fluid.element == "stabilized"
+    path = tmp_path / "s.toml"
+    path.write_text(BAFFLED.format(mesh="[10, 4, 6]", extra=""))
+    assert main(["check", str(path)]) == 0
+    out = capsys.readouterr().out
+    assert "element 'rt' at full order (by default: a tank with baffles" in out
+    r = js.simulate(small)
+    assert r.status == "ok"

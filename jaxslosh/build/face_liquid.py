@@ -9,10 +9,10 @@ from scipy.linalg import block_diag
 
 from ..fem.liquid_rt import ROTATION_PENALTY_RATIO, FaceLiquid, _gauss, _loads, _Mixed, face_modes
 from ..physics.face_liquid import FluxLiquid
-from ..scene.types import SceneError
+from ..scene.types import RT_FULL_FACES, SceneError
 
 #: free faces above which a full-order "rt" tank is refused (its dense blocks: M, K and two inverses)
-MAX_FULL_FACES = 4000
+MAX_FULL_FACES = RT_FULL_FACES
 
 
 def recovery_weights(model: FaceLiquid, gauss=None):
@@ -84,7 +84,8 @@ def face_full_liquid(tanks, models):
         if f.size > MAX_FULL_FACES:
             raise SceneError(f"tanks[{i}].fluid.element", f"a full-order \"rt\" tank holds {f.size} free faces on "
                                                           f"this mesh, more than {MAX_FULL_FACES} (its blocks are dense): "
-                                                          "add a [tanks.reduction] table (modes = N)")
+                                                          "add a [tanks.reduction] table (modes = N), or set "
+                                                          "element = \"stabilized\"")
         gauss = _gauss(model)
         x, w, phys = gauss
         E, P = x.shape[:2]
