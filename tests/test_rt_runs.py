@@ -228,3 +228,44 @@ def test_the_default_element_is_rt_where_the_stabilized_one_locks(tmp_path, caps
     assert "element 'rt' at full order (by default: a tank with baffles" in out
     r = js.simulate(small)
     assert r.status == "ok"
+
+
+# --- rao and sweep ----------------------------------------------------------------------------
+
+
+def test_rao_of_an_rt_tank_full_and_reduced():
+    """js.rao on the paper ship (box hull, Froude-Krylov) with its tank on "rt" (6 x 6 x 4): the
+    roll and the probe on the surface from the full-order face fluxes and from 20 modes with the
+    static correction within 1 % of the peak, and the roll resonance within 1 % of the stabilized
+    element's (the liquid's inertia is the same ideal liquid's)."""
+    from test_frequency import ROOT, with_hull
+    text = (ROOT / "scenes" / "paper_ship_tank.toml").read_text().replace("mesh = [5, 5, 5]", "mesh = [6, 6, 4]")
+    rt = text.replace("sound_speed = 1500.0", 'sound_speed = 1500.0\nelement = "rt"')
+    w = np.linspace(0.5, 3.0, 26)
+    full = js.rao(with_hull(rt), w, [math.pi / 4])
+    red = js.rao(with_hull(rt.replace("[[probes]]", "[tanks.reduction]\nmodes = 20\n\n[[probes]]", 1)), w,
+                 [math.pi / 4])
+    st = js.rao(with_hull(text), w, [math.pi / 4])
+    for name in ("roll", "B"):
+        a = full.vessel[:, 0, 3] if name == "roll" else full.probes["B"][:, 0, 2]
+        b = red.vessel[:, 0, 3] if name == "roll" else red.probes["B"][:, 0, 2]
+        assert np.abs(a - b).max() < 0.01 * np.abs(a).max(), name
+    peak = lambda r: w[np.argmax(np.abs(r.vessel[:, 0, 3]))]   # noqa: E731
+    assert abs(peak(full) / peak(st) - 1) < 0.01, (peak(full), peak(st))
+
+
+def test_a_sweep_of_the_damping_ratio_on_an_rt_tank_equals_the_single_runs():
+    """js.simulate_batch (what `jaxslosh sweep` runs) over tanks.<name>.damping.ratio on an rt tank,
+    full order and reduced: each run equals its single run."""
+    for extra in ("", "[tanks.reduction]\nmodes = 6\n"):
+        text = HELD.format(duration=1.0, dt=0.01, scheme="newmark", alpha=0.0).replace(
+            'dof = "surge"\namplitude = 0.0', 'dof = "roll"\namplitude = 0.02').replace(
+            "frequency = 1.0", "frequency = 5.0") + FULL + extra + "[tanks.damping]\nratio = 0.01\n"
+        text += '[[probes]]\nname = "c"\ntank = "tank"\npoint = [0.0, 0.0, 0.5]\n'
+        batch, statuses = js.simulate_batch(js.load_scene(text), {"tanks.tank.damping.ratio": np.array([0.01, 0.2])})
+        assert statuses == ["ok", "ok"]
+        zb = np.asarray(batch.probes["c"].displacement)[..., 2]
+        one = js.simulate(js.load_scene(text.replace("ratio = 0.01", "ratio = 0.2")))
+        za = np.asarray(one.probes["c"].displacement)[:, 2]
+        assert np.abs(zb[1] - za).max() < 1e-9 + 1e-6 * np.abs(za).max()
+        assert np.abs(zb[0] - zb[1]).max() > 0.01 * np.abs(za).max()
