@@ -1,10 +1,13 @@
 """The full-order liquid of face-normal ("rt") tanks (physics/face_liquid.py FluxLiquid) from their
 models (fem/liquid_rt.py): the Gauss points' fields and masses, the dense blocks on the free faces,
-the hydrostatic responses and the nodal recovery's weights, all host-side NumPy."""
+the absolute-rotation penalty and the nodal recovery's weights, host-side NumPy (scaled by traced
+density, sound speed or gravity where given)."""
 from __future__ import annotations
 
+import jax
 import jax.numpy as jnp
 import numpy as np
+from jax.scipy.linalg import block_diag as jax_block_diag
 from scipy.linalg import block_diag
 
 from ..fem.liquid_rt import ROTATION_PENALTY_RATIO, FaceLiquid, _gauss, _loads, _Mixed, face_modes
@@ -33,21 +36,6 @@ def recovery_weights(model: FaceLiquid, gauss=None):
     return rows.reshape(E * P, 8), w.reshape(E * P, 8)
 
 
-def static_responses(model: FaceLiquid, gauss=None):
-    """(nf, 3) on the free faces: K^+ F_k for the loads of unit uniform accelerations along x, y, z,
-    the response M-orthogonal to K's kernel (fem/liquid_rt.py face_basis's mixed solves)."""
-    gauss = _gauss(model) if gauss is None else gauss
-    E, P = gauss[0].shape[:2]
-    fields = np.zeros((3, E, P, 3))
-    for k in range(3):
-        fields[k, ..., k] = 1.0
-    mixed = _Mixed(model)
-    F = _loads(model, gauss, fields)[mixed.f]
-    z, _ = mixed.solve(mixed.B @ mixed.Mlu.solve(F))
-    _, Psi = mixed.solve(mixed.winv[:, None] * mixed.pool_fix(z))
-    return Psi
-
-
 def absolute_rotation_penalty(model: FaceLiquid, origin, gauss=None):
     """(K_c (nf, nf), K_dt (nf, 3), K_tt (3, 3)): the penalty 1/2 kappa |P (d + C theta)|_M^2 that holds
     the circulation (K's kernel, the M-orthogonal projection P onto it) at the part of the tank's
@@ -73,13 +61,18 @@ def absolute_rotation_penalty(model: FaceLiquid, origin, gauss=None):
     return kappa * 0.5 * (MP + MP.T), kappa * MPc, kappa * (Pc.T @ MPc)
 
 
-def face_full_liquid(tanks, models):
+def face_full_liquid(tanks, models, scales=None):
     """The FluxLiquid of every tank (all face-normal, full order), stacked, and the (K_dt, K_tt) of
-    the absolute-rotation penalty (physics/liquid.py RotationPenalty)."""
-    rs, ms, phis, slots, Ks, Ms, Zs, scales, rec_n, rec_w, Kdts = ([] for _ in range(11))
-    Ktt = np.zeros((3, 3))
+    the absolute-rotation penalty (physics/liquid.py RotationPenalty). `scales`: per tank None or its
+    (rho, rho c^2, rho g) over its model's (build/liquid.py face_scales), traced or not: the masses, the
+    compression and the free-surface blocks scale with them."""
+    scales = scales or [None] * len(models)
+    xp = jnp if any(isinstance(v, jax.core.Tracer) for sc in scales if sc for v in sc) else np
+    rs, ms, phis, slots, Ks, Ms, row_scales, rec_n, rec_w, Kdts = ([] for _ in range(10))
+    Ktt = 0.0
     off, node_off = 0, 0
-    for i, (t, model) in enumerate(zip(tanks, models)):
+    for i, (t, model, fs) in enumerate(zip(tanks, models, scales)):
+        sr, sc, sg = fs if fs is not None else (1.0, 1.0, 1.0)
         f = np.flatnonzero(model.free)
         if f.size > MAX_FULL_FACES:
             raise SceneError(f"tanks[{i}].fluid.element", f"a full-order \"rt\" tank holds {f.size} free faces on "
@@ -92,18 +85,17 @@ def face_full_liquid(tanks, models):
         slot = np.full(len(model.faces), -1)
         slot[f] = np.arange(f.size) + off
         rs.append((x + np.asarray(t.origin, dtype=float)).reshape(-1, 3))
-        ms.append((model.density * w).reshape(-1))
+        ms.append(sr * (model.density * w).reshape(-1))
         phis.append(phys.reshape(E * P, 6, 3))
         slots.append(np.repeat(slot[model.element_faces], P, axis=0).reshape(E * P, 6))
         Kc, Kdt, Ktt_t = absolute_rotation_penalty(model, t.origin, gauss)
-        Ks.append(model.stiffness[f][:, f].toarray() + Kc)
-        Kdts.append(Kdt)
-        Ktt = Ktt + Ktt_t
-        Ms.append(model.mass[f][:, f].toarray())
-        Zs.append(static_responses(model, gauss))
+        Ks.append(sc * model.acoustic[f][:, f].toarray() + sg * model.surface[f][:, f].toarray() + sr * Kc)
+        Kdts.append(sr * Kdt)
+        Ktt = Ktt + sr * Ktt_t
+        Ms.append(sr * model.mass[f][:, f].toarray())
         X = model.nodes[model.faces[f]]
         area = np.linalg.norm(0.5 * np.cross(X[:, 2] - X[:, 0], X[:, 3] - X[:, 1]), axis=1)
-        scales.append(np.diag(Ms[-1]) * area)
+        row_scales.append(np.diag(model.mass[f][:, f].toarray()) * area)
         n_, w_ = recovery_weights(model, gauss)
         rec_n.append(n_ + node_off)
         rec_w.append(w_)
@@ -111,11 +103,11 @@ def face_full_liquid(tanks, models):
         node_off += model.n_nodes
     slot = np.concatenate(slots)
     slot = np.where(slot < 0, off, slot)
-    liquid = FluxLiquid(r=jnp.asarray(np.concatenate(rs)), m=jnp.asarray(np.concatenate(ms)),
+    stack = jax_block_diag if xp is jnp else block_diag
+    liquid = FluxLiquid(r=jnp.asarray(np.concatenate(rs)), m=jnp.asarray(xp.concatenate(ms)),
                       phi=jnp.asarray(np.concatenate(phis)), slots=jnp.asarray(slot.astype(np.int32)),
-                      K=jnp.asarray(block_diag(*Ks)), Mff=jnp.asarray(block_diag(*Ms)),
-                      Z=jnp.asarray(np.concatenate(Zs, axis=0)),   # each tank answers the same g_b
-                      scale=jnp.asarray(np.concatenate(scales)), rec_nodes=jnp.asarray(np.concatenate(rec_n)),
+                      K=jnp.asarray(stack(*Ks)), Mff=jnp.asarray(stack(*Ms)),
+                      scale=jnp.asarray(np.concatenate(row_scales)), rec_nodes=jnp.asarray(np.concatenate(rec_n)),
                       rec_w=jnp.asarray(np.concatenate(rec_w)), n_nodes=node_off)
-    return liquid, (jnp.asarray(np.concatenate(Kdts)), jnp.asarray(Ktt))
+    return liquid, (jnp.asarray(xp.concatenate(Kdts)), jnp.asarray(Ktt))
 

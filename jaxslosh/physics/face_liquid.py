@@ -10,11 +10,14 @@ particle kinematics (eqs. 1-4)
     T = 1/2 sum_g m_g |A^T V0 + u_g' + omega x (r_g + u_g)|^2,   V = 1/2 d^T K d - g_b . sum_g m_g u_g,
 
 with u_g = G d (each Gauss point's field from the six faces of its element). K's kernel (the
-circulation modes, divergence-free with no surface flux) has no stiffness: those coordinates carry
-the liquid's relative rotation that keeps its absolute flow irrotational (Kelvin), driven only by
-the tank's angular acceleration, with no penalty. The hydrostatic start solves K d0 = F_g in the
-complement of that kernel (the load of a uniform field is orthogonal to it): d0 = Z g_b with Z
-the responses to the three unit loads, formed on the host.
+circulation modes, divergence-free with no surface flux) has no stiffness of the liquid's own: an
+ideal liquid's absolute flow stays irrotational (Kelvin), so relative to the tank its circulation
+is the part -P C theta of the tank's rotation it does not follow. The penalty
+1/2 kappa |P (d + C theta)|_M^2 (physics/liquid.py RotationPenalty: its d-d block is in K) holds it
+there, as the reduced basis does on its three circulation vectors (fem/liquid_rt.py face_basis);
+without it, a start with the tank turning (an initial angular velocity) would leave the liquid
+with the rigid rotation's vorticity, and second-order terms would drift in the kernel. With it, K
+is definite and the hydrostatic start solves K d0 = F_g.
 
 Outputs and probes read the nodal field of the element's patch recovery (FaceLiquid.nodal_field),
 here as fixed weights of each Gauss point's displacement on the nodes of its element.
@@ -25,6 +28,7 @@ import equinox as eqx
 import jax
 import jax.numpy as jnp
 
+from ..fem.linalg import solve
 from .kinematics import mv3, tv3
 from .liquid import AbstractLiquid
 from .terms import Kin, Rows
@@ -38,7 +42,6 @@ class FluxLiquid(AbstractLiquid):
     slots: jax.Array      # (G, 6) each field's unknown (nf: a held face, zero)
     K: jax.Array          # (nf, nf) stiffness (compression and free surface)
     Mff: jax.Array        # (nf, nf) the consistent mass on the unknowns (the Newton block)
-    Z: jax.Array          # (nf, 3) the hydrostatic responses to unit body gravity components
     scale: jax.Array      # (nf,) a mass per row (M_ff's diagonal times the face's area: row / scale in m/s^2)
     rec_nodes: jax.Array  # (G, 8) the nodes the recovery spreads each Gauss point's field on
     rec_w: jax.Array      # (G, 8) and its weights
@@ -120,4 +123,7 @@ class FluxLiquid(AbstractLiquid):
         return self.Mff, self.K
 
     def static_start(self, g_b):
-        return self.Z @ g_b
+        """The discrete hydrostatic equilibrium K d0 = F_g: K holds the absolute-rotation penalty on
+        the circulation, so it is definite, and the load of a uniform field has no circulation part
+        (the start is at rest in the kernel)."""
+        return solve(self.K, self.free_part(self.m[:, None] * g_b[None, :]))
