@@ -25,7 +25,7 @@ import jax
 jax.config.update("jax_enable_x64", True)
 
 import jaxslosh as js  # noqa: E402
-from jaxslosh.build.effects import count_unknowns, scene_effects  # noqa: E402
+from jaxslosh.assemble.effects import count_unknowns, scene_effects  # noqa: E402
 from jaxslosh.run.loop import core as _core, advance, start  # noqa: E402
 from jaxslosh.run.simulate import prepare
 from jaxslosh.scene.keys import with_overrides

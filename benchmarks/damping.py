@@ -16,8 +16,8 @@ import jax.numpy as jnp  # noqa: E402
 import numpy as np  # noqa: E402
 
 import jaxslosh as js  # noqa: E402
-from jaxslosh.build.damping import build_damping  # noqa: E402
-from jaxslosh.build.liquid import build_liquid_block  # noqa: E402
+from jaxslosh.assemble.damping import build_damping  # noqa: E402
+from jaxslosh.assemble.liquid import build_liquid_block  # noqa: E402
 from jaxslosh.fem.damping import rectangular_ratio  # noqa: E402
 from jaxslosh.run.simulate import prepare  # noqa: E402
 from jaxslosh.solve.integrator import initial_state, step  # noqa: E402

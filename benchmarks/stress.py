@@ -1,4 +1,4 @@
-"""Stress runs of issue 7 (the long versions of tests/test_hard_cases.py): long runs, stiffness,
+"""Stress runs of issue 7 (the long versions of tests/solve/test_hard_cases.py): long runs, stiffness,
 resonance, odd tank geometries. Prints one table: case, steps, energy drift, constraint drift
 (max ||q| - 1|), wall time, and a note with the case's own measure.
 

@@ -23,6 +23,7 @@ import numpy as np  # noqa: E402
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 sys.path.insert(0, os.path.join(HERE, "..", "tests"))
+sys.path.insert(0, os.path.join(HERE, "..", "tests", "analysis"))
 
 import jaxslosh as js  # noqa: E402
 import sloshing_reference as ref  # noqa: E402

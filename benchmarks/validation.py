@@ -17,7 +17,7 @@ from scipy.integrate import solve_ivp  # noqa: E402
 
 import jaxslosh as js  # noqa: E402
 from jaxslosh.fem.modes import effective_roll_inertia  # noqa: E402
-from jaxslosh.build.system import build  # noqa: E402
+from jaxslosh.assemble.system import build  # noqa: E402
 from jaxslosh.physics.kinematics import rotation_matrix  # noqa: E402
 from jaxslosh.fem.liquid import build_liquid  # noqa: E402
 from jaxslosh.fem.modes import analytic_sloshing_omegas, liquid_modes  # noqa: E402
@@ -107,7 +107,7 @@ def inertia():
 
 
 def waves():
-    """The rows of tests/test_waves.py: the regular-wave RAO and the Cummins memory, Capytaine's box."""
+    """The rows of tests/hydro/test_waves.py: the regular-wave RAO and the Cummins memory, Capytaine's box."""
     import test_waves as tw
     from jaxslosh.hydro.capytaine import capytaine_hydrostatics
     from jaxslosh.scene.types import Hull

@@ -8,7 +8,7 @@
 - the guides: every `docs/guide/*.md` that mkdocs.yml's nav does not list is added to its "Guides"
   section, so a new guide needs no edit of mkdocs.yml.
 
-The generators are plain functions returning Markdown, so tests/test_docs.py checks them without
+The generators are plain functions returning Markdown, so tests/docs/test_docs.py checks them without
 running mkdocs.
 """
 from __future__ import annotations

@@ -8,7 +8,7 @@ sloshing" (2013). Entry points switch on float64 (`jax_enable_x64`); a library u
     result = js.simulate(js.load_scene("scenes/paper_ship_tank.toml"))
 
 The package's layers, lowest first (docs/design.md): scene/ (TOML to a Scene), fem/ and hydro/
-(host-side models), physics/ (traced terms), solve/ (schemes, Newton, linear solvers), build/
+(host-side models), physics/ (traced terms), solve/ (schemes, Newton, linear solvers), assemble/
 (scene to System), run/ (time loop), io/ (files), analysis/, campaign/, fit/, plot/, cli/.
 
 The public names below are imported on first use (PEP 562): `import jaxslosh` stays light, and a

@@ -27,7 +27,7 @@ import jax
 import jax.numpy as jnp
 import numpy as np
 
-from ..build.system import Built
+from ..assemble.system import Built
 from ..physics import structures as mb
 from ..physics.seakeeping import AddedMass
 from ..physics.system import advance_config

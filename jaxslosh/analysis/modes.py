@@ -1,7 +1,7 @@
 """Natural modes of a scene's tank liquid or flexible structure, the vessel held fixed (`jaxslosh modes`)."""
 from __future__ import annotations
 
-from ..build.effects import free_liquid_dofs
+from ..assemble.effects import free_liquid_dofs
 from ..fem.liquid import build_liquid
 from ..fem.liquid_rt import build_face_liquid, face_modes
 from ..fem.mesh import face_nodes

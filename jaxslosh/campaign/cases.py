@@ -17,7 +17,7 @@ try:
 except ModuleNotFoundError:  # Python 3.10
     import tomli as tomllib  # type: ignore[no-redef]
 
-from ..build.seakeeping import make_excitation
+from ..assemble.seakeeping import make_excitation
 from ..hydro.source import excitation_rao
 from ..hydro.spectra import components
 from ..scene.load import parse_scene
@@ -192,7 +192,7 @@ def _set_duration(text: str, duration: float) -> str:
 
 def sea_arrays(scene: Scene) -> tuple:
     """(omega (N,), amp (6, N) per unit Hs, phase (6, N), Hs): the wave excitation the build of
-    `scene` makes (build/seakeeping.py), as the arrays a batch of seas runs on."""
+    `scene` makes (assemble/seakeeping.py), as the arrays a batch of seas runs on."""
     waves = scene.waves
     c = components(waves)
     e = make_excitation(waves, excitation_rao(scene, c.omega, c.headings), waves.hs)

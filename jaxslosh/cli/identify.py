@@ -21,7 +21,8 @@ def add_parsers(subparsers):
     p.add_argument("--data", required=True, metavar="MEASURED.h5", help="the measured result file")
     p.add_argument("--fit", required=True, metavar="KEY[,KEY...]",
                    help="dotted scene keys to fit, comma-separated, e.g. "
-                        "vessel.hydrostatics.gm_t,vessel.hydrostatics.gm_l")
+                        "vessel.hydrostatics.gm_t,vessel.hydrostatics.gm_l, or vessel.hull.kg with the "
+                        "nonlinear hydrostatics (the implied GM0 is printed too)")
     p.add_argument("-o", "--output", metavar="FIT.json",
                    help="the fit as JSON (default: the scene's name with _fit.json, here)")
     p.add_argument("--method", default="gauss-newton", choices=METHODS, help="optimiser (default gauss-newton)")
@@ -105,10 +106,13 @@ def cmd_identify(a) -> int:
     if not fr.loss_history or not math.isfinite(fr.loss_history[0]):
         print(f"jaxslosh identify: numerical failure: {fr.message}", file=sys.stderr)
         return EXIT_NUMERICAL
-    width = max(len(k) for k in fr.values)
+    width = max(len(k) for k in list(fr.values) + list(fr.implied))
     for k, v in fr.values.items():
         s = fr.standard_errors[k]
         print(f"{k:<{width}} = {format_value(v)} +- {format_value(s)}   (start {format_value(fr.start[k])})")
+    for k, v in fr.implied.items():       # not fitted: what the fitted values imply (GM0 = KM - KG)
+        s = fr.implied_standard_errors[k]
+        print(f"{k:<{width}} = {format_value(v)} +- {format_value(s)}   (implied: KM - KG of the hull at rest)")
     print(f"{fr.method}: {fr.status} after {fr.iterations} iterations ({fr.evaluations} simulations, "
           f"{fr.wall_time:.1f} s); loss {fr.loss_history[0]:.4g} -> {fr.loss_history[-1]:.4g} ({fr.message})")
     fr.to_json(out)

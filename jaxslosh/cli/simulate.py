@@ -5,9 +5,9 @@ from __future__ import annotations
 import os
 import sys
 
-from ..build.cost import check_cost, describe_cost, estimate
-from ..build.damping import describe_damping
-from ..build.effects import describe, effects_summary
+from ..assemble.cost import check_cost, describe_cost, estimate
+from ..assemble.damping import describe_damping
+from ..assemble.effects import describe, effects_summary
 from ..io.output import OutputError
 from ..io.status import Status
 from ..run.progress import wanted

@@ -6,7 +6,7 @@ chunks are done (`ParallelBatchMap` in jaxlib/cpu/lapack_kernels.cc: nothing hel
 waits). When as many such kernels run at once as the pool has threads -- independent inverses that
 XLA's thunk executor starts side by side, or one per host device of a sharded batch -- every pool
 thread waits for chunks that only a pool thread could run: the program deadlocks inside XLA (the
-`jaxslosh sweep` of a tank's density on a 2-core machine, `tests/test_sweep.py`). A kernel splits
+`jaxslosh sweep` of a tank's density on a 2-core machine, `tests/run/test_sweep.py`). A kernel splits
 only a batch of more than one matrix, so here a vmapped batch is never handed to LAPACK as one: the
 custom batching rule maps the unbatched kernel over the runs (`lax.map`), each run's factorization
 the same as an unbatched call's. A batch of small matrices (the Newton step's 6 x 6 Schur

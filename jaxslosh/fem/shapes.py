@@ -411,7 +411,7 @@ def _extra_pairs(geo, h, mesh, nodes):
     where a bottom (hopper) chamfer meets the vertical wall -- gets, for each element along it, the
     curl rows about the line's direction of the two elements across it replaced by their difference
     (one constraint less), as `_rotation_pairs` does for odd rows. (The kink of a top chamfer needs
-    none: with one there, a spurious mode enters below the first; tests/test_shapes.py.)"""
+    none: with one there, a spurious mode enters below the first; tests/fem/test_shapes.py.)"""
     nx, ny, nz = mesh
     eid = lambda i, j, k: (i * ny + j) * nz + k           # noqa: E731
     pairs = []

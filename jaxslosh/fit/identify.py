@@ -24,7 +24,7 @@ Parameters and bounds
     stay at the scene's values). The optimiser works on a transformed variable theta, so that
     bounds hold by construction (no projection, no clipping of steps):
       - default bounds: positive physical quantities (gravity, water density, mass, inertia,
-        waterplane area, displaced volume, GM_T, GM_L) are bounded below by 0 and fitted in
+        waterplane area, displaced volume, GM_T, GM_L, KG) are bounded below by 0 and fitted in
         log: p = exp(theta), so they stay positive and steps are relative changes.
         (GM <= 0 is legal in a scene: pass bounds={"vessel.hydrostatics.gm_t": (None, None)} to
         let a GM change sign.) Initial conditions are unbounded.
@@ -32,6 +32,15 @@ Parameters and bounds
         p = lo + exp(theta); only hi: p = hi - exp(theta); neither: p = s theta with s = |x0|
         (1 where x0 = 0).
     The start (`x0`, default the scene's values) must lie strictly inside the bounds.
+
+KG and GM0 with the nonlinear hydrostatics
+    `vessel.hull.kg` (a box hull, `model = "nonlinear"`) moves the COG against the hull: the
+    restoring of the instantaneous wetted surface follows, over the whole GZ curve, from one
+    number. GM0 is then not a parameter of its own: the fit reports the implied GM0 = KM - KG of
+    the hull at rest (`implied`), and fitting the springs' values (GM_T, GM_L, A_w, V), which the
+    nonlinear model does not read, is refused naming the key. With the linear model KG cannot be
+    traced (the springs were derived from it when the scene was loaded): fit GM_T there. A mesh
+    hull's analogue is `vessel.hull.cog` (the COG in the file's coordinates).
 
 Methods (`method=`)
     "gauss-newton": Levenberg-Marquardt damped Gauss-Newton. J = d r / d theta by forward mode
@@ -85,7 +94,7 @@ import numpy as np
 
 from ..scene.types import Scene, SceneError
 from .optimize import gauss_newton, optax_loop
-from .params import fit_keys, make_params
+from .params import fit_keys, implied_values, make_params
 from .problem import Problem, as_result
 from .quality import data_scene_mismatch, goodness
 
@@ -107,6 +116,9 @@ class FitResult:
     r2: channel -> R^2 at the returned parameters; residual_to_noise: channel -> the residual's
     RMS over the noise estimated from the record; quality: "" or "poor fit: R^2 0.12 on roll";
     data_scene: "" or how the scene stored with the data differs from the fitted one.
+    implied / implied_standard_errors: key -> value of what the fitted keys imply, not fitted
+    themselves: for a fitted `vessel.hull.kg` the hull's GM0 = KM - KG (`vessel.hydrostatics.gm_t`
+    and `gm_l`), with the standard error of KG.
     """
     values: dict
     standard_errors: dict
@@ -127,6 +139,8 @@ class FitResult:
     residual_to_noise: dict = dataclasses.field(default_factory=dict)
     quality: str = ""
     data_scene: str = ""
+    implied: dict = dataclasses.field(default_factory=dict)
+    implied_standard_errors: dict = dataclasses.field(default_factory=dict)
 
     @property
     def loss(self) -> float:
@@ -147,12 +161,14 @@ class FitResult:
                 "loss_history": [float(x) for x in self.loss_history], "iterations": int(self.iterations),
                 "converged": bool(self.converged), "method": self.method,
                 "quality": self.quality or "good", "r2": dict(self.r2),
-                "residual_to_noise": dict(self.residual_to_noise), "data_scene": self.data_scene or None}
+                "residual_to_noise": dict(self.residual_to_noise), "data_scene": self.data_scene or None,
+                "implied": dict(self.implied), "implied_standard_errors": dict(self.implied_standard_errors)}
 
     def to_json(self, path: Optional[str] = None, **kw) -> str:
         """The JSON text of {"values", "standard_errors", "loss_history", "iterations", "converged",
         "method", "quality" ("good" or "poor fit: R^2 0.12 on roll"), "r2", "residual_to_noise",
-        "data_scene" (null, or how the data's scene differs)}; also written to `path` when given."""
+        "data_scene" (null, or how the data's scene differs), "implied", "implied_standard_errors"};
+        also written to `path` when given."""
         text = json.dumps(_json_safe(self.to_dict()), **({"indent": 2} | kw))
         if path is not None:
             with open(path, "w") as f:
@@ -235,7 +251,9 @@ def identify(scene: Scene, measured, fit: Sequence[str], *, weights: Optional[di
         history.append(float(res @ res) / pb.n if ok else math.inf)   # the loss at the returned parameters
     start = {p.key: (float(p.start[0]) if p.scalar else p.start.tolist()) for p in params}
     r2, noise, quality = goodness(res, pb.data[1], pb.data[2], pb.active) if ok else ({}, {}, "")
-    return FitResult(values=pb.values(theta), standard_errors=se, loss_history=[float(x) for x in history],
+    values = pb.values(theta)
+    implied, implied_se = implied_values(scene, values, se)
+    return FitResult(values=values, standard_errors=se, implied=implied, implied_standard_errors=implied_se, loss_history=[float(x) for x in history],
                      iterations=int(it), converged=bool(converged), method=method, message=message,
                      evaluations=pb.evaluations, n_residuals=pb.n, channels=dict(pb.weights), start=start,
                      wall_time=_time.perf_counter() - t0, compile_time=pb.compile_time, solve_time=solve_time,

@@ -9,14 +9,16 @@ import jax
 import jax.numpy as jnp
 import numpy as np
 
-from ..scene.keys import canonical_key, scene_values, traceable
+from ..hull.hydrostatics import rest_hydrostatics
+from ..hull.surface import hull_triangles
+from ..scene.keys import SPRING_KEYS, canonical_key, scene_values, traceable
 from ..scene.types import Scene, SceneError
 
 
 # keys whose values are positive by nature: fitted in log by default
 POSITIVE = ("environment.gravity", "environment.water_density", "vessel.mass", "vessel.inertia",
             "vessel.hydrostatics.waterplane_area", "vessel.hydrostatics.displaced_volume",
-            "vessel.hydrostatics.gm_t", "vessel.hydrostatics.gm_l")
+            "vessel.hydrostatics.gm_t", "vessel.hydrostatics.gm_l", "vessel.hull.kg")
 
 
 class Param:
@@ -92,7 +94,46 @@ def fit_keys(scene: Scene, fit: Sequence[str]) -> tuple:
     fit = list(fit)
     if not fit:
         raise SceneError("fit", "give at least one key to fit")
-    return traceable(scene, fit)
+    keys = traceable(scene, fit)
+    h = scene.vessel.hydrostatics
+    if h is not None and h.nonlinear:
+        for given, key in zip(fit, keys):
+            if key in SPRING_KEYS:
+                raise SceneError(given, 'model = "nonlinear" takes its restoring from the hull, which this value '
+                                        "does not enter: fit vessel.hull.kg (a mesh: vessel.hull.cog); the fit reports "
+                                        "the implied GM0 = KM - KG")
+    return keys
+
+
+# GM0 = KM - KG of the hull at rest: what a fitted KG (a mesh's COG) implies for the small-angle
+# springs, reported beside it
+IMPLIED_BY_KG = ("vessel.hydrostatics.gm_t", "vessel.hydrostatics.gm_l")
+
+
+def implied_keys(keys) -> tuple:
+    """The scene values that follow from the fitted keys (the GM0s of a fitted KG or COG): a record
+    made with another KG differs in them too, and the fit reports them."""
+    return IMPLIED_BY_KG if ("vessel.hull.kg" in keys or "vessel.hull.cog" in keys) else ()
+
+
+def implied_values(scene: Scene, values: dict, errors: dict) -> tuple[dict, dict]:
+    """({key: value}, {key: standard error}) of the implied keys: GM0 = KM - KG with the hull's KM
+    (the scene's GM0 plus its KG) for a fitted KG, whose standard error it shares (dGM0/dKG = -1);
+    for a mesh's fitted COG the GM0s of its surface at rest about that COG, with the standard
+    error of the COG's height (exact for a COG on the centre plane of a symmetric hull)."""
+    h = scene.vessel.hydrostatics
+    if "vessel.hull.kg" in values:
+        kg0, kg = scene.vessel.hull.kg, values["vessel.hull.kg"]
+        out = {"vessel.hydrostatics.gm_t": h.gm_t + kg0 - kg, "vessel.hydrostatics.gm_l": h.gm_l + kg0 - kg}
+        return out, {k: errors["vessel.hull.kg"] for k in out}
+    if "vessel.hull.cog" in values:
+        hull, env = scene.vessel.hull, scene.environment
+        cog = np.asarray(values["vessel.hull.cog"], dtype=float)
+        tris = hull_triangles(hull) + (np.asarray(hull.cog, dtype=float) - cog)
+        own = rest_hydrostatics(tris, -cog[2], env.water_density, env.gravity)
+        out = {k: own[k.split(".")[-1]] for k in IMPLIED_BY_KG}
+        return out, {k: errors["vessel.hull.cog"][2] for k in out}
+    return {}, {}
 
 
 def make_params(scene: Scene, keys, x0, bounds) -> list:

@@ -36,6 +36,7 @@ from ..io.result import Result
 from ..scene.compare import differences, show_value
 from ..scene.load import load_scene
 from ..scene.types import Scene, SceneError
+from .params import implied_keys
 
 R2_POOR = 0.9          # below: the model explains less than 90 % of the channel's variance
 NOISE_FACTOR = 3.0     # ... and the residual is this many times the noise estimated from the record
@@ -53,7 +54,7 @@ def data_scene_mismatch(scene: Scene, measured: Result, fitted) -> str:
     except SceneError as e:
         msg = str(e).replace("\n", " ")
         return f"the scene stored with the data does not load, so it cannot be compared with this one ({msg})"
-    diff = differences(scene, theirs, ignore=fitted)
+    diff = differences(scene, theirs, ignore=tuple(fitted) + implied_keys(fitted))
     if not diff:
         return ""
     items = [f"{k} = {show_value(theirs_v)} in the data's scene, {show_value(ours_v)} here"

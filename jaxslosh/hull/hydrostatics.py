@@ -16,10 +16,16 @@ from .clip import MIDPOINT_RULE, area_vectors, clip_below, submerged
 BISECTIONS = 52
 
 
-def buoyancy(tris, z_water, X0, A):
+def buoyancy(tris, z_water, X0, A, shift=None):
     """(V, m): the displaced volume and its first moment about the COG (body frame) for the pose
-    (X0 inertial, A body to inertial): the body's part below n_b . r = z_water - Z0, n_b = A^T e_z."""
-    return volume_below(tris, A[2], z_water - X0[2])
+    (X0 inertial, A body to inertial): the body's part below n_b . r = z_water - Z0, n_b = A^T e_z.
+    `shift` (3,), body frame: the surface is `tris + shift` (a traced KG moves the hull against the
+    COG); the plane moves the other way over the fixed triangles instead, so the tangent stays the
+    lid's (volume_below) and the triangles stay constants: V is unchanged and m gains shift V."""
+    if shift is None:
+        return volume_below(tris, A[2], z_water - X0[2])
+    V, m = volume_below(tris, A[2], z_water - X0[2] - A[2] @ shift)
+    return V, m + shift * V
 
 
 def _lid_integrals(tris, n, c):
@@ -72,10 +78,11 @@ def _volume_below_jvp(primals, tangents):
 volume_below.defjvp(_volume_below_jvp, symbolic_zeros=True)
 
 
-def still_force_moment(tris, z_water, rho_g, X0, A):
+def still_force_moment(tris, z_water, rho_g, X0, A, shift=None):
     """F (inertial) and M (body, about the COG) of the still-water pressure: by the divergence
-    theorem rho g V e_z, and m x rho g n_b for the first moment m of the displaced volume."""
-    V, m = buoyancy(tris, z_water, X0, A)
+    theorem rho g V e_z, and m x rho g n_b for the first moment m of the displaced volume (the
+    surface `tris + shift`, as `buoyancy`)."""
+    V, m = buoyancy(tris, z_water, X0, A, shift)
     return jnp.array([0.0, 0.0, rho_g * V]), jnp.cross(m, rho_g * A[2])
 
 

@@ -25,7 +25,7 @@ crest's share by the factor 1 / f(0) - 1 of the dynamic part that Wheeler remove
 first order. Each hull triangle is cut by the plane tangent to eta at its centroid: the wetted
 pieces then follow the wave without centroid switching, with an error of the order of the
 triangle's size squared times the surface curvature (k a / panel^2), so panels must be small
-against the wave length (build/hull.py divides the box accordingly).
+against the wave length (assemble/hull.py divides the box accordingly).
 """
 from __future__ import annotations
 
@@ -97,27 +97,34 @@ class HullPressure(AbstractTerm):
     gravity: jax.Array
     z_water: jax.Array                      # inertial height of the still water plane
     waves: Optional[IncidentWaves] = None
+    # (3,) body frame: the surface is tris + shift (a traced KG: assemble/hull.py); None: tris itself
+    shift: Optional[jax.Array] = None
+
+    def surface(self):
+        """The closed surface (n, 3, 3) in the body frame, the shift applied."""
+        return self.tris if self.shift is None else self.tris + self.shift
 
     def buoyancy(self, X0, A):
         """(V, m): displaced volume and its first moment about the COG (body frame) in still water."""
-        return buoyancy(self.tris, self.z_water, X0, A)
+        return buoyancy(self.tris, self.z_water, X0, A, self.shift)
 
     def still_force_moment(self, X0, A):
         """F (inertial) and M (body, about the COG) of the still-water pressure."""
-        return still_force_moment(self.tris, self.z_water, self.rho_w * self.gravity, X0, A)
+        return still_force_moment(self.tris, self.z_water, self.rho_w * self.gravity, X0, A, self.shift)
 
     def wave_force_moment(self, X0, A, t):
         """F (inertial) and M (body) of the total pressure (hydrostatic and incident) on the part of
         each triangle below the plane tangent to the incident surface at its centroid."""
         w = self.waves
-        cen = self.tris.mean(axis=1)                                 # (n, 3) body
+        tris = self.surface()
+        cen = tris.mean(axis=1)                                      # (n, 3) body
         C = X0 + cen @ A.T
         eta, slope = w.elevation_and_slope(C, t)
         N_in = jnp.concatenate([-slope, jnp.ones_like(eta)[:, None]], axis=1)          # (n, 3)
         off_in = self.z_water + eta - slope[:, 0] * C[:, 0] - slope[:, 1] * C[:, 1]
         nb = N_in @ A                                                # A^T N_in, per row
         ob = off_in - N_in @ X0
-        pieces = jax.vmap(lambda tri, n, o: clip_below(tri[None], n, o)[0])(self.tris, nb, ob)
+        pieces = jax.vmap(lambda tri, n, o: clip_below(tri[None], n, o)[0])(tris, nb, ob)
         rg = self.rho_w * self.gravity
 
         def pressure(x):

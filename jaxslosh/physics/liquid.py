@@ -273,7 +273,7 @@ class RotationPenalty(AbstractTerm):
         return c.d @ (self.Kdt @ th) + 0.5 * th @ (self.Ktt @ th)
 
     def rows(self, k: Kin) -> Rows:
-        """The gradient of `energy` along the increments, written out (tests/test_model.py checks it
+        """The gradient of `energy` along the increments, written out (tests/physics/test_model.py checks it
         with the liquid's: the whole residual against the gradient of the potential)."""
         th, J = self.rotation(k.c.q)
         d = k.c.d

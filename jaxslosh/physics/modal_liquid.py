@@ -8,7 +8,7 @@ T(P, Q) = sum_ij Ms_ij P_i Q_j^T (3x3) for nodal fields P, Q,
 
 so a residual costs O(m^2) small products, independent of the mesh. The rigid rows, the modal rows,
 the kinetic and the potential energy are those of the full model at d = V eta, to round-off
-(tests/test_reduction.py checks them against liquid.py).
+(tests/fem/test_reduction.py checks them against liquid.py).
 """
 from __future__ import annotations
 

@@ -1,7 +1,7 @@
 """The one interface of the physics: a term of the virtual work (eq. 26) and what every term reads.
 
 A System (system.py) is the sum of its terms: each is an equinox module, abstract or final (STYLE.md),
-built once from the scene with only what the scene has (build/), and evaluated inside the jitted
+built once from the scene with only what the scene has (assemble/), and evaluated inside the jitted
 step. A term gives
 
 * `rows(k)`: its share of the residual, inertia minus applied forces, for the unknown accelerations
@@ -15,7 +15,7 @@ A term's rows are written out. Where the term has a potential, a test checks its
 the potential's gradient along the step's increments (`potential_rows`, by JAX): a gradient inside
 the residual would be linearised and transposed again in every Newton preconditioner, which
 lengthens compilation; the liquid's rows must also stay linear and sparse for large meshes
-(tests/test_model.py checks them against the gradient and the Hessian of its energies).
+(tests/physics/test_model.py checks them against the gradient and the Hessian of its energies).
 """
 from __future__ import annotations
 

@@ -64,16 +64,15 @@ class Weight(AbstractTerm):
 
 
 class Hydrostatics(AbstractTerm):
-    """Linear hydrostatic restoring about the initial equilibrium (eqs. 33-36). The moment is the
-    gradient of the restoring potential (`moment_form = "conservative"`, taken by JAX) or eq. (36)
-    literally ("paper"), which is not conservative when GM_T != GM_L."""
+    """Linear hydrostatic restoring about the initial equilibrium (eqs. 33-36), its moment the
+    gradient of the restoring potential (`vessel.hydrostatics.moment = "conservative"`);
+    `PaperHydrostatics` takes eq. (36) literally."""
     rho_w: jax.Array
     gravity: jax.Array
     waterplane_area: jax.Array
     displaced_volume: jax.Array
     gm_t: jax.Array
     gm_l: jax.Array
-    moment_form: str = eqx.field(static=True, default="conservative")
 
     def force(self, X0):
         """Eq. (35) in the inertial frame: F_z = -rho g A_w (Z0 - Z0^0), equilibrium at Z0^0 = 0."""
@@ -98,9 +97,7 @@ class Hydrostatics(AbstractTerm):
         derivative of the potential along body-frame rotations, written out (a JAX gradient inside
         the residual would be linearised and transposed again in every Newton preconditioner):
         with g = A^T e_z, a body rotation d theta changes g by g x d theta, so M = g x dV/dg.
-        tests/test_vessel.py checks it against the gradient of `restoring_potential`."""
-        if self.moment_form == "paper":
-            return self.moment_paper(q)
+        tests/physics/test_vessel.py checks it against the gradient of `restoring_potential`."""
         k = self.rho_w * self.gravity * self.displaced_volume
         g = rotation_matrix(q)[2]
         D = 1.0 + g[2]
@@ -113,6 +110,15 @@ class Hydrostatics(AbstractTerm):
 
     def potential(self, k: Kin):
         return self.restoring_potential(k.c.X0, k.c.q)
+
+
+class PaperHydrostatics(Hydrostatics):
+    """The restoring of eqs. (33)-(36) with the moment of eq. (36) literally
+    (`vessel.hydrostatics.moment = "paper"`): not the gradient of a potential when GM_T != GM_L, so
+    a run's energy is not conserved with it."""
+
+    def moment(self, q):
+        return self.moment_paper(q)
 
 
 def smooth_ramp(s):

@@ -116,7 +116,7 @@ def check_runs(scene: Scene, params: dict) -> list:
 def simulate_seas(scene: Scene, omega, amp, phase, height) -> tuple[Result, list]:
     """Runs of one scene in B seas, one compiled vmapped loop: each run's wave excitation is
     omega (B, N), amp (B, 6, N) per unit height, phase (B, 6, N) and height (B,) (the arrays
-    build/seakeeping.make_excitation makes of a scene's sea, all with the same component count).
+    assemble/seakeeping.make_excitation makes of a scene's sea, all with the same component count).
     Returns (result with a leading run axis, one status per run), as simulate_batch."""
     vals = [jnp.asarray(x, dtype=float) for x in (omega, amp, phase, height)]
     setup0 = _setup0(scene)

@@ -29,7 +29,7 @@ def vanishing_angles(system) -> Optional[tuple]:
         return None
     h, w = hull[0], weight[0]
     angles = np.linspace(0.0, np.pi, HEELS)
-    return tuple(first_vanishing(angles, gz_curve(h.tris, h.z_water, w.mass / h.rho_w, w.S / w.mass,
+    return tuple(first_vanishing(angles, gz_curve(h.surface(), h.z_water, w.mass / h.rho_w, w.S / w.mass,
                                                   jnp.asarray(angles), axis)) for axis in (0, 1))
 
 

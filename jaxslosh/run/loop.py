@@ -10,7 +10,7 @@ import equinox as eqx
 import jax
 import jax.numpy as jnp
 
-from ..build.system import Built
+from ..assemble.system import Built
 from ..io.status import Status
 from ..physics import structures as mb
 from ..physics.kinematics import rotation_matrix, rpy_from_quat

@@ -15,7 +15,7 @@ import equinox as eqx
 import jax
 import numpy as np
 
-from ..build.system import Built, build
+from ..assemble.system import Built, build
 from ..io.status import TEXT, Status, failure_text
 from ..io.result import Result, result_from, truncated
 from ..scene.keys import check_values, with_overrides

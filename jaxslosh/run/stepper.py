@@ -16,7 +16,7 @@ from typing import Optional
 
 import equinox as eqx
 
-from ..build.system import Built
+from ..assemble.system import Built
 from ..io.status import Status
 from ..physics.kinematics import rpy_from_quat
 from ..scene.keys import with_overrides

@@ -1,5 +1,5 @@
 """What every scene key means: its default, unit and meaning, for the scene reference of the
-documentation (docs/hooks.py writes the page from these rows; tests/test_docs.py holds them to the
+documentation (docs/hooks.py writes the page from these rows; tests/docs/test_docs.py holds them to the
 keys the loader accepts).
 
 A key is written as the scene file writes it, without indices: `tanks.fluid.density` is the
@@ -107,10 +107,12 @@ KEYS = (
     ("vessel.hull.length", "required (box)", "m", "Box hull length, centred on the COG in plan."),
     ("vessel.hull.beam", "required (box)", "m", "Box hull beam."),
     ("vessel.hull.draft", "required (box)", "m", "Box hull draft."),
-    ("vessel.hull.kg", "required (box)", "m", "The COG's height above the keel."),
+    ("vessel.hull.kg", "required (box)", "m", "The COG's height above the keel. Traced by the nonlinear "
+                                              "hydrostatics only (`identify --fit vessel.hull.kg`)."),
     ("vessel.hull.file", "required (mesh)", "", "The hull mesh (any format meshio or Capytaine reads; triangles "
                                                "and quads), relative to the scene, waterline at z = 0."),
-    ("vessel.hull.cog", "[0, 0, 0]", "m", "The COG in the mesh's coordinates."),
+    ("vessel.hull.cog", "[0, 0, 0]", "m", "The COG in the mesh's coordinates. Traced by the nonlinear "
+                                          "hydrostatics only (`identify --fit vessel.hull.cog`)."),
     ("vessel.hull.depth", "required (box, nonlinear or stability)", "m", "Box hull: keel to deck, above the "
                                                                           "draft (large angles immerse the deck edge)."),
     ("vessel.hydrodynamics.frequencies", "none", "rad/s", "Ascending, at least 4: the tables below are per "

@@ -58,8 +58,16 @@ TRACEABLE = _Keys((
     "vessel.hydrostatics.waterplane_area", "vessel.hydrostatics.displaced_volume",
     "vessel.hydrostatics.gm_t", "vessel.hydrostatics.gm_l",
     "vessel.initial.position", "vessel.initial.velocity", "vessel.initial.angular_velocity",
-    "vessel.initial.roll_pitch_yaw",
+    "vessel.initial.roll_pitch_yaw", "vessel.hull.kg", "vessel.hull.cog",
 ) + tuple(f"tanks.<name>.{k}" for k in TANK_TRACEABLE) + ("waves.amplitude", "waves.hs"))
+
+# keys traced by the nonlinear hydrostatics alone (assemble/hull.py moves the hull's surface against the
+# COG); the linear model's GM springs were derived from them when the scene was loaded
+HULL_TRACEABLE = ("vessel.hull.kg", "vessel.hull.cog")
+# keys the nonlinear hydrostatics does not read (the restoring is the hull's): tracing them would
+# change nothing
+SPRING_KEYS = ("vessel.hydrostatics.waterplane_area", "vessel.hydrostatics.displaced_volume",
+               "vessel.hydrostatics.gm_t", "vessel.hydrostatics.gm_l")
 
 
 def scene_values(scene: Scene) -> dict[str, Any]:
@@ -84,6 +92,11 @@ def scene_values(scene: Scene) -> dict[str, Any]:
             v[f"vessel.hydrostatics.{key}"] = getattr(ves.hydrostatics, key)
     for key in ("position", "velocity", "angular_velocity", "roll_pitch_yaw"):
         v[f"vessel.initial.{key}"] = getattr(ves.initial, key)
+    if ves.hull is not None:      # the COG against the hull: a box's KG, a mesh's COG in its file's coordinates
+        if ves.hull.type == "box":
+            v["vessel.hull.kg"] = ves.hull.kg
+        else:
+            v["vessel.hull.cog"] = ves.hull.cog
     f = ves.forced
     if f is not None and f.profile != "record":   # a record's samples are its file's, not values of the scene
         own = ("amplitude", "frequency", "phase", "ramp") if f.profile == "harmonic" else ("rate", "duration")
@@ -169,12 +182,23 @@ def traceable(scene: Scene, keys: Iterable[str]) -> tuple[str, ...]:
         if key not in TRACEABLE:
             raise SceneError(given, "cannot be traced by params, a sweep or a fit (traceable: "
                                     + ", ".join(traceable_keys(scene)) + ")")
+        if key in HULL_TRACEABLE and not _hull_restoring(scene):
+            raise SceneError(given, 'is traced by the nonlinear hydrostatics only ([vessel.hydrostatics] model = '
+                                    '"nonlinear", [effects] buoyancy on): the linear model\'s GM springs were fixed '
+                                    "when the scene was loaded (trace vessel.hydrostatics.gm_t there)")
     return canon
+
+
+def _hull_restoring(scene: Scene) -> bool:
+    """Whether the restoring is the hull's wetted surface (the nonlinear hydrostatics, switched on)."""
+    h = scene.vessel.hydrostatics
+    return h is not None and h.nonlinear and scene.effects.buoyancy
 
 
 def traceable_keys(scene: Scene) -> tuple[str, ...]:
     """The keys of this scene that params may trace."""
-    return tuple(k for k in scene_values(scene) if "[" not in k and k in TRACEABLE)
+    hull = _hull_restoring(scene)
+    return tuple(k for k in scene_values(scene) if "[" not in k and k in TRACEABLE and (hull or k not in HULL_TRACEABLE))
 
 
 def _shaped(key: str, value, base):

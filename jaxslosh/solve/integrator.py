@@ -140,7 +140,8 @@ def step_equations(system: System, solver: Solver, s: State):
     preconditioner, parts(Delta[:r], Delta[r:]) = (rigid rows, the others) with r the rigid
     unknowns (System.residual_parts; with structures their inertia rows, without the multipliers:
     structures.inertia_rows_parts)."""
-    h, (am, af, beta, gamma) = solver.h, solver.scheme
+    h, sc = solver.h, solver.scheme
+    am, af, beta, gamma = sc.alpha_m, sc.alpha_f, sc.beta, sc.gamma
     base = h * s.v + h * h * (0.5 - beta) * s.a
 
     def rates(delta, i):
@@ -181,7 +182,7 @@ def static_structures(system, solver: Solver, c0: Config, v0, alg0):
     r, nf = L.n_rigid, L.nf
     held = jnp.zeros(L.n_dyn, dtype=bool).at[:6].set(True).at[r:r + nf].set(True)
     held_x = L.to_x(held, jnp.zeros(L.n_alg, dtype=bool))
-    f = 1.0 / (solver.scheme.beta * solver.h ** 2)
+    f = solver.scheme.c_d(solver.h)
     gsc, alg_sc = mb.alg_scales(system, f, lambda itf: jnp.maximum(1.0 / f, 1e-13 * itf.L_ref / solver.tol))
     scale = L.to_x(mb.scales(system), alg_sc)
     z = jnp.zeros(L.n_dyn)
@@ -244,8 +245,7 @@ def _flex_step(system, solver: Solver, s: State, fresh=None) -> tuple[State, Ste
     like the acceleration errors of the other rows, or |g| below 1e-13 of the interface's size
     (round-off), whichever is larger."""
     L = mb.layout(system)
-    h, beta = solver.h, solver.scheme.beta
-    f = 1.0 / (beta * h * h)
+    f = solver.scheme.c_d(solver.h)
     gsc, alg_sc = mb.alg_scales(system, f, lambda itf: jnp.maximum(1.0 / f, 1e-13 * itf.L_ref / solver.tol))
     scale = L.to_x(mb.scales(system), alg_sc)
     _, unpack, pred, Rm_parts = step_equations(system, solver, s)
@@ -267,7 +267,8 @@ def _flex_step(system, solver: Solver, s: State, fresh=None) -> tuple[State, Ste
     dyn, alg = L.from_x(x)
     c, v, acc, a = unpack(dyn)
     ok = ok & jnp.all(jnp.isfinite(x))
-    return (State(c, v, acc, a, s.t + h, pre_new if solver.reuse else s.pre, alg, memory_next(system, solver, s, v)),
+    return (State(c, v, acc, a, s.t + solver.h, pre_new if solver.reuse else s.pre, alg,
+                  memory_next(system, solver, s, v)),
             StepInfo(it, err, ok))
 
 

@@ -61,8 +61,7 @@ class Solver(eqx.Module):
 
     @property
     def c_a(self):
-        s = self.scheme
-        return (1.0 - s.alpha_m) / ((1.0 - s.alpha_f) * s.beta * self.h ** 2)
+        return self.scheme.c_a(self.h)
 
 
 def make_solver(system: System, h: float, scheme: Scheme, tol: float, max_iter: int, substeps: int = 0,
@@ -83,8 +82,8 @@ def make_solver(system: System, h: float, scheme: Scheme, tol: float, max_iter: 
                       reuse=reuse, adaptive=adaptive, ns=6 + nf)
     L = system.liquid
     if L.sparse:         # large mesh (sparse.py): fast diagonalization, factors in JAX, or the host's LU
-        c_a = lambda hh: (1.0 - scheme.alpha_m) / ((1.0 - scheme.alpha_f) * scheme.beta * hh ** 2)  # noqa: E731
-        step_inv, mass_inv, sub_inv, K = sparse_solver_blocks(L, c_a(h), c_a(h / substeps) if substeps else None)
+        step_inv, mass_inv, sub_inv, K = sparse_solver_blocks(L, scheme.c_a(h),
+                                                              scheme.c_a(h / substeps) if substeps else None)
         step_inv = damped(step_inv, system, scheme, h)
         sub_inv = damped(sub_inv, system, scheme, h / substeps) if substeps else None
         scale = np.asarray(jax.lax.stop_gradient(system.scales()[6:]))
@@ -100,8 +99,7 @@ def make_solver(system: System, h: float, scheme: Scheme, tol: float, max_iter: 
         return inv(A) if traced else jnp.asarray(np.linalg.inv(A))
 
     def step_block_inverse(hh):
-        c_a = (1.0 - scheme.alpha_m) / ((1.0 - scheme.alpha_f) * scheme.beta * hh ** 2)
-        Cs = c_a * M_ff + K_ff
+        Cs = scheme.c_a(hh) * M_ff + K_ff
         return inverse(0.5 * (Cs + Cs.T))
 
     noise = _noise(system, K_ff)
@@ -147,7 +145,7 @@ def damped(base, system: System, scheme: Scheme, hh):
         return base
     B, c = jax.lax.stop_gradient((system.damping.B, system.damping.c))
     W = base @ B
-    D = scheme.gamma / (scheme.beta * hh) * c
+    D = scheme.c_v(hh) * c
     G = B.T @ W
     S = solve(jnp.eye(c.shape[0]) + D[:, None] * G, jnp.diag(D))      # (I + D G)^-1 D = D (I + G D)^-1
     return LowRankUpdate(base, W, S)
@@ -175,12 +173,8 @@ def _flex_solver(system: System, h, scheme: Scheme, tol, max_iter, substeps, reu
     modal block, which is diagonal (Phi^T M Phi = I, Phi^T K Phi = omega^2): 1 / (c_a + omega^2)."""
     base = make_solver(dataclasses.replace(system, flex=None), h, scheme, tol, max_iter, substeps, reuse, adaptive)
     w2 = jax.lax.stop_gradient(jnp.concatenate([b.omega2 for b in system.flex.bodies]))
-
-    def c_a(hh):
-        return (1.0 - scheme.alpha_m) / ((1.0 - scheme.alpha_f) * scheme.beta * hh ** 2)
-
-    sub = BlockInverse(base.Cinv_sub, 1.0 / (c_a(h / substeps) + w2)) if substeps else None
-    return Solver(BlockInverse(base.Cinv_step, 1.0 / (c_a(h) + w2)), BlockInverse(base.Cinv_mass, jnp.ones_like(w2)),
+    sub = BlockInverse(base.Cinv_sub, 1.0 / (scheme.c_a(h / substeps) + w2)) if substeps else None
+    return Solver(BlockInverse(base.Cinv_step, 1.0 / (scheme.c_a(h) + w2)), BlockInverse(base.Cinv_mass, jnp.ones_like(w2)),
                   jnp.asarray(h, dtype=float), scheme, tol, max_iter, substeps, sub, noise=base.noise, reuse=reuse,
                   adaptive=adaptive, ns=layout(system).n_small)
 

@@ -8,6 +8,9 @@ a constant block whose inverse `Cinv` is formed once per run (solve/linear.py).
 """
 from __future__ import annotations
 
+from typing import NamedTuple
+
+import equinox as eqx
 import jax
 import jax.numpy as jnp
 
@@ -90,95 +93,139 @@ def _preconditioner(A, like, Cinv, ns=6):
 SLOW = 0.01
 
 
-def _newton(R, x0, Cinv, scale, tol, max_iter, pre=None, floor=0.0, adaptive=True, ns=6, split=None, fresh=None,
-            parts=None):
-    """Quasi-Newton iterations on R(x) = 0 (x: ns rigid and algebraic unknowns, then the liquid's and
-    the structures' modal ones) with the
-    structured approximate inverse of the Jacobian, formed at the first iteration of the step and
-    formed again only when the residual stops falling fast (a rotation that changed a lot).
+class NewtonStatus(NamedTuple):
+    """How a root was found: the evaluations of the residual after the first, the scaled residual's
+    largest entry at the end, and whether that is converged."""
+    iterations: jax.Array
+    error: jax.Array
+    ok: jax.Array
 
-    `pre` = (data, valid): a preconditioner carried from the previous step, used while it keeps the
-    convergence fast (and formed afresh when not valid); the one used last is returned with the
-    aux. `floor`: the round-off floor of the scaled residual; the iterations stop below
-    max(tol, floor). `adaptive=False`: formed once before the iterations, never inside (vmapped
-    batches, where a lax.cond computes both branches); then, with `pre` carried, `fresh` (a boolean
-    that is the same for every run of a batch) says whether to form it anew or use the carried one
-    through this step. `split` = (Rm, Rc, nr, parts_m): R = Rm + Rc, unknowns nr..ns enter R only
-    through the cheap part Rc, and parts_m gives Rm in parts (see _precond_data_split). `parts`: R
-    in parts (see _precond_data_parts), for the preconditioner."""
-    tol = jnp.maximum(tol, floor)
 
-    def err_of(r):
-        return jnp.max(jnp.abs(r / scale))
+class NewtonState(NamedTuple):
+    """The iterations' carry: `dx` is the update prepared by the last pass (applied by the next),
+    `it` counts evaluations of R from -1 (none yet), `fresh` says the update came from a
+    preconditioner formed for it, `need` asks the next pass to form one, `data` its factors."""
+    x: jax.Array
+    dx: jax.Array
+    it: jax.Array
+    err: jax.Array
+    fresh: jax.Array
+    stalled: jax.Array
+    need: jax.Array
+    data: tuple
+
+
+class StructuredNewton(eqx.Module):
+    """Quasi-Newton iterations on R(x) = 0 (x: `ns` rigid and algebraic unknowns, then the liquid's
+    and the structures' modal ones) with the structured approximate inverse of the Jacobian (the
+    first `ns` rows and columns exact, the rest the constant block `Cinv`), formed at the first
+    iteration of the step and formed again only when the residual stops falling fast (a rotation
+    that changed a lot). A root finder in optimistix's shape: `init`, `step`, `terminate`, driven
+    by `root` in one `lax.while_loop`.
+
+    `floor`: the round-off floor of the scaled residual; the iterations stop below max(tol, floor).
+    `adaptive=False`: the preconditioner is formed once before the iterations, never inside
+    (vmapped batches, where a lax.cond computes both branches). `split` = (Rm, Rc, nr, parts_m):
+    R = Rm + Rc, unknowns nr..ns enter R only through the cheap part Rc, and parts_m gives Rm in
+    parts (see _precond_data_split). `parts`: R in parts (see _precond_data_parts)."""
+    Cinv: object
+    scale: jax.Array
+    tol: jax.Array
+    max_iter: int = eqx.field(static=True)
+    adaptive: bool = eqx.field(static=True, default=True)
+    ns: int = eqx.field(static=True, default=6)
+    split: object = eqx.field(static=True, default=None)
+    parts: object = eqx.field(static=True, default=None)
+
+    def error(self, r):
+        return jnp.max(jnp.abs(r / self.scale))
 
     @jax.named_scope("preconditioner")
-    def refresh(x):
-        if split is not None:     # R = Rm + Rc, each part linearised once (not R, then Rc again)
-            _, Rc, nr, parts_m = split
+    def precondition(self, R, x):
+        """The factors of the structured inverse of R's Jacobian at x."""
+        if self.split is not None:     # R = Rm + Rc, each part linearised once (not R, then Rc again)
+            _, Rc, nr, parts_m = self.split
             _, jvp_c = jax.linearize(Rc, x)
-            return _precond_data_split(parts_m, jvp_c, x, Cinv, nr, ns)
-        if parts is not None:
-            return _precond_data_parts(parts, x, Cinv, ns)
+            return _precond_data_split(parts_m, jvp_c, x, self.Cinv, nr, self.ns)
+        if self.parts is not None:
+            return _precond_data_parts(self.parts, x, self.Cinv, self.ns)
         _, jvp = jax.linearize(R, x)
-        return _precond_data(jvp, x, Cinv, ns)
+        return _precond_data(jvp, x, self.Cinv, self.ns)
 
-    def going(it, err, stalled):
-        return (err > tol) & (it < max_iter) & jnp.isfinite(err) & ~stalled
+    def going(self, it, err, stalled):
+        return (err > self.tol) & (it < self.max_iter) & jnp.isfinite(err) & ~stalled
 
-    # The loop runs over evaluations of R, its first at x0: R appears once in the program (a
-    # residual before the loop would be compiled a second time). Each pass applies the update the
-    # last one prepared, evaluates R, judges the update, and prepares the next (forming the
-    # preconditioner again where the last update was slow).
-    def body(carry):
-        x, dx, it, err_prev, was_fresh, _, need_prev, data = carry
-        x = x + dx
+    def init(self, R, x0, pre=None, fresh=None) -> NewtonState:
+        """The state before the first evaluation. `pre` = (data, valid): a preconditioner carried
+        from the previous step, used while it keeps the convergence fast (formed afresh when not
+        valid). Not adaptive, with `pre` carried, `fresh` (a boolean that is the same for every run
+        of a batch) says whether to form it anew or use the carried one through this step."""
+        if not self.adaptive:
+            if pre is not None and fresh is not None:
+                # `fresh` only, never the carried validity flag, which is per run: the predicate
+                # stays unbatched and the cond a branch (the first step of a run is always fresh)
+                data0 = jax.lax.cond(fresh, lambda x: self.precondition(R, x), lambda _: pre[0], x0)
+            else:
+                data0 = self.precondition(R, x0)
+            need0 = jnp.array(False)
+        elif pre is not None:
+            data0, need0 = pre[0], ~(pre[1] > 0.5)
+        else:    # placeholders of the shapes precondition returns (eval_shape would trace it again)
+            n, ns = x0.shape[0], self.ns
+            data0 = ((jnp.zeros((ns, ns), x0.dtype),) if self.split is None and n == ns else
+                     (jnp.zeros((ns, ns), x0.dtype), jnp.zeros((ns, n - ns), x0.dtype),
+                      jnp.zeros((n - ns, ns), x0.dtype)))
+            need0 = jnp.array(True)
+        return NewtonState(x0, jnp.zeros_like(x0), jnp.array(-1), jnp.array(jnp.inf, x0.dtype), jnp.array(False),
+                           jnp.array(False), need0, data0)
+
+    def step(self, R, s: NewtonState) -> NewtonState:
+        """One pass: apply the update the last pass prepared, evaluate R (R appears once in the
+        program: a residual before the loop would be compiled a second time), judge the update, and
+        prepare the next, forming the preconditioner again where the last update was slow."""
+        x = s.x + s.dx
         r = R(x)
-        err = err_of(r)
-        first = it < 0
+        err = self.error(r)
+        first = s.it < 0
         # a stale preconditioner that slows down is formed again; a fresh one that cannot is a stall
-        stalled = ~first & was_fresh & (err > 0.5 * err_prev)
-        need = jnp.where(first, need_prev, err > jnp.where(was_fresh, 0.1, SLOW) * err_prev)
-        it = it + 1
-
-        if adaptive:
+        stalled = ~first & s.fresh & (err > 0.5 * s.err)
+        need = jnp.where(first, s.need, err > jnp.where(s.fresh, 0.1, SLOW) * s.err)
+        it = s.it + 1
+        if self.adaptive:
             def prepare(data):
-                data = jax.lax.cond(need, refresh, lambda _: data, x)
-                return data, _precond_apply(data, Cinv, -r, ns)
+                data = jax.lax.cond(need, lambda x_: self.precondition(R, x_), lambda _: data, x)
+                return data, _precond_apply(data, self.Cinv, -r, self.ns)
 
-            data, dx = jax.lax.cond(going(it, err, stalled), prepare, lambda d: (d, jnp.zeros_like(x)), data)
+            data, dx = jax.lax.cond(self.going(it, err, stalled), prepare, lambda d: (d, jnp.zeros_like(x)),
+                                    s.data)
         else:    # batches: the preconditioner is fixed through the iterations (a cond on a per-run
-            dx = _precond_apply(data, Cinv, -r, ns)     # test would run both branches under vmap)
-        return x, dx, it, err, need | (not adaptive), stalled, need, data
+            data, dx = s.data, _precond_apply(s.data, self.Cinv, -r, self.ns)  # test runs both branches)
+        return NewtonState(x, dx, it, err, need | (not self.adaptive), stalled, need, data)
 
-    def cond(carry):
-        _, _, it, err, _, stalled, _, _ = carry
-        return (it < 0) | going(it, err, stalled)
+    def terminate(self, s: NewtonState):
+        """(done, status): converged below the tolerance, or stalled at round-off within a factor
+        100 of it; out of iterations, or not finite."""
+        done = (s.it >= 0) & ~self.going(s.it, s.err, s.stalled)
+        ok = jnp.isfinite(s.err) & ((s.err <= self.tol) | (s.stalled & (s.err <= 100.0 * self.tol)))
+        return done, NewtonStatus(s.it, s.err, ok)
 
-    if not adaptive:
-        if pre is not None and fresh is not None:
-            # `fresh` only, never the carried validity flag, which is per run: the predicate stays
-            # unbatched and the cond a branch (the first step of a run is always fresh)
-            data0 = jax.lax.cond(fresh, refresh, lambda _: pre[0], x0)
-        else:
-            data0 = refresh(x0)
-        need0 = jnp.array(False)
-    elif pre is not None:
-        data0, need0 = pre[0], ~(pre[1] > 0.5)
-    else:    # placeholders of the shapes refresh returns (jax.eval_shape(refresh) would trace it again)
-        n = x0.shape[0]
-        data0 = ((jnp.zeros((ns, ns), x0.dtype),) if split is None and n == ns else
-                 (jnp.zeros((ns, ns), x0.dtype), jnp.zeros((ns, n - ns), x0.dtype), jnp.zeros((n - ns, ns), x0.dtype)))
-        need0 = jnp.array(True)
-    init = (x0, jnp.zeros_like(x0), jnp.array(-1), jnp.array(jnp.inf, x0.dtype), jnp.array(False), jnp.array(False),
-            need0, data0)
-    x, _, it, err, _, stalled, _, data = jax.lax.while_loop(cond, body, init)
-    # Converged: below the tolerance, or stalled at round-off within a factor 100 of it.
-    ok = jnp.isfinite(err) & ((err <= tol) | (stalled & (err <= 100.0 * tol)))
-    # aux leaves are floats: custom_root's JVP rule cannot carry integer or boolean aux tangents
-    aux = (it.astype(float), err, ok.astype(float))
-    if pre is not None:
-        aux = aux + ((data, jnp.ones(())),)
-    return x, aux
+    def root(self, R, x0, pre=None, fresh=None):
+        """The iterations from x0: returns x and the aux `lax.custom_root` carries (floats: its JVP
+        rule cannot carry integer or boolean aux tangents), with the preconditioner used last and a
+        valid flag when `pre` was carried in."""
+        s = jax.lax.while_loop(lambda s: ~self.terminate(s)[0], lambda s: self.step(R, s), self.init(R, x0, pre, fresh))
+        _, st = self.terminate(s)
+        aux = (st.iterations.astype(float), st.error, st.ok.astype(float))
+        if pre is not None:
+            aux = aux + ((s.data, jnp.ones(())),)
+        return s.x, aux
+
+
+def _newton(R, x0, Cinv, scale, tol, max_iter, pre=None, floor=0.0, adaptive=True, ns=6, split=None, fresh=None,
+            parts=None):
+    """`StructuredNewton(...).root(R, x0, pre, fresh)` with the tolerance raised to the round-off floor."""
+    solver = StructuredNewton(Cinv, scale, jnp.maximum(tol, floor), max_iter, adaptive, ns, split, parts)
+    return solver.root(R, x0, pre, fresh)
 
 
 def _structured_linear_solve(A, b, Cinv, rtol=1e-13, max_sweeps=30, ns=6):
@@ -223,7 +270,7 @@ def solve_root(R, x0, Cinv, scale, tol, max_iter, ns=6, split=None, implicit=Tru
     x, (it, err, ok) = _root(R, x0, lambda f, x: _newton(f, x, Cinv, scale, tol, max_iter, ns=ns, split=split,
                                                          parts=parts), Cinv, ns, implicit)
     it, err, ok = jax.lax.stop_gradient((it, err, ok))
-    return x, (it.astype(jnp.int32), err, ok > 0.5)
+    return x, NewtonStatus(it.astype(jnp.int32), err, ok > 0.5)
 
 
 def solve_root_carried(R, x0, Cinv, scale, tol, max_iter, pre=None, floor=0.0, adaptive=True, ns=6, split=None,
@@ -235,4 +282,4 @@ def solve_root_carried(R, x0, Cinv, scale, tol, max_iter, pre=None, floor=0.0, a
     x, aux = out
     it, err, ok = jax.lax.stop_gradient(aux[:3])
     new_pre = jax.lax.stop_gradient(aux[3]) if pre is not None else None
-    return x, (it.astype(jnp.int32), err, ok > 0.5), new_pre
+    return x, NewtonStatus(it.astype(jnp.int32), err, ok > 0.5), new_pre

@@ -1,0 +1,129 @@
+"""KG from a roll decay (docs/guide/identification.md, issue 32 item 6): a box barge (20 x 10 m,
+draft 3 m, depth 6 m, KG 3.6 m, GM0 0.678 m) released at several heels, its roll decay (linear
+roll damping of about 7 % of critical, 16 s at dt = 0.1 s) recorded with noise (0.2 degrees on
+roll and pitch, 5 mm on heave; several seeds), then fitted two ways:
+
+- `--fit vessel.hull.kg` with the nonlinear hydrostatics (started at KG 3.5 m; every channel,
+  weights 1 / noise), which reports the implied GM0 = KM - KG;
+- `--fit vessel.hydrostatics.gm_t` with the GM springs (`model = "linear"`, started at the
+  hull's GM0 for KG 3.5 m; the roll alone, which is all the springs can follow), and the KG that
+  GM implies, KM - GM.
+
+    python benchmarks/kg_identification.py [--angles 10,20,28] [--seeds 3] [--out DIR]
+
+Prints a table: per release heel the mean (and spread over the seeds) of each fit's error against
+the record's true KG and GM0. With --out, also writes the 28-degree case's files (barge.toml,
+barge_linear.toml, measured.h5) and prints the `jaxslosh identify` commands that fit them.
+"""
+import argparse
+import math
+import os
+import warnings
+
+import jax
+
+jax.config.update("jax_enable_x64", True)
+
+import numpy as np  # noqa: E402
+
+import jaxslosh as js  # noqa: E402
+from jaxslosh.fit.problem import add_noise  # noqa: E402
+
+RHO, L, B, T = 1025.0, 20.0, 10.0, 3.0
+MASS = RHO * L * B * T
+TRUE_KG, START_KG = 3.6, 3.5
+KM = T / 2 + B ** 2 / (12 * T)
+NOISE = {"roll": math.radians(0.2), "pitch": math.radians(0.2), "heave": 0.005}
+
+BARGE = """title = "box barge roll decay"
+[environment]
+gravity = 9.81
+water_density = 1025.0
+[simulation]
+duration = 16.0
+dt = 0.1
+scheme = "newmark"
+[vessel]
+mass = {mass}
+inertia = [7.5e6, 2.5e7, 2.8e7]
+[vessel.hull]
+length = 20.0
+beam = 10.0
+draft = 3.0
+kg = {kg}
+depth = 6.0
+[vessel.hydrostatics]
+model = "{model}"
+[vessel.hydrodynamics]
+viscous_damping = [0.0, 0.0, 0.0, 8.0e5, 0.0, 0.0]
+[vessel.initial]
+roll_pitch_yaw = [{roll}, 0.0, 0.0]
+"""
+
+
+def barge(kg, roll, model="nonlinear"):
+    return BARGE.format(mass=MASS, kg=kg, model=model, roll=roll)
+
+
+def fits(angle_deg, seeds):
+    roll = math.radians(angle_deg)
+    clean = js.simulate(js.load_scene(barge(TRUE_KG, roll)))
+    nonlinear = js.load_scene(barge(START_KG, roll))
+    linear = js.load_scene(barge(START_KG, roll, "linear"))
+    kg, gm = [], []
+    for seed in range(seeds):
+        measured = add_noise(clean, NOISE, seed=seed)
+        f = js.identify(nonlinear, measured, ["vessel.hull.kg"], weights={c: 1 / s for c, s in NOISE.items()})
+        kg.append((f.values["vessel.hull.kg"], f.standard_errors["vessel.hull.kg"], f.converged))
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")
+            g = js.identify(linear, measured, ["vessel.hydrostatics.gm_t"], weights={"roll": 1 / NOISE["roll"]},
+                            data_scene="ignore")
+        gm.append((g.values["vessel.hydrostatics.gm_t"], g.standard_errors["vessel.hydrostatics.gm_t"], g.converged,
+                   g.residual_to_noise["roll"]))
+    return np.array(kg), np.array(gm)
+
+
+def write_case(out):
+    os.makedirs(out, exist_ok=True)
+    roll = math.radians(28.0)
+    for name, model in (("barge.toml", "nonlinear"), ("barge_linear.toml", "linear")):
+        with open(os.path.join(out, name), "w") as f:
+            f.write(barge(START_KG, roll, model))
+    clean = js.simulate(js.load_scene(barge(TRUE_KG, roll)))
+    data = os.path.join(out, "measured.h5")
+    js.save_result(add_noise(clean, NOISE, seed=0), data)
+    print(f"\nwrote {out}/barge.toml, barge_linear.toml (KG {START_KG} m) and measured.h5 (KG {TRUE_KG} m, noise):")
+    print(f"  jaxslosh identify {out}/barge.toml --data {data} --fit vessel.hull.kg")
+    print(f"  jaxslosh identify {out}/barge_linear.toml --data {data} --fit vessel.hydrostatics.gm_t "
+          "--data-scene ignore")
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    ap.add_argument("--angles", default="10,20,28", help="release heels, degrees (default 10,20,28)")
+    ap.add_argument("--seeds", type=int, default=3, help="noise seeds per heel (default 3)")
+    ap.add_argument("--out", help="also write the 28-degree case's scene and record files here")
+    a = ap.parse_args()
+    gm0 = KM - TRUE_KG
+    print(f"box barge {L} x {B} m, draft {T} m: KM {KM:.4f} m, true KG {TRUE_KG} m, GM0 {gm0:.4f} m; "
+          f"{a.seeds} noise seeds per heel\n")
+    print("| release heel | KG fit (nonlinear), m | KG error | KG std. error | GM fit (springs), m | GM bias "
+          "| KG = KM - GM, m | its KG error | springs' roll residual / noise |")
+    print("| ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: |")
+    for angle in (float(x) for x in a.angles.split(",")):
+        kg, gm = fits(angle, a.seeds)
+        ekg = (kg[:, 0] - TRUE_KG) / TRUE_KG * 100
+        bias = (gm[:, 0] - gm0) / gm0 * 100
+        kg_s = KM - gm[:, 0]
+        ekg_s = (kg_s - TRUE_KG) / TRUE_KG * 100
+        ok = "" if kg[:, 2].all() and gm[:, 2].all() else " (a fit did not converge)"
+        print(f"| {angle:g} deg | {kg[:, 0].mean():.4f} | {ekg.mean():+.3f} % (max {np.abs(ekg).max():.3f} %) "
+              f"| {kg[:, 1].mean():.4f} | {gm[:, 0].mean():.4f} | {bias.mean():+.1f} % | {kg_s.mean():.4f} "
+              f"| {ekg_s.mean():+.2f} % | {gm[:, 3].mean():.1f} |{ok}")
+    if a.out:
+        write_case(a.out)
+
+
+if __name__ == "__main__":
+    main()

@@ -1,0 +1,178 @@
+"""From a validated scene to the static model: `System`, probes and the initial state.
+
+Only what the scene has is built (STYLE.md: Python branches on static model data): a vessel
+without tanks has no liquid block, a scene without `[vessel.hydrostatics]` no buoyancy.
+Numbers named in `params` (dotted TOML paths, scene/keys.py) replace the scene's values and may be
+JAX tracers, which is what makes `jax.grad` through `simulate(scene, params=...)` work.
+"""
+from __future__ import annotations
+
+import dataclasses
+from typing import NamedTuple, Optional
+
+import jax
+import jax.numpy as jnp
+import numpy as np
+
+from ..physics.kinematics import quat_from_rpy, rotation_matrix
+from ..physics.liquid import RotationPenalty, SpinStiffening
+from ..physics.system import System
+from ..physics.terms import Config
+from ..physics.vessel import (FreeMotion, HarmonicMotion, Hydrostatics, PaperHydrostatics, RecordedMotion, RigidBody,
+                              SpinUpMotion, Weight, record_coefficients)
+from ..programs import staged
+from ..scene.keys import resolve_params
+from ..scene.types import DOFS, Scene, SceneError
+from ..solve.sparse import hydrostatic_start
+from .damping import build_damping
+from .hull import build_hull_pressure
+from .liquid import LiquidBlock, build_liquid_block, rigid_part
+from .multimodal import build_multimodal, multimodal_damping, multimodal_scene, probe_modal, surfaces
+from .probes import Probes, build_probes
+from .seakeeping import build_seakeeping
+from .structures import build_flex, flex_start
+
+
+class Built(NamedTuple):
+    system: System
+    c0: Config
+    v0: jnp.ndarray
+    probes: Probes
+    tanks: tuple
+    alg0: Optional[jnp.ndarray] = None    # interface frame positions (and zero multipliers) at t = 0
+    structures: tuple = ()               # host-side StructureBlock per structure (result fields)
+    surfaces: tuple = ()                 # per tank, the stacked indices of its free-surface nodes (validity)
+
+
+#: the build's jax.numpy steps, each one compiled program (programs.staged), wrapped once per process
+_quat_from_rpy = staged(quat_from_rpy)
+_flex_start = staged(flex_start)
+
+
+def _inertia(value):
+    a = jnp.asarray(value, dtype=float)
+    return jnp.diag(a) if a.ndim == 1 else a
+
+
+def build(scene: Scene, params: Optional[dict] = None) -> Built:
+    params = resolve_params(scene, params)
+    P = params.get
+    env, ves, eff = scene.environment, scene.vessel, scene.effects
+    g = jnp.asarray(P("environment.gravity", env.gravity), dtype=float)
+    terms = []
+    nonlinear = ves.hydrostatics is not None and ves.hydrostatics.nonlinear and eff.buoyancy
+    if nonlinear:              # the hull's wetted surface (assemble/hull.py); the weight below
+        terms.append(build_hull_pressure(scene, params, g))
+    elif ves.hydrostatics is not None and eff.buoyancy:
+        h = ves.hydrostatics
+        f = lambda k, v: jnp.asarray(P(k, v), dtype=float)  # noqa: E731
+        form = PaperHydrostatics if h.moment == "paper" else Hydrostatics
+        terms.append(form(
+            rho_w=f("environment.water_density", env.water_density), gravity=g,
+            waterplane_area=f("vessel.hydrostatics.waterplane_area", h.waterplane_area),
+            displaced_volume=f("vessel.hydrostatics.displaced_volume", h.displaced_volume),
+            gm_t=f("vessel.hydrostatics.gm_t", h.gm_t), gm_l=f("vessel.hydrostatics.gm_l", h.gm_l)))
+    multimodal = eff.liquid and multimodal_scene(scene)
+    block = LiquidBlock(build_multimodal(scene, params, g)) if multimodal else \
+        build_liquid_block(scene, params, g, include_liquid=eff.liquid)
+    liquid = dataclasses.replace(block.liquid, coriolis=eff.coriolis, centrifugal=eff.centrifugal) \
+        if block.liquid.nf and not multimodal else block.liquid
+    motion = FreeMotion()
+    if ves.forced is not None:
+        motion = _prescribed(ves.forced)
+    ini = ves.initial
+    q0 = _quat_from_rpy(jnp.asarray(P("vessel.initial.roll_pitch_yaw", ini.roll_pitch_yaw), dtype=float))
+    if motion.prescribed:     # the prescribed attitude at t = 0 (upright unless a phase or a record tilts it)
+        x0 = motion.coordinates(jnp.zeros(()))
+        q0 = _quat_from_rpy(x0[3:])
+    sea_terms, memory = build_seakeeping(scene, params) if scene.waves is not None or ves.hydrodynamics is not None \
+        else ((), None)
+    terms += sea_terms
+    own = [s for s in scene.structures if s.frame == "own"]
+    flex, blocks = build_flex(scene) if own else (None, ())
+    mass, inertia = jnp.asarray(P("vessel.mass", ves.mass), dtype=float), _inertia(P("vessel.inertia", ves.inertia))
+    hull_S = None
+    carried = block.carried + tuple(rigid_part(b.model.mass, b.model.nodes + np.asarray(scene.structure(b.name).origin))
+                                    for b in blocks)
+    if carried:       # the ship's mass and inertia include these parts: the hull is the rest (SPEC)
+        mass, inertia, hull_S = _hull(mass, inertia, carried)
+    body = RigidBody(mass=mass, inertia=inertia, S=hull_S)
+    balanced = ves.hydrostatics is not None and not nonlinear
+    if not balanced:           # nothing holds the vessel up, or the hull's pressure does: its weight, liquid included
+        S = liquid.rigid_first_moment() if hull_S is None else hull_S + liquid.rigid_first_moment()
+        terms.append(Weight(mass=mass + liquid.total_mass(), S=S, gravity=g))
+    if block.penalty is not None:
+        terms.append(RotationPenalty(Kdt=block.penalty[0], Ktt=block.penalty[1], q_ref=q0))
+    if block.Kg is not None:
+        terms.append(SpinStiffening(block.Kg))
+    if multimodal:
+        damping = multimodal_damping(scene, params, liquid)
+    else:
+        damping, _ = build_damping(scene, params, block) if eff.liquid else (None, ())
+    system = System(body=body, terms=tuple(terms), liquid=liquid, gravity=g, q_ref=q0, motion=motion, memory=memory,
+                    flex=flex, gravity_turning=eff.gravity_turning or not liquid.nf, balanced=balanced,
+                    damping=damping)
+    nf = system.nf
+    d_init = jnp.zeros(nf)
+    if nf:
+        d_init = _hydrostatic_start(system, q0)
+    c0 = Config(jnp.asarray(P("vessel.initial.position", ini.position), dtype=float), q0, d_init)
+    v0 = jnp.concatenate([jnp.asarray(P("vessel.initial.velocity", ini.velocity), dtype=float),
+                          jnp.asarray(P("vessel.initial.angular_velocity", ini.angular_velocity), dtype=float),
+                          jnp.zeros(nf)])
+    if motion.prescribed:   # the prescribed motion sets the rigid state at t = 0
+        c0 = Config(x0[:3], q0, c0.d)
+        v0 = v0.at[:6].set(motion.rates(jnp.zeros(())))
+    alg0 = None
+    if flex is not None:
+        c0, v0, alg0 = _flex_start(system, c0, v0)
+    probes = build_probes(scene, block.tanks, liquid, blocks, block.vstructs)
+    probes = probes._replace(modal=liquid.probe_modal(probes.weights))    # a modal liquid: probes from eta
+    if multimodal:
+        probes = probes._replace(modal=probe_modal(scene))
+        tops = surfaces(scene)
+    else:
+        tops = tuple(jnp.asarray(t.node_offset + np.flatnonzero(np.isclose(t.nodes[:, 2], t.nodes[:, 2].max())))
+                     for t in block.tanks)
+    return Built(system, c0, v0, probes, block.tanks, alg0, blocks, tops)
+
+
+def _prescribed(f):
+    """The motion of a `[vessel.forced]` table: one dof's profile, or a record's spline."""
+    if f.profile == "record":
+        knots, coef = record_coefficients(f.times, f.columns, DOFS)
+        return RecordedMotion(knots=jnp.asarray(knots), coef=jnp.asarray(coef))
+    if f.profile == "spin-up":
+        return SpinUpMotion(dof=DOFS.index(f.dof), rate=float(f.rate), duration=float(f.duration))
+    return HarmonicMotion(dof=DOFS.index(f.dof), amplitude=jnp.asarray(f.amplitude, dtype=float),
+                          frequency=jnp.asarray(f.frequency, dtype=float), ramp=float(f.ramp), phase=float(f.phase))
+
+
+def _hull(mass, inertia, parts):
+    """The hull's own mass, inertia about the origin and first moment: the ship's (mass, inertia
+    about its COG at the origin) less the parts that carry their own (structures, elastic walls)."""
+    m = sum(p[0] for p in parts)
+    S = sum(p[1] for p in parts)
+    I = sum(p[2] for p in parts)
+    if not isinstance(mass, jax.core.Tracer):
+        if float(mass) <= m:
+            raise SceneError("vessel.mass", f"{float(mass):.6g} kg is the whole ship without its liquid, structures "
+                                            f"and elastic walls included, but those alone weigh {m:.6g} kg")
+        if np.min(np.linalg.eigvalsh(np.asarray(inertia) - I)) <= 0:
+            raise SceneError("vessel.inertia", "is the whole ship's about its COG, structures and elastic walls "
+                                               "included, but it is smaller than theirs alone (the hull's would not "
+                                               f"be positive definite; theirs: {np.round(np.diag(I), 1).tolist()} kg m^2)")
+    return mass - m, inertia - jnp.asarray(I), -jnp.asarray(S)
+
+
+def _hydrostatic_start(system: System, q0):
+    """Discrete hydrostatic equilibrium K d0 = F_g under the initial gravity direction (PHYSICS.md
+    item 6), so that the stiff acoustic modes are not excited by the start."""
+    if system.liquid.sparse:
+        return hydrostatic_start(system.liquid, system.gravity_body(rotation_matrix(q0)))
+    return _dense_static_start(system, q0)
+
+
+@staged
+def _dense_static_start(system: System, q0):
+    return system.liquid.static_start(system.gravity_body(rotation_matrix(q0)))

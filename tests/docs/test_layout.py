@@ -1,0 +1,117 @@
+"""The package's layout (README "Design"): sub-packages in layers, imports at the top of files and
+only downwards, no import circles, no module over 500 lines. Read from the source with `ast`."""
+import ast
+import os
+
+import pytest
+
+ROOT = os.path.join(os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__)))), "jaxslosh")
+
+# lowest first; a module may import its own package and the packages on earlier lines
+LAYERS = [
+    {"_version", "executables"},
+    {"programs", "fem.mesh", "fem.meshfile", "fem.slip", "physics.kinematics"},
+    {"fem.shapes"},
+    {"hull"},
+    {"hydro", "io"},
+    {"scene"},
+    {"fem"},
+    {"physics"},
+    {"solve"},
+    {"assemble"},
+    {"run"},
+    {"analysis", "campaign", "fit"},
+    {"plot"},
+    {"cli"},
+    {"entry"},
+    {"__init__", "__main__"},
+]
+
+
+def _modules():
+    out = {}
+    for dirpath, _, files in os.walk(ROOT):
+        for f in files:
+            if f.endswith(".py"):
+                path = os.path.join(dirpath, f)
+                rel = os.path.relpath(path, ROOT)[:-3].replace(os.sep, ".")
+                out[rel] = path
+    return out
+
+
+def _resolve(module, node):
+    """The package-relative module an ImportFrom names (None for third-party imports)."""
+    if node.level == 0:
+        if node.module and node.module.startswith("jaxslosh."):
+            return node.module[len("jaxslosh."):]
+        return None
+    parts = module.split(".")
+    is_pkg = parts[-1] == "__init__"
+    base = parts[:-1] if not is_pkg else parts[:-1]
+    base = base[:len(base) - (node.level - 1)] if node.level > 1 else base
+    return ".".join(base + ([node.module] if node.module else []))
+
+
+def _imports(module, path):
+    tree = ast.parse(open(path).read())
+    top, nested = set(), []
+    for node in ast.walk(tree):
+        if isinstance(node, ast.ImportFrom):
+            target = _resolve(module, node)
+            if target is None:
+                continue
+            if node.module is None:          # from . import a, b
+                names = {f"{target}.{a.name}".strip(".") for a in node.names}
+            else:
+                names = {target}
+            if node in tree.body:
+                top |= names
+            else:
+                nested.append((node.lineno, target))
+    return top, nested
+
+
+def _layer(module):
+    for i, layer in enumerate(LAYERS):
+        for prefix in sorted(layer, key=len, reverse=True):
+            if module == prefix or module.startswith(prefix + "."):
+                return i, prefix
+    raise AssertionError(f"{module} is in no layer")
+
+
+MODULES = _modules()
+
+
+@pytest.mark.parametrize("module", sorted(MODULES))
+def test_module_is_short_and_imports_downwards_at_the_top(module):
+    path = MODULES[module]
+    n = sum(1 for _ in open(path))
+    assert n <= 500, f"{module}: {n} lines"
+    top, nested = _imports(module, path)
+    assert not nested, f"{module}: package imports inside functions at lines {nested}"
+    mine, pkg = _layer(module)
+    for t in top:
+        t = t[:-len(".__init__")] if t.endswith(".__init__") else t
+        theirs, other = _layer(t if t in MODULES or t + ".__init__" in MODULES else t.rsplit(".", 1)[0])
+        assert theirs < mine or other == pkg, f"{module} (layer {pkg}) imports {t} (layer {other})"
+
+
+def test_no_import_circles():
+    graph = {}
+    for m, path in MODULES.items():
+        top, _ = _imports(m, path)
+        graph[m] = {t for t in top if t in MODULES} | {t + ".__init__" for t in top if t + ".__init__" in MODULES}
+    state = {}
+
+    def visit(m, stack):
+        state[m] = 1
+        for t in graph.get(m, ()):
+            if state.get(t) == 1:
+                raise AssertionError("import circle: " + " -> ".join(stack[stack.index(t):] + [t]))
+            if t not in state:
+                visit(t, stack + [t])
+        state[m] = 2
+
+    for m in graph:
+        if m not in state:
+            visit(m, [m])
