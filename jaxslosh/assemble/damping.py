@@ -15,12 +15,14 @@ import scipy.sparse as sp
 
 from ..fem.damping import SPARSE_SEARCH, boundary_layer_ratios, sloshing_modes, sloshing_share
 from ..fem.liquid import build_liquid
+from ..fem.liquid_rt import FaceLiquid, face_modes
 from ..fem.modes import free_matrices
 from ..fem.reduction import tank_basis
 from ..physics.damping import ModalDamping
 from ..scene.fields import show
 from ..scene.types import Scene, SceneError
 from .liquid import build_liquid_block
+from .reduced import face_sloshing, face_tank_basis
 
 
 class TankDamping(NamedTuple):
@@ -36,10 +38,6 @@ def build_damping(scene: Scene, params: Optional[dict], block) -> tuple[Optional
     tanks = scene.tanks
     if not any(t.damping is not None for t in tanks) or not block.liquid.nf or not block.tanks:
         return None, ()
-    for i, t in enumerate(tanks):
-        if t.damping is not None and t.fluid.element == "rt":
-            raise SceneError(f"tanks[{i}].damping", 'is not available with the face-normal element ("rt") yet; '
-                                                    'use "stabilized" for a damped tank')
     if block.vstructs or any(t.wall_spec is not None for t in tanks):
         i = next(i for i, t in enumerate(tanks) if t.damping is not None)
         raise SceneError(f"tanks[{i}].damping", "is not available with elastic tank walls or structures in the "
@@ -49,10 +47,28 @@ def build_damping(scene: Scene, params: Optional[dict], block) -> tuple[Optional
     parts, cs, table, offset = [], [], [], 0
     for i, (t, tb) in enumerate(zip(tanks, block.tanks)):
         model = tb.model
-        if model.traced:
+        if isinstance(model, FaceLiquid) and not reduced:      # full order: its lowest modes, on the free faces
+            fm = face_modes(model, SPARSE_SEARCH)
+            slosh = np.array([k == "sloshing" for k in fm.kind], dtype=bool)
+            f = np.flatnonzero(model.free)
+            omega, Phi = fm.omega[slosh], fm.fluxes[slosh].T                # Phi on all faces (wall integrals)
+            n_t = f.size
+            Bt = model.mass[f][:, f] @ Phi[f]
+            where = f"the {SPARSE_SEARCH} lowest modes searched on this mesh hold {omega.size}"
+        elif isinstance(model, FaceLiquid):      # on its modal basis
+            V, omega_b, n_modes, (_, _, _, k0) = face_tank_basis(model, t.origin, t.reduction.modes,
+                                                                 t.reduction.static_correction)
+            n_t = V.shape[1]
+            slosh = face_sloshing(model, V, n_modes)
+            omega, Phi = omega_b[slosh], V[:, slosh]
+            Bt = np.eye(n_t)[:, slosh]
+            where = f"the reduced basis holds {slosh.size} ([tanks.reduction] modes = {t.reduction.modes})"
+        elif model.traced:
             model = build_liquid(t.size, t.fill_depth, t.mesh, t.fluid.density, t.fluid.sound_speed,
                                  scene.environment.gravity, element=t.fluid.element, geometry=t.geometry)
-        if reduced:
+        if isinstance(model, FaceLiquid):
+            pass        # done above
+        elif reduced:
             basis = tank_basis(model, t.origin, t.reduction.modes, t.reduction.static_correction)
             n_t = basis.V.shape[1]
             slosh = np.flatnonzero(sloshing_share(model, basis.V[:, :basis.n_modes]))

@@ -81,7 +81,7 @@ def scene_effects(scene: Scene) -> list[tuple[str, str]]:
     if liquid:
         for t in scene.tanks:
             eff.append((f"liquid in tank {t.name!r}", f"{shape_words(t)}{mesh_words(t, short=True)}, "
-                        f"{t.liquid_mass:.6g} kg, element {t.fluid.element!r}, {t.walls} walls (slip)"))
+                        f"{t.liquid_mass:.6g} kg, element {t.fluid.element!r}{element_why(t)}, {t.walls} walls (slip)"))
             if t.damping is not None:
                 d = t.damping
                 ratio = list(d.ratio) if isinstance(d.ratio, tuple) else d.ratio
@@ -290,3 +290,14 @@ def effects_summary(scene: Scene) -> str:
         lines.append("switched off in [effects]: " + ", ".join(off))
     lines.append(f"unknowns per step: {count_unknowns(scene)}")
     return "\n".join(lines)
+
+
+def element_why(t) -> str:
+    """`check`'s note on a liquid element the scene left out: which one the loader chose, and why
+    (scene/shape.py default_element); a given element needs none. Face-normal tanks say how they run."""
+    runs = ""
+    if t.fluid.element == "rt":
+        runs = f" on {t.reduction.modes} modes" if t.reduction is not None else " at full order"
+    if not t.fluid.element_default or t.model != "fem":
+        return runs
+    return f"{runs} (by default: {t.fluid.element_default})"

@@ -22,6 +22,7 @@ from ..physics.liquid import AbstractLiquid, Liquid, NoLiquid
 from ..scene.types import FACE_FORMS, Scene, SceneError
 from ..solve.sparse import SPARSE_AUTO, host_sparse
 from .effects import liquid_unknowns
+from .face_liquid import face_full_liquid
 from .reduced import reduce_liquid
 
 
@@ -84,6 +85,9 @@ def build_liquid_block(scene: Scene, params: Optional[dict] = None, gravity=None
     elastic = [t.wall_spec is not None for t in rigid]
     if any(elastic) or in_vessel_frame:
         for i, t in enumerate(rigid):
+            if isinstance(models[i], FaceLiquid):
+                raise SceneError(f"tanks[{i}].fluid.element", f"{t.fluid.element!r} does not take structures in the "
+                                                              "vessel's frame yet; use \"stabilized\"")
             if models[i].frames is not None:
                 raise SceneError(f"tanks[{i}].shape", "structures in the vessel's frame go with box tanks (and "
                                                       "shapes whose walls are all along the axes) only")
@@ -93,8 +97,11 @@ def build_liquid_block(scene: Scene, params: Optional[dict] = None, gravity=None
                                  "liquid with the scene's own values (no [tanks.reduction], no sparse solver, no "
                                  "traced tank values)")
         return _liquid_with_walls(rigid, models, in_vessel_frame)
+    scales = [face_scales(scene, t, params, g) if isinstance(m, FaceLiquid) else None for t, m in zip(rigid, models)]
     if any(reduced):
-        return _reduced_liquid(scene, rigid, models, reduced, g)
+        return _reduced_liquid(scene, rigid, models, reduced, g, scales)
+    if any(isinstance(m, FaceLiquid) for m in models):
+        return _face_full(rigid, models, scales)
 
     blocks, rs, Ms_list, K_list, free_list, Kdt_list, Ktt = [], [], [], [], [], [], xp.zeros((3, 3))
     coupled = False
@@ -255,22 +262,43 @@ class VesselFrameStructure(NamedTuple):
 
 
 def _face_model(scene, t, i, params, g):
-    """The face-normal liquid of one tank (fem/liquid_rt.py): runs take it on its modal basis only,
-    with the scene's own values."""
+    """The face-normal liquid of one tank (fem/liquid_rt.py), with the scene's own values: runs take it
+    on its modal basis (assemble/reduced.py) or at full order (assemble/face_liquid.py)."""
     where = f"tanks[{i}].fluid.element"
-    if t.reduction is None:
-        raise SceneError(where, f"{t.fluid.element!r} (face-normal) runs on its modes: add a [tanks.reduction] "
-                                "table (modes = N), or use \"stabilized\" for the full-order liquid")
     if t.wall_spec is not None:
         raise SceneError(where, f"{t.fluid.element!r} does not take elastic walls yet; use \"stabilized\"")
-    traced = [k for k in ("fill_depth", "fluid.density", "fluid.sound_speed")
-              if isinstance(params.get(f"tanks.{t.name}.{k}"), jax.core.Tracer)]
-    if traced or isinstance(g, jax.core.Tracer):
-        raise SceneError(where, f"{t.fluid.element!r} needs the scene's own values: "
-                                f"{', '.join(traced) or 'gravity'} cannot be traced with it yet")
+    if isinstance(params.get(f"tanks.{t.name}.fill_depth"), jax.core.Tracer):
+        raise SceneError(where, f"{t.fluid.element!r} needs the scene's own fill depth (its mesh follows "
+                                "the fill): tanks.<name>.fill_depth cannot be traced with it")
     tm = tank_mesh(t.geometry, t.fill_depth, t.mesh)
-    return build_face_liquid(tm.nodes, tm.elements, tm.depth, t.fluid.density, t.fluid.sound_speed, g,
-                             geometry=None if t.geometry.plain_box else t.geometry)
+    return build_face_liquid(tm.nodes, tm.elements, tm.depth, t.fluid.density, t.fluid.sound_speed,
+                             scene.environment.gravity, geometry=None if t.geometry.plain_box else t.geometry)
+
+
+def face_scales(scene, t, params, g):
+    """(rho, rho c^2, rho g) of a face-normal tank over the scene's values, for traced density, sound
+    speed and gravity: its model (and basis) is built at the scene's values, and its mass, compression
+    and free-surface blocks scale with these (the element's matrices are linear in each)."""
+    f = t.fluid
+    rho = params.get(f"tanks.{t.name}.fluid.density", f.density)
+    c = params.get(f"tanks.{t.name}.fluid.sound_speed", f.sound_speed)
+    g0 = scene.environment.gravity
+    return rho / f.density, rho * c * c / (f.density * f.sound_speed ** 2), rho * g / (f.density * g0)
+
+
+def _face_full(tanks, models, scales):
+    """Face-normal tanks at full order (assemble/face_liquid.py): every tank's, none of the nodal ones."""
+    for i, m in enumerate(models):
+        if not isinstance(m, FaceLiquid):
+            raise SceneError(f"tanks[{i}].fluid.element", "a full-order \"rt\" tank goes with other \"rt\" tanks "
+                                                          "only: give this one element = \"rt\" too, or give every "
+                                                          "tank a [tanks.reduction] table")
+    blocks, offset = [], 0
+    for t, m in zip(tanks, models):
+        blocks.append(_host_block(t, m, offset))
+        offset += m.n_nodes
+    liquid, penalty = face_full_liquid(tanks, models, scales)
+    return LiquidBlock(liquid, tuple(blocks), penalty)
 
 
 def _host_block(t, m, offset) -> TankBlock:
@@ -283,7 +311,7 @@ def _host_block(t, m, offset) -> TankBlock:
     return TankBlock(t.name, offset, nodes, np.asarray(m.elements), m)
 
 
-def _reduced_liquid(scene: Scene, tanks, models, reduced, g):
+def _reduced_liquid(scene: Scene, tanks, models, reduced, g, scales):
     """Every tank's liquid on its modal basis (reduction.py); the bases come from the scene's values."""
     for i, (t, r) in enumerate(zip(tanks, reduced)):
         if not r:
@@ -301,7 +329,7 @@ def _reduced_liquid(scene: Scene, tanks, models, reduced, g):
         blocks.append(_host_block(t, m, offset))
         offset += m.n_nodes
     liquid, penalty = reduce_liquid(models, concrete, [t.origin for t in tanks], offsets,
-                                    [(t.reduction.modes, t.reduction.static_correction) for t in tanks])
+                                    [(t.reduction.modes, t.reduction.static_correction) for t in tanks], scales)
     return LiquidBlock(liquid, tuple(blocks), penalty)
 
 

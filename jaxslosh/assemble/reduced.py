@@ -2,6 +2,9 @@
 invariants of physics/modal_liquid.py, computed once."""
 from __future__ import annotations
 
+import functools
+
+import jax
 import jax.numpy as jnp
 import numpy as np
 import scipy.sparse as sp
@@ -13,40 +16,67 @@ from ..fem.reduction import tank_basis
 from ..physics.modal_liquid import ReducedLiquid
 
 
-def reduce_liquid(models, concrete_models, origins, offsets, reductions):
+@functools.lru_cache(maxsize=8)
+def _face_basis(model: FaceLiquid, origin: tuple, n: int, static: bool):
+    return face_basis(model, origin, n, static)
+
+
+def face_tank_basis(model: FaceLiquid, origin, n: int, static: bool):
+    """`face_basis` of a face-normal tank, computed once per model (the liquid block and the damping
+    of the same scene take the same basis; FaceLiquid hashes by identity)."""
+    return _face_basis(model, tuple(float(v) for v in origin), int(n), bool(static))
+
+
+def face_sloshing(model: FaceLiquid, V, n_modes: int) -> np.ndarray:
+    """The columns of V[:, :n_modes] (face_basis's modes) that are sloshing modes: most of their
+    energy in the free surface (fem/liquid_rt.py face_modes' rule)."""
+    Vm = V[:, :n_modes]
+    total = np.einsum("fi,fi->i", Vm, model.stiffness @ Vm)
+    surf = np.einsum("fi,fi->i", Vm, model.surface @ Vm)
+    return np.flatnonzero(surf > 0.5 * np.where(total > 0, total, np.inf))
+
+
+def reduce_liquid(models, concrete_models, origins, offsets, reductions, scales=None):
     """The reduced liquid of every tank (stacked), from the per-tank `LiquidModel`s.
 
     `models` may hold traced values (then JAX arithmetic); `concrete_models` are the same tanks at
     the scene's values, from which the bases are computed (they are the `models` when concrete).
     `reductions` holds (modes, static_correction) per tank. Returns (ReducedLiquid, (K_dt, K_tt) of
-    the rotation penalty on the modal coordinates, or None)."""
-    traced = any(m.traced for m in models)
+    the rotation penalty on the modal coordinates, or None). `scales`: per tank, None or the
+    face-normal tank's (rho, rho c^2, rho g) over its model's (assemble/liquid.py face_scales; traced
+    values scale its blocks, the basis stays the scene's)."""
+    scales = scales or [None] * len(models)
+    traced = any(m.traced for m in models) or any(isinstance(v, jax.core.Tracer) for s in scales if s for v in s)
     xp = jnp if traced else np
     N = sum(int(m.n_nodes) for m in models)
-    Us, Kr_blocks, Mr_blocks, Kdt_rows, scales = [], [], [], [], []
+    Us, Kr_blocks, Mr_blocks, Kdt_rows, row_scales = [], [], [], [], []
     S0, Q0, mass, Ktt = 0.0, 0.0, 0.0, xp.zeros((3, 3))
     U1s, Q1s, Q2_blocks = [], [], []
     rs, ms = [], []
     coupled = any(m.rotation_coupling is not None or isinstance(m, FaceLiquid) for m in models)
-    for model, cmodel, origin, off, (n, static) in zip(models, concrete_models, origins, offsets, reductions):
+    for model, cmodel, origin, off, (n, static), fs in zip(models, concrete_models, origins, offsets, reductions,
+                                                           scales):
         if isinstance(model, FaceLiquid):         # the face-normal element: invariants are its fields' integrals
-            V, _, _, (Kdt_t, Ktt_t, kappa, k0) = face_basis(model, origin, n, static)
+            V, _, _, (Kdt_t, Ktt_t, kappa, k0) = face_tank_basis(model, origin, n, static)
             inv = face_invariants(model, V, origin)
+            sr, sc, sg = fs if fs is not None else (1.0, 1.0, 1.0)
             m = V.shape[1]
-            Kr_t = inv["Kr"].copy()
-            Kr_t[k0:, k0:] += kappa * np.eye(m - k0)               # the absolute-rotation penalty's own block
-            S0, Q0, mass = S0 + inv["S0"], Q0 + inv["Q0"], mass + inv["mass"]
-            U1s.append(xp.asarray(inv["U1"]))
-            Q1s.append(xp.asarray(inv["Q1"]))
-            Q2_blocks.append(xp.asarray(inv["Q2"]))
-            Mr_blocks.append(xp.asarray(inv["Mr"]))
+            Kr_t = sc * (V.T @ (model.acoustic @ V)) + sg * (V.T @ (model.surface @ V))
+            pen = np.zeros((m, m))
+            pen[k0:, k0:] = kappa * np.eye(m - k0)               # the absolute-rotation penalty's own block
+            Kr_t = 0.5 * (Kr_t + Kr_t.T) + sr * pen
+            S0, Q0, mass = S0 + sr * inv["S0"], Q0 + sr * inv["Q0"], mass + sr * inv["mass"]
+            U1s.append(sr * xp.asarray(inv["U1"]))
+            Q1s.append(sr * xp.asarray(inv["Q1"]))
+            Q2_blocks.append(sr * xp.asarray(inv["Q2"]))
+            Mr_blocks.append(sr * xp.asarray(inv["Mr"]))
             Kr_blocks.append(xp.asarray(Kr_t))
-            Kdt_rows.append(xp.asarray(Kdt_t))
-            Ktt = Ktt + xp.asarray(Ktt_t)
-            scales.append(1.0 / np.maximum(np.abs(inv["U"]).max(axis=(1, 2)), 1e-300))
+            Kdt_rows.append(sr * xp.asarray(Kdt_t))
+            Ktt = Ktt + sr * xp.asarray(Ktt_t)
+            row_scales.append(1.0 / np.maximum(np.abs(inv["U"]).max(axis=(1, 2)), 1e-300))
             Us.append((off, inv["U"]))
             rs.append(xp.asarray(inv["r"]))
-            ms.append(xp.asarray(inv["m_nodes"]))
+            ms.append(sr * xp.asarray(inv["m_nodes"]))
             continue
         basis = tank_basis(cmodel, origin, n, static)
         f = np.flatnonzero(np.asarray(model.free))
@@ -79,7 +109,7 @@ def reduce_liquid(models, concrete_models, origins, offsets, reductions):
                 Ktt = Ktt + xp.asarray(model.rotation_stiffness)
             else:
                 Kdt_rows.append(xp.zeros((m, 3)))
-        scales.append(1.0 / np.abs(basis.V).max(axis=0))
+        row_scales.append(1.0 / np.abs(basis.V).max(axis=0))
         Us.append((off, Ut))
         rs.append(r)
         ms.append(mvec)
@@ -100,6 +130,6 @@ def reduce_liquid(models, concrete_models, origins, offsets, reductions):
         r=jnp.asarray(xp.concatenate(rs)), m_nodes=jnp.asarray(xp.concatenate(ms)), U=jnp.asarray(U),
         mass=jnp.asarray(mass), S0=jnp.asarray(S0), U1=jnp.asarray(xp.concatenate(U1s)), Q0=jnp.asarray(Q0),
         Q1=jnp.asarray(xp.concatenate(Q1s)), Q2=jnp.asarray(Q2), Mr=jnp.asarray(block_diag_(*Mr_blocks)),
-        Kr=jnp.asarray(block_diag_(*Kr_blocks)), row_scale=jnp.asarray(np.concatenate(scales)), n_nodes=N)
+        Kr=jnp.asarray(block_diag_(*Kr_blocks)), row_scale=jnp.asarray(np.concatenate(row_scales)), n_nodes=N)
     penalty = (jnp.asarray(xp.concatenate(Kdt_rows)), jnp.asarray(Ktt)) if coupled else None
     return liquid, penalty

@@ -25,6 +25,7 @@ import numpy as np
 import scipy.linalg as sl
 import scipy.sparse as sp
 
+from .liquid_rt import _shape_gradients
 from .mesh import grid_index
 from .modes import classify, free_matrices, natural_modes
 
@@ -79,6 +80,8 @@ def wall_integrals(model, Phi):
     """(k,) int_wetted |phi_t|^2 dA of each mode (columns of Phi on the free dofs): the tangential
     components on the bottom (z = 0) and the four walls (x = 0, a; y = 0, b) up to the fill depth
     (a tank of another shape: on its wall faces, both faces of baffles included)."""
+    if hasattr(model, "element_faces"):          # the face-normal element: Phi (F, k) face fluxes
+        return _rt_wall_integrals(model, Phi)
     if model.wall_faces is not None:
         return _face_integrals(model, Phi)
     nx, ny, nz = (int(n) for n in model.mesh)
@@ -159,3 +162,34 @@ def _face_integrals(model, Phi):
     Uf = U[:, faces]                                                      # (k, W, 4, 3)
     Ut = Uf - np.einsum("kwac,wc->kwa", Uf, nrm)[..., None] * nrm[None, :, None, :]
     return np.einsum("kwac,wab,kwbc->k", Ut, Mf, Ut)
+
+
+def _rt_wall_integrals(model, Q):
+    """`wall_integrals` of the face-normal element (fem/liquid_rt.py) for face fluxes Q (F, k): on
+    every wall face (a boundary face that is not on the free surface, both faces of a plate
+    included), the tangential part of the element's own field (its normal part there is zero),
+    integrated with 2 x 2 Gauss points on the mapped face."""
+    counts = np.bincount(model.element_faces.reshape(-1), minlength=len(model.faces))
+    wall = counts == 1
+    wall[model.top] = False
+    e, j = np.nonzero(wall[model.element_faces])                  # element and local face of each wall face
+    axis = np.array([2, 2, 1, 0, 1, 0])[j]                        # liquid_rt's reference face (axis, side)
+    side = np.array([-1.0, 1.0, -1.0, 1.0, 1.0, -1.0])[j]
+    g = 1.0 / np.sqrt(3.0)
+    out = np.zeros(Q.shape[1])
+    for a, b in ((-g, -g), (g, -g), (-g, g), (g, g)):
+        xi = np.zeros((len(e), 3))
+        xi[np.arange(len(e)), axis] = side
+        xi[np.arange(len(e)), (axis + 1) % 3] = a
+        xi[np.arange(len(e)), (axis + 2) % 3] = b
+        Jm = np.einsum("pai,pak->pik", model.nodes[model.elements[e]], _shape_gradients(xi))
+        t1 = Jm[np.arange(len(e)), :, (axis + 1) % 3]
+        t2 = Jm[np.arange(len(e)), :, (axis + 2) % 3]
+        nrm = np.cross(t1, t2)
+        dA = np.linalg.norm(nrm, axis=1)
+        n = nrm / np.maximum(dA, 1e-300)[:, None]
+        for k in range(Q.shape[1]):
+            u = model.displacement_at(Q[:, k], e, xi)
+            ut = u - np.einsum("pi,pi->p", u, n)[:, None] * n
+            out[k] += np.einsum("pi,pi,p->", ut, ut, dA)
+    return out

@@ -28,7 +28,8 @@ HARMLESS = frozenset(("title", "simulation.duration", "simulation.chunk", "simul
 # dataclass fields written under another name in the scene file; None: not compared
 _TOML_NAME = {("Tank", "wall_spec"): "walls", ("Tank", "walls"): None,      # the [tanks.walls] table says it
               ("Waves", "omega"): "frequency", ("Waves", "omega_range"): "frequency_range",
-              ("Hydrodynamics", "base_dir"): None, ("Hull", "base_dir"): None}   # where the scene file lay
+              ("Hydrodynamics", "base_dir"): None, ("Hull", "base_dir"): None,   # where the scene file lay
+              ("Fluid", "element_default"): None}                                 # the loader's note
 
 _TABLE = object()      # a table that is present (its keys follow)
 

@@ -32,7 +32,7 @@ from .fields import (at_least, counts, flat_list, non_negative, one_of, poisson_
                      valid_name)
 from .record import forced_span, read_forced
 from .hull import read_hydrostatics
-from .shape import fill_and_mesh, read_shape
+from .shape import default_element, fill_and_mesh, read_shape
 from .types import (EFFECTS, ELEMENT_FORMS, FACE_FORMS, FACES, Damping, Effects, Environment, Fluid,
                     Initial, Material, Probe, Reduction, Scene, SceneError, Simulation, Structure, Tank,
                     Vessel, Walls)
@@ -337,6 +337,9 @@ def _tank(table, where: str, base_dir: str = "") -> Tank:
         }, required=("modes",)))
     damping = _damping(table["damping"], f"{where}.damping") if "damping" in table else None
     shape = read_shape(table, v, where, base_dir, elastic=wall_spec is not None)
+    if "element" not in table.get("fluid", {}):
+        element, why = default_element(shape, v["size"], depth, v["mesh"], reduction is not None)
+        fluid = dataclasses.replace(fluid, element=element, element_default=why)
     return Tank(name=v["name"], origin=v["origin"], size=v["size"], fill_depth=depth, mesh=v["mesh"],
                 walls=walls, fluid=fluid, wall_spec=wall_spec, reduction=reduction, damping=damping,
                 model=model, modes=v.get("modes", 6), **shape)

@@ -6,9 +6,9 @@ import os
 
 import numpy as np
 
-from ..fem.shapes import Baffle, TankGeometry, check_geometry, grid_counts, read_mesh
+from ..fem.shapes import Baffle, TankGeometry, box_equivalent, check_geometry, grid_counts, read_mesh
 from .fields import one_of, read, show
-from .types import SceneError
+from .types import RT_FULL_FACES, SceneError
 
 
 def read_shape(table, v, where: str, base_dir: str, elastic: bool = False) -> dict:
@@ -141,3 +141,23 @@ def _chamfers(value, where):
         out.append((float(w[0]), float(w[1])))
     return tuple(out)
 
+
+
+def default_element(shape: dict, size, fill_depth, mesh, reduced: bool) -> tuple[str, str]:
+    """(element, why) for a tank whose [tanks.fluid] leaves `element` out: the face-normal "rt" where
+    the stabilized element locks (a mesh file that is not a box grid, a tank with baffles: issue 30),
+    unless the tank runs at full order on a mesh too large for rt's dense full-order blocks; else
+    "stabilized" (boxes keep their fast diagonalization; shapes their tested element)."""
+    if shape["shape"] == "mesh":
+        geo = TankGeometry(kind="mesh", size=tuple(size), file=shape["file"])
+        if box_equivalent(geo, float(fill_depth)) is not None:
+            return "stabilized", "a mesh file that is a box grid builds as the box"
+        why = "a mesh tank"
+    elif shape["baffles"]:
+        why = "a tank with baffles"
+    else:
+        return "stabilized", ""
+    if not reduced and 3 * int(np.prod(mesh)) > RT_FULL_FACES:
+        return "stabilized", (f"{why} too large for the full-order face-normal element (about "
+                              f"{3 * int(np.prod(mesh))} faces): give it a [tanks.reduction] table for \"rt\"")
+    return "rt", f"{why}: the stabilized element locks there"

@@ -22,6 +22,9 @@ ELEMENT_FORMS = ("stabilized", "paper")
 
 #: the face-normal liquid elements (fem/liquid_rt.py): `tanks.fluid.element` takes these too
 FACE_FORMS = ("rt",)
+#: free faces above which a full-order face-normal tank is refused (its blocks are dense), and above
+#: which the loader does not choose "rt" by default for a tank without [tanks.reduction]
+RT_FULL_FACES = 4000
 
 Vec3 = tuple[float, float, float]
 Mat3 = tuple[Vec3, Vec3, Vec3]
@@ -130,6 +133,7 @@ class Fluid:
     density: float = 1000.0          # kg/m^3, > 0
     sound_speed: float = 1500.0      # m/s, > 0
     element: str = "stabilized"      # liquid element form: ELEMENT_FORMS (fem/liquid.py) or FACE_FORMS (fem/liquid_rt.py)
+    element_default: str = ""        # why the loader chose `element` when the scene left it out ("" when given)
 
 
 @dataclass(frozen=True)

@@ -1,0 +1,113 @@
+"""The full-order liquid of face-normal ("rt") tanks (physics/face_liquid.py FluxLiquid) from their
+models (fem/liquid_rt.py): the Gauss points' fields and masses, the dense blocks on the free faces,
+the absolute-rotation penalty and the nodal recovery's weights, host-side NumPy (scaled by traced
+density, sound speed or gravity where given)."""
+from __future__ import annotations
+
+import jax
+import jax.numpy as jnp
+import numpy as np
+from jax.scipy.linalg import block_diag as jax_block_diag
+from scipy.linalg import block_diag
+
+from ..fem.liquid_rt import ROTATION_PENALTY_RATIO, FaceLiquid, _gauss, _loads, _Mixed, face_modes
+from ..physics.face_liquid import FluxLiquid
+from ..scene.types import RT_FULL_FACES, SceneError
+
+#: free faces above which a full-order "rt" tank is refused (its dense blocks: M, K and two inverses)
+MAX_FULL_FACES = RT_FULL_FACES
+
+
+def recovery_weights(model: FaceLiquid, gauss=None):
+    """(nodes (G, 8), weights (G, 8)): FaceLiquid.nodal_fields as fixed weights, G = E x 8 Gauss
+    points in element-major order: each node's value is the constant term of the linear field
+    fitted by least squares to the Gauss-point values of its elements."""
+    x = (_gauss(model) if gauss is None else gauss)[0]                 # (E, P, 3)
+    E, P = x.shape[:2]
+    rows = np.repeat(model.elements[:, None, :], P, axis=1)             # (E, P, 8)
+    h = np.cbrt(model.volume)[:, None, None, None]
+    d = (x[:, :, None, :] - model.nodes[rows]) / h
+    A = np.concatenate([np.ones(d.shape[:-1] + (1,)), d], axis=-1)    # (E, P, 8, 4)
+    N = len(model.nodes)
+    AtA = np.zeros((N, 4, 4))
+    np.add.at(AtA, rows.reshape(-1), np.einsum("...i,...j->...ij", A, A).reshape(-1, 4, 4))
+    row0 = np.linalg.solve(AtA + 1e-12 * np.eye(4), np.broadcast_to(np.eye(4)[:, :1], (N, 4, 1)))[..., 0]
+    w = np.einsum("epai,epai->epa", A, row0[rows])
+    return rows.reshape(E * P, 8), w.reshape(E * P, 8)
+
+
+def absolute_rotation_penalty(model: FaceLiquid, origin, gauss=None):
+    """(K_c (nf, nf), K_dt (nf, 3), K_tt (3, 3)): the penalty 1/2 kappa |P (d + C theta)|_M^2 that holds
+    the circulation (K's kernel, the M-orthogonal projection P onto it) at the part of the tank's
+    rotation an ideal liquid does not follow, -P C theta (Kelvin: its absolute flow stays
+    irrotational), as fem/liquid_rt.py face_basis does on its three circulation vectors; C: the
+    rigid rotations e_k x r as fluxes (their M-projection). M P = M - B^T G^+ B, G = B M^-1 B^T.
+    kappa: the penalty's modes at ROTATION_PENALTY_RATIO times the highest of the 20 lowest modes that
+    is sloshing (an acoustic mode would make it needlessly stiff)."""
+    gauss = _gauss(model) if gauss is None else gauss
+    mixed = _Mixed(model)
+    r = gauss[0] + np.asarray(origin, dtype=float)
+    rot = np.stack([np.cross(np.eye(3)[k], r) for k in range(3)])
+    c = mixed.Mlu.solve(_loads(model, gauss, rot)[mixed.f])
+    Bd = mixed.B.toarray()
+    Y = mixed.Mlu.solve(Bd.T)                                         # M^-1 B^T
+    Gp = np.linalg.pinv(Bd @ Y, hermitian=True)
+    Pc = c - Y @ (Gp @ (Bd @ c))
+    MP = mixed.M.toarray() - Bd.T @ Gp @ Bd
+    fm = face_modes(model, 20)
+    slosh = [w for w, k in zip(fm.omega, fm.kind) if k == "sloshing"] or list(fm.omega)
+    kappa = (ROTATION_PENALTY_RATIO * float(max(slosh))) ** 2
+    MPc = mixed.M @ Pc
+    return kappa * 0.5 * (MP + MP.T), kappa * MPc, kappa * (Pc.T @ MPc)
+
+
+def face_full_liquid(tanks, models, scales=None):
+    """The FluxLiquid of every tank (all face-normal, full order), stacked, and the (K_dt, K_tt) of
+    the absolute-rotation penalty (physics/liquid.py RotationPenalty). `scales`: per tank None or its
+    (rho, rho c^2, rho g) over its model's (assemble/liquid.py face_scales), traced or not: the masses, the
+    compression and the free-surface blocks scale with them."""
+    scales = scales or [None] * len(models)
+    xp = jnp if any(isinstance(v, jax.core.Tracer) for sc in scales if sc for v in sc) else np
+    rs, ms, phis, slots, Ks, Ms, row_scales, rec_n, rec_w, Kdts = ([] for _ in range(10))
+    Ktt = 0.0
+    off, node_off = 0, 0
+    for i, (t, model, fs) in enumerate(zip(tanks, models, scales)):
+        sr, sc, sg = fs if fs is not None else (1.0, 1.0, 1.0)
+        f = np.flatnonzero(model.free)
+        if f.size > MAX_FULL_FACES:
+            raise SceneError(f"tanks[{i}].fluid.element", f"a full-order \"rt\" tank holds {f.size} free faces on "
+                                                          f"this mesh, more than {MAX_FULL_FACES} (its blocks are dense): "
+                                                          "add a [tanks.reduction] table (modes = N), or set "
+                                                          "element = \"stabilized\"")
+        gauss = _gauss(model)
+        x, w, phys = gauss
+        E, P = x.shape[:2]
+        slot = np.full(len(model.faces), -1)
+        slot[f] = np.arange(f.size) + off
+        rs.append((x + np.asarray(t.origin, dtype=float)).reshape(-1, 3))
+        ms.append(sr * (model.density * w).reshape(-1))
+        phis.append(phys.reshape(E * P, 6, 3))
+        slots.append(np.repeat(slot[model.element_faces], P, axis=0).reshape(E * P, 6))
+        Kc, Kdt, Ktt_t = absolute_rotation_penalty(model, t.origin, gauss)
+        Ks.append(sc * model.acoustic[f][:, f].toarray() + sg * model.surface[f][:, f].toarray() + sr * Kc)
+        Kdts.append(sr * Kdt)
+        Ktt = Ktt + sr * Ktt_t
+        Ms.append(sr * model.mass[f][:, f].toarray())
+        X = model.nodes[model.faces[f]]
+        area = np.linalg.norm(0.5 * np.cross(X[:, 2] - X[:, 0], X[:, 3] - X[:, 1]), axis=1)
+        row_scales.append(np.diag(model.mass[f][:, f].toarray()) * area)
+        n_, w_ = recovery_weights(model, gauss)
+        rec_n.append(n_ + node_off)
+        rec_w.append(w_)
+        off += f.size
+        node_off += model.n_nodes
+    slot = np.concatenate(slots)
+    slot = np.where(slot < 0, off, slot)
+    stack = jax_block_diag if xp is jnp else block_diag
+    liquid = FluxLiquid(r=jnp.asarray(np.concatenate(rs)), m=jnp.asarray(xp.concatenate(ms)),
+                      phi=jnp.asarray(np.concatenate(phis)), slots=jnp.asarray(slot.astype(np.int32)),
+                      K=jnp.asarray(stack(*Ks)), Mff=jnp.asarray(stack(*Ms)),
+                      scale=jnp.asarray(np.concatenate(row_scales)), rec_nodes=jnp.asarray(np.concatenate(rec_n)),
+                      rec_w=jnp.asarray(np.concatenate(rec_w)), n_nodes=node_off)
+    return liquid, (jnp.asarray(xp.concatenate(Kdts)), jnp.asarray(Ktt))
+

@@ -1,0 +1,129 @@
+"""The face-normal liquid element ("rt", fem/liquid_rt.py) at full order: the unknowns d are the
+volumes moved through the free faces (m^3), and the displacement inside each element is its
+Raviart-Thomas field u = sum_f phi_f d_f.
+
+The kinetic energy of the element is the integral of rho |v|^2 at its 2 x 2 x 2 Gauss points (the
+consistent RT0 mass fem/liquid_rt.py assembles), so the liquid is written as physics/liquid.py's
+`Liquid` with the Gauss points as its particles, each with the diagonal mass rho det J: the same
+particle kinematics (eqs. 1-4)
+
+    T = 1/2 sum_g m_g |A^T V0 + u_g' + omega x (r_g + u_g)|^2,   V = 1/2 d^T K d - g_b . sum_g m_g u_g,
+
+with u_g = G d (each Gauss point's field from the six faces of its element). K's kernel (the
+circulation modes, divergence-free with no surface flux) has no stiffness of the liquid's own: an
+ideal liquid's absolute flow stays irrotational (Kelvin), so relative to the tank its circulation
+is the part -P C theta of the tank's rotation it does not follow. The penalty
+1/2 kappa |P (d + C theta)|_M^2 (physics/liquid.py RotationPenalty: its d-d block is in K) holds it
+there, as the reduced basis does on its three circulation vectors (fem/liquid_rt.py face_basis);
+without it, a start with the tank turning (an initial angular velocity) would leave the liquid
+with the rigid rotation's vorticity, and second-order terms would drift in the kernel. With it, K
+is definite and the hydrostatic start solves K d0 = F_g.
+
+Outputs and probes read the nodal field of the element's patch recovery (FaceLiquid.nodal_field),
+here as fixed weights of each Gauss point's displacement on the nodes of its element.
+"""
+from __future__ import annotations
+
+import equinox as eqx
+import jax
+import jax.numpy as jnp
+
+from ..fem.linalg import solve
+from .kinematics import mv3, tv3
+from .liquid import AbstractLiquid
+from .terms import Kin, Rows
+
+
+class FluxLiquid(AbstractLiquid):
+    """All tank liquid on face fluxes (tanks stacked: every tank's free faces, then the next's)."""
+    r: jax.Array          # (G, 3) Gauss points in the vessel frame
+    m: jax.Array          # (G,) their masses rho det J
+    phi: jax.Array        # (G, 6, 3) the six face fields of each Gauss point's element there
+    slots: jax.Array      # (G, 6) each field's unknown (nf: a held face, zero)
+    K: jax.Array          # (nf, nf) stiffness (compression and free surface)
+    Mff: jax.Array        # (nf, nf) the consistent mass on the unknowns (the Newton block)
+    scale: jax.Array      # (nf,) a mass per row (M_ff's diagonal times the face's area: row / scale in m/s^2)
+    rec_nodes: jax.Array  # (G, 8) the nodes the recovery spreads each Gauss point's field on
+    rec_w: jax.Array      # (G, 8) and its weights
+    n_nodes: int = eqx.field(static=True)
+    coriolis: bool = eqx.field(static=True, default=True)
+    centrifugal: bool = eqx.field(static=True, default=True)
+    sparse = False
+
+    @property
+    def nf(self) -> int:
+        return int(self.K.shape[0])
+
+    def field(self, d):
+        """(nf,) face fluxes -> (G, 3) displacements at the Gauss points."""
+        dz = jnp.concatenate([d, jnp.zeros(1, d.dtype)])
+        return jnp.einsum("gfi,gf->gi", self.phi, dz[self.slots])
+
+    def free_part(self, F):
+        """The transpose of `field`: forces (G, 3) at the Gauss points -> generalized forces (nf,)."""
+        local = jnp.einsum("gfi,gi->gf", self.phi, F)
+        return jax.ops.segment_sum(local.reshape(-1), self.slots.reshape(-1), self.nf + 1)[:self.nf]
+
+    def total_mass(self):
+        return self.m.sum()
+
+    def rigid_first_moment(self):
+        return self.m @ self.r
+
+    def rows(self, k: Kin) -> Rows:
+        c, A, omega = k.c, k.A, k.omega
+        a0, alpha = k.a6[:3], k.a6[3:6]
+        D, Dv, Da = self.field(c.d), self.field(k.d_dot), self.field(k.d_acc)
+        x = self.r + D
+        a = tv3(A, a0) + Da + jnp.cross(alpha, x)
+        if self.coriolis:
+            a = a + 2.0 * jnp.cross(omega, Dv)
+        if self.centrifugal:
+            a = a + jnp.cross(omega, jnp.cross(omega, x))
+        F = self.m[:, None] * a
+        mD = self.m @ D
+        r_t = mv3(A, F.sum(axis=0))
+        r_r = jnp.cross(x, F).sum(axis=0) - jnp.cross(mD, k.g_b)
+        r_d = self.free_part(F - self.m[:, None] * k.g_b) + self.K @ c.d
+        return Rows(jnp.concatenate([r_t, r_r]), r_d)
+
+    def kinetic(self, k: Kin):
+        v = k.A.T @ k.V0 + self.field(k.d_dot) + jnp.cross(k.omega, self.r + self.field(k.c.d))
+        return 0.5 * jnp.sum(self.m[:, None] * v * v)
+
+    def potential(self, k: Kin):
+        d = k.c.d
+        return 0.5 * d @ (self.K @ d) - k.g_b @ (self.m @ self.field(d))
+
+    def mass_scale(self):
+        m, x = self.m, self.r
+        I = jnp.array([m @ (x[:, 1] ** 2 + x[:, 2] ** 2), m @ (x[:, 0] ** 2 + x[:, 2] ** 2),
+                       m @ (x[:, 0] ** 2 + x[:, 1] ** 2)])
+        return jnp.concatenate([jnp.full(3, m.sum()), I])
+
+    def d_scale(self):
+        return self.scale
+
+    def frame_field(self, d):
+        return d          # the frames keep the fluxes; the nodal field is formed after the run
+
+    def nodal_fields(self, D):
+        """Face fluxes (..., nf) -> the recovered nodal displacement fields (..., N, 3)."""
+        def one(d):
+            u = self.field(d)                                           # (G, 3)
+            contrib = self.rec_w[:, :, None] * u[:, None, :]            # (G, 8, 3)
+            return jax.ops.segment_sum(contrib.reshape(-1, 3), self.rec_nodes.reshape(-1), self.n_nodes)
+        flat = D.reshape((-1, D.shape[-1]))
+        return jax.vmap(one)(flat).reshape(D.shape[:-1] + (self.n_nodes, 3))
+
+    def probe_displacements(self, weights, modal, d):
+        return weights @ self.nodal_fields(d)
+
+    def constant_blocks(self):
+        return self.Mff, self.K
+
+    def static_start(self, g_b):
+        """The discrete hydrostatic equilibrium K d0 = F_g: K holds the absolute-rotation penalty on
+        the circulation, so it is definite, and the load of a uniform field has no circulation part
+        (the start is at rest in the kernel)."""
+        return solve(self.K, self.free_part(self.m[:, None] * g_b[None, :]))
