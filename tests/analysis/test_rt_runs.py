@@ -1,5 +1,5 @@
 """Runs of the face-normal liquid element "rt" (issue 30, fem/liquid_rt.py) beyond the plain
-reduced run of tests/test_liquid_element_rt.py: modal damping (`[tanks.damping]`) on its sloshing
+reduced run of tests/fem/test_liquid_element_rt.py: modal damping (`[tanks.damping]`) on its sloshing
 modes, the U-tube's exchange in a forced roll near its frequency against an independent linear
 theory (tests/u_tube_response.py), the default element, and rao / sweep on an rt tank."""
 import math
@@ -208,7 +208,7 @@ height = 1.0
 
 def test_the_default_element_is_rt_where_the_stabilized_one_locks(tmp_path, capsys):
     """Left out, the element is "rt" for a tank with baffles (and a mesh file that is not a box grid,
-    tests/test_liquid_element_rt.py's U-tube), "stabilized" for a plain box, a box grid given as a
+    tests/fem/test_liquid_element_rt.py's U-tube), "stabilized" for a plain box, a box grid given as a
     mesh file and a baffled tank too large for rt at full order; `check` says which and why; a given
     element stays."""
     from jaxslosh.cli.main import main
