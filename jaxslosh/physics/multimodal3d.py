@@ -41,7 +41,7 @@ from .multimodal_modes import (base_quadrature, box_modes, box_vortical, cylinde
                                mode_values, wavenumbers)
 
 #: Gauss points through the depth
-NZ = 16
+NZ = 12
 
 
 class Integrals3(NamedTuple):

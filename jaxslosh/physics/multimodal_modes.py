@@ -20,7 +20,7 @@ from jax.scipy.special import i0e, i1e
 from scipy import special
 
 #: terms of the vortical flows' series
-SJ_TERMS = 40
+SJ_TERMS = 24
 #: relative tolerance of two modes' wavenumbers that makes them one degenerate group
 DEGENERATE = 1e-9
 
@@ -97,7 +97,7 @@ def base_quadrature(kind: str, size, modes):
     (weight r) and the trapezoidal rule in theta (exact for trigonometric polynomials) on a disk."""
     if kind == "box":
         top = max(max(i for i, _ in modes), max(j for _, j in modes))
-        n = max(16, 4 * top + 8)
+        n = max(12, 4 * top + 4)
         g, gw = np.polynomial.legendre.leggauss(n)
         xs, xw = 0.5 * size[0] * (g + 1.0), 0.5 * size[0] * gw
         ys, yw = 0.5 * size[1] * (g + 1.0), 0.5 * size[1] * gw
@@ -106,9 +106,9 @@ def base_quadrature(kind: str, size, modes):
     R = 0.5 * size[0]
     mmax = max(m for m, _, _ in modes)
     smax = max(s for _, s, _ in modes)
-    g, gw = np.polynomial.legendre.leggauss(max(16, 6 * smax + 2 * mmax + 4))
+    g, gw = np.polynomial.legendre.leggauss(max(12, 6 * smax + 2 * mmax))
     r, rw = 0.5 * R * (g + 1.0), 0.5 * R * gw * 0.5 * R * (g + 1.0)
-    nt = max(32, 8 * mmax + 8)
+    nt = max(24, 8 * mmax + 8)
     th = 2.0 * np.pi * np.arange(nt) / nt
     Rr, T = np.meshgrid(r, th, indexing="ij")
     return (R + Rr * np.cos(T)).ravel(), (R + Rr * np.sin(T)).ravel(), np.outer(rw, np.full(nt, 2 * np.pi / nt)).ravel()
