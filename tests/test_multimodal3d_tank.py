@@ -152,7 +152,7 @@ def test_keys():
 
 
 @eqx.filter_jit
-def _forced_surge(t, sig, amp, periods, per=40):
+def _forced_surge(t, sig, amp, periods, per=24):
     """The modal rows alone (RK4) under a surge x = amp cos(sig t), no damping, from a level surface
     with a 1e-4 m seed of the cross mode (0, 1): (periods * per, N) amplitudes."""
     n = t.n
