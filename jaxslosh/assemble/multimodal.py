@@ -11,6 +11,7 @@ import numpy as np
 from ..physics.damping import ModalDamping
 from ..physics.multimodal import MultimodalLiquid, modal_tank
 from ..scene.types import Scene, SceneError
+from .multimodal3d import probe_row, sample_points, tank_3d, three_dimensional
 
 #: surface samples per tank for the validity watch (walls included, where the extremes are)
 SAMPLES = 33
@@ -25,16 +26,20 @@ def build_multimodal(scene: Scene, params: Optional[dict], gravity) -> Multimoda
     tanks, rows = [], []
     for t in scene.tanks:
         P = lambda k, d: params.get(f"tanks.{t.name}.{k}", d)  # noqa: E731
+        if three_dimensional(t):         # waves across the whole base (physics/multimodal3d.py)
+            tanks.append(tank_3d(t, P("fill_depth", t.fill_depth), P("fluid.density", t.fluid.density)))
+            rows.append(tanks[-1].surface_rows(*sample_points(t, SAMPLES)))
+            continue
         tanks.append(modal_tank(t.size[0], t.size[1], P("fill_depth", t.fill_depth), P("fluid.density", t.fluid.density),
                                 t.origin, t.modes, D=t.size[2]))
         rows.append(np.cos(np.outer(np.linspace(0.0, t.size[0], SAMPLES), np.arange(1, t.modes + 1) * np.pi / t.size[0])))
-    nf = sum(t.modes for t in scene.tanks)
-    samples = np.zeros((SAMPLES * len(tanks), nf))
+    sizes = tuple(r.shape[1] for r in rows)
+    samples = np.zeros((SAMPLES * len(tanks), sum(sizes)))
     off = 0
-    for i, (t, r) in enumerate(zip(scene.tanks, rows)):
-        samples[i * SAMPLES:(i + 1) * SAMPLES, off:off + t.modes] = r
-        off += t.modes
-    return MultimodalLiquid(tanks=tuple(tanks), sizes=tuple(t.modes for t in scene.tanks),
+    for i, r in enumerate(rows):
+        samples[i * SAMPLES:(i + 1) * SAMPLES, off:off + r.shape[1]] = r
+        off += r.shape[1]
+    return MultimodalLiquid(tanks=tuple(tanks), sizes=sizes,
                             samples=jnp.asarray(samples), gravity=jnp.asarray(gravity, dtype=float))
 
 
@@ -43,21 +48,25 @@ def surfaces(scene: Scene) -> tuple:
     return tuple(jnp.arange(i * SAMPLES, (i + 1) * SAMPLES) for i in range(len(scene.tanks)))
 
 
-def probe_modal(scene: Scene) -> jnp.ndarray:
+def probe_modal(scene: Scene, liquid: MultimodalLiquid) -> jnp.ndarray:
     """(P, nf, 3): a probe at its tank's fill depth rises and falls with the free surface there; any other
     follows the tank (the multimodal method resolves the surface, not the particles)."""
     offsets, off = {}, 0
-    for t in scene.tanks:
+    for t, n in zip(scene.tanks, liquid.sizes):
         offsets[t.name] = off
-        off += t.modes
+        off += n
     out = np.zeros((len(scene.probes), off, 3))
     for p_i, p in enumerate(scene.probes):
         if p.tank is None:
             continue
-        t = scene.tank(p.tank)
+        i, t = next((i, t) for i, t in enumerate(scene.tanks) if t.name == p.tank)
         if abs(p.point[2] - t.fill_depth) <= 1e-6 * max(t.size):
-            k = np.arange(1, t.modes + 1) * np.pi / t.size[0]
-            out[p_i, offsets[t.name]:offsets[t.name] + t.modes, 2] = np.cos(k * p.point[0])
+            n = liquid.sizes[i]
+            if three_dimensional(t):
+                row = probe_row(liquid.tanks[i], p.point)
+            else:
+                row = np.cos(np.arange(1, n + 1) * np.pi / t.size[0] * p.point[0])
+            out[p_i, offsets[t.name]:offsets[t.name] + n, 2] = row
     return jnp.asarray(out)
 
 
@@ -70,16 +79,17 @@ def multimodal_damping(scene: Scene, params: Optional[dict], liquid: MultimodalL
     Bs, cs = [], []
     for i, (t, mt) in enumerate(zip(scene.tanks, liquid.tanks)):
         Bs.append(jnp.sqrt(mt.modal_mass()))
+        n = mt.n
         if t.damping is None:
-            cs.append(jnp.zeros(t.modes))
+            cs.append(jnp.zeros(n))
             continue
         ratio = params.get(f"tanks.{t.name}.damping.ratio", t.damping.ratio)
         if np.ndim(ratio) == 1:
-            if len(ratio) > t.modes:
+            if len(ratio) > n:
                 raise SceneError(f"tanks[{i}].damping.ratio", f"gives {len(ratio)} damping ratios, but the "
-                                                              f"multimodal tank has {t.modes} modes")
-            zeta = jnp.concatenate([jnp.asarray(ratio, dtype=float), jnp.zeros(t.modes - len(ratio))])
+                                                              f"multimodal tank has {n} modes")
+            zeta = jnp.concatenate([jnp.asarray(ratio, dtype=float), jnp.zeros(n - len(ratio))])
         else:
-            zeta = jnp.full(t.modes, 1.0) * jnp.asarray(ratio, dtype=float)
+            zeta = jnp.full(n, 1.0) * jnp.asarray(ratio, dtype=float)
         cs.append(2.0 * zeta * mt.omega_linear(liquid.gravity))
     return ModalDamping(B=jnp.diag(jnp.concatenate(Bs)), c=jnp.concatenate(cs))

@@ -129,7 +129,7 @@ def build(scene: Scene, params: Optional[dict] = None) -> Built:
     probes = build_probes(scene, block.tanks, liquid, blocks, block.vstructs)
     probes = probes._replace(modal=liquid.probe_modal(probes.weights))    # a modal liquid: probes from eta
     if multimodal:
-        probes = probes._replace(modal=probe_modal(scene))
+        probes = probes._replace(modal=probe_modal(scene, liquid))
         tops = surfaces(scene)
     else:
         tops = tuple(jnp.asarray(t.node_offset + np.flatnonzero(np.isclose(t.nodes[:, 2], t.nodes[:, 2].max())))

@@ -156,8 +156,13 @@ KEYS = (
     ("tanks.file", "required (mesh)", "", "Mesh tank: the liquid at rest as hexahedra (any format meshio "
                                           "reads), relative to the scene."),
     ("tanks.model", '"fem"', "", '"fem" (the linear finite elements) or "multimodal": nonlinear sloshing '
-                                 "along the length of a box tank (every tank of the scene the same)."),
-    ("tanks.modes", "6", "", "Multimodal: the free-surface modes along the tank's length."),
+                                 "in a box tank or an upright (axis = \"z\") circular cylinder (every tank of the "
+                                 "scene the same)."),
+    ("tanks.modes", "6", "", "Multimodal: the free-surface modes, the lowest; with flow = \"3d\" and in a "
+                             "cylinder completed to whole degenerate groups (a square's (1, 0), (0, 1) pair, a "
+                             "cylinder's cos/sin pairs)."),
+    ("tanks.flow", '"2d" ("3d" cylinder)', "", 'Multimodal: "2d", waves along a box\'s length, or "3d", across '
+                                              "its whole base (swirl included); a cylinder's are \"3d\"."),
     ("tanks.fluid.density", "1000.0", "kg/m^3", "Liquid density."),
     ("tanks.fluid.sound_speed", "1500.0", "m/s", "Liquid sound speed."),
     ("tanks.fluid.element", '"rt" for mesh files and baffles, else "stabilized"', "",

@@ -42,6 +42,7 @@ SCHEMES = ("newmark", "hht", "generalized-alpha")
 LINEAR_SOLVERS = ("auto", "dense", "sparse", "sparse-host")      # [simulation] linear_solver (sparse.py)
 WALLS = ("rigid", "elastic")
 TANK_MODELS = ("fem", "multimodal")
+MULTIMODAL_FLOWS = ("2d", "3d")         # a multimodal box's waves along its length, or across its whole base
 #: below this fill depth over length the multimodal method's ordering fails (shallow water, bores)
 MULTIMODAL_SHALLOW = 0.1
 PROBE_TOLERANCE = 1e-9                           # m: how far outside its owner a probe may lie
@@ -298,14 +299,16 @@ def _tank(table, where: str, base_dir: str = "") -> Tank:
         "fluid": ("table", None), "reduction": ("table", None), "damping": ("table", None),
         "shape": ("str", one_of(SHAPES)), "chamfers": ("any", None), "axis": ("str", one_of(AXES)),
         "file": ("str", None), "baffles": ("tables", None), "model": ("str", one_of(TANK_MODELS)),
-        "modes": ("int", at_least(1)),
+        "modes": ("int", at_least(1)), "flow": ("str", one_of(MULTIMODAL_FLOWS)),
     }, required=("name", "origin", "size"))
     model = v.get("model", "fem")
     if model == "multimodal":
         _multimodal_tank(table, where)
-        v.setdefault("mesh", (1, 1, 1))          # the multimodal tank has no mesh
-    elif "modes" in table:
-        raise SceneError(f"{where}.modes", 'is the multimodal tank\'s: it needs model = "multimodal"')
+        v.setdefault("mesh", (2, 2, 1))          # the multimodal tank has no mesh
+    else:
+        for key in ("modes", "flow"):
+            if key in table:
+                raise SceneError(f"{where}.{key}", 'is the multimodal tank\'s: it needs model = "multimodal"')
     fill_and_mesh(table, v, where, base_dir)
     # SPEC writes `walls = "elastic"` and a `[tanks.walls]` table, but TOML cannot hold both under
     # one key: `walls` is either the string "rigid" or the table, which makes the walls elastic.
@@ -342,14 +345,22 @@ def _tank(table, where: str, base_dir: str = "") -> Tank:
         fluid = dataclasses.replace(fluid, element=element, element_default=why)
     return Tank(name=v["name"], origin=v["origin"], size=v["size"], fill_depth=depth, mesh=v["mesh"],
                 walls=walls, fluid=fluid, wall_spec=wall_spec, reduction=reduction, damping=damping,
-                model=model, modes=v.get("modes", 6), **shape)
+                model=model, modes=v.get("modes", 6),
+                flow=v.get("flow", "3d" if shape["shape"] == "cylinder" else "2d"), **shape)
 
 
 def _multimodal_tank(table, where: str) -> None:
-    """A multimodal tank is a plain box with rigid walls (physics/multimodal.py)."""
-    for key, why in (("shape", "a box"), ("baffles", "a box without baffles"), ("walls", "rigid walls"),
-                     ("reduction", "its own modes"), ("file", "a box")):
-        if key in table and not (key == "shape" and table[key] == "box") and \
+    """A multimodal tank is a plain box (physics/multimodal.py, or multimodal3d.py with flow = "3d") or
+    an upright circular cylinder (multimodal3d.py) with rigid walls."""
+    cylinder = table.get("shape") == "cylinder"
+    if cylinder and table.get("axis", "x") != "z":
+        raise SceneError(f"{where}.axis", 'a model = "multimodal" cylinder stands upright: axis = "z"')
+    if cylinder and table.get("flow", "3d") != "3d":
+        raise SceneError(f"{where}.flow", 'a model = "multimodal" cylinder\'s waves are three-dimensional: '
+                                          'leave flow out or write flow = "3d"')
+    for key, why in (("shape", "a box or an upright cylinder"), ("baffles", "a tank without baffles"),
+                     ("walls", "rigid walls"), ("reduction", "its own modes"), ("file", "a box or a cylinder")):
+        if key in table and not (key == "shape" and table[key] in ("box", "cylinder")) and \
                 not (key == "walls" and table[key] == "rigid"):
             raise SceneError(f"{where}.{key}", f'a model = "multimodal" tank is {why}: leave {key} out')
     visc = table.get("damping", {}).get("viscosity", 0.0) if isinstance(table.get("damping"), dict) else 0.0

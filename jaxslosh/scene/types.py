@@ -176,7 +176,8 @@ class Tank:
     file: str = ""                          # mesh: the mesh file (absolute path)
     baffles: tuple = ()                     # fem/shapes.Baffle per [[tanks.baffles]]
     model: str = "fem"                      # "fem" | "multimodal" (physics/multimodal.py)
-    modes: int = 6                          # multimodal: free-surface modes along the tank's length
+    modes: int = 6                          # multimodal: free-surface modes (the lowest, whole degenerate groups)
+    flow: str = "2d"                        # multimodal: "2d" along a box's length | "3d" (a cylinder's always)
 
     @property
     def geometry(self) -> TankGeometry:
