@@ -405,7 +405,7 @@ def face_basis(model: FaceLiquid, origin, n: int, static_correction: bool = True
     relative to the tank it turns back by -theta (Kelvin); the basis holds span{P c_k}, and the
     penalty 1/2 kappa |P (c theta) + V_c zeta|_M^2 ties those coordinates to the body rotation
     theta through the same K_dt, K_tt terms as the stabilized element's rotation penalty
-    (kappa: the penalty modes at ROTATION_PENALTY_RATIO times the highest mode kept)."""
+    (kappa: the penalty modes at ROTATION_PENALTY_RATIO times the highest sloshing mode kept)."""
     modes = face_modes(model, n)
     f = np.flatnonzero(model.free)
     Phi = modes.fluxes[:, f].T                                   # (nf, n), M-orthonormal
@@ -460,7 +460,8 @@ def face_basis(model: FaceLiquid, origin, n: int, static_correction: bool = True
     Mv = V.T @ (M @ V)
     Lc = np.linalg.cholesky(0.5 * (Mv + Mv.T))
     V = np.linalg.solve(Lc, V.T).T                               # V^T M V = I to round-off
-    kappa = (ROTATION_PENALTY_RATIO * max(float(np.max(om[0])), 1e-30)) ** 2
+    slosh = [w for w, k in zip(modes.omega, modes.kind) if k == "sloshing"] or [float(np.max(om[0]))]
+    kappa = (ROTATION_PENALTY_RATIO * max(max(slosh), 1e-30)) ** 2     # not an acoustic mode's: needlessly stiff
     m = V.shape[1]
     nc = Vc.shape[1]
     # the kernel coordinates are the last nc (the Cholesky pass leaves a triangular mix: project again)

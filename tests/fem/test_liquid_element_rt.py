@@ -340,3 +340,16 @@ point = [0.1, 7.5, 1.0]
     dz = np.asarray(r.probes["L"].displacement)[:, 2] - np.asarray(r.probes["R"].displacement)[:, 2]
     ratio = np.abs(dz[t > 40]).max() / (0.02 * 7.0)
     assert 0.01 < ratio < 0.06, ratio
+
+
+def test_rotation_penalty_follows_the_highest_sloshing_mode_not_an_acoustic_one():
+    """Asked for more modes than the mesh has sloshing modes, the basis takes acoustic ones too; the
+    penalty's stiffness stays ROTATION_PENALTY_RATIO times the highest *sloshing* mode kept (an
+    acoustic mode's would make it needlessly stiff and the run's liquid with it)."""
+    from jaxslosh.fem.liquid_rt import ROTATION_PENALTY_RATIO, face_basis, face_modes
+    m = box((5.0, 5.0, 4.0), 3.0, (3, 3, 2))
+    fm = face_modes(m, 14)
+    assert "acoustic" in fm.kind and "sloshing" in fm.kind
+    top = max(w for w, k in zip(fm.omega, fm.kind) if k == "sloshing")
+    *_, (_, _, kappa, _) = face_basis(m, (0.0, 0.0, 0.0), 14)
+    assert kappa == pytest.approx((ROTATION_PENALTY_RATIO * top) ** 2, rel=1e-9)
