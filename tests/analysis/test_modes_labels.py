@@ -21,7 +21,7 @@ inertia = [6.0e6, 1.6e7, 2.0e7]
 """
 
 # a standing baffle with slender elements beside it: the stabilized element's 12th mode is a
-# spurious one between sloshing modes
+# spurious one between sloshing modes (the element pinned: "rt", the default with baffles, has none)
 BAFFLED = HEAD + """
 [[tanks]]
 name = "baffled"
@@ -29,6 +29,8 @@ origin = [0.0, 0.0, 0.0]
 size = [0.2, 1.0, 1.0]
 fill_depth = 0.5
 mesh = [2, 20, 10]
+[tanks.fluid]
+element = "stabilized"
 [[tanks.baffles]]
 normal = "y"
 position = 0.5
