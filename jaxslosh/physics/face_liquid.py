@@ -30,7 +30,7 @@ import jax.numpy as jnp
 
 from ..fem.linalg import solve
 from .kinematics import mv3, tv3
-from .liquid import AbstractLiquid
+from .liquid import AbstractLiquid, point_mass_scale
 from .terms import Kin, Rows
 
 
@@ -96,10 +96,7 @@ class FluxLiquid(AbstractLiquid):
         return 0.5 * d @ (self.K @ d) - k.g_b @ (self.m @ self.field(d))
 
     def mass_scale(self):
-        m, x = self.m, self.r
-        I = jnp.array([m @ (x[:, 1] ** 2 + x[:, 2] ** 2), m @ (x[:, 0] ** 2 + x[:, 2] ** 2),
-                       m @ (x[:, 0] ** 2 + x[:, 1] ** 2)])
-        return jnp.concatenate([jnp.full(3, m.sum()), I])
+        return point_mass_scale(self.m, self.r)
 
     def d_scale(self):
         return self.scale

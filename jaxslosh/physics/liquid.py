@@ -38,6 +38,13 @@ def nodal_product(Ms, a):
     return jnp.stack([Ms @ a[:, i] for i in range(a.shape[1])], axis=1)
 
 
+def point_mass_scale(m, x, total=None):
+    """The rigid rows' scales of point masses m (n,) at x (n, 3), body frame: their total mass for
+    the translations and their moments of inertia about the body axes for the rotations."""
+    I = jnp.array([m @ (x[:, 1] ** 2 + x[:, 2] ** 2), m @ (x[:, 0] ** 2 + x[:, 2] ** 2),
+                   m @ (x[:, 0] ** 2 + x[:, 1] ** 2)])
+    return jnp.concatenate([jnp.full(3, m.sum() if total is None else total), I])
+
 class AbstractLiquid(AbstractTerm):
     """The owner of the deformable unknowns d: what the solver, the build and the frames need of it
     besides its rows and energies."""
@@ -209,10 +216,7 @@ class Liquid(AbstractLiquid):
         return 0.5 * d @ (self.K @ d) - k.g_b @ (self.m_nodes @ self.full(d))
 
     def mass_scale(self):
-        m, x = self.m_nodes, self.r
-        I = jnp.array([m @ (x[:, 1] ** 2 + x[:, 2] ** 2), m @ (x[:, 0] ** 2 + x[:, 2] ** 2),
-                       m @ (x[:, 0] ** 2 + x[:, 1] ** 2)])
-        return jnp.concatenate([jnp.full(3, m.sum()), I])
+        return point_mass_scale(self.m_nodes, self.r)
 
     def d_scale(self):
         if self.frames is not None:

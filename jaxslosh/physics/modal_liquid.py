@@ -18,7 +18,7 @@ import jax.numpy as jnp
 
 from ..fem.linalg import solve
 from .kinematics import mv3, tv3
-from .liquid import AbstractLiquid
+from .liquid import AbstractLiquid, point_mass_scale
 from .terms import Kin, Rows
 
 
@@ -111,10 +111,7 @@ class ReducedLiquid(AbstractLiquid):
         return 0.5 * eta @ (self.Kr @ eta) - k.g_b @ (self.U1.T @ eta)
 
     def mass_scale(self):
-        m, x = self.m_nodes, self.r
-        I = jnp.array([m @ (x[:, 1] ** 2 + x[:, 2] ** 2), m @ (x[:, 0] ** 2 + x[:, 2] ** 2),
-                       m @ (x[:, 0] ** 2 + x[:, 1] ** 2)])
-        return jnp.concatenate([jnp.full(3, self.mass), I])
+        return point_mass_scale(self.m_nodes, self.r, self.mass)
 
     def d_scale(self):
         return self.row_scale
