@@ -42,9 +42,8 @@ import jax.numpy as jnp
 import numpy as np
 import scipy.sparse as sp
 
-from ..scene.types import ELEMENT_FORMS, FACE_FORMS
 from .liquid_element import FLAT_CORNER_PENALTY, ROTATION_PENALTY, SURFACE_BENDING, element_matrices, is_traced
-from .mesh import box_elements, grid_index, grid_nodes
+from .mesh import ELEMENT_FORMS, FACE_FORMS, box_elements, grid_index, grid_nodes
 from .shapes import box_equivalent, tank_mesh
 from .slip import rotate_matrix, rotate_rows, surface_jump_pattern
 

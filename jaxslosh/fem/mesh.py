@@ -14,6 +14,11 @@ from __future__ import annotations
 
 import numpy as np
 
+#: the liquid's element forms on these meshes, here below the scene loader that reads them from
+#: `tanks.fluid.element`: the nodal forms (fem/liquid_element.py) and the face-normal ones
+#: (fem/liquid_rt.py)
+ELEMENT_FORMS = ("stabilized", "paper")
+FACE_FORMS = ("rt",)
 #: reference coordinates of the eight corners of the hex8 element
 HEX_CORNERS = np.array([[-1, -1, -1], [1, -1, -1], [1, 1, -1], [-1, 1, -1],
                         [-1, -1, 1], [1, -1, 1], [1, 1, 1], [-1, 1, 1]], dtype=float)

@@ -11,17 +11,13 @@ import os
 from dataclasses import dataclass, field
 from typing import Optional, Union
 
+from ..fem.mesh import ELEMENT_FORMS, FACE_FORMS  # noqa: F401  (the loader reads them here)
 from ..fem.shapes import TankGeometry, liquid_volume
 
 #: the six rigid dofs, in the order of every 6-vector and 6 x 6 table
 DOFS = ("surge", "sway", "heave", "roll", "pitch", "yaw")
 #: faces of a block ("x-" is x = 0, "z+" is z = size_z)
 FACES = ("x-", "x+", "y-", "y+", "z-", "z+")
-#: liquid element forms (fem/liquid_element.py)
-ELEMENT_FORMS = ("stabilized", "paper")
-
-#: the face-normal liquid elements (fem/liquid_rt.py): `tanks.fluid.element` takes these too
-FACE_FORMS = ("rt",)
 #: free faces above which a full-order face-normal tank is refused (its blocks are dense), and above
 #: which the loader does not choose "rt" by default for a tank without [tanks.reduction]
 RT_FULL_FACES = 4000

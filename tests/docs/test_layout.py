@@ -132,3 +132,12 @@ def test_nothing_below_the_compile_cache_imports_it():
         top, _ = _imports(module, path)
         if any(t == "cache" or t.startswith("cache.") for t in top):
             assert _layer(module)[0] > cache_layer or module.startswith("cache"), module
+
+
+def test_the_finite_elements_import_neither_the_scene_nor_the_compile_cache():
+    """fem/ is below the scene loader and the cache: it takes numbers and meshes, not scenes."""
+    for module, path in MODULES.items():
+        if module.startswith("fem."):
+            top, _ = _imports(module, path)
+            bad = [t for t in top if t.split(".")[0] in ("scene", "cache")]
+            assert not bad, f"{module} imports {bad}"
