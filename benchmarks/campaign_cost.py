@@ -1,7 +1,7 @@
 """What a campaign case costs against the stepping of a plain run of the same scene, in one process.
 
     PYTHONPATH=. python benchmarks/campaign_cost.py [--duration 600] [--batch 8] [--repeat 2]
-        [--parallel [--cases 64]]
+        [--parallel [--cases 80]]
 
 The scene is benchmarks/campaign.py's (scenes/paper_ship_waves.toml: the paper ship, its tank on 20
 modes, Froude-Krylov forces on its box, a yaw damping), its cases that benchmark's scatter x 5
@@ -128,7 +128,7 @@ def main(argv=None):
     p.add_argument("--batch", type=int, default=8)
     p.add_argument("--repeat", type=int, default=2)
     p.add_argument("--parallel", action="store_true")
-    p.add_argument("--cases", type=int, default=64)
+    p.add_argument("--cases", type=int, default=80)
     a = p.parse_args(argv)
     d = tempfile.mkdtemp()
     scene_path, csv_path = os.path.join(d, "ship.toml"), os.path.join(d, "scatter.csv")
