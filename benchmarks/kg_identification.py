@@ -18,6 +18,7 @@ barge_linear.toml, measured.h5) and prints the `jaxslosh identify` commands that
 import argparse
 import math
 import os
+import sys
 import warnings
 
 import jax
@@ -29,36 +30,12 @@ import numpy as np  # noqa: E402
 import jaxslosh as js  # noqa: E402
 from jaxslosh.fit.problem import add_noise  # noqa: E402
 
-RHO, L, B, T = 1025.0, 20.0, 10.0, 3.0
-MASS = RHO * L * B * T
-TRUE_KG, START_KG = 3.6, 3.5
-KM = T / 2 + B ** 2 / (12 * T)
-NOISE = {"roll": math.radians(0.2), "pitch": math.radians(0.2), "heave": 0.005}
+# the barge, its true KG and the record's noise are the test's (tests/fit/test_identify_kg.py)
+TESTS = os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "tests")
+sys.path[:0] = [TESTS, os.path.join(TESTS, "fit")]
+from test_identify_kg import B, BARGE, KM, L, MASS, NOISE, T, TRUE_KG  # noqa: E402
 
-BARGE = """title = "box barge roll decay"
-[environment]
-gravity = 9.81
-water_density = 1025.0
-[simulation]
-duration = 16.0
-dt = 0.1
-scheme = "newmark"
-[vessel]
-mass = {mass}
-inertia = [7.5e6, 2.5e7, 2.8e7]
-[vessel.hull]
-length = 20.0
-beam = 10.0
-draft = 3.0
-kg = {kg}
-depth = 6.0
-[vessel.hydrostatics]
-model = "{model}"
-[vessel.hydrodynamics]
-viscous_damping = [0.0, 0.0, 0.0, 8.0e5, 0.0, 0.0]
-[vessel.initial]
-roll_pitch_yaw = [{roll}, 0.0, 0.0]
-"""
+START_KG = 3.5
 
 
 def barge(kg, roll, model="nonlinear"):
