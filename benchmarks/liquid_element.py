@@ -41,7 +41,7 @@ from sloshing_reference import (Baffle as RefBaffle, prismatic, rectangle, recti
 from jaxslosh.fem.liquid import build_liquid  # noqa: E402
 from jaxslosh.fem.liquid_rt import build_face_liquid, face_modes  # noqa: E402
 from jaxslosh.fem.modes import liquid_modes  # noqa: E402
-from jaxslosh.fem.shapes import Baffle, TankGeometry, tank_mesh  # noqa: E402
+from jaxslosh.geometry import Baffle, Box, MeshFile, Prismatic# noqa: E402
 
 G, RHO, C = 9.81, 1000.0, 1500.0
 T = 0.2          # the sections' thickness (x), two elements
@@ -62,7 +62,7 @@ def reference(case):
 
 
 def meshes(case):
-    """[(label, geometry, depth, counts)]: a TankGeometry the loader would build (a mesh file for
+    """[(label, geometry, depth, counts)]: a shape the loader would build (a mesh file for
     the sections it cannot describe)."""
     out = []
     if case == "utube":
@@ -71,12 +71,12 @@ def meshes(case):
     elif case in ("hanging", "standing"):
         bf = Baffle("y", 0.5, "top", 0.8) if case == "hanging" else Baffle("y", 0.5, "bottom", 0.3)
         for ny, nz in [(20, 10), (40, 20), (80, 40)]:
-            out.append((f"2x{ny}x{nz}", TankGeometry(kind="box", size=(T, 1.0, 1.0), baffles=(bf,)), 0.5, (2, ny, nz)))
+            out.append((f"2x{ny}x{nz}", Box(size=(T, 1.0, 1.0), baffles=(bf,)), 0.5, (2, ny, nz)))
     elif case == "hopper":
         for ny, nz in [(20, 10), (40, 20), (80, 40)]:
             out.append((f"2x{ny}x{nz}", _file(*hopper_baffle_hex(1.0, 0.2, 0.5, 0.5, 0.3, ny, nz, T)), 0.5, None))
     elif case == "lng30":
-        geo = TankGeometry(kind="prismatic", size=(T, 1.0, 1.0), chamfers=((0.2, 0.2), (0.2, 0.2)))
+        geo = Prismatic(size=(T, 1.0, 1.0), chamfers=((0.2, 0.2), (0.2, 0.2)))
         for ny, nz in [(24, 8), (24, 16), (48, 16), (48, 32)]:
             out.append((f"2x{ny}x{nz}", geo, 0.3, (2, ny, nz)))
     return out
@@ -89,12 +89,12 @@ def _file(nodes, elements):
     import meshio
     path = os.path.join(_TMP, f"m{len(os.listdir(_TMP))}.vtu")
     meshio.write(path, meshio.Mesh(nodes, [("hexahedron", elements)]))
-    return TankGeometry(kind="mesh", size=tuple(np.ptp(nodes, axis=0)), file=path)
+    return MeshFile(size=tuple(np.ptp(nodes, axis=0)), file=path)
 
 
 def omegas(element, geo, depth, counts, n=3):
     if element == "rt":
-        tm = tank_mesh(geo, depth, counts or (1, 1, 1))
+        tm = geo.mesh(depth, counts or (1, 1, 1))
         m = build_face_liquid(tm.nodes, tm.elements, tm.depth, RHO, C, G)
         md = face_modes(m, n)
         return md.omega[:n], len(tm.elements)
@@ -126,7 +126,7 @@ def cost(meshes):
     for mesh in meshes:
         counts = tuple(int(v) for v in mesh.split("x"))
         t = [time.perf_counter()]
-        tm = tank_mesh(TankGeometry(kind="box", size=(5.0, 5.0, 4.0)), 3.0, counts)
+        tm = Box(size=(5.0, 5.0, 4.0)).mesh(3.0, counts)
         m = build_face_liquid(tm.nodes, tm.elements, 3.0, RHO, C, G)
         t.append(time.perf_counter())
         face_modes(m, 10)

@@ -43,41 +43,41 @@ def _u_tube_file(nx, ny, nz, length):
 def case(name):
     """(geometry, depth, mesh or None, element, reference omega (N,)) of the named case."""
     from jaxslosh.fem.modes import analytic_sloshing_omegas
-    from jaxslosh.fem.shapes import Baffle, TankGeometry
+    from jaxslosh.geometry import Baffle, Box, Cylinder, MeshFile, Prismatic
 
     lng = ref.prismatic(6.0, 4.0, 1.5, 1.0, 1.5, 1.0)
-    lng_geo = TankGeometry(kind="prismatic", size=(8.0, 6.0, 4.0), chamfers=((1.5, 1.0), (1.5, 1.0)))
-    hcyl = TankGeometry(kind="cylinder", size=(3.0, 2.0, 2.0), axis="x")
+    lng_geo = Prismatic(size=(8.0, 6.0, 4.0), chamfers=((1.5, 1.0), (1.5, 1.0)))
+    hcyl = Cylinder(size=(3.0, 2.0, 2.0), axis="x")
     el = ELEMENT.get(name, "rt")
     if name == "box":
-        return (TankGeometry(kind="box", size=(5.0, 5.0, 4.0)), 3.0, (10, 10, 10), el,
+        return (Box(size=(5.0, 5.0, 4.0)), 3.0, (10, 10, 10), el,
                 analytic_sloshing_omegas(5.0, 5.0, 3.0, G, N))
     if name in ("lng_30", "lng_90"):
         d = 1.2 if name == "lng_30" else 3.6
         return lng_geo, d, (10, 12, 8), el, ref.prism_sloshing_omegas(lng, d, 8.0, G, N, h_target=0.08)[0]
     if name == "low_hopper":
-        return (TankGeometry(kind="prismatic", size=(6.0, 8.0, 1.5), chamfers=((1.0, 0.3), (0.0, 0.0))), 1.2,
+        return (Prismatic(size=(6.0, 8.0, 1.5), chamfers=((1.0, 0.3), (0.0, 0.0))), 1.2,
                 (8, 16, 8), el, ref.prism_sloshing_omegas(ref.prismatic(8.0, 1.5, 1.0, 0.3), 1.2, 6.0, G, N,
                                                           h_target=0.05)[0])
     if name == "v_trough":
-        return (TankGeometry(kind="prismatic", size=(2.0, 2.0, 1.0), chamfers=((1.0, 1.0), (0.0, 0.0))), 0.8,
+        return (Prismatic(size=(2.0, 2.0, 1.0), chamfers=((1.0, 1.0), (0.0, 0.0))), 0.8,
                 (8, 12, 10), el, ref.prism_sloshing_omegas(ref.prismatic(2.0, 1.0, 1.0, 1.0), 0.8, 2.0, G, N,
                                                            h_target=0.04)[0])
     if name == "vertical_cylinder":
-        return (TankGeometry(kind="cylinder", size=(2.0, 2.0, 2.0), axis="z"), 1.0, (10, 10, 10), el,
+        return (Cylinder(size=(2.0, 2.0, 2.0), axis="z"), 1.0, (10, 10, 10), el,
                 _vertical_cylinder(1.0, 1.0, N))
     if name.startswith("horizontal_cylinder_"):
         d = {"25": 0.5, "50": 1.0, "80": 1.6}[name.rsplit("_", 1)[1]]
         return hcyl, d, (10, 16, 6), el, ref.prism_sloshing_omegas(ref.circle(1.0), d, 3.0, G, N, h_target=0.04)[0]
     if name == "u_tube_file":
         path, size = _u_tube_file(5, 40, 10, 1.0)
-        return (TankGeometry(kind="mesh", size=size, file=path), 1.0, None, el,
+        return (MeshFile(size=size, file=path), 1.0, None, el,
                 ref.prism_sloshing_omegas(ref.u_tube(8.0, 1.0, 0.3, 2.0), 1.0, 1.0, G, N, h_target=0.05)[0])
     if name in ("hanging_baffle", "standing_baffle"):
         hanging = name == "hanging_baffle"
         bf = Baffle("y", 0.5, "top", 0.8) if hanging else Baffle("y", 0.5, "bottom", 0.3)
         rbf = ref.Baffle(0.5, 0.8, hanging=True) if hanging else ref.Baffle(0.5, 0.3)
-        return (TankGeometry(kind="box", size=(1.0, 1.0, 1.0), baffles=(bf,)), 0.5, (6, 18, 9), el,
+        return (Box(size=(1.0, 1.0, 1.0), baffles=(bf,)), 0.5, (6, 18, 9), el,
                 ref.prism_sloshing_omegas(ref.rectangle(1.0, 1.0), 0.5, 1.0, G, N, h_target=0.02, baffles=[rbf])[0])
     raise ValueError(name)
 
@@ -89,10 +89,10 @@ CASES = ("box", "lng_30", "lng_90", "low_hopper", "v_trough", "vertical_cylinder
 def sloshing_omegas(geo, depth, mesh, element, n=N):
     """(omega of the n lowest sloshing modes, elements, kinds of the modes up to the n-th sloshing
     one) of the tank with the given element."""
-    from jaxslosh.fem.shapes import tank_mesh
+    from jaxslosh.geometry import Baffle, Box, Cylinder, MeshFile, Prismatic
     if element == "rt":
         from jaxslosh.fem.liquid_rt import build_face_liquid, face_modes
-        tm = tank_mesh(geo, depth, mesh or (1, 1, 1))
+        tm = geo.mesh(depth, mesh or (1, 1, 1))
         md = face_modes(build_face_liquid(tm.nodes, tm.elements, tm.depth, 1000.0, 1500.0, G), n)
         return md.omega, len(tm.elements), list(md.kind)
     from jaxslosh.fem.liquid import build_liquid

@@ -10,7 +10,6 @@ from ..fem.mesh import face_nodes
 from ..fem.modes import Modes, liquid_modes
 from ..fem.structure import build_structure, clamped_modes
 from ..fem.walls import build_tank_with_walls, tank_modes
-from ..fem.shapes import tank_mesh
 from ..scene.types import Scene, SceneError
 from ..solve.sparse import SPARSE_AUTO
 
@@ -51,7 +50,7 @@ def _face_modes(scene: Scene, t, n: int) -> Modes:
     if t.wall_spec is not None:
         i = scene.tanks.index(t)
         raise SceneError(f"tanks[{i}].fluid.element", '"rt" does not take elastic walls yet; use "stabilized"')
-    tm = tank_mesh(t.geometry, t.fill_depth, t.mesh)
+    tm = t.geometry.mesh(t.fill_depth, t.mesh)
     model = build_face_liquid(tm.nodes, tm.elements, tm.depth, t.fluid.density, t.fluid.sound_speed,
                               scene.environment.gravity)
     fm = face_modes(model, n)

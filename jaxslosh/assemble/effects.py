@@ -5,10 +5,6 @@ from __future__ import annotations
 
 import os
 
-import numpy as np
-
-from ..fem.meshfile import read_mesh_file
-from ..fem.shapes import free_count, grid_counts, read_mesh, tank_mesh
 from ..fem.walls import shell_mesh
 from ..hydro.source import excitation_source
 from ..scene.types import EFFECTS, Scene
@@ -178,87 +174,30 @@ def mesh_words(t, short: bool = False) -> str:
     "mesh file of 12 hexahedra on 30 nodes" (a mesh tank's file that is not a grid: its counts
     along x, y, z mean nothing)."""
     nx, ny, nz = t.mesh
-    if t.shape == "mesh":
-        try:
-            nodes, elements = read_mesh(t.file)
-        except (OSError, ValueError):
-            nodes = elements = None
-        if elements is not None and grid_counts(nodes, elements) is None:
-            return f"mesh file of {len(elements)} hexahedra on {len(nodes)} nodes"
+    words = t.geometry.mesh_words()
+    if words is not None:
+        return words
     return f"{nx}x{ny}x{nz} hexahedra" if short else f"mesh {nx} x {ny} x {nz} = {nx * ny * nz} hexahedra"
-
-
-#: a horizontal cylinder's surface elements this many times taller than wide (a nearly full tank:
-#: its free surface a narrow strip) carry no sloshing mode the mesh resolves: `check` says so
-SLIVER_ASPECT = 8.0
-
-
-def sliver_note(t) -> list[str]:
-    """A note on a horizontal cylinder filled so near its top that its mesh resolves no sloshing."""
-    if t.shape != "cylinder" or t.axis == "z":
-        return []
-    tm = tank_mesh(t.geometry, t.fill_depth, tuple(t.mesh))
-    top = np.isclose(tm.nodes[:, 2], tm.depth)
-    E = tm.elements[top[tm.elements].sum(axis=1) >= 4]             # the elements under the free surface
-    if not len(E):
-        return []
-    across = 1 if t.axis == "x" else 0
-    X = tm.nodes[E]
-    height = np.ptp(X[:, :, 2], axis=1)
-    width = np.array([np.ptp(x[np.isclose(x[:, 2], tm.depth), across]) for x in X])
-    aspect = float(np.max(height / np.maximum(width, 1e-300)))
-    if aspect <= SLIVER_ASPECT:
-        return []
-    D = t.size[2]
-    w = float(np.ptp(tm.nodes[top, across]))
-    return [f"  note: the horizontal cylinder is nearly full ({t.fill_depth:g} of {D:g} m): its free surface is a "
-            f"strip {w:.3g} m wide ({100 * w / D:.2g} % of the diameter), over elements {aspect:.0f} times taller "
-            f"than wide, which resolve no sloshing mode: the lowest modes found there (`jaxslosh modes`) are "
-            f"spurious"]
 
 
 def shape_words(t) -> str:
     """"prismatic (chamfers ...) " and the like for a tank that is not a plain box, else ""."""
     if t.geometry.plain_box:
         return ""
-    words = {"box": "box", "prismatic": "prismatic", "cylinder": "cylinder", "mesh": "mesh"}[t.shape]
-    if t.shape == "prismatic":
-        (cw, ch), (tw, th) = t.chamfers
-        words += f" (chamfers bottom {cw:g} x {ch:g} m, top {tw:g} x {th:g} m)"
-    elif t.shape == "cylinder":
-        words += " (vertical)" if t.axis == "z" else f" (horizontal, along {t.axis})"
-    elif t.shape == "mesh":
-        words += f" ({t.file})"
-    if t.baffles:
-        words += f" with {len(t.baffles)} baffle{'s' if len(t.baffles) > 1 else ''}"
-    return words + ", "
+    return t.geometry.describe() + ", "
 
 
 def tank_notes(t) -> list[str]:
     """Indented lines under a tank: each baffle as the model reads it (its plane, side and edge), a
-    nearly full horizontal cylinder's unresolved free surface (sliver_note), and how many hexahedra
-    of a mesh file were re-oriented (numbered left-handed in the file)."""
-    out = []
-    H = t.size[2]
-    for i, b in enumerate(t.baffles):
-        edge = b.height if b.mount == "bottom" else H - b.height
-        side = ("standing on the bottom, its upper edge" if b.mount == "bottom"
-                else "hanging from the roof, its lower edge")
-        out.append(f"  baffle {i}: the plane {b.normal} = {b.at:g} m from the tank's origin, {side} {edge:g} m above "
-                   f"the tank bottom ({b.height:g} m of plate)")
-    out += sliver_note(t)
-    if t.shape == "mesh":
-        m = read_mesh_file(t.file)
-        if m.reoriented:
-            out.append(f"  note: {m.reoriented} of the {len(m.elements)} hexahedra in {os.path.basename(t.file)} are "
-                       f"numbered left-handed (inverted) in the file; they are re-oriented")
-    return out
+    nearly full horizontal cylinder's unresolved free surface, and how many hexahedra of a mesh file
+    were re-oriented (numbered left-handed in the file): the shape's notes (jaxslosh/geometry)."""
+    return t.geometry.notes(t.fill_depth, tuple(t.mesh))
 
 
 def free_liquid_dofs(tank) -> int:
     """A tank's free liquid dofs: three per node, less the wall-normal ones the slip walls hold."""
     if not tank.geometry.plain_box:
-        return free_count(tank.geometry, tank.fill_depth, tuple(tank.mesh))
+        return tank.geometry.free_count(tank.fill_depth, tuple(tank.mesh))
     nx, ny, nz = tank.mesh
     nodes = (nx + 1) * (ny + 1) * (nz + 1)
     return 3 * nodes - (2 * (ny + 1) * (nz + 1) + 2 * (nx + 1) * (nz + 1) + (nx + 1) * (ny + 1))

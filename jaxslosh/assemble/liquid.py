@@ -15,7 +15,6 @@ from scipy.linalg import block_diag
 from ..fem.liquid import build_liquid, surface_bending_scale
 from ..fem.liquid_rt import FaceLiquid, build_face_liquid
 from ..fem.mesh import box_mesh, face_nodes, grid_nodes
-from ..fem.shapes import tank_mesh
 from ..fem.structure import assemble, box_element, centrifugal_stiffness
 from ..fem.walls import build_tank_with_walls
 from ..physics.liquid import AbstractLiquid, Liquid, NoLiquid
@@ -270,7 +269,7 @@ def _face_model(scene, t, i, params, g):
     if isinstance(params.get(f"tanks.{t.name}.fill_depth"), jax.core.Tracer):
         raise SceneError(where, f"{t.fluid.element!r} needs the scene's own fill depth (its mesh follows "
                                 "the fill): tanks.<name>.fill_depth cannot be traced with it")
-    tm = tank_mesh(t.geometry, t.fill_depth, t.mesh)
+    tm = t.geometry.mesh(t.fill_depth, t.mesh)
     return build_face_liquid(tm.nodes, tm.elements, tm.depth, t.fluid.density, t.fluid.sound_speed,
                              scene.environment.gravity, geometry=None if t.geometry.plain_box else t.geometry)
 

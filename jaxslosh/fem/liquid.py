@@ -44,7 +44,6 @@ import scipy.sparse as sp
 
 from .liquid_element import FLAT_CORNER_PENALTY, ROTATION_PENALTY, SURFACE_BENDING, element_matrices, is_traced
 from .mesh import ELEMENT_FORMS, FACE_FORMS, box_elements, grid_index, grid_nodes
-from .shapes import box_equivalent, tank_mesh
 from .slip import rotate_matrix, rotate_rows, surface_jump_pattern
 
 
@@ -89,13 +88,13 @@ class LiquidModel:
     # sparse builds on a grid whose layers are uniform: the element matrices of each layer, for
     # products element by element (boxsolve.elements); None otherwise
     layers: Optional[dict] = None
-    # tanks of other shapes (fem/shapes.py): each node's frame (N, 3, 3), whose columns are its axes;
+    # tanks of other shapes (jaxslosh/geometry): each node's frame (N, 3, 3), whose columns are its axes;
     # `stiffness`, `rotation_coupling`, `parts` and `free` are then on the components in these frames
     # (the scalar `mass` stays on the tank's axes); None: every frame is the tank's
     frames: Optional[np.ndarray] = None
     top_faces: Optional[np.ndarray] = None     # (F, 4) free-surface faces of a shaped tank
     wall_faces: Optional[np.ndarray] = None    # (W, 4) its wetted wall faces, outward
-    geometry: Optional[object] = None          # fem/shapes.TankGeometry of a shaped tank
+    geometry: Optional[object] = None          # the shape of a shaped tank (jaxslosh/geometry)
 
     @property
     def n_nodes(self) -> int:
@@ -145,14 +144,14 @@ def build_liquid(size, fill_depth, mesh, density, sound_speed, gravity, element=
     ``mesh`` = (nx, ny, nz) hexahedra over the liquid region; ``element`` one of ``ELEMENT_FORMS``.
     ``fill_depth``, ``density``, ``sound_speed`` and ``gravity`` may be JAX tracers (float64).
     ``sparse=True`` (concrete values only): ``mass`` and ``stiffness`` are SciPy CSR matrices, for
-    meshes whose dense matrices would not fit (see solve/sparse.py). ``geometry``: a fem/shapes
-    TankGeometry for other shapes than the plain box (then the fill depth is concrete).
+    meshes whose dense matrices would not fit (see solve/sparse.py). ``geometry``: the tank's shape
+    (jaxslosh/geometry) where it is not the plain box (then the fill depth is concrete).
     """
     if element not in ELEMENT_FORMS:
         raise ValueError(f"element form {element!r} unknown; choose one of {ELEMENT_FORMS} (the face-normal "
                          f"forms {FACE_FORMS} are fem/liquid_rt.py's)")
-    if geometry is not None and geometry.kind == "mesh" and not is_traced(fill_depth):
-        counts = box_equivalent(geometry, float(fill_depth))
+    if geometry is not None and not is_traced(fill_depth):
+        counts = geometry.box_counts(float(fill_depth))
         if counts is not None:                 # a box grid given as a mesh file: the box itself
             return build_liquid(size, fill_depth, counts, density, sound_speed, gravity, element, sparse)
     if geometry is not None and not geometry.plain_box:
@@ -203,12 +202,12 @@ def build_liquid(size, fill_depth, mesh, density, sound_speed, gravity, element=
 
 
 def _build_shaped(geometry, fill_depth, mesh, rho, c, g, element, sparse) -> LiquidModel:
-    """`build_liquid` for another shape (fem/shapes.py): its mesh, then the matrices on the nodes' frames."""
+    """`build_liquid` for another shape (jaxslosh/geometry): its mesh, then the matrices on the nodes' frames."""
     if is_traced(fill_depth):
         raise ValueError("the fill depth of a tank that is not a plain box cannot be traced (its mesh follows it)")
     traced = any(is_traced(v) for v in (rho, c, g))
     h = float(fill_depth)
-    tm = tank_mesh(geometry, h, mesh)
+    tm = geometry.mesh(h, mesh)
     nodes, elements, faces, frames = tm.nodes, tm.elements, tm.top_faces, tm.frames
     pairs = bending = None
     if element != "paper":

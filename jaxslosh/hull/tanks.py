@@ -41,7 +41,7 @@ def prism_surface(polygon, length):
     return np.concatenate([sides, end, start])
 
 
-def _cyclic(tris, axis):
+def cyclic(tris, axis):
     """A prism built along x turned to lie along `axis` by a cyclic permutation of the coordinates
     (a rotation: orientation kept)."""
     if axis == "x":
@@ -73,24 +73,12 @@ def circle(center, radius, sides=CYLINDER_SIDES):
 
 
 def tank_surface(tank) -> np.ndarray:
-    """The tank's closed inner surface (n, 3, 3), outward, tank-local (module docstring)."""
-    a, b, H = tank.size
-    if tank.shape == "box":
-        return box_surface([0, 0, 0], [a, b, H])
-    if tank.shape == "prismatic":
-        return prism_surface(prismatic_section(tank.size, tank.chamfers), a)
-    if tank.shape == "cylinder":
-        if tank.axis == "x":
-            return prism_surface(circle((b / 2, H / 2), H / 2), a)
-        if tank.axis == "y":         # the polygon in (z, x): centre (H/2, a/2)
-            return _cyclic(prism_surface(circle((H / 2, a / 2), H / 2), b), "y")
-        return _cyclic(prism_surface(circle((a / 2, b / 2), a / 2), H), "z")
-    if tank.shape == "mesh":
-        return _mesh_surface(tank.file, H)
-    raise ValueError(f"unknown tank shape {tank.shape!r}")
+    """The tank's closed inner surface (n, 3, 3), outward, tank-local (module docstring): its shape's
+    (jaxslosh/geometry)."""
+    return tank.geometry.surface()
 
 
-def _mesh_surface(path, height):
+def mesh_surface(path, height):
     nodes, elements = read_mesh(path)
     top = float(nodes[:, 2].max())
     bd = boundary(nodes, elements, top)

@@ -37,8 +37,7 @@ import jax
 import jax.numpy as jnp
 import numpy as np
 
-from .multimodal_modes import (base_quadrature, box_modes, box_vortical, cylinder_modes, cylinder_vortical,
-                               mode_values, wavenumbers)
+from .multimodal_modes import DiskBase, RectangleBase
 
 #: Gauss points through the depth
 NZ = 12
@@ -78,7 +77,7 @@ class ModalTank3D(eqx.Module):
     norms: jax.Array      # (N,) integral of f_n^2 over the base
     sq: jax.Array         # (NZ,) points on [0, 1] through the depth
     ws: jax.Array         # (NZ,) their weights
-    kind: str = eqx.field(static=True)       # "box" | "cylinder"
+    base: object = eqx.field(static=True)    # RectangleBase | DiskBase (physics/multimodal_modes.py)
     modes: tuple = eqx.field(static=True)    # box (i, j); cylinder (m, s, cos 0 | sin 1)
 
     @property
@@ -99,13 +98,10 @@ class ModalTank3D(eqx.Module):
 
     def surface_rows(self, x, y) -> np.ndarray:
         """(P, N): the free-surface elevation at tank-local points per unit beta (numpy, build time)."""
-        return mode_values(self.kind, tuple(np.asarray(self.size)), self.modes, x, y)[0]
+        return self.base.values(self.modes, x, y)[0]
 
     def vortical(self, x, y, z):
-        L, B = self.size[0], self.size[1]
-        if self.kind == "box":
-            return box_vortical(L, B, self.D, x, y, z)
-        return cylinder_vortical(0.5 * L, self.D, x, y, z)
+        return self.base.vortical(self.D, x, y, z)
 
     # ------------------------------------------------------------------ integrals
     def integrals(self, beta) -> Integrals3:
@@ -199,26 +195,30 @@ class ModalTank3D(eqx.Module):
         return f, m, dp[6:] - dT - g_b @ (self.rho * I.dm1)           # dV/dbeta = -g_b . dS/dbeta
 
 
-def _tank(kind, size, h, D, rho, origin, modes) -> ModalTank3D:
-    size = tuple(float(s) for s in size)
-    x, y, w = base_quadrature(kind, size, modes)
-    F, Fx, Fy = mode_values(kind, size, modes, x, y)
+def _tank(base, h, D, rho, origin, modes) -> ModalTank3D:
+    x, y, w = base.quadrature(modes)
+    F, Fx, Fy = base.values(modes, x, y)
     sg, sw = np.polynomial.legendre.leggauss(NZ)
     f = lambda a: jnp.asarray(a, dtype=float)  # noqa: E731
-    return ModalTank3D(size=f(size), h=f(h), D=f(D), rho=f(rho), origin=f(origin),
-                       k=f(wavenumbers(kind, size, modes)), xq=f(x), yq=f(y), wq=f(w), F=f(F), Fx=f(Fx), Fy=f(Fy),
-                       norms=f(w @ F ** 2), sq=f(0.5 * (sg + 1.0)), ws=f(0.5 * sw), kind=kind, modes=tuple(modes))
+    return ModalTank3D(size=f(base.size), h=f(h), D=f(D), rho=f(rho), origin=f(origin),
+                       k=f(base.wavenumbers(modes)), xq=f(x), yq=f(y), wq=f(w), F=f(F), Fx=f(Fx), Fy=f(Fy),
+                       norms=f(w @ F ** 2), sq=f(0.5 * (sg + 1.0)), ws=f(0.5 * sw), base=base, modes=tuple(modes))
 
 
 def box_tank3d(L, B, h, rho, origin, n_modes: int = 0, D=None, modes=None) -> ModalTank3D:
     """A box tank's liquid on its base's lowest n_modes modes (whole degenerate groups), or on the
     given (i, j) modes."""
-    modes = box_modes(float(L), float(B), n_modes) if modes is None else tuple(tuple(m) for m in modes)
-    return _tank("box", (L, B), h, 2.0 * h if D is None else D, rho, origin, modes)
+    return base_tank3d(RectangleBase(float(L), float(B)), h, rho, origin, n_modes, D, modes)
 
 
 def cylinder_tank(R, h, rho, origin, n_modes: int = 0, D=None, modes=None) -> ModalTank3D:
     """An upright circular cylinder's liquid (radius R; origin: the min corner of its bounding box) on
     its lowest n_modes modes (whole cos/sin pairs), or on the given (m, s, c) modes."""
-    modes = cylinder_modes(float(R), n_modes) if modes is None else tuple(tuple(m) for m in modes)
-    return _tank("cylinder", (2.0 * R, 2.0 * R), h, 2.0 * h if D is None else D, rho, origin, modes)
+    return base_tank3d(DiskBase(float(R)), h, rho, origin, n_modes, D, modes)
+
+
+def base_tank3d(base, h, rho, origin, n_modes: int = 0, D=None, modes=None) -> ModalTank3D:
+    """The liquid of a tank standing on `base` (RectangleBase, DiskBase) on its lowest n_modes modes
+    (whole degenerate groups), or on the given modes."""
+    modes = base.lowest(n_modes) if modes is None else tuple(tuple(m) for m in modes)
+    return _tank(base, h, 2.0 * h if D is None else D, rho, origin, modes)

@@ -14,6 +14,9 @@ square base, the cos and sin pair of a cylinder's m >= 1 modes): the swirling wa
 """
 from __future__ import annotations
 
+from dataclasses import dataclass
+from typing import ClassVar
+
 import jax.numpy as jnp
 import numpy as np
 from jax.scipy.special import i0e, i1e
@@ -56,62 +59,114 @@ def cylinder_modes(R: float, n: int) -> tuple:
     return _lowest(cands, n)
 
 
-def wavenumbers(kind: str, size, modes) -> np.ndarray:
-    if kind == "box":
-        L, B = size
-        return np.array([np.pi * np.hypot(i / L, j / B) for i, j in modes])
-    R = 0.5 * size[0]
-    return np.array([special.jnp_zeros(m, s)[-1] / R for m, s, _ in modes])
+@dataclass(frozen=True)
+class RectangleBase:
+    """The L x B base of a box tank: modes (i, j), f = cos(i pi x / L) cos(j pi y / B)."""
+    L: float
+    B: float
+    name: ClassVar[str] = "box"
 
+    @property
+    def size(self) -> tuple:
+        return (self.L, self.B)
 
-def mode_values(kind: str, size, modes, x, y):
-    """(f, df/dx, df/dy), each (P, N), of the base's modes at tank-local points x, y (P,)."""
-    x, y = np.asarray(x, float).ravel(), np.asarray(y, float).ravel()
-    k = wavenumbers(kind, size, modes)
-    if kind == "box":
-        L, B = size
-        i = np.array([m[0] for m in modes]) * np.pi / L
-        j = np.array([m[1] for m in modes]) * np.pi / B
+    def lowest(self, n: int) -> tuple:
+        return box_modes(self.L, self.B, n)
+
+    def wavenumbers(self, modes) -> np.ndarray:
+        return np.array([np.pi * np.hypot(i / self.L, j / self.B) for i, j in modes])
+
+    def values(self, modes, x, y):
+        """(f, df/dx, df/dy), each (P, N), of the base's modes at tank-local points x, y (P,)."""
+        x, y = np.asarray(x, float).ravel(), np.asarray(y, float).ravel()
+        i = np.array([m[0] for m in modes]) * np.pi / self.L
+        j = np.array([m[1] for m in modes]) * np.pi / self.B
         cx, sx = np.cos(np.outer(x, i)), np.sin(np.outer(x, i))
         cy, sy = np.cos(np.outer(y, j)), np.sin(np.outer(y, j))
         return cx * cy, -i * sx * cy, -j * cx * sy
-    R = 0.5 * size[0]
-    xc, yc = x - R, y - R
-    r, th = np.hypot(xc, yc), np.arctan2(yc, xc)
-    m = np.array([md[0] for md in modes])
-    sin_form = np.array([md[2] == 1 for md in modes])
-    kr = np.outer(r, k)
-    norm = special.jv(m, k * R)
-    Jm, dJ = special.jv(m, kr) / norm, k * special.jvp(m, kr) / norm
-    ang = np.where(sin_form, np.sin(np.outer(th, m)), np.cos(np.outer(th, m)))
-    dang = m * np.where(sin_form, np.cos(np.outer(th, m)), -np.sin(np.outer(th, m)))
-    # J_m(k r) / r is finite at the centre (zero unless m = 1, where the mode's gradient is k / 2 / norm)
-    Jr = np.where(kr > 1e-12, special.jv(m, kr) / np.maximum(r, 1e-300)[:, None], np.where(m == 1, 0.5 * k, 0.0)) / norm
-    f, fr, ft = Jm * ang, dJ * ang, Jr * dang            # ft: (1 / r) df / dtheta
-    c, s = np.cos(th)[:, None], np.sin(th)[:, None]
-    return f, fr * c - ft * s, fr * s + ft * c
 
-
-def base_quadrature(kind: str, size, modes):
-    """(x, y, w) the base's quadrature points and weights: Gauss-Legendre in x and y on a box, in r
-    (weight r) and the trapezoidal rule in theta (exact for trigonometric polynomials) on a disk."""
-    if kind == "box":
+    def quadrature(self, modes):
+        """(x, y, w): Gauss-Legendre in x and y."""
         top = max(max(i for i, _ in modes), max(j for _, j in modes))
         n = max(12, 4 * top + 4)
         g, gw = np.polynomial.legendre.leggauss(n)
-        xs, xw = 0.5 * size[0] * (g + 1.0), 0.5 * size[0] * gw
-        ys, yw = 0.5 * size[1] * (g + 1.0), 0.5 * size[1] * gw
+        xs, xw = 0.5 * self.L * (g + 1.0), 0.5 * self.L * gw
+        ys, yw = 0.5 * self.B * (g + 1.0), 0.5 * self.B * gw
         X, Y = np.meshgrid(xs, ys, indexing="ij")
         return X.ravel(), Y.ravel(), np.outer(xw, yw).ravel()
-    R = 0.5 * size[0]
-    mmax = max(m for m, _, _ in modes)
-    smax = max(s for _, s, _ in modes)
-    g, gw = np.polynomial.legendre.leggauss(max(12, 6 * smax + 2 * mmax))
-    r, rw = 0.5 * R * (g + 1.0), 0.5 * R * gw * 0.5 * R * (g + 1.0)
-    nt = max(24, 8 * mmax + 8)
-    th = 2.0 * np.pi * np.arange(nt) / nt
-    Rr, T = np.meshgrid(r, th, indexing="ij")
-    return (R + Rr * np.cos(T)).ravel(), (R + Rr * np.sin(T)).ravel(), np.outer(rw, np.full(nt, 2 * np.pi / nt)).ravel()
+
+    def vortical(self, D, x, y, z):
+        return box_vortical(self.L, self.B, D, x, y, z)
+
+    def rim(self, n: int):
+        """(x, y): n points round the walls, the corners among them."""
+        L, B = self.L, self.B
+        q = n // 4
+        s = np.arange(q) / q
+        x = np.concatenate([L * s, np.full(q, L), L * (1 - s), np.zeros(n - 3 * q)])
+        y = np.concatenate([np.zeros(q), B * s, np.full(q, B), B * (1 - np.arange(n - 3 * q) / (n - 3 * q))])
+        return x, y
+
+
+@dataclass(frozen=True)
+class DiskBase:
+    """The disk of radius R (centre (R, R)) of an upright cylinder: modes (m, s, c),
+    f = J_m(k r) / J_m(k R) (cos m theta | sin m theta)."""
+    R: float
+    name: ClassVar[str] = "cylinder"
+
+    @property
+    def size(self) -> tuple:
+        return (2.0 * self.R, 2.0 * self.R)
+
+    def lowest(self, n: int) -> tuple:
+        return cylinder_modes(self.R, n)
+
+    def wavenumbers(self, modes) -> np.ndarray:
+        return np.array([special.jnp_zeros(m, s)[-1] / self.R for m, s, _ in modes])
+
+    def values(self, modes, x, y):
+        """(f, df/dx, df/dy), each (P, N), of the base's modes at tank-local points x, y (P,)."""
+        x, y = np.asarray(x, float).ravel(), np.asarray(y, float).ravel()
+        k = self.wavenumbers(modes)
+        R = self.R
+        xc, yc = x - R, y - R
+        r, th = np.hypot(xc, yc), np.arctan2(yc, xc)
+        m = np.array([md[0] for md in modes])
+        sin_form = np.array([md[2] == 1 for md in modes])
+        kr = np.outer(r, k)
+        norm = special.jv(m, k * R)
+        Jm, dJ = special.jv(m, kr) / norm, k * special.jvp(m, kr) / norm
+        ang = np.where(sin_form, np.sin(np.outer(th, m)), np.cos(np.outer(th, m)))
+        dang = m * np.where(sin_form, np.cos(np.outer(th, m)), -np.sin(np.outer(th, m)))
+        # J_m(k r) / r is finite at the centre (zero unless m = 1, where the mode's gradient is k / 2 / norm)
+        Jr = np.where(kr > 1e-12, special.jv(m, kr) / np.maximum(r, 1e-300)[:, None],
+                      np.where(m == 1, 0.5 * k, 0.0)) / norm
+        f, fr, ft = Jm * ang, dJ * ang, Jr * dang            # ft: (1 / r) df / dtheta
+        c, s = np.cos(th)[:, None], np.sin(th)[:, None]
+        return f, fr * c - ft * s, fr * s + ft * c
+
+    def quadrature(self, modes):
+        """(x, y, w): Gauss-Legendre in r (weight r), the trapezoidal rule in theta (exact for
+        trigonometric polynomials)."""
+        R = self.R
+        mmax = max(m for m, _, _ in modes)
+        smax = max(s for _, s, _ in modes)
+        g, gw = np.polynomial.legendre.leggauss(max(12, 6 * smax + 2 * mmax))
+        r, rw = 0.5 * R * (g + 1.0), 0.5 * R * gw * 0.5 * R * (g + 1.0)
+        nt = max(24, 8 * mmax + 8)
+        th = 2.0 * np.pi * np.arange(nt) / nt
+        Rr, T = np.meshgrid(r, th, indexing="ij")
+        return ((R + Rr * np.cos(T)).ravel(), (R + Rr * np.sin(T)).ravel(),
+                np.outer(rw, np.full(nt, 2 * np.pi / nt)).ravel())
+
+    def vortical(self, D, x, y, z):
+        return cylinder_vortical(self.R, D, x, y, z)
+
+    def rim(self, n: int):
+        """(x, y): n points round the wall."""
+        th = 2.0 * np.pi * np.arange(n) / n
+        return self.R + self.R * np.cos(th), self.R + self.R * np.sin(th)
 
 
 # ---------------------------------------------------------------------------------- vortical flows

@@ -9,9 +9,8 @@ from matplotlib.cm import ScalarMappable
 from matplotlib.colors import Normalize
 from mpl_toolkits.mplot3d.art3d import Poly3DCollection
 
-from ..fem.outline import outline
-from ..fem.shapes import TankGeometry
 from ..fem.slip import HEX_FACES
+from ..geometry import SHAPES
 from ..physics.kinematics import rotation_matrix
 from ..scene.load import load_scene, tomllib
 from ..scene.types import SceneError
@@ -55,11 +54,10 @@ class _Tanks:
             else:
                 # a mesh tank gives no fill_depth: its free surface is its mesh's highest plane (SPEC 5)
                 depth = float(t["fill_depth"]) if "fill_depth" in t else float(nodes[:, 2].max())
-                geo = TankGeometry(kind=t.get("shape", "box"), size=tuple(t["size"]), axis=t.get("axis", "x"))
+                geo = SHAPES.get(t.get("shape", "box"), SHAPES["box"]).sketch(t)
             s, tri = _surface_triangles(nodes, elements, depth)
             # a mesh tank's outline from the liquid mesh the result keeps (its file may be elsewhere now)
-            mesh = (nodes, elements) if geo.kind == "mesh" else None
-            lines = [origin + line for line in outline(geo, depth, mesh)]
+            lines = [origin + line for line in geo.outline(depth, (nodes, elements))]
             self.tanks.append((name, origin, nodes[s], s, tri, lines))
             if s.size:
                 high = max(high, float(np.nanmax(np.abs(np.asarray(tf.displacement)[:, s, 2]), initial=0.0)))

@@ -29,7 +29,8 @@ HARMLESS = frozenset(("title", "simulation.duration", "simulation.chunk", "simul
 _TOML_NAME = {("Tank", "wall_spec"): "walls", ("Tank", "walls"): None,      # the [tanks.walls] table says it
               ("Waves", "omega"): "frequency", ("Waves", "omega_range"): "frequency_range",
               ("Hydrodynamics", "base_dir"): None, ("Hull", "base_dir"): None,   # where the scene file lay
-              ("Fluid", "element_default"): None}                                 # the loader's note
+              ("Fluid", "element_default"): None,                                 # the loader's note
+              ("Tank", "geometry"): None}                                         # the shape keys, as a shape
 
 _TABLE = object()      # a table that is present (its keys follow)
 

@@ -26,13 +26,13 @@ except ModuleNotFoundError:  # Python 3.10
     import tomli as tomllib  # type: ignore[no-redef]
 
 from ..fem.mesh import box_mesh, face_nodes
-from ..fem.shapes import AXES, SHAPES
+from ..geometry import AXES, SHAPES
 from .campaign import read_campaign
 from .fields import (at_least, counts, flat_list, non_negative, one_of, poisson_ratio, positive, read, show, sizes,
                      valid_name)
 from .record import forced_span, read_forced
 from .hull import read_hydrostatics
-from .shape import default_element, fill_and_mesh, read_shape
+from .shape import default_element, fill_and_mesh, read_multimodal_shape, read_shape
 from .types import (EFFECTS, ELEMENT_FORMS, FACE_FORMS, FACES, Damping, Effects, Environment, Fluid,
                     Initial, Material, Probe, Reduction, Scene, SceneError, Simulation, Structure, Tank,
                     Vessel, Walls)
@@ -339,28 +339,23 @@ def _tank(table, where: str, base_dir: str = "") -> Tank:
             "modes": ("int", at_least(1)), "static_correction": ("bool", None),
         }, required=("modes",)))
     damping = _damping(table["damping"], f"{where}.damping") if "damping" in table else None
-    shape = read_shape(table, v, where, base_dir, elastic=wall_spec is not None)
+    shape, geo = read_shape(table, v, where, base_dir, elastic=wall_spec is not None)
     if "element" not in table.get("fluid", {}):
-        element, why = default_element(shape, v["size"], depth, v["mesh"], reduction is not None)
+        element, why = default_element(geo, depth, v["mesh"], reduction is not None)
         fluid = dataclasses.replace(fluid, element=element, element_default=why)
     return Tank(name=v["name"], origin=v["origin"], size=v["size"], fill_depth=depth, mesh=v["mesh"],
                 walls=walls, fluid=fluid, wall_spec=wall_spec, reduction=reduction, damping=damping,
                 model=model, modes=v.get("modes", 6),
-                flow=v.get("flow", "3d" if shape["shape"] == "cylinder" else "2d"), **shape)
+                flow=v.get("flow", geo.modal_flow), geometry=geo, **shape)
 
 
 def _multimodal_tank(table, where: str) -> None:
     """A multimodal tank is a plain box (physics/multimodal.py, or multimodal3d.py with flow = "3d") or
     an upright circular cylinder (multimodal3d.py) with rigid walls."""
-    cylinder = table.get("shape") == "cylinder"
-    if cylinder and table.get("axis", "x") != "z":
-        raise SceneError(f"{where}.axis", 'a model = "multimodal" cylinder stands upright: axis = "z"')
-    if cylinder and table.get("flow", "3d") != "3d":
-        raise SceneError(f"{where}.flow", 'a model = "multimodal" cylinder\'s waves are three-dimensional: '
-                                          'leave flow out or write flow = "3d"')
+    read_multimodal_shape(table, where)
     for key, why in (("shape", "a box or an upright cylinder"), ("baffles", "a tank without baffles"),
                      ("walls", "rigid walls"), ("reduction", "its own modes"), ("file", "a box or a cylinder")):
-        if key in table and not (key == "shape" and table[key] in ("box", "cylinder")) and \
+        if key in table and not (key == "shape" and SHAPES[table[key]].modal) and \
                 not (key == "walls" and table[key] == "rigid"):
             raise SceneError(f"{where}.{key}", f'a model = "multimodal" tank is {why}: leave {key} out')
     visc = table.get("damping", {}).get("viscosity", 0.0) if isinstance(table.get("damping"), dict) else 0.0

@@ -12,7 +12,7 @@ from dataclasses import dataclass, field
 from typing import Optional, Union
 
 from ..fem.mesh import ELEMENT_FORMS, FACE_FORMS  # noqa: F401  (the loader reads them here)
-from ..fem.shapes import TankGeometry, liquid_volume
+from ..geometry import SHAPES, AbstractShape
 
 #: the six rigid dofs, in the order of every 6-vector and 6 x 6 table
 DOFS = ("surge", "sway", "heave", "roll", "pitch", "yaw")
@@ -166,25 +166,29 @@ class Tank:
     wall_spec: Optional[Walls] = None   # the [tanks.walls] table when walls = "elastic"
     reduction: Optional[Reduction] = None   # None: full order
     damping: Optional[Damping] = None       # None: an inviscid, undamped liquid
-    shape: str = "box"                      # "box" | "prismatic" | "cylinder" | "mesh" (fem/shapes.py)
+    shape: str = "box"                      # "box" | "prismatic" | "cylinder" | "mesh" (geometry.SHAPES)
     chamfers: tuple = ((0.0, 0.0), (0.0, 0.0))   # prismatic: (width y, height z) of the bottom and top cuts
     axis: str = "x"                         # cylinder: "x", "y" (horizontal) or "z" (vertical)
     file: str = ""                          # mesh: the mesh file (absolute path)
-    baffles: tuple = ()                     # fem/shapes.Baffle per [[tanks.baffles]]
+    baffles: tuple = ()                     # geometry.Baffle per [[tanks.baffles]]
     model: str = "fem"                      # "fem" | "multimodal" (physics/multimodal.py)
     modes: int = 6                          # multimodal: free-surface modes (the lowest, whole degenerate groups)
     flow: str = "2d"                        # multimodal: "2d" along a box's length | "3d" (a cylinder's always)
 
-    @property
-    def geometry(self) -> TankGeometry:
-        return TankGeometry(kind=self.shape, size=tuple(self.size), chamfers=self.chamfers, axis=self.axis,
-                            file=self.file, baffles=self.baffles)
+    #: the shape (jaxslosh/geometry), built by the loader from the keys above; a Tank made by hand
+    #: gets it from them
+    geometry: Optional[AbstractShape] = field(default=None, compare=False, repr=False)
+
+    def __post_init__(self):
+        if self.geometry is None:
+            cls = SHAPES[self.shape]
+            own = {k: getattr(self, k) for k in ("chamfers", "axis", "file", "baffles")
+                   if k in cls.__dataclass_fields__}
+            object.__setattr__(self, "geometry", cls(size=tuple(self.size), **own))
 
     @property
     def liquid_volume(self) -> float:
-        if self.shape == "box":
-            return self.size[0] * self.size[1] * self.fill_depth
-        return liquid_volume(self.geometry, self.fill_depth)
+        return self.geometry.volume(self.fill_depth)
 
     @property
     def liquid_mass(self) -> float:

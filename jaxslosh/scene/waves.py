@@ -88,8 +88,8 @@ def read_hull(table, base_dir: str = "") -> Hull:
         "draft": ("float", positive), "kg": ("float", None), "file": ("str", None), "cog": ("vec3", None),
         "depth": ("float", positive),
     })
-    kind = v.get("type", "box")
-    if kind == "box":
+    hull_type = v.get("type", "box")
+    if hull_type == "box":
         for k in ("length", "beam", "draft", "kg"):
             if k not in v:
                 raise SceneError(f"{where}.{k}", "a required key is missing (box hull)")

@@ -182,7 +182,7 @@ def test_every_tank_shape_plots_its_surface_and_animation(tmp_path, capsys):
     the drawn surface is the mesh's highest plane, its triangles cover the surface's nodes."""
     meshio = pytest.importorskip("meshio")
     from jaxslosh.fem.mesh import box_mesh
-    from jaxslosh.fem.shapes import TankGeometry, tank_mesh
+    from jaxslosh.geometry import SHAPES
     path = tmp_path / "liquid.msh"
     nodes, elements = box_mesh((3.0, 2.0, 1.5), (3, 2, 2))
     meshio.write(str(path), meshio.Mesh(nodes, [("hexahedron", elements)]), file_format="gmsh22")
@@ -196,9 +196,9 @@ def test_every_tank_shape_plots_its_surface_and_animation(tmp_path, capsys):
             ("cylinder", 'axis = "x"\n', (3.0, 2.0, 2.0), (3, 4, 4)),
             ("cylinder-z", 'axis = "z"\n', (2.0, 2.0, 2.0), (4, 4, 2))):
         kind = shape.split("-")[0]
-        geo = TankGeometry(kind=kind, size=size, axis="z" if shape.endswith("-z") else "x",
-                           chamfers=((0.5, 0.5), (0.0, 0.0)) if kind == "prismatic" else ((0.0, 0.0), (0.0, 0.0)))
-        tm = tank_mesh(geo, 1.2, mesh)
+        own = {"axis": "z" if shape.endswith("-z") else "x", "chamfers": ((0.5, 0.5), (0.0, 0.0))}
+        geo = SHAPES[kind](size=size, **{k: x for k, x in own.items() if k in SHAPES[kind].keys})
+        tm = geo.mesh(1.2, mesh)
         text = (f'[[tanks]]\n{head}size = [{size[0]}, {size[1]}, {size[2]}]\nshape = "{kind}"\n{extra}'
                 f'fill_depth = 1.2\nmesh = [{mesh[0]}, {mesh[1]}, {mesh[2]}]\n')
         cases[shape] = (text, tm.nodes, tm.elements)

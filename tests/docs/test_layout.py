@@ -13,6 +13,8 @@ LAYERS = [
     {"fem.mesh", "fem.meshfile", "fem.slip", "physics.kinematics"},
     {"fem.shapes"},
     {"hull"},
+    # the tank shapes: below the scene loader that builds them and the finite elements that mesh them
+    {"geometry"},
     {"hydro", "io"},
     {"scene"},
     {"fem"},
@@ -141,3 +143,56 @@ def test_the_finite_elements_import_neither_the_scene_nor_the_compile_cache():
             top, _ = _imports(module, path)
             bad = [t for t in top if t.split(".")[0] in ("scene", "cache")]
             assert not bad, f"{module} imports {bad}"
+
+
+#: the values of a tank's `shape` key (jaxslosh/geometry SHAPES)
+TANK_SHAPES = {"box", "prismatic", "cylinder", "mesh"}
+
+
+def _names_a_shape(node) -> bool:
+    """`kind`, `x.kind`, `shape`, `x.shape`, `x["shape"]`, `x.get("shape", ...)`: where a tank's shape
+    would sit as a string."""
+    if isinstance(node, ast.Name):
+        return node.id in ("kind", "shape")
+    if isinstance(node, ast.Attribute):
+        return node.attr in ("kind", "shape")
+    if isinstance(node, ast.Subscript):
+        return isinstance(node.slice, ast.Constant) and node.slice.value == "shape"
+    if isinstance(node, ast.Call) and isinstance(node.func, ast.Attribute) and node.func.attr == "get":
+        return bool(node.args) and isinstance(node.args[0], ast.Constant) and node.args[0].value == "shape"
+    return False
+
+
+def _shape_strings(node) -> set:
+    if isinstance(node, ast.Constant) and isinstance(node.value, str):
+        return {node.value} & TANK_SHAPES
+    if isinstance(node, (ast.Tuple, ast.List, ast.Set)):
+        return set().union(*(_shape_strings(e) for e in node.elts)) if node.elts else set()
+    return set()
+
+
+def shape_branches(source: str) -> list:
+    """(line, text) of each comparison of a shape-like name with a tank shape's name."""
+    out = []
+    for node in ast.walk(ast.parse(source)):
+        if isinstance(node, ast.Compare):
+            sides = [node.left] + node.comparators
+            if any(_names_a_shape(s) for s in sides) and any(_shape_strings(s) for s in sides):
+                out.append((node.lineno, ast.unparse(node)))
+    return out
+
+
+def test_shape_branches_are_found():
+    """The finder below sees the forms a branch on a tank's shape takes."""
+    src = ('a = geo.kind == "mesh"\nb = t.shape != "cylinder"\nc = kind in ("box", "prismatic")\n'
+           'd = v.get("shape") == "mesh"\ne = shape["shape"] == "box"\nf = s.shape == (3, 4)\ng = hull == "box"\n')
+    assert [line for line, _ in shape_branches(src)] == [1, 2, 3, 4, 5]
+
+
+def test_no_string_branches_on_tank_shapes_outside_the_geometry():
+    """A tank's shape is a class of jaxslosh/geometry that owns what differs between shapes (its keys,
+    volume, mesh, outline, surface and words): code elsewhere calls its methods instead of asking
+    which shape it holds (`geo.kind == "mesh"`, `t.shape in ("box", "prismatic")`)."""
+    bad = [f"{module}:{line}: {text}" for module, path in sorted(MODULES.items()) if not module.startswith("geometry.")
+           for line, text in shape_branches(open(path).read())]
+    assert not bad, "\n".join(bad)

@@ -16,7 +16,7 @@ import scipy.linalg as sl
 from jaxslosh.cli.main import main
 from jaxslosh.fem.liquid_rt import build_face_liquid, face_modes
 from jaxslosh.fem.modes import analytic_sloshing_omegas
-from jaxslosh.fem.shapes import Baffle, TankGeometry, tank_mesh
+from jaxslosh.geometry import Baffle, Box, Prismatic
 
 sys.path.insert(0, os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 import sloshing_reference as ref  # noqa: E402
@@ -27,7 +27,7 @@ T = 0.2
 
 
 def box(size, depth, mesh, baffles=()):
-    tm = tank_mesh(TankGeometry(kind="box", size=size, baffles=baffles), depth, mesh)
+    tm = Box(size=size, baffles=baffles).mesh(depth, mesh)
     return build_face_liquid(tm.nodes, tm.elements, depth, RHO, C, G)
 
 
@@ -48,7 +48,7 @@ def test_uniform_flow_is_reproduced_on_a_distorted_mesh():
     """Fluxes q_f = U . n_f A_f of a uniform displacement U give back U everywhere inside every
     element of a sheared mesh (RT0 holds constants on parallelepipeds; on general hexahedra only
     asymptotically, as smooth meshes are refined), and its kinetic energy is 1/2 rho V |U|^2."""
-    tm = tank_mesh(TankGeometry(kind="box", size=(1.0, 2.0, 2.0)), 1.0, (2, 3, 4))
+    tm = Box(size=(1.0, 2.0, 2.0)).mesh(1.0, (2, 3, 4))
     A = np.array([[1.0, 0.3, 0.1], [-0.2, 1.1, 0.25], [0.0, 0.0, 0.9]])
     m = build_face_liquid(tm.nodes @ A.T, tm.elements, 0.9, RHO, C, G)
     U = np.array([0.3, -0.2, 0.5])
@@ -146,10 +146,10 @@ def test_baffle_in_a_hopper_is_not_a_bulkhead():
 
 
 def test_lng_section_30_percent_on_refinements_in_either_direction():
-    geo = TankGeometry(kind="prismatic", size=(T, 1.0, 1.0), chamfers=((0.2, 0.2), (0.2, 0.2)))
+    geo = Prismatic(size=(T, 1.0, 1.0), chamfers=((0.2, 0.2), (0.2, 0.2)))
     w_ref = ref.section_sloshing_omegas(ref.prismatic(1.0, 1.0, 0.2, 0.2, 0.2, 0.2), 0.3, G, 3, h_target=0.01)
     for mesh in ((2, 24, 8), (2, 24, 16), (2, 48, 16), (2, 48, 32)):
-        tm = tank_mesh(geo, 0.3, mesh)
+        tm = geo.mesh(0.3, mesh)
         w = omegas(build_face_liquid(tm.nodes, tm.elements, 0.3, RHO, C, G))
         assert np.all(np.abs(rel(w, w_ref)) < 0.01), (mesh, w, w_ref)
 
@@ -205,10 +205,10 @@ def test_static_tilt_keeps_the_surface_level():
     gravity (to 1e-4 of the tilt: the basis holds compression modes 1e6 times stiffer), in a box and in
     a hopper (sloping walls)."""
     from jaxslosh.fem.liquid_rt import _gauss, _loads, face_basis
-    for geo, mesh in [(TankGeometry(kind="box", size=(3.0, 2.0, 2.0)), (6, 4, 3)),
-                      (TankGeometry(kind="prismatic", size=(1.0, 2.0, 2.0), chamfers=((0.5, 0.5), (0.0, 0.0))),
+    for geo, mesh in [(Box(size=(3.0, 2.0, 2.0)), (6, 4, 3)),
+                      (Prismatic(size=(1.0, 2.0, 2.0), chamfers=((0.5, 0.5), (0.0, 0.0))),
                        (2, 8, 4))]:
-        tm = tank_mesh(geo, 1.0, mesh)
+        tm = geo.mesh(1.0, mesh)
         m = build_face_liquid(tm.nodes, tm.elements, 1.0, RHO, C, G)
         V, _, _, (_, _, _, k0) = face_basis(m, (0.0, 0.0, 0.0), 4)
         gs = _gauss(m)

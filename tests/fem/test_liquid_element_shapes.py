@@ -12,7 +12,7 @@ import numpy as np
 import pytest
 
 from jaxslosh.fem.liquid_rt import build_face_liquid, face_modes
-from jaxslosh.fem.shapes import TankGeometry, tank_mesh
+from jaxslosh.geometry import Cylinder, Prismatic
 
 sys.path.insert(0, os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 import shape_cases  # noqa: E402
@@ -22,7 +22,7 @@ G, RHO, C = 9.81, 1000.0, 1500.0
 
 
 def rt_modes(geo, depth, mesh, n):
-    tm = tank_mesh(geo, depth, mesh)
+    tm = geo.mesh(depth, mesh)
     m = build_face_liquid(tm.nodes, tm.elements, tm.depth, RHO, C, G)
     md = face_modes(m, n)
     assert all(k == "sloshing" for k in md.kind), md.kind
@@ -31,7 +31,7 @@ def rt_modes(geo, depth, mesh, n):
 
 def v_trough(length):
     """A 90-degree V trough 2 m wide, 1 m high (chamfers meeting at the centre line)."""
-    return TankGeometry(kind="prismatic", size=(length, 2.0, 1.0), chamfers=((1.0, 1.0), (0.0, 0.0)))
+    return Prismatic(size=(length, 2.0, 1.0), chamfers=((1.0, 1.0), (0.0, 0.0)))
 
 
 def test_v_trough_and_quarter_full_cylinder_in_3d():
@@ -45,7 +45,7 @@ def test_v_trough_and_quarter_full_cylinder_in_3d():
     assert np.all(np.abs(md.omega / w - 1) < tol), (md.omega, w, order)
     assert abs(md.omega[3] / w[3] - 1) < 0.0125
     w, order = ref.prism_sloshing_omegas(ref.circle(1.0), 0.5, 2.4, G, 8, h_target=0.04)
-    md, _ = rt_modes(TankGeometry(kind="cylinder", size=(2.4, 2.0, 2.0), axis="x"), 0.5, (12, 16, 6), 8)
+    md, _ = rt_modes(Cylinder(size=(2.4, 2.0, 2.0), axis="x"), 0.5, (12, 16, 6), 8)
     assert np.all(np.abs(md.omega / w - 1) < tol), (md.omega, w, order)
     assert abs(md.omega[2] / w[2] - 1) < 0.005
 
@@ -92,8 +92,8 @@ def test_low_hopper_is_not_locked(chamfer):
     that corner locked the liquid. With the layers following the bottom both elements are within
     0.5 % on the first mode, 1.5 % on the first three."""
     w = ref.section_sloshing_omegas(ref.prismatic(8.0, 1.5, *chamfer), 1.2, G, 3, h_target=0.05)
-    geo = TankGeometry(kind="prismatic", size=(0.2, 8.0, 1.5), chamfers=(chamfer, (0.0, 0.0)))
-    tm = tank_mesh(geo, 1.2, (2, 16, 4))
+    geo = Prismatic(size=(0.2, 8.0, 1.5), chamfers=(chamfer, (0.0, 0.0)))
+    tm = geo.mesh(1.2, (2, 16, 4))
     assert not tm.flat.any()
     for omega in (stabilized_sloshing(geo, 1.2, (2, 16, 4), 3), rt_modes(geo, 1.2, (2, 16, 4), 3)[0].omega):
         assert abs(omega[0] / w[0] - 1) < 0.005 and np.all(np.abs(omega / w - 1) < 0.015), (omega, w)

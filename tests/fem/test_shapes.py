@@ -11,7 +11,7 @@ import pytest
 import jaxslosh as js
 from jaxslosh.fem.liquid import build_liquid
 from jaxslosh.fem.modes import free_matrices, liquid_modes
-from jaxslosh.fem.shapes import Baffle, TankGeometry
+from jaxslosh.geometry import Baffle, Box, Cylinder, MeshFile, Prismatic
 
 sys.path.insert(0, os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 import sloshing_reference as ref  # noqa: E402
@@ -37,7 +37,7 @@ def distinct(omega, rtol=2e-3):
 
 def test_vertical_cylinder_first_three_modes_against_bessel():
     # R = 2 m filled to 2 m; the disk is mapped from the square (its mode pairs split slightly)
-    geo = TankGeometry(kind="cylinder", size=(4.0, 4.0, 3.0), axis="z")
+    geo = Cylinder(size=(4.0, 4.0, 3.0), axis="z")
     _, md = modes(geo, 2.0, (16, 16, 6), n=8)
     exact = ref.vertical_cylinder_omegas(2.0, 2.0, G, n=3)          # k R = 1.8412, 3.0542, 3.8317
     for w_exact in exact:
@@ -50,7 +50,7 @@ def test_vertical_cylinder_first_three_modes_against_bessel():
 
 def test_horizontal_cylinder_half_full_against_mciver():
     # R = 1.5 m, a 1 m slice along x (its longitudinal modes lie far above the first transverse one)
-    geo = TankGeometry(kind="cylinder", size=(1.0, 3.0, 3.0), axis="x")
+    geo = Cylinder(size=(1.0, 3.0, 3.0), axis="x")
     m, md = modes(geo, 1.5, (2, 12, 6), n=3)
     exact = ref.horizontal_cylinder_half_full_first(1.5, G)          # omega^2 R / g = 1.3557
     assert abs(md.omega[0] / exact - 1) < 0.015
@@ -64,14 +64,14 @@ def test_horizontal_cylinder_half_full_against_mciver():
 
 def test_v_section_against_kirchhoff():
     # chamfers meeting at the centre line at 45 degrees: a 90-degree V, 2 m deep at the apex
-    geo = TankGeometry(kind="prismatic", size=(1.0, 4.0, 3.0), chamfers=((2.0, 2.0), (0.0, 0.0)))
+    geo = Prismatic(size=(1.0, 4.0, 3.0), chamfers=((2.0, 2.0), (0.0, 0.0)))
     _, md = modes(geo, 2.0, (2, 8, 6), n=3)
     assert abs(md.omega[0] / ref.v_section_first(2.0, G) - 1) < 0.01
 
 
 def test_trapezoidal_section_against_the_section_solver():
     # bottom chamfers 1.5 m wide, 3 m high, filled to 2.5 m: straight inclined walls
-    geo = TankGeometry(kind="prismatic", size=(1.0, 6.0, 4.0), chamfers=((1.5, 3.0), (0.0, 0.0)))
+    geo = Prismatic(size=(1.0, 6.0, 4.0), chamfers=((1.5, 3.0), (0.0, 0.0)))
     _, md = modes(geo, 2.5, (2, 12, 8), n=3)
     w = ref.section_sloshing_omegas(ref.prismatic(6.0, 4.0, 1.5, 3.0), 2.5, G, n=2)
     assert abs(md.omega[0] / w[0] - 1) < 0.015
@@ -81,7 +81,7 @@ def test_trapezoidal_section_against_the_section_solver():
 def test_lng_section_against_the_section_solver(fill):
     """Hopper and top chamfers (membrane LNG tank section), filled above the hopper's kink and into
     the top chamfers: the first two transverse modes within 1.5 % of the section solver."""
-    geo = TankGeometry(kind="prismatic", size=(1.0, 6.0, 4.0), chamfers=((1.5, 1.0), (1.5, 1.0)))
+    geo = Prismatic(size=(1.0, 6.0, 4.0), chamfers=((1.5, 1.0), (1.5, 1.0)))
     _, md = modes(geo, fill, (2, 12, 8), n=2)
     w = ref.section_sloshing_omegas(ref.prismatic(6.0, 4.0, 1.5, 1.0, 1.5, 1.0), fill, G, n=2)
     np.testing.assert_allclose(md.omega, w, rtol=0.015)
@@ -97,7 +97,7 @@ def test_a_pinned_line_inside_the_liquid_locks_without_the_paired_rows():
     free[(np.abs(m.nodes[:, 0] - 2.0) < 1e-9) & (m.nodes[:, 2] < 1e-9), 0] = False
     pinned = liquid_modes(dataclasses.replace(m, free=free.reshape(-1)), 1).omega[0]
     assert pinned > 1.4 * liquid_modes(m, 1).omega[0]
-    geo = TankGeometry(kind="prismatic", size=(1.0, 6.0, 4.0), chamfers=((1.5, 1.0), (0.0, 0.0)))
+    geo = Prismatic(size=(1.0, 6.0, 4.0), chamfers=((1.5, 1.0), (0.0, 0.0)))
     _, md = modes(geo, 2.5, (2, 12, 8), n=1)
     w = ref.section_sloshing_omegas(ref.prismatic(6.0, 4.0, 1.5, 1.0), 2.5, G, n=1)[0]
     assert abs(md.omega[0] / w - 1) < 0.002
@@ -108,7 +108,7 @@ def test_heeled_trapezoidal_tank_keeps_its_surface_as_level_as_the_box():
     spread of heights along gravity (compression included) is no larger with inclined walls than in
     the box of the same mesh and depth, and under 3 % of the tilt's."""
     def spread(chamfers):
-        geo = TankGeometry(kind="prismatic", size=(4.0, 6.0, 4.0), chamfers=chamfers)
+        geo = Prismatic(size=(4.0, 6.0, 4.0), chamfers=chamfers)
         m = build_liquid(geo.size, 2.5, (4, 8, 6), 1000.0, 1500.0, G, geometry=geo)
         th = np.radians(5.0)
         g_b = G * np.array([0.0, np.sin(th), -np.cos(th)])
@@ -127,7 +127,7 @@ def test_heeled_trapezoidal_tank_keeps_its_surface_as_level_as_the_box():
 def test_standing_baffle_against_the_section_solver():
     """A plate 1 m high across a 5 m tank filled to 2 m, at mid-length: its first mode within 2 % of
     the section solver's (2.1253 rad/s; 2.2891 without the plate)."""
-    geo = TankGeometry(kind="box", size=(5.0, 1.0, 3.0), baffles=(Baffle("x", 2.5, "bottom", 1.0),))
+    geo = Box(size=(5.0, 1.0, 3.0), baffles=(Baffle("x", 2.5, "bottom", 1.0),))
     _, md = modes(geo, 2.0, (20, 2, 8), n=2)
     exact = ref.section_sloshing_omegas(ref.rectangle(5.0), 2.0, G, n=1, baffles=(ref.Baffle(2.5, 1.0),))[0]
     assert abs(md.omega[0] / exact - 1) < 0.02
@@ -204,7 +204,7 @@ def test_shape_scenes_check(name):
 def test_horizontal_cylinder_longitudinal_mode_against_the_box():
     """A check: the lowest longitudinal mode of a half-full horizontal cylinder (R = 1.5 m, 6 m long)
     against the box of the same free surface and volume (6 m long, its depth the mean, pi R / 4)."""
-    geo = TankGeometry(kind="cylinder", size=(6.0, 3.0, 3.0), axis="x")
+    geo = Cylinder(size=(6.0, 3.0, 3.0), axis="x")
     _, md = modes(geo, 1.5, (8, 12, 6), n=2)
     box = ref.rectangular_omegas(6.0, np.pi * 1.5 / 4, G, n=1)[0]
     assert abs(md.omega[0] / box - 1) < 0.01
@@ -216,7 +216,7 @@ def test_wall_integrals_on_faces_equal_the_box_planes():
     from jaxslosh.fem.damping import wall_integrals
     box = build_liquid((5.0, 4.0, 3.0), 2.0, (6, 4, 4), 1000.0, 1500.0, G)
     same = build_liquid((5.0, 4.0, 3.0), 2.0, (6, 4, 4), 1000.0, 1500.0, G,
-                        geometry=TankGeometry(kind="prismatic", size=(5.0, 4.0, 3.0)))
+                        geometry=Prismatic(size=(5.0, 4.0, 3.0)))
     assert same.wall_faces is not None and box.wall_faces is None
     X = liquid_modes(box, 3).shapes[:, np.flatnonzero(box.free)].T
     np.testing.assert_allclose(wall_integrals(same, X), wall_integrals(box, X), rtol=1e-10)
@@ -243,7 +243,7 @@ def test_box_written_by_gmsh_runs_as_the_box(tmp_path):
         gmsh.write(path)
     finally:
         gmsh.finalize()
-    geo = TankGeometry(kind="mesh", size=(5.0, 5.0, 4.0), file=path)
+    geo = MeshFile(size=(5.0, 5.0, 4.0), file=path)
     m = build_liquid(geo.size, 3.0, (5, 5, 5), 1000.0, 1500.0, G, geometry=geo)
     box = build_liquid((5.0, 5.0, 4.0), 3.0, (5, 5, 5), 1000.0, 1500.0, G)
     assert m.geometry is None                  # recognised as the box grid, built as the box

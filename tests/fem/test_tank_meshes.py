@@ -14,7 +14,7 @@ import pytest
 from jaxslosh.cli.main import main
 from jaxslosh.fem.mesh import box_mesh
 from jaxslosh.fem.meshfile import check_hexahedra, read_mesh_file
-from jaxslosh.fem.shapes import TankGeometry, tank_mesh
+from jaxslosh.geometry import MeshFile
 
 meshio = pytest.importorskip("meshio")
 
@@ -131,8 +131,8 @@ def test_left_handed_elements_are_reoriented_and_counted(tmp_path, capsys):
     assert m.reoriented == 3 and good.reoriented == 0
     np.testing.assert_array_equal(m.elements, good.elements)      # the same right-handed numbering as the good file
     geo = dict(size=(5.0, 5.0, 4.0))
-    a = tank_mesh(TankGeometry(kind="mesh", file=str(path), **geo), 3.0, (5, 5, 5))
-    b = tank_mesh(TankGeometry(kind="mesh", file=str(tmp_path / "good.msh"), **geo), 3.0, (5, 5, 5))
+    a = MeshFile(file=str(path), **geo).mesh(3.0, (5, 5, 5))
+    b = MeshFile(file=str(tmp_path / "good.msh"), **geo).mesh(3.0, (5, 5, 5))
     np.testing.assert_array_equal(a.elements, b.elements)
     code, out, _ = _check(tmp_path, capsys, path)
     assert code == 0

@@ -17,7 +17,7 @@ from scipy.sparse.linalg import spsolve
 
 import jaxslosh as js
 from jaxslosh.fem.liquid import build_liquid
-from jaxslosh.fem.shapes import TankGeometry
+from jaxslosh.geometry import Prismatic
 from jaxslosh.solve.factored import Banded, Dense, factored_inverse
 
 ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
@@ -26,7 +26,7 @@ CHAMFERS = 'shape = "prismatic"\nchamfers = [[1.5, 1.0], [1.0, 0.8]]'
 
 
 def _blocks():
-    geo = TankGeometry(kind="prismatic", size=(3.0, 6.0, 4.0), chamfers=((1.5, 1.0), (1.0, 0.8)))
+    geo = Prismatic(size=(3.0, 6.0, 4.0), chamfers=((1.5, 1.0), (1.0, 0.8)))
     m = build_liquid(geo.size, 3.5, (2, 6, 4), 1000.0, 1500.0, 9.81, geometry=geo, sparse=True)
     free = np.flatnonzero(np.asarray(m.free))
     M = sp.kron(m.mass, sp.eye(3), format="csr")
