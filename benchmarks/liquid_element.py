@@ -41,7 +41,7 @@ from sloshing_reference import (Baffle as RefBaffle, prismatic, rectangle, recti
 from jaxslosh.fem.liquid import build_liquid  # noqa: E402
 from jaxslosh.fem.liquid_rt import build_face_liquid, face_modes  # noqa: E402
 from jaxslosh.fem.modes import liquid_modes  # noqa: E402
-from jaxslosh.geometry import Baffle, Box, MeshFile, Prismatic# noqa: E402
+from jaxslosh.geometry import Baffle, Box, MeshFile, Prismatic  # noqa: E402
 
 G, RHO, C = 9.81, 1000.0, 1500.0
 T = 0.2          # the sections' thickness (x), two elements

@@ -89,7 +89,6 @@ CASES = ("box", "lng_30", "lng_90", "low_hopper", "v_trough", "vertical_cylinder
 def sloshing_omegas(geo, depth, mesh, element, n=N):
     """(omega of the n lowest sloshing modes, elements, kinds of the modes up to the n-th sloshing
     one) of the tank with the given element."""
-    from jaxslosh.geometry import Baffle, Box, Cylinder, MeshFile, Prismatic
     if element == "rt":
         from jaxslosh.fem.liquid_rt import build_face_liquid, face_modes
         tm = geo.mesh(depth, mesh or (1, 1, 1))

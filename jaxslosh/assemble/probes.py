@@ -112,7 +112,7 @@ def probe_weights(point, size, depth, nodes, elements, eps=1e-9):
 
 
 def mapped_weights(point, depth, nodes, elements, tol=1e-9):
-    """`probe_weights` in a tank of another shape (fem/shapes.py): the trilinear weights of the point in
+    """`probe_weights` in a tank of another shape (jaxslosh/geometry): the trilinear weights of the point in
     the hexahedron that holds it (its reference coordinates by Newton's method), a point at the fill
     depth on the free surface; outside the liquid (in the air, in a wall): zeros, the probe follows
     the tank. (Unlike the box, a point on a wall below the surface follows the liquid there.)"""

@@ -212,7 +212,7 @@ def _build_shaped(geometry, fill_depth, mesh, rho, c, g, element, sparse) -> Liq
     pairs = bending = None
     if element != "paper":
         keep, pairs = _rotation_pairs(*tm.grid) if tm.grid is not None else (np.ones((len(elements), 6), bool), [])
-        for e0, e1, k in tm.pairs:                 # the shape's extra wall constraints (fem/shapes.py)
+        for e0, e1, k in tm.pairs:                 # the shape's extra wall constraints (geometry/section.py)
             keep[[e0, e1], 2 * k:2 * k + 2] = False
         pairs = (keep, list(pairs) + list(tm.pairs))
         bending = surface_jump_pattern(nodes, faces)

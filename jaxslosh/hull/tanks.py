@@ -17,7 +17,6 @@ import numpy as np
 
 from ..fem.shapes import read_mesh
 from ..fem.slip import boundary
-from .box import box_surface
 
 #: sides of the polygon that stands for a cylinder's circle (area kept exact; the centroid of a
 #: level segment is within (pi / sides)^2 / 3 of the circle's, relative)

@@ -141,7 +141,7 @@ class Liquid(AbstractLiquid):
     # large meshes of other shapes: the constant block's solves by SciPy's sparse LU on the host
     # (`simulation.linear_solver = "sparse-host"`), not by the JAX factors of solve/factored.py
     host_lu: bool = eqx.field(static=True, default=False)
-    # tanks of other shapes (fem/shapes.py): each node's frame (N, 3, 3); the unknowns are the free
+    # tanks of other shapes (jaxslosh/geometry): each node's frame (N, 3, 3); the unknowns are the free
     # components in these frames (tangential on a wall). None: the vessel's axes everywhere
     frames: Optional[jax.Array] = None
     # (3N,) the position of each nodal dof in [d; 0] (nf: held at zero): `full` as a gather, where a

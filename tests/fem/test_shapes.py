@@ -88,7 +88,7 @@ def test_lng_section_against_the_section_solver(fill):
 
 
 def test_a_pinned_line_inside_the_liquid_locks_without_the_paired_rows():
-    """Why shapes.py pairs curl rows where a shape pins more than the box: pin the horizontal
+    """Why geometry/section.py pairs curl rows where a shape pins more than the box: pin the horizontal
     displacement of one line of bottom nodes in a plain box and the first mode (2.30 rad/s) jumps
     to near the next one; with the hopper's pairing, the hopper section is within 0.2 %."""
     import dataclasses
