@@ -146,8 +146,9 @@ def _chamfers(value, where):
 def default_element(shape: dict, size, fill_depth, mesh, reduced: bool) -> tuple[str, str]:
     """(element, why) for a tank whose [tanks.fluid] leaves `element` out: the face-normal "rt" where
     the stabilized element locks (a mesh file that is not a box grid, a tank with baffles: issue 30),
-    unless the tank runs at full order on a mesh too large for rt's dense full-order blocks; else
-    "stabilized" (boxes keep their fast diagonalization; shapes their tested element)."""
+    unless the tank runs at full order on a mesh too large for rt's dense full-order blocks; "rt" for
+    prismatic and cylindrical tanks on modes ([tanks.reduction]); else "stabilized" (boxes keep
+    their fast diagonalization; shapes at full order their quicker steps)."""
     if shape["shape"] == "mesh":
         geo = TankGeometry(kind="mesh", size=tuple(size), file=shape["file"])
         if box_equivalent(geo, float(fill_depth)) is not None:
@@ -155,6 +156,11 @@ def default_element(shape: dict, size, fill_depth, mesh, reduced: bool) -> tuple
         why = "a mesh tank"
     elif shape["baffles"]:
         why = "a tank with baffles"
+    elif shape["shape"] in ("prismatic", "cylinder") and reduced:
+        # on modes "rt" costs about what the stabilized element does and holds the higher modes at
+        # sloping and curved walls better; at full order its dense blocks step several times slower
+        # (docs/guide/liquid-element.md, "Prismatic and cylindrical tanks")
+        return "rt", f"a {shape['shape']} tank on modes: its higher modes are more accurate with \"rt\""
     else:
         return "stabilized", ""
     if not reduced and 3 * int(np.prod(mesh)) > RT_FULL_FACES:

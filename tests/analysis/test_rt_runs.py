@@ -209,8 +209,8 @@ height = 1.0
 def test_the_default_element_is_rt_where_the_stabilized_one_locks(tmp_path, capsys):
     """Left out, the element is "rt" for a tank with baffles (and a mesh file that is not a box grid,
     tests/fem/test_liquid_element_rt.py's U-tube), "stabilized" for a plain box, a box grid given as a
-    mesh file and a baffled tank too large for rt at full order; `check` says which and why; a given
-    element stays."""
+    mesh file and a baffled tank too large for rt at full order; "rt" for prismatic and cylindrical
+    tanks on modes, "stabilized" at full order; `check` says which and why; a given element stays."""
     from jaxslosh.cli.main import main
     small = js.load_scene(BAFFLED.format(mesh="[10, 4, 6]", extra=""))
     assert small.tanks[0].fluid.element == "rt" and "baffles" in small.tanks[0].fluid.element_default
@@ -222,6 +222,17 @@ def test_the_default_element_is_rt_where_the_stabilized_one_locks(tmp_path, caps
     assert given.tanks[0].fluid.element == "stabilized" and given.tanks[0].fluid.element_default == ""
     plain = js.load_scene(BAFFLED.format(mesh="[10, 4, 6]", extra="").split("[[tanks.baffles]]")[0])
     assert plain.tanks[0].fluid.element == "stabilized"
+    # prismatic and cylindrical tanks: "rt" on modes, "stabilized" at full order (quicker steps)
+    for shape in ('shape = "prismatic"\nchamfers = [[1.0, 1.0], [1.0, 1.0]]', 'shape = "cylinder"\naxis = "z"\n'
+                  'size = [5.0, 5.0, 4.0]'):
+        text = BAFFLED.format(mesh="[6, 6, 4]", extra="").split("[[tanks.baffles]]")[0].replace(
+            "size = [5.0, 5.0, 4.0]\n", "") + shape + "\n"
+        if "size" not in shape:
+            text += "size = [5.0, 5.0, 4.0]\n"
+        full = js.load_scene(text)
+        on_modes = js.load_scene(text + "[tanks.reduction]\nmodes = 6\n")
+        assert full.tanks[0].fluid.element == "stabilized" and on_modes.tanks[0].fluid.element == "rt", shape
+        assert "on modes" in on_modes.tanks[0].fluid.element_default
     path = tmp_path / "s.toml"
     path.write_text(BAFFLED.format(mesh="[10, 4, 6]", extra=""))
     assert main(["check", str(path)]) == 0
