@@ -8,6 +8,11 @@ frequencies' errors (%) per element.
     python benchmarks/liquid_element.py [--elements rt,stabilized] [--cases utube,hanging,...]
     python benchmarks/liquid_element.py --cases shapes
     python benchmarks/liquid_element.py --cases cost [--meshes 10x10x6,20x20x12]
+    python benchmarks/liquid_element.py --cases lng [--meshes 24x8,24x16,48x16,48x32]
+
+``lng``: the LNG section (1 m square, 0.2 m chamfers at the bottom and the top) filled 10, 30, 50,
+70, 85 and 95 % (one case each: lng10, ..., lng95), on meshes refined across (y) and up (z):
+2 x 24 x 8 to 2 x 96 x 64 (``--meshes`` takes the y x z counts).
 
 ``cost``: rt's times (s) on a 5x5x3 m box: build, face_modes (10), face_basis (20 modes and the
 static correction), face_invariants.
@@ -56,12 +61,21 @@ def reference(case):
         return section_sloshing_omegas(rectangle(1.0, 1.0), 0.5, G, 3, [RefBaffle(0.5, 0.3)], 0.005)
     if case == "hopper":
         return section_sloshing_omegas(prismatic(1.0, 1.0, 0.2, 0.2), 0.5, G, 3, [RefBaffle(0.5, 0.3)], 0.005)
-    if case == "lng30":
-        return section_sloshing_omegas(prismatic(1.0, 1.0, 0.2, 0.2, 0.2, 0.2), 0.3, G, 3, (), 0.005)
+    if case.startswith("lng"):
+        h = 0.005 if case == "lng30" else 0.01
+        return section_sloshing_omegas(prismatic(1.0, 1.0, 0.2, 0.2, 0.2, 0.2), _fill(case), G, 3, (), h)
     raise ValueError(case)
 
 
-def meshes(case):
+LNG_FILLS = ("lng10", "lng30", "lng50", "lng70", "lng85", "lng95")
+LNG_MESHES = "24x8,24x16,48x16,48x32,96x32,48x64,96x64"
+
+
+def _fill(case):
+    return int(case[3:]) / 100.0
+
+
+def meshes(case, lng_meshes=LNG_MESHES):
     """[(label, geometry, depth, counts)]: a shape the loader would build (a mesh file for
     the sections it cannot describe)."""
     out = []
@@ -75,10 +89,10 @@ def meshes(case):
     elif case == "hopper":
         for ny, nz in [(20, 10), (40, 20), (80, 40)]:
             out.append((f"2x{ny}x{nz}", _file(*hopper_baffle_hex(1.0, 0.2, 0.5, 0.5, 0.3, ny, nz, T)), 0.5, None))
-    elif case == "lng30":
+    elif case.startswith("lng"):
         geo = Prismatic(size=(T, 1.0, 1.0), chamfers=((0.2, 0.2), (0.2, 0.2)))
-        for ny, nz in [(24, 8), (24, 16), (48, 16), (48, 32)]:
-            out.append((f"2x{ny}x{nz}", geo, 0.3, (2, ny, nz)))
+        for ny, nz in [tuple(int(v) for v in m.split("x")) for m in lng_meshes.split(",")]:
+            out.append((f"2x{ny}x{nz}", geo, _fill(case), (2, ny, nz)))
     return out
 
 
@@ -143,18 +157,19 @@ def main():
     p = argparse.ArgumentParser()
     p.add_argument("--elements", default="rt,stabilized")
     p.add_argument("--cases", default="utube,hanging,standing,hopper,lng30")
-    p.add_argument("--meshes", default="10x10x6,20x20x12,30x30x16")
+    p.add_argument("--meshes", default=None, help="cost: 10x10x6,20x20x12,30x30x16; lng: " + LNG_MESHES)
     a = p.parse_args()
     if a.cases == "cost":
-        return cost(a.meshes.split(","))
+        return cost((a.meshes or "10x10x6,20x20x12,30x30x16").split(","))
     if a.cases == "shapes":
         return shapes(a.elements.split(","))
-    for case in a.cases.split(","):
+    cases = [c for name in a.cases.split(",") for c in (LNG_FILLS if name == "lng" else (name,))]
+    for case in cases:
         ref = reference(case)
         print(f"\n{case}: reference omega = {', '.join(f'{w:.5f}' for w in ref)} rad/s")
         print(f"| mesh | elements | " + " | ".join(f"{e} err % (modes 1, 2, 3)" for e in a.elements.split(",")) + " |")
         print("|---|---|" + "---|" * len(a.elements.split(",")))
-        for label, geo, depth, counts in meshes(case):
+        for label, geo, depth, counts in meshes(case, a.meshes or LNG_MESHES):
             cells = []
             for element in a.elements.split(","):
                 t0 = time.perf_counter()

@@ -1,12 +1,14 @@
 """The full-order liquid of face-normal ("rt") tanks (physics/face_liquid.py FluxLiquid) from their
 models (fem/liquid_rt.py): the Gauss points' fields and masses, the dense blocks on the free faces,
 the absolute-rotation penalty and the nodal recovery's weights, host-side NumPy (scaled by traced
-density, sound speed or gravity where given)."""
+density, sound speed or gravity where given). A plain box's fill depth may be traced too: its layers
+scale with the depth, so every block is a closed function of h / h0 (`traced_depth_blocks`)."""
 from __future__ import annotations
 
 import jax
 import jax.numpy as jnp
 import numpy as np
+import scipy.sparse as sp
 from jax.scipy.linalg import block_diag as jax_block_diag
 from scipy.linalg import block_diag
 
@@ -61,17 +63,71 @@ def absolute_rotation_penalty(model: FaceLiquid, origin, gauss=None):
     return kappa * 0.5 * (MP + MP.T), kappa * MPc, kappa * (Pc.T @ MPc)
 
 
-def face_full_liquid(tanks, models, scales=None):
+def _component_masses(model, w, phys):
+    """(M_xy, M_z) on the free faces (dense): the consistent mass's horizontal and vertical parts."""
+    f = np.flatnonzero(model.free)
+    rows = np.repeat(model.element_faces, 6, axis=1).reshape(-1)
+    cols = np.tile(model.element_faces, (1, 6)).reshape(-1)
+    out = []
+    for comp in (slice(0, 2), slice(2, 3)):
+        Me = model.density * np.einsum("epfi,epgi,ep->efg", phys[..., comp], phys[..., comp], w)
+        M = sp.coo_matrix((Me.reshape(-1), (rows, cols)), shape=(len(model.faces),) * 2).tocsr()
+        out.append(M[f][:, f].toarray())
+    return out
+
+
+def traced_depth_blocks(model: FaceLiquid, origin, s, gauss=None):
+    """A plain box's blocks at the fill depth s h0 (s traced), from its model at h0: the layers scale
+    with the depth (z = s z0), so J = diag(1, 1, s) J0, det J = s det J0 and the Piola field is
+    diag(1/s, 1/s, 1) u0. Returns (x (E, P, 3), w (E, P), phys (E, P, 6, 3), M, K_acoustic, K_c,
+    K_dt, K_tt) on the free faces, in the model's density: the mass M_xy / s + s M_z, the compression
+    over s, and the absolute-rotation penalty of `absolute_rotation_penalty` in JAX (G^+ from G
+    plus the pools' null vectors, which are topological) with kappa held at h0's (it sets how stiffly
+    the circulation is held, not the physics)."""
+    gauss = _gauss(model) if gauss is None else gauss
+    x0, w0, phys0 = gauss
+    mixed = _Mixed(model)
+    f = mixed.f
+    Mxy, Mz = _component_masses(model, w0, phys0)
+    S = jnp.stack([1.0 / s, 1.0 / s, jnp.ones_like(s)])
+    x = x0 * jnp.stack([jnp.ones_like(s), jnp.ones_like(s), s])
+    w, phys = w0 * s, phys0 * S
+    M = Mxy / s + Mz * s
+    Kac = jnp.asarray(model.acoustic[f][:, f].toarray()) / s
+    B = mixed.B.toarray()
+    N = mixed.P                                        # orthonormal null vectors of G (one per pool)
+    G0 = B @ mixed.Mlu.solve(B.T)
+    alpha = np.trace(G0) / G0.shape[0]
+    Y = jnp.linalg.solve(M, B.T)
+    Gp = jnp.linalg.inv(B @ Y + alpha * N @ N.T) - N @ N.T / alpha
+    r = x + jnp.asarray(origin, dtype=float)
+    rot = jnp.stack([jnp.cross(jnp.eye(3)[k], r) for k in range(3)])                # (3, E, P, 3)
+    local = model.density * jnp.einsum("ep,epfi,kepi->efk", w, phys, rot)            # (E, 6, 3)
+    F = jax.ops.segment_sum(local.reshape(-1, 3), model.element_faces.reshape(-1), len(model.faces))[f]
+    c = jnp.linalg.solve(M, F)
+    Pc = c - Y @ (Gp @ (B @ c))
+    MP = M - B.T @ Gp @ B
+    fm = face_modes(model, 20)
+    slosh = [v for v, k in zip(fm.omega, fm.kind) if k == "sloshing"] or list(fm.omega)
+    kappa = (ROTATION_PENALTY_RATIO * float(max(slosh))) ** 2
+    MPc = M @ Pc
+    return x, w, phys, M, Kac, kappa * 0.5 * (MP + MP.T), kappa * MPc, kappa * (Pc.T @ MPc)
+
+
+def face_full_liquid(tanks, models, scales=None, depths=None):
     """The FluxLiquid of every tank (all face-normal, full order), stacked, and the (K_dt, K_tt) of
     the absolute-rotation penalty (physics/liquid.py RotationPenalty). `scales`: per tank None or its
     (rho, rho c^2, rho g) over its model's (assemble/liquid.py face_scales), traced or not: the masses, the
-    compression and the free-surface blocks scale with them."""
+    compression and the free-surface blocks scale with them. `depths`: per tank None or a plain box's
+    fill depth over its model's (traced): `traced_depth_blocks`."""
     scales = scales or [None] * len(models)
-    xp = jnp if any(isinstance(v, jax.core.Tracer) for sc in scales if sc for v in sc) else np
+    depths = depths or [None] * len(models)
+    xp = jnp if any(isinstance(v, jax.core.Tracer) for sc in scales if sc for v in sc) \
+        or any(isinstance(d, jax.core.Tracer) for d in depths) else np
     rs, ms, phis, slots, Ks, Ms, row_scales, rec_n, rec_w, Kdts = ([] for _ in range(10))
     Ktt = 0.0
     off, node_off = 0, 0
-    for i, (t, model, fs) in enumerate(zip(tanks, models, scales)):
+    for i, (t, model, fs, ds) in enumerate(zip(tanks, models, scales, depths)):
         sr, sc, sg = fs if fs is not None else (1.0, 1.0, 1.0)
         f = np.flatnonzero(model.free)
         if f.size > MAX_FULL_FACES:
@@ -80,19 +136,23 @@ def face_full_liquid(tanks, models, scales=None):
                                                           "add a [tanks.reduction] table (modes = N), or set "
                                                           "element = \"stabilized\"")
         gauss = _gauss(model)
-        x, w, phys = gauss
-        E, P = x.shape[:2]
+        E, P = gauss[0].shape[:2]
+        if ds is None:
+            x, w, phys = gauss
+            Kc, Kdt, Ktt_t = absolute_rotation_penalty(model, t.origin, gauss)
+            Mf, Kac = model.mass[f][:, f].toarray(), model.acoustic[f][:, f].toarray()
+        else:
+            x, w, phys, Mf, Kac, Kc, Kdt, Ktt_t = traced_depth_blocks(model, t.origin, ds, gauss)
         slot = np.full(len(model.faces), -1)
         slot[f] = np.arange(f.size) + off
         rs.append((x + np.asarray(t.origin, dtype=float)).reshape(-1, 3))
         ms.append(sr * (model.density * w).reshape(-1))
         phis.append(phys.reshape(E * P, 6, 3))
         slots.append(np.repeat(slot[model.element_faces], P, axis=0).reshape(E * P, 6))
-        Kc, Kdt, Ktt_t = absolute_rotation_penalty(model, t.origin, gauss)
-        Ks.append(sc * model.acoustic[f][:, f].toarray() + sg * model.surface[f][:, f].toarray() + sr * Kc)
+        Ks.append(sc * Kac + sg * model.surface[f][:, f].toarray() + sr * Kc)
         Kdts.append(sr * Kdt)
         Ktt = Ktt + sr * Ktt_t
-        Ms.append(sr * model.mass[f][:, f].toarray())
+        Ms.append(sr * Mf)
         X = model.nodes[model.faces[f]]
         area = np.linalg.norm(0.5 * np.cross(X[:, 2] - X[:, 0], X[:, 3] - X[:, 1]), axis=1)
         row_scales.append(np.diag(model.mass[f][:, f].toarray()) * area)
@@ -104,8 +164,8 @@ def face_full_liquid(tanks, models, scales=None):
     slot = np.concatenate(slots)
     slot = np.where(slot < 0, off, slot)
     stack = jax_block_diag if xp is jnp else block_diag
-    liquid = FluxLiquid(r=jnp.asarray(np.concatenate(rs)), m=jnp.asarray(xp.concatenate(ms)),
-                      phi=jnp.asarray(np.concatenate(phis)), slots=jnp.asarray(slot.astype(np.int32)),
+    liquid = FluxLiquid(r=jnp.asarray(xp.concatenate(rs)), m=jnp.asarray(xp.concatenate(ms)),
+                      phi=jnp.asarray(xp.concatenate(phis)), slots=jnp.asarray(slot.astype(np.int32)),
                       K=jnp.asarray(stack(*Ks)), Mff=jnp.asarray(stack(*Ms)),
                       scale=jnp.asarray(np.concatenate(row_scales)), rec_nodes=jnp.asarray(np.concatenate(rec_n)),
                       rec_w=jnp.asarray(np.concatenate(rec_w)), n_nodes=node_off)

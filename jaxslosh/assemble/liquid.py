@@ -100,7 +100,10 @@ def build_liquid_block(scene: Scene, params: Optional[dict] = None, gravity=None
     if any(reduced):
         return _reduced_liquid(scene, rigid, models, reduced, g, scales)
     if any(isinstance(m, FaceLiquid) for m in models):
-        return _face_full(rigid, models, scales)
+        depths = [params.get(f"tanks.{t.name}.fill_depth", t.fill_depth) / t.fill_depth
+                  if isinstance(m, FaceLiquid) and isinstance(params.get(f"tanks.{t.name}.fill_depth"), jax.core.Tracer)
+                  else None for t, m in zip(rigid, models)]
+        return _face_full(rigid, models, scales, depths)
 
     blocks, rs, Ms_list, K_list, free_list, Kdt_list, Ktt = [], [], [], [], [], [], xp.zeros((3, 3))
     coupled = False
@@ -267,8 +270,14 @@ def _face_model(scene, t, i, params, g):
     if t.wall_spec is not None:
         raise SceneError(where, f"{t.fluid.element!r} does not take elastic walls yet; use \"stabilized\"")
     if isinstance(params.get(f"tanks.{t.name}.fill_depth"), jax.core.Tracer):
-        raise SceneError(where, f"{t.fluid.element!r} needs the scene's own fill depth (its mesh follows "
-                                "the fill): tanks.<name>.fill_depth cannot be traced with it")
+        if not t.geometry.plain_box:
+            raise SceneError(f"tanks[{i}].fill_depth", f"the fill depth of a {t.shape} tank (or one with baffles) "
+                                                      f"with element {t.fluid.element!r} cannot be traced: its mesh "
+                                                      "follows the fill (a plain box's can, at full order)")
+        if t.reduction is not None:
+            raise SceneError(f"tanks[{i}].fill_depth", f"a traced fill depth with element {t.fluid.element!r} runs "
+                                                      "at full order only (its modes are the scene's fill's): "
+                                                      "leave out [tanks.reduction]")
     tm = t.geometry.mesh(t.fill_depth, t.mesh)
     return build_face_liquid(tm.nodes, tm.elements, tm.depth, t.fluid.density, t.fluid.sound_speed,
                              scene.environment.gravity, geometry=None if t.geometry.plain_box else t.geometry)
@@ -285,7 +294,7 @@ def face_scales(scene, t, params, g):
     return rho / f.density, rho * c * c / (f.density * f.sound_speed ** 2), rho * g / (f.density * g0)
 
 
-def _face_full(tanks, models, scales):
+def _face_full(tanks, models, scales, depths=None):
     """Face-normal tanks at full order (assemble/face_liquid.py): every tank's, none of the nodal ones."""
     for i, m in enumerate(models):
         if not isinstance(m, FaceLiquid):
@@ -296,7 +305,7 @@ def _face_full(tanks, models, scales):
     for t, m in zip(tanks, models):
         blocks.append(_host_block(t, m, offset))
         offset += m.n_nodes
-    liquid, penalty = face_full_liquid(tanks, models, scales)
+    liquid, penalty = face_full_liquid(tanks, models, scales, depths)
     return LiquidBlock(liquid, tuple(blocks), penalty)
 
 

@@ -68,7 +68,7 @@ class FaceLiquid:
     sound_speed: float
     gravity: float
     depth: float
-    geometry: object = None           # fem/shapes.TankGeometry it was meshed from (probes, outputs)
+    geometry: object = None           # the geometry shape (jaxslosh.geometry) it was meshed from (probes, outputs)
 
     traced = False                    # built from concrete values only
     frames = None                     # no node frames: the walls hold face fluxes

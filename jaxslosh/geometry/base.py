@@ -57,6 +57,8 @@ class AbstractShape(abc.ABC):
     #: when the tank leaves `flow` out
     modal: ClassVar[bool] = False
     modal_flow: ClassVar[str] = "2d"
+    # the loader's default element on modes is "rt" (its higher modes at sloping and curved walls)
+    rt_on_modes: ClassVar[bool] = False
 
     size: tuple
     baffles: tuple

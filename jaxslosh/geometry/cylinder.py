@@ -28,6 +28,7 @@ SLIVER_ASPECT = 8.0
 @dataclass(frozen=True)
 class Cylinder(AbstractShape):
     name: ClassVar[str] = "cylinder"
+    rt_on_modes: ClassVar[bool] = True
     keys: ClassVar[tuple] = ("axis",)
     modal: ClassVar[bool] = True
     modal_flow: ClassVar[str] = "3d"

@@ -19,6 +19,7 @@ class Prismatic(AbstractShape):
     """`chamfers` = ((width, height) of the bottom cuts, (width, height) of the top cuts), m, both
     sides; baffles across x."""
     name: ClassVar[str] = "prismatic"
+    rt_on_modes: ClassVar[bool] = True
     keys: ClassVar[tuple] = ("chamfers",)
     baffle_normals: ClassVar[tuple] = ("x",)
 

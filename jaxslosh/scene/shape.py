@@ -56,10 +56,16 @@ def read_multimodal_shape(table, where: str) -> None:
 def default_element(geo: AbstractShape, fill_depth, mesh, reduced: bool) -> tuple[str, str]:
     """(element, why) for a tank whose [tanks.fluid] leaves `element` out: the face-normal "rt" where
     the stabilized element locks (a mesh file that is not a box grid, a tank with baffles: issue 30),
-    unless the tank runs at full order on a mesh too large for rt's dense full-order blocks; else
-    "stabilized" (boxes keep their fast diagonalization; shapes their tested element)."""
+    unless the tank runs at full order on a mesh too large for rt's dense full-order blocks; "rt" for
+    the shapes that prefer it on modes ([tanks.reduction]: prismatic and cylindrical tanks); else
+    "stabilized" (boxes keep their fast diagonalization; shapes at full order their quicker steps)."""
     locks, why = geo.locks(float(fill_depth))
     if not locks:
+        if geo.rt_on_modes and reduced:
+            # on modes "rt" costs about what the stabilized element does and holds the higher modes at
+            # sloping and curved walls better; at full order its dense blocks step several times slower
+            # (docs/guide/liquid-element.md, "Prismatic and cylindrical tanks")
+            return "rt", f"a {geo.name} tank on modes: its higher modes are more accurate with \"rt\""
         return "stabilized", why
     if not reduced and 3 * int(np.prod(mesh)) > RT_FULL_FACES:
         return "stabilized", (f"{why} too large for the full-order face-normal element (about "

@@ -209,8 +209,8 @@ height = 1.0
 def test_the_default_element_is_rt_where_the_stabilized_one_locks(tmp_path, capsys):
     """Left out, the element is "rt" for a tank with baffles (and a mesh file that is not a box grid,
     tests/fem/test_liquid_element_rt.py's U-tube), "stabilized" for a plain box, a box grid given as a
-    mesh file and a baffled tank too large for rt at full order; `check` says which and why; a given
-    element stays."""
+    mesh file and a baffled tank too large for rt at full order; "rt" for prismatic and cylindrical
+    tanks on modes, "stabilized" at full order; `check` says which and why; a given element stays."""
     from jaxslosh.cli.main import main
     small = js.load_scene(BAFFLED.format(mesh="[10, 4, 6]", extra=""))
     assert small.tanks[0].fluid.element == "rt" and "baffles" in small.tanks[0].fluid.element_default
@@ -222,6 +222,17 @@ def test_the_default_element_is_rt_where_the_stabilized_one_locks(tmp_path, caps
     assert given.tanks[0].fluid.element == "stabilized" and given.tanks[0].fluid.element_default == ""
     plain = js.load_scene(BAFFLED.format(mesh="[10, 4, 6]", extra="").split("[[tanks.baffles]]")[0])
     assert plain.tanks[0].fluid.element == "stabilized"
+    # prismatic and cylindrical tanks: "rt" on modes, "stabilized" at full order (quicker steps)
+    for shape in ('shape = "prismatic"\nchamfers = [[1.0, 1.0], [1.0, 1.0]]', 'shape = "cylinder"\naxis = "z"\n'
+                  'size = [5.0, 5.0, 4.0]'):
+        text = BAFFLED.format(mesh="[6, 6, 4]", extra="").split("[[tanks.baffles]]")[0].replace(
+            "size = [5.0, 5.0, 4.0]\n", "") + shape + "\n"
+        if "size" not in shape:
+            text += "size = [5.0, 5.0, 4.0]\n"
+        full = js.load_scene(text)
+        on_modes = js.load_scene(text + "[tanks.reduction]\nmodes = 6\n")
+        assert full.tanks[0].fluid.element == "stabilized" and on_modes.tanks[0].fluid.element == "rt", shape
+        assert "on modes" in on_modes.tanks[0].fluid.element_default
     path = tmp_path / "s.toml"
     path.write_text(BAFFLED.format(mesh="[10, 4, 6]", extra=""))
     assert main(["check", str(path)]) == 0
@@ -229,6 +240,21 @@ def test_the_default_element_is_rt_where_the_stabilized_one_locks(tmp_path, caps
     assert "element 'rt' at full order (by default: a tank with baffles" in out
     r = js.simulate(small)
     assert r.status == "ok"
+
+
+def test_rt_with_elastic_walls_is_refused_by_check(tmp_path, capsys):
+    """"rt" does not take elastic walls yet: `check` (not only `run`) exits 2 with one line naming
+    tanks[0].fluid.element."""
+    from jaxslosh.cli.main import main
+    walls = '[tanks.walls]\nthickness = 0.05\n[tanks.walls.material]\nyoung = 2.1e11\npoisson = 0.3\ndensity = 7850.0\n'
+    text = BAFFLED.format(mesh="[5, 5, 5]", extra=walls + '[tanks.fluid]\nelement = "rt"').split("[[tanks.baffles]]")[0]
+    path = tmp_path / "s.toml"
+    path.write_text(text)
+    assert main(["check", str(path)]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and "tanks[0].fluid.element" in err[0] and "elastic walls" in err[0], err
+    path.write_text(text.replace('element = "rt"', 'element = "stabilized"'))
+    assert main(["check", str(path)]) == 0
 
 
 # --- rao and sweep ----------------------------------------------------------------------------
@@ -277,7 +303,7 @@ def test_a_sweep_over_density_and_sound_speed_of_an_rt_tank_equals_the_single_ru
     compression and free-surface blocks scale with the density, rho c^2 and rho g. At full order a
     batch over the density and the sound speed equals the single runs with those values (1e-6 of
     the peak); on modes (whose shapes do not depend on the density) a batch over the density does.
-    The fill depth (the mesh follows it) is refused naming the key."""
+    The fill depth on modes (their shapes are the scene's fill's) is refused naming the key."""
     base = HELD.format(duration=1.0, dt=0.01, scheme="newmark", alpha=0.0).replace(
         'dof = "surge"\namplitude = 0.0', 'dof = "roll"\namplitude = 0.02').replace("frequency = 1.0", "frequency = 5.0")
     base += '[[probes]]\nname = "c"\ntank = "tank"\npoint = [0.0, 0.0, 0.5]\n'
@@ -296,5 +322,6 @@ def test_a_sweep_over_density_and_sound_speed_of_an_rt_tank_equals_the_single_ru
         assert np.abs(zb - za).max() < 1e-6 * np.abs(za).max(), (extra, np.abs(zb - za).max(), np.abs(za).max())
         ra, rb = np.asarray(one.energy.kinetic), np.asarray(batch.energy.kinetic)[1]
         assert np.abs(ra - rb).max() < 1e-6 * np.abs(ra).max()
-    with pytest.raises(js.SceneError, match="fill_depth"):
-        js.simulate_batch(js.load_scene(base + FULL), {"tanks.tank.fill_depth": np.array([0.5, 0.45])})
+    with pytest.raises(js.SceneError, match=r"tanks\[0\].fill_depth"):      # on modes (full order: test_gradients_rt)
+        js.simulate_batch(js.load_scene(base + FULL + "[tanks.reduction]\nmodes = 6\n"),
+                          {"tanks.tank.fill_depth": np.array([0.5, 0.45])})

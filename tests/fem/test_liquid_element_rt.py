@@ -154,6 +154,39 @@ def test_lng_section_30_percent_on_refinements_in_either_direction():
         assert np.all(np.abs(rel(w, w_ref)) < 0.01), (mesh, w, w_ref)
 
 
+LNG_GEO = Prismatic(size=(T, 1.0, 1.0), chamfers=((0.2, 0.2), (0.2, 0.2)))
+
+
+def _lng_errors(fill, meshes):
+    w_ref = ref.section_sloshing_omegas(ref.prismatic(1.0, 1.0, 0.2, 0.2, 0.2, 0.2), fill, G, 3, h_target=0.02)
+    out = []
+    for mesh in meshes:
+        tm = LNG_GEO.mesh(fill, mesh)
+        out.append(rel(omegas(build_face_liquid(tm.nodes, tm.elements, fill, RHO, C, G)), w_ref))
+    return np.array(out)
+
+
+@pytest.mark.parametrize("fill", [0.1, 0.5, 0.7, 0.85, 0.95])
+def test_lng_sections_10_to_95_percent_within_1_percent(fill):
+    """The LNG section (1 m square, 0.2 m chamfers at the bottom and the top) filled 10 to 95 %:
+    the first three modes within 1 % of the reference on 2x48x32, and, up to 70 %, on the coarser
+    2x24x16 and 2x48x16 (a refinement across). Filled into the top chamfer (85, 95 %), the coarser
+    meshes put one or two thin rows of trapezoids under the surface, and the third mode is 1 to 2 %
+    low there (docs/design/liquid-element.md's table; the stabilized element misses too at 95 %)."""
+    meshes = [(2, 48, 32)] + ([(2, 24, 16), (2, 48, 16)] if fill <= 0.7 else [])
+    e = _lng_errors(fill, meshes)
+    assert np.all(np.abs(e) < 0.01), (meshes, e)
+
+
+@pytest.mark.slow
+def test_lng_sections_refined_from_2x48x32_in_either_direction():
+    """From 2x48x32, refined across, up and both (2x96x32, 2x48x64, 2x96x64): the first three modes
+    within 1 % at every fill, 10 to 95 %."""
+    for fill in (0.1, 0.3, 0.5, 0.7, 0.85, 0.95):
+        e = _lng_errors(fill, [(2, 48, 32), (2, 96, 32), (2, 48, 64), (2, 96, 64)])
+        assert np.all(np.abs(e) < 0.01), (fill, e)
+
+
 # --- the command ------------------------------------------------------------------------------
 
 

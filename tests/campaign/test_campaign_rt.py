@@ -1,0 +1,91 @@
+"""A campaign with a face-normal ("rt") tank: the batched loop on a local Dask cluster gives each
+case the statistics of the same case run alone (`jaxslosh run` of its scene file), as the box
+alone does in test_campaign.py. A small tank on its modal basis, coarse dt, short records."""
+import os
+from pathlib import Path
+
+import numpy as np
+from dask.distributed import Client, LocalCluster
+
+import jaxslosh as js
+from jaxslosh.campaign.cases import case_scene
+from jaxslosh.cli import main
+
+ROOT = Path(__file__).resolve().parents[2]
+BEAM = 1.5707963267948966
+CACHE = Path(os.environ.get("TMPDIR", "/tmp")) / f"jaxslosh-test-campaign-cache-{os.getuid()}"
+
+SCENE = """
+title = "box with an rt tank in irregular seas"
+[environment]
+gravity = 9.81
+water_density = 1025.0
+[simulation]
+duration = 30.0
+dt = 0.1
+scheme = "newmark"
+save_every = 2
+[vessel]
+mass = 4.1e5
+inertia = [6.0e6, 1.6e7, 2.0e7]
+[vessel.hull]
+length = 20.0
+beam = 10.0
+draft = 2.0
+kg = 2.5
+[vessel.hydrodynamics]
+viscous_damping = [0.0, 0.0, 1.0e5, 1.5e6, 5.0e6, 0.0]
+[waves]
+type = "pierson-moskowitz"
+hs = 0.3
+tp = 7.0
+heading = 1.5707963267948966
+seed = 0
+components = 20
+frequency_range = [0.3, 2.5]
+ramp = 10.0
+[[tanks]]
+name = "tank"
+origin = [0.0, 0.0, 1.0]
+size = [2.0, 6.0, 2.0]
+fill_depth = 1.0
+mesh = [2, 8, 4]
+[tanks.fluid]
+element = "rt"
+[tanks.reduction]
+modes = 4
+[tanks.damping]
+ratio = 0.05
+"""
+
+SCATTER = "hs,tp,occurrences\n0.6,7.0,100\n"
+
+
+def test_a_campaign_with_an_rt_tank_gives_the_statistics_of_single_runs(tmp_path, monkeypatch):
+    monkeypatch.setenv("PYTHONPATH", os.pathsep.join([str(ROOT), os.environ.get("PYTHONPATH", "")]))
+    monkeypatch.setenv("JAXSLOSH_PROGRESS", "0")
+    p = tmp_path / "rt.toml"
+    p.write_text(SCENE)
+    s = tmp_path / "scatter.csv"
+    s.write_text(SCATTER)
+    template = js.load_scene(str(p))
+    with LocalCluster(n_workers=1, threads_per_worker=1, processes=True, dashboard_address=None) as cl, \
+            Client(cl) as client:
+        r = js.campaign(template, str(s), headings=[BEAM], seeds=2, cache_dir=str(CACHE), batch=2, client=client,
+                        output=str(tmp_path / "c.h5"))
+    assert r.status == ["ok"] * 2
+    stds = r.statistics["roll"]["std"]
+    assert abs(stds[0] / stds[1] - 1) > 1e-3                      # two seeds, two seas, one batch
+    for k in (1,):
+        case = case_scene(template, {"hs": 0.6, "tp": 7.0, "heading": BEAM, "seed": k})
+        cp = tmp_path / f"case{k}.toml"
+        cp.write_text(case.text)
+        assert main(["run", str(cp), "-o", str(tmp_path / f"case{k}.h5"), "--no-progress"]) == 0
+        res = js.load_result(str(tmp_path / f"case{k}.h5"))
+        t = np.asarray(res.time)
+        roll = np.asarray(res.vessel.roll_pitch_yaw)[:, 0][t >= 10.0 - 1e-9]
+        assert roll.std() > 1e-4                                   # the sea rolls the vessel
+        # batches refresh their Newton preconditioner every few steps, single runs when convergence
+        # slows: both converge to Newton's tolerance
+        np.testing.assert_allclose(roll.std(), r.statistics["roll"]["std"][k], rtol=1e-7)
+        np.testing.assert_allclose(np.abs(roll - roll.mean()).max(), r.statistics["roll"]["max"][k], rtol=1e-6)
