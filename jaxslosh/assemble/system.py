@@ -17,6 +17,7 @@ import numpy as np
 from ..physics.damping import ModalDamping
 from ..physics.kinematics import quat_from_rpy, rotation_matrix
 from ..physics.liquid import NoLiquid, RotationPenalty, SpinStiffening
+from ..physics.multimodal import MultimodalLiquid
 from ..physics.structures import Flex
 from ..physics.system import System
 from ..physics.terms import Config
@@ -102,7 +103,7 @@ def outline(scene: Scene) -> System:
     """The scene's model as `build` assembles it, its terms and their descriptions (`describe`), but
     none of the arrays that cost time or memory: no mesh assembled, no basis, modes or radiation fit
     computed, nothing compiled, no initial state (the arrays are None). What `jaxslosh check` lists
-    (assemble/check.py); tests/scene/test_check_effects.py holds it to the built model's terms."""
+    (assemble/check.py); tests/cli/test_check_effects.py holds it to the built model's terms."""
     return _model(scene, {}, outline=True).system
 
 
@@ -126,7 +127,9 @@ def _model(scene: Scene, params: dict, outline: bool = False) -> _Model:
             displaced_volume=f("vessel.hydrostatics.displaced_volume", h.displaced_volume),
             gm_t=f("vessel.hydrostatics.gm_t", h.gm_t), gm_l=f("vessel.hydrostatics.gm_l", h.gm_l)))
     multimodal = eff.liquid and multimodal_scene(scene)
-    if multimodal:
+    if multimodal and outline:
+        block = LiquidBlock(MultimodalLiquid(tanks=(), sizes=(), samples=None, gravity=g))
+    elif multimodal:
         block = LiquidBlock(build_multimodal(scene, params, g))
     elif outline:
         block = outline_liquid_block(scene, include_liquid=eff.liquid)
@@ -180,11 +183,11 @@ def _model(scene: Scene, params: dict, outline: bool = False) -> _Model:
     if block.Kg is not None:
         terms.append(SpinStiffening(None if outline else block.Kg, about=stiffening_about(scene, "vessel")))
     damping = None
-    if multimodal:
-        damping = multimodal_damping(scene, params, liquid)
-    elif eff.liquid and outline:
+    if outline:
         damping = ModalDamping(B=None, c=None) if any(t.damping is not None for t in scene.tanks) and has_liquid \
-            else None
+            and eff.liquid else None
+    elif multimodal:
+        damping = multimodal_damping(scene, params, liquid)
     elif eff.liquid:
         damping, _ = build_damping(scene, params, block)
     if damping is not None:
