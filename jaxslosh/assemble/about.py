@@ -42,7 +42,9 @@ def tank_line(t) -> tuple[str, str]:
     if t.model == "multimodal":
         flow = "three-dimensional" if t.shape == "cylinder" or t.flow == "3d" else "two-dimensional along x"
         return (f"liquid in tank {t.name!r}", f"{shape_words(t)}multimodal ({flow}), {t.modes} free-surface "
-                                              f"modes, {t.liquid_mass:.6g} kg")
+                                              f"modes, {t.liquid_mass:.6g} kg; its inertial loads (Coriolis and "
+                                              "centrifugal among them) are the modal Lagrangian's, not switched by "
+                                              "[effects]")
     return (f"liquid in tank {t.name!r}", f"{shape_words(t)}{mesh_words(t, short=True)}, {t.liquid_mass:.6g} kg, "
                                           f"element {t.fluid.element!r}{element_why(t)}, {t.walls} walls (slip)")
 
