@@ -68,7 +68,8 @@ def load_variant(filename, off):
 def effects_column(scene):
     """The effects `check` lists for the scene's model (its terms' own lines), but the hull's inertia
     and the liquid element's rotation penalty, which every row with liquid has."""
-    names = [name for name, _, _ in model_effects(outline(scene)) if name not in ("rigid-body inertia", "rotation penalty")]
+    names = [name for name, _, _ in model_effects(outline(scene))
+             if name not in ("rigid-body inertia", "rotation penalty")]
     return ", ".join(names) or "-"
 
 

@@ -18,7 +18,6 @@ from jaxslosh.assemble.system import build, outline
 from jaxslosh.cli import main
 from jaxslosh.physics.about import About
 from jaxslosh.physics.liquid import AbstractLiquid, NoLiquid
-from jaxslosh.physics.seakeeping import LinearDamping
 from jaxslosh.physics.vessel import FreeMotion
 
 DATA = os.path.join(os.path.dirname(os.path.dirname(__file__)), "data")
