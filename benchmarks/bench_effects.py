@@ -25,7 +25,9 @@ import jax
 jax.config.update("jax_enable_x64", True)
 
 import jaxslosh as js  # noqa: E402
-from jaxslosh.assemble.effects import count_unknowns, scene_effects  # noqa: E402
+from jaxslosh.assemble.check import model_effects  # noqa: E402
+from jaxslosh.assemble.effects import count_unknowns  # noqa: E402
+from jaxslosh.assemble.system import outline  # noqa: E402
 from jaxslosh.run.loop import core as _core, advance, start  # noqa: E402
 from jaxslosh.run.simulate import prepare
 from jaxslosh.scene.keys import with_overrides
@@ -64,7 +66,10 @@ def load_variant(filename, off):
 
 
 def effects_column(scene):
-    names = [name for name, _ in scene_effects(scene) if name != "rigid-body inertia"]
+    """The effects `check` lists for the scene's model (its terms' own lines), but the hull's inertia
+    and the liquid element's rotation penalty, which every row with liquid has."""
+    names = [name for name, _, _ in model_effects(outline(scene))
+             if name not in ("rigid-body inertia", "rotation penalty")]
     return ", ".join(names) or "-"
 
 

@@ -12,6 +12,7 @@ from ..hull.clip import MIDPOINT_RULE, area_vectors, clip_below
 from ..hull.surface import hull_triangles, water_height
 from ..hydro.spectra import components, wavenumber
 from ..physics.hull import HullPressure, IncidentWaves
+from .about import hull_about
 
 #: box panels per shortest wave length (the wave pressure's quadrature and tangent planes)
 PANELS_PER_WAVELENGTH = 12
@@ -84,7 +85,7 @@ def build_hull_pressure(scene, params: dict, g) -> HullPressure:
         cog = jnp.asarray(params["vessel.hull.cog"], dtype=float)
         z_water = -cog[2]
         shift = jnp.asarray(hull.cog, dtype=float) - cog
-    return HullPressure(jnp.asarray(tris), rho, g, z_water, inc, shift)
+    return HullPressure(jnp.asarray(tris), rho, g, z_water, inc, shift, about=hull_about(scene, waves is not None))
 
 
 def froude_krylov_surface(tris, z_water, omega, headings, rho=1025.0, g=9.81, depth=None):

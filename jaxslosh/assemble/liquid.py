@@ -350,3 +350,17 @@ def wants_sparse(scene) -> bool:
     if any(t.wall_spec is not None for t in scene.tanks):
         return False             # elastic walls have dense blocks of their own
     return liquid_unknowns(scene) > SPARSE_AUTO
+
+
+def outline_liquid_block(scene: Scene, include_liquid: bool = True) -> LiquidBlock:
+    """`build_liquid_block`'s terms without their arrays (None), for `jaxslosh check` (assemble/
+    check.py), whatever the mesh's size: no mesh is assembled. The liquid (its class the nodal one
+    whatever the element: only its description is read), the rotation penalty that tank liquid of
+    every element form brings, and the vessel-frame structures' spin stiffening."""
+    tanks = list(scene.tanks) if include_liquid else []
+    in_vessel_frame = [s for s in scene.structures if s.frame == "vessel"]
+    if not tanks and not in_vessel_frame:
+        return LiquidBlock(NoLiquid())
+    stiffened = any(s.stiffening == "centrifugal" for s in in_vessel_frame)
+    return LiquidBlock(Liquid(r=None, Ms=None, K=None, free=None, n_nodes=0), penalty=(None, None) if tanks else None,
+                       Kg=np.zeros((6, 0, 0)) if stiffened else None)

@@ -9,6 +9,7 @@ import numpy as np
 
 from ..hydro.radiation import RadiationFit
 from ..hydro.source import excitation_rao, excitation_source, radiation_fit
+from .about import added_mass_about, memory_about, viscous_about, waves_about
 from .hull import froude_krylov_hull, hull_pressure
 from ..hydro.spectra import components
 from ..hydro.tables import matrix6
@@ -58,15 +59,34 @@ def build_seakeeping(scene, params: dict) -> tuple:
         X = linear_excitation_rao(scene, components(waves))
         if X is not None:
             key = "waves.amplitude" if waves.type == "regular" else "waves.hs"
-            terms.append(WaveExcitation(make_excitation(waves, X, params.get(key, waves.height))))
+            terms.append(WaveExcitation(make_excitation(waves, X, params.get(key, waves.height)),
+                                        about=waves_about(scene, hull_pressure(scene))))
     hd = ves.hydrodynamics
     if hd is not None and eff.radiation:
         fit = radiation_fit(scene)
         if fit is not None:
-            terms.append(AddedMass(jnp.asarray(fit.added_mass_infinite)))
+            terms.append(AddedMass(jnp.asarray(fit.added_mass_infinite), about=added_mass_about(scene)))
             memory = memory_module(fit)
             if memory is not None:
-                terms.append(RadiationMemory())
+                terms.append(RadiationMemory(about=memory_about(scene)))
         if hd.viscous_damping is not None:
-            terms.append(LinearDamping(jnp.asarray(matrix6(hd.viscous_damping))))
+            terms.append(LinearDamping(jnp.asarray(matrix6(hd.viscous_damping)), about=viscous_about()))
     return tuple(terms), memory
+
+
+def outline_seakeeping(scene) -> tuple:
+    """`build_seakeeping`'s terms without their arrays (None), for `jaxslosh check`
+    (assemble/check.py): no excitation tables interpolated, no radiation fitted. The memory term is
+    there where the tables have radiation, as the build's fit of them finds poles (tables of zero
+    damping would give none)."""
+    eff, ves, waves = scene.effects, scene.vessel, scene.waves
+    terms = []
+    if waves is not None and eff.waves and not (hull_pressure(scene) and excitation_source(scene) == "froude-krylov"):
+        terms.append(WaveExcitation(None, about=waves_about(scene, hull_pressure(scene))))
+    hd = ves.hydrodynamics
+    if hd is not None and eff.radiation:
+        if hd.capytaine or hd.added_mass is not None:          # hydro/source.radiation_fit has a fit
+            terms += [AddedMass(None, about=added_mass_about(scene)), RadiationMemory(about=memory_about(scene))]
+        if hd.viscous_damping is not None:
+            terms.append(LinearDamping(None, about=viscous_about()))
+    return tuple(terms)

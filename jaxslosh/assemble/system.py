@@ -14,8 +14,11 @@ import jax
 import jax.numpy as jnp
 import numpy as np
 
+from ..physics.damping import ModalDamping
 from ..physics.kinematics import quat_from_rpy, rotation_matrix
-from ..physics.liquid import RotationPenalty, SpinStiffening
+from ..physics.liquid import NoLiquid, RotationPenalty, SpinStiffening
+from ..physics.multimodal import MultimodalLiquid
+from ..physics.structures import Flex
 from ..physics.system import System
 from ..physics.terms import Config
 from ..physics.vessel import (FreeMotion, HarmonicMotion, Hydrostatics, PaperHydrostatics, RecordedMotion, RigidBody,
@@ -24,12 +27,13 @@ from ..staging import staged
 from ..scene.keys import resolve_params
 from ..scene.types import DOFS, Scene, SceneError
 from ..solve.sparse import hydrostatic_start
+from .about import damping_about, flex_about, liquid_about, record_about, stiffening_about, weight_about
 from .damping import build_damping
 from .hull import build_hull_pressure
-from .liquid import LiquidBlock, build_liquid_block, rigid_part
+from .liquid import LiquidBlock, build_liquid_block, outline_liquid_block, rigid_part
 from .multimodal import build_multimodal, multimodal_damping, multimodal_scene, probe_modal, surfaces
 from .probes import Probes, build_probes
-from .seakeeping import build_seakeeping
+from .seakeeping import build_seakeeping, outline_seakeeping
 from .structures import build_flex, flex_start
 
 
@@ -54,8 +58,57 @@ def _inertia(value):
     return jnp.diag(a) if a.ndim == 1 else a
 
 
+class _Model(NamedTuple):
+    """The static model of a scene and what the build's initial state and probes need of it."""
+    system: System
+    block: LiquidBlock
+    blocks: tuple             # StructureBlock per structure in its own frame
+    multimodal: bool
+
+
 def build(scene: Scene, params: Optional[dict] = None) -> Built:
     params = resolve_params(scene, params)
+    P = params.get
+    ves = scene.vessel
+    system, block, blocks, multimodal = _model(scene, params)
+    liquid, motion, flex, q0 = system.liquid, system.motion, system.flex, system.q_ref
+    ini = ves.initial
+    nf = system.nf
+    d_init = jnp.zeros(nf)
+    if nf:
+        d_init = _hydrostatic_start(system, q0)
+    c0 = Config(jnp.asarray(P("vessel.initial.position", ini.position), dtype=float), q0, d_init)
+    v0 = jnp.concatenate([jnp.asarray(P("vessel.initial.velocity", ini.velocity), dtype=float),
+                          jnp.asarray(P("vessel.initial.angular_velocity", ini.angular_velocity), dtype=float),
+                          jnp.zeros(nf)])
+    if motion.prescribed:   # the prescribed motion sets the rigid state at t = 0
+        c0 = Config(motion.coordinates(jnp.zeros(()))[:3], q0, c0.d)
+        v0 = v0.at[:6].set(motion.rates(jnp.zeros(())))
+    alg0 = None
+    if flex is not None:
+        c0, v0, alg0 = _flex_start(system, c0, v0)
+    probes = build_probes(scene, block.tanks, liquid, blocks, block.vstructs)
+    probes = probes._replace(modal=liquid.probe_modal(probes.weights))    # a modal liquid: probes from eta
+    if multimodal:
+        probes = probes._replace(modal=probe_modal(scene, liquid))
+        tops = surfaces(scene)
+    else:
+        tops = tuple(jnp.asarray(t.node_offset + np.flatnonzero(np.isclose(t.nodes[:, 2], t.nodes[:, 2].max())))
+                     for t in block.tanks)
+    return Built(system, c0, v0, probes, block.tanks, alg0, blocks, tops)
+
+
+def outline(scene: Scene) -> System:
+    """The scene's model as `build` assembles it, its terms and their descriptions (`describe`), but
+    none of the arrays that cost time or memory: no mesh assembled, no basis, modes or radiation fit
+    computed, nothing compiled, no initial state (the arrays are None). What `jaxslosh check` lists
+    (assemble/check.py); tests/cli/test_check_effects.py holds it to the built model's terms."""
+    return _model(scene, {}, outline=True).system
+
+
+def _model(scene: Scene, params: dict, outline: bool = False) -> _Model:
+    """The System of `build` (or of `outline`: the same terms, from the same branches, without their
+    arrays), each term with its description (assemble/about.py)."""
     P = params.get
     env, ves, eff = scene.environment, scene.vessel, scene.effects
     g = jnp.asarray(P("environment.gravity", env.gravity), dtype=float)
@@ -73,23 +126,42 @@ def build(scene: Scene, params: Optional[dict] = None) -> Built:
             displaced_volume=f("vessel.hydrostatics.displaced_volume", h.displaced_volume),
             gm_t=f("vessel.hydrostatics.gm_t", h.gm_t), gm_l=f("vessel.hydrostatics.gm_l", h.gm_l)))
     multimodal = eff.liquid and multimodal_scene(scene)
-    block = LiquidBlock(build_multimodal(scene, params, g)) if multimodal else \
-        build_liquid_block(scene, params, g, include_liquid=eff.liquid)
-    liquid = dataclasses.replace(block.liquid, coriolis=eff.coriolis, centrifugal=eff.centrifugal) \
-        if block.liquid.nf and not multimodal else block.liquid
+    if multimodal and outline:
+        block = LiquidBlock(MultimodalLiquid(tanks=(), sizes=(), samples=None, gravity=g))
+    elif multimodal:
+        block = LiquidBlock(build_multimodal(scene, params, g))
+    elif outline:
+        block = outline_liquid_block(scene, include_liquid=eff.liquid)
+    else:
+        block = build_liquid_block(scene, params, g, include_liquid=eff.liquid)
+    has_liquid = not isinstance(block.liquid, NoLiquid)
+    about = liquid_about(scene, eff.liquid)
+    liquid = block.liquid
+    if has_liquid and not multimodal:
+        liquid = dataclasses.replace(liquid, coriolis=eff.coriolis, centrifugal=eff.centrifugal, about=about)
+    elif has_liquid:
+        liquid = dataclasses.replace(liquid, about=about)
     motion = FreeMotion()
     if ves.forced is not None:
         motion = _prescribed(ves.forced)
-    ini = ves.initial
-    q0 = _quat_from_rpy(jnp.asarray(P("vessel.initial.roll_pitch_yaw", ini.roll_pitch_yaw), dtype=float))
-    if motion.prescribed:     # the prescribed attitude at t = 0 (upright unless a phase or a record tilts it)
-        x0 = motion.coordinates(jnp.zeros(()))
-        q0 = _quat_from_rpy(x0[3:])
-    sea_terms, memory = build_seakeeping(scene, params) if scene.waves is not None or ves.hydrodynamics is not None \
-        else ((), None)
-    terms += sea_terms
+    q0 = None
+    if not outline:
+        ini = ves.initial
+        q0 = _quat_from_rpy(jnp.asarray(P("vessel.initial.roll_pitch_yaw", ini.roll_pitch_yaw), dtype=float))
+        if motion.prescribed:     # the prescribed attitude at t = 0 (upright unless a phase or a record tilts it)
+            q0 = _quat_from_rpy(motion.coordinates(jnp.zeros(()))[3:])
+    memory = None
+    if scene.waves is not None or ves.hydrodynamics is not None:
+        if outline:
+            terms += outline_seakeeping(scene)
+        else:
+            sea_terms, memory = build_seakeeping(scene, params)
+            terms += sea_terms
     own = [s for s in scene.structures if s.frame == "own"]
-    flex, blocks = build_flex(scene) if own else (None, ())
+    flex, blocks = None, ()
+    if own:
+        flex, blocks = (Flex(bodies=(), interfaces=()), ()) if outline else build_flex(scene)
+        flex = dataclasses.replace(flex, about=flex_about(scene))
     mass, inertia = jnp.asarray(P("vessel.mass", ves.mass), dtype=float), _inertia(P("vessel.inertia", ves.inertia))
     hull_S = None
     carried = block.carried + tuple(rigid_part(b.model.mass, b.model.nodes + np.asarray(scene.structure(b.name).origin))
@@ -99,49 +171,37 @@ def build(scene: Scene, params: Optional[dict] = None) -> Built:
     body = RigidBody(mass=mass, inertia=inertia, S=hull_S)
     balanced = ves.hydrostatics is not None and not nonlinear
     if not balanced:           # nothing holds the vessel up, or the hull's pressure does: its weight, liquid included
-        S = liquid.rigid_first_moment() if hull_S is None else hull_S + liquid.rigid_first_moment()
-        terms.append(Weight(mass=mass + liquid.total_mass(), S=S, gravity=g))
+        weight = weight_about(scene, nonlinear)
+        if outline:
+            terms.append(Weight(mass=None, S=None, gravity=g, about=weight))
+        else:
+            S = liquid.rigid_first_moment() if hull_S is None else hull_S + liquid.rigid_first_moment()
+            terms.append(Weight(mass=mass + liquid.total_mass(), S=S, gravity=g, about=weight))
     if block.penalty is not None:
         terms.append(RotationPenalty(Kdt=block.penalty[0], Ktt=block.penalty[1], q_ref=q0))
     if block.Kg is not None:
-        terms.append(SpinStiffening(block.Kg))
-    if multimodal:
+        terms.append(SpinStiffening(None if outline else block.Kg, about=stiffening_about(scene, "vessel")))
+    damping = None
+    if outline:
+        damping = ModalDamping(B=None, c=None) if any(t.damping is not None for t in scene.tanks) and has_liquid \
+            and eff.liquid else None
+    elif multimodal:
         damping = multimodal_damping(scene, params, liquid)
-    else:
-        damping, _ = build_damping(scene, params, block) if eff.liquid else (None, ())
+    elif eff.liquid:
+        damping, _ = build_damping(scene, params, block)
+    if damping is not None:
+        damping = dataclasses.replace(damping, about=damping_about(scene))
     system = System(body=body, terms=tuple(terms), liquid=liquid, gravity=g, q_ref=q0, motion=motion, memory=memory,
-                    flex=flex, gravity_turning=eff.gravity_turning or not liquid.nf, balanced=balanced,
+                    flex=flex, gravity_turning=eff.gravity_turning or not has_liquid, balanced=balanced,
                     damping=damping)
-    nf = system.nf
-    d_init = jnp.zeros(nf)
-    if nf:
-        d_init = _hydrostatic_start(system, q0)
-    c0 = Config(jnp.asarray(P("vessel.initial.position", ini.position), dtype=float), q0, d_init)
-    v0 = jnp.concatenate([jnp.asarray(P("vessel.initial.velocity", ini.velocity), dtype=float),
-                          jnp.asarray(P("vessel.initial.angular_velocity", ini.angular_velocity), dtype=float),
-                          jnp.zeros(nf)])
-    if motion.prescribed:   # the prescribed motion sets the rigid state at t = 0
-        c0 = Config(x0[:3], q0, c0.d)
-        v0 = v0.at[:6].set(motion.rates(jnp.zeros(())))
-    alg0 = None
-    if flex is not None:
-        c0, v0, alg0 = _flex_start(system, c0, v0)
-    probes = build_probes(scene, block.tanks, liquid, blocks, block.vstructs)
-    probes = probes._replace(modal=liquid.probe_modal(probes.weights))    # a modal liquid: probes from eta
-    if multimodal:
-        probes = probes._replace(modal=probe_modal(scene, liquid))
-        tops = surfaces(scene)
-    else:
-        tops = tuple(jnp.asarray(t.node_offset + np.flatnonzero(np.isclose(t.nodes[:, 2], t.nodes[:, 2].max())))
-                     for t in block.tanks)
-    return Built(system, c0, v0, probes, block.tanks, alg0, blocks, tops)
+    return _Model(system, block, blocks, multimodal)
 
 
 def _prescribed(f):
     """The motion of a `[vessel.forced]` table: one dof's profile, or a record's spline."""
     if f.profile == "record":
         knots, coef = record_coefficients(f.times, f.columns, DOFS)
-        return RecordedMotion(knots=jnp.asarray(knots), coef=jnp.asarray(coef))
+        return RecordedMotion(knots=jnp.asarray(knots), coef=jnp.asarray(coef), about=record_about(f))
     if f.profile == "spin-up":
         return SpinUpMotion(dof=DOFS.index(f.dof), rate=float(f.rate), duration=float(f.duration))
     return HarmonicMotion(dof=DOFS.index(f.dof), amplitude=jnp.asarray(f.amplitude, dtype=float),

@@ -7,7 +7,8 @@ import sys
 
 from ..assemble.cost import check_cost, describe_cost, estimate
 from ..assemble.damping import describe_damping
-from ..assemble.effects import describe, effects_summary
+from ..assemble.check import effects_summary
+from ..assemble.effects import describe
 from ..io.output import OutputError
 from ..io.status import Status
 from ..run.progress import wanted

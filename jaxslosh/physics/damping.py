@@ -15,9 +15,11 @@ coordinates of its sloshing modes and C = B diag(c) B^T is diagonal on them.
 """
 from __future__ import annotations
 
+import equinox as eqx
 import jax
 import jax.numpy as jnp
 
+from .about import About
 from .terms import AbstractTerm, Kin, Rows
 
 
@@ -25,6 +27,10 @@ class ModalDamping(AbstractTerm):
     """C d_dot on the deformable block's rows; no energy of its own (it only removes energy)."""
     B: jax.Array     # (nf, k) M Phi: the sloshing modes' mass-weighted shapes on the unknowns
     c: jax.Array     # (k,) 2 zeta_i omega_i, 1/s (zeta traceable: `tanks.<name>.damping.ratio`)
+    about: About = eqx.field(static=True, default=About())     # the damped tanks and their ratios
 
     def rows(self, k: Kin) -> Rows:
         return Rows(jnp.zeros(6), self.B @ (self.c * (self.B.T @ k.d_dot)))
+
+    def describe(self) -> tuple:
+        return self.about.lines

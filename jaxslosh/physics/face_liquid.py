@@ -30,7 +30,8 @@ import jax.numpy as jnp
 
 from ..fem.linalg import solve
 from .kinematics import mv3, tv3
-from .liquid import AbstractLiquid, point_mass_scale
+from .about import About
+from .liquid import AbstractLiquid, inertial_lines, point_mass_scale
 from .terms import Kin, Rows
 
 
@@ -48,7 +49,11 @@ class FluxLiquid(AbstractLiquid):
     n_nodes: int = eqx.field(static=True)
     coriolis: bool = eqx.field(static=True, default=True)
     centrifugal: bool = eqx.field(static=True, default=True)
+    about: About = eqx.field(static=True, default=About())     # its tanks
     sparse = False
+
+    def describe(self) -> tuple:
+        return inertial_lines(self)
 
     @property
     def nf(self) -> int:

@@ -37,6 +37,7 @@ import jax.numpy as jnp
 
 from ..hull.clip import cross3, cut_pieces, panels as coordinate_major
 from ..hull.hydrostatics import buoyancy, still_force_moment
+from .about import About
 from .terms import AbstractTerm, Kin, Rows
 
 
@@ -107,10 +108,15 @@ class HullPressure(AbstractTerm):
     waves: Optional[IncidentWaves] = None
     # (3,) body frame: the surface is tris + shift (a traced KG: assemble/hull.py); None: tris itself
     shift: Optional[jax.Array] = None
+    about: About = eqx.field(static=True, default=About())     # the hull (box or mesh file) and its waves
 
-    def __init__(self, tris, rho_w, gravity, z_water, waves=None, shift=None):
+    def __init__(self, tris, rho_w, gravity, z_water, waves=None, shift=None, about=About()):
         self.panels = coordinate_major(tris)
         self.rho_w, self.gravity, self.z_water, self.waves, self.shift = rho_w, gravity, z_water, waves, shift
+        self.about = about
+
+    def describe(self) -> tuple:
+        return self.about.lines
 
     def surface(self):
         """The closed surface (n, 3, 3) in the body frame, the shift applied."""

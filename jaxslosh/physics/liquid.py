@@ -24,6 +24,7 @@ import numpy as np
 
 from ..fem.linalg import solve
 from ..fem.slip import rotate_matrix
+from .about import About
 from .kinematics import mv3, quat_multiply, skew, spin_tensor_components, tv3
 from .terms import AbstractTerm, Config, Kin, Rows
 
@@ -90,6 +91,17 @@ class AbstractLiquid(AbstractTerm):
         return self
 
 
+def inertial_lines(liquid) -> tuple:
+    """A nodal, face-normal or reduced liquid's lines: its tanks' (its `about`, set at assembly),
+    then the inertial loads its `coriolis` and `centrifugal` switches keep."""
+    lines = liquid.about.lines
+    if liquid.coriolis:
+        lines += (("Coriolis", "2 omega x d_dot on the liquid (eq. 19)"),)
+    if liquid.centrifugal:
+        lines += (("centrifugal", "omega x (omega x r) on the liquid (eq. 19)"),)
+    return lines
+
+
 class NoLiquid(AbstractLiquid):
     """A vessel without tank liquid: no unknowns, no rows."""
     nf = 0
@@ -147,6 +159,10 @@ class Liquid(AbstractLiquid):
     # (3N,) the position of each nodal dof in [d; 0] (nf: held at zero): `full` as a gather, where a
     # scatter into the nodal vector compiles to a loop on the CPU (None: the scatter)
     slot: Optional[jax.Array] = None
+    about: About = eqx.field(static=True, default=About())     # its tanks (and walls, structures)
+
+    def describe(self) -> tuple:
+        return inertial_lines(self)
 
     @property
     def nf(self) -> int:
@@ -265,6 +281,10 @@ class RotationPenalty(AbstractTerm):
     Ktt: jax.Array        # (3, 3)
     q_ref: jax.Array      # (4,)
 
+    def describe(self) -> tuple:
+        return (("rotation penalty", "the liquid's absolute rotation held at zero by a penalty (PHYSICS.md item 5): "
+                                     "no spurious rotational modes of the element"),)
+
     def rotation(self, q):
         """theta = 2 vec(q_ref^-1 q): the small rotation since the reference attitude (body frame),
         and its derivative along body-frame rotation increments, d theta / d eps."""
@@ -292,7 +312,11 @@ class SpinStiffening(AbstractTerm):
     stress the spin causes, K_G(omega) = sum_k (omega omega^T)_k K_k (fem/structure.py). It follows
     the current spin, so it has no potential of its own."""
     Kg: jax.Array         # (6, nf, nf)
+    about: About = eqx.field(static=True, default=About())     # the stiffened structures
 
     def rows(self, k: Kin) -> Rows:
         W = jnp.stack(spin_tensor_components(k.omega))
         return Rows(jnp.zeros(6), jnp.einsum("k,kij,j->i", W, self.Kg, k.c.d))
+
+    def describe(self) -> tuple:
+        return self.about.lines

@@ -18,7 +18,8 @@ import jax.numpy as jnp
 
 from ..fem.linalg import solve
 from .kinematics import mv3, tv3
-from .liquid import AbstractLiquid, point_mass_scale
+from .about import About
+from .liquid import AbstractLiquid, inertial_lines, point_mass_scale
 from .terms import Kin, Rows
 
 
@@ -41,7 +42,11 @@ class ReducedLiquid(AbstractLiquid):
     n_nodes: int = eqx.field(static=True)
     coriolis: bool = eqx.field(static=True, default=True)
     centrifugal: bool = eqx.field(static=True, default=True)
+    about: About = eqx.field(static=True, default=About())     # its tanks and their bases
     sparse = False
+
+    def describe(self) -> tuple:
+        return inertial_lines(self)
 
     @property
     def nf(self) -> int:

@@ -51,6 +51,7 @@ import jax.numpy as jnp
 import numpy as np
 
 from .kinematics import mv3, tv3
+from .about import About
 from .liquid import AbstractLiquid
 from .terms import Kin, Rows
 
@@ -374,7 +375,11 @@ class MultimodalLiquid(AbstractLiquid):
     sizes: tuple = eqx.field(static=True)     # modes per tank
     samples: jax.Array                # (Ns, nf) surface elevation at sample points of every tank (validity)
     gravity: jax.Array                # m/s^2, for the rest stiffness
+    about: About = eqx.field(static=True, default=About())     # its tanks
     sparse = False
+
+    def describe(self) -> tuple:
+        return self.about.lines
     n_nodes = 0
     nonlinear = True
 

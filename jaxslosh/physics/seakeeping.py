@@ -25,6 +25,7 @@ import equinox as eqx
 import jax
 import jax.numpy as jnp
 
+from .about import About
 from .terms import AbstractTerm, Kin, Rows
 
 
@@ -103,17 +104,25 @@ class Excitation(eqx.Module):
 class WaveExcitation(AbstractTerm):
     """First-order wave forces on the rigid rows: a known function of time."""
     excitation: Excitation
+    about: About = eqx.field(static=True, default=About())     # the sea and the forces' source
 
     def rows(self, k: Kin) -> Rows:
         return Rows(-self.excitation.force(k.t))
+
+    def describe(self) -> tuple:
+        return self.about.lines
 
 
 class AddedMass(AbstractTerm):
     """The radiation added mass at infinite frequency, A_inf (6, 6) about the COG: it moves with the hull."""
     matrix: jax.Array
+    about: About = eqx.field(static=True, default=About())     # where the coefficients come from
 
     def rows(self, k: Kin) -> Rows:
         return Rows(self.matrix @ k.a6)
+
+    def describe(self) -> tuple:
+        return self.about.lines
 
     def kinetic(self, k: Kin):
         v6 = k.v6
@@ -126,15 +135,23 @@ class AddedMass(AbstractTerm):
 class LinearDamping(AbstractTerm):
     """Linear (viscous) damping B_v (6, 6) added to the radiation: bilge keels, viscous roll damping."""
     matrix: jax.Array
+    about: About = eqx.field(static=True, default=About())
 
     def rows(self, k: Kin) -> Rows:
         return Rows(self.matrix @ k.v6)
+
+    def describe(self) -> tuple:
+        return self.about.lines
 
 
 class RadiationMemory(AbstractTerm):
     """The memory force mu(t) of the Cummins equation: the System's `memory` states give it (the
     integrator advances them), this term puts it on the rigid rows."""
+    about: About = eqx.field(static=True, default=About())     # where the fit comes from
 
     def rows(self, k: Kin) -> Rows:
         return Rows(jnp.zeros(6) if k.mu is None else k.mu)
+
+    def describe(self) -> tuple:
+        return self.about.lines
 

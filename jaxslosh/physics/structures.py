@@ -38,6 +38,7 @@ import jax
 import jax.numpy as jnp
 
 from .kinematics import quat_exp, quat_multiply, rotation_matrix, spin_tensor_components
+from .about import About
 from .terms import Config
 
 
@@ -84,6 +85,10 @@ class Interface(eqx.Module):
 class Flex(eqx.Module):
     bodies: tuple
     interfaces: tuple
+    about: About = eqx.field(static=True, default=About())     # the structures, as `check` lists them
+
+    def describe(self) -> tuple:
+        return self.about.lines
 
     @property
     def S(self) -> int:

@@ -84,6 +84,11 @@ class AbstractTerm(eqx.Module):
     def mass_scale(self):
         return jnp.zeros(6)
 
+    def describe(self) -> tuple:
+        """(effect, text) lines: what this term adds to the model, as `jaxslosh check` lists it
+        (`- effect: text`); a final term says it from its own fields and its static `About`."""
+        return ()
+
 
 def potential_rows(potential, c: Config):
     """The rigid rows of a conservative term: the gradient of its potential V(c) along the step's

@@ -10,8 +10,12 @@ import jax
 import jax.numpy as jnp
 import numpy as np
 
+from .about import About
 from .kinematics import mv3, rotation_matrix, tv3
 from .terms import AbstractTerm, Kin, Rows
+
+#: the rigid dofs' names, in the order of the rigid rows
+DOF_NAMES = ("surge", "sway", "heave", "roll", "pitch", "yaw")
 
 # eq. (36): q^T A_phi q = 2 (q0 q1 + q2 q3) = sin(roll) cos(pitch), q^T A_theta q = 2 (q0 q2 - q1 q3)
 A_PHI = np.array([[0, 1, 0, 0], [1, 0, 0, 0], [0, 0, 0, 1], [0, 0, 1, 0]], dtype=float)
@@ -46,6 +50,9 @@ class RigidBody(AbstractTerm):
     def mass_scale(self):
         return jnp.concatenate([jnp.full(3, self.mass), jnp.diag(self.inertia)])
 
+    def describe(self) -> tuple:
+        return (("rigid-body inertia", "vessel: 6 unknowns, rotations on the group (|q| = 1 exactly)"),)
+
 
 class Weight(AbstractTerm):
     """Gravity on the whole vessel, liquid included, when no hydrostatics hold it up: mass M, first
@@ -54,6 +61,7 @@ class Weight(AbstractTerm):
     mass: jax.Array
     S: jax.Array
     gravity: jax.Array
+    about: About = eqx.field(static=True, default=About())     # what holds the vessel up, if anything
 
     def rows(self, k: Kin) -> Rows:
         g_vec = jnp.array([0.0, 0.0, -self.gravity])
@@ -61,6 +69,9 @@ class Weight(AbstractTerm):
 
     def potential(self, k: Kin):
         return self.mass * self.gravity * k.c.X0[2] - k.g_b @ self.S
+
+    def describe(self) -> tuple:
+        return self.about.lines
 
 
 class Hydrostatics(AbstractTerm):
@@ -111,6 +122,10 @@ class Hydrostatics(AbstractTerm):
     def potential(self, k: Kin):
         return self.restoring_potential(k.c.X0, k.c.q)
 
+    def describe(self) -> tuple:
+        form = "paper" if isinstance(self, PaperHydrostatics) else "conservative"
+        return (("buoyancy", f"restoring force and moments of eqs. (33)-(36), moment form {form!r}"),)
+
 
 class PaperHydrostatics(Hydrostatics):
     """The restoring of eqs. (33)-(36) with the moment of eq. (36) literally
@@ -143,6 +158,10 @@ class AbstractMotion(eqx.Module):
     @abc.abstractmethod
     def rigid_rows(self, rows, a6, t, scale):
         """The rigid rows of the residual, from the terms' sum `rows` (`scale()`: the rigid rows' masses)."""
+
+    def describe(self) -> tuple:
+        """(effect, text) lines, as a term's (terms.py): a free hull has none."""
+        return ()
 
 
 class FreeMotion(AbstractMotion):
@@ -197,6 +216,12 @@ class HarmonicMotion(AbstractPrescribedMotion):
             x = x * smooth_ramp(t / self.ramp)
         return jnp.zeros(6).at[self.dof].set(x)
 
+    def describe(self) -> tuple:
+        phase = f" + {self.phase:g}" if self.phase else ""
+        ramp = f", faded in over {self.ramp:g} s" if self.ramp else ""
+        return (("prescribed motion", f"{DOF_NAMES[self.dof]} = {float(self.amplitude):g} "
+                                      f"sin({float(self.frequency):g} t{phase}){ramp}, other rigid dofs held"),)
+
 
 class SpinUpMotion(AbstractPrescribedMotion):
     """One rotation whose rate grows smoothly to `rate` over `duration` (rate r(t / duration), the
@@ -211,6 +236,10 @@ class SpinUpMotion(AbstractPrescribedMotion):
         up = W / T * (0.5 * t * t + c * c * (jnp.cos(t / c) - 1.0))
         return jnp.zeros(6).at[self.dof].set(jnp.where(t < T, up, W * (0.5 * T) + W * (t - T)))
 
+    def describe(self) -> tuple:
+        return (("prescribed motion", f"{DOF_NAMES[self.dof]} rate spun up to {self.rate:g} rad/s over "
+                                      f"{self.duration:g} s, other rigid dofs held"),)
+
 
 class RecordedMotion(AbstractPrescribedMotion):
     """Coordinates from a record (`[vessel.forced] file`): a natural cubic spline through the samples
@@ -219,12 +248,16 @@ class RecordedMotion(AbstractPrescribedMotion):
     ((c0 s + c1) s + c2) s + c3, s = t - t_i; found by a binary search, not a loop."""
     knots: jax.Array        # (n,) sample times, increasing
     coef: jax.Array         # (n - 1, 4, 6) the pieces' coefficients, highest power first
+    about: About = eqx.field(static=True, default=About())     # the record's file and columns
 
     def coordinates(self, t):
         i = jnp.clip(jnp.searchsorted(self.knots, t, side="right") - 1, 0, self.knots.shape[0] - 2)
         s = t - self.knots[i]
         c = self.coef[i]
         return ((c[0] * s + c[1]) * s + c[2]) * s + c[3]
+
+    def describe(self) -> tuple:
+        return self.about.lines
 
 
 def record_coefficients(times, columns, dofs):

@@ -1,0 +1,56 @@
+"""The effects `jaxslosh check` lists: the assembled model's own description. Each term of the
+model (physics/terms.py `describe`) says what it adds; an effect is listed exactly when its term is
+in the model, since the list is read from the model that assemble/system.py assembles (its outline:
+the same terms without their arrays, so that a scene of any size is checked at once)."""
+from __future__ import annotations
+
+import dataclasses
+
+from ..physics.liquid import NoLiquid
+from ..physics.structures import Flex
+from ..physics.system import System
+from ..physics.terms import AbstractTerm
+from ..physics.vessel import AbstractMotion
+from ..scene.types import Scene
+from .effects import count_unknowns, switched_off
+from .system import outline
+
+#: the System's own line, for the one switch it holds itself (System.gravity_body)
+GRAVITY_TURNING = ("gravity turning with the body", "load of eq. (32) on the liquid")
+
+
+#: what describes itself: the terms, and the System's parts beside them (the hull's motion, the
+#: structures in their own frames)
+DESCRIBED = (AbstractTerm, AbstractMotion, Flex)
+
+
+def model_parts(system: System) -> tuple:
+    """Every part of the model that describes itself, in the System's order: its fields, a tuple's
+    members in turn (the terms); each part once."""
+    parts = []
+    for f in dataclasses.fields(system):
+        value = getattr(system, f.name)
+        for part in value if isinstance(value, tuple) else (value,):
+            if isinstance(part, DESCRIBED) and all(part is not p for p in parts):
+                parts.append(part)
+    return tuple(parts)
+
+
+def model_effects(system: System) -> list[tuple[str, str, object]]:
+    """(effect, text, its owner) for every line the model's parts give; the owner is the term (or
+    the System itself for gravity turning with the body)."""
+    out = [(effect, text, part) for part in model_parts(system) for effect, text in part.describe()]
+    if system.gravity_turning and not isinstance(system.liquid, NoLiquid) and float(system.gravity) > 0:
+        out.append((*GRAVITY_TURNING, system))
+    return out
+
+
+def effects_summary(scene: Scene) -> str:
+    """`check`'s effects: the model's own lines, what `[effects]` switched off, and the unknowns."""
+    lines = ["effects simulated:"]
+    lines += [f"  - {name}: {why}" for name, why, _ in model_effects(outline(scene))]
+    off = switched_off(scene)
+    if off:
+        lines.append("switched off in [effects]: " + ", ".join(off))
+    lines.append(f"unknowns per step: {count_unknowns(scene)}")
+    return "\n".join(lines)
