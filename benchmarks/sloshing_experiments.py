@@ -90,7 +90,7 @@ def main():
         import matplotlib
         matplotlib.use("Agg")
         import matplotlib.pyplot as plt
-        cases = sorted({c for c, _ in runs}, reverse=True)
+        cases = list(dict.fromkeys(c for c, _ in runs))
         fig, axes = plt.subplots(len(cases), 1, figsize=(9, 3.2 * len(cases)), sharex=True)
         for ax, case in zip(axes, cases):
             ax.plot(tm, zm, "k.", ms=4, label="experiment (Faltinsen et al. 2000, fig. 7)")
@@ -98,7 +98,7 @@ def main():
                 if c == case:
                     ax.plot(t, z, label=label)
             ax.set_ylabel("elevation (m)")
-            ax.set_title(f"0.05 m from the wall; forcing {case}", fontsize=10)
+            ax.set_title(f"0.05 m from the wall; surge amplitude {case}", fontsize=10)
             ax.grid(alpha=0.3)
         axes[0].legend(fontsize=8, loc="lower right")
         axes[-1].set_xlabel("t (s)")
