@@ -19,8 +19,8 @@ L, H, G, A, W, X = 1.73, 0.6, 9.81, 0.032, 2 * np.pi / 1.3, 0.05
 
 
 def _measured():
-    rows = [line.split(",") for line in (ROOT / "benchmarks" / "data" / "faltinsen2000_fig7.csv").read_text().splitlines()
-            if line.strip() and not line.startswith("#")]
+    text = (ROOT / "benchmarks" / "data" / "faltinsen2000_fig7.csv").read_text()
+    rows = [line.split(",") for line in text.splitlines() if line.strip() and not line.startswith("#")]
     assert rows[0] == ["t", "elevation"]
     d = np.array(rows[1:], dtype=float)
     return d[:, 0], d[:, 1]
