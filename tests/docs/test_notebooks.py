@@ -99,3 +99,17 @@ def test_parametric_roll_notebook_runs():
     (threshold,) = numbers(r"threshold h = 4 lambda / omega_0 = ([\d.]+)", text)
     assert threshold < 0.2 < h < 0.4, (h, threshold)
     assert "not ok" not in text
+
+
+@pytest.mark.slow
+def test_nonlinear_sloshing_notebook_runs():
+    """A few minutes at the small size (4 s runs of each tank, two batches of 3 frequencies)."""
+    text = printed(run_notebook("nonlinear_sloshing.ipynb", {"JAXSLOSH_NOTEBOOK_SMALL": "1"}, timeout=1800))
+    # 1 mm: the multimodal tank (8 modes) and the finite elements (16 x 1 x 6) within a few per cent
+    (d,) = numbers(r"multimodal against finite elements: largest difference ([\d.]+) %", text)
+    assert d < 5.0, d
+    # 32 mm: the multimodal crests stand higher above the troughs than the linear ones
+    ratio = {name: float(v) for name, v in re.findall(
+        r"^(multimodal|fem)\s+[\d.]+%\s+[+-][\d.]+%\s+[+-][\d.]+%\s+([\d.]+)$", text, re.M)}
+    assert ratio["multimodal"] > 1.4 and ratio["fem"] < 1.2, ratio
+    assert text.count("3 runs, 3 ok") == 2, text

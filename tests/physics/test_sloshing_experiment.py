@@ -1,0 +1,69 @@
+"""The multimodal tank against a laboratory experiment: Faltinsen, Rognebakke, Lukovsky & Timokha
+(2000, J. Fluid Mech. 407), figure 7 (benchmarks/data/faltinsen2000_fig7.csv, scenes/sloshing_experiment.toml):
+the wave elevation 0.05 m from the wall of a 1.73 m tank filled to 0.6 m, moved in surge by
+x = 0.032 cos(2 pi t / 1.3) m from rest.
+
+Linear theory here is the closed form of the tank's standing waves forced from rest (independent of
+the finite elements). What the measurement supports: linear theory is off by more than 15 % rms of
+the measured maximum and makes crests and troughs equal, where the measured crests rise about 1.5
+times as high as the troughs fall; the multimodal tank reproduces that asymmetry. It does not
+reproduce the measured heights within 10 % at the forcing as documented (benchmarks/sloshing_experiments.py)."""
+from pathlib import Path
+
+import numpy as np
+
+import jaxslosh as js
+
+ROOT = Path(__file__).resolve().parents[2]
+L, H, G, A, W, X = 1.73, 0.6, 9.81, 0.032, 2 * np.pi / 1.3, 0.05
+
+
+def _measured():
+    text = (ROOT / "benchmarks" / "data" / "faltinsen2000_fig7.csv").read_text()
+    rows = [line.split(",") for line in text.splitlines() if line.strip() and not line.startswith("#")]
+    assert rows[0] == ["t", "elevation"]
+    d = np.array(rows[1:], dtype=float)
+    return d[:, 0], d[:, 1]
+
+
+def _linear(t, n=60):
+    """Linear theory from rest: each standing wave cos(k_n x) of the tank, forced by the surge
+    acceleration -A w^2 cos(w t), is beta_n = F_n (cos w t - cos w_n t) / (w_n^2 - w^2)."""
+    k = np.arange(1, n + 1) * np.pi / L
+    wn = np.sqrt(G * k * np.tanh(k * H))
+    c = ((-1.0) ** np.arange(1, n + 1) - 1.0) / k ** 2      # integral of x cos(k x) over the length
+    mn = 0.5 * L / (k * np.tanh(k * H))                      # the mode's mass per unit rho b
+    F = c * A * W ** 2 / mn
+    t = np.asarray(t)[:, None]
+    return np.sum(F / (wn ** 2 - W ** 2) * (np.cos(W * t) - np.cos(wn * t)) * np.cos(k * X), axis=1)
+
+
+def test_linear_theory_misses_the_measured_elevation():
+    """Over the whole record (0.1 to 9.9 s): more than 15 % rms of the measured maximum, its
+    troughs more than 1.4 times as deep as the measured ones."""
+    tm, zm = _measured()
+    zl = _linear(tm)
+    assert np.sqrt(np.mean((zl - zm) ** 2)) > 0.15 * zm.max()
+    t = np.linspace(tm[0], tm[-1], 4001)
+    assert -_linear(t).min() > 1.4 * -zm.min()
+
+
+def test_multimodal_tank_has_the_measured_crest_to_trough_ratio():
+    """The first beat (to 3.6 s: the largest measured crest at 2.57 s and the deepest trough at
+    3.27 s): the measured crest is 1.54 times the trough; the multimodal tank's within 15 % of that,
+    linear theory's (about 1.06) more than 25 % off. Crest and trough at the measured times (0.05 s)."""
+    tm, zm = _measured()
+    first = tm <= 3.6
+    tm, zm = tm[first], zm[first]
+    text = (ROOT / "scenes" / "sloshing_experiment.toml").read_text().replace("duration = 10.0", "duration = 3.6")
+    r = js.simulate(js.load_scene(text))
+    assert r.status == "ok"
+    t, z = np.asarray(r.time), np.asarray(r.probes["wall"].displacement)[:, 2]
+    measured = zm.max() / -zm.min()
+    multimodal = z.max() / -z.min()
+    zl = _linear(t)
+    linear = zl.max() / -zl.min()
+    assert abs(multimodal / measured - 1) < 0.15, (multimodal, measured)
+    assert abs(linear / measured - 1) > 0.25, (linear, measured)
+    assert abs(t[np.argmax(z)] - tm[np.argmax(zm)]) < 0.05
+    assert abs(t[np.argmin(z)] - tm[np.argmin(zm)]) < 0.05
