@@ -40,7 +40,7 @@ def hull_about(scene: Scene, waves: bool) -> About:
 def tank_line(t) -> tuple[str, str]:
     """One tank's liquid, as the liquid term holds it."""
     if t.model == "multimodal":
-        flow = "three-dimensional" if t.shape == "cylinder" or t.flow == "3d" else "two-dimensional along x"
+        flow = "three-dimensional" if t.flow == "3d" else "two-dimensional along x"
         return (f"liquid in tank {t.name!r}", f"{shape_words(t)}multimodal ({flow}), {t.modes} free-surface "
                                               f"modes, {t.liquid_mass:.6g} kg; its inertial loads (Coriolis and "
                                               "centrifugal among them) are the modal Lagrangian's, not switched by "
