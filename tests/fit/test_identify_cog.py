@@ -100,13 +100,37 @@ def test_identify_recovers_the_cog_height_within_half_a_percent_of_kg(decay):
     assert fit.implied_standard_errors["vessel.hydrostatics.gm_t"] == pytest.approx(se[2])
 
 
-def test_cli_fits_the_cog(decay, tmp_path, capsys):
+def test_cli_fits_the_cog_weighted_by_the_noise(decay, tmp_path, capsys):
+    """`--noise roll=...,pitch=...,heave=...` weights the channels 1 / noise, as `weights` does."""
     from jaxslosh.cli import main
     _, _, _, path, data, _ = decay
     out = tmp_path / "fit.json"
-    code = main(["identify", str(path), "--data", str(data), "--fit", "vessel.hull.cog", "-o", str(out)])
+    noise = ",".join(f"{c}={s!r}" for c, s in NOISE.items())
+    code = main(["identify", str(path), "--data", str(data), "--fit", "vessel.hull.cog", "--noise", noise,
+                 "-o", str(out)])
     printed = capsys.readouterr().out
     assert code == 0, printed
-    cog = json.loads(out.read_text())["values"]["vessel.hull.cog"]
+    fit = json.loads(out.read_text())
+    assert fit["weights"] == pytest.approx({c: 1.0 / s for c, s in NOISE.items()}, rel=1e-12)
+    cog, se = fit["values"]["vessel.hull.cog"], fit["standard_errors"]["vessel.hull.cog"]
     assert abs(cog[2] - TRUE_COG[2]) < 0.005 * (DRAFT + TRUE_COG[2]), cog
+    assert 0 < se[2] < 0.002 * (DRAFT + TRUE_COG[2]), se
     assert any(s.startswith("vessel.hull.cog") for s in printed.splitlines()), printed
+
+
+@pytest.mark.parametrize("args, named", [
+    (["--noise", "roll=0"], "--noise: roll"),
+    (["--noise", "roll"], "--noise"),
+    (["--weights", "heave=-1"], "--weights: heave"),
+    (["--noise", "roll=0.01", "--weights", "roll=3"], "--noise"),
+    (["--noise", "sway=0.01"], "--noise: weights.sway"),
+])
+def test_cli_bad_noise_or_weights_exit_2_naming_the_flag(decay, tmp_path, capsys, args, named):
+    from jaxslosh.cli import main
+    _, _, _, path, data, _ = decay
+    out = tmp_path / "fit.json"
+    code = main(["identify", str(path), "--data", str(data), "--fit", "vessel.hull.cog", "-o", str(out)] + args)
+    err = capsys.readouterr().err
+    assert code == 2, err
+    assert len(err.strip().splitlines()) == 1 and named in err, err
+    assert not out.exists()
