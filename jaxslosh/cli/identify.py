@@ -21,8 +21,8 @@ def add_parsers(subparsers):
     p.add_argument("--data", required=True, metavar="MEASURED.h5", help="the measured result file")
     p.add_argument("--fit", required=True, metavar="KEY[,KEY...]",
                    help="dotted scene keys to fit, comma-separated, e.g. "
-                        "vessel.hydrostatics.gm_t,vessel.hydrostatics.gm_l, or vessel.hull.kg with the "
-                        "nonlinear hydrostatics (the implied GM0 is printed too)")
+                        "vessel.hydrostatics.gm_t,vessel.hydrostatics.gm_l, or vessel.hull.kg (a mesh hull: "
+                        "vessel.hull.cog) with the nonlinear hydrostatics (the implied GM0 is printed too)")
     p.add_argument("-o", "--output", metavar="FIT.json",
                    help="the fit as JSON (default: the scene's name with _fit.json, here)")
     p.add_argument("--method", default="gauss-newton", choices=METHODS, help="optimiser (default gauss-newton)")
