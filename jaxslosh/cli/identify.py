@@ -21,13 +21,20 @@ def add_parsers(subparsers):
     p.add_argument("--data", required=True, metavar="MEASURED.h5", help="the measured result file")
     p.add_argument("--fit", required=True, metavar="KEY[,KEY...]",
                    help="dotted scene keys to fit, comma-separated, e.g. "
-                        "vessel.hydrostatics.gm_t,vessel.hydrostatics.gm_l, or vessel.hull.kg with the "
-                        "nonlinear hydrostatics (the implied GM0 is printed too)")
+                        "vessel.hydrostatics.gm_t,vessel.hydrostatics.gm_l, or vessel.hull.kg (a mesh hull: "
+                        "vessel.hull.cog) with the nonlinear hydrostatics (the implied GM0 is printed too)")
     p.add_argument("-o", "--output", metavar="FIT.json",
                    help="the fit as JSON (default: the scene's name with _fit.json, here)")
     p.add_argument("--method", default="gauss-newton", choices=METHODS, help="optimiser (default gauss-newton)")
     p.add_argument("--max-iter", type=int, default=50, dest="max_iter", help="iterations at most (default 50)")
     p.add_argument("--start", metavar="KEY=VALUE[,...]", help="start values (default: the scene's values)")
+    p.add_argument("--noise", metavar="CHANNEL=STD[,...]",
+                   help="the measurement noise of channels (roll, pitch, heave, probes.NAME; standard deviations "
+                        "in the channel's units, rad or m): weight 1 / STD, with which the standard errors are "
+                        "exact for independent Gaussian noise")
+    p.add_argument("--weights", metavar="CHANNEL=W[,...]",
+                   help="weights of channels (0 leaves one out); channels named by neither --noise nor --weights "
+                        "keep the default 1 / std of the measured signal")
     p.add_argument("--plot", metavar="FIG.png", help="also draw measured against fitted time histories")
     p.add_argument("--data-scene", default="check", choices=("check", "ignore"), dest="data_scene",
                    help="when the data file carries a scene that differs from SCENE (besides the fitted keys): "
@@ -37,6 +44,31 @@ def add_parsers(subparsers):
 
 def _split_keys(text):
     return [k.strip() for k in str(text).split(",") if k.strip()]
+
+
+def _channel_weights(a) -> dict:
+    """{channel: weight} of --noise (1 / STD) and --weights; InputError naming the flag and the item."""
+    weights = {}
+    for flag, text in (("--noise", getattr(a, "noise", None)), ("--weights", getattr(a, "weights", None))):
+        for item in _split_keys(text or ""):
+            k, sep, v = item.partition("=")
+            k = k.strip()
+            try:
+                x = float(v)
+            except ValueError:
+                x = None
+            if not sep or not k or x is None:
+                raise InputError(f"{flag}: expected CHANNEL=VALUE, got {item!r}")
+            if k in weights:
+                raise InputError(f"{flag}: channel {k} is given twice (in --noise and --weights together)")
+            if flag == "--noise":
+                if not (math.isfinite(x) and x > 0):
+                    raise InputError(f"{flag}: {k}: the noise's standard deviation must be finite and > 0, got {v}")
+                x = 1.0 / x
+            elif not (math.isfinite(x) and x >= 0):
+                raise InputError(f"{flag}: {k}: a weight must be finite and >= 0, got {v}")
+            weights[k] = (x, flag)
+    return weights
 
 
 def cmd_identify(a) -> int:
@@ -77,6 +109,8 @@ def cmd_identify(a) -> int:
         if not sep:
             raise InputError(f"--start: expected KEY=VALUE, got {item!r}")
 
+    weights = _channel_weights(a)
+
     setup_jax()
     scene = load(a.scene)            # SceneError (exit 2, naming the key) for a bad scene
     try:
@@ -98,10 +132,13 @@ def cmd_identify(a) -> int:
     if mismatch:
         print(f"jaxslosh identify: note: {mismatch}; fitting anyway (--data-scene ignore)", file=sys.stderr)
     try:
-        fr = identify(scene, measured, keys, method=method, max_iter=max_iter, x0=x0 or None, data_scene="ignore")
+        fr = identify(scene, measured, keys, method=method, max_iter=max_iter, x0=x0 or None, data_scene="ignore",
+                      weights={k: w for k, (w, _) in weights.items()} or None)
     except SceneError as e:
         msg = str(e).replace("\n", " ")
         flag = "--start" if ("the start" in msg or "given in x0" in msg) else "--data" if e.key == "measured" else None
+        if e.key.startswith("weights.") and e.key[len("weights."):] in weights:
+            flag = weights[e.key[len("weights."):]][1]
         raise InputError(f"{flag}: {msg}" if flag else msg)
     if not fr.loss_history or not math.isfinite(fr.loss_history[0]):
         print(f"jaxslosh identify: numerical failure: {fr.message}", file=sys.stderr)

@@ -162,12 +162,14 @@ class FitResult:
                 "converged": bool(self.converged), "method": self.method,
                 "quality": self.quality or "good", "r2": dict(self.r2),
                 "residual_to_noise": dict(self.residual_to_noise), "data_scene": self.data_scene or None,
-                "implied": dict(self.implied), "implied_standard_errors": dict(self.implied_standard_errors)}
+                "implied": dict(self.implied), "implied_standard_errors": dict(self.implied_standard_errors),
+                "weights": dict(self.channels)}
 
     def to_json(self, path: Optional[str] = None, **kw) -> str:
         """The JSON text of {"values", "standard_errors", "loss_history", "iterations", "converged",
         "method", "quality" ("good" or "poor fit: R^2 0.12 on roll"), "r2", "residual_to_noise",
-        "data_scene" (null, or how the data's scene differs), "implied", "implied_standard_errors"};
+        "data_scene" (null, or how the data's scene differs), "implied", "implied_standard_errors",
+        "weights" (channel: the weight its residual had)};
         also written to `path` when given."""
         text = json.dumps(_json_safe(self.to_dict()), **({"indent": 2} | kw))
         if path is not None:

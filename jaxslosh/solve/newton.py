@@ -168,6 +168,11 @@ class StructuredNewton(eqx.Module):
             else:
                 data0 = self.precondition(R, x0)
             need0 = jnp.array(False)
+            # whether the preconditioner was formed for this step (a carried one converges more
+            # slowly without being stalled: see `step`)
+            fresh0 = jnp.asarray(True) if pre is None or fresh is None else jnp.asarray(fresh)
+            return NewtonState(x0, jnp.zeros_like(x0), jnp.array(-1), jnp.array(jnp.inf, x0.dtype), fresh0,
+                               jnp.array(False), need0, data0)
         elif pre is not None:
             data0, need0 = pre[0], ~(pre[1] > 0.5)
         else:    # placeholders of the shapes precondition returns (eval_shape would trace it again)
@@ -187,8 +192,11 @@ class StructuredNewton(eqx.Module):
         r = R(x)
         err = self.error(r)
         first = s.it < 0
-        # a stale preconditioner that slows down is formed again; a fresh one that cannot is a stall
-        stalled = ~first & s.fresh & (err > 0.5 * s.err)
+        # a stale preconditioner that slows down is formed again; a fresh one that cannot is a stall.
+        # Batches cannot form it again inside the iterations: a carried one (formed some steps
+        # before, the rigid block's Jacobian since moved by large rotations) may contract by less
+        # than half per pass and still converge; it stalls only where the residual stops falling
+        stalled = ~first & jnp.where(s.fresh, err > 0.5 * s.err, (not self.adaptive) & (err >= s.err))
         need = jnp.where(first, s.need, err > jnp.where(s.fresh, 0.1, SLOW) * s.err)
         it = s.it + 1
         if self.adaptive:
@@ -200,7 +208,7 @@ class StructuredNewton(eqx.Module):
                                     s.data)
         else:    # batches: the preconditioner is fixed through the iterations (a cond on a per-run
             data, dx = s.data, _precond_apply(s.data, self.Cinv, -r, self.ns)  # test runs both branches)
-        return NewtonState(x, dx, it, err, need | (not self.adaptive), stalled, need, data)
+        return NewtonState(x, dx, it, err, s.fresh if not self.adaptive else need, stalled, need, data)
 
     def terminate(self, s: NewtonState):
         """(done, status): converged below the tolerance, or stalled at round-off within a factor
