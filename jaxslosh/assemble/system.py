@@ -85,8 +85,7 @@ def build(scene: Scene, params: Optional[dict] = None) -> Built:
     if motion.prescribed:     # the prescribed attitude at t = 0 (upright unless a phase or a record tilts it)
         x0 = motion.coordinates(jnp.zeros(()))
         q0 = _quat_from_rpy(x0[3:])
-    sea_terms, memory = build_seakeeping(scene, params) if scene.waves is not None or ves.hydrodynamics is not None \
-        else ((), None)
+    sea_terms = build_seakeeping(scene, params) if scene.waves is not None or ves.hydrodynamics is not None else ()
     terms += sea_terms
     own = [s for s in scene.structures if s.frame == "own"]
     flex, blocks = build_flex(scene) if own else (None, ())
@@ -109,8 +108,8 @@ def build(scene: Scene, params: Optional[dict] = None) -> Built:
         damping = multimodal_damping(scene, params, liquid)
     else:
         damping, _ = build_damping(scene, params, block) if eff.liquid else (None, ())
-    system = System(body=body, terms=tuple(terms), liquid=liquid, gravity=g, q_ref=q0, motion=motion, memory=memory,
-                    flex=flex, gravity_turning=eff.gravity_turning or not liquid.nf, balanced=balanced,
+    system = System(body=body, terms=tuple(terms), liquid=liquid, gravity=g, q_ref=q0, motion=motion, flex=flex,
+                    gravity_turning=eff.gravity_turning or not liquid.nf, balanced=balanced,
                     damping=damping)
     nf = system.nf
     d_init = jnp.zeros(nf)

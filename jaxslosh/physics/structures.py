@@ -275,14 +275,14 @@ def structure_potential(system, c: Config):
     return V
 
 
-def inertia_rows(system, c: Config, v, acc, t, mu=None):
+def inertia_rows(system, c: Config, v, acc, t, z=None):
     """Dyn rows without the multipliers: the vessel-and-liquid residual of model.py, each structure's
     rigid and elastic inertia rows, and the forces of the structures' potential (elastic, gravity)."""
     r = layout(system).n_rigid
-    return jnp.concatenate(inertia_rows_parts(system, c, v[:r], v[r:], acc[:r], acc[r:], t, mu))
+    return jnp.concatenate(inertia_rows_parts(system, c, v[:r], v[r:], acc[:r], acc[r:], t, z))
 
 
-def inertia_rows_parts(system, c: Config, vy, vz, ay, az, t, mu=None, core=True):
+def inertia_rows_parts(system, c: Config, vy, vz, ay, az, t, z=None, core=True):
     """`inertia_rows` as (rigid rows (n_rigid,), the others (nf + m,)), with the rates of the rigid
     unknowns (y: vessel, structures) and of the others (z: liquid, modal) passed apart, as
     System.residual_parts does for the vessel and its liquid (the Newton preconditioner's rigid rows
@@ -292,7 +292,7 @@ def inertia_rows_parts(system, c: Config, vy, vz, ay, az, t, mu=None, core=True)
     ves_v, st_v, d_v, e_v = vy[:6], vy[6:].reshape(L.S, 6), vz[:L.nf], vz[L.nf:]
     ves_a, st_a, d_a, e_a = ay[:6], ay[6:].reshape(L.S, 6), az[:L.nf], az[L.nf:]
     if core:
-        core_y, core_z = system.residual_parts(c, ves_v[:3], ves_v[3:], d_v, ves_a, d_a, t, mu)
+        core_y, core_z = system.residual_parts(c, ves_v[:3], ves_v[3:], d_v, ves_a, d_a, t, z)
     else:
         core_y, core_z = jnp.zeros(6), jnp.zeros(L.nf)
     flex = system.flex
@@ -390,7 +390,7 @@ def frame_velocities(system, c: Config, v):
     return jnp.concatenate(out)
 
 
-def initial_residuals(system, c: Config, v, alg0, t, mscale, mu=None):
+def initial_residuals(system, c: Config, v, alg0, t, mscale, z=None):
     """The initial accelerations as (R_main, R_c, main_parts) of x = [acc_y, (frame accelerations,
     multipliers), acc_z]; the constraint rows are d^2 g / dt^2 = 0 times `mscale` (per interface);
     main_parts(acc_y, acc_z): R_main's rows apart (inertia_rows_parts)."""
@@ -400,7 +400,7 @@ def initial_residuals(system, c: Config, v, alg0, t, mscale, mu=None):
     r = L.n_rigid
 
     def main_parts(ay, az):
-        return inertia_rows_parts(system, c, v[:r], v[r:], ay, az, t, mu)
+        return inertia_rows_parts(system, c, v[:r], v[r:], ay, az, t, z)
 
     def R_main(x):
         return in_x(L, *main_parts(x[:r], x[L.n_small:]))

@@ -22,7 +22,6 @@ from . import structures as mb
 from .damping import ModalDamping
 from .kinematics import G_matrix, quat_exp, quat_multiply, rotation_matrix, tv3
 from .liquid import AbstractLiquid
-from .seakeeping import Memory
 from .terms import Config, Kin
 from .vessel import AbstractMotion, FreeMotion, RigidBody
 
@@ -34,7 +33,6 @@ class System(eqx.Module):
     gravity: jax.Array               # m/s^2, along -Z
     q_ref: jax.Array                 # the initial attitude
     motion: AbstractMotion = FreeMotion()
-    memory: Optional[Memory] = None  # radiation memory states (advanced by the integrator)
     flex: Optional[mb.Flex] = None   # flexible structures in their own frames, and their interfaces
     damping: Optional[ModalDamping] = None   # the liquid's modal damping ([tanks.damping]), the last term
     gravity_turning: bool = eqx.field(static=True, default=True)   # off: g_b stays as at the start
@@ -61,29 +59,42 @@ class System(eqx.Module):
         g_vec = jnp.array([0.0, 0.0, -self.gravity])
         return tv3(A if self.gravity_turning else rotation_matrix(self.q_ref), g_vec)
 
-    def kin(self, c: Config, V0, omega, d_dot, a6=None, d_acc=None, t=0.0, mu=None) -> Kin:
+    def kin(self, c: Config, V0, omega, d_dot, a6=None, d_acc=None, t=0.0) -> Kin:
         A = rotation_matrix(c.q)
-        return Kin(c, V0, omega, d_dot, a6, d_acc, jnp.asarray(t), mu, A, self.gravity_body(A))
+        return Kin(c, V0, omega, d_dot, a6, d_acc, jnp.asarray(t), jnp.zeros((0,)), A, self.gravity_body(A))
+
+    # ---------------------------------------------------------------- the terms' integrator states
+    def states_init(self) -> tuple:
+        """Every term's integrator states at t = 0 (AbstractTerm.state_init), in all_terms' order."""
+        return tuple(term.state_init() for term in self.all_terms())
+
+    def states_coefficients(self, h) -> tuple:
+        return tuple(term.state_coefficients(h) for term in self.all_terms())
+
+    def states_advance(self, z: tuple, v_old, v_new, coef: tuple) -> tuple:
+        """The terms' states at t_{n+1} (rigid velocities (6,) at t_n and t_{n+1})."""
+        return tuple(term.state_advance(zi, v_old, v_new, ci)
+                     for term, zi, ci in zip(self.all_terms(), z, coef))
 
     # ---------------------------------------------------------------- equations of motion
-    def residual(self, c: Config, V0, omega, d_dot, acc, t=0.0, mu=None):
+    def residual(self, c: Config, V0, omega, d_dot, acc, t=0.0, z=None):
         """Virtual work of inertia minus applied forces (eq. 26) for the unknown accelerations
         acc = (dV0/dt (3, inertial), d omega/dt (3, body), d2 d/dt2 (nf)): the sum of the terms' rows.
         Rows: translation (inertial, N), rotation (body, N m), the deformable block's (N).
-        `mu` (6,): the radiation memory force at t, from the integrator's states."""
-        return jnp.concatenate(self.residual_parts(c, V0, omega, d_dot, acc[:6], acc[6:], t, mu))
+        `z`: the terms' integrator states at t (states_init's tree; None: those of t = 0)."""
+        return jnp.concatenate(self.residual_parts(c, V0, omega, d_dot, acc[:6], acc[6:], t, z))
 
-    def residual_parts(self, c: Config, V0, omega, d_dot, a6, d_acc, t=0.0, mu=None):
+    def residual_parts(self, c: Config, V0, omega, d_dot, a6, d_acc, t=0.0, z=None):
         """`residual` as (rigid rows (6,), deformable rows (nf,)), with the rigid and the deformable
         unknowns passed apart. Kept apart, JAX sees which rows and unknowns do not touch: the Newton
         preconditioner's rigid rows over the liquid's unknowns (solve/newton.py) are then a
         transpose of the liquid's rigid rows alone, where through one stacked vector every term's
         rows would be linearised and transposed with zero tangents."""
-        k = self.kin(c, V0, omega, d_dot, a6, d_acc, t, mu)
+        k = self.kin(c, V0, omega, d_dot, a6, d_acc, t)
         rigid, d = None, None
-        for term in self.all_terms():
+        for term, zi in zip(self.all_terms(), self.states_init() if z is None else z):
             with jax.named_scope(type(term).__name__):
-                r = term.rows(k)
+                r = term.rows(k._replace(z=zi))
             rigid = r.rigid if rigid is None else rigid + r.rigid
             if r.d is not None:
                 d = r.d if d is None else d + r.d

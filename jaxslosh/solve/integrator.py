@@ -40,7 +40,7 @@ class State(NamedTuple):
     t: jax.Array
     pre: Any = None   # the Newton preconditioner carried to the next step (Solver.reuse), else None
     alg: Optional[jax.Array] = None   # interface frame positions and multipliers (multibody.py), if any
-    z: Optional[jax.Array] = None   # radiation memory states (hydrodynamics.Memory), None without them
+    z: tuple = ()   # the terms' integrator states (System.states_init: zero-size for a term without)
     e0: Optional[jax.Array] = None  # the initial total energy, held by the energy projection (Solver.project)
 
 
@@ -68,14 +68,11 @@ def initial_state(system: System, solver: Solver, c0: Config, v0, alg0=None) -> 
         return _flex_initial_state(system, solver, c0, v0, alg0)
     scale = system.scales()
 
-    memory = system.memory
-    z0 = None if memory is None else memory.init()
-    mu0 = None if memory is None else memory.force(z0)
-
+    z0 = system.states_init()
     V0, om, dd = _split(v0)
 
     def parts(a6, d_acc):
-        return system.residual_parts(c0, V0, om, dd, a6, d_acc, jnp.zeros(()), mu0)
+        return system.residual_parts(c0, V0, om, dd, a6, d_acc, jnp.zeros(()), z0)
 
     def R(acc):
         return jnp.concatenate(parts(acc[:6], acc[6:]))
@@ -93,8 +90,7 @@ def initial_state_like(system: System, solver: Solver, c0: Config, v0, alg0=None
     the shapes the time loop is lowered for while the initial state's own program is still being
     traced (cache/compiled.compile_run; a test keeps the two in step)."""
     zeros = jnp.zeros_like(v0)
-    memory = system.memory
-    z0 = None if memory is None else memory.init()
+    z0 = system.states_init()
     pre = empty_pre(system) if solver.reuse else None
     info = StepInfo(jnp.zeros((), jnp.int32), jnp.zeros(()), jnp.array(True))
     if system.flex is not None:
@@ -123,13 +119,10 @@ def project_energy(system: System, c: Config, v, e0):
     return v * jnp.sqrt(jnp.where(ok, room / jnp.where(ok, T, 1.0), 1.0))
 
 
-def memory_next(system: System, solver: Solver, s: State, v_new):
-    """Radiation states at t_{n+1}: exact for a rigid velocity linear over the step, so they are a
-    linear function of the step's unknown new velocity (None without radiation)."""
-    memory = system.memory
-    if memory is None:
-        return None
-    return memory.advance(s.z, s.v[:6], v_new[:6], memory.coefficients(solver.h))
+def states_next(system: System, solver: Solver, s: State, v_new):
+    """The terms' integrator states at t_{n+1} (the radiation memory's: exact for a rigid velocity
+    linear over the step, so they are a linear function of the step's unknown new velocity)."""
+    return system.states_advance(s.z, s.v[:6], v_new[:6], system.states_coefficients(solver.h))
 
 
 def step_equations(system: System, solver: Solver, s: State):
@@ -154,18 +147,16 @@ def step_equations(system: System, solver: Solver, s: State):
     def unpack(delta):
         return (_advance(system, s.c, delta),) + rates(delta, slice(None))
 
-    memory = system.memory
-    coef = None if memory is None else memory.coefficients(h)
-
+    coef = system.states_coefficients(h)
     r = mb.layout(system).n_rigid
 
     def parts(y, z):
         vy, ay, _ = rates(y, slice(0, r))
         vz, az, _ = rates(z, slice(r, None))
-        mu = None if memory is None else memory.force(memory.advance(s.z, s.v[:6], vy[:6], coef))
+        states = system.states_advance(s.z, s.v[:6], vy[:6], coef)
         if system.flex is not None:
-            return mb.inertia_rows_parts(system, mb.advance_parts(system, s.c, y, z), vy, vz, ay, az, s.t + h, mu)
-        return system.residual_parts(advance_config_parts(s.c, y, z), vy[:3], vy[3:], vz, ay, az, s.t + h, mu)
+            return mb.inertia_rows_parts(system, mb.advance_parts(system, s.c, y, z), vy, vz, ay, az, s.t + h, states)
+        return system.residual_parts(advance_config_parts(s.c, y, z), vy[:3], vy[3:], vz, ay, az, s.t + h, states)
 
     def R(delta):
         return jnp.concatenate(parts(delta[:r], delta[r:]))
@@ -225,10 +216,8 @@ def _flex_initial_state(system, solver: Solver, c0: Config, v0, alg0):
     c0, v0, alg0, info0 = static_structures(system, solver, c0, v0, alg0)
     gsc, alg_sc = mb.alg_scales(system, 1.0, lambda itf: 1.0)       # rows m_ref d2g/dt2: forces
     scale = L.to_x(mb.scales(system), alg_sc)
-    memory = system.memory
-    z0 = None if memory is None else memory.init()
-    Rm, Rc, Rm_parts = mb.initial_residuals(system, c0, v0, alg0, jnp.zeros(()), gsc,
-                                            None if memory is None else memory.force(z0))
+    z0 = system.states_init()
+    Rm, Rc, Rm_parts = mb.initial_residuals(system, c0, v0, alg0, jnp.zeros(()), gsc, z0)
     x, (it, err, ok) = solve_root(lambda x: Rm(x) + Rc(x), jnp.zeros(L.n), solver.Cinv_mass, scale, solver.tol,
                                   solver.max_iter, L.n_small, split=(Rm, Rc, L.n_rigid, Rm_parts),
                                   implicit=solver.implicit)
@@ -268,7 +257,7 @@ def _flex_step(system, solver: Solver, s: State, fresh=None) -> tuple[State, Ste
     c, v, acc, a = unpack(dyn)
     ok = ok & jnp.all(jnp.isfinite(x))
     return (State(c, v, acc, a, s.t + solver.h, pre_new if solver.reuse else s.pre, alg,
-                  memory_next(system, solver, s, v)),
+                  states_next(system, solver, s, v)),
             StepInfo(it, err, ok))
 
 
@@ -291,7 +280,7 @@ def step(system: System, solver: Solver, s: State, fresh=None) -> tuple[State, S
     with jax.named_scope("update"):
         c, v, acc, a = unpack(delta)
         ok = ok & jnp.all(jnp.isfinite(delta))
-        z = memory_next(system, solver, s, v)
+        z = states_next(system, solver, s, v)
         if solver.project:
             v = project_energy(system, c, v, s.e0)
     return (State(c, v, acc, a, s.t + solver.h, pre=pre_new if solver.reuse else s.pre, z=z, e0=s.e0),
