@@ -110,7 +110,7 @@ def build(scene: Scene, params: Optional[dict] = None) -> Built:
         damping, _ = build_damping(scene, params, block) if eff.liquid else (None, ())
     system = System(body=body, terms=tuple(terms), liquid=liquid, gravity=g, q_ref=q0, motion=motion, flex=flex,
                     gravity_turning=eff.gravity_turning or not liquid.nf, balanced=balanced,
-                    damping=damping)
+                    tail=() if damping is None else (damping,))
     nf = system.nf
     d_init = jnp.zeros(nf)
     if nf:

@@ -19,7 +19,6 @@ import jax
 import jax.numpy as jnp
 
 from . import structures as mb
-from .damping import ModalDamping
 from .kinematics import G_matrix, quat_exp, quat_multiply, rotation_matrix, tv3
 from .liquid import AbstractLiquid
 from .terms import Config, Kin
@@ -34,7 +33,9 @@ class System(eqx.Module):
     q_ref: jax.Array                 # the initial attitude
     motion: AbstractMotion = FreeMotion()
     flex: Optional[mb.Flex] = None   # flexible structures in their own frames, and their interfaces
-    damping: Optional[ModalDamping] = None   # the liquid's modal damping ([tanks.damping]), the last term
+    # terms summed after the liquid's rows (its modal damping, [tanks.damping]): the sums' order is
+    # the residual's rounding
+    tail: tuple = ()
     gravity_turning: bool = eqx.field(static=True, default=True)   # off: g_b stays as at the start
     balanced: bool = eqx.field(static=True, default=True)          # weight balanced by static buoyancy
 
@@ -47,9 +48,7 @@ class System(eqx.Module):
         return 6 + self.nf
 
     def all_terms(self) -> tuple:
-        if self.damping is None:
-            return (self.body, *self.terms, self.liquid)
-        return (self.body, *self.terms, self.liquid, self.damping)
+        return (self.body, *self.terms, self.liquid, *self.tail)
 
     def total_mass(self):
         return self.body.mass + self.liquid.total_mass()

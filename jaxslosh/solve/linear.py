@@ -10,7 +10,7 @@ import jax
 import jax.numpy as jnp
 import numpy as np
 
-from ..fem.linalg import inv, solve
+from ..fem.linalg import inv
 from ..physics.structures import layout
 from ..physics.system import System
 from ..staging import staged
@@ -116,39 +116,14 @@ def _noise(system: System, K_ff):
     return jnp.finfo(jnp.float64).eps * jnp.max(jnp.sum(jnp.abs(jnp.asarray(K_ff)), axis=1) / scale)
 
 
-class LowRankUpdate(eqx.Module):
-    """The inverse of A + U D U^T from A's: the step block with the liquid's modal damping
-    (physics/damping.py), whose C = B diag(c) B^T has the rank of its few sloshing modes. By the
-    Sherman-Morrison-Woodbury formula, in the form that allows zero entries of D (undamped modes):
-
-        (A + U D U^T)^-1 = A^-1 - W D (I + G D)^-1 W^T,   W = A^-1 U,  G = U^T W
-
-    W is formed once per run (k solves with the constant block's inverse, dense or sparse); a solve
-    is A's and two thin products. D follows a traced damping ratio (a k x k solve per run)."""
-    base: Any              # A^-1: a matrix, or an object with `@` (the sparse paths)
-    W: jax.Array           # (nf, k)
-    S: jax.Array           # (k, k) D (I + G D)^-1
-
-    @property
-    def shape(self):
-        return self.base.shape
-
-    def __matmul__(self, x):
-        return self.base @ x - self.W @ (self.S @ (self.W.T @ x))
-
-
 def damped(base, system: System, scheme: Scheme, hh):
-    """The step block's inverse with the modal damping's c_v C added (c_v = d v_{n+1} / d Delta =
-    gamma / (beta h)); `base` itself where the system has none. Formed from stop_gradient values:
-    it only preconditions the iterations, whose solutions do not depend on it."""
-    if system.damping is None:
-        return base
-    B, c = jax.lax.stop_gradient((system.damping.B, system.damping.c))
-    W = base @ B
-    D = scheme.c_v(hh) * c
-    G = B.T @ W
-    S = solve(jnp.eye(c.shape[0]) + D[:, None] * G, jnp.diag(D))      # (I + D G)^-1 D = D (I + G D)^-1
-    return LowRankUpdate(base, W, S)
+    """The step block's inverse with every term's constant velocity tangent c_v dR/d(d_dot) added
+    (c_v = d v_{n+1} / d Delta = gamma / (beta h)): AbstractTerm.update_inverse, the modal
+    damping's low-rank update (physics/damping.py); `base` itself from a term without one."""
+    c_v = scheme.c_v(hh)
+    for term in system.all_terms():
+        base = term.update_inverse(base, c_v)
+    return base
 
 
 class BlockInverse(eqx.Module):
