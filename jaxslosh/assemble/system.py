@@ -30,7 +30,7 @@ from .liquid import LiquidBlock, build_liquid_block, rigid_part
 from .multimodal import build_multimodal, multimodal_damping, multimodal_scene, probe_modal, surfaces
 from .probes import Probes, build_probes
 from .seakeeping import build_seakeeping
-from .structures import build_flex, flex_start
+from .structures import build_structures
 
 
 class Built(NamedTuple):
@@ -39,14 +39,20 @@ class Built(NamedTuple):
     v0: jnp.ndarray
     probes: Probes
     tanks: tuple
-    alg0: Optional[jnp.ndarray] = None    # interface frame positions (and zero multipliers) at t = 0
+    alg0: jnp.ndarray                    # algebraic unknowns at t = 0: interface frame positions, zero multipliers
     structures: tuple = ()               # host-side StructureBlock per structure (result fields)
     surfaces: tuple = ()                 # per tank, the stacked indices of its free-surface nodes (validity)
 
 
 #: the build's jax.numpy steps, each one compiled program (staging.staged), wrapped once per process
 _quat_from_rpy = staged(quat_from_rpy)
-_flex_start = staged(flex_start)
+
+
+def _owners_start(system: System, c0: Config, v0):
+    return system.start(c0, v0)
+
+
+_start = staged(_owners_start)
 
 
 def _inertia(value):
@@ -88,7 +94,7 @@ def build(scene: Scene, params: Optional[dict] = None) -> Built:
     sea_terms = build_seakeeping(scene, params) if scene.waves is not None or ves.hydrodynamics is not None else ()
     terms += sea_terms
     own = [s for s in scene.structures if s.frame == "own"]
-    flex, blocks = build_flex(scene) if own else (None, ())
+    structures, blocks = build_structures(scene) if own else (None, ())
     mass, inertia = jnp.asarray(P("vessel.mass", ves.mass), dtype=float), _inertia(P("vessel.inertia", ves.inertia))
     hull_S = None
     carried = block.carried + tuple(rigid_part(b.model.mass, b.model.nodes + np.asarray(scene.structure(b.name).origin))
@@ -104,11 +110,13 @@ def build(scene: Scene, params: Optional[dict] = None) -> Built:
         terms.append(RotationPenalty(Kdt=block.penalty[0], Ktt=block.penalty[1], q_ref=q0))
     if block.Kg is not None:
         terms.append(SpinStiffening(block.Kg))
+    if structures is not None:
+        terms.append(structures)
     if multimodal:
         damping = multimodal_damping(scene, params, liquid)
     else:
         damping, _ = build_damping(scene, params, block) if eff.liquid else (None, ())
-    system = System(body=body, terms=tuple(terms), liquid=liquid, gravity=g, q_ref=q0, motion=motion, flex=flex,
+    system = System(body=body, terms=tuple(terms), liquid=liquid, gravity=g, q_ref=q0, motion=motion,
                     gravity_turning=eff.gravity_turning or not liquid.nf, balanced=balanced,
                     tail=() if damping is None else (damping,))
     nf = system.nf
@@ -122,9 +130,8 @@ def build(scene: Scene, params: Optional[dict] = None) -> Built:
     if motion.prescribed:   # the prescribed motion sets the rigid state at t = 0
         c0 = Config(x0[:3], q0, c0.d)
         v0 = v0.at[:6].set(motion.rates(jnp.zeros(())))
-    alg0 = None
-    if flex is not None:
-        c0, v0, alg0 = _flex_start(system, c0, v0)
+    # the terms that own unknowns (the structures) start them; nothing to compile without
+    c0, v0, alg0 = _start(system, c0, v0) if system.owners() else (c0, v0, jnp.zeros(0))
     probes = build_probes(scene, block.tanks, liquid, blocks, block.vstructs)
     probes = probes._replace(modal=liquid.probe_modal(probes.weights))    # a modal liquid: probes from eta
     if multimodal:

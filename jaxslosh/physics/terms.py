@@ -19,7 +19,11 @@ for every term and never asks which term has what):
   zero-size array. A term reads its states at the evaluation's time as `k.z`;
 * `update_inverse(inv, c_v)`: the inverse of the deformable block of the step matrix with this
   term's constant velocity tangent added (the modal damping's low-rank update); the default
-  leaves it as it is.
+  leaves it as it is;
+* `unknowns()`: unknowns of the term's own beside the vessel's and the deformable block's
+  (floating frames, algebraic unknowns with their constraints, deformable coordinates); the
+  default is none. A term with unknowns implements the interface of `unknowns.AbstractOwner`
+  (the flexible structures, physics/structures.py).
 
 A term's rows are written out. Where the term has a potential, a test checks its rows against
 the potential's gradient along the step's increments (`potential_rows`, by JAX): a gradient inside
@@ -74,6 +78,15 @@ class Kin(NamedTuple):
         return jnp.concatenate([self.V0, self.omega])
 
 
+class Unknowns(NamedTuple):
+    """A term's own unknowns (static sizes): `frames` floating frames of 6 rigid unknowns each
+    (solved with the vessel's), `alg` algebraic ones (multipliers, interface frames: no inertia,
+    solved at t_{n+1}) and `deformable` ones (with a constant block, beside the liquid's)."""
+    frames: int = 0
+    alg: int = 0
+    deformable: int = 0
+
+
 class Rows(NamedTuple):
     rigid: jax.Array                 # (6,)
     d: Optional[jax.Array] = None    # (nf,) the deformable block's rows (its owner only)
@@ -108,6 +121,10 @@ class AbstractTerm(eqx.Module):
         """Its states at t_{n+1} from those at t_n and the rigid velocities (6,) at both ends (v_new
         is the step's unknown: the states enter the residual through it)."""
         return z
+
+    def unknowns(self) -> Unknowns:
+        """Its own unknowns: none (see unknowns.AbstractOwner for a term that has some)."""
+        return Unknowns()
 
     def update_inverse(self, inv, c_v):
         """The inverse of the step matrix's deformable block with this term's c_v dR/d(d_dot) added

@@ -11,7 +11,6 @@ import jax.numpy as jnp
 import numpy as np
 
 from ..fem.linalg import inv
-from ..physics.structures import layout
 from ..physics.system import System
 from ..staging import staged
 from .schemes import Scheme
@@ -38,8 +37,8 @@ class Solver(eqx.Module):
     # refresh the preconditioner inside the iterations when convergence slows (a lax.cond); False
     # for vmapped batches, where a cond computes both branches
     adaptive: bool = eqx.field(static=True, default=True)
-    # unknowns of the exact (Schur) block: the 6 rigid ones, and with flexible structures their rigid
-    # unknowns and the interface frames and multipliers (multibody.Layout.n_small)
+    # unknowns of the exact (Schur) block: the 6 rigid ones, and the owners' rigid and algebraic
+    # unknowns (physics/unknowns.Layout.n_small); a nonlinear liquid's too
     ns: int = eqx.field(static=True, default=6)
     # after each step, scale the velocities so that the total energy is the initial one (the
     # `simulation.energy_projection` key: trapezoidal rule, conservative scenes only; see project_energy)
@@ -67,15 +66,24 @@ class Solver(eqx.Module):
 def make_solver(system: System, h: float, scheme: Scheme, tol: float, max_iter: int, substeps: int = 0,
                 reuse: bool = False, adaptive: bool = True) -> Solver:
     """Factor the constant liquid blocks once (float64): NumPy for concrete matrices, JAX when the
-    liquid was built from traced values (under jit).
+    liquid was built from traced values (under jit); the terms that own deformable unknowns append
+    their block, diagonal (the structures' modal one, Phi^T M Phi = I, Phi^T K Phi = omega^2:
+    1 / (c_a + omega^2)), and their rigid and algebraic unknowns join the exact block.
 
     The inverses only precondition the Newton iterations and the tangent solves, whose solutions do
     not depend on them (`lax.custom_root` drops their tangents), so they are formed from
     `stop_gradient` values: under `jax.grad` outside jit the matrices are then concrete again."""
-    nf = system.nf
     substeps = int(substeps) if substeps and substeps > 1 else 0
-    if system.flex is not None:
-        return _flex_solver(system, h, scheme, tol, max_iter, substeps, reuse, adaptive)
+    base = _liquid_solver(system, h, scheme, tol, max_iter, substeps, reuse, adaptive)
+    sub = _extended(base.Cinv_sub, system.block_diagonal(scheme.c_a(h / substeps), 1.0)) if substeps else None
+    return dataclasses.replace(base, Cinv_step=_extended(base.Cinv_step, system.block_diagonal(scheme.c_a(h), 1.0)),
+                               Cinv_mass=_extended(base.Cinv_mass, system.block_diagonal(1.0, 0.0)), Cinv_sub=sub,
+                               ns=base.ns + system.layout().n_small - 6)
+
+
+def _liquid_solver(system: System, h, scheme: Scheme, tol, max_iter, substeps, reuse, adaptive) -> Solver:
+    """The solver of the vessel and its liquid: the deformable block's inverses."""
+    nf = system.nf
     if nf == 0 or system.liquid.nonlinear:      # a nonlinear liquid's few unknowns: linearised exactly
         z = jnp.zeros((0, 0))
         return Solver(z, z, jnp.asarray(h, dtype=float), scheme, tol, max_iter, substeps, z if substeps else None,
@@ -127,8 +135,8 @@ def damped(base, system: System, scheme: Scheme, hh):
 
 
 class BlockInverse(eqx.Module):
-    """The constant-block inverse with flexible structures: the liquid's (a dense matrix, or the
-    sparse factors of sparse.py) and the structures' modal block, which is diagonal."""
+    """The constant-block inverse with the owners' deformable unknowns: the liquid's (a dense
+    matrix, or the sparse factors of sparse.py) and theirs, which is diagonal (the structures' modal block)."""
     liquid: Any           # (nf, nf)
     modal: jax.Array      # (m,)
 
@@ -143,22 +151,15 @@ class BlockInverse(eqx.Module):
         return jnp.concatenate([self.liquid @ x[:nf], bottom])
 
 
-def _flex_solver(system: System, h, scheme: Scheme, tol, max_iter, substeps, reuse, adaptive) -> Solver:
-    """With flexible structures: the liquid block inverses as without them, and the structures'
-    modal block, which is diagonal (Phi^T M Phi = I, Phi^T K Phi = omega^2): 1 / (c_a + omega^2)."""
-    base = make_solver(dataclasses.replace(system, flex=None), h, scheme, tol, max_iter, substeps, reuse, adaptive)
-    w2 = jax.lax.stop_gradient(jnp.concatenate([b.omega2 for b in system.flex.bodies]))
-    sub = BlockInverse(base.Cinv_sub, 1.0 / (scheme.c_a(h / substeps) + w2)) if substeps else None
-    return Solver(BlockInverse(base.Cinv_step, 1.0 / (scheme.c_a(h) + w2)), BlockInverse(base.Cinv_mass, jnp.ones_like(w2)),
-                  jnp.asarray(h, dtype=float), scheme, tol, max_iter, substeps, sub, noise=base.noise, reuse=reuse,
-                  adaptive=adaptive, ns=layout(system).n_small)
+def _extended(inv, diag):
+    """The inverse with the owners' diagonal block `diag` appended (itself where they have none: a
+    size, static)."""
+    return inv if diag.shape[0] == 0 else BlockInverse(inv, 1.0 / diag)
 
 
 def empty_pre(system: System):
     """A carried preconditioner of the right shapes, marked not valid (formed at the first step)."""
-    ns, nz = (6 + system.nf, 0) if system.liquid.nonlinear else (6, system.nf)
-    if system.flex is not None:
-        L = layout(system)
-        ns, nz = L.n_small, L.nf + L.m
+    L = system.layout()
+    ns, nz = (L.n_small + L.nf, L.m) if system.liquid.nonlinear else (L.n_small, L.nf + L.m)
     data = (jnp.zeros((ns, ns)),) if nz == 0 else (jnp.zeros((ns, ns)), jnp.zeros((ns, nz)), jnp.zeros((nz, ns)))
     return data, jnp.zeros(())
