@@ -38,6 +38,11 @@ class System(eqx.Module):
     gravity_turning: bool = eqx.field(static=True, default=True)   # off: g_b stays as at the start
     balanced: bool = eqx.field(static=True, default=True)          # weight balanced by static buoyancy
 
+    def __check_init__(self):
+        if len(self.owners()) > 1:      # the layout places one owner's unknowns (physics/unknowns.py)
+            raise ValueError("a System holds at most one term that owns unknowns (the structures' term "
+                             "holds every structure and interface)")
+
     @property
     def nf(self) -> int:
         return self.liquid.nf
@@ -112,6 +117,17 @@ class System(eqx.Module):
         """The constraints' rows in Newton order [y, alg, z] (zero without owners)."""
         rows = [o.constraint_rows(self, c, alg, g_rows, gscale) for o in self.owners()]
         return sum(rows[1:], rows[0]) if rows else jnp.zeros(self.layout().n)
+
+    def constraint_residual(self, x, config, gscale):
+        """The constraints' part Rc of the step's residual at x = [y, alg, z] in Newton order,
+        `config(dyn)` the configuration of the dynamic unknowns: zero without owners, where not
+        even the configuration is formed (a dead update in every Newton iteration is not always
+        removed by XLA: it doubled the paper example's step)."""
+        if not self.owners():
+            return jnp.zeros_like(x)
+        dyn, alg = self.layout().from_x(x)
+        c = config(dyn)
+        return self.constraint_rows(c, alg, self.constraint(c, alg), gscale)
 
     def initial_constraint_rows(self, c: Config, v, alg0, mscale):
         """x -> the constraints' rows of the initial accelerations (d^2 g / dt^2 = 0)."""

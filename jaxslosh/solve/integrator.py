@@ -225,9 +225,7 @@ def step(system: System, solver: Solver, s: State, fresh=None) -> tuple[State, S
         _, unpack, pred, Rm_parts = step_equations(system, solver, s)
 
         def Rc(x):
-            dyn, alg = L.from_x(x)
-            c = unpack(dyn)[0]
-            return system.constraint_rows(c, alg, system.constraint(c, alg), gsc)
+            return system.constraint_residual(x, lambda dyn: unpack(dyn)[0], gsc)
 
         R, split = _split_newton(system, Rm_parts, Rc, L.n_rigid)
         floor = solver.noise * jnp.max(jnp.abs(s.c.d), initial=0.0)
