@@ -143,6 +143,8 @@ class System(eqx.Module):
         """Characteristic mass of each dynamic unknown (dyn order): the vessel-and-liquid scales
         and the owners' (so that every row over its scale is an acceleration)."""
         base = self.scales()
+        if not self.owners():
+            return base
         y, z = base[:6], base[6:]
         for o in self.owners():
             y, z = o.add_scales(y, z)
