@@ -22,7 +22,7 @@ import jax.numpy as jnp  # noqa: E402
 import numpy as np  # noqa: E402
 
 import jaxslosh as js  # noqa: E402
-from jaxslosh.solve.integrator import State, StepInfo, step_equations  # noqa: E402
+from jaxslosh.solve.integrator import StepInfo, step_equations  # noqa: E402
 from jaxslosh.run.loop import core as _core, advance, start  # noqa: E402
 from jaxslosh.run.simulate import prepare
 from jaxslosh.scene.keys import with_overrides
@@ -43,7 +43,7 @@ def naive_step(system, solver, s):
     x, it, err = jax.lax.while_loop(lambda c: (c[2] > solver.tol) & (c[1] < solver.max_iter), body,
                                     (x0, 0, jnp.max(jnp.abs(R(x0) / scale))))
     c, v, acc, a = unpack(x)
-    return State(c, v, acc, a, s.t + solver.h, s.pre), StepInfo(it, err, err <= solver.tol)
+    return s._replace(c=c, v=v, acc=acc, a=a, t=s.t + solver.h), StepInfo(it, err, err <= solver.tol)
 
 
 @eqx.filter_jit

@@ -51,7 +51,7 @@ def decay_decrement(scene):
     setup = prepare(scene)
     b, solver, system = setup.built, setup.solver, setup.built.system
     M = np.asarray(system.liquid.constant_blocks()[0])
-    mode = np.linalg.solve(M, np.asarray(system.damping.B[:, 0]))
+    mode = np.linalg.solve(M, np.asarray(system.tail[0].B[:, 0]))
     mode = mode / np.max(np.abs(np.asarray(system.liquid.nodal_fields(system.liquid.frame_field(jnp.asarray(mode))))))
     K = np.asarray(system.liquid.constant_blocks()[1])
     omega = float(np.sqrt(mode @ K @ mode / (mode @ M @ mode)))

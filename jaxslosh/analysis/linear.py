@@ -28,13 +28,12 @@ import jax.numpy as jnp
 import numpy as np
 
 from ..assemble.system import Built
-from ..physics import structures as mb
 from ..physics.seakeeping import AddedMass
-from ..physics.system import advance_config
 from ..run.loop import probe_positions
 from ..run.simulate import is_traced, prepare
 from ..scene.types import DOFS, Initial, Scene, SceneError
-from ..solve.integrator import static_structures
+from ..physics.unknowns import Layout
+from ..solve.integrator import static_equilibrium
 
 #: above this many unknowns the dense matrices (3 n^2 doubles, and a complex factor per frequency)
 #: outgrow a workstation: the liquid should be reduced to its modes ([tanks.reduction])
@@ -75,7 +74,7 @@ def rest_scene(scene: Scene) -> Scene:
     return dataclasses.replace(scene, vessel=dataclasses.replace(ves, initial=Initial()))
 
 
-def _labels(b: Built, L: mb.Layout) -> tuple:
+def _labels(b: Built, L: Layout) -> tuple:
     names = list(DOFS)
     for s in b.structures:
         names += [f"structure {s.name}"] * 6
@@ -92,36 +91,28 @@ def linearise(scene: Scene, params=None) -> Linearisation:
     setup = prepare(rest_scene(scene), params)
     b, solver = setup.built, setup.solver
     sysm = b.system
-    L = mb.layout(sysm)
+    L = sysm.layout()
     n = L.n
     if n > MAX_UNKNOWNS:
         raise SceneError("tanks.reduction", f"the linearised model has {n} unknowns (dense matrices above "
                                             f"{MAX_UNKNOWNS}): reduce the liquid to its modes with [tanks.reduction]")
-    flex = sysm.flex
-    if flex is None:
-        c0, alg0 = b.c0, jnp.zeros(0)
-    else:
-        c0, _, alg0, info = static_structures(sysm, solver, b.c0, b.v0, b.alg0)
-        if not bool(info.ok):
-            raise SceneError("structures", "no static equilibrium of the structures under their weight was found")
-        # the interface rows as forces per metre of gap (any scale solves the same equations; the
-        # structure's mass keeps them near the other rows' size for the factorisations)
-        gscale = [itf.m_ref for itf in flex.interfaces]
+    c0, _, alg0, info = static_equilibrium(sysm, solver, b.c0, b.v0, b.alg0)
+    if not bool(info.ok):
+        raise SceneError("structures", "no static equilibrium of the structures under their weight was found")
+    # the interface rows as forces per metre of gap (any scale solves the same equations; the
+    # structure's mass keeps them near the other rows' size for the factorisations)
+    gscale, _ = sysm.alg_scales(1.0, lambda itf: 1.0)
 
     def rows(x, v, acc):
         dyn, alg = L.from_x(x)
-        if flex is None:
-            c = advance_config(c0, dyn)
-            return sysm.residual(c, v[:3], v[3:6], v[6:], acc, jnp.zeros(()), None)
-        c = mb.advance(sysm, c0, dyn)
+        c = sysm.advance(c0, dyn)
         alg = alg0 + alg
-        main = L.to_x(mb.inertia_rows(sysm, c, v, acc, jnp.zeros(())), jnp.zeros(L.n_alg))
-        return main + mb.constraint_rows(sysm, c, alg, mb.constraint(sysm, c, alg), gscale)
+        main = L.to_x(sysm.step_rows(c, v, acc, jnp.zeros(())), jnp.zeros(L.n_alg))
+        return main + sysm.constraint_rows(c, alg, sysm.constraint(c, alg), gscale)
 
     def position(x):
         dyn, _ = L.from_x(x)
-        c = advance_config(c0, dyn) if flex is None else mb.advance(sysm, c0, dyn)
-        return probe_positions(b, c)
+        return probe_positions(b, sysm.advance(c0, dyn))
 
     zx, zd = jnp.zeros(n), jnp.zeros(L.n_dyn)
 

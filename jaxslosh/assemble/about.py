@@ -75,7 +75,7 @@ def stiffening_about(scene: Scene, frame: str) -> About:
 
 
 def flex_about(scene: Scene) -> About:
-    """The structures in their own floating frames (physics/structures.py Flex)."""
+    """The structures in their own floating frames (physics/structures.py Structures)."""
     lines = []
     for s in scene.structures:
         if s.frame != "own":

@@ -7,7 +7,6 @@ from __future__ import annotations
 import dataclasses
 
 from ..physics.liquid import NoLiquid
-from ..physics.structures import Flex
 from ..physics.system import System
 from ..physics.terms import AbstractTerm
 from ..physics.vessel import AbstractMotion
@@ -19,9 +18,9 @@ from .system import outline
 GRAVITY_TURNING = ("gravity turning with the body", "load of eq. (32) on the liquid")
 
 
-#: what describes itself: the terms, and the System's parts beside them (the hull's motion, the
-#: structures in their own frames)
-DESCRIBED = (AbstractTerm, AbstractMotion, Flex)
+#: what describes itself: the terms (the structures in their own frames among them), and the
+#: System's parts beside them (the hull's motion)
+DESCRIBED = (AbstractTerm, AbstractMotion)
 
 
 def model_parts(system: System) -> tuple:

@@ -49,12 +49,12 @@ def linear_excitation_rao(scene, c) -> Optional[np.ndarray]:
 
 
 def build_seakeeping(scene, params: dict) -> tuple:
-    """(terms, memory): the wave and radiation terms of a scene, with what its effects switch on,
-    and the radiation memory whose states the integrator carries (None without). Host-side tables
+    """The wave and radiation terms of a scene, with what its effects switch on (the radiation
+    memory among them, a term with integrator states). Host-side tables
     use the scene's water density and gravity (params overrides of those do not reach the
     hydrodynamic coefficients); `waves.amplitude` / `waves.hs` may be traced."""
     eff, ves, waves = scene.effects, scene.vessel, scene.waves
-    terms, memory = [], None
+    terms = []
     if waves is not None and eff.waves:
         X = linear_excitation_rao(scene, components(waves))
         if X is not None:
@@ -68,10 +68,10 @@ def build_seakeeping(scene, params: dict) -> tuple:
             terms.append(AddedMass(jnp.asarray(fit.added_mass_infinite), about=added_mass_about(scene)))
             memory = memory_module(fit)
             if memory is not None:
-                terms.append(RadiationMemory(about=memory_about(scene)))
+                terms.append(RadiationMemory(memory, about=memory_about(scene)))
         if hd.viscous_damping is not None:
             terms.append(LinearDamping(jnp.asarray(matrix6(hd.viscous_damping)), about=viscous_about()))
-    return tuple(terms), memory
+    return tuple(terms)
 
 
 def outline_seakeeping(scene) -> tuple:
@@ -86,7 +86,7 @@ def outline_seakeeping(scene) -> tuple:
     hd = ves.hydrodynamics
     if hd is not None and eff.radiation:
         if hd.capytaine or hd.added_mass is not None:          # hydro/source.radiation_fit has a fit
-            terms += [AddedMass(None, about=added_mass_about(scene)), RadiationMemory(about=memory_about(scene))]
+            terms += [AddedMass(None, about=added_mass_about(scene)), RadiationMemory(None, about=memory_about(scene))]
         if hd.viscous_damping is not None:
             terms.append(LinearDamping(None, about=viscous_about()))
     return tuple(terms)

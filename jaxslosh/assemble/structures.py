@@ -9,10 +9,7 @@ import numpy as np
 
 from ..fem.mesh import face_nodes
 from ..fem.structure import build_structure, centrifugal_stiffness
-from ..physics.kinematics import rotation_matrix
-from ..physics.structures import Body, Flex, Interface, Side, layout
-from ..physics.system import System
-from ..physics.terms import Config
+from ..physics.structures import Body, Interface, Side, Structures
 from ..scene.types import Scene
 
 
@@ -25,7 +22,7 @@ class StructureBlock(NamedTuple):
     model: object
 
 
-def build_flex(scene: Scene):
+def build_structures(scene: Scene):
     """Each structure in its own floating frame (origin at its COG), tied at its `attach` face to an
     interface frame that the vessel is tied to as well (localized multipliers on both sides)."""
     bodies, interfaces, blocks, models = [], [], [], {}
@@ -64,22 +61,4 @@ def build_flex(scene: Scene):
         L_ref = float(max(max(st.size), np.abs(points).max()))
         interfaces.append(Interface(sides=(other, Side(i, jnp.asarray(nodes), jnp.asarray(points))),
                                     m_ref=jnp.asarray(m_ref), L_ref=L_ref))
-    return Flex(bodies=tuple(bodies), interfaces=tuple(interfaces)), tuple(blocks)
-
-
-def flex_start(system: System, c0: Config, v0):
-    """Structures at rest relative to the vessel, undeformed: frames aligned with the vessel's, at
-    their centres of gravity, moving with it; interface frames on the vessel's attachment points."""
-    flex = system.flex
-    L = layout(system)
-    A = rotation_matrix(c0.q)
-    V, om = v0[:3], v0[3:6]
-    Xs = jnp.stack([c0.X0 + A @ b.c0 for b in flex.bodies])
-    qs = jnp.tile(c0.q, (L.S, 1))
-    c = c0._replace(Xs=Xs, qs=qs, eta=jnp.zeros(L.m))
-    rig = jnp.concatenate([jnp.concatenate([V + A @ jnp.cross(om, b.c0), om]) for b in flex.bodies])
-    v = jnp.concatenate([v0[:6], rig, v0[6:], jnp.zeros(L.m)])
-    alg = []
-    for itf in flex.interfaces:
-        alg += [(c0.X0[None, :] + itf.sides[0].points @ A.T).reshape(-1), jnp.zeros(3 * itf.n * len(itf.sides))]
-    return c, v, jnp.concatenate(alg)
+    return Structures(bodies=tuple(bodies), interfaces=tuple(interfaces)), tuple(blocks)

@@ -18,7 +18,7 @@ from ..physics.damping import ModalDamping
 from ..physics.kinematics import quat_from_rpy, rotation_matrix
 from ..physics.liquid import NoLiquid, RotationPenalty, SpinStiffening
 from ..physics.multimodal import MultimodalLiquid
-from ..physics.structures import Flex
+from ..physics.structures import Structures
 from ..physics.system import System
 from ..physics.terms import Config
 from ..physics.vessel import (FreeMotion, HarmonicMotion, Hydrostatics, PaperHydrostatics, RecordedMotion, RigidBody,
@@ -34,7 +34,7 @@ from .liquid import LiquidBlock, build_liquid_block, outline_liquid_block, rigid
 from .multimodal import build_multimodal, multimodal_damping, multimodal_scene, probe_modal, surfaces
 from .probes import Probes, build_probes
 from .seakeeping import build_seakeeping, outline_seakeeping
-from .structures import build_flex, flex_start
+from .structures import build_structures
 
 
 class Built(NamedTuple):
@@ -43,14 +43,20 @@ class Built(NamedTuple):
     v0: jnp.ndarray
     probes: Probes
     tanks: tuple
-    alg0: Optional[jnp.ndarray] = None    # interface frame positions (and zero multipliers) at t = 0
+    alg0: jnp.ndarray                    # algebraic unknowns at t = 0: interface frame positions, zero multipliers
     structures: tuple = ()               # host-side StructureBlock per structure (result fields)
     surfaces: tuple = ()                 # per tank, the stacked indices of its free-surface nodes (validity)
 
 
 #: the build's jax.numpy steps, each one compiled program (staging.staged), wrapped once per process
 _quat_from_rpy = staged(quat_from_rpy)
-_flex_start = staged(flex_start)
+
+
+def _owners_start(system: System, c0: Config, v0):
+    return system.start(c0, v0)
+
+
+_start = staged(_owners_start)
 
 
 def _inertia(value):
@@ -71,7 +77,7 @@ def build(scene: Scene, params: Optional[dict] = None) -> Built:
     P = params.get
     ves = scene.vessel
     system, block, blocks, multimodal = _model(scene, params)
-    liquid, motion, flex, q0 = system.liquid, system.motion, system.flex, system.q_ref
+    liquid, motion, q0 = system.liquid, system.motion, system.q_ref
     ini = ves.initial
     nf = system.nf
     d_init = jnp.zeros(nf)
@@ -84,9 +90,8 @@ def build(scene: Scene, params: Optional[dict] = None) -> Built:
     if motion.prescribed:   # the prescribed motion sets the rigid state at t = 0
         c0 = Config(motion.coordinates(jnp.zeros(()))[:3], q0, c0.d)
         v0 = v0.at[:6].set(motion.rates(jnp.zeros(())))
-    alg0 = None
-    if flex is not None:
-        c0, v0, alg0 = _flex_start(system, c0, v0)
+    # the terms that own unknowns (the structures) start them; nothing to compile without
+    c0, v0, alg0 = _start(system, c0, v0) if system.owners() else (c0, v0, jnp.zeros(0))
     probes = build_probes(scene, block.tanks, liquid, blocks, block.vstructs)
     probes = probes._replace(modal=liquid.probe_modal(probes.weights))    # a modal liquid: probes from eta
     if multimodal:
@@ -150,18 +155,13 @@ def _model(scene: Scene, params: dict, outline: bool = False) -> _Model:
         q0 = _quat_from_rpy(jnp.asarray(P("vessel.initial.roll_pitch_yaw", ini.roll_pitch_yaw), dtype=float))
         if motion.prescribed:     # the prescribed attitude at t = 0 (upright unless a phase or a record tilts it)
             q0 = _quat_from_rpy(motion.coordinates(jnp.zeros(()))[3:])
-    memory = None
     if scene.waves is not None or ves.hydrodynamics is not None:
-        if outline:
-            terms += outline_seakeeping(scene)
-        else:
-            sea_terms, memory = build_seakeeping(scene, params)
-            terms += sea_terms
+        terms += outline_seakeeping(scene) if outline else build_seakeeping(scene, params)
     own = [s for s in scene.structures if s.frame == "own"]
-    flex, blocks = None, ()
+    structures, blocks = None, ()
     if own:
-        flex, blocks = (Flex(bodies=(), interfaces=()), ()) if outline else build_flex(scene)
-        flex = dataclasses.replace(flex, about=flex_about(scene))
+        structures, blocks = (Structures(bodies=(), interfaces=()), ()) if outline else build_structures(scene)
+        structures = dataclasses.replace(structures, about=flex_about(scene))
     mass, inertia = jnp.asarray(P("vessel.mass", ves.mass), dtype=float), _inertia(P("vessel.inertia", ves.inertia))
     hull_S = None
     carried = block.carried + tuple(rigid_part(b.model.mass, b.model.nodes + np.asarray(scene.structure(b.name).origin))
@@ -181,6 +181,8 @@ def _model(scene: Scene, params: dict, outline: bool = False) -> _Model:
         terms.append(RotationPenalty(Kdt=block.penalty[0], Ktt=block.penalty[1], q_ref=q0))
     if block.Kg is not None:
         terms.append(SpinStiffening(None if outline else block.Kg, about=stiffening_about(scene, "vessel")))
+    if structures is not None:
+        terms.append(structures)
     damping = None
     if outline:
         damping = ModalDamping(B=None, c=None) if any(t.damping is not None for t in scene.tanks) and has_liquid \
@@ -191,9 +193,9 @@ def _model(scene: Scene, params: dict, outline: bool = False) -> _Model:
         damping, _ = build_damping(scene, params, block)
     if damping is not None:
         damping = dataclasses.replace(damping, about=damping_about(scene))
-    system = System(body=body, terms=tuple(terms), liquid=liquid, gravity=g, q_ref=q0, motion=motion, memory=memory,
-                    flex=flex, gravity_turning=eff.gravity_turning or not has_liquid, balanced=balanced,
-                    damping=damping)
+    system = System(body=body, terms=tuple(terms), liquid=liquid, gravity=g, q_ref=q0, motion=motion,
+                    gravity_turning=eff.gravity_turning or not has_liquid, balanced=balanced,
+                    tail=() if damping is None else (damping,))
     return _Model(system, block, blocks, multimodal)
 
 

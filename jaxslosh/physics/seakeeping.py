@@ -16,7 +16,7 @@ motions). In the frequency domain this is the classical
 which the tests check against the time-domain run.
 
 The memory (hydro/radiation.py fits it) is a set of complex poles p_k, each with a state
-w_k' = p_k w_k + xi_dot_j; the states live in the integrator's State and a step advances them exactly
+w_k' = p_k w_k + xi_dot_j; the states are the RadiationMemory term's integrator states and a step advances them exactly
 for a velocity linear over the step, so the memory force is linear in the step's unknown new velocity.
 """
 from __future__ import annotations
@@ -145,13 +145,22 @@ class LinearDamping(AbstractTerm):
 
 
 class RadiationMemory(AbstractTerm):
-    """The memory force mu(t) of the Cummins equation: the System's `memory` states give it (the
-    integrator advances them), this term puts it on the rigid rows."""
+    """The memory force mu(t) of the Cummins equation on the rigid rows, from the memory's states:
+    integrator states of this term (terms.AbstractTerm's hooks), advanced by every step."""
+    memory: Memory
     about: About = eqx.field(static=True, default=About())     # where the fit comes from
 
     def rows(self, k: Kin) -> Rows:
-        return Rows(jnp.zeros(6) if k.mu is None else k.mu)
+        return Rows(self.memory.force(k.z))
 
     def describe(self) -> tuple:
         return self.about.lines
 
+    def state_init(self):
+        return self.memory.init()
+
+    def state_coefficients(self, h):
+        return self.memory.coefficients(h)
+
+    def state_advance(self, z, v_old, v_new, coef):
+        return self.memory.advance(z, v_old, v_new, coef)

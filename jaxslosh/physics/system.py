@@ -7,23 +7,21 @@ coordinates: X0 (inertial position of the vessel COG), q (Euler parameters), d (
 block: liquid displacement relative to the tank on the dofs the slip walls leave free, or its modal
 coordinates). Generalised velocities: V0 = dX0/dt (inertial), omega (body frame), d_dot. The
 residual is the virtual work of inertia minus applied forces (eq. 26), the sum of the terms' rows;
-the energy is the sum of the terms' energies; tangents come from JAX. Flexible structures in their
-own frames (structures.py) add unknowns and multipliers around this core.
+the energy is the sum of the terms' energies; tangents come from JAX. A term with unknowns of its
+own (unknowns.py: the flexible structures in their own frames, structures.py) adds unknowns,
+multipliers and constraints around this core through its hooks; the System's `layout`, `advance`,
+`step_rows_parts`, `constraint_rows` and the rest are what the step calls, the same for every system.
 """
 from __future__ import annotations
-
-from typing import Optional
 
 import equinox as eqx
 import jax
 import jax.numpy as jnp
 
-from . import structures as mb
-from .damping import ModalDamping
 from .kinematics import G_matrix, quat_exp, quat_multiply, rotation_matrix, tv3
 from .liquid import AbstractLiquid
-from .seakeeping import Memory
-from .terms import Config, Kin
+from .terms import Config, Kin, Unknowns
+from .unknowns import Layout
 from .vessel import AbstractMotion, FreeMotion, RigidBody
 
 
@@ -34,11 +32,16 @@ class System(eqx.Module):
     gravity: jax.Array               # m/s^2, along -Z
     q_ref: jax.Array                 # the initial attitude
     motion: AbstractMotion = FreeMotion()
-    memory: Optional[Memory] = None  # radiation memory states (advanced by the integrator)
-    flex: Optional[mb.Flex] = None   # flexible structures in their own frames, and their interfaces
-    damping: Optional[ModalDamping] = None   # the liquid's modal damping ([tanks.damping]), the last term
+    # terms summed after the liquid's rows (its modal damping, [tanks.damping]): the sums' order is
+    # the residual's rounding
+    tail: tuple = ()
     gravity_turning: bool = eqx.field(static=True, default=True)   # off: g_b stays as at the start
     balanced: bool = eqx.field(static=True, default=True)          # weight balanced by static buoyancy
+
+    def __check_init__(self):
+        if len(self.owners()) > 1:      # the layout places one owner's unknowns (physics/unknowns.py)
+            raise ValueError("a System holds at most one term that owns unknowns (the structures' term "
+                             "holds every structure and interface)")
 
     @property
     def nf(self) -> int:
@@ -49,9 +52,115 @@ class System(eqx.Module):
         return 6 + self.nf
 
     def all_terms(self) -> tuple:
-        if self.damping is None:
-            return (self.body, *self.terms, self.liquid)
-        return (self.body, *self.terms, self.liquid, self.damping)
+        return (self.body, *self.terms, self.liquid, *self.tail)
+
+    # ---------------------------------------------------------------- the terms' own unknowns
+    def owners(self) -> tuple:
+        """The terms with unknowns of their own (unknowns.AbstractOwner): static, from their sizes."""
+        return tuple(t for t in self.all_terms() if t.unknowns() != Unknowns())
+
+    def layout(self) -> Layout:
+        u = [t.unknowns() for t in self.owners()]
+        return Layout(sum(x.frames for x in u), self.nf, sum(x.deformable for x in u), sum(x.alg for x in u))
+
+    def start(self, c0: Config, v0):
+        """(c, v, alg) at t = 0 with the owners' unknowns (alg empty without)."""
+        alg = jnp.zeros(0)
+        for o in self.owners():
+            c0, v0, alg = o.start(self, c0, v0)
+        return c0, v0, alg
+
+    def carried_velocities(self, c: Config, v):
+        """v with the owners' rates those of moving rigidly with the vessel."""
+        for o in self.owners():
+            v = o.carried_velocities(self, c, v)
+        return v
+
+    def advance(self, c: Config, delta) -> Config:
+        """Apply a dynamic increment: translations added, rotations on the group (q exp(Theta))."""
+        r = self.layout().n_rigid
+        return self.advance_parts(c, delta[:r], delta[r:])
+
+    def advance_parts(self, c: Config, y, z) -> Config:
+        """`advance` for the rigid increments y (vessel, frames) and the others z (liquid, the
+        owners' deformable) apart (see step_rows_parts)."""
+        nf = self.nf
+        out = Config(c.X0 + y[:3], quat_multiply(c.q, quat_exp(y[3:6])), c.d + z[:nf])
+        for o in self.owners():
+            out = o.advance(c, out, y[6:], z[nf:])
+        return out
+
+    def step_rows(self, c: Config, v, acc, t, z=None):
+        """The dynamic rows (every term's, the owners' with theirs; without the multipliers)."""
+        r = self.layout().n_rigid
+        return jnp.concatenate(self.step_rows_parts(c, v[:r], v[r:], acc[:r], acc[r:], t, z))
+
+    def step_rows_parts(self, c: Config, vy, vz, ay, az, t, z=None, core=True):
+        """`step_rows` as (rigid rows (n_rigid,), the others), with the rates of the rigid unknowns
+        (y) and of the others (z) passed apart, as residual_parts. `core=False`: without the
+        vessel-and-liquid terms (zero on the liquid's rows, the owners' balance alone on the
+        vessel's)."""
+        nf = self.nf
+        if core:
+            ry, rz = self.residual_parts(c, vy[:3], vy[3:6], vz[:nf], ay[:6], az[:nf], t, z)
+        else:
+            ry, rz = jnp.zeros(6), jnp.zeros(nf)
+        for o in self.owners():
+            ry, rz = o.add_rows(self, c, ry, rz, vy, vz, ay, az)
+        return ry, rz
+
+    def constraint(self, c: Config, alg):
+        """The owners' constraints g (empty without)."""
+        return jnp.concatenate([jnp.zeros(0)] + [o.constraint(self, c, alg) for o in self.owners()])
+
+    def constraint_rows(self, c: Config, alg, g_rows, gscale):
+        """The constraints' rows in Newton order [y, alg, z] (zero without owners)."""
+        rows = [o.constraint_rows(self, c, alg, g_rows, gscale) for o in self.owners()]
+        return sum(rows[1:], rows[0]) if rows else jnp.zeros(self.layout().n)
+
+    def constraint_residual(self, x, config, gscale):
+        """The constraints' part Rc of the step's residual at x = [y, alg, z] in Newton order,
+        `config(dyn)` the configuration of the dynamic unknowns: zero without owners, where not
+        even the configuration is formed (a dead update in every Newton iteration is not always
+        removed by XLA: it doubled the paper example's step)."""
+        if not self.owners():
+            return jnp.zeros_like(x)
+        dyn, alg = self.layout().from_x(x)
+        c = config(dyn)
+        return self.constraint_rows(c, alg, self.constraint(c, alg), gscale)
+
+    def initial_constraint_rows(self, c: Config, v, alg0, mscale):
+        """x -> the constraints' rows of the initial accelerations (d^2 g / dt^2 = 0)."""
+        fs = [o.initial_constraint_rows(self, c, v, alg0, mscale) for o in self.owners()]
+        return lambda x: sum((f(x) for f in fs[1:]), fs[0](x)) if fs else jnp.zeros_like(x)
+
+    def initial_alg(self, alg0, alg_a):
+        for o in self.owners():
+            alg_a = o.initial_alg(alg0, alg_a)
+        return alg_a
+
+    def unknown_scales(self):
+        """Characteristic mass of each dynamic unknown (dyn order): the vessel-and-liquid scales
+        and the owners' (so that every row over its scale is an acceleration)."""
+        base = self.scales()
+        if not self.owners():
+            return base
+        y, z = base[:6], base[6:]
+        for o in self.owners():
+            y, z = o.add_scales(y, z)
+        return jnp.concatenate([y, z])
+
+    def alg_scales(self, row_factor, err_factor):
+        """(gscale, the alg part of the error scale): the owners' (empty without)."""
+        gsc, sc = [], [jnp.zeros(0)]
+        for o in self.owners():
+            g, a = o.alg_scales(row_factor, err_factor)
+            gsc, sc = gsc + list(g), sc + [a]
+        return gsc, jnp.concatenate(sc)
+
+    def block_diagonal(self, c_m, c_k):
+        """The diagonal of the owners' deformable block of c_m M + c_k K (empty without)."""
+        return jnp.concatenate([jnp.zeros(0)] + [o.block_diagonal(c_m, c_k) for o in self.owners()])
 
     def total_mass(self):
         return self.body.mass + self.liquid.total_mass()
@@ -61,29 +170,42 @@ class System(eqx.Module):
         g_vec = jnp.array([0.0, 0.0, -self.gravity])
         return tv3(A if self.gravity_turning else rotation_matrix(self.q_ref), g_vec)
 
-    def kin(self, c: Config, V0, omega, d_dot, a6=None, d_acc=None, t=0.0, mu=None) -> Kin:
+    def kin(self, c: Config, V0, omega, d_dot, a6=None, d_acc=None, t=0.0) -> Kin:
         A = rotation_matrix(c.q)
-        return Kin(c, V0, omega, d_dot, a6, d_acc, jnp.asarray(t), mu, A, self.gravity_body(A))
+        return Kin(c, V0, omega, d_dot, a6, d_acc, jnp.asarray(t), jnp.zeros((0,)), A, self.gravity_body(A))
+
+    # ---------------------------------------------------------------- the terms' integrator states
+    def states_init(self) -> tuple:
+        """Every term's integrator states at t = 0 (AbstractTerm.state_init), in all_terms' order."""
+        return tuple(term.state_init() for term in self.all_terms())
+
+    def states_coefficients(self, h) -> tuple:
+        return tuple(term.state_coefficients(h) for term in self.all_terms())
+
+    def states_advance(self, z: tuple, v_old, v_new, coef: tuple) -> tuple:
+        """The terms' states at t_{n+1} (rigid velocities (6,) at t_n and t_{n+1})."""
+        return tuple(term.state_advance(zi, v_old, v_new, ci)
+                     for term, zi, ci in zip(self.all_terms(), z, coef, strict=True))
 
     # ---------------------------------------------------------------- equations of motion
-    def residual(self, c: Config, V0, omega, d_dot, acc, t=0.0, mu=None):
+    def residual(self, c: Config, V0, omega, d_dot, acc, t=0.0, z=None):
         """Virtual work of inertia minus applied forces (eq. 26) for the unknown accelerations
         acc = (dV0/dt (3, inertial), d omega/dt (3, body), d2 d/dt2 (nf)): the sum of the terms' rows.
         Rows: translation (inertial, N), rotation (body, N m), the deformable block's (N).
-        `mu` (6,): the radiation memory force at t, from the integrator's states."""
-        return jnp.concatenate(self.residual_parts(c, V0, omega, d_dot, acc[:6], acc[6:], t, mu))
+        `z`: the terms' integrator states at t (states_init's tree; None: those of t = 0)."""
+        return jnp.concatenate(self.residual_parts(c, V0, omega, d_dot, acc[:6], acc[6:], t, z))
 
-    def residual_parts(self, c: Config, V0, omega, d_dot, a6, d_acc, t=0.0, mu=None):
+    def residual_parts(self, c: Config, V0, omega, d_dot, a6, d_acc, t=0.0, z=None):
         """`residual` as (rigid rows (6,), deformable rows (nf,)), with the rigid and the deformable
         unknowns passed apart. Kept apart, JAX sees which rows and unknowns do not touch: the Newton
         preconditioner's rigid rows over the liquid's unknowns (solve/newton.py) are then a
         transpose of the liquid's rigid rows alone, where through one stacked vector every term's
         rows would be linearised and transposed with zero tangents."""
-        k = self.kin(c, V0, omega, d_dot, a6, d_acc, t, mu)
+        k = self.kin(c, V0, omega, d_dot, a6, d_acc, t)
         rigid, d = None, None
-        for term in self.all_terms():
+        for term, zi in zip(self.all_terms(), self.states_init() if z is None else z, strict=True):
             with jax.named_scope(type(term).__name__):
-                r = term.rows(k)
+                r = term.rows(k._replace(z=zi))
             rigid = r.rigid if rigid is None else rigid + r.rigid
             if r.d is not None:
                 d = r.d if d is None else d + r.d
@@ -93,19 +215,19 @@ class System(eqx.Module):
     # ---------------------------------------------------------------- energies
     def kinetic_energy(self, c: Config, v):
         """The kinetic energy for the velocity vector v (vessel, [structures,] liquid, [modal])."""
-        ves, _, d_dot, _ = mb.layout(self).split(v)
+        ves, _, d_dot, _ = self.layout().split(v)
         k = self.kin(c, ves[:3], ves[3:6], d_dot)
         T = sum((term.kinetic(k) for term in self.all_terms()), jnp.zeros(()))
-        if self.flex is not None:
-            T = T + mb.structure_kinetic(self, c, v)
+        for o in self.owners():
+            T = T + o.extra_kinetic(self, c, v)
         return T
 
     def potential_energy(self, c: Config):
         z = jnp.zeros(3)
         k = self.kin(c, z, z, jnp.zeros(self.nf))
         V = sum((term.potential(k) for term in self.all_terms()), jnp.zeros(()))
-        if self.flex is not None:
-            V = V + mb.structure_potential(self, c)
+        for o in self.owners():
+            V = V + o.extra_potential(self, c)
         return V
 
     def energy(self, c: Config, v):

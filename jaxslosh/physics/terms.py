@@ -11,6 +11,20 @@ step. A term gives
 * `mass_scale()`: its characteristic mass on each rigid row (kg, kg m^2), so that a row over the
   summed scale is an acceleration error.
 
+Optional hooks of the step, whose defaults are a term without them (the integrator calls them
+for every term and never asks which term has what):
+
+* integrator states (`state_init`, `state_coefficients`, `state_advance`): states of the term's
+  own that the step advances from t_n to t_{n+1} (the radiation memory); the default is none, a
+  zero-size array. A term reads its states at the evaluation's time as `k.z`;
+* `update_inverse(inv, c_v)`: the inverse of the deformable block of the step matrix with this
+  term's constant velocity tangent added (the modal damping's low-rank update); the default
+  leaves it as it is;
+* `unknowns()`: unknowns of the term's own beside the vessel's and the deformable block's
+  (floating frames, algebraic unknowns with their constraints, deformable coordinates); the
+  default is none. A term with unknowns implements the interface of `unknowns.AbstractOwner`
+  (the flexible structures, physics/structures.py).
+
 A term's rows are written out. Where the term has a potential, a test checks its rows against
 the potential's gradient along the step's increments (`potential_rows`, by JAX): a gradient inside
 the residual would be linearised and transposed again in every Newton preconditioner, which
@@ -40,8 +54,9 @@ class Config(NamedTuple):
 
 class Kin(NamedTuple):
     """What the terms read at one evaluation: the configuration, the rigid and deformable rates, the
-    unknown accelerations (None for energies), the time, the radiation memory force, and what the
-    System computes once for all terms: the rotation A(q) and gravity in the body frame."""
+    unknown accelerations (None for energies), the time, the evaluated term's own integrator states
+    at that time (`AbstractTerm.state_init`; zero-size for a term without), and what the System
+    computes once for all terms: the rotation A(q) and gravity in the body frame."""
     c: Config
     V0: jax.Array           # (3,) inertial
     omega: jax.Array        # (3,) body frame
@@ -49,7 +64,7 @@ class Kin(NamedTuple):
     a6: Optional[jax.Array]    # (6,) rigid accelerations: dV0/dt (inertial), d omega/dt (body); None for energies
     d_acc: Optional[jax.Array]  # (nf,) d2 d/dt2 (kept apart from a6: see System.residual_parts)
     t: jax.Array
-    mu: Optional[jax.Array]    # (6,) radiation memory force at t, from the integrator's states
+    z: jax.Array            # this term's integrator states at t (zero-size for a term without)
     A: jax.Array            # (3, 3) rotation matrix of q
     g_b: jax.Array          # (3,) gravity acceleration in the body frame
 
@@ -61,6 +76,15 @@ class Kin(NamedTuple):
     @property
     def v6(self):
         return jnp.concatenate([self.V0, self.omega])
+
+
+class Unknowns(NamedTuple):
+    """A term's own unknowns (static sizes): `frames` floating frames of 6 rigid unknowns each
+    (solved with the vessel's), `alg` algebraic ones (multipliers, interface frames: no inertia,
+    solved at t_{n+1}) and `deformable` ones (with a constant block, beside the liquid's)."""
+    frames: int = 0
+    alg: int = 0
+    deformable: int = 0
 
 
 class Rows(NamedTuple):
@@ -88,6 +112,29 @@ class AbstractTerm(eqx.Module):
         """(effect, text) lines: what this term adds to the model, as `jaxslosh check` lists it
         (`- effect: text`); a final term says it from its own fields and its static `About`."""
         return ()
+
+    # ---------------------------------------------------------------- optional hooks of the step
+    def state_init(self) -> jax.Array:
+        """Its integrator states at t = 0: none (a zero-size array)."""
+        return jnp.zeros((0,))
+
+    def state_coefficients(self, h):
+        """What advancing its states over a step h needs, formed once per step (outside the iterations)."""
+        return ()
+
+    def state_advance(self, z, v_old, v_new, coef):
+        """Its states at t_{n+1} from those at t_n and the rigid velocities (6,) at both ends (v_new
+        is the step's unknown: the states enter the residual through it)."""
+        return z
+
+    def unknowns(self) -> Unknowns:
+        """Its own unknowns: none (see unknowns.AbstractOwner for a term that has some)."""
+        return Unknowns()
+
+    def update_inverse(self, inv, c_v):
+        """The inverse of the step matrix's deformable block with this term's c_v dR/d(d_dot) added
+        (`inv`: the block's inverse without it, a matrix or an object with `@`): unchanged."""
+        return inv
 
 
 def potential_rows(potential, c: Config):

@@ -12,7 +12,6 @@ import jax.numpy as jnp
 
 from ..assemble.system import Built
 from ..io.status import Status
-from ..physics import structures as mb
 from ..physics.kinematics import rotation_matrix, rpy_from_quat
 from ..physics.terms import Config
 from ..solve.integrator import State, initial_state, initial_state_like, step_or_retry
@@ -54,14 +53,15 @@ class Frame(NamedTuple):
 def probe_positions(b: Built, c: Config):
     """(P, 3) inertial positions of the probes' material points in configuration c (the frames' and
     the frequency domain's one definition: analysis/linear.py differentiates it)."""
-    sysm, pr, flex = b.system, b.probes, b.system.flex
+    sysm, pr = b.system, b.probes
     A = rotation_matrix(c.q)
     local = pr.points + sysm.liquid.probe_displacements(pr.weights, pr.modal, c.d)
     probes = c.X0[None, :] + local @ A.T
-    if flex is not None:
-        etas = mb.split_eta(flex, c.eta)
+    if pr.on_structures:                  # probes on the structures: the term that owns them
+        structures, = sysm.owners()
+        etas = structures.split_eta(c.eta)
         for sp in pr.on_structures:
-            body = flex.bodies[sp.index]
+            body = structures.bodies[sp.index]
             x = sp.r + sp.W @ body.u(etas[sp.index])
             probes = probes.at[sp.rows].set(c.Xs[sp.index][None, :] + x @ rotation_matrix(c.qs[sp.index]).T)
     return probes
@@ -70,12 +70,10 @@ def probe_positions(b: Built, c: Config):
 def _frame(b: Built, s: State, it, err, failed) -> Frame:
     """What a saved frame keeps of a state: the vessel, the probes, the energies, the solver's figures
     and the liquid's field (its nodal displacement, or a modal liquid's coordinates)."""
-    sysm, flex = b.system, b.system.flex
+    sysm = b.system
     probes = probe_positions(b, s.c)
     ke, pe = sysm.energy(s.c, s.v)
-    gmax = jnp.zeros(())
-    if flex is not None:
-        gmax = jnp.max(jnp.abs(mb.constraint(sysm, s.c, s.alg)))
+    gmax = jnp.max(jnp.abs(sysm.constraint(s.c, s.alg)), initial=0.0)
     heave = [sysm.liquid.surface_heave(s.c.d, idx) for idx in b.surfaces]
     surface = jnp.array([[h.min(), h.max()] for h in heave]).reshape(len(heave), 2)
     return Frame(s.t, s.c.X0, s.c.q, s.v[3:6], probes, ke, pe, it, err, sysm.liquid.frame_field(s.c.d), failed, gmax,

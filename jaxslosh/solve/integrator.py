@@ -16,6 +16,11 @@ construction and the free rigid body reduces to the trapezoidal rule on Euler's 
 
 Each step solves R(Delta) = 0 by Newton iterations (newton.py) wrapped in `lax.custom_root`, so
 gradients use the implicit function theorem instead of running back through the iterations.
+
+One step and one initial state serve every system: the unknowns are those of the System's layout
+(physics/unknowns.py), R = Rm + Rc with Rc the constraints of the terms that own unknowns (an
+empty set without them), the terms' integrator states advanced with the step (the radiation
+memory) and the constant blocks' inverses extended by the terms' hooks (linear.py).
 """
 from __future__ import annotations
 
@@ -24,9 +29,7 @@ from typing import Any, NamedTuple, Optional
 import jax
 import jax.numpy as jnp
 
-from ..physics import structures as mb
-from ..physics.kinematics import rotation_matrix
-from ..physics.system import System, advance_config, advance_config_parts
+from ..physics.system import System
 from ..physics.terms import Config
 from .linear import Solver, empty_pre
 from .newton import solve_root, solve_root_carried
@@ -34,13 +37,13 @@ from .newton import solve_root, solve_root_carried
 
 class State(NamedTuple):
     c: Config
-    v: jax.Array      # (n,) V0 (inertial), omega (body), d_dot
+    v: jax.Array      # (n,) V0 (inertial), omega (body), d_dot [, the owners' rates: physics/unknowns.py]
     acc: jax.Array    # (n,) accelerations satisfying the equations of motion
     a: jax.Array      # (n,) generalized-alpha pseudo-accelerations
     t: jax.Array
+    alg: jax.Array    # algebraic unknowns (interface frames, multipliers; physics/unknowns.py): empty without
+    z: tuple          # the terms' integrator states (System.states_init: zero-size for a term without)
     pre: Any = None   # the Newton preconditioner carried to the next step (Solver.reuse), else None
-    alg: Optional[jax.Array] = None   # interface frame positions and multipliers (multibody.py), if any
-    z: Optional[jax.Array] = None   # radiation memory states (hydrodynamics.Memory), None without them
     e0: Optional[jax.Array] = None  # the initial total energy, held by the energy projection (Solver.project)
 
 
@@ -50,42 +53,44 @@ class StepInfo(NamedTuple):
     ok: jax.Array         # converged and finite
 
 
-def _advance(system, c, delta):
-    if system.flex is not None:
-        return mb.advance(system, c, delta)
-    return advance_config(c, delta)
+def _split_newton(system: System, Rm_parts, Rc, r):
+    """(R, the split of R = Rm + Rc the Newton preconditioner takes, or None): every unknown in
+    the exact block for a nonlinear liquid (its few unknowns linearised exactly)."""
+    L = system.layout()
 
+    def Rm(x):
+        return L.in_x(*Rm_parts(x[:r], x[L.n_small:]))
 
-def _split(v):
-    return v[:3], v[3:6], v[6:]
+    def R(x):
+        return Rm(x) + Rc(x)
+
+    return R, None if system.liquid.nonlinear else (Rm, Rc, r, Rm_parts)
 
 
 def initial_state(system: System, solver: Solver, c0: Config, v0, alg0=None) -> tuple[State, StepInfo]:
-    """Accelerations consistent with the initial configuration and velocities (with structures:
-    their static equilibrium first, then the accelerations and multipliers from the constraints
-    differentiated twice in time)."""
-    if system.flex is not None:
-        return _flex_initial_state(system, solver, c0, v0, alg0)
-    scale = system.scales()
+    """Accelerations consistent with the initial configuration and velocities (with terms that own
+    unknowns: their static equilibrium first, then the accelerations and multipliers from the
+    constraints differentiated twice in time)."""
+    alg0 = jnp.zeros(0) if alg0 is None else alg0
+    c0, v0, alg0, info0 = static_equilibrium(system, solver, c0, v0, alg0)
+    L = system.layout()
+    gsc, alg_sc = system.alg_scales(1.0, lambda itf: 1.0)       # rows m_ref d2g/dt2: forces
+    scale = L.to_x(system.unknown_scales(), alg_sc)
+    z0 = system.states_init()
+    r, t0 = L.n_rigid, jnp.zeros(())
 
-    memory = system.memory
-    z0 = None if memory is None else memory.init()
-    mu0 = None if memory is None else memory.force(z0)
+    def Rm_parts(ay, az):
+        return system.step_rows_parts(c0, v0[:r], v0[r:], ay, az, t0, z0)
 
-    V0, om, dd = _split(v0)
-
-    def parts(a6, d_acc):
-        return system.residual_parts(c0, V0, om, dd, a6, d_acc, jnp.zeros(()), mu0)
-
-    def R(acc):
-        return jnp.concatenate(parts(acc[:6], acc[6:]))
-
-    exact = system.liquid.nonlinear    # every unknown in the exact block: R's parts are not needed
-    acc0, (it, err, ok) = solve_root(R, jnp.zeros_like(v0), solver.Cinv_mass, scale, solver.tol, solver.max_iter,
-                                     ns=solver.ns, implicit=solver.implicit, parts=None if exact else parts)
+    R, split = _split_newton(system, Rm_parts, system.initial_constraint_rows(c0, v0, alg0, gsc), r)
+    x, (it, err, ok) = solve_root(R, jnp.zeros(L.n, dtype=v0.dtype), solver.Cinv_mass, scale, solver.tol,
+                                  solver.max_iter, solver.ns, split=split, implicit=solver.implicit)
+    acc0, alg_a = L.from_x(x)
+    alg = system.initial_alg(alg0, alg_a)
+    info = StepInfo(it + info0.iterations, jnp.maximum(err, info0.residual), ok & info0.ok)
     pre = empty_pre(system) if solver.reuse else None
     e0 = total_energy(system, c0, v0) if solver.project else None
-    return State(c0, v0, acc0, acc0, jnp.zeros(()), pre=pre, z=z0, e0=e0), StepInfo(it, err, ok)
+    return State(c0, v0, acc0, acc0, jnp.zeros(()), alg, z0, pre, e0), info
 
 
 def initial_state_like(system: System, solver: Solver, c0: Config, v0, alg0=None) -> tuple[State, StepInfo]:
@@ -93,14 +98,11 @@ def initial_state_like(system: System, solver: Solver, c0: Config, v0, alg0=None
     the shapes the time loop is lowered for while the initial state's own program is still being
     traced (cache/compiled.compile_run; a test keeps the two in step)."""
     zeros = jnp.zeros_like(v0)
-    memory = system.memory
-    z0 = None if memory is None else memory.init()
     pre = empty_pre(system) if solver.reuse else None
     info = StepInfo(jnp.zeros((), jnp.int32), jnp.zeros(()), jnp.array(True))
-    if system.flex is not None:
-        return State(c0, v0, zeros, zeros, jnp.zeros(()), pre, alg0, z0), info
     e0 = jnp.zeros(()) if solver.project else None
-    return State(c0, v0, zeros, zeros, jnp.zeros(()), pre=pre, z=z0, e0=e0), info
+    alg = jnp.zeros(0) if alg0 is None else alg0
+    return State(c0, v0, zeros, zeros, jnp.zeros(()), alg, system.states_init(), pre, e0), info
 
 
 def total_energy(system: System, c: Config, v):
@@ -123,23 +125,19 @@ def project_energy(system: System, c: Config, v, e0):
     return v * jnp.sqrt(jnp.where(ok, room / jnp.where(ok, T, 1.0), 1.0))
 
 
-def memory_next(system: System, solver: Solver, s: State, v_new):
-    """Radiation states at t_{n+1}: exact for a rigid velocity linear over the step, so they are a
-    linear function of the step's unknown new velocity (None without radiation)."""
-    memory = system.memory
-    if memory is None:
-        return None
-    return memory.advance(s.z, s.v[:6], v_new[:6], memory.coefficients(solver.h))
+def states_next(system: System, solver: Solver, s: State, v_new):
+    """The terms' integrator states at t_{n+1} (the radiation memory's: exact for a rigid velocity
+    linear over the step, so they are a linear function of the step's unknown new velocity)."""
+    return system.states_advance(s.z, s.v[:6], v_new[:6], system.states_coefficients(solver.h))
 
 
 def step_equations(system: System, solver: Solver, s: State):
     """The equations of one step t_n -> t_{n+1} in the increment Delta = (dX0, Theta, dd):
-    returns (R, unpack, x0, parts): the residual R(Delta) (with structures, of their dynamic
-    unknowns, without the multipliers), the map Delta -> (config, v, acc, a) of the scheme, the
-    predictor (a_{n+1} = a_n), and the residual in parts for the Newton
-    preconditioner, parts(Delta[:r], Delta[r:]) = (rigid rows, the others) with r the rigid
-    unknowns (System.residual_parts; with structures their inertia rows, without the multipliers:
-    structures.inertia_rows_parts)."""
+    returns (R, unpack, x0, parts): the residual R(Delta) of the dynamic unknowns (without the
+    multipliers), the map Delta -> (config, v, acc, a) of the scheme, the predictor
+    (a_{n+1} = a_n), and the residual in parts for the Newton preconditioner,
+    parts(Delta[:r], Delta[r:]) = (rigid rows, the others) with r the rigid unknowns
+    (System.step_rows_parts)."""
     h, sc = solver.h, solver.scheme
     am, af, beta, gamma = sc.alpha_m, sc.alpha_f, sc.beta, sc.gamma
     base = h * s.v + h * h * (0.5 - beta) * s.a
@@ -152,20 +150,16 @@ def step_equations(system: System, solver: Solver, s: State):
         return v_new, acc_new, a_new
 
     def unpack(delta):
-        return (_advance(system, s.c, delta),) + rates(delta, slice(None))
+        return (system.advance(s.c, delta),) + rates(delta, slice(None))
 
-    memory = system.memory
-    coef = None if memory is None else memory.coefficients(h)
-
-    r = mb.layout(system).n_rigid
+    coef = system.states_coefficients(h)
+    r = system.layout().n_rigid
 
     def parts(y, z):
         vy, ay, _ = rates(y, slice(0, r))
         vz, az, _ = rates(z, slice(r, None))
-        mu = None if memory is None else memory.force(memory.advance(s.z, s.v[:6], vy[:6], coef))
-        if system.flex is not None:
-            return mb.inertia_rows_parts(system, mb.advance_parts(system, s.c, y, z), vy, vz, ay, az, s.t + h, mu)
-        return system.residual_parts(advance_config_parts(s.c, y, z), vy[:3], vy[3:], vz, ay, az, s.t + h, mu)
+        states = system.states_advance(s.z, s.v[:6], vy[:6], coef)
+        return system.step_rows_parts(system.advance_parts(s.c, y, z), vy, vz, ay, az, s.t + h, states)
 
     def R(delta):
         return jnp.concatenate(parts(delta[:r], delta[r:]))
@@ -173,128 +167,81 @@ def step_equations(system: System, solver: Solver, s: State):
     return R, unpack, base + h * h * beta * s.a, parts
 
 
-def static_structures(system, solver: Solver, c0: Config, v0, alg0):
-    """The structures in static equilibrium under gravity, the vessel and the liquid held where they
-    are (the counterpart of the liquid's hydrostatic start, PHYSICS.md item 6: a mast that starts
-    undeformed would ring with its own weight). Returns the configuration, velocities in which every
-    structure moves rigidly with the vessel, and the frames and multipliers of the equilibrium."""
-    L = mb.layout(system)
+def static_equilibrium(system: System, solver: Solver, c0: Config, v0, alg0):
+    """The owners' unknowns (the structures) in static equilibrium under gravity, the vessel and
+    the liquid held where they are (the counterpart of the liquid's hydrostatic start, PHYSICS.md
+    item 6: a mast that starts undeformed would ring with its own weight). Returns the
+    configuration, velocities in which every structure moves rigidly with the vessel, and the
+    frames and multipliers of the equilibrium. Nothing to solve without owners: the static layout
+    says so (a Python branch on static model data, as MJX's stages skip what a model lacks)."""
+    L = system.layout()
+    if not system.owners():
+        return c0, v0, alg0, StepInfo(jnp.zeros((), jnp.int32), jnp.zeros(()), jnp.array(True))
     r, nf = L.n_rigid, L.nf
     held = jnp.zeros(L.n_dyn, dtype=bool).at[:6].set(True).at[r:r + nf].set(True)
     held_x = L.to_x(held, jnp.zeros(L.n_alg, dtype=bool))
     f = solver.scheme.c_d(solver.h)
-    gsc, alg_sc = mb.alg_scales(system, f, lambda itf: jnp.maximum(1.0 / f, 1e-13 * itf.L_ref / solver.tol))
-    scale = L.to_x(mb.scales(system), alg_sc)
+    gsc, alg_sc = system.alg_scales(f, lambda itf: jnp.maximum(1.0 / f, 1e-13 * itf.L_ref / solver.tol))
+    scale = L.to_x(system.unknown_scales(), alg_sc)
     z = jnp.zeros(L.n_dyn)
-    w2 = jax.lax.stop_gradient(jnp.concatenate([b.omega2 for b in system.flex.bodies]))
-    Cinv = jnp.zeros((nf + L.m, nf + L.m)).at[:nf, :nf].set(jnp.eye(nf)).at[nf:, nf:].set(jnp.diag(1.0 / w2))
-
+    Cinv = jnp.zeros((nf + L.m, nf + L.m)).at[:nf, :nf].set(jnp.eye(nf)).at[nf:, nf:].set(
+        jnp.diag(1.0 / system.block_diagonal(0.0, 1.0)))
     held_y, held_z = held[:r], held[r:]
     zy, zz = jnp.zeros(r), jnp.zeros(L.n_dyn - r)
 
     # the vessel's and the liquid's rows are held: their terms are left out, not computed and dropped
     def Rm_parts(y, w):
-        ry, rw = mb.inertia_rows_parts(system, mb.advance_parts(system, c0, y, w), zy, zz, zy, zz, jnp.zeros(()),
-                                       core=False)
+        ry, rw = system.step_rows_parts(system.advance_parts(c0, y, w), zy, zz, zy, zz, jnp.zeros(()), core=False)
         return jnp.where(held_y, y * scale[:r], ry), jnp.where(held_z, w * scale[L.n_small:], rw)
 
     def Rm(x):
-        return mb.in_x(L, *Rm_parts(x[:r], x[L.n_small:]))
+        return L.in_x(*Rm_parts(x[:r], x[L.n_small:]))
 
     def Rc(x):
         dyn, alg = L.from_x(x)
-        c = mb.advance(system, c0, dyn)
-        return jnp.where(held_x, 0.0, mb.constraint_rows(system, c, alg, mb.constraint(system, c, alg), gsc))
+        c = system.advance(c0, dyn)
+        return jnp.where(held_x, 0.0, system.constraint_rows(c, alg, system.constraint(c, alg), gsc))
 
     x, (it, err, ok) = solve_root(lambda x: Rm(x) + Rc(x), L.to_x(z, alg0), Cinv, scale, solver.tol,
                                   solver.max_iter, L.n_small, split=(Rm, Rc, L.n_rigid, Rm_parts),
                                   implicit=solver.implicit)
     dyn, alg = L.from_x(x)
-    c = mb.advance(system, c0, dyn)
-    # every structure moves rigidly with the vessel: V_s = V + (A omega) x (X_s - X0), omega_s = A_s^T A omega
-    ves, _, d_v, _ = L.split(v0)
-    w = rotation_matrix(c.q) @ ves[3:]
-    rig = jnp.concatenate([jnp.concatenate([ves[:3] + jnp.cross(w, c.Xs[k] - c.X0), rotation_matrix(c.qs[k]).T @ w])
-                           for k in range(L.S)])
-    v = jnp.concatenate([ves, rig, d_v, jnp.zeros(L.m)])
-    return c, v, alg, StepInfo(it, err, ok)
-
-
-def _flex_initial_state(system, solver: Solver, c0: Config, v0, alg0):
-    L = mb.layout(system)
-    c0, v0, alg0, info0 = static_structures(system, solver, c0, v0, alg0)
-    gsc, alg_sc = mb.alg_scales(system, 1.0, lambda itf: 1.0)       # rows m_ref d2g/dt2: forces
-    scale = L.to_x(mb.scales(system), alg_sc)
-    memory = system.memory
-    z0 = None if memory is None else memory.init()
-    Rm, Rc, Rm_parts = mb.initial_residuals(system, c0, v0, alg0, jnp.zeros(()), gsc,
-                                            None if memory is None else memory.force(z0))
-    x, (it, err, ok) = solve_root(lambda x: Rm(x) + Rc(x), jnp.zeros(L.n), solver.Cinv_mass, scale, solver.tol,
-                                  solver.max_iter, L.n_small, split=(Rm, Rc, L.n_rigid, Rm_parts),
-                                  implicit=solver.implicit)
-    acc0, alg_a = L.from_x(x)
-    alg = jnp.where(mb.position_mask(system.flex), alg0, alg_a)
-    info = StepInfo(it + info0.iterations, jnp.maximum(err, info0.residual), ok & info0.ok)
-    pre = empty_pre(system) if solver.reuse else None
-    return State(c0, v0, acc0, acc0, jnp.zeros(()), pre, alg, z0), info
-
-
-def _flex_step(system, solver: Solver, s: State, fresh=None) -> tuple[State, StepInfo]:
-    """The step with structures: unknowns [Delta_y, (X_f, lambda), Delta_z]; the constraint rows
-    are g(q_{n+1}) m_ref / (beta h^2) (forces), converged when g / (beta h^2) is below the tolerance
-    like the acceleration errors of the other rows, or |g| below 1e-13 of the interface's size
-    (round-off), whichever is larger."""
-    L = mb.layout(system)
-    f = solver.scheme.c_d(solver.h)
-    gsc, alg_sc = mb.alg_scales(system, f, lambda itf: jnp.maximum(1.0 / f, 1e-13 * itf.L_ref / solver.tol))
-    scale = L.to_x(mb.scales(system), alg_sc)
-    _, unpack, pred, Rm_parts = step_equations(system, solver, s)
-    r = L.n_rigid
-
-    def Rm(x):
-        return mb.in_x(L, *Rm_parts(x[:r], x[L.n_small:]))
-
-    def Rc(x):
-        dyn, alg = L.from_x(x)
-        c = unpack(dyn)[0]
-        return mb.constraint_rows(system, c, alg, mb.constraint(system, c, alg), gsc)
-
-    floor = solver.noise * jnp.max(jnp.abs(s.c.d), initial=0.0)
-    pre = s.pre if solver.reuse else None
-    x, (it, err, ok), pre_new = solve_root_carried(lambda x: Rm(x) + Rc(x), L.to_x(pred, s.alg), solver.Cinv_step,
-                                                   scale, solver.tol, solver.max_iter, pre, floor, solver.adaptive,
-                                                   L.n_small, (Rm, Rc, L.n_rigid, Rm_parts), fresh, solver.implicit)
-    dyn, alg = L.from_x(x)
-    c, v, acc, a = unpack(dyn)
-    ok = ok & jnp.all(jnp.isfinite(x))
-    return (State(c, v, acc, a, s.t + solver.h, pre_new if solver.reuse else s.pre, alg,
-                  memory_next(system, solver, s, v)),
-            StepInfo(it, err, ok))
+    c = system.advance(c0, dyn)
+    return c, system.carried_velocities(c, v0), alg, StepInfo(it, err, ok)
 
 
 def step(system: System, solver: Solver, s: State, fresh=None) -> tuple[State, StepInfo]:
-    """One implicit step t_n -> t_{n+1}; the unknown is the increment Delta = (dX0, Theta, dd).
-    `fresh`: batch mode with a carried preconditioner, whether this step forms it anew (see _newton)."""
-    if system.flex is not None:
-        return _flex_step(system, solver, s, fresh)
+    """One implicit step t_n -> t_{n+1}; the unknowns x = [Delta_y, alg, Delta_z] (the System's
+    layout: Delta = (dX0, Theta, dd) without terms that own unknowns). With constraints their rows
+    are g(q_{n+1}) m_ref / (beta h^2) (forces), converged when g / (beta h^2) is below the tolerance
+    like the acceleration errors of the other rows, or |g| below 1e-13 of the interface's size
+    (round-off), whichever is larger. `fresh`: batch mode with a carried preconditioner, whether
+    this step forms it anew (see newton.StructuredNewton.init)."""
     with jax.named_scope("predictor"):
-        scale = system.scales()            # residual rows / scale: accelerations (m/s^2, rad/s^2)
-        R, unpack, x0, parts = step_equations(system, solver, s)
+        L = system.layout()
+        f = solver.scheme.c_d(solver.h)
+        gsc, alg_sc = system.alg_scales(f, lambda itf: jnp.maximum(1.0 / f, 1e-13 * itf.L_ref / solver.tol))
+        scale = L.to_x(system.unknown_scales(), alg_sc)   # rows / scale: accelerations (m/s^2, rad/s^2)
+        _, unpack, pred, Rm_parts = step_equations(system, solver, s)
+
+        def Rc(x):
+            return system.constraint_residual(x, lambda dyn: unpack(dyn)[0], gsc)
+
+        R, split = _split_newton(system, Rm_parts, Rc, L.n_rigid)
         floor = solver.noise * jnp.max(jnp.abs(s.c.d), initial=0.0)
     pre = s.pre if solver.reuse else None
     with jax.named_scope("newton"):
-        exact = system.liquid.nonlinear    # every unknown in the exact block: R's parts are not needed
-        delta, (it, err, ok), pre_new = solve_root_carried(R, x0, solver.Cinv_step, scale, solver.tol,
-                                                           solver.max_iter, pre, floor, solver.adaptive, ns=solver.ns,
-                                                           fresh=fresh, implicit=solver.implicit,
-                                                           parts=None if exact else parts)
+        x, (it, err, ok), pre_new = solve_root_carried(R, L.to_x(pred, s.alg), solver.Cinv_step, scale, solver.tol,
+                                                       solver.max_iter, pre, floor, solver.adaptive, solver.ns, split,
+                                                       fresh, solver.implicit)
     with jax.named_scope("update"):
-        c, v, acc, a = unpack(delta)
-        ok = ok & jnp.all(jnp.isfinite(delta))
-        z = memory_next(system, solver, s, v)
+        dyn, alg = L.from_x(x)
+        c, v, acc, a = unpack(dyn)
+        ok = ok & jnp.all(jnp.isfinite(x))
+        z = states_next(system, solver, s, v)
         if solver.project:
             v = project_energy(system, c, v, s.e0)
-    return (State(c, v, acc, a, s.t + solver.h, pre=pre_new if solver.reuse else s.pre, z=z, e0=s.e0),
+    return (State(c, v, acc, a, s.t + solver.h, alg, z, pre_new if solver.reuse else s.pre, s.e0),
             StepInfo(it, err, ok))
 
 

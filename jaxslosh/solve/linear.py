@@ -10,8 +10,7 @@ import jax
 import jax.numpy as jnp
 import numpy as np
 
-from ..fem.linalg import inv, solve
-from ..physics.structures import layout
+from ..fem.linalg import inv
 from ..physics.system import System
 from ..staging import staged
 from .schemes import Scheme
@@ -38,8 +37,8 @@ class Solver(eqx.Module):
     # refresh the preconditioner inside the iterations when convergence slows (a lax.cond); False
     # for vmapped batches, where a cond computes both branches
     adaptive: bool = eqx.field(static=True, default=True)
-    # unknowns of the exact (Schur) block: the 6 rigid ones, and with flexible structures their rigid
-    # unknowns and the interface frames and multipliers (multibody.Layout.n_small)
+    # unknowns of the exact (Schur) block: the 6 rigid ones, and the owners' rigid and algebraic
+    # unknowns (physics/unknowns.Layout.n_small); a nonlinear liquid's too
     ns: int = eqx.field(static=True, default=6)
     # after each step, scale the velocities so that the total energy is the initial one (the
     # `simulation.energy_projection` key: trapezoidal rule, conservative scenes only; see project_energy)
@@ -67,15 +66,24 @@ class Solver(eqx.Module):
 def make_solver(system: System, h: float, scheme: Scheme, tol: float, max_iter: int, substeps: int = 0,
                 reuse: bool = False, adaptive: bool = True) -> Solver:
     """Factor the constant liquid blocks once (float64): NumPy for concrete matrices, JAX when the
-    liquid was built from traced values (under jit).
+    liquid was built from traced values (under jit); the terms that own deformable unknowns append
+    their block, diagonal (the structures' modal one, Phi^T M Phi = I, Phi^T K Phi = omega^2:
+    1 / (c_a + omega^2)), and their rigid and algebraic unknowns join the exact block.
 
     The inverses only precondition the Newton iterations and the tangent solves, whose solutions do
     not depend on them (`lax.custom_root` drops their tangents), so they are formed from
     `stop_gradient` values: under `jax.grad` outside jit the matrices are then concrete again."""
-    nf = system.nf
     substeps = int(substeps) if substeps and substeps > 1 else 0
-    if system.flex is not None:
-        return _flex_solver(system, h, scheme, tol, max_iter, substeps, reuse, adaptive)
+    base = _liquid_solver(system, h, scheme, tol, max_iter, substeps, reuse, adaptive)
+    sub = _extended(base.Cinv_sub, system.block_diagonal(scheme.c_a(h / substeps), 1.0)) if substeps else None
+    return dataclasses.replace(base, Cinv_step=_extended(base.Cinv_step, system.block_diagonal(scheme.c_a(h), 1.0)),
+                               Cinv_mass=_extended(base.Cinv_mass, system.block_diagonal(1.0, 0.0)), Cinv_sub=sub,
+                               ns=base.ns + system.layout().n_small - 6)
+
+
+def _liquid_solver(system: System, h, scheme: Scheme, tol, max_iter, substeps, reuse, adaptive) -> Solver:
+    """The solver of the vessel and its liquid: the deformable block's inverses."""
+    nf = system.nf
     if nf == 0 or system.liquid.nonlinear:      # a nonlinear liquid's few unknowns: linearised exactly
         z = jnp.zeros((0, 0))
         return Solver(z, z, jnp.asarray(h, dtype=float), scheme, tol, max_iter, substeps, z if substeps else None,
@@ -116,44 +124,19 @@ def _noise(system: System, K_ff):
     return jnp.finfo(jnp.float64).eps * jnp.max(jnp.sum(jnp.abs(jnp.asarray(K_ff)), axis=1) / scale)
 
 
-class LowRankUpdate(eqx.Module):
-    """The inverse of A + U D U^T from A's: the step block with the liquid's modal damping
-    (physics/damping.py), whose C = B diag(c) B^T has the rank of its few sloshing modes. By the
-    Sherman-Morrison-Woodbury formula, in the form that allows zero entries of D (undamped modes):
-
-        (A + U D U^T)^-1 = A^-1 - W D (I + G D)^-1 W^T,   W = A^-1 U,  G = U^T W
-
-    W is formed once per run (k solves with the constant block's inverse, dense or sparse); a solve
-    is A's and two thin products. D follows a traced damping ratio (a k x k solve per run)."""
-    base: Any              # A^-1: a matrix, or an object with `@` (the sparse paths)
-    W: jax.Array           # (nf, k)
-    S: jax.Array           # (k, k) D (I + G D)^-1
-
-    @property
-    def shape(self):
-        return self.base.shape
-
-    def __matmul__(self, x):
-        return self.base @ x - self.W @ (self.S @ (self.W.T @ x))
-
-
 def damped(base, system: System, scheme: Scheme, hh):
-    """The step block's inverse with the modal damping's c_v C added (c_v = d v_{n+1} / d Delta =
-    gamma / (beta h)); `base` itself where the system has none. Formed from stop_gradient values:
-    it only preconditions the iterations, whose solutions do not depend on it."""
-    if system.damping is None:
-        return base
-    B, c = jax.lax.stop_gradient((system.damping.B, system.damping.c))
-    W = base @ B
-    D = scheme.c_v(hh) * c
-    G = B.T @ W
-    S = solve(jnp.eye(c.shape[0]) + D[:, None] * G, jnp.diag(D))      # (I + D G)^-1 D = D (I + G D)^-1
-    return LowRankUpdate(base, W, S)
+    """The step block's inverse with every term's constant velocity tangent c_v dR/d(d_dot) added
+    (c_v = d v_{n+1} / d Delta = gamma / (beta h)): AbstractTerm.update_inverse, the modal
+    damping's low-rank update (physics/damping.py); `base` itself from a term without one."""
+    c_v = scheme.c_v(hh)
+    for term in system.all_terms():
+        base = term.update_inverse(base, c_v)
+    return base
 
 
 class BlockInverse(eqx.Module):
-    """The constant-block inverse with flexible structures: the liquid's (a dense matrix, or the
-    sparse factors of sparse.py) and the structures' modal block, which is diagonal."""
+    """The constant-block inverse with the owners' deformable unknowns: the liquid's (a dense
+    matrix, or the sparse factors of sparse.py) and theirs, which is diagonal (the structures' modal block)."""
     liquid: Any           # (nf, nf)
     modal: jax.Array      # (m,)
 
@@ -168,22 +151,15 @@ class BlockInverse(eqx.Module):
         return jnp.concatenate([self.liquid @ x[:nf], bottom])
 
 
-def _flex_solver(system: System, h, scheme: Scheme, tol, max_iter, substeps, reuse, adaptive) -> Solver:
-    """With flexible structures: the liquid block inverses as without them, and the structures'
-    modal block, which is diagonal (Phi^T M Phi = I, Phi^T K Phi = omega^2): 1 / (c_a + omega^2)."""
-    base = make_solver(dataclasses.replace(system, flex=None), h, scheme, tol, max_iter, substeps, reuse, adaptive)
-    w2 = jax.lax.stop_gradient(jnp.concatenate([b.omega2 for b in system.flex.bodies]))
-    sub = BlockInverse(base.Cinv_sub, 1.0 / (scheme.c_a(h / substeps) + w2)) if substeps else None
-    return Solver(BlockInverse(base.Cinv_step, 1.0 / (scheme.c_a(h) + w2)), BlockInverse(base.Cinv_mass, jnp.ones_like(w2)),
-                  jnp.asarray(h, dtype=float), scheme, tol, max_iter, substeps, sub, noise=base.noise, reuse=reuse,
-                  adaptive=adaptive, ns=layout(system).n_small)
+def _extended(inv, diag):
+    """The inverse with the owners' diagonal block `diag` appended (itself where they have none: a
+    size, static)."""
+    return inv if diag.shape[0] == 0 else BlockInverse(inv, 1.0 / diag)
 
 
 def empty_pre(system: System):
     """A carried preconditioner of the right shapes, marked not valid (formed at the first step)."""
-    ns, nz = (6 + system.nf, 0) if system.liquid.nonlinear else (6, system.nf)
-    if system.flex is not None:
-        L = layout(system)
-        ns, nz = L.n_small, L.nf + L.m
+    L = system.layout()
+    ns, nz = (L.n_small + L.nf, L.m) if system.liquid.nonlinear else (L.n_small, L.nf + L.m)
     data = (jnp.zeros((ns, ns)),) if nz == 0 else (jnp.zeros((ns, ns)), jnp.zeros((ns, nz)), jnp.zeros((nz, ns)))
     return data, jnp.zeros(())

@@ -1,7 +1,7 @@
 """Newton iterations with the structured approximate inverse of the step matrix, and the tangent
 solves of the implicit function theorem (`lax.custom_root`).
 
-The first `ns` unknowns (the rigid ones, and with flexible structures their frames and multipliers)
+The first `ns` unknowns (the rigid ones, and the frames and multipliers of the terms that own some)
 enter nonlinearly: their rows and columns of the Jacobian are linearised with JAX (ns products each
 way) and closed by a Schur complement; the rest (liquid and elastic modal coordinates) is replaced by
 a constant block whose inverse `Cinv` is formed once per run (solve/linear.py).
@@ -29,6 +29,8 @@ def _precond_data_split(parts_m, Ac, x, Cinv, nr, ns):
     cm, Am_yz = _parts_linearised(parts_m, x[:nr], x[ns:])
     cols = jax.vmap(Ac, in_axes=1, out_axes=1)(I)
     cols = cols.at[:nr, :nr].add(cm[:nr]).at[ns:, :nr].add(cm[nr:])
+    if n == ns:                      # no constant block (no liquid, no deformable unknowns)
+        return (inv(cols),)
     AcT = jax.linear_transpose(Ac, x)
     Ayz = jax.vmap(lambda e: AcT(e)[0])(I.T)[:, ns:].at[:nr].add(Am_yz)
     Wz = Cinv @ cols[ns:]
@@ -177,7 +179,7 @@ class StructuredNewton(eqx.Module):
             data0, need0 = pre[0], ~(pre[1] > 0.5)
         else:    # placeholders of the shapes precondition returns (eval_shape would trace it again)
             n, ns = x0.shape[0], self.ns
-            data0 = ((jnp.zeros((ns, ns), x0.dtype),) if self.split is None and n == ns else
+            data0 = ((jnp.zeros((ns, ns), x0.dtype),) if n == ns else
                      (jnp.zeros((ns, ns), x0.dtype), jnp.zeros((ns, n - ns), x0.dtype),
                       jnp.zeros((n - ns, ns), x0.dtype)))
             need0 = jnp.array(True)

@@ -16,7 +16,7 @@ from jaxslosh.fit.identify import identify
 from jaxslosh.fit.problem import add_noise
 from jaxslosh.run.simulate import prepare
 from jaxslosh.solve.integrator import initial_state, step
-from jaxslosh.solve.linear import LowRankUpdate
+from jaxslosh.physics.damping import LowRankUpdate, ModalDamping
 
 from helpers import vessel_scene
 
@@ -59,7 +59,7 @@ def free_decay(scene, amplitude=1e-3, mode=None):
     system = b.system
     M = system.liquid.constant_blocks()[0]
     if mode is None:
-        mode = np.linalg.solve(np.asarray(M), np.asarray(system.damping.B[:, 0]))
+        mode = np.linalg.solve(np.asarray(M), np.asarray(system.tail[0].B[:, 0]))
     mode = mode / np.max(np.abs(np.asarray(system.liquid.nodal_fields(system.liquid.frame_field(jnp.asarray(mode))))))
     omega = float(np.sqrt(mode @ np.asarray(system.liquid.constant_blocks()[1]) @ mode / (mode @ np.asarray(M) @ mode)))
     v0 = b.v0.at[6:].set(amplitude * omega * jnp.asarray(mode))
@@ -164,7 +164,8 @@ def test_the_step_block_takes_the_damping_by_a_low_rank_update(linear_solver):
         solver = prepare(js.load_scene(text)).solver
     assert isinstance(solver.Cinv_step, LowRankUpdate)
     M, K = (np.asarray(x) for x in system.liquid.constant_blocks())
-    B, c = np.asarray(system.damping.B), np.asarray(system.damping.c)
+    damping, = (t for t in system.all_terms() if isinstance(t, ModalDamping))
+    B, c = np.asarray(damping.B), np.asarray(damping.c)
     s = solver.scheme
     h = float(scene.simulation.dt)
     A = solver.c_a * M + K + s.gamma / (s.beta * h) * (B * c) @ B.T
@@ -297,7 +298,7 @@ def test_without_the_table_nothing_changes():
     """No [tanks.damping]: no damping term, the solver's inverse is the plain one."""
     scene = held()
     setup = prepare(scene)
-    assert setup.built.system.damping is None and not isinstance(setup.solver.Cinv_step, LowRankUpdate)
+    assert not setup.built.system.tail and not isinstance(setup.solver.Cinv_step, LowRankUpdate)
     system = build(scene).system
     assert system.all_terms()[-1] is system.liquid
 

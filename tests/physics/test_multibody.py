@@ -8,7 +8,6 @@ import jax.numpy as jnp
 import numpy as np
 
 import jaxslosh as js
-from jaxslosh.physics import structures as mb
 from jaxslosh.assemble.system import build
 
 from helpers import MULTIBODY_TANK as TANK, mast, multibody_vessel as vessel, zero_crossing_period
@@ -27,9 +26,9 @@ def _random_state():
         mast("high", origin=(-0.15, -0.15, 3.0), size=(0.3, 0.3, 1.5), mesh=(1, 1, 2), to="low")
     b = build(js.load_scene(text))
     system = b.system
-    L = mb.layout(system)
+    L = system.layout()
     rng = np.random.default_rng(0)
-    c0 = jax.jit(lambda c, d: mb.advance(system, c, d))(
+    c0 = jax.jit(lambda c, d: system.advance(c, d))(
         b.c0, jnp.asarray(rng.normal(size=L.n_dyn)) *
         jnp.concatenate([jnp.full(6 + 6 * L.S, 0.2), jnp.full(L.nf, 1e-3), jnp.full(L.m, 1e-1)]))
     v = jnp.asarray(rng.normal(size=L.n_dyn) * 0.3)
@@ -42,15 +41,16 @@ def test_constraint_forces_are_the_transposed_constraint_jacobian():
     vector-Jacobian product of the constraints g through the configuration update (rotations varied
     on the group)."""
     system, L, c, v, alg = _random_state()
-    f_dyn, f_frames = jax.jit(lambda c, alg: mb._frame_rows(system, c, alg))(c, alg)
-    parts = mb.split_alg(system.flex, alg)
+    st, = system.owners()
+    f_dyn, f_frames = jax.jit(lambda c, alg: st.frame_rows(system, c, alg))(c, alg)
+    parts = st.split_alg(alg)
     lam = jnp.concatenate([jnp.concatenate([lk.reshape(-1) for lk in lams]) for _, lams in parts])
 
     def g(delta, Xfs):
         a = []
         for (_, lams), Xf in zip(parts, Xfs):
             a += [Xf.reshape(-1)] + [lk.reshape(-1) for lk in lams]
-        return mb.constraint(system, mb.advance(system, c, delta), jnp.concatenate(a))
+        return system.constraint(system.advance(c, delta), jnp.concatenate(a))
 
     ref_dyn, ref_frames = jax.jit(lambda lam: jax.vjp(g, jnp.zeros(L.n_dyn), [Xf for Xf, _ in parts])[1](lam))(lam)
     assert np.allclose(f_dyn, ref_dyn, rtol=1e-12, atol=1e-9 * np.abs(ref_dyn).max())
@@ -60,8 +60,9 @@ def test_constraint_forces_are_the_transposed_constraint_jacobian():
 
 def test_potential_forces_are_the_gradient_of_the_potential():
     system, L, c, v, alg = _random_state()
-    ref = jax.jit(jax.grad(lambda d: mb.structure_potential(system, mb.advance(system, c, d))))(jnp.zeros(L.n_dyn))
-    got = jax.jit(lambda c: mb.potential_forces(system, c))(c)
+    st, = system.owners()
+    ref = jax.jit(jax.grad(lambda d: st.extra_potential(system, system.advance(c, d))))(jnp.zeros(L.n_dyn))
+    got = jax.jit(lambda c: jnp.concatenate(st.potential_forces_parts(system, c)))(c)
     assert np.allclose(got, ref, rtol=1e-12, atol=1e-9 * np.abs(ref).max())
 
 
@@ -70,14 +71,15 @@ def test_constraint_acceleration_is_the_second_time_derivative_of_g():
     rng = np.random.default_rng(1)
     acc = jnp.asarray(rng.normal(size=L.n_dyn))
     Vf, Af = (jnp.asarray(rng.normal(size=L.n_alg)) for _ in range(2))
-    mask = mb.position_mask(system.flex)
+    st, = system.owners()
+    mask = st.position_mask()
     Vf, Af = jnp.where(mask, Vf, 0.0), jnp.where(mask, Af, 0.0)
 
     def G(tau):
-        return mb.constraint(system, mb.advance(system, c, tau * v + 0.5 * tau ** 2 * acc), alg + tau * Vf + 0.5 * tau ** 2 * Af)
+        return system.constraint(system.advance(c, tau * v + 0.5 * tau ** 2 * acc), alg + tau * Vf + 0.5 * tau ** 2 * Af)
 
     ref = jax.jit(lambda t0: jax.jvp(lambda t: jax.jvp(G, (t,), (1.0,))[1], (t0,), (1.0,))[1])(0.0)
-    got = jax.jit(lambda *a: mb.constraint_acceleration(system, c, *a))(v, acc, alg, Vf, Af)
+    got = jax.jit(lambda *a: st.constraint_acceleration(system, c, *a))(v, acc, alg, Vf, Af)
     assert np.allclose(got, ref, rtol=1e-10, atol=1e-10 * np.abs(ref).max())
 
 
@@ -88,15 +90,15 @@ def test_residual_is_lagrangian():
     system, L, c, v, _ = _random_state()
     T = lambda w: system.kinetic_energy(c, w)  # noqa: E731   (vessel, liquid and structures)
     M_ref = jax.jit(jax.hessian(T))(v)
-    M = jax.jit(jax.jacfwd(lambda a: mb.inertia_rows(system, c, v, a, 0.0)))(jnp.zeros(L.n_dyn))
+    M = jax.jit(jax.jacfwd(lambda a: system.step_rows(c, v, a, 0.0)))(jnp.zeros(L.n_dyn))
     assert np.allclose(M, M_ref, rtol=1e-10, atol=1e-10 * np.abs(M_ref).max())
     z = jnp.zeros(L.n_dyn)
 
     def V(d):
-        return system.potential_energy(mb.advance(system, c, d))      # structures included
+        return system.potential_energy(system.advance(c, d))      # structures included
 
     g_ref = jax.jit(jax.grad(V))(z)
-    g = jax.jit(lambda z: mb.inertia_rows(system, c, z, z, 0.0))(z)
+    g = jax.jit(lambda z: system.step_rows(c, z, z, 0.0))(z)
     assert np.allclose(g, g_ref, rtol=1e-9, atol=1e-9 * np.abs(g_ref).max())
 
 

@@ -33,7 +33,7 @@ def measured_amplification(scheme, Om):
         vel = jnp.array([0, 0, v, 0, 0, 0.0])
         acc = jnp.array([0, 0, -OMEGA ** 2 * z, 0, 0, 0.0])
         pa = jnp.array([0, 0, a, 0, 0, 0.0])
-        s1, info = STEP(SYSTEM, solver, State(c, vel, acc, pa, jnp.zeros(())))
+        s1, info = STEP(SYSTEM, solver, State(c, vel, acc, pa, jnp.zeros(()), jnp.zeros(0), SYSTEM.states_init()))
         assert bool(info.ok)
         cols.append(np.array([float(s1.c.X0[2]), float(s1.v[2]) * h, float(s1.a[2]) * h ** 2]) / eps)
     return np.array(cols).T
