@@ -53,6 +53,7 @@ import numpy as np
 from .kinematics import mv3, tv3
 from .about import About
 from .liquid import AbstractLiquid
+from .multimodal_modes import odd_powers
 from .terms import Kin, Rows
 
 #: quadrature points along the tank (Gauss-Legendre; at least, and 8 per mode: the integrands hold
@@ -60,6 +61,22 @@ from .terms import Kin, Rows
 NX, NZ = 48, 20
 #: terms of the vortical flow's series (`ModalTank.vortical`)
 SJ_TERMS = 40
+
+
+def _vortical_tables(L, D, xq):
+    """(Te, Tf), each (NX, SJ_TERMS, 5): the vortical series' coefficients at the quadrature points,
+    multiplying exp(-kappa_m (D - H)) and exp(-kappa_m H) in chi, w_x, w_z - 2 xi, G_x and the
+    depth primitive of sinh (`ModalTank._vortical_surface`; `vortical` sums the same series)."""
+    a, d = 0.5 * L, 0.5 * D
+    m = jnp.arange(SJ_TERMS)
+    kap = (2 * m + 1) * jnp.pi / (2 * a)
+    c = -2.0 * (2.0 / a) * (-1.0) ** m / kap ** 2 / (1.0 + jnp.exp(-2.0 * kap * d))
+    xi = xq[:, None] - a
+    Cm, Sm = jnp.cos(kap * xi), jnp.sin(kap * xi)
+    sh = jnp.stack([Sm * c / kap, Cm * c, jnp.zeros_like(Cm), jnp.zeros_like(Cm), Cm * c / kap ** 2], -1)
+    chh = jnp.stack([jnp.zeros_like(Cm), jnp.zeros_like(Cm), Sm * c, Cm * c / kap, jnp.zeros_like(Cm)], -1)
+    # sinh = (e - f) / den, cosh = (e + f) / den, with e = exp(-kappa (d - eta)), f = exp(-kappa (d + eta))
+    return sh + chh, chh - sh
 
 
 @jax.custom_jvp
@@ -112,8 +129,7 @@ class ModalTank(eqx.Module):
     cx: jax.Array         # (NX, N) cos(k_n x_q), sin(k_n x_q): the tables of the integrals
     sx: jax.Array
     cj: jax.Array         # (NX, 2N + 1) cos(j pi x_q / L)
-    cm: jax.Array         # (NX, SJ_TERMS) cos(kappa_m xi_q), sin(kappa_m xi_q) (`vortical`)
-    sm: jax.Array
+    vtab: tuple           # (NX, SJ_TERMS, 5) twice: the vortical series' tables (`_vortical_tables`)
     vort0: tuple          # the vortical integrals (Bw, W, wint, Zwx, Xwz) at rest less their surface terms
     S0: jax.Array         # (3,) the first moment at rest (vessel frame)
 
@@ -144,23 +160,29 @@ class ModalTank(eqx.Module):
         cosh(k_n u) make sinh(k_j H) / k_j with k_j = j pi / L, j = |n - m| or n + m), the vortical
         flow's from their values at rest (`vort0`) plus the flux through the free surface (Green: the
         integrands are divergences of fields with no flux through the walls), all along x by Gauss
-        quadrature over the instantaneous surface H(x) = h + zeta(x)."""
+        quadrature over the instantaneous surface H(x) = h + zeta(x).
+
+        Written for the step's cost: one exponential per point and wavenumber k_j (sinh and cosh of
+        k_n H are those of k_j H for j = n), A_nk from the (2N + 1)^2 moments of sinh(k_a H) cos(k_b x)
+        (one matrix product), and the vortical flow's terms as powers (`_vortical_surface`)."""
         k, x, w, ch = self.k, self.xq, self.wq, jnp.cosh(self.k * self.h)
         n, cx, sx = self.n, self.cx, self.sx
         H = self.h + cx @ beta                                             # (NX,)
         Hp = -(sx * k) @ beta                                               # dH/dx
-        shH, chH = jnp.sinh(H[:, None] * k), jnp.cosh(H[:, None] * k)
+        # sinh(k_j H) / k_j (H for j = 0) and cosh(k_j H), j = 0..2N, from one exponential each
+        kj = jnp.arange(2 * n + 1) * jnp.pi / self.L
+        E = jnp.exp(H[:, None] * kj)
+        Ei = 1.0 / E
+        Sh, Chj = 0.5 * (E - Ei), 0.5 * (E + Ei)
+        Sj = jnp.concatenate([H[:, None], Sh[:, 1:] / kj[1:]], axis=1)
+        shH, chH = Sh[:, 1:n + 1], Chj[:, 1:n + 1]
         An = w @ (cx * shH) / (k * ch)
         phis = cx * chH / ch                                                # phi_n at the surface
-        Jn = jnp.einsum("q,qn,qj->nj", w, phis, cx)
-        # sinh(k_j H) / k_j (H for j = 0) and cos(k_j x), j = 0..2N
-        kj = jnp.arange(2 * n + 1) * jnp.pi / self.L
-        kj_ = jnp.where(kj > 0, kj, 1.0)
-        Sj = jnp.where(kj > 0, jnp.sinh(H[:, None] * kj) / kj_, H[:, None])
-        Cj = self.cj
+        Jn = (phis * w[:, None]).T @ cx
         i = np.arange(1, n + 1)
         P, M = i[:, None] + i[None, :], np.abs(i[:, None] - i[None, :])
-        Ank = 0.5 * jnp.outer(k / ch, k / ch) * jnp.einsum("q,qnm->nm", w, Sj[:, P] * Cj[:, M] - Sj[:, M] * Cj[:, P])
+        T = (Sj * w[:, None]).T @ self.cj                                   # (2N + 1)^2: sinh(k_a H) / k_a, cos(k_b x)
+        Ank = 0.5 * jnp.outer(k / ch, k / ch) * (T[P, M] - T[M, P])
         grad = jnp.stack([-(w @ (sx * shH)) / ch, (w @ (cx * (chH - 1.0))) / ch], axis=-1)
         Zux = -(w @ (sx * (H[:, None] * shH - (chH - 1.0) / k))) / ch
         Xuz = ((w * x) @ (cx * (chH - 1.0))) / ch
@@ -176,22 +198,20 @@ class ModalTank(eqx.Module):
     def _vortical_surface(self, H, Hp):
         """At the quadrature points' surface (x_q, H_q), slope Hp: chi, the flux w . (-H', 1) of the
         vortical flow (`vortical`), and the depth primitives of w_x, w_z and u w_x (their values at
-        u = H; the vortical integrals' differences from rest are sums of these)."""
-        a, d = 0.5 * self.L, 0.5 * self.D
-        xi, eta = self.xq - a, H - d
-        m = jnp.arange(SJ_TERMS)
-        kap = (2 * m + 1) * jnp.pi / (2 * a)
-        c = -2.0 * (2.0 / a) * (-1.0) ** m / kap ** 2
-        e = jnp.exp(-kap * (d - eta[:, None]))
-        f = jnp.exp(-kap * (d + eta[:, None]))
-        den = 1.0 + jnp.exp(-2.0 * kap * d)
-        sh, chh = (e - f) / den, (e + f) / den
-        Cm, Sm = self.cm, self.sm
-        chi = (Sm * sh) @ (c / kap)
-        wx = (Cm * sh) @ c
-        wz = 2.0 * xi + (Sm * chh) @ c
-        Gx = (Cm * chh) @ (c / kap)
-        return chi, wz - Hp * wx, Gx, 2.0 * xi * H + chi, H * Gx - (Cm * sh) @ (c / kap ** 2)
+        u = H; the vortical integrals' differences from rest are sums of these).
+
+        The series' exponentials exp(-kappa_m (D - H)) and exp(-kappa_m H), kappa_m = (2m + 1) kappa_0,
+        are the odd powers of their m = 0 terms (by doubling: a few products, no exponential per
+        term); the sums are then two products with the tables `vtab` (the series' coefficients times
+        sin or cos (kappa_m xi_q), formed once)."""
+        kap0 = jnp.pi / self.L
+        e = odd_powers(jnp.exp(-kap0 * (self.D - H)), SJ_TERMS)             # (NX, SJ_TERMS)
+        f = odd_powers(jnp.exp(-kap0 * H), SJ_TERMS)
+        Te, Tf = self.vtab
+        s = jnp.einsum("qm,qmk->qk", e, Te) + jnp.einsum("qm,qmk->qk", f, Tf)  # (NX, 5)
+        chi, wx, wz0, Gx, Gux0 = s[:, 0], s[:, 1], s[:, 2], s[:, 3], s[:, 4]
+        wz = 2.0 * (self.xq - 0.5 * self.L) + wz0
+        return chi, wz - Hp * wx, Gx, 2.0 * (self.xq - 0.5 * self.L) * H + chi, H * Gx - Gux0
 
     def integrals_quadrature(self, beta) -> Integrals:
         """The same integrals by Gauss quadrature over the liquid (NZ points through the depth): the
@@ -317,7 +337,13 @@ class ModalTank(eqx.Module):
         return 0.5 * v @ (self.mass_matrix(beta) @ v)
 
     def first_moment(self, beta):
-        return self.moments(self.integrals(beta))[0]
+        """S(beta) (vessel frame): the liquid's first moment, from the surface alone (the potential
+        energy of every saved frame reads it; the other integrals are not needed)."""
+        w, x = self.wq, self.xq
+        H = self.h + self.cx @ beta
+        rb, o = self.rho * self.b, self.origin
+        area = w @ H
+        return rb * jnp.array([w @ (x * H), 0.5 * self.b * area, w @ (0.5 * H ** 2)]) + rb * area * o
 
     def rest_moment(self):
         return self.S0
@@ -330,13 +356,13 @@ class ModalTank(eqx.Module):
         """Kirchhoff's equations (module docstring): (translation rows (body), rotation rows (body),
         modal rows), from the momenta p = M(beta) v and their rates M v_dot + (dM/dt) v."""
         v = jnp.concatenate([Vb, omega, beta_dot])
-        # M and its derivatives along every beta_j in one forward pass (dM: (N, 6 + N, 6 + N))
-        (M, (P, dS)), (dM, _) = jax.vmap(lambda e: jax.jvp(self._mass, (beta,), (e,)),
-                                         out_axes=((None, (None, None)), 0))(jnp.eye(self.n, dtype=beta.dtype))
-        Mv = dM @ v                                                         # (N, 6 + N)
+        # M's rate along beta_dot by one forward pass and dT/dbeta by one reverse pass (not the N
+        # derivatives dM/dbeta_j: the rows need only these two contractions of them)
+        (M, (P, dS)), (Md, _) = jax.jvp(self._mass, (beta,), (beta_dot,))
+        Mdv = Md @ v
+        dT = jax.grad(lambda be: 0.5 * v @ (self._mass(be)[0] @ v))(beta)
         p = M @ v
-        dp = M @ jnp.concatenate([Vb_dot, alpha, beta_dd]) + beta_dot @ Mv
-        dT = 0.5 * Mv @ v
+        dp = M @ jnp.concatenate([Vb_dot, alpha, beta_dd]) + Mdv
         P_lin, H = p[:3], p[3:6]
         f = dp[:3] + jnp.cross(omega, P_lin)
         m = dp[3:6] + jnp.cross(omega, H) + jnp.cross(Vb, P_lin) - jnp.cross(dS, g_b)
@@ -353,12 +379,11 @@ def modal_tank(L, b, h, rho, origin, n_modes: int, D=None) -> ModalTank:
     z = jnp.zeros(n_modes)
     x = 0.5 * L * (jnp.asarray(xg) + 1.0)
     k = jnp.arange(1, n_modes + 1) * jnp.pi / L
-    kap = (2 * jnp.arange(SJ_TERMS) + 1) * jnp.pi / L
     t = ModalTank(L=L, b=jnp.asarray(b, dtype=float), h=jnp.asarray(h, dtype=float), D=D,
                   rho=jnp.asarray(rho, dtype=float), origin=jnp.asarray(origin, dtype=float),
                   k=k, xq=x, wq=0.5 * L * jnp.asarray(wg), cx=jnp.cos(x[:, None] * k), sx=jnp.sin(x[:, None] * k),
                   cj=jnp.cos(x[:, None] * jnp.arange(2 * n_modes + 1) * jnp.pi / L),
-                  cm=jnp.cos(kap * (x[:, None] - 0.5 * L)), sm=jnp.sin(kap * (x[:, None] - 0.5 * L)),
+                  vtab=_vortical_tables(L, D, x),
                   vort0=(z, jnp.zeros(()), jnp.zeros(2), jnp.zeros(()), jnp.zeros(())), S0=jnp.zeros(3))
     I = t.integrals_quadrature(z)
     w, H = t.wq, jnp.full(nx, t.h)

@@ -170,21 +170,33 @@ class DiskBase:
 
 
 # ---------------------------------------------------------------------------------- vortical flows
+def odd_powers(a, m: int):
+    """(..., m): a, a^3, ..., a^(2m - 1), by doubling: a few products in place of m exponentials or
+    sines (exp((2k + 1) x) and exp(i (2k + 1) x) from exp(x), exp(i x)); relative error a few m eps."""
+    p, r = a[..., None], a * a
+    while p.shape[-1] < m:
+        p = jnp.concatenate([p, p * r[..., None]], axis=-1)
+        r = r * r
+    return p[..., :m]
+
+
 def _section(length, depth, xi, eta):
     """The vortical flow (w1, w2) of a unit rotation of a length x depth rectangle about its normal,
     at (xi, eta) from its centre: curl w = -2, no flux through its sides; with w = grad chi + (0, 2 xi),
     chi = sum_m c_m sin(k_m xi) sinh(k_m eta) / (k_m cosh(k_m d)), k_m = (2m + 1) pi / length, c_m the
-    sine series of -2 xi (the Stokes-Joukowski potential less the rigid rotation)."""
+    sine series of -2 xi (the Stokes-Joukowski potential less the rigid rotation). The series' terms
+    are odd powers of their first (`odd_powers`)."""
     a, d = 0.5 * length, 0.5 * depth
     m = jnp.arange(SJ_TERMS)
-    k = (2 * m + 1) * jnp.pi / (2 * a)
-    c = -2.0 * (2.0 / a) * (-1.0) ** m / k ** 2
-    eta = jnp.asarray(eta)[..., None]
-    e, f = jnp.exp(-k * (d - eta)), jnp.exp(-k * (d + eta))       # no overflow: |eta| <= d
-    den = 1.0 + jnp.exp(-2.0 * k * d)
-    sh, ch = (e - f) / den, (e + f) / den
-    xi = jnp.asarray(xi)[..., None]
-    return jnp.sum(c * jnp.cos(k * xi) * sh, axis=-1), 2.0 * xi[..., 0] + jnp.sum(c * jnp.sin(k * xi) * ch, axis=-1)
+    k0 = jnp.pi / (2 * a)
+    k = (2 * m + 1) * k0
+    c = -2.0 * (2.0 / a) * (-1.0) ** m / k ** 2 / (1.0 + jnp.exp(-2.0 * k * d))
+    eta, xi = jnp.asarray(eta), jnp.asarray(xi)
+    e = odd_powers(jnp.exp(-k0 * (d - eta)), SJ_TERMS)            # exp(-k (d -+ eta)): no overflow, |eta| <= d
+    f = odd_powers(jnp.exp(-k0 * (d + eta)), SJ_TERMS)
+    z = odd_powers(jnp.exp(1j * k0 * xi), SJ_TERMS)               # cos(k xi) + i sin(k xi)
+    sh, ch = e - f, e + f
+    return jnp.sum(c * z.real * sh, axis=-1), 2.0 * xi + jnp.sum(c * z.imag * ch, axis=-1)
 
 
 def box_vortical(L, B, D, x, y, z):
