@@ -194,7 +194,7 @@ def test_square_base_forced_along_x_swirls_at_resonance():
     assert np.abs(below[:, 0]).max() > 0.01
 
 
-@pytest.mark.slow      # about 2 min of CPU: the 3-D integrals traced twice over
+@pytest.mark.slow      # minutes of CPU on 2 cores: kept out of the default suite
 def test_gradient_through_a_run_with_a_3d_tank_matches_finite_differences():
     """The gradient of a corner's elevation after 10 steps of a free vessel carrying a `flow = "3d"`
     box (its lowest pair of modes, across and along), with respect to the fill depth, by the implicit
