@@ -56,7 +56,7 @@ def test_anti_roll_tank_notebook_runs():
                 r"\[\s*([-\d.e]+)\s+([-\d.e]+)\s*\]", text)
     for a, b in ((g[0], g[2]), (g[1], g[3])):
         assert abs(a - b) <= 0.01 * abs(b) + 1e-5, g
-    # a few adam steps lower the peak, and the re-read scene agrees that the new design is better
+    # a few L-BFGS iterations lower the peak, and the re-read scene agrees that the new design is better
     start, end = numbers(r"grid max ([\d.]+) rad/m \(start ([\d.]+)\)", text)[::-1]
     assert end < start, (start, end)
     scene_peak = numbers(r"scene's tank\s+[\d.]+\s+[\d.]+\s+([\d.]+)", text)[0]
