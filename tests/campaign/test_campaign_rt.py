@@ -10,40 +10,15 @@ from dask.distributed import Client, LocalCluster
 import jaxslosh as js
 from jaxslosh.campaign.cases import case_scene
 from jaxslosh.cli import main
+from test_campaign import scene_text
 
 ROOT = Path(__file__).resolve().parents[2]
 BEAM = 1.5707963267948966
 CACHE = Path(os.environ.get("TMPDIR", "/tmp")) / f"jaxslosh-test-campaign-cache-{os.getuid()}"
 
-SCENE = """
-title = "box with an rt tank in irregular seas"
-[environment]
-gravity = 9.81
-water_density = 1025.0
-[simulation]
-duration = 30.0
-dt = 0.1
-scheme = "newmark"
-save_every = 2
-[vessel]
-mass = 4.1e5
-inertia = [6.0e6, 1.6e7, 2.0e7]
-[vessel.hull]
-length = 20.0
-beam = 10.0
-draft = 2.0
-kg = 2.5
-[vessel.hydrodynamics]
-viscous_damping = [0.0, 0.0, 1.0e5, 1.5e6, 5.0e6, 0.0]
-[waves]
-type = "pierson-moskowitz"
-hs = 0.3
-tp = 7.0
-heading = 1.5707963267948966
-seed = 0
-components = 20
-frequency_range = [0.3, 2.5]
-ramp = 10.0
+# test_campaign.py's box in irregular seas (30 s, 20 components), with a small rt tank on 4 modes
+SCENE = scene_text(duration=30.0, components=20).replace("box alone in irregular seas",
+                                                         "box with an rt tank in irregular seas") + """
 [[tanks]]
 name = "tank"
 origin = [0.0, 0.0, 1.0]
