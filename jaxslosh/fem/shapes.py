@@ -68,6 +68,54 @@ def breaks(lo, hi, points, n, where="mesh"):
     return np.array(out)
 
 
+#: the surface layers' thickness scale over the free surface's width (`surface_layers`)
+SURFACE_GRADING = 0.1
+#: the weight of the band under the surface where its walls slope (`surface_layers`)
+SLOPED_SURFACE_BAND = 2.0
+#: the fewest layers of a band between two kinks, or between a kink and the surface or the bottom
+BAND_LAYERS = 2
+
+
+def surface_layers(h, points, n, width, sloped=False, where="mesh[2]"):
+    """n + 1 heights from 0 to the surface h with every kink of `points` (inside) among them, the
+    layers thinner toward the surface: for the face-normal element (fem/liquid_rt.py), whose
+    horizontal displacements are constant through a layer, while a sloshing mode decays from the
+    surface down (as exp(-k d)). The layers are spread by the density 1 / (1 + d / l) at the depth
+    d, l = SURFACE_GRADING x the surface's `width` (so they thicken linearly with depth); each band
+    between kinks takes its share of that density, the band under the surface twice it where its
+    walls slope (a surface in the top chamfers: RT0's error on that band's trapezoids is several
+    times a box's on layers of the same thickness), and at least BAND_LAYERS layers (one where n is
+    too small for that). Measured on a 1 m LNG section filled 85 and 95 % (docs/design/liquid-element.md):
+    the top chamfer's one row of trapezoids put the third mode 1 to 12 % low; graded, within 1 %."""
+    cuts = sorted({float(p) for p in points if 1e-9 * h < p < h * (1 - 1e-9)})
+    ends = np.array([0.0] + cuts + [h])
+    k = len(ends) - 1
+    if n < k:
+        raise ValueError(f"{where}: {n} elements cannot put a node at each of the shape's {k - 1} breaks "
+                         f"({', '.join(f'{c:g}' for c in cuts)} m); use at least {k}")
+    ell = SURFACE_GRADING * width
+
+    def depth_count(z):                   # the layers' density integrated from the surface down to z
+        return ell * np.log1p((h - z) / ell)
+
+    share = -np.diff(depth_count(ends))
+    if sloped:
+        share[-1] *= SLOPED_SURFACE_BAND
+    share = share / share.sum() * n
+    least = np.full(k, BAND_LAYERS if n >= BAND_LAYERS * k else 1)
+    counts = np.maximum(least, np.floor(share).astype(int))
+    while counts.sum() > n:               # borrow from the band with the most layers for its share
+        counts[np.argmin(np.where(counts > least, share / counts, np.inf))] -= 1
+    while counts.sum() < n:
+        counts[np.argmax(share / counts)] += 1
+    out = [0.0]
+    for s, e, c in zip(ends[:-1], ends[1:], counts):
+        u = np.linspace(depth_count(s), depth_count(e), c + 1)[1:]
+        out += list(h - ell * np.expm1(u / ell))
+    out[-1] = h
+    return np.array(out)
+
+
 def merge_coincident(nodes, elements, n_grid=None):
     """Merge nodes at the same place (a V bottom's collapsed row); None merged: unchanged. Nodes from
     `n_grid` on (a baffle's second side) are never merged with the grid's."""
