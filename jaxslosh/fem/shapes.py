@@ -47,9 +47,10 @@ def _jacobian_det(X, xi):
     return np.linalg.det(J)
 
 
-def breaks(lo, hi, points, n, where="mesh"):
+def breaks(lo, hi, points, n, where="mesh", least=1):
     """n + 1 coordinates from lo to hi with every point of `points` (inside) among them: each
-    interval between them gets a share of the n elements proportional to its length (at least one)."""
+    interval between them gets a share of the n elements proportional to its length (at least
+    `least`, one where n is too small for that)."""
     cuts = sorted({float(p) for p in points if lo + 1e-9 * (hi - lo) < p < hi - 1e-9 * (hi - lo)})
     ends = [lo] + cuts + [hi]
     lengths = np.diff(ends)
@@ -57,9 +58,10 @@ def breaks(lo, hi, points, n, where="mesh"):
     if n < k:
         raise ValueError(f"{where}: {n} elements cannot put a node at each of the shape's {k - 1} breaks "
                          f"({', '.join(f'{c:g}' for c in cuts)} m); use at least {k}")
-    counts = np.maximum(1, np.floor(lengths / lengths.sum() * n).astype(int))
+    least = least if n >= least * k else 1
+    counts = np.maximum(least, np.floor(lengths / lengths.sum() * n).astype(int))
     while counts.sum() > n:
-        counts[np.argmax(counts)] -= 1
+        counts[np.argmax(np.where(counts > least, counts, 0))] -= 1
     while counts.sum() < n:
         counts[np.argmax(lengths / counts)] += 1
     out = [lo]
@@ -85,8 +87,8 @@ def surface_layers(h, points, n, width, sloped=False, where="mesh[2]"):
     between kinks takes its share of that density, the band under the surface twice it where its
     walls slope (a surface in the top chamfers: RT0's error on that band's trapezoids is several
     times a box's on layers of the same thickness), and at least BAND_LAYERS layers (one where n is
-    too small for that). Measured on a 1 m LNG section filled 85 and 95 % (docs/design/liquid-element.md):
-    the top chamfer's one row of trapezoids put the third mode 1 to 12 % low; graded, within 1 %."""
+    too small for that). Proportional layers leave one row of trapezoids under a surface in the top
+    chamfers, and the modes low (docs/design/liquid-element.md, "Layers")."""
     cuts = sorted({float(p) for p in points if 1e-9 * h < p < h * (1 - 1e-9)})
     ends = np.array([0.0] + cuts + [h])
     k = len(ends) - 1

@@ -17,7 +17,7 @@ from __future__ import annotations
 import numpy as np
 
 from ..fem.mesh import box_elements, count_nodes, grid_index
-from ..fem.shapes import TankMesh, breaks, finish, merge_coincident, surface_layers
+from ..fem.shapes import BAND_LAYERS, TankMesh, breaks, finish, merge_coincident, surface_layers
 from ..fem.slip import FEATURE_ANGLE
 
 #: a box's section: no corner cut
@@ -68,7 +68,7 @@ def _layered(size, chamfers, baffles, h, mesh, graded=True):
     for bf in baffles:
         zb.append(bf.height if bf.mount == "bottom" else H - bf.height)
     xs = breaks(0.0, a, xb, nx, "mesh[0]")
-    zs = _heights(size, chamfers, h, zb, nz, graded)
+    zs = _heights(size, chamfers, baffles, h, zb, nz, graded)
     # across: a node on every y-baffle's plane (box tanks only), the same counts on every layer
     ys_rest = breaks(0.0, b, yb, ny, "mesh[1]")
     g = grid_index(nx, ny, nz)
@@ -92,13 +92,18 @@ def _layered(size, chamfers, baffles, h, mesh, graded=True):
     return np.stack([xs[g[:, 0]], y, z], axis=1)
 
 
-def _heights(size, chamfers, h, kinks, nz, graded):
+def _heights(size, chamfers, baffles, h, kinks, nz, graded):
     """The layers' heights: with no kink below the surface (a plain box, a prismatic tank filled within
     its hopper) even; else graded toward the surface (fem/shapes.py `surface_layers`) or, not
-    `graded`, spread in proportion to the bands between the kinks (`breaks`)."""
+    `graded`, spread in proportion to the bands between the kinks (`breaks`). With baffles (kinks at
+    their edges) the face-normal element's layers are proportional too, two or more a band: graded
+    toward the surface they thicken at a hanging plate's edge, where the flow is singular, and its
+    first mode moves further off (docs/design/liquid-element.md, "Layers")."""
     inside = [z for z in kinks if 1e-9 * h < z < h * (1 - 1e-9)]
     if not graded or not inside:
         return breaks(0.0, h, kinks, nz, "mesh[2]")
+    if baffles:
+        return breaks(0.0, h, kinks, nz, "mesh[2]", BAND_LAYERS)
     lo, hi = section_walls(size, chamfers, h)
     below = max(inside)
     lo_k, hi_k = section_walls(size, chamfers, below)
