@@ -146,7 +146,7 @@ def _model(scene: Scene, params: dict, outline: bool = False) -> _Model:
     elif has_liquid:
         liquid = dataclasses.replace(liquid, about=about)
     # a prescribed motion is a term that holds the vessel's rows (System.hold); a free vessel has none
-    motion = None if ves.forced is None else _prescribed(ves.forced)
+    motion = None if ves.forced is None else _prescribed(ves.forced, P)
     q0 = None
     if not outline:
         ini = ves.initial
@@ -199,15 +199,17 @@ def _model(scene: Scene, params: dict, outline: bool = False) -> _Model:
     return _Model(system, block, blocks, multimodal)
 
 
-def _prescribed(f):
-    """The motion of a `[vessel.forced]` table: one dof's profile, or a record's spline."""
+def _prescribed(f, P):
+    """The motion of a `[vessel.forced]` table: one dof's profile, or a record's spline; the harmonic
+    form's amplitude, frequency and phase from `params` where it names them (tracers too)."""
     if f.profile == "record":
         knots, coef = record_coefficients(f.times, f.columns, DOFS)
         return RecordedMotion(knots=jnp.asarray(knots), coef=jnp.asarray(coef), about=record_about(f))
     if f.profile == "spin-up":
         return SpinUpMotion(dof=DOFS.index(f.dof), rate=float(f.rate), duration=float(f.duration))
-    return HarmonicMotion(dof=DOFS.index(f.dof), amplitude=jnp.asarray(f.amplitude, dtype=float),
-                          frequency=jnp.asarray(f.frequency, dtype=float), ramp=float(f.ramp), phase=float(f.phase))
+    value = lambda key: jnp.asarray(P(f"vessel.forced.{key}", getattr(f, key)), dtype=float)  # noqa: E731
+    return HarmonicMotion(dof=DOFS.index(f.dof), amplitude=value("amplitude"), frequency=value("frequency"),
+                          ramp=float(f.ramp), phase=value("phase"))
 
 
 def _hull(mass, inertia, parts):

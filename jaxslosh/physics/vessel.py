@@ -195,12 +195,13 @@ class AbstractPrescribedMotion(AbstractTerm):
 
 class HarmonicMotion(AbstractPrescribedMotion):
     """One rigid dof at amplitude sin(frequency t + phase), faded in over `ramp` by `smooth_ramp`
-    (C2: no jump in the acceleration); the others held at zero."""
+    (C2: no jump in the acceleration); the others held at zero. Amplitude, frequency and phase are
+    leaves of the model (traceable: `vessel.forced.amplitude`, `.frequency`, `.phase`)."""
     dof: int = eqx.field(static=True)      # 0-2 surge, sway, heave; 3-5 roll, pitch, yaw
     amplitude: jax.Array
     frequency: jax.Array
     ramp: float = eqx.field(static=True, default=0.0)
-    phase: float = eqx.field(static=True, default=0.0)     # rad
+    phase: jax.Array = 0.0                                 # rad
 
     def coordinates(self, t):
         x = self.amplitude * jnp.sin(self.frequency * t + self.phase)
@@ -209,7 +210,7 @@ class HarmonicMotion(AbstractPrescribedMotion):
         return jnp.zeros(6).at[self.dof].set(x)
 
     def describe(self) -> tuple:
-        phase = f" + {self.phase:g}" if self.phase else ""
+        phase = f" + {float(self.phase):g}" if float(self.phase) else ""
         ramp = f", faded in over {self.ramp:g} s" if self.ramp else ""
         return (("prescribed motion", f"{DOF_NAMES[self.dof]} = {float(self.amplitude):g} "
                                       f"sin({float(self.frequency):g} t{phase}){ramp}, other rigid dofs held"),)
