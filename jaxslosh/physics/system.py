@@ -78,9 +78,7 @@ class System(eqx.Module):
     def hold_forces(self, rows):
         """Rows in Newton order [y, alg, z] of forces beside the terms' (the multipliers'), none on
         the vessel's rows where its motion is prescribed: its rows are the constraint alone."""
-        for _ in self.prescribing():
-            rows = rows.at[:6].set(0.0)
-        return rows
+        return rows.at[:6].set(0.0) if self.prescribing() else rows
 
     def layout(self) -> Layout:
         u = [t.unknowns() for t in self.owners()]
