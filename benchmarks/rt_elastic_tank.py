@@ -76,7 +76,8 @@ def modes(mesh):
     for name, m, wall in (("rt", fm, np.array([k == "wall" for k in fm.kind])),
                           ("stabilized", nodal, nodal.wall_share > 0.5)):
         slosh = m.omega[[k == "sloshing" for k in m.kind]][:5]
-        print(f"| {name} | {', '.join(f'{w:.4f}' for w in slosh)} | {', '.join(f'{w:.2f}' for w in m.omega[wall][:6])} |")
+        walls = ", ".join(f"{w:.2f}" for w in m.omega[wall][:6])
+        print(f"| {name} | {', '.join(f'{w:.4f}' for w in slosh)} | {walls} |")
 
 
 if __name__ == "__main__":

@@ -11,7 +11,7 @@ from ..fem.modes import Modes, liquid_modes
 from ..fem.structure import build_structure, clamped_modes
 from ..fem.walls import build_tank_with_walls, tank_modes
 from ..fem.walls_rt import build_face_tank_with_walls, face_tank_modes
-from ..scene.types import Scene, SceneError
+from ..scene.types import Scene
 from ..solve.sparse import SPARSE_AUTO
 
 

@@ -64,10 +64,9 @@ def face_area_weights(model: FaceLiquid, faces) -> np.ndarray:
 
 def wall_faces(model: FaceLiquid) -> np.ndarray:
     """The liquid's wetted wall faces: on the boundary, not free surface, not collapsed."""
-    E = len(model.elements)
     count = np.bincount(model.element_faces.reshape(-1), minlength=len(model.faces))
     collapsed = np.array([len(set(f)) < 3 for f in model.faces])
-    return np.flatnonzero((count == 1) & ~model.free & ~collapsed) if E else np.zeros(0, dtype=int)
+    return np.flatnonzero((count == 1) & ~model.free & ~collapsed)
 
 
 @dataclass(frozen=True, eq=False)
@@ -114,7 +113,7 @@ def couple_walls(model: FaceLiquid, Tw, Mw, Kw, origin=(0.0, 0.0, 0.0), walls=No
     I = sp.coo_matrix((np.ones(nq), (f, np.arange(nq))), shape=(len(model.faces), nq))
     T = sp.hstack([I, Tw]).tocsr()
     M, K = model.mass, model.stiffness
-    MT = (M @ T).toarray() if sp.issparse(M @ T) else np.asarray(M @ T)
+    MT = (M @ T).toarray()
     Mz = T.T @ MT
     Kz = T.T @ (K @ T).toarray()
     Mz[nq:, nq:] += np.asarray(Mw)

@@ -161,10 +161,12 @@ def test_wall_faces_sweep_the_walls_volume():
     faces = wall_faces(tw.model)
     X = tw.model.nodes[tw.model.faces[faces]]
     centre = X.mean(axis=1)
-    normal = np.where(np.abs(centre[:, :1]) < 1e-9, [-1, 0, 0], 0) + np.where(np.abs(centre[:, :1] - 5) < 1e-9,
-                                                                               [1, 0, 0], 0)
-    normal = normal + np.where(np.abs(centre[:, 1:2]) < 1e-9, [0, -1, 0], 0) + \
-        np.where(np.abs(centre[:, 1:2] - 5) < 1e-9, [0, 1, 0], 0) + np.where(np.abs(centre[:, 2:]) < 1e-9, [0, 0, -1], 0)
+    normal = np.zeros_like(centre)              # the box's outward normals, from the plane each face is on
+    for axis, top in ((0, 5.0), (1, 5.0), (2, None)):
+        normal[np.abs(centre[:, axis]) < 1e-9, axis] = -1.0
+        if top is not None:
+            normal[np.abs(centre[:, axis] - top) < 1e-9, axis] = 1.0
+    assert np.all(np.abs(normal).sum(axis=1) == 1)
     area = np.abs(np.linalg.norm(np.cross(X[:, 1] - X[:, 0], X[:, 3] - X[:, 0]), axis=1))
     v = np.array([0.3, -0.2, 0.7])
     u = np.tile(v, len(w.nodes))[tw.wall_dofs]
