@@ -228,15 +228,17 @@ def test_modes_command_and_a_run(tmp_path, capsys):
     np.testing.assert_allclose(out["omega"], analytic_sloshing_omegas(5.0, 5.0, 3.0, G, 4), rtol=0.02)
     assert main(["modes", str(scene), "-n", "2"]) == 0
     assert "circulation modes at zero frequency left out" in capsys.readouterr().out
-    # a full-order run (tests/analysis/test_rt_runs.py checks it); one with elastic walls is refused
+    # a full-order run (tests/analysis/test_rt_runs.py checks it); with elastic walls on modes it is
+    # refused (elastic walls need the full order: tests/physics/test_rt_elastic_walls.py runs them)
     assert main(["run", str(scene), "-o", str(tmp_path / "r.h5")]) == 0
     capsys.readouterr()
     walls = tmp_path / "w.toml"
     walls.write_text(SCENE.replace("[tanks.fluid]", "[tanks.walls]\nthickness = 0.02\n[tanks.walls.material]\n"
-                                   "young = 2.0e11\npoisson = 0.3\ndensity = 7850.0\n[tanks.fluid]"))
+                                   "young = 2.0e11\npoisson = 0.3\ndensity = 7850.0\n[tanks.reduction]\nmodes = 4\n"
+                                   "[tanks.fluid]"))
     assert main(["run", str(walls), "-o", str(tmp_path / "w.h5")]) == 2
     err = capsys.readouterr().err
-    assert "tanks[0]" in err and not (tmp_path / "w.h5").exists()
+    assert "tanks[0].walls" in err and "full-order" in err and not (tmp_path / "w.h5").exists()
 
 
 # --- runs: the modal basis -------------------------------------------------------------------
