@@ -1,5 +1,6 @@
-"""`jaxslosh modes --coupled` with a multimodal tank: the linearisation of its rows about rest (jax)
+"""A multimodal tank linearised about rest. `jaxslosh modes --coupled`: its rows' tangent (by jax)
 in the coupled eigenproblem, against the closed form of a vessel free in surge carrying the tank.
+`jaxslosh rao`: a two-dimensional tank in beam seas says what it leaves out.
 
 Forced in surge at frequency w, a two-dimensional tank of N modes pushes back with the apparent mass
 m + sum_n m_n w^2 / (w_n^2 - w^2) (n odd, m_n = 8 m tanh(k_n h) / (n^3 pi^3 h / L), the spring-mass
@@ -80,3 +81,28 @@ def test_coupled_modes_of_a_vessel_free_in_surge_carrying_a_multimodal_tank(tmp_
     dominant = dict(zip(np.round(w, 9), out["dominant"]))
     assert dominant[np.round(found[np.argmin(abs(found - heave))], 9)] == "heave"
     assert all(dominant[np.round(found[np.argmin(abs(found - we))], 9)] == "liquid" for we in even)
+
+
+def test_rao_in_beam_seas_says_a_2d_tank_does_not_slosh_across(tmp_path, capsys):
+    """A two-dimensional multimodal tank sloshes along its length only: `jaxslosh rao` at a heading
+    with a beam component says so, names the tank and the key that gives waves across it; in head
+    seas (heading 0 or pi) it says nothing, nor for a `flow = "3d"` tank."""
+    from pathlib import Path
+
+    import jaxslosh as js
+    from jaxslosh.analysis.rao import across_tank_warnings
+    from test_frequency import HULL
+    text = (Path(__file__).resolve().parents[2] / "scenes" / "paper_ship_tank.toml").read_text()
+    text = text.replace('mesh = [5, 5, 5]\nwalls = "rigid"', 'model = "multimodal"\nmodes = 2')
+    text = text.replace("[vessel.hydrostatics]", HULL + "[vessel.hydrostatics]", 1)
+    p = tmp_path / "s.toml"
+    p.write_text(text)
+    assert main(["rao", str(p), "--frequencies", "1:1:1", "--headings", "0,1.5707963267948966",
+                 "-o", str(tmp_path / "r.h5")]) == 0
+    err = capsys.readouterr().err
+    lines = [x for x in err.splitlines() if x.startswith("warning: tanks[")]
+    assert len(lines) == 1, err
+    assert "tanks[0] 'tank'" in lines[0] and "heading 90 deg" in lines[0] and 'flow = "3d"' in lines[0], lines
+    scene = js.load_scene(text)
+    assert across_tank_warnings(scene, [0.0, np.pi]) == []
+    assert across_tank_warnings(js.load_scene(text.replace("modes = 2", 'flow = "3d"\nmodes = 2')), [np.pi / 2]) == []
