@@ -4,6 +4,7 @@ the run, the finite elements' converged value by Richardson extrapolation (where
 monotone), and each variant's difference from it. Prints a table.
 
     python benchmarks/paper_probe_b.py [--duration T] [--meshes 5,8,10] [--modes 6,12] [--flow3d 5]
+                                       [--omega 0.1,0.05,0]
 
 The elevation is probe B's vertical displacement (B sits on the free surface at the tank's
 centre line, 0.5 m from the wall at x = +2.5 m)."""
@@ -46,8 +47,11 @@ def main():
     ap.add_argument("--meshes", default="5,8,10")
     ap.add_argument("--modes", default="6,12")
     ap.add_argument("--flow3d", default="", help="modes of a flow = \"3d\" multimodal tank (comma list)")
+    ap.add_argument("--omega", default="0.1,0.05,0.0", help="the initial angular velocity (rad/s; the paper's)")
     args = ap.parse_args()
     text = open("scenes/paper_ship_tank.toml").read().replace("duration = 20.0", f"duration = {args.duration}")
+    omega = [float(x) for x in args.omega.split(",")]
+    text = text.replace("angular_velocity = [0.1, 0.05, 0.0]", f"angular_velocity = {omega}")
     variants = {}
     for n in [int(x) for x in args.meshes.split(",") if x]:
         variants[f"fem {n}x{n}x{n}"] = text.replace("mesh = [5, 5, 5]", f"mesh = [{n}, {n}, {n}]")
