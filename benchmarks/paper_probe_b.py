@@ -91,8 +91,8 @@ def main():
         if what in ref:
             print(f"# {what}: Richardson over {', '.join(fem[-3:])}: {ref[what][0]:.5f} m (order {ref[what][1]:.2f})")
         else:
-            print(f"# {what}: the finite elements' sequence is not monotone: no extrapolation; "
-                  f"differences against {finest}")
+            why = "not monotone" if len(fem) >= 3 else "fewer than three meshes"
+            print(f"# {what}: the finite elements' sequence: {why}: no extrapolation; differences against {finest}")
 
 
 if __name__ == "__main__":
