@@ -19,7 +19,7 @@ from ..scene.types import Scene, SceneError
 from ..staging import XLA_OPTIONS
 from .capsize import vanishing_angles
 from .loop import advance, concat_frames, core, frame_datasets, start
-from .simulate import failure_message, is_traced, prepare
+from .simulate import BATCH_AXIS, failure_message, is_traced, prepare
 
 
 _BATCH_FNS: dict = {}
@@ -79,7 +79,7 @@ def _batch_fn(scene: Scene, keys: tuple, mesh: Optional[Mesh] = None, excited: b
         fr = concat_frames([jax.tree_util.tree_map(lambda x: x[None], f0), frames])
         return carry, fr
 
-    fn = jax.vmap(one)
+    fn = jax.vmap(one, axis_name=BATCH_AXIS)     # the solver's collectives (a failed step's redo) name it
     if mesh is not None:
         fn = jax.shard_map(fn, mesh=mesh, in_specs=PartitionSpec("batch"), out_specs=PartitionSpec("batch"),
                            check_vma=False)

@@ -114,7 +114,7 @@ def carry_shapes(b: Built, solver: Solver) -> Carry:
 def step(b: Built, solver: Solver, c: Carry) -> tuple[Carry, tuple]:
     """One step of the loop: the integrator's step (retried as sub-steps where the scene asks);
     a step that fails freezes the state and records the first failure's step, residual and code."""
-    s_new, info = step_or_retry(b.system, solver, c.s, c.n)
+    s_new, info = step_or_retry(b.system, solver, c.s, c.n, ~c.failed)
     # the time from the step index, t = (k + 1) h (runs start at t = 0), not the running sum of h:
     # summing rounds at every step (2000 steps of 0.01 s ended at 20.000000000000327)
     s_new = s_new._replace(t=(c.k + 1).astype(s_new.t.dtype) * solver.h)

@@ -37,6 +37,8 @@ class NumericalFailure(RuntimeError):
 #: in vmapped batches the Newton preconditioner is carried from step to step and formed anew every
 #: this many steps (single runs form it anew when convergence slows, which a batch cannot test per run)
 BATCH_REFRESH = 4
+#: the name of the vmapped runs' axis in batches (run/batch.py): the solver's collectives over the runs
+BATCH_AXIS = "runs"
 
 
 class Setup(NamedTuple):
@@ -65,7 +67,8 @@ def prepare(scene: Scene, params=None, batch: bool = False, check: bool = True) 
         solver = make_solver(b.system, h, scheme, sim.tolerance, sim.max_iterations, sim.substeps,
                              reuse=True, adaptive=not batch)
     if batch:      # carried, formed anew every BATCH_REFRESH steps (a cond inside the iterations would
-        solver = dataclasses.replace(solver, refresh_every=BATCH_REFRESH)    # run both branches under vmap)
+        solver = dataclasses.replace(solver, refresh_every=BATCH_REFRESH,    # run both branches under vmap)
+                                     batch_axis=BATCH_AXIS)
     # a gradient can reach the run only through traced params (a batch is never differentiated):
     # otherwise the Newton solves skip custom_root's tracing of the tangent solves
     traced = is_traced(params or {})

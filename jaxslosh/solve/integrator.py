@@ -245,14 +245,18 @@ def step(system: System, solver: Solver, s: State, fresh=None) -> tuple[State, S
             StepInfo(it, err, ok))
 
 
-def step_or_retry(system: System, solver: Solver, s: State, n=None) -> tuple[State, StepInfo]:
+def step_or_retry(system: System, solver: Solver, s: State, n=None, live=None) -> tuple[State, StepInfo]:
     """One step; when it fails and `solver.substeps` > 1, the step is redone as that many sub-steps
     (the iterations of every attempt are counted). `n`: the steps attempted so far (the same for every
-    run of a batch), which times the preconditioner's refresh in batch mode (Solver.refresh_every)."""
+    run of a batch), which times the preconditioner's refresh in batch mode (Solver.refresh_every).
+    `live`: whether this run has not failed before (batches: only live runs ask for a redo)."""
     fresh = None
     if solver.refresh_every and n is not None:
         fresh = n % solver.refresh_every == 0
-    s1, info = step(system, solver, s, fresh)
+    if fresh is not None and solver.batch_axis is not None:
+        s1, info = _step_or_redo(system, solver, s, fresh, live)
+    else:
+        s1, info = step(system, solver, s, fresh)
     if not solver.substeps:
         return s1, info
     sub = solver.sub_solver()
@@ -268,3 +272,33 @@ def step_or_retry(system: System, solver: Solver, s: State, n=None) -> tuple[Sta
         return st, StepInfo(it, err, ok)
 
     return jax.lax.cond(info.ok, lambda _: (s1, info), retry, None)
+
+
+def _step_or_redo(system: System, solver: Solver, s: State, fresh, live):
+    """Batches: `step`, and a step that failed with the carried preconditioner is redone with one
+    formed for it. Formed some steps before, the carried one can contract by only about half per
+    iteration where the Jacobian moves fast (a multimodal liquid's rows near resonance, whose high
+    modes' integrals go as exp(k_n zeta)), and then runs out of iterations above the tolerance; a
+    fresh one converges in a few. The redo is decided for the whole batch, by a sum over the vmapped
+    runs' axis, so that the loop's test is not batched (the redo runs only when some live run
+    failed; the step appears once in the program), and only the failed runs take its result (the
+    iterations of both attempts counted). A step that fails again fails as before."""
+    live = jnp.asarray(True) if live is None else live
+
+    def attempt(c):
+        k, s1, info = c
+        s2, info2 = step(system, solver, s, fresh | (k > 0))
+        take = (k == 0) | ~info.ok
+        pick = lambda a, b: jnp.where(take, a, b)  # noqa: E731
+        return (k + 1, jax.tree_util.tree_map(pick, s2, s1),
+                StepInfo(jnp.where(take, info.iterations + info2.iterations, info.iterations),
+                         pick(info2.residual, info.residual), pick(info2.ok, info.ok)))
+
+    def again(c):
+        k, _, info = c
+        bad = jax.lax.psum((~info.ok & live).astype(jnp.int32), solver.batch_axis) > 0
+        return (k == 0) | ((k == 1) & ~fresh & bad)
+
+    info0 = StepInfo(jnp.zeros((), jnp.int32), jnp.zeros(()), jnp.array(True))
+    _, s1, info = jax.lax.while_loop(again, attempt, (jnp.zeros((), jnp.int32), s, info0))
+    return s1, info

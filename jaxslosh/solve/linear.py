@@ -47,6 +47,10 @@ class Solver(eqx.Module):
     # every this-many-th step (the step counter is the same for every run of a batch, so the cond
     # stays a branch under vmap); 0: at every step
     refresh_every: int = eqx.field(static=True, default=0)
+    # the vmapped runs' axis name (batches): a step that failed with the carried preconditioner is
+    # redone with a fresh one, decided for the batch by a collective over this axis so that the
+    # cond stays a branch (integrator.step_or_retry); None for single runs (adaptive)
+    batch_axis: Optional[str] = eqx.field(static=True, default=None)
     # the Newton solves are differentiable (lax.custom_root: gradients by the implicit function
     # theorem). False where nothing a run depends on is traced for differentiation (run.prepare):
     # custom_root traces the linearisation and both tangent solves of every root even when no

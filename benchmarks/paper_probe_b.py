@@ -1,0 +1,99 @@
+"""Probe B of the paper example (scenes/paper_ship_tank.toml) with its tank as finite elements on
+refined meshes and as a multimodal tank: the peak and rms of the free surface's elevation at B over
+the run, the finite elements' converged value by Richardson extrapolation (where the sequence is
+monotone), and each variant's difference from it. Prints a table.
+
+    python benchmarks/paper_probe_b.py [--duration T] [--meshes 5,8,10] [--modes 6,12] [--flow3d 5]
+                                       [--omega 0.1,0.05,0]
+
+The elevation is probe B's vertical displacement (B sits on the free surface at the tank's
+centre line, 0.5 m from the wall at x = +2.5 m)."""
+from __future__ import annotations
+
+import argparse
+import time
+
+import jax
+
+jax.config.update("jax_enable_x64", True)
+
+import numpy as np  # noqa: E402
+from scipy.optimize import brentq  # noqa: E402
+
+import jaxslosh as js  # noqa: E402
+
+
+def _richardson(h, f):
+    """(f at h = 0, order p) of f = f0 + C h^p through three points (h descending), or None where
+    the differences change sign (not monotone: no extrapolation)."""
+    (h1, h2, h3), (f1, f2, f3) = h, f
+    if (f1 - f2) * (f2 - f3) <= 0:
+        return None
+
+    def g(p):     # (f1 - f2) / (f2 - f3) against (h1^p - h2^p) / (h2^p - h3^p)
+        return (h1 ** p - h2 ** p) / (h2 ** p - h3 ** p) - (f1 - f2) / (f2 - f3)
+
+    try:
+        p = brentq(g, 0.05, 8.0)
+    except ValueError:
+        return None
+    C = (f2 - f3) / (h2 ** p - h3 ** p)
+    return f3 - C * h3 ** p, p
+
+
+def main():
+    ap = argparse.ArgumentParser()
+    ap.add_argument("--duration", type=float, default=20.0)
+    ap.add_argument("--meshes", default="5,8,10")
+    ap.add_argument("--modes", default="6,12")
+    ap.add_argument("--flow3d", default="", help="modes of a flow = \"3d\" multimodal tank (comma list)")
+    ap.add_argument("--omega", default="0.1,0.05,0.0", help="the initial angular velocity (rad/s; the paper's)")
+    args = ap.parse_args()
+    text = open("scenes/paper_ship_tank.toml").read().replace("duration = 20.0", f"duration = {args.duration}")
+    omega = [float(x) for x in args.omega.split(",")]
+    text = text.replace("angular_velocity = [0.1, 0.05, 0.0]", f"angular_velocity = {omega}")
+    variants = {}
+    for n in [int(x) for x in args.meshes.split(",") if x]:
+        variants[f"fem {n}x{n}x{n}"] = text.replace("mesh = [5, 5, 5]", f"mesh = [{n}, {n}, {n}]")
+    for m in [int(x) for x in args.modes.split(",") if x]:
+        variants[f"multimodal 2d, {m} modes"] = text.replace('mesh = [5, 5, 5]\nwalls = "rigid"',
+                                                            f'model = "multimodal"\nmodes = {m}')
+    for m in [int(x) for x in args.flow3d.split(",") if x]:
+        variants[f"multimodal 3d, {m} modes"] = text.replace('mesh = [5, 5, 5]\nwalls = "rigid"',
+                                                            f'model = "multimodal"\nflow = "3d"\nmodes = {m}')
+    stats = {}
+    for name, t in variants.items():
+        t0 = time.perf_counter()
+        r = js.simulate(js.load_scene(t))
+        z = np.asarray(r.probes["B"].displacement)[:, 2]
+        stats[name] = (np.abs(z).max(), np.sqrt(np.mean(z ** 2)), z)
+        print(f"# {name}: {r.status}, {time.perf_counter() - t0:.0f} s", flush=True)
+    fem = [k for k in stats if k.startswith("fem")]
+    ref = {}
+    if len(fem) >= 3:
+        h = [1.0 / int(k.split()[1].split("x")[0]) for k in fem[-3:]]
+        for j, what in enumerate(("peak", "rms")):
+            ex = _richardson(h, [stats[k][j] for k in fem[-3:]])
+            if ex is not None:
+                ref[what] = ex
+    finest = fem[-1] if fem else None
+    print(f"\n{'tank':<26} {'peak m':>9} {'rms m':>9} {'peak vs ref':>12} {'rms vs ref':>11} "
+          f"{'rms diff vs finest':>19}")
+    for name, (pk, rms, z) in stats.items():
+        cols = []
+        for j, v in enumerate((pk, rms)):
+            r0 = ref.get(("peak", "rms")[j])
+            base = r0[0] if r0 is not None else (stats[finest][j] if finest else np.nan)
+            cols.append(100 * (v / base - 1))
+        d = 100 * np.sqrt(np.mean((z - stats[finest][2]) ** 2)) / stats[finest][1] if finest else np.nan
+        print(f"{name:<26} {pk:9.5f} {rms:9.5f} {cols[0]:+11.2f}% {cols[1]:+10.2f}% {d:18.2f}%")
+    for what in ("peak", "rms"):
+        if what in ref:
+            print(f"# {what}: Richardson over {', '.join(fem[-3:])}: {ref[what][0]:.5f} m (order {ref[what][1]:.2f})")
+        else:
+            why = "not monotone" if len(fem) >= 3 else "fewer than three meshes"
+            print(f"# {what}: the finite elements' sequence: {why}: no extrapolation; differences against {finest}")
+
+
+if __name__ == "__main__":
+    main()
