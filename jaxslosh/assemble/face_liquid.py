@@ -129,7 +129,7 @@ def stack_sparse(parts: list) -> tuple:
     K = FaceStiffness(ops, jnp.asarray(kM), tuple(jnp.asarray(p["Y"]) for p in parts),
                       jnp.asarray(np.concatenate([p["rowsum"] for p in parts])),
                       tuple(jnp.asarray(p["winv"]) for p in parts), jnp.asarray(kappa_n),
-                      tuple(float(p["kappa"]) for p in parts))
+                      jnp.asarray([p["kappa"] for p in parts]))
     lo = min(p["bounds"][0] for p in parts)
     hi = max(p["bounds"][1] for p in parts)
     Minv = mass_inverse(ops, Me, np.concatenate([p["diag"] for p in parts]), lo, hi)

@@ -62,7 +62,7 @@ class FaceStiffness(eqx.Module):
     abs_rowsum: jax.Array   # (n,) sum_j |K_ij| (the Newton iterations' round-off floor)
     winv: tuple             # per tank (ny_t,) W^-1 (the Newton block's inverse is formed from Y, W, kappa)
     kappa_n: jax.Array      # (n,) each unknown's tank's kappa
-    kappas: tuple = eqx.field(static=True, default=())     # per tank kappa
+    kappas: jax.Array       # (tanks,) each tank's kappa (an array: a static float would name the program)
 
     @property
     def shape(self):

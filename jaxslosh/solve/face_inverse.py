@@ -102,8 +102,8 @@ def face_solver_blocks(liquid, c_step: float, c_sub=None):
     K, mi = liquid.K, liquid.Minv
 
     def block(c):
-        H = tuple(jnp.asarray(schur_inverse(np.asarray(Y), np.asarray(wi), k, c))
-                  for Y, wi, k in zip(K.Y, K.winv, K.kappas))
+        H = tuple(jnp.asarray(schur_inverse(np.asarray(Y), np.asarray(wi), float(k), c))
+                  for Y, wi, k in zip(K.Y, K.winv, np.asarray(K.kappas)))
         return BlockInverse(mi, jnp.asarray(1.0 / (c + np.asarray(K.kappa_n))), H)
 
     return block(float(c_step)), mi, block(float(c_sub)) if c_sub is not None else None, np.asarray(K.abs_rowsum)
