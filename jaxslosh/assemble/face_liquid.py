@@ -1,8 +1,11 @@
 """The full-order liquid of face-normal ("rt") tanks (physics/face_liquid.py FluxLiquid) from their
-models (fem/liquid_rt.py): the Gauss points' fields and masses, the dense blocks on the free faces,
-the absolute-rotation penalty and the nodal recovery's weights, host-side NumPy (scaled by traced
-density, sound speed or gravity where given). A plain box's fill depth may be traced too: its layers
-scale with the depth, so every block is a closed function of h / h0 (`traced_depth_blocks`)."""
+models (fem/liquid_rt.py): the Gauss points' fields and masses, the blocks, the absolute-rotation
+penalty and the nodal recovery's weights, host-side NumPy. The blocks are either kept without dense
+matrices on the faces (`sparse_tank_blocks`: the mass element by element and the penalty's dense
+part on the elements and top faces, fem/face_schur.py), or dense on the free faces (scaled by traced
+density, sound speed or gravity where given). A plain box's fill depth may be traced too on the
+dense blocks: its layers scale with the depth, so every block is a closed function of h / h0
+(`traced_depth_blocks`)."""
 from __future__ import annotations
 
 import jax
