@@ -296,13 +296,16 @@ def face_scales(scene, t, params, g):
 
 def face_sparse(scene, models, scales, depths) -> bool:
     """Whether full-order face-normal tanks take the blocks without dense matrices on the faces
-    (assemble/face_liquid.py sparse_tank_blocks): the scene's own values only (no traced density,
-    sound speed, gravity or fill depth), and `simulation.linear_solver` "sparse" or "sparse-host", or
-    "auto" above RT_SPARSE_AUTO free faces in all."""
-    traced = any(isinstance(v, jax.core.Tracer) for sc in scales if sc for v in sc) or any(d is not None for d in depths)
+    (assemble/face_liquid.py sparse_tank_blocks): the scene's own values only (no density, sound
+    speed, gravity or fill depth from params, traced or not: the dense blocks scale with them), and
+    `simulation.linear_solver` "sparse" or "sparse-host", or "auto" above RT_SPARSE_AUTO free faces."""
+    values = [v for sc in scales if sc for v in sc]
+    if any(isinstance(v, jax.core.Tracer) for v in values) or any(d is not None for d in depths) \
+            or any(abs(float(np.asarray(v)) - 1.0) > 1e-12 for v in values):    # blocks at the scene's values
+        return False
     choice = scene.simulation.linear_solver
     faces = sum(int(np.count_nonzero(m.free)) for m in models)
-    return not traced and (choice in ("sparse", "sparse-host") or (choice == "auto" and faces > RT_SPARSE_AUTO))
+    return choice in ("sparse", "sparse-host") or (choice == "auto" and faces > RT_SPARSE_AUTO)
 
 
 def _face_full(tanks, models, scales, depths=None, sparse=False):
