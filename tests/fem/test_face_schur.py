@@ -11,6 +11,7 @@ import numpy as np
 
 import jaxslosh as js
 from jaxslosh.assemble.face_liquid import face_full_liquid
+from jaxslosh.assemble.liquid import build_liquid_block
 from jaxslosh.fem.face_schur import face_schur
 from jaxslosh.fem.liquid_rt import build_face_liquid
 from jaxslosh.geometry import Baffle, Box, Prismatic
@@ -124,8 +125,9 @@ def test_a_run_through_the_sparse_blocks_equals_the_dense_run():
     """The same rolling ship through both: the free-surface probe and the roll agree within 1e-10 m
     and rad (the Newton iterations' round-off floor), with the same iterations per step but where a
     step ends at that floor (one more or fewer)."""
-    a = js.simulate(js.load_scene(ROLLING.format(solver="dense")))
-    b = js.simulate(js.load_scene(ROLLING.format(solver="sparse")))
+    dense, sparse = (js.load_scene(ROLLING.format(solver=s)) for s in ("dense", "sparse"))
+    assert build_liquid_block(sparse).liquid.sparse and not build_liquid_block(dense).liquid.sparse
+    a, b = js.simulate(dense), js.simulate(sparse)
     pa, pb = np.asarray(a.probes["wall"].displacement), np.asarray(b.probes["wall"].displacement)
     assert np.abs(pa).max() > 1e-3
     assert np.abs(pa - pb).max() < 1e-10
