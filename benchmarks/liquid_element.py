@@ -7,6 +7,7 @@ frequencies' errors (%) per element.
 
     python benchmarks/liquid_element.py [--elements rt,stabilized] [--cases utube,hanging,...]
     python benchmarks/liquid_element.py --cases shapes
+    python benchmarks/liquid_element.py --cases six
     python benchmarks/liquid_element.py --cases cost [--meshes 10x10x6,20x20x12]
     python benchmarks/liquid_element.py --cases lng [--meshes 24x8,24x16,48x16,48x32]
 
@@ -14,6 +15,9 @@ frequencies' errors (%) per element.
 70, 85 and 95 % (one case each: lng10, ..., lng95), on meshes refined across (y) and up (z):
 2 x 24 x 8 to 2 x 96 x 64 (``--meshes`` takes the y x z counts).
 
+``six``: the same tanks and the LNG tank at 10 to 95 % (tests/shape_cases.py), the worst of the first
+six sloshing modes' errors (%) per element, and the element each tank gets by default (on modes /
+at full order).
 ``cost``: rt's times (s) on a 5x5x3 m box: build, face_modes (10), face_basis (20 modes and the
 static correction), face_invariants.
 ``shapes``: every tank shape on about 1,000 elements (tests/shape_cases.py), 3-D, the first six
@@ -133,6 +137,29 @@ def shapes(elements):
         print(f"| {name} | {ne} | " + " | ".join(cells) + " |", flush=True)
 
 
+def six(elements, names):
+    """Per shape, the worst of the first six sloshing modes' errors (%) and which mode, per element,
+    and the element a scene gets when it leaves `element` out, on modes and at full order."""
+    import shape_cases
+    from jaxslosh.scene.shape import default_element
+    print("| tank | elements | default on modes / full order | "
+          + " | ".join(f"{e}: worst of modes 1-6 (%)" for e in elements) + " |")
+    print("|---|---|---|" + "---|" * len(elements))
+    for name in names:
+        geo, depth, mesh, _, ref_w = shape_cases.case(name)
+        cells = []
+        for element in elements:
+            w, ne, kinds = shape_cases.sloshing_omegas(geo, depth, mesh, element)
+            err = (w / ref_w[:len(w)] - 1) * 100
+            worst = int(np.argmax(np.abs(err)))
+            other = sum(kind != "sloshing" for kind in kinds)
+            cells.append(f"{err[worst]:+.2f} (mode {worst + 1})" + ("" if len(w) == 6 else " (missing)")
+                         + (f", {other} other modes among them" if other else ""))
+        counts = mesh or (1, 1, ne)
+        default = "/".join(default_element(geo, depth, counts, reduced)[0] for reduced in (True, False))
+        print(f"| {name} | {ne} | {default} | " + " | ".join(cells) + " |", flush=True)
+
+
 def cost(meshes):
     from jaxslosh.fem.liquid_rt import face_basis, face_invariants
     print("| mesh | face unknowns | build | face_modes (10) | face_basis (20 + correction) | invariants |")
@@ -163,6 +190,9 @@ def main():
         return cost((a.meshes or "10x10x6,20x20x12,30x30x16").split(","))
     if a.cases == "shapes":
         return shapes(a.elements.split(","))
+    if a.cases == "six":
+        import shape_cases
+        return six(a.elements.split(","), shape_cases.CASES[:3] + shape_cases.LNG_FILLS + shape_cases.CASES[3:])
     cases = [c for name in a.cases.split(",") for c in (LNG_FILLS if name == "lng" else (name,))]
     for case in cases:
         ref = reference(case)

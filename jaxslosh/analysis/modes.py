@@ -10,7 +10,8 @@ from ..fem.mesh import face_nodes
 from ..fem.modes import Modes, liquid_modes
 from ..fem.structure import build_structure, clamped_modes
 from ..fem.walls import build_tank_with_walls, tank_modes
-from ..scene.types import Scene, SceneError
+from ..fem.walls_rt import build_face_tank_with_walls, face_tank_modes
+from ..scene.types import Scene
 from ..solve.sparse import SPARSE_AUTO
 
 
@@ -47,12 +48,11 @@ def _face_modes(scene: Scene, t, n: int) -> Modes:
     """The face-normal element's modes (fem/liquid_rt.py): the circulation modes, all at zero
     frequency, are left out and counted (`Modes.circulation`); shapes are nodal fields, each node the
     mean of its elements' displacements there."""
-    if t.wall_spec is not None:
-        i = scene.tanks.index(t)
-        raise SceneError(f"tanks[{i}].fluid.element", '"rt" does not take elastic walls yet; use "stabilized"')
     tm = t.geometry.mesh(t.fill_depth, t.mesh)
     model = build_face_liquid(tm.nodes, tm.elements, tm.depth, t.fluid.density, t.fluid.sound_speed,
                               scene.environment.gravity)
+    if t.wall_spec is not None:       # the liquid and its elastic walls together (kinds add "wall")
+        return face_tank_modes(build_face_tank_with_walls(t, model), n=n)
     fm = face_modes(model, n)
     shapes = model.nodal_fields(fm.fluxes).reshape(len(fm.omega), -1)
     return Modes(omega=fm.omega, kind=fm.kind, free_surface_share=fm.free_surface_share, shapes=shapes,

@@ -58,7 +58,9 @@ def liquid_about(scene: Scene, include_liquid: bool) -> About:
         if t.wall_spec is not None:
             lines.append((f"elastic walls of tank {t.name!r}",
                           f"{t.wall_spec.thickness:g} m thick, {t.wall_mass:.6g} kg of elastic hexahedra built into "
-                          "the hull (the vessel's frame), the liquid tied to them in the normal direction only"))
+                          "the hull (the vessel's frame), the liquid tied to them in the normal direction only"
+                          + (": each wall face's flux is the volume the wall sweeps there" if t.fluid.element == "rt"
+                             else "")))
     for s in scene.structures:
         if s.frame == "vessel":
             nx, ny, nz = s.mesh

@@ -9,7 +9,6 @@ import dataclasses
 from ..physics.liquid import NoLiquid
 from ..physics.system import System
 from ..physics.terms import AbstractTerm
-from ..physics.vessel import AbstractMotion
 from ..scene.types import Scene
 from .effects import count_unknowns, switched_off
 from .system import outline
@@ -18,9 +17,9 @@ from .system import outline
 GRAVITY_TURNING = ("gravity turning with the body", "load of eq. (32) on the liquid")
 
 
-#: what describes itself: the terms (the structures in their own frames among them), and the
-#: System's parts beside them (the hull's motion)
-DESCRIBED = (AbstractTerm, AbstractMotion)
+#: what describes itself: the terms (the structures in their own frames and a prescribed motion
+#: among them)
+DESCRIBED = (AbstractTerm,)
 
 
 def model_parts(system: System) -> tuple:

@@ -17,6 +17,7 @@ from scipy.linalg import block_diag
 
 from ..fem.face_schur import face_schur, mass_bounds
 from ..fem.liquid_rt import ROTATION_PENALTY_RATIO, FaceLiquid, _gauss, _loads, _Mixed, face_modes
+from ..fem.walls_rt import build_face_tank_with_walls, wall_points
 from ..physics.face_blocks import FaceOps, FaceStiffness
 from ..physics.face_liquid import FluxLiquid
 from ..scene.types import RT_FULL_FACES, SceneError
@@ -191,19 +192,23 @@ def traced_depth_blocks(model: FaceLiquid, origin, s, gauss=None):
 
 
 def face_full_liquid(tanks, models, scales=None, depths=None, sparse=False):
-    """The FluxLiquid of every tank (all face-normal, full order), stacked, and the (K_dt, K_tt) of
-    the absolute-rotation penalty (physics/liquid.py RotationPenalty). `scales`: per tank None or its
-    (rho, rho c^2, rho g) over its model's (assemble/liquid.py face_scales), traced or not: the masses, the
-    compression and the free-surface blocks scale with them. `depths`: per tank None or a plain box's
-    fill depth over its model's (traced): `traced_depth_blocks`. `sparse`: the blocks without dense
-    matrices on the faces (`sparse_tank_blocks`; the scene's own values only)."""
+    """The FluxLiquid of every tank (all face-normal, full order), stacked, the (K_dt, K_tt) of the
+    absolute-rotation penalty (physics/liquid.py RotationPenalty), and per tank its elastic walls
+    (fem/walls.py WallModel) or None. `scales`: per tank None or its (rho, rho c^2, rho g) over its
+    model's (assemble/liquid.py face_scales), traced or not: the masses, the compression and the
+    free-surface blocks scale with them. `depths`: per tank None or a plain box's fill depth over its
+    model's (traced): `traced_depth_blocks`. A tank with elastic walls (fem/walls_rt.py) adds its
+    walls' free nodal dofs after its free faces, and its walls' Gauss points after every tank's liquid
+    points; its values are the scene's."""
     scales = scales or [None] * len(models)
     depths = depths or [None] * len(models)
     xp = jnp if any(isinstance(v, jax.core.Tracer) for sc in scales if sc for v in sc) \
         or any(isinstance(d, jax.core.Tracer) for d in depths) else np
-    rs, ms, phis, slots, Ks, Ms, row_scales, rec_n, rec_w, Kdts, parts = ([] for _ in range(11))
+    rs, ms, phis, slots, Ks, Ms, row_scales, rec_n, rec_w, Kdts = ([] for _ in range(10))
+    walls, wall_parts, node_slots, parts = [], [], [], []          # wall_parts: (rows, cols, coef, x, m, N, slots) per tank
     Ktt = 0.0
-    off, node_off = 0, 0
+    off, node_off, n_wf = 0, 0, 0
+    HELD = -1                                           # the zero slot, known once every tank is counted
     for i, (t, model, fs, ds) in enumerate(zip(tanks, models, scales, depths)):
         sr, sc, sg = fs if fs is not None else (1.0, 1.0, 1.0)
         f = np.flatnonzero(model.free)
@@ -215,44 +220,83 @@ def face_full_liquid(tanks, models, scales=None, depths=None, sparse=False):
                                                           "set element = \"stabilized\"")
         gauss = _gauss(model)
         E, P = gauss[0].shape[:2]
-        x, w, phys = gauss
-        if sparse:
+        slot = np.full(len(model.faces), HELD)
+        slot[f] = np.arange(f.size) + off
+        tw = None
+        if t.wall_spec is not None:
+            if ds is not None or any(isinstance(v, jax.core.Tracer) for v in (fs or ())):
+                raise SceneError(f"tanks[{i}].walls", "elastic walls need the liquid with the scene's own values "
+                                                      "(no traced fill depth, density, sound speed or gravity)")
+            tw = build_face_tank_with_walls(t, model)
+            x, w, phys = gauss
+            Mf, Kf, Kdt, Ktt_t = tw.mass, tw.stiffness + tw.penalty, tw.Kdt, tw.Ktt
+            Tw = tw.T[:, f.size:].tocoo()
+            wf = np.unique(Tw.row)                                       # the wall faces, in face order
+            local = np.searchsorted(wf, Tw.row)
+            slot[wf] = -2 - (n_wf + np.arange(wf.size))                  # coded: wall face n_wf + j
+            nq = f.size
+            xw, mw, Nw, sw = wall_points(tw.walls, tw.wall_dofs, off + nq, HELD)
+            wall_parts.append((n_wf + local, off + nq + Tw.col, Tw.data, xw + np.asarray(t.origin, dtype=float),
+                               mw, Nw, sw))
+            n_wf += wf.size
+            ns = np.full((model.n_nodes + len(tw.walls.nodes), 3), HELD)
+            ns[model.n_nodes:].reshape(-1)[tw.wall_dofs] = off + nq + np.arange(tw.wall_dofs.size)
+            node_slots.append(ns)
+            walls.append(tw.walls)
+        elif sparse:                    # no dense matrix on the faces (the scene's own values, no walls)
+            x, w, phys = gauss
             parts.append(sparse_tank_blocks(model, t.origin, gauss))
-            Kdt, Ktt_t = parts[-1]["Kdt"], parts[-1]["Ktt"]
+            Kdt, Ktt_t, Mf, Kf = parts[-1]["Kdt"], parts[-1]["Ktt"], None, None
         elif ds is None:
+            x, w, phys = gauss
             Kc, Kdt, Ktt_t = absolute_rotation_penalty(model, t.origin, gauss)
             Mf, Kac = model.mass[f][:, f].toarray(), model.acoustic[f][:, f].toarray()
+            Kf = sc * Kac + sg * model.surface[f][:, f].toarray() + sr * Kc
         else:
             x, w, phys, Mf, Kac, Kc, Kdt, Ktt_t = traced_depth_blocks(model, t.origin, ds, gauss)
-        slot = np.full(len(model.faces), -1)
-        slot[f] = np.arange(f.size) + off
+            Kf = sc * Kac + sg * model.surface[f][:, f].toarray() + sr * Kc
+        if tw is None:
+            walls.append(None)
+            node_slots.append(np.full((model.n_nodes, 3), HELD))
         rs.append((x + np.asarray(t.origin, dtype=float)).reshape(-1, 3))
         ms.append(sr * (model.density * w).reshape(-1))
         phis.append(phys.reshape(E * P, 6, 3))
         slots.append(np.repeat(slot[model.element_faces], P, axis=0).reshape(E * P, 6))
-        if not sparse:
-            Ks.append(sc * Kac + sg * model.surface[f][:, f].toarray() + sr * Kc)
+        if Kf is not None:
+            Ks.append(Kf)
             Ms.append(sr * Mf)
         Kdts.append(sr * Kdt)
         Ktt = Ktt + sr * Ktt_t
         X = model.nodes[model.faces[f]]
         area = np.linalg.norm(0.5 * np.cross(X[:, 2] - X[:, 0], X[:, 3] - X[:, 1]), axis=1)
-        row_scales.append(model.mass[f][:, f].diagonal() * area)
+        rscale = model.mass[f][:, f].diagonal() * area
+        if tw is not None:                         # a wall dof's row over its mass (liquid's share included)
+            rscale = np.concatenate([rscale, np.diag(tw.mass)[f.size:]])
+        row_scales.append(rscale)
         n_, w_ = recovery_weights(model, gauss)
         rec_n.append(n_ + node_off)
         rec_w.append(w_)
-        off += f.size
-        node_off += model.n_nodes
-    slot = np.concatenate(slots)
-    slot = np.where(slot < 0, off, slot)
+        off += f.size if Mf is None else Mf.shape[0]
+        node_off += node_slots[-1].shape[0]
+    fix = lambda a: np.where(a == HELD, off, np.where(a <= -2, off + 1 + (-2 - a), a)).astype(np.int32)  # noqa: E731
+    slot = fix(np.concatenate(slots))
     if sparse:
         K, Minv, start = stack_sparse(parts)
         blocks = dict(K=K, Mff=None, Minv=Minv, start=jnp.asarray(start), sparse=True)
     else:
         stack = jax_block_diag if xp is jnp else block_diag
         blocks = dict(K=jnp.asarray(stack(*Ks)), Mff=jnp.asarray(stack(*Ms)))
+    extra = {}
+    if wall_parts:
+        rows, cols, coef, xw, mw, Nw, sw = (np.concatenate(p) for p in zip(*wall_parts))
+        rs.append(xw)
+        ms.append(mw)
+        extra = dict(wall_rows=jnp.asarray(rows.astype(np.int32)), wall_cols=jnp.asarray(cols.astype(np.int32)),
+                     wall_coef=jnp.asarray(coef), wall_N=jnp.asarray(Nw), wall_slots=jnp.asarray(fix(sw)),
+                     node_slots=jnp.asarray(fix(np.concatenate(node_slots))), n_wall_faces=n_wf,
+                     n_liquid_points=int(sum(len(p) for p in phis)))
     liquid = FluxLiquid(r=jnp.asarray(xp.concatenate(rs)), m=jnp.asarray(xp.concatenate(ms)),
-                        phi=jnp.asarray(xp.concatenate(phis)), slots=jnp.asarray(slot.astype(np.int32)),
+                        phi=jnp.asarray(xp.concatenate(phis)), slots=jnp.asarray(slot),
                         scale=jnp.asarray(np.concatenate(row_scales)), rec_nodes=jnp.asarray(np.concatenate(rec_n)),
-                        rec_w=jnp.asarray(np.concatenate(rec_w)), n_nodes=node_off, **blocks)
-    return liquid, (jnp.asarray(xp.concatenate(Kdts)), jnp.asarray(Ktt))
+                        rec_w=jnp.asarray(np.concatenate(rec_w)), n_nodes=node_off, **blocks, **extra)
+    return liquid, (jnp.asarray(xp.concatenate(Kdts)), jnp.asarray(Ktt)), tuple(walls)

@@ -16,7 +16,7 @@ from ..fem.liquid import build_liquid, surface_bending_scale
 from ..fem.liquid_rt import FaceLiquid, build_face_liquid
 from ..fem.mesh import box_mesh, face_nodes, grid_nodes
 from ..fem.structure import assemble, box_element, centrifugal_stiffness
-from ..fem.walls import build_tank_with_walls
+from ..fem.walls import build_tank_with_walls, shell_mesh
 from ..physics.liquid import AbstractLiquid, Liquid, NoLiquid
 from ..scene.types import FACE_FORMS, Scene, SceneError
 from ..solve.sparse import SPARSE_AUTO, host_sparse
@@ -82,11 +82,20 @@ def build_liquid_block(scene: Scene, params: Optional[dict] = None, gravity=None
     xp = jnp if traced else np
     reduced = [t.reduction is not None for t in rigid]
     elastic = [t.wall_spec is not None for t in rigid]
-    if any(elastic) or in_vessel_frame:
+    faces = bool(models) and all(isinstance(m, FaceLiquid) for m in models)
+    if any(elastic) and faces and not in_vessel_frame:     # "rt" in elastic walls: fem/walls_rt.py, full order
+        for i, t in enumerate(rigid):
+            if reduced[i]:
+                raise SceneError(f"tanks[{i}].walls" if elastic[i] else f"tanks[{i}].reduction",
+                                 "elastic walls need the full-order liquid (no [tanks.reduction] in any tank)")
+    elif any(elastic) or in_vessel_frame:
         for i, t in enumerate(rigid):
             if isinstance(models[i], FaceLiquid):
-                raise SceneError(f"tanks[{i}].fluid.element", f"{t.fluid.element!r} does not take structures in the "
-                                                              "vessel's frame yet; use \"stabilized\"")
+                raise SceneError(f"tanks[{i}].fluid.element",
+                                 f"{t.fluid.element!r} does not take structures in the vessel's frame yet, nor elastic "
+                                 "walls beside a nodal tank; use \"stabilized\"" if in_vessel_frame or not elastic[i]
+                                 else f"{t.fluid.element!r} in elastic walls goes with other \"rt\" tanks only; "
+                                      "give every tank the same element")
             if models[i].frames is not None:
                 raise SceneError(f"tanks[{i}].shape", "structures in the vessel's frame go with box tanks (and "
                                                       "shapes whose walls are all along the axes) only")
@@ -266,9 +275,6 @@ class VesselFrameStructure(NamedTuple):
 def _face_model(scene, t, i, params, g):
     """The face-normal liquid of one tank (fem/liquid_rt.py), with the scene's own values: runs take it
     on its modal basis (assemble/reduced.py) or at full order (assemble/face_liquid.py)."""
-    where = f"tanks[{i}].fluid.element"
-    if t.wall_spec is not None:
-        raise SceneError(where, f"{t.fluid.element!r} does not take elastic walls yet; use \"stabilized\"")
     if isinstance(params.get(f"tanks.{t.name}.fill_depth"), jax.core.Tracer):
         if not t.geometry.plain_box:
             raise SceneError(f"tanks[{i}].fill_depth", f"the fill depth of a {t.shape} tank (or one with baffles) "
@@ -300,6 +306,8 @@ def face_sparse(scene, models, scales, depths) -> bool:
     speed, gravity or fill depth from params, traced or not: the dense blocks scale with them), and
     `simulation.linear_solver` "sparse" or "sparse-host", or "auto" above RT_SPARSE_AUTO free faces."""
     values = [v for sc in scales if sc for v in sc]
+    if any(t.wall_spec is not None for t in scene.tanks):     # elastic walls: their dense blocks
+        return False
     if any(isinstance(v, jax.core.Tracer) for v in values) or any(d is not None for d in depths) \
             or any(abs(float(np.asarray(v)) - 1.0) > 1e-12 for v in values):    # blocks at the scene's values
         return False
@@ -318,9 +326,11 @@ def _face_full(tanks, models, scales, depths=None, sparse=False):
     blocks, offset = [], 0
     for t, m in zip(tanks, models):
         blocks.append(_host_block(t, m, offset))
-        offset += m.n_nodes
-    liquid, penalty = face_full_liquid(tanks, models, scales, depths, sparse)
-    return LiquidBlock(liquid, tuple(blocks), penalty)
+        offset += m.n_nodes + (0 if t.wall_spec is None else wall_node_count(t))    # a tank's walls follow its liquid
+    liquid, penalty, walls = face_full_liquid(tanks, models, scales, depths, sparse)
+    carried = tuple(rigid_part(w.mass, w.nodes + np.asarray(t.origin)[None, :]) for t, w in zip(tanks, walls)
+                    if w is not None)           # the walls are part of the ship's mass (SPEC)
+    return LiquidBlock(liquid, tuple(blocks), penalty, carried=carried)
 
 
 def _host_block(t, m, offset) -> TankBlock:
@@ -378,3 +388,8 @@ def outline_liquid_block(scene: Scene, include_liquid: bool = True) -> LiquidBlo
     stiffened = any(s.stiffening == "centrifugal" for s in in_vessel_frame)
     return LiquidBlock(Liquid(r=None, Ms=None, K=None, free=None, n_nodes=0), penalty=(None, None) if tanks else None,
                        Kg=np.zeros((6, 0, 0)) if stiffened else None)
+
+
+def wall_node_count(t) -> int:
+    """The nodes of a tank's elastic walls (fem/walls.py shell_mesh)."""
+    return int(shell_mesh(t.size, t.fill_depth, t.mesh, t.wall_spec.thickness, t.wall_spec.mesh)[0].shape[0])

@@ -22,8 +22,8 @@ from ..physics.multimodal import MultimodalLiquid
 from ..physics.structures import Structures
 from ..physics.system import System
 from ..physics.terms import Config
-from ..physics.vessel import (FreeMotion, HarmonicMotion, Hydrostatics, PaperHydrostatics, RecordedMotion, RigidBody,
-                              SpinUpMotion, Weight, record_coefficients)
+from ..physics.vessel import (HarmonicMotion, Hydrostatics, PaperHydrostatics, RecordedMotion, RigidBody, SpinUpMotion,
+                              Weight, record_coefficients)
 from ..staging import staged
 from ..scene.keys import resolve_params
 from ..scene.types import DOFS, Scene, SceneError
@@ -78,7 +78,7 @@ def build(scene: Scene, params: Optional[dict] = None) -> Built:
     P = params.get
     ves = scene.vessel
     system, block, blocks, multimodal = _model(scene, params)
-    liquid, motion, q0 = system.liquid, system.motion, system.q_ref
+    liquid, q0 = system.liquid, system.q_ref
     ini = ves.initial
     nf = system.nf
     d_init = jnp.zeros(nf)
@@ -88,9 +88,8 @@ def build(scene: Scene, params: Optional[dict] = None) -> Built:
     v0 = jnp.concatenate([jnp.asarray(P("vessel.initial.velocity", ini.velocity), dtype=float),
                           jnp.asarray(P("vessel.initial.angular_velocity", ini.angular_velocity), dtype=float),
                           jnp.zeros(nf)])
-    if motion.prescribed:   # the prescribed motion sets the rigid state at t = 0
-        c0 = Config(motion.coordinates(jnp.zeros(()))[:3], q0, c0.d)
-        v0 = v0.at[:6].set(motion.rates(jnp.zeros(())))
+    for motion in system.prescribing():     # a prescribed motion sets the rigid state at t = 0
+        c0, v0 = motion.start(c0, v0)
     # the terms that own unknowns (the structures) start them; nothing to compile without
     c0, v0, alg0 = _start(system, c0, v0) if system.owners() else (c0, v0, jnp.zeros(0))
     probes = build_probes(scene, block.tanks, liquid, blocks, block.vstructs)
@@ -147,14 +146,13 @@ def _model(scene: Scene, params: dict, outline: bool = False) -> _Model:
         liquid = dataclasses.replace(liquid, coriolis=eff.coriolis, centrifugal=eff.centrifugal, about=about)
     elif has_liquid:
         liquid = dataclasses.replace(liquid, about=about)
-    motion = FreeMotion()
-    if ves.forced is not None:
-        motion = _prescribed(ves.forced)
+    # a prescribed motion is a term that holds the vessel's rows (System.hold); a free vessel has none
+    motion = None if ves.forced is None else _prescribed(ves.forced, P)
     q0 = None
     if not outline:
         ini = ves.initial
         q0 = _quat_from_rpy(jnp.asarray(P("vessel.initial.roll_pitch_yaw", ini.roll_pitch_yaw), dtype=float))
-        if motion.prescribed:     # the prescribed attitude at t = 0 (upright unless a phase or a record tilts it)
+        if motion is not None:     # the prescribed attitude at t = 0 (upright unless a phase or a record tilts it)
             q0 = _quat_from_rpy(motion.coordinates(jnp.zeros(()))[3:])
     if scene.waves is not None or ves.hydrodynamics is not None:
         terms += outline_seakeeping(scene) if outline else build_seakeeping(scene, params)
@@ -194,21 +192,25 @@ def _model(scene: Scene, params: dict, outline: bool = False) -> _Model:
         damping, _ = build_damping(scene, params, block)
     if damping is not None:
         damping = dataclasses.replace(damping, about=damping_about(scene))
-    system = System(body=body, terms=tuple(terms), liquid=liquid, gravity=g, q_ref=q0, motion=motion,
+    if motion is not None:     # listed (and summed, with no share) first, after the hull's inertia
+        terms.insert(0, motion)
+    system = System(body=body, terms=tuple(terms), liquid=liquid, gravity=g, q_ref=q0,
                     gravity_turning=eff.gravity_turning or not has_liquid, balanced=balanced,
                     tail=() if damping is None else (damping,))
     return _Model(system, block, blocks, multimodal)
 
 
-def _prescribed(f):
-    """The motion of a `[vessel.forced]` table: one dof's profile, or a record's spline."""
+def _prescribed(f, P):
+    """The motion of a `[vessel.forced]` table: one dof's profile, or a record's spline; the harmonic
+    form's amplitude, frequency and phase from `params` where it names them (tracers too)."""
     if f.profile == "record":
         knots, coef = record_coefficients(f.times, f.columns, DOFS)
         return RecordedMotion(knots=jnp.asarray(knots), coef=jnp.asarray(coef), about=record_about(f))
     if f.profile == "spin-up":
         return SpinUpMotion(dof=DOFS.index(f.dof), rate=float(f.rate), duration=float(f.duration))
-    return HarmonicMotion(dof=DOFS.index(f.dof), amplitude=jnp.asarray(f.amplitude, dtype=float),
-                          frequency=jnp.asarray(f.frequency, dtype=float), ramp=float(f.ramp), phase=float(f.phase))
+    value = lambda key: jnp.asarray(P(f"vessel.forced.{key}", getattr(f, key)), dtype=float)  # noqa: E731
+    return HarmonicMotion(dof=DOFS.index(f.dof), amplitude=value("amplitude"), frequency=value("frequency"),
+                          ramp=float(f.ramp), phase=value("phase"))
 
 
 def _hull(mass, inertia, parts):

@@ -207,7 +207,7 @@ def _build_shaped(geometry, fill_depth, mesh, rho, c, g, element, sparse) -> Liq
         raise ValueError("the fill depth of a tank that is not a plain box cannot be traced (its mesh follows it)")
     traced = any(is_traced(v) for v in (rho, c, g))
     h = float(fill_depth)
-    tm = geometry.mesh(h, mesh)
+    tm = geometry.mesh(h, mesh, graded=False)      # the layers of fem/shapes.py `breaks`: see AbstractShape.mesh
     nodes, elements, faces, frames = tm.nodes, tm.elements, tm.top_faces, tm.frames
     pairs = bending = None
     if element != "paper":

@@ -47,9 +47,10 @@ def _jacobian_det(X, xi):
     return np.linalg.det(J)
 
 
-def breaks(lo, hi, points, n, where="mesh"):
+def breaks(lo, hi, points, n, where="mesh", least=1):
     """n + 1 coordinates from lo to hi with every point of `points` (inside) among them: each
-    interval between them gets a share of the n elements proportional to its length (at least one)."""
+    interval between them gets a share of the n elements proportional to its length (at least
+    `least`, one where n is too small for that)."""
     cuts = sorted({float(p) for p in points if lo + 1e-9 * (hi - lo) < p < hi - 1e-9 * (hi - lo)})
     ends = [lo] + cuts + [hi]
     lengths = np.diff(ends)
@@ -57,14 +58,63 @@ def breaks(lo, hi, points, n, where="mesh"):
     if n < k:
         raise ValueError(f"{where}: {n} elements cannot put a node at each of the shape's {k - 1} breaks "
                          f"({', '.join(f'{c:g}' for c in cuts)} m); use at least {k}")
-    counts = np.maximum(1, np.floor(lengths / lengths.sum() * n).astype(int))
+    least = least if n >= least * k else 1
+    counts = np.maximum(least, np.floor(lengths / lengths.sum() * n).astype(int))
     while counts.sum() > n:
-        counts[np.argmax(counts)] -= 1
+        counts[np.argmax(np.where(counts > least, counts, 0))] -= 1
     while counts.sum() < n:
         counts[np.argmax(lengths / counts)] += 1
     out = [lo]
     for (s, e), c in zip(zip(ends[:-1], ends[1:]), counts):
         out += list(np.linspace(s, e, c + 1)[1:])
+    return np.array(out)
+
+
+#: the surface layers' thickness scale over the free surface's width (`surface_layers`)
+SURFACE_GRADING = 0.1
+#: the weight of the band under the surface where its walls slope (`surface_layers`)
+SLOPED_SURFACE_BAND = 2.0
+#: the fewest layers of a band between two kinks, or between a kink and the surface or the bottom
+BAND_LAYERS = 2
+
+
+def surface_layers(h, points, n, width, sloped=False, where="mesh[2]"):
+    """n + 1 heights from 0 to the surface h with every kink of `points` (inside) among them, the
+    layers thinner toward the surface: for the face-normal element (fem/liquid_rt.py), whose
+    horizontal displacements are constant through a layer, while a sloshing mode decays from the
+    surface down (as exp(-k d)). The layers are spread by the density 1 / (1 + d / l) at the depth
+    d, l = SURFACE_GRADING x the surface's `width` (so they thicken linearly with depth); each band
+    between kinks takes its share of that density, the band under the surface twice it where its
+    walls slope (a surface in the top chamfers: RT0's error on that band's trapezoids is several
+    times a box's on layers of the same thickness), and at least BAND_LAYERS layers (one where n is
+    too small for that). Proportional layers leave one row of trapezoids under a surface in the top
+    chamfers, and the modes low (docs/design/liquid-element.md, "Layers")."""
+    cuts = sorted({float(p) for p in points if 1e-9 * h < p < h * (1 - 1e-9)})
+    ends = np.array([0.0] + cuts + [h])
+    k = len(ends) - 1
+    if n < k:
+        raise ValueError(f"{where}: {n} elements cannot put a node at each of the shape's {k - 1} breaks "
+                         f"({', '.join(f'{c:g}' for c in cuts)} m); use at least {k}")
+    ell = SURFACE_GRADING * width
+
+    def depth_count(z):                   # the layers' density integrated from the surface down to z
+        return ell * np.log1p((h - z) / ell)
+
+    share = -np.diff(depth_count(ends))
+    if sloped:
+        share[-1] *= SLOPED_SURFACE_BAND
+    share = share / share.sum() * n
+    least = np.full(k, BAND_LAYERS if n >= BAND_LAYERS * k else 1)
+    counts = np.maximum(least, np.floor(share).astype(int))
+    while counts.sum() > n:               # borrow from the band with the most layers for its share
+        counts[np.argmin(np.where(counts > least, share / counts, np.inf))] -= 1
+    while counts.sum() < n:
+        counts[np.argmax(share / counts)] += 1
+    out = [0.0]
+    for s, e, c in zip(ends[:-1], ends[1:], counts):
+        u = np.linspace(depth_count(s), depth_count(e), c + 1)[1:]
+        out += list(h - ell * np.expm1(u / ell))
+    out[-1] = h
     return np.array(out)
 
 

@@ -143,14 +143,18 @@ class AbstractShape(abc.ABC):
     def volume(self, fill_depth: float) -> float:
         """The liquid's volume at rest, exactly for the shape (a mesh file: its elements' volume)."""
 
-    def mesh(self, fill_depth: float, counts) -> TankMesh:
+    def mesh(self, fill_depth: float, counts, graded: bool = True) -> TankMesh:
         """The liquid at rest filled to `fill_depth` on `counts` = (nx, ny, nz) elements mapped onto
-        the shape. Built once per shape, fill and counts (`jaxslosh check` counts its unknowns, the
-        build uses it); its arrays are shared: read them, do not write them."""
-        return _mesh(self, float(fill_depth), tuple(int(m) for m in counts))
+        the shape. Built once per shape, fill, counts and `graded` (`jaxslosh check` counts its
+        unknowns, the build uses it); its arrays are shared: read them, do not write them. `graded`:
+        the layers of a tank whose section has kinks (prismatic, baffles) thinner toward the surface,
+        the face-normal element's mesh (fem/shapes.py `surface_layers`); False: spread in proportion
+        to the bands between the kinks, the nodal elements' mesh (their one-point curl locks on thin
+        layers at a top chamfer's kink). Other shapes have one mesh."""
+        return _mesh(self, float(fill_depth), tuple(int(m) for m in counts), bool(graded))
 
     @abc.abstractmethod
-    def _mesh(self, h: float, counts: tuple) -> TankMesh:
+    def _mesh(self, h: float, counts: tuple, graded: bool = True) -> TankMesh:
         """`mesh`, uncached."""
 
     def free_count(self, fill_depth: float, counts) -> int:
@@ -228,8 +232,8 @@ class AbstractShape(abc.ABC):
 
 
 @functools.lru_cache(maxsize=16)
-def _mesh(shape: AbstractShape, h: float, counts: tuple) -> TankMesh:
-    return shape._mesh(h, counts)
+def _mesh(shape: AbstractShape, h: float, counts: tuple, graded: bool) -> TankMesh:
+    return shape._mesh(h, counts, graded)
 
 
 def read_baffles(table, v, where: str, reader: Reader) -> tuple:

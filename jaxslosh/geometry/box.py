@@ -30,8 +30,8 @@ class Box(AbstractShape):
         a, b, _ = self.size
         return a * b * fill_depth                     # traced fill depths pass through
 
-    def _mesh(self, h: float, counts: tuple) -> TankMesh:
-        return section_mesh(self.size, NO_CHAMFERS, self.baffles, h, counts)
+    def _mesh(self, h: float, counts: tuple, graded: bool = True) -> TankMesh:
+        return section_mesh(self.size, NO_CHAMFERS, self.baffles, h, counts, graded)
 
     def _outline(self, fill_depth: float, mesh) -> list:
         return section_outline(self.size, NO_CHAMFERS)

@@ -82,7 +82,7 @@ class Cylinder(AbstractShape):
         seg = np.arccos(-t) - (-t) * np.sqrt(max(0.0, 1 - t * t))
         return float(L * seg * (B / 2.0) * R)
 
-    def _mesh(self, h: float, counts: tuple) -> TankMesh:
+    def _mesh(self, h: float, counts: tuple, graded: bool = True) -> TankMesh:
         if self.axis == "z":
             nodes = _vertical(self.size, h, counts)
         else:

@@ -74,7 +74,7 @@ class MeshFile(AbstractShape):
         nodes, elements = read_mesh(self.file)
         return float(hex_volumes(nodes, elements).sum())
 
-    def _mesh(self, h: float, counts: tuple) -> TankMesh:
+    def _mesh(self, h: float, counts: tuple, graded: bool = True) -> TankMesh:
         nodes, elements = read_mesh(self.file)
         grid = as_grid(nodes, elements)
         if grid is not None:

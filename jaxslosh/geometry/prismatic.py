@@ -56,8 +56,8 @@ class Prismatic(AbstractShape):
         return float(a * sum(0.5 * ((w[i][1] - w[i][0]) + (w[i + 1][1] - w[i + 1][0])) * (zs[i + 1] - zs[i])
                              for i in range(len(zs) - 1)))
 
-    def _mesh(self, h: float, counts: tuple) -> TankMesh:
-        return section_mesh(self.size, self.chamfers, self.baffles, h, counts)
+    def _mesh(self, h: float, counts: tuple, graded: bool = True) -> TankMesh:
+        return section_mesh(self.size, self.chamfers, self.baffles, h, counts, graded)
 
     def _outline(self, fill_depth: float, mesh) -> list:
         return section_outline(self.size, self.chamfers)

@@ -4,7 +4,8 @@ with or without baffles. Functions of the numbers (size, chamfers, baffles), sha
 and geometry/prismatic.py.
 
 Layer k of the mesh sits at a height chosen so that every kink of the section (the chamfers' ends,
-a baffle's edge) lies on a layer; across, the nodes of a layer are spread evenly between the
+a baffle's edge) lies on a layer, each band between kinks with two layers or more, the layers
+thinner toward the surface for the face-normal element (`_heights`); across, the nodes of a layer are spread evenly between the
 section's walls at that height. Chamfers that meet at the centre line give a V bottom: the bottom
 row of nodes of each x station then merges into one node (those elements are wedges, hexahedra with
 a collapsed face). Baffles are thin plates across the tank on a plane of the mesh, standing on the
@@ -16,17 +17,18 @@ from __future__ import annotations
 import numpy as np
 
 from ..fem.mesh import box_elements, count_nodes, grid_index
-from ..fem.shapes import TankMesh, breaks, finish, merge_coincident
+from ..fem.shapes import BAND_LAYERS, TankMesh, breaks, finish, merge_coincident, surface_layers
 from ..fem.slip import FEATURE_ANGLE
 
 #: a box's section: no corner cut
 NO_CHAMFERS = ((0.0, 0.0), (0.0, 0.0))
 
 
-def section_mesh(size, chamfers, baffles, h: float, counts: tuple) -> TankMesh:
-    """The liquid at rest of a box or prismatic tank filled to h on counts = (nx, ny, nz)."""
+def section_mesh(size, chamfers, baffles, h: float, counts: tuple, graded: bool = True) -> TankMesh:
+    """The liquid at rest of a box or prismatic tank filled to h on counts = (nx, ny, nz); `graded`:
+    layers thinner toward the surface where the section has kinks (AbstractShape.mesh)."""
     nx, ny, nz = counts
-    nodes = _layered(size, chamfers, baffles, h, counts)
+    nodes = _layered(size, chamfers, baffles, h, counts, graded)
     elements = box_elements(nx, ny, nz)
     pairs = _extra_pairs(size, chamfers, baffles, h, counts, nodes)
     nodes, elements = _baffles(size, baffles, counts, nodes, elements)
@@ -57,7 +59,7 @@ def section_outline(size, chamfers) -> list:
     return lines + [np.array([[0.0, y, z], [a, y, z]]) for y, z in sec[:-1]]
 
 
-def _layered(size, chamfers, baffles, h, mesh):
+def _layered(size, chamfers, baffles, h, mesh, graded=True):
     nx, ny, nz = mesh
     a, b, H = size
     zb = [chamfers[0][1], H - chamfers[1][1]]          # a box's (0 and H) are no breaks
@@ -66,7 +68,7 @@ def _layered(size, chamfers, baffles, h, mesh):
     for bf in baffles:
         zb.append(bf.height if bf.mount == "bottom" else H - bf.height)
     xs = breaks(0.0, a, xb, nx, "mesh[0]")
-    zs = breaks(0.0, h, zb, nz, "mesh[2]")
+    zs = _heights(size, chamfers, baffles, h, zb, nz, graded)
     # across: a node on every y-baffle's plane (box tanks only), the same counts on every layer
     ys_rest = breaks(0.0, b, yb, ny, "mesh[1]")
     g = grid_index(nx, ny, nz)
@@ -88,6 +90,25 @@ def _layered(size, chamfers, baffles, h, mesh):
         zb = _hopper_bottom(size, chamfers, y)
         z = np.where(below, zb + (zt - zb) * z / zt, z)
     return np.stack([xs[g[:, 0]], y, z], axis=1)
+
+
+def _heights(size, chamfers, baffles, h, kinks, nz, graded):
+    """The layers' heights: with no kink below the surface (a plain box, a prismatic tank filled within
+    its hopper) even; else graded toward the surface (fem/shapes.py `surface_layers`) or, not
+    `graded`, spread in proportion to the bands between the kinks (`breaks`). With baffles (kinks at
+    their edges) the face-normal element's layers are proportional too, two or more a band: graded
+    toward the surface they thicken at a hanging plate's edge, where the flow is singular, and its
+    first mode moves further off (docs/design/liquid-element.md, "Layers")."""
+    inside = [z for z in kinks if 1e-9 * h < z < h * (1 - 1e-9)]
+    if not graded or not inside:
+        return breaks(0.0, h, kinks, nz, "mesh[2]")
+    if baffles:
+        return breaks(0.0, h, kinks, nz, "mesh[2]", BAND_LAYERS)
+    lo, hi = section_walls(size, chamfers, h)
+    below = max(inside)
+    lo_k, hi_k = section_walls(size, chamfers, below)
+    sloped = abs((hi - lo) - (hi_k - lo_k)) > 1e-9 * size[1]
+    return surface_layers(h, inside, nz, hi - lo, sloped)
 
 
 def _hopper_bottom(size, chamfers, y):

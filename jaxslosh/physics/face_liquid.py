@@ -21,10 +21,16 @@ is definite and the hydrostatic start solves K d0 = F_g.
 
 Outputs and probes read the nodal field of the element's patch recovery (FaceLiquid.nodal_field),
 here as fixed weights of each Gauss point's displacement on the nodes of its element.
+
+Elastic tank walls (fem/walls_rt.py): their free nodal dofs are unknowns after the faces', a wall
+face's flux is a fixed combination of them (`wall_rows`, `wall_cols`, `wall_coef`: the map Tw as
+triplets), and the walls are particles too, at their elements' Gauss points (`n_liquid_points`
+splits r and m), each moving with the trilinear interpolation of its element's nodal unknowns.
+Their nodes follow each tank's liquid nodes in the nodal fields.
 """
 from __future__ import annotations
 
-from typing import Any
+from typing import Any, Optional
 
 import equinox as eqx
 import jax
@@ -55,6 +61,17 @@ class FluxLiquid(AbstractLiquid):
     Minv: Any = None
     start: Any = None
     sparse: bool = eqx.field(static=True, default=False)
+    # elastic walls (None without): the wall faces' fluxes qw = segment_sum(coef * d[cols], rows), held
+    # in slots nf + 1 + j of the liquid points' gathers; the wall points' shape values (Gw, 8) and
+    # their corners' unknowns (Gw, 8, 3); each node's own unknown (n_nodes, 3) (nf: a liquid node)
+    wall_rows: Optional[jax.Array] = None
+    wall_cols: Optional[jax.Array] = None
+    wall_coef: Optional[jax.Array] = None
+    wall_N: Optional[jax.Array] = None
+    wall_slots: Optional[jax.Array] = None
+    node_slots: Optional[jax.Array] = None
+    n_wall_faces: int = eqx.field(static=True, default=0)
+    n_liquid_points: int = eqx.field(static=True, default=-1)     # -1: every point is the liquid's
     coriolis: bool = eqx.field(static=True, default=True)
     centrifugal: bool = eqx.field(static=True, default=True)
     about: About = eqx.field(static=True, default=About())     # its tanks
@@ -67,14 +84,27 @@ class FluxLiquid(AbstractLiquid):
         return int(self.K.shape[0])
 
     def field(self, d):
-        """(nf,) face fluxes -> (G, 3) displacements at the Gauss points."""
+        """(nf,) unknowns -> (G, 3) displacements at the points (the liquid's Gauss points, then the
+        walls')."""
         dz = jnp.concatenate([d, jnp.zeros(1, d.dtype)])
-        return jnp.einsum("gfi,gf->gi", self.phi, dz[self.slots])
+        if self.wall_N is None:
+            return jnp.einsum("gfi,gf->gi", self.phi, dz[self.slots])
+        qw = jax.ops.segment_sum(self.wall_coef * d[self.wall_cols], self.wall_rows, self.n_wall_faces)
+        u = jnp.einsum("gfi,gf->gi", self.phi, jnp.concatenate([dz, qw])[self.slots])
+        return jnp.concatenate([u, jnp.einsum("ga,gai->gi", self.wall_N, dz[self.wall_slots])])
 
     def free_part(self, F):
-        """The transpose of `field`: forces (G, 3) at the Gauss points -> generalized forces (nf,)."""
-        local = jnp.einsum("gfi,gi->gf", self.phi, F)
-        return jax.ops.segment_sum(local.reshape(-1), self.slots.reshape(-1), self.nf + 1)[:self.nf]
+        """The transpose of `field`: forces (G, 3) at the points -> generalized forces (nf,)."""
+        nf = self.nf
+        if self.wall_N is None:
+            local = jnp.einsum("gfi,gi->gf", self.phi, F)
+            return jax.ops.segment_sum(local.reshape(-1), self.slots.reshape(-1), nf + 1)[:nf]
+        G = self.n_liquid_points
+        local = jnp.einsum("gfi,gi->gf", self.phi, F[:G])
+        acc = jax.ops.segment_sum(local.reshape(-1), self.slots.reshape(-1), nf + 1 + self.n_wall_faces)
+        out = acc[:nf] + jax.ops.segment_sum(self.wall_coef * acc[nf + 1:][self.wall_rows], self.wall_cols, nf)
+        wl = self.wall_N[:, :, None] * F[G:][:, None, :]
+        return out + jax.ops.segment_sum(wl.reshape(-1), self.wall_slots.reshape(-1), nf + 1)[:nf]
 
     def total_mass(self):
         return self.m.sum()
@@ -119,9 +149,12 @@ class FluxLiquid(AbstractLiquid):
     def nodal_fields(self, D):
         """Face fluxes (..., nf) -> the recovered nodal displacement fields (..., N, 3)."""
         def one(d):
-            u = self.field(d)                                           # (G, 3)
+            u = self.field(d)[:self.rec_w.shape[0]]                     # (G, 3) the liquid's points
             contrib = self.rec_w[:, :, None] * u[:, None, :]            # (G, 8, 3)
-            return jax.ops.segment_sum(contrib.reshape(-1, 3), self.rec_nodes.reshape(-1), self.n_nodes)
+            out = jax.ops.segment_sum(contrib.reshape(-1, 3), self.rec_nodes.reshape(-1), self.n_nodes)
+            if self.node_slots is None:
+                return out
+            return out + jnp.concatenate([d, jnp.zeros(1, d.dtype)])[self.node_slots]   # the walls' nodes
         flat = D.reshape((-1, D.shape[-1]))
         return jax.vmap(one)(flat).reshape(D.shape[:-1] + (self.n_nodes, 3))
 

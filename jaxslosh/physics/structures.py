@@ -229,8 +229,6 @@ class Structures(AbstractOwner):
         dynamic unknowns (dg/d delta)^T lambda, the frame equilibrium rows, and `g_rows` (the
         constraints g, or their second time derivative at the start) times `gscale` per interface."""
         f_dyn, f_frames = self.frame_rows(system, c, alg)
-        if system.motion.prescribed:
-            f_dyn = f_dyn.at[:6].set(0.0)
         rows, k = [], 0
         for itf, fr, gsc in zip(self.interfaces, f_frames, gscale):
             ng = 3 * itf.n * len(itf.sides)
@@ -340,7 +338,8 @@ class Structures(AbstractOwner):
     def add_rows(self, system, c: Config, core_y, core_z, vy, vz, ay, az):
         """The rows of the whole dynamic vector from the vessel-and-liquid ones (core_y (6,), core_z
         (nf,)): each structure's rigid and elastic inertia rows appended, and the forces of its
-        potential (elastic, gravity) added, the vessel's share too unless its motion is prescribed."""
+        potential (elastic, gravity) added, the vessel's share too (a prescribed motion replaces the
+        vessel's rows afterwards: System.hold)."""
         L = system.layout()
         st_v, e_v = vy[6:].reshape(L.S, 6), vz[L.nf:]
         st_a, e_a = ay[6:].reshape(L.S, 6), az[L.nf:]
@@ -359,8 +358,6 @@ class Structures(AbstractOwner):
                 r_eta = r_eta + jnp.einsum("k,kij,j->i", jnp.stack(spin_tensor_components(om)), b.Kg, eta)
             modal.append(r_eta)
         gy, gz = self.potential_forces_parts(system, c)
-        if system.motion.prescribed:            # the vessel's rows prescribe its motion
-            gy = jnp.concatenate([jnp.zeros(6), gy[6:]])
         return jnp.concatenate([core_y, *rigid_s]) + gy, jnp.concatenate([core_z, *modal]) + gz
 
     def potential_forces_parts(self, system, c: Config):

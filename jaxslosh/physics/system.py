@@ -11,6 +11,9 @@ the energy is the sum of the terms' energies; tangents come from JAX. A term wit
 own (unknowns.py: the flexible structures in their own frames, structures.py) adds unknowns,
 multipliers and constraints around this core through its hooks; the System's `layout`, `advance`,
 `step_rows_parts`, `constraint_rows` and the rest are what the step calls, the same for every system.
+A term that prescribes the vessel's motion (`[vessel.forced]`, vessel.AbstractPrescribedMotion)
+gives the vessel's rows of the whole step in place of the others' (`hold`); a free vessel has no
+such term.
 """
 from __future__ import annotations
 
@@ -22,7 +25,7 @@ from .kinematics import G_matrix, quat_exp, quat_multiply, rotation_matrix, tv3
 from .liquid import AbstractLiquid
 from .terms import Config, Kin, Unknowns
 from .unknowns import Layout
-from .vessel import AbstractMotion, FreeMotion, RigidBody
+from .vessel import RigidBody
 
 
 class System(eqx.Module):
@@ -31,7 +34,6 @@ class System(eqx.Module):
     liquid: AbstractLiquid           # the owner of the deformable unknowns (liquid.NoLiquid without tanks)
     gravity: jax.Array               # m/s^2, along -Z
     q_ref: jax.Array                 # the initial attitude
-    motion: AbstractMotion = FreeMotion()
     # terms summed after the liquid's rows (its modal damping, [tanks.damping]): the sums' order is
     # the residual's rounding
     tail: tuple = ()
@@ -42,6 +44,8 @@ class System(eqx.Module):
         if len(self.owners()) > 1:      # the layout places one owner's unknowns (physics/unknowns.py)
             raise ValueError("a System holds at most one term that owns unknowns (the structures' term "
                              "holds every structure and interface)")
+        if len(self.prescribing()) > 1:  # the vessel's rows are one term's constraint (hold)
+            raise ValueError("a System holds at most one term that prescribes the vessel's motion")
 
     @property
     def nf(self) -> int:
@@ -58,6 +62,23 @@ class System(eqx.Module):
     def owners(self) -> tuple:
         """The terms with unknowns of their own (unknowns.AbstractOwner): static, from their sizes."""
         return tuple(t for t in self.all_terms() if t.unknowns() != Unknowns())
+
+    def prescribing(self) -> tuple:
+        """The term that prescribes the vessel's motion, if any (AbstractTerm.prescribes): static."""
+        return tuple(t for t in self.all_terms() if t.prescribes())
+
+    def hold(self, ry, a6, t):
+        """The rigid rows ry (the vessel's six first) with the vessel's replaced by the constraint of
+        the term that prescribes its motion: unchanged without one (a branch on static model data)."""
+        for term in self.prescribing():
+            with jax.named_scope(type(term).__name__):
+                ry = jnp.concatenate([term.prescribed_rows(a6, jnp.asarray(t), lambda: self.scales()[:6]), ry[6:]])
+        return ry
+
+    def hold_forces(self, rows):
+        """Rows in Newton order [y, alg, z] of forces beside the terms' (the multipliers'), none on
+        the vessel's rows where its motion is prescribed: its rows are the constraint alone."""
+        return rows.at[:6].set(0.0) if self.prescribing() else rows
 
     def layout(self) -> Layout:
         u = [t.unknowns() for t in self.owners()]
@@ -102,12 +123,12 @@ class System(eqx.Module):
         vessel's)."""
         nf = self.nf
         if core:
-            ry, rz = self.residual_parts(c, vy[:3], vy[3:6], vz[:nf], ay[:6], az[:nf], t, z)
+            ry, rz = self.terms_rows(c, vy[:3], vy[3:6], vz[:nf], ay[:6], az[:nf], t, z)
         else:
             ry, rz = jnp.zeros(6), jnp.zeros(nf)
         for o in self.owners():
             ry, rz = o.add_rows(self, c, ry, rz, vy, vz, ay, az)
-        return ry, rz
+        return self.hold(ry, ay[:6], t), rz
 
     def constraint(self, c: Config, alg):
         """The owners' constraints g (empty without)."""
@@ -116,7 +137,7 @@ class System(eqx.Module):
     def constraint_rows(self, c: Config, alg, g_rows, gscale):
         """The constraints' rows in Newton order [y, alg, z] (zero without owners)."""
         rows = [o.constraint_rows(self, c, alg, g_rows, gscale) for o in self.owners()]
-        return sum(rows[1:], rows[0]) if rows else jnp.zeros(self.layout().n)
+        return self.hold_forces(sum(rows[1:], rows[0])) if rows else jnp.zeros(self.layout().n)
 
     def constraint_residual(self, x, config, gscale):
         """The constraints' part Rc of the step's residual at x = [y, alg, z] in Newton order,
@@ -132,7 +153,7 @@ class System(eqx.Module):
     def initial_constraint_rows(self, c: Config, v, alg0, mscale):
         """x -> the constraints' rows of the initial accelerations (d^2 g / dt^2 = 0)."""
         fs = [o.initial_constraint_rows(self, c, v, alg0, mscale) for o in self.owners()]
-        return lambda x: sum((f(x) for f in fs[1:]), fs[0](x)) if fs else jnp.zeros_like(x)
+        return lambda x: self.hold_forces(sum((f(x) for f in fs[1:]), fs[0](x))) if fs else jnp.zeros_like(x)
 
     def initial_alg(self, alg0, alg_a):
         for o in self.owners():
@@ -200,7 +221,13 @@ class System(eqx.Module):
         unknowns passed apart. Kept apart, JAX sees which rows and unknowns do not touch: the Newton
         preconditioner's rigid rows over the liquid's unknowns (solve/newton.py) are then a
         transpose of the liquid's rigid rows alone, where through one stacked vector every term's
-        rows would be linearised and transposed with zero tangents."""
+        rows would be linearised and transposed with zero tangents. The vessel's rows are those of
+        a prescribed motion where the System has one (`hold`)."""
+        rigid, d = self.terms_rows(c, V0, omega, d_dot, a6, d_acc, t, z)
+        return self.hold(rigid, a6, t), d
+
+    def terms_rows(self, c: Config, V0, omega, d_dot, a6, d_acc, t=0.0, z=None):
+        """`residual_parts` before `hold`: the sum of the terms' rows."""
         k = self.kin(c, V0, omega, d_dot, a6, d_acc, t)
         rigid, d = None, None
         for term, zi in zip(self.all_terms(), self.states_init() if z is None else z, strict=True):
@@ -209,7 +236,6 @@ class System(eqx.Module):
             rigid = r.rigid if rigid is None else rigid + r.rigid
             if r.d is not None:
                 d = r.d if d is None else d + r.d
-        rigid = self.motion.rigid_rows(rigid, a6, k.t, lambda: self.scales()[:6])
         return rigid, d
 
     # ---------------------------------------------------------------- energies

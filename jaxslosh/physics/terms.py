@@ -23,7 +23,11 @@ for every term and never asks which term has what):
 * `unknowns()`: unknowns of the term's own beside the vessel's and the deformable block's
   (floating frames, algebraic unknowns with their constraints, deformable coordinates); the
   default is none. A term with unknowns implements the interface of `unknowns.AbstractOwner`
-  (the flexible structures, physics/structures.py).
+  (the flexible structures, physics/structures.py);
+* a constraint on the vessel's rigid unknowns (`prescribes`, `prescribed_rows`): a term that
+  prescribes the vessel's motion gives the vessel's six rows of the step itself, in place of every
+  term's and owner's share of them (the prescribed motion of `[vessel.forced]`,
+  vessel.AbstractPrescribedMotion); the default prescribes nothing.
 
 A term's rows are written out. Where the term has a potential, a test checks its rows against
 the potential's gradient along the step's increments (`potential_rows`, by JAX): a gradient inside
@@ -130,6 +134,17 @@ class AbstractTerm(eqx.Module):
     def unknowns(self) -> Unknowns:
         """Its own unknowns: none (see unknowns.AbstractOwner for a term that has some)."""
         return Unknowns()
+
+    def prescribes(self) -> bool:
+        """Whether it prescribes the vessel's rigid motion (static): its `prescribed_rows` are then
+        the vessel's rows of the step (System.hold); a System holds at most one such term."""
+        return False
+
+    def prescribed_rows(self, a6, t, scale):
+        """The vessel's six rows of a term that `prescribes` its motion: the constraint on its rigid
+        accelerations a6 at time t (`scale()`: the rows' masses, so that a row over its scale is an
+        acceleration error). Never called on a term that prescribes nothing."""
+        raise NotImplementedError(f"{type(self).__name__} prescribes no motion")
 
     def update_inverse(self, inv, c_v):
         """The inverse of the step matrix's deformable block with this term's c_v dR/d(d_dot) added

@@ -1,5 +1,6 @@
 """The vessel's own terms: the hull's rigid-body inertia, the weight of a vessel that nothing holds
-up, buoyancy (eqs. 33-38), and a prescribed motion of the hull instead of a free one."""
+up, buoyancy (eqs. 33-38), and a prescribed motion of the hull instead of a free one (a term that
+prescribes the vessel's rows; a free hull has none)."""
 from __future__ import annotations
 
 import abc
@@ -12,7 +13,7 @@ import numpy as np
 
 from .about import About
 from .kinematics import mv3, rotation_matrix, tv3
-from .terms import AbstractTerm, Kin, Rows
+from .terms import AbstractTerm, Config, Kin, Rows
 
 #: the rigid dofs' names, in the order of the rigid rows
 DOF_NAMES = ("surge", "sway", "heave", "roll", "pitch", "yaw")
@@ -147,41 +148,35 @@ def smooth_ramp(s):
     return s - jnp.sin(2.0 * jnp.pi * s) / (2.0 * jnp.pi)
 
 
-class AbstractMotion(eqx.Module):
-    """How the hull moves: free (its rigid rows are the equations of motion) or prescribed."""
-
-    @property
-    @abc.abstractmethod
-    def prescribed(self) -> bool:
-        """Whether the rigid rows prescribe the motion instead of being equations of motion."""
-
-    @abc.abstractmethod
-    def rigid_rows(self, rows, a6, t, scale):
-        """The rigid rows of the residual, from the terms' sum `rows` (`scale()`: the rigid rows' masses)."""
-
-    def describe(self) -> tuple:
-        """(effect, text) lines, as a term's (terms.py): a free hull has none."""
-        return ()
-
-
-class FreeMotion(AbstractMotion):
-    prescribed = False
-
-    def rigid_rows(self, rows, a6, t, scale):
-        return rows
-
-
-class AbstractPrescribedMotion(AbstractMotion):
-    """A hull whose six rigid coordinates are given functions of time: the rigid rows prescribe their
-    accelerations, scaled by the rigid masses like the free rows; positions and velocities follow by
-    the scheme from the prescribed initial state. The coordinates are surge, sway, heave (the COG's
+class AbstractPrescribedMotion(AbstractTerm):
+    """A hull whose six rigid coordinates are given functions of time (`[vessel.forced]`): a term
+    that prescribes the vessel's motion (terms.py, `prescribes`). Its rows are the vessel's six rows
+    of the step: the prescribed accelerations, scaled by the rigid masses like the free rows, in place
+    of every other term's share (the vessel's equations of motion are replaced by the constraint);
+    positions and velocities follow by the scheme from the prescribed initial state (`start`). A
+    scene without forced motion has no such term. The coordinates are surge, sway, heave (the COG's
     inertial position, m) and roll, pitch, yaw (Z-Y-X angles, rad); the body angular velocity is
     their rates turned into the body frame."""
-    prescribed = True
 
     @abc.abstractmethod
     def coordinates(self, t):
         """(6,) surge, sway, heave, roll, pitch, yaw at time t."""
+
+    def rows(self, k: Kin) -> Rows:
+        """No share of the sum: the vessel's rows are replaced by `prescribed_rows`."""
+        return Rows(jnp.zeros(6))
+
+    def prescribes(self) -> bool:
+        return True
+
+    def prescribed_rows(self, a6, t, scale):
+        return scale() * (a6 - self.accelerations(t))
+
+    def start(self, c0: Config, v0):
+        """The vessel's position and rigid velocities at t = 0 prescribed (its attitude is the
+        System's q_ref, which the build takes from `coordinates(0)`)."""
+        t0 = jnp.zeros(())
+        return c0._replace(X0=self.coordinates(t0)[:3]), v0.at[:6].set(self.rates(t0))
 
     def rates(self, t):
         """Prescribed (dX0/dt inertial, omega body) at time t: omega = E(roll, pitch) (roll, pitch,
@@ -197,18 +192,16 @@ class AbstractPrescribedMotion(AbstractMotion):
         """(d2X0/dt2, d omega/dt) at time t: the time derivative of `rates`."""
         return jax.jvp(self.rates, (t,), (jnp.ones_like(t),))[1]
 
-    def rigid_rows(self, rows, a6, t, scale):
-        return scale() * (a6 - self.accelerations(t))
-
 
 class HarmonicMotion(AbstractPrescribedMotion):
     """One rigid dof at amplitude sin(frequency t + phase), faded in over `ramp` by `smooth_ramp`
-    (C2: no jump in the acceleration); the others held at zero."""
+    (C2: no jump in the acceleration); the others held at zero. Amplitude, frequency and phase are
+    leaves of the model (traceable: `vessel.forced.amplitude`, `.frequency`, `.phase`)."""
     dof: int = eqx.field(static=True)      # 0-2 surge, sway, heave; 3-5 roll, pitch, yaw
     amplitude: jax.Array
     frequency: jax.Array
     ramp: float = eqx.field(static=True, default=0.0)
-    phase: float = eqx.field(static=True, default=0.0)     # rad
+    phase: jax.Array = 0.0                                 # rad
 
     def coordinates(self, t):
         x = self.amplitude * jnp.sin(self.frequency * t + self.phase)
@@ -217,7 +210,7 @@ class HarmonicMotion(AbstractPrescribedMotion):
         return jnp.zeros(6).at[self.dof].set(x)
 
     def describe(self) -> tuple:
-        phase = f" + {self.phase:g}" if self.phase else ""
+        phase = f" + {float(self.phase):g}" if float(self.phase) else ""
         ramp = f", faded in over {self.ramp:g} s" if self.ramp else ""
         return (("prescribed motion", f"{DOF_NAMES[self.dof]} = {float(self.amplitude):g} "
                                       f"sin({float(self.frequency):g} t{phase}){ramp}, other rigid dofs held"),)

@@ -171,7 +171,8 @@ KEYS = (
      '(Raviart-Thomas) element that does not lock on re-entrant tanks (U-tubes, baffles, hoppers). Left '
      'out: "rt" for a mesh file that is not a box grid and for a tank with baffles (unless it runs at '
      'full order on more than about 4,000 faces) and for a prismatic or cylindrical tank on modes '
-     '([tanks.reduction]), "stabilized" otherwise; `check` says which and why. Not with elastic walls.'),
+     '([tanks.reduction]), "stabilized" otherwise; `check` says which and why. With elastic walls, every '
+     'element runs at full order only.'),
     ("tanks.walls.thickness", _REQ, "m", "Wall thickness (one element through it)."),
     ("tanks.walls.mesh", "the liquid mesh", "", "Wall elements along the tank's length, breadth and height."),
     ("tanks.walls.material.young", _REQ, "Pa", "Young's modulus."),

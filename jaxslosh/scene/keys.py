@@ -49,7 +49,8 @@ class _Keys(tuple):
 
 # Scene values that simulate(params=...) may replace by traced values (the vessel is rebuilt per
 # call; the liquid matrices are assembled from traced fill depth, density, sound speed and gravity;
-# a traced damping ratio scales the modal damping, whose modes come from the scene's values).
+# a traced damping ratio scales the modal damping, whose modes come from the scene's values; the
+# harmonic forced motion's amplitude, frequency and phase are leaves of its term).
 TANK_TRACEABLE = ("fill_depth", "fluid.density", "fluid.sound_speed", "damping.ratio")
 
 
@@ -59,6 +60,7 @@ TRACEABLE = _Keys((
     "vessel.hydrostatics.gm_t", "vessel.hydrostatics.gm_l",
     "vessel.initial.position", "vessel.initial.velocity", "vessel.initial.angular_velocity",
     "vessel.initial.roll_pitch_yaw", "vessel.hull.kg", "vessel.hull.cog",
+    "vessel.forced.amplitude", "vessel.forced.frequency", "vessel.forced.phase",
 ) + tuple(f"tanks.<name>.{k}" for k in TANK_TRACEABLE) + ("waves.amplitude", "waves.hs"))
 
 # keys traced by the nonlinear hydrostatics alone (assemble/hull.py moves the hull's surface against the

@@ -343,9 +343,6 @@ def _tank(table, where: str, base_dir: str = "") -> Tank:
     if "element" not in table.get("fluid", {}):
         element, why = default_element(geo, depth, v["mesh"], reduction is not None)
         fluid = dataclasses.replace(fluid, element=element, element_default=why)
-    if wall_spec is not None and fluid.element in FACE_FORMS:     # `check` says it, not only `run`
-        raise SceneError(f"{where}.fluid.element", f"{fluid.element!r} does not take elastic walls yet; use "
-                                                   "\"stabilized\" (or walls = \"rigid\")")
     return Tank(name=v["name"], origin=v["origin"], size=v["size"], fill_depth=depth, mesh=v["mesh"],
                 walls=walls, fluid=fluid, wall_spec=wall_spec, reduction=reduction, damping=damping,
                 model=model, modes=v.get("modes", 6),

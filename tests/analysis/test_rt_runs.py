@@ -243,19 +243,19 @@ def test_the_default_element_is_rt_where_the_stabilized_one_locks(tmp_path, caps
     assert r.status == "ok"
 
 
-def test_rt_with_elastic_walls_is_refused_by_check(tmp_path, capsys):
-    """"rt" does not take elastic walls yet: `check` (not only `run`) exits 2 with one line naming
-    tanks[0].fluid.element."""
+def test_rt_with_elastic_walls_check_names_the_element(tmp_path, capsys):
+    """"rt" in elastic walls (fem/walls_rt.py; tests/fem/test_walls_rt.py and
+    tests/physics/test_rt_elastic_walls.py check it): `check` accepts it and prints the element, how
+    it runs, and how the walls hold the liquid."""
     from jaxslosh.cli.main import main
     walls = '[tanks.walls]\nthickness = 0.05\n[tanks.walls.material]\nyoung = 2.1e11\npoisson = 0.3\ndensity = 7850.0\n'
     text = BAFFLED.format(mesh="[5, 5, 5]", extra=walls + '[tanks.fluid]\nelement = "rt"').split("[[tanks.baffles]]")[0]
     path = tmp_path / "s.toml"
     path.write_text(text)
-    assert main(["check", str(path)]) == 2
-    err = capsys.readouterr().err.strip().splitlines()
-    assert len(err) == 1 and "tanks[0].fluid.element" in err[0] and "elastic walls" in err[0], err
-    path.write_text(text.replace('element = "rt"', 'element = "stabilized"'))
     assert main(["check", str(path)]) == 0
+    out = capsys.readouterr().out
+    assert "element 'rt' at full order, elastic walls (slip)" in out, out
+    assert "each wall face's flux is the volume the wall sweeps there" in out, out
 
 
 # --- rao and sweep ----------------------------------------------------------------------------

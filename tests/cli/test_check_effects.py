@@ -18,7 +18,7 @@ from jaxslosh.assemble.system import build, outline
 from jaxslosh.cli import main
 from jaxslosh.physics.about import About
 from jaxslosh.physics.liquid import AbstractLiquid, NoLiquid
-from jaxslosh.physics.vessel import FreeMotion
+from jaxslosh.physics.vessel import AbstractPrescribedMotion
 
 DATA = os.path.join(os.path.dirname(os.path.dirname(__file__)), "data")
 BOX = open(os.path.join(DATA, "box_20x10x2.toml")).read()
@@ -90,9 +90,9 @@ def test_check_prints_the_lines_of_the_built_models_terms_and_no_other(name, tmp
     system = build(scene).system
     full = model_effects(system)
     parts = model_parts(system)
-    # every term of the model says what it adds (a free hull and a vessel without liquid add nothing)
+    # every term of the model says what it adds (a vessel without liquid adds nothing)
     for part in parts:
-        if isinstance(part, (NoLiquid, FreeMotion)):
+        if isinstance(part, NoLiquid):
             assert part.describe() == ()
         else:
             assert part.describe(), f"{type(part).__name__} is in the model and has no line"
@@ -102,6 +102,10 @@ def test_check_prints_the_lines_of_the_built_models_terms_and_no_other(name, tmp
     effects = [e for e, _, _ in full]
     assert present <= set(effects), present - set(effects)
     assert not absent & set(effects), absent & set(effects)
+    # a prescribed motion is a term of the model, with its own line; a free vessel has no such term
+    motion = [o for e, _, o in full if e == "prescribed motion"]
+    assert [type(o) for o in motion] == [type(t) for t in system.terms if isinstance(t, AbstractPrescribedMotion)]
+    assert [id(t) for t in system.prescribing()] == [id(o) for o in motion]
     # what check assembles (the outline, no arrays) has the same lines from the same terms
     lite = model_effects(outline(scene))
     assert [(e, t, _kind(o)) for e, t, o in lite] == [(e, t, _kind(o)) for e, t, o in full]

@@ -32,9 +32,9 @@ def _models():
 def test_the_sparse_blocks_equal_the_dense_ones_to_round_off():
     models = _models()
     assert models[1].pools == 2
-    tanks = [SimpleNamespace(origin=(0.3, -1.0, -0.5)), SimpleNamespace(origin=(-1.0, 0.5, -0.2))]
-    dense, (Kdt0, Ktt0) = face_full_liquid(tanks, models)
-    sparse, (Kdt1, Ktt1) = face_full_liquid(tanks, models, sparse=True)
+    tanks = [SimpleNamespace(origin=(0.3, -1.0, -0.5), wall_spec=None), SimpleNamespace(origin=(-1.0, 0.5, -0.2), wall_spec=None)]
+    dense, (Kdt0, Ktt0), _ = face_full_liquid(tanks, models)
+    sparse, (Kdt1, Ktt1), _ = face_full_liquid(tanks, models, sparse=True)
     n = dense.nf
     V = np.random.default_rng(0).standard_normal((n, 5))
     K0, M0 = np.asarray(dense.K), np.asarray(dense.Mff)
@@ -71,7 +71,7 @@ def test_chebyshev_steps_reach_the_bound():
 
 def test_the_operators_vmap_and_export():
     models = _models()
-    liquid, _ = face_full_liquid([SimpleNamespace(origin=(0.0, 0.0, 0.0))], models[:1], sparse=True)
+    liquid, _, _ = face_full_liquid([SimpleNamespace(origin=(0.0, 0.0, 0.0), wall_spec=None)], models[:1], sparse=True)
     step, *_ = face_solver_blocks(liquid, 4.0 / 0.01 ** 2)
     X = jnp.asarray(np.random.default_rng(1).standard_normal((3, liquid.nf)))
 

@@ -106,7 +106,7 @@ FAST = "horizontal_cylinder_50"
 
 
 @pytest.mark.parametrize("name", [pytest.param(c, marks=() if c == FAST else pytest.mark.slow)
-                                  for c in shape_cases.CASES])
+                                  for c in shape_cases.CASES + shape_cases.LNG_FILLS])
 def test_every_shape_first_six_modes_within_2_5_percent(name):
     """The issue's "every shape": the first 6 sloshing modes within 2.5 % of the reference on a mesh
     of about 1,000 elements (560 to 1,024), with the element shape_cases.ELEMENT names ("rt" but for

@@ -2,13 +2,13 @@
 solver (tests/sloshing_reference.py), the hydrostatics of inclined walls, a box given as a mesh file,
 the scene's checks, and a coupled run."""
 import os
-import subprocess
 import sys
 
 import numpy as np
 import pytest
 
 import jaxslosh as js
+from jaxslosh.cli.main import main
 from jaxslosh.fem.liquid import build_liquid
 from jaxslosh.fem.modes import free_matrices, liquid_modes
 from jaxslosh.geometry import Baffle, Box, Cylinder, MeshFile, Prismatic
@@ -159,7 +159,7 @@ def test_box_given_as_a_gmsh_file_runs_as_the_box(tmp_path):
     np.testing.assert_allclose(mesh.probes["B"].position, box.probes["B"].position, rtol=0, atol=1e-10)
 
 
-def test_shape_keys_are_checked(tmp_path):
+def test_shape_keys_are_checked(tmp_path, capsys):
     cases = [('shape = "prismatic"\nchamfers = { bottom = [3.0, 1.0] }', "tanks[0].chamfers"),
              ('shape = "prismatic"\nchamfers = [[1.0, 1.0], [1.0]]', "tanks[0].chamfers[1]"),
              ('shape = "cylinder"\naxis = "z"', "tanks[0].size"),         # 5 x 4 across: not a circle
@@ -175,8 +175,9 @@ def test_shape_keys_are_checked(tmp_path):
         if "nowhere" in extra:
             text = text.replace("fill_depth = 3.0\n", "").replace("mesh = [5, 5, 5]\n", "")
         path.write_text(text)
-        out = subprocess.run([sys.executable, "-m", "jaxslosh", "check", str(path)], capture_output=True, text=True)
-        assert out.returncode == 2 and key in out.stderr, (extra, out.stderr)
+        code = main(["check", str(path)])       # in process: the command's exit status and its line
+        err = capsys.readouterr().err
+        assert code == 2 and key in err, (extra, err)
 
 
 def test_ship_with_a_vertical_cylinder_tank_full_and_reduced():
@@ -194,11 +195,11 @@ def test_ship_with_a_vertical_cylinder_tank_full_and_reduced():
 
 
 @pytest.mark.parametrize("name", ["type_c_tank", "lng_carrier"])
-def test_shape_scenes_check(name):
-    out = subprocess.run([sys.executable, "-m", "jaxslosh", "check", os.path.join(ROOT, "scenes", f"{name}.toml")],
-                         capture_output=True, text=True)
-    assert out.returncode == 0, out.stderr
-    assert "warning" not in out.stderr                 # the masses balance the displacement
+def test_shape_scenes_check(name, capsys):
+    code = main(["check", os.path.join(ROOT, "scenes", f"{name}.toml")])
+    err = capsys.readouterr().err
+    assert code == 0, err
+    assert "warning" not in err                        # the masses balance the displacement
 
 
 def test_horizontal_cylinder_longitudinal_mode_against_the_box():

@@ -17,7 +17,7 @@ FORCED = """
 gravity = 9.81
 [simulation]
 duration = {duration}
-dt = 0.02
+dt = {dt}
 scheme = "newmark"
 [vessel]
 mass = 1.0e4
@@ -74,12 +74,13 @@ def _transfer(shape, w, zeta, h=0.5):
     return abs(lam * w ** 2 / (mu * (w1 ** 2 - w ** 2 + 2j * zeta * w1 * w)))
 
 
-@pytest.mark.parametrize("shape", [BOX, pytest.param(CYLINDER, marks=pytest.mark.slow)])
-def test_forced_small_amplitude_is_linear_theory(shape):
+@pytest.mark.parametrize("shape, dt", [(BOX, 0.04), pytest.param(CYLINDER, 0.02, marks=pytest.mark.slow)])
+def test_forced_small_amplitude_is_linear_theory(shape, dt):
     """1 mm of surge: the steady elevation at the wall on the surge axis is linear theory's; the wall
-    across (y = 0) barely moves."""
+    across (y = 0) barely moves. (The box at dt = 0.04 s, 40 steps a forcing period: the
+    trapezoidal rule's error, of order (w dt)^2 / 12 = 0.2 %, stays inside the 1 %.)"""
     w = 4.0
-    r = js.simulate(js.load_scene(FORCED.format(duration=7.0, amplitude=0.001, w=w, ratio=0.4, shape=shape)))
+    r = js.simulate(js.load_scene(FORCED.format(duration=7.0, dt=dt, amplitude=0.001, w=w, ratio=0.4, shape=shape)))
     assert r.status == "ok"
     t, z = np.asarray(r.time), np.asarray(r.probes["wall"].displacement)[:, 2]
     amp = _amplitude(t, z, w, 4.5)
@@ -138,16 +139,16 @@ def test_free_vessel_conserves_energy(shape):
 
 
 def test_keys():
-    base = FORCED.format(duration=1.0, amplitude=0.001, w=4.0, ratio=0.1, shape=CYLINDER)
+    base = FORCED.format(duration=1.0, dt=0.02, amplitude=0.001, w=4.0, ratio=0.1, shape=CYLINDER)
     s = js.load_scene(base)
     assert s.tanks[0].flow == "3d" and s.tanks[0].shape == "cylinder"
-    assert js.load_scene(FORCED.format(duration=1.0, amplitude=0.001, w=4.0, ratio=0.1, shape="")).tanks[0].flow == "2d"
+    assert js.load_scene(FORCED.format(duration=1.0, dt=0.02, amplitude=0.001, w=4.0, ratio=0.1, shape="")).tanks[0].flow == "2d"
     with pytest.raises(js.SceneError, match=r"tanks\[0\]\.flow"):
         js.load_scene(base.replace('axis = "z"', 'axis = "z"\nflow = "2d"'))
     with pytest.raises(js.SceneError, match=r"tanks\[0\]\.axis"):
         js.load_scene(base.replace('axis = "z"', 'axis = "x"'))
     with pytest.raises(js.SceneError, match=r"tanks\[0\]\.flow"):
-        js.load_scene(FORCED.format(duration=1.0, amplitude=0.001, w=4.0, ratio=0.1, shape=BOX)
+        js.load_scene(FORCED.format(duration=1.0, dt=0.02, amplitude=0.001, w=4.0, ratio=0.1, shape=BOX)
                       .replace('model = "multimodal"\n', 'mesh = [2, 2, 2]\n').replace("modes = 5\n", ""))
 
 

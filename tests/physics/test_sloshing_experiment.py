@@ -4,15 +4,21 @@ the wave elevation 0.05 m from the wall of a 1.73 m tank filled to 0.6 m, moved 
 x = 0.032 cos(2 pi t / 1.3) m from rest.
 
 Linear theory here is the closed form of the tank's standing waves forced from rest (independent of
-the finite elements). What the measurement supports: linear theory is off by more than 15 % rms of
-the measured maximum and makes crests and troughs equal, where the measured crests rise about 1.5
-times as high as the troughs fall; the multimodal tank reproduces that asymmetry. It does not
-reproduce the measured heights within 10 % at the forcing as documented (benchmarks/sloshing_experiments.py)."""
+the finite elements); the fully nonlinear potential flow is the high-order spectral solution of
+tests/hos_sloshing.py (independent of the multimodal liquid). What the measurement supports: linear
+theory is off by more than 15 % rms of the measured maximum and makes crests and troughs equal, where
+the measured crests rise about 1.5 times as high as the troughs fall; the multimodal tank reproduces
+that asymmetry. It does not reproduce the measured heights within 10 % at the forcing as documented
+(benchmarks/sloshing_experiments.py), and neither does the fully nonlinear potential flow, which the
+multimodal tank follows: already in the first half-period, where the motion is still linear, the
+documented forcing gives a trough 30 % deeper than the measured one."""
+from functools import lru_cache
 from pathlib import Path
 
 import numpy as np
 
 import jaxslosh as js
+from hos_sloshing import hos_tank
 
 ROOT = Path(__file__).resolve().parents[2]
 L, H, G, A, W, X = 1.73, 0.6, 9.81, 0.032, 2 * np.pi / 1.3, 0.05
@@ -38,6 +44,15 @@ def _linear(t, n=60):
     return np.sum(F / (wn ** 2 - W ** 2) * (np.cos(W * t) - np.cos(wn * t)) * np.cos(k * X), axis=1)
 
 
+@lru_cache(maxsize=None)
+def _multimodal_first_beat():
+    """The scene's multimodal tank over the first beat (to 3.6 s): (t, elevation at the probe)."""
+    text = (ROOT / "scenes" / "sloshing_experiment.toml").read_text().replace("duration = 10.0", "duration = 3.6")
+    r = js.simulate(js.load_scene(text))
+    assert r.status == "ok"
+    return np.asarray(r.time), np.asarray(r.probes["wall"].displacement)[:, 2]
+
+
 def test_linear_theory_misses_the_measured_elevation():
     """Over the whole record (0.1 to 9.9 s): more than 15 % rms of the measured maximum, its
     troughs more than 1.4 times as deep as the measured ones."""
@@ -55,10 +70,7 @@ def test_multimodal_tank_has_the_measured_crest_to_trough_ratio():
     tm, zm = _measured()
     first = tm <= 3.6
     tm, zm = tm[first], zm[first]
-    text = (ROOT / "scenes" / "sloshing_experiment.toml").read_text().replace("duration = 10.0", "duration = 3.6")
-    r = js.simulate(js.load_scene(text))
-    assert r.status == "ok"
-    t, z = np.asarray(r.time), np.asarray(r.probes["wall"].displacement)[:, 2]
+    t, z = _multimodal_first_beat()
     measured = zm.max() / -zm.min()
     multimodal = z.max() / -z.min()
     zl = _linear(t)
@@ -67,3 +79,26 @@ def test_multimodal_tank_has_the_measured_crest_to_trough_ratio():
     assert abs(linear / measured - 1) > 0.25, (linear, measured)
     assert abs(t[np.argmax(z)] - tm[np.argmax(zm)]) < 0.05
     assert abs(t[np.argmin(z)] - tm[np.argmin(zm)]) < 0.05
+
+
+def test_multimodal_tank_is_the_fully_nonlinear_potential_flow():
+    """The scene's forcing over the first beat: the multimodal tank (8 modes) within 10 mm (5 % of its
+    0.2 m crest) of the independent high-order spectral solution (16 modes, fourth order). Both
+    overshoot the measured crest by more than 30 %: the overshoot is not the multimodal model's."""
+    t, z = _multimodal_first_beat()
+    th, zh = hos_tank(L, H, G, lambda s: -A * W ** 2 * np.cos(W * s), 3.6, 0.01, X)
+    assert np.max(np.abs(np.interp(t, th, zh) - z)) < 0.010
+    zm = _measured()[1]
+    assert z.max() > 1.3 * zm.max() and zh.max() > 1.3 * zm.max()
+
+
+def test_documented_forcing_misses_the_linear_first_half_period():
+    """The first trough (before 0.8 s, 0.04 m: still linear): the multimodal tank's within 2 % of
+    linear theory's, and both more than 25 % deeper than the measured one (so no model of the liquid
+    mends it: the tank's motion at the start differs from the documented one)."""
+    tm, zm = _measured()
+    t, z = _multimodal_first_beat()
+    early = t < 0.8
+    multimodal, linear, measured = z[early].min(), _linear(t[early]).min(), zm[tm < 0.8].min()
+    assert abs(multimodal / linear - 1) < 0.02, (multimodal, linear)
+    assert multimodal < 1.25 * measured and linear < 1.25 * measured, (multimodal, linear, measured)

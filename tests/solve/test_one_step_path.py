@@ -1,13 +1,19 @@
 """One step path: solve/ sees only the System and its terms' hooks (physics/terms.py,
-physics/unknowns.py). No structure-only step (no `_flex` name) and no branch on whether a System
-has an optional piece of physics (`system.<attribute> is None`): flexible structures, radiation
-memory and modal damping enter the step through the hooks of their terms. Read from the source
-with `ast`."""
+physics/unknowns.py). No structure-only step (no `_flex` name), no name of the prescribed motion
+(`motion`, `prescribed`, `forced`) and no branch on whether a System has an optional piece of
+physics (`system.<attribute> is None`): flexible structures, radiation memory, modal damping and
+a prescribed motion enter the step through the hooks of their terms, and the System has no slot
+for any of them. Read from the source with `ast`."""
 import ast
+import dataclasses
 import os
+
+from jaxslosh.physics.system import System
 
 ROOT = os.path.join(os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__)))), "jaxslosh", "solve")
 SYSTEM_NAMES = {"system", "sysm", "self.system"}
+#: the optional physics whose names solve/ must not hold: the structures and the prescribed motion
+OPTIONAL = ("flex", "motion", "prescrib", "forced")
 
 
 def _root(node):
@@ -18,7 +24,9 @@ def _root(node):
 
 
 def offences(source: str) -> list:
-    """(line, what) for every `_flex` name and every `<system>.<attr> is [not] None` in the source."""
+    """(line, what) for every name of optional physics (OPTIONAL: `_flex_step`, `system.motion`,
+    `prescribed`, ...) and every `<system>.<attr> is [not] None` in the source (prose, as in
+    "equations of motion", is no name)."""
     out = []
     for node in ast.walk(ast.parse(source)):
         names = []
@@ -28,7 +36,9 @@ def offences(source: str) -> list:
             names.append(node.id)
         elif isinstance(node, ast.Attribute):
             names.append(node.attr)
-        out += [(node.lineno, f"name {n}") for n in names if "flex" in n.lower()]
+        elif isinstance(node, ast.arg):
+            names.append(node.arg)
+        out += [(node.lineno, f"name {n}") for n in names if any(w in n.lower() for w in OPTIONAL)]
         if isinstance(node, ast.Compare) and any(isinstance(op, (ast.Is, ast.IsNot)) for op in node.ops):
             sides = [node.left] + list(node.comparators)
             none = any(isinstance(x, ast.Constant) and x.value is None for x in sides)
@@ -48,6 +58,11 @@ def test_the_detector_finds_a_structure_step_and_an_optional_branch():
     assert (7, "branch on system.flex.bodies is None") in found
     # an argument's default or a solver option is not optional physics
     assert offences("def f(system, alg0=None, n=None):\n    return alg0 is None or n is None\n") == []
+    # the prescribed motion, read from the System or passed along, is found; prose is not
+    src = ('def step(system, s, prescribed):\n    """The equations of motion."""\n'
+           "    return system.motion.rigid_rows(s)\n")
+    found = offences(src)
+    assert (1, "name prescribed") in found and (3, "name motion") in found and len(found) == 2
 
 
 def test_solve_has_one_step_path():
@@ -57,3 +72,11 @@ def test_solve_has_one_step_path():
             with open(os.path.join(ROOT, f)) as fh:
                 bad += [f"solve/{f}:{line}: {what}" for line, what in offences(fh.read())]
     assert not bad, "\n".join(bad)
+
+
+def test_the_system_has_no_slot_for_optional_physics():
+    """A prescribed motion is a term (physics/vessel.py AbstractPrescribedMotion, found by
+    `System.prescribing`), not a field of the System: a scene without one has no such term."""
+    fields = {f.name for f in dataclasses.fields(System)}
+    assert not {n for n in fields if any(w in n.lower() for w in OPTIONAL)}, fields
+    assert not hasattr(System, "motion")
