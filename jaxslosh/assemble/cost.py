@@ -54,12 +54,17 @@ def _factor_bytes(t, nf: int) -> float:
     return 2 * 8.0 * 2 * nf * min(nf, 2 * 3 * a * b)
 
 
-def _tank_bytes(t, sparse: bool, host_lu: bool = False) -> float:
+def _tank_bytes(t, sparse: bool, host_lu: bool = False, rt_dense: bool = False) -> float:
     nx, ny, nz = t.mesh
     E = nx * ny * nz
     N = (nx + 1) * (ny + 1) * (nz + 1)
     nf = free_liquid_dofs(t)
     assembly = 8.0 * E * (24 * 24) * 3 + 8.0 * E * 64 * 3            # COO rows, columns and values
+    if t.fluid.element == "rt" and t.reduction is None:
+        # face-normal at full order (assemble/face_liquid.py): dense M, K and inverses on the ~3E
+        # faces, or (sparse) dense blocks on the elements and top faces only, ~7 of them while the
+        # Schur complement's inverses are formed (fem/face_schur.py)
+        return max(assembly, 8.0 * 6 * (3 * E) ** 2 if rt_dense else 8.0 * 7 * (E + nx * ny) ** 2)
     if not sparse:
         solver = 8.0 * (N * N + 4.0 * nf * nf)                      # mass, stiffness, two or three inverses
     else:
@@ -81,7 +86,7 @@ def estimate(scene: Scene) -> Cost:
                                     and not any(t.wall_spec is not None for t in scene.tanks))
     worst, total = ("", 0.0), 0.0
     for i, t in enumerate(scene.tanks if scene.effects.liquid else ()):
-        b = _tank_bytes(t, sparse, choice == "sparse-host")
+        b = _tank_bytes(t, sparse, choice == "sparse-host", choice == "dense")
         total += b
         if b > worst[1]:
             worst = (f"tanks[{i}].mesh", b)

@@ -1,8 +1,11 @@
 """The full-order liquid of face-normal ("rt") tanks (physics/face_liquid.py FluxLiquid) from their
-models (fem/liquid_rt.py): the Gauss points' fields and masses, the dense blocks on the free faces,
-the absolute-rotation penalty and the nodal recovery's weights, host-side NumPy (scaled by traced
-density, sound speed or gravity where given). A plain box's fill depth may be traced too: its layers
-scale with the depth, so every block is a closed function of h / h0 (`traced_depth_blocks`)."""
+models (fem/liquid_rt.py): the Gauss points' fields and masses, the blocks, the absolute-rotation
+penalty and the nodal recovery's weights, host-side NumPy. The blocks are either kept without dense
+matrices on the faces (`sparse_tank_blocks`: the mass element by element and the penalty's dense
+part on the elements and top faces, fem/face_schur.py), or dense on the free faces (scaled by traced
+density, sound speed or gravity where given). A plain box's fill depth may be traced too on the
+dense blocks: its layers scale with the depth, so every block is a closed function of h / h0
+(`traced_depth_blocks`)."""
 from __future__ import annotations
 
 import jax
@@ -12,13 +15,21 @@ import scipy.sparse as sp
 from jax.scipy.linalg import block_diag as jax_block_diag
 from scipy.linalg import block_diag
 
+from ..fem.face_schur import face_schur, mass_bounds
 from ..fem.liquid_rt import ROTATION_PENALTY_RATIO, FaceLiquid, _gauss, _loads, _Mixed, face_modes
 from ..fem.walls_rt import build_face_tank_with_walls, wall_points
+from ..physics.face_blocks import FaceOps, FaceStiffness
 from ..physics.face_liquid import FluxLiquid
 from ..scene.types import RT_FULL_FACES, SceneError
+from ..solve.face_inverse import mass_inverse
 
-#: free faces above which a full-order "rt" tank is refused (its dense blocks: M, K and two inverses)
+#: free faces above which a full-order "rt" tank is refused on the dense path (its dense blocks: M, K
+#: and two inverses); the sparse path (fem/face_schur.py) has no such limit
 MAX_FULL_FACES = RT_FULL_FACES
+#: `simulation.linear_solver = "auto"` takes the sparse blocks above this many free faces in all
+RT_SPARSE_AUTO = 0
+#: rows of K formed at once for the sums of |K_ij| (the Newton iterations' round-off floor)
+ROWS = 1024
 
 
 def recovery_weights(model: FaceLiquid, gauss=None):
@@ -39,6 +50,14 @@ def recovery_weights(model: FaceLiquid, gauss=None):
     return rows.reshape(E * P, 8), w.reshape(E * P, 8)
 
 
+def _kappa(model: FaceLiquid) -> float:
+    """The penalty's kappa: its modes at ROTATION_PENALTY_RATIO times the highest of the 20 lowest
+    modes that is sloshing (an acoustic mode would make it needlessly stiff)."""
+    fm = face_modes(model, 20)
+    slosh = [w for w, k in zip(fm.omega, fm.kind) if k == "sloshing"] or list(fm.omega)
+    return (ROTATION_PENALTY_RATIO * float(max(slosh))) ** 2
+
+
 def absolute_rotation_penalty(model: FaceLiquid, origin, gauss=None):
     """(K_c (nf, nf), K_dt (nf, 3), K_tt (3, 3)): the penalty 1/2 kappa |P (d + C theta)|_M^2 that holds
     the circulation (K's kernel, the M-orthogonal projection P onto it) at the part of the tank's
@@ -57,11 +76,68 @@ def absolute_rotation_penalty(model: FaceLiquid, origin, gauss=None):
     Gp = np.linalg.pinv(Bd @ Y, hermitian=True)
     Pc = c - Y @ (Gp @ (Bd @ c))
     MP = mixed.M.toarray() - Bd.T @ Gp @ Bd
-    fm = face_modes(model, 20)
-    slosh = [w for w, k in zip(fm.omega, fm.kind) if k == "sloshing"] or list(fm.omega)
-    kappa = (ROTATION_PENALTY_RATIO * float(max(slosh))) ** 2
+    kappa = _kappa(model)
     MPc = mixed.M @ Pc
     return kappa * 0.5 * (MP + MP.T), kappa * MPc, kappa * (Pc.T @ MPc)
+
+
+def sparse_tank_blocks(model: FaceLiquid, origin, gauss=None) -> dict:
+    """One tank's full-order blocks without dense matrices on the faces (fem/face_schur.py): the
+    element mass blocks (signed), Y = W - kappa G^+ on its elements and top faces, the
+    absolute-rotation penalty's K_dt, K_tt (as `absolute_rotation_penalty`, through G^+), the static
+    start's columns K^-1 F for unit gravity along x, y, z, the sums of |K_ij| per row, and the
+    spectral bounds of the Jacobi-scaled mass (the Chebyshev iteration's)."""
+    gauss = _gauss(model) if gauss is None else gauss
+    x, w, phys = gauss
+    sch = face_schur(model)
+    kappa = _kappa(model)
+    r = x + np.asarray(origin, dtype=float)
+    rot = np.stack([np.cross(np.eye(3)[k], r) for k in range(3)])
+    Pc = sch.kernel_part(sch.minv(_loads(model, gauss, rot)[sch.f]))
+    MPc = sch.M @ Pc
+    uniform = np.stack([np.broadcast_to(np.eye(3)[k], x.shape) for k in range(3)])
+    start = sch.static_solve(_loads(model, gauss, uniform)[sch.f], kappa)
+    Y = np.diag(1.0 / sch.winv) - kappa * sch.Gp
+    Me = model.density * np.einsum("epfi,epgi,ep->efg", phys, phys, w)        # phys carries the signs
+    nf = sch.f.size
+    rowsum = np.empty(nf)
+    Bc, Mr = sch.B.tocsc(), sch.M.tocsr()
+    for s in range(0, nf, ROWS):
+        rows = (Bc[:, s:s + ROWS].T @ Y) @ sch.B + kappa * Mr[s:s + ROWS].toarray()   # K's rows s..
+        rowsum[s:s + ROWS] = np.abs(rows).sum(axis=1)
+    slot = np.full(len(model.faces), -1)
+    slot[sch.f] = np.arange(nf)
+    return dict(nf=nf, kappa=kappa, Y=Y, winv=sch.winv, Kdt=kappa * MPc, Ktt=kappa * (Pc.T @ MPc), start=start,
+                Me=Me, slots=slot[model.element_faces], signs=model.signs, top=slot[model.top], rowsum=rowsum,
+                diag=sch.M.diagonal(), bounds=mass_bounds(sch.M, sch.Mlu))
+
+
+def stack_sparse(parts: list) -> tuple:
+    """(FaceStiffness, MassInverse, start (n, 3)) of the tanks' `sparse_tank_blocks`, stacked (tank
+    after tank)."""
+    n = sum(p["nf"] for p in parts)
+    slots, tops, elements, top_ranges, off, e0, t0 = [], [], [], [], 0, 0, 0
+    for p in parts:
+        slots.append(np.where(p["slots"] < 0, n, p["slots"] + off))
+        tops.append(p["top"] + off)
+        E, T = len(p["slots"]), len(p["top"])
+        elements.append((e0, e0 + E))
+        top_ranges.append((t0, t0 + T))
+        off, e0, t0 = off + p["nf"], e0 + E, t0 + T
+    ops = FaceOps(jnp.asarray(np.concatenate(slots).astype(np.int32)),
+                  jnp.asarray(np.concatenate([p["signs"] for p in parts])),
+                  jnp.asarray(np.concatenate(tops).astype(np.int32)), n, tuple(elements), tuple(top_ranges))
+    Me = np.concatenate([p["Me"] for p in parts])
+    kM = np.concatenate([p["kappa"] * p["Me"] for p in parts])
+    kappa_n = np.concatenate([np.full(p["nf"], p["kappa"]) for p in parts])
+    K = FaceStiffness(ops, jnp.asarray(kM), tuple(jnp.asarray(p["Y"]) for p in parts),
+                      jnp.asarray(np.concatenate([p["rowsum"] for p in parts])),
+                      tuple(jnp.asarray(p["winv"]) for p in parts), jnp.asarray(kappa_n),
+                      jnp.asarray([p["kappa"] for p in parts]))
+    lo = min(p["bounds"][0] for p in parts)
+    hi = max(p["bounds"][1] for p in parts)
+    Minv = mass_inverse(ops, Me, np.concatenate([p["diag"] for p in parts]), lo, hi)
+    return K, Minv, np.concatenate([p["start"] for p in parts])
 
 
 def _component_masses(model, w, phys):
@@ -115,7 +191,7 @@ def traced_depth_blocks(model: FaceLiquid, origin, s, gauss=None):
     return x, w, phys, M, Kac, kappa * 0.5 * (MP + MP.T), kappa * MPc, kappa * (Pc.T @ MPc)
 
 
-def face_full_liquid(tanks, models, scales=None, depths=None):
+def face_full_liquid(tanks, models, scales=None, depths=None, sparse=False):
     """The FluxLiquid of every tank (all face-normal, full order), stacked, the (K_dt, K_tt) of the
     absolute-rotation penalty (physics/liquid.py RotationPenalty), and per tank its elastic walls
     (fem/walls.py WallModel) or None. `scales`: per tank None or its (rho, rho c^2, rho g) over its
@@ -129,18 +205,19 @@ def face_full_liquid(tanks, models, scales=None, depths=None):
     xp = jnp if any(isinstance(v, jax.core.Tracer) for sc in scales if sc for v in sc) \
         or any(isinstance(d, jax.core.Tracer) for d in depths) else np
     rs, ms, phis, slots, Ks, Ms, row_scales, rec_n, rec_w, Kdts = ([] for _ in range(10))
-    walls, wall_parts, node_slots = [], [], []          # wall_parts: (rows, cols, coef, x, m, N, slots) per tank
+    walls, wall_parts, node_slots, parts = [], [], [], []          # wall_parts: (rows, cols, coef, x, m, N, slots) per tank
     Ktt = 0.0
     off, node_off, n_wf = 0, 0, 0
     HELD = -1                                           # the zero slot, known once every tank is counted
     for i, (t, model, fs, ds) in enumerate(zip(tanks, models, scales, depths)):
         sr, sc, sg = fs if fs is not None else (1.0, 1.0, 1.0)
         f = np.flatnonzero(model.free)
-        if f.size > MAX_FULL_FACES:
+        if f.size > MAX_FULL_FACES and not sparse:
             raise SceneError(f"tanks[{i}].fluid.element", f"a full-order \"rt\" tank holds {f.size} free faces on "
-                                                          f"this mesh, more than {MAX_FULL_FACES} (its blocks are dense): "
-                                                          "add a [tanks.reduction] table (modes = N), or set "
-                                                          "element = \"stabilized\"")
+                                                          f"this mesh, more than {MAX_FULL_FACES} for the dense "
+                                                          "blocks: leave simulation.linear_solver at \"auto\" (or "
+                                                          "\"sparse\"), add a [tanks.reduction] table (modes = N), or "
+                                                          "set element = \"stabilized\"")
         gauss = _gauss(model)
         E, P = gauss[0].shape[:2]
         slot = np.full(len(model.faces), HELD)
@@ -166,6 +243,10 @@ def face_full_liquid(tanks, models, scales=None, depths=None):
             ns[model.n_nodes:].reshape(-1)[tw.wall_dofs] = off + nq + np.arange(tw.wall_dofs.size)
             node_slots.append(ns)
             walls.append(tw.walls)
+        elif sparse:                    # no dense matrix on the faces (the scene's own values, no walls)
+            x, w, phys = gauss
+            parts.append(sparse_tank_blocks(model, t.origin, gauss))
+            Kdt, Ktt_t, Mf, Kf = parts[-1]["Kdt"], parts[-1]["Ktt"], None, None
         elif ds is None:
             x, w, phys = gauss
             Kc, Kdt, Ktt_t = absolute_rotation_penalty(model, t.origin, gauss)
@@ -181,24 +262,30 @@ def face_full_liquid(tanks, models, scales=None, depths=None):
         ms.append(sr * (model.density * w).reshape(-1))
         phis.append(phys.reshape(E * P, 6, 3))
         slots.append(np.repeat(slot[model.element_faces], P, axis=0).reshape(E * P, 6))
-        Ks.append(Kf)
+        if Kf is not None:
+            Ks.append(Kf)
+            Ms.append(sr * Mf)
         Kdts.append(sr * Kdt)
         Ktt = Ktt + sr * Ktt_t
-        Ms.append(sr * Mf)
         X = model.nodes[model.faces[f]]
         area = np.linalg.norm(0.5 * np.cross(X[:, 2] - X[:, 0], X[:, 3] - X[:, 1]), axis=1)
-        rscale = np.diag(model.mass[f][:, f].toarray()) * area
+        rscale = model.mass[f][:, f].diagonal() * area
         if tw is not None:                         # a wall dof's row over its mass (liquid's share included)
             rscale = np.concatenate([rscale, np.diag(tw.mass)[f.size:]])
         row_scales.append(rscale)
         n_, w_ = recovery_weights(model, gauss)
         rec_n.append(n_ + node_off)
         rec_w.append(w_)
-        off += Mf.shape[0]
+        off += f.size if Mf is None else Mf.shape[0]
         node_off += node_slots[-1].shape[0]
     fix = lambda a: np.where(a == HELD, off, np.where(a <= -2, off + 1 + (-2 - a), a)).astype(np.int32)  # noqa: E731
     slot = fix(np.concatenate(slots))
-    stack = jax_block_diag if xp is jnp else block_diag
+    if sparse:
+        K, Minv, start = stack_sparse(parts)
+        blocks = dict(K=K, Mff=None, Minv=Minv, start=jnp.asarray(start), sparse=True)
+    else:
+        stack = jax_block_diag if xp is jnp else block_diag
+        blocks = dict(K=jnp.asarray(stack(*Ks)), Mff=jnp.asarray(stack(*Ms)))
     extra = {}
     if wall_parts:
         rows, cols, coef, xw, mw, Nw, sw = (np.concatenate(p) for p in zip(*wall_parts))
@@ -210,7 +297,6 @@ def face_full_liquid(tanks, models, scales=None, depths=None):
                      n_liquid_points=int(sum(len(p) for p in phis)))
     liquid = FluxLiquid(r=jnp.asarray(xp.concatenate(rs)), m=jnp.asarray(xp.concatenate(ms)),
                         phi=jnp.asarray(xp.concatenate(phis)), slots=jnp.asarray(slot),
-                        K=jnp.asarray(stack(*Ks)), Mff=jnp.asarray(stack(*Ms)),
                         scale=jnp.asarray(np.concatenate(row_scales)), rec_nodes=jnp.asarray(np.concatenate(rec_n)),
-                        rec_w=jnp.asarray(np.concatenate(rec_w)), n_nodes=node_off, **extra)
+                        rec_w=jnp.asarray(np.concatenate(rec_w)), n_nodes=node_off, **blocks, **extra)
     return liquid, (jnp.asarray(xp.concatenate(Kdts)), jnp.asarray(Ktt)), tuple(walls)

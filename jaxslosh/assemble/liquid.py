@@ -21,7 +21,7 @@ from ..physics.liquid import AbstractLiquid, Liquid, NoLiquid
 from ..scene.types import FACE_FORMS, Scene, SceneError
 from ..solve.sparse import SPARSE_AUTO, host_sparse
 from .effects import liquid_unknowns
-from .face_liquid import face_full_liquid
+from .face_liquid import RT_SPARSE_AUTO, face_full_liquid
 from .reduced import reduce_liquid
 
 
@@ -112,7 +112,7 @@ def build_liquid_block(scene: Scene, params: Optional[dict] = None, gravity=None
         depths = [params.get(f"tanks.{t.name}.fill_depth", t.fill_depth) / t.fill_depth
                   if isinstance(m, FaceLiquid) and isinstance(params.get(f"tanks.{t.name}.fill_depth"), jax.core.Tracer)
                   else None for t, m in zip(rigid, models)]
-        return _face_full(rigid, models, scales, depths)
+        return _face_full(rigid, models, scales, depths, face_sparse(scene, models, scales, depths))
 
     blocks, rs, Ms_list, K_list, free_list, Kdt_list, Ktt = [], [], [], [], [], [], xp.zeros((3, 3))
     coupled = False
@@ -300,7 +300,23 @@ def face_scales(scene, t, params, g):
     return rho / f.density, rho * c * c / (f.density * f.sound_speed ** 2), rho * g / (f.density * g0)
 
 
-def _face_full(tanks, models, scales, depths=None):
+def face_sparse(scene, models, scales, depths) -> bool:
+    """Whether full-order face-normal tanks take the blocks without dense matrices on the faces
+    (assemble/face_liquid.py sparse_tank_blocks): the scene's own values only (no density, sound
+    speed, gravity or fill depth from params, traced or not: the dense blocks scale with them), and
+    `simulation.linear_solver` "sparse" or "sparse-host", or "auto" above RT_SPARSE_AUTO free faces."""
+    values = [v for sc in scales if sc for v in sc]
+    if any(t.wall_spec is not None for t in scene.tanks):     # elastic walls: their dense blocks
+        return False
+    if any(isinstance(v, jax.core.Tracer) for v in values) or any(d is not None for d in depths) \
+            or any(abs(float(np.asarray(v)) - 1.0) > 1e-12 for v in values):    # blocks at the scene's values
+        return False
+    choice = scene.simulation.linear_solver
+    faces = sum(int(np.count_nonzero(m.free)) for m in models)
+    return choice in ("sparse", "sparse-host") or (choice == "auto" and faces > RT_SPARSE_AUTO)
+
+
+def _face_full(tanks, models, scales, depths=None, sparse=False):
     """Face-normal tanks at full order (assemble/face_liquid.py): every tank's, none of the nodal ones."""
     for i, m in enumerate(models):
         if not isinstance(m, FaceLiquid):
@@ -311,7 +327,7 @@ def _face_full(tanks, models, scales, depths=None):
     for t, m in zip(tanks, models):
         blocks.append(_host_block(t, m, offset))
         offset += m.n_nodes + (0 if t.wall_spec is None else wall_node_count(t))    # a tank's walls follow its liquid
-    liquid, penalty, walls = face_full_liquid(tanks, models, scales, depths)
+    liquid, penalty, walls = face_full_liquid(tanks, models, scales, depths, sparse)
     carried = tuple(rigid_part(w.mass, w.nodes + np.asarray(t.origin)[None, :]) for t, w in zip(tanks, walls)
                     if w is not None)           # the walls are part of the ship's mass (SPEC)
     return LiquidBlock(liquid, tuple(blocks), penalty, carried=carried)

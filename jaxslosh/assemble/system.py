@@ -15,6 +15,7 @@ import jax.numpy as jnp
 import numpy as np
 
 from ..physics.damping import ModalDamping
+from ..physics.face_liquid import FluxLiquid
 from ..physics.kinematics import quat_from_rpy, rotation_matrix
 from ..physics.liquid import NoLiquid, RotationPenalty, SpinStiffening
 from ..physics.multimodal import MultimodalLiquid
@@ -232,7 +233,7 @@ def _hull(mass, inertia, parts):
 def _hydrostatic_start(system: System, q0):
     """Discrete hydrostatic equilibrium K d0 = F_g under the initial gravity direction (PHYSICS.md
     item 6), so that the stiff acoustic modes are not excited by the start."""
-    if system.liquid.sparse:
+    if system.liquid.sparse and not isinstance(system.liquid, FluxLiquid):   # face-normal: columns of its own
         return hydrostatic_start(system.liquid, system.gravity_body(rotation_matrix(q0)))
     return _dense_static_start(system, q0)
 

@@ -30,7 +30,7 @@ Their nodes follow each tank's liquid nodes in the nodal fields.
 """
 from __future__ import annotations
 
-from typing import Optional
+from typing import Any, Optional
 
 import equinox as eqx
 import jax
@@ -49,12 +49,18 @@ class FluxLiquid(AbstractLiquid):
     m: jax.Array          # (G,) their masses rho det J
     phi: jax.Array        # (G, 6, 3) the six face fields of each Gauss point's element there
     slots: jax.Array      # (G, 6) each field's unknown (nf: a held face, zero)
-    K: jax.Array          # (nf, nf) stiffness (compression and free surface)
-    Mff: jax.Array        # (nf, nf) the consistent mass on the unknowns (the Newton block)
+    K: Any                # (nf, nf) stiffness (compression, free surface, circulation penalty); sparse:
+    #                       physics/face_blocks.FaceStiffness, kappa M + B^T Y B
+    Mff: Any              # (nf, nf) the consistent mass on the unknowns (the Newton block); sparse: None
     scale: jax.Array      # (nf,) a mass per row (M_ff's diagonal times the face's area: row / scale in m/s^2)
     rec_nodes: jax.Array  # (G, 8) the nodes the recovery spreads each Gauss point's field on
     rec_w: jax.Array      # (G, 8) and its weights
     n_nodes: int = eqx.field(static=True)
+    # sparse (no dense matrix on the faces): M^-1 (solve/face_inverse.MassInverse) and the static
+    # start's columns K^-1 F for unit gravity along each axis (nf, 3), both formed at build time
+    Minv: Any = None
+    start: Any = None
+    sparse: bool = eqx.field(static=True, default=False)
     # elastic walls (None without): the wall faces' fluxes qw = segment_sum(coef * d[cols], rows), held
     # in slots nf + 1 + j of the liquid points' gathers; the wall points' shape values (Gw, 8) and
     # their corners' unknowns (Gw, 8, 3); each node's own unknown (n_nodes, 3) (nf: a liquid node)
@@ -69,7 +75,6 @@ class FluxLiquid(AbstractLiquid):
     coriolis: bool = eqx.field(static=True, default=True)
     centrifugal: bool = eqx.field(static=True, default=True)
     about: About = eqx.field(static=True, default=About())     # its tanks
-    sparse = False
 
     def describe(self) -> tuple:
         return inertial_lines(self)
@@ -157,10 +162,17 @@ class FluxLiquid(AbstractLiquid):
         return weights @ self.nodal_fields(d)
 
     def constant_blocks(self):
+        """(M_ff, K_ff) dense; the sparse liquid's formed from its products (the solver does not ask
+        for them: solve/face_inverse.py)."""
+        if self.sparse:
+            eye = jnp.eye(self.nf)
+            return self.Minv.ops.elementwise(self.Minv.Me, eye), self.K @ eye
         return self.Mff, self.K
 
     def static_start(self, g_b):
         """The discrete hydrostatic equilibrium K d0 = F_g: K holds the absolute-rotation penalty on
         the circulation, so it is definite, and the load of a uniform field has no circulation part
-        (the start is at rest in the kernel)."""
+        (the start is at rest in the kernel). Sparse: the columns formed at build time."""
+        if self.start is not None:
+            return self.start @ g_b
         return solve(self.K, self.free_part(self.m[:, None] * g_b[None, :]))

@@ -66,7 +66,8 @@ KEYS = (
     ("simulation.linear_solver", '"auto"', "", 'The liquid block of the Newton matrix: "dense" inverses, '
      '"sparse" (fast diagonalization on box grids, else factors computed at build time and applied in JAX), '
      '"sparse-host" (SciPy SuperLU called from the step: very large shaped meshes; no export, batching or '
-     'cache), "auto": sparse above 1,500 liquid unknowns.'),
+     'cache), "auto": sparse above 1,500 liquid unknowns. Face-normal ("rt") tanks at full order: every '
+     'value but "dense" takes their blocks without dense matrices on the faces (docs/guide/linear-solvers.md).'),
     ("simulation.energy_projection", "false", "", 'scheme = "newmark" in a conservative scene only: after each '
      "step the velocities are scaled back onto the initial energy."),
     # vessel

@@ -2,11 +2,10 @@
 shape's class (jaxslosh/geometry) reads and checks its own; here what is common to them all."""
 from __future__ import annotations
 
-import numpy as np
 
 from ..geometry import SHAPES, AbstractShape, Reader
 from .fields import one_of, read, show
-from .types import RT_FULL_FACES, SceneError
+from .types import SceneError
 
 def _read(table, where, spec, required=()):
     return read(table, where, spec, required)          # this module's `read` when called (the docs' test spies on it)
@@ -56,9 +55,9 @@ def read_multimodal_shape(table, where: str) -> None:
 def default_element(geo: AbstractShape, fill_depth, mesh, reduced: bool) -> tuple[str, str]:
     """(element, why) for a tank whose [tanks.fluid] leaves `element` out: the face-normal "rt" where
     the stabilized element locks (a mesh file that is not a box grid, a tank with baffles: issue 30),
-    unless the tank runs at full order on a mesh too large for rt's dense full-order blocks; "rt" for
-    the shapes that prefer it on modes ([tanks.reduction]: prismatic and cylindrical tanks); else
-    "stabilized" (boxes keep their fast diagonalization; shapes at full order their quicker steps)."""
+    at full order on any mesh (its blocks without dense matrices on the faces, assemble/face_liquid.py);
+    "rt" for the shapes that prefer it on modes ([tanks.reduction]: prismatic and cylindrical tanks);
+    else "stabilized" (boxes keep their fast diagonalization; shapes at full order their quicker steps)."""
     locks, why = geo.locks(float(fill_depth))
     if not locks:
         if geo.rt_on_modes and reduced:
@@ -67,7 +66,4 @@ def default_element(geo: AbstractShape, fill_depth, mesh, reduced: bool) -> tupl
             # (docs/guide/liquid-element.md, "Prismatic and cylindrical tanks")
             return "rt", f"a {geo.name} tank on modes: its higher modes are more accurate with \"rt\""
         return "stabilized", why
-    if not reduced and 3 * int(np.prod(mesh)) > RT_FULL_FACES:
-        return "stabilized", (f"{why} too large for the full-order face-normal element (about "
-                              f"{3 * int(np.prod(mesh))} faces): give it a [tanks.reduction] table for \"rt\"")
     return "rt", f"{why}: the stabilized element locks there"

@@ -11,9 +11,11 @@ import jax.numpy as jnp
 import numpy as np
 
 from ..fem.linalg import inv
+from ..physics.face_liquid import FluxLiquid
 from ..physics.system import System
 from ..staging import staged
 from .schemes import Scheme
+from .face_inverse import face_solver_blocks
 from .sparse import sparse_solver_blocks
 
 
@@ -93,13 +95,15 @@ def _liquid_solver(system: System, h, scheme: Scheme, tol, max_iter, substeps, r
         return Solver(z, z, jnp.asarray(h, dtype=float), scheme, tol, max_iter, substeps, z if substeps else None,
                       reuse=reuse, adaptive=adaptive, ns=6 + nf)
     L = system.liquid
-    if L.sparse:         # large mesh (sparse.py): fast diagonalization, factors in JAX, or the host's LU
-        step_inv, mass_inv, sub_inv, K = sparse_solver_blocks(L, scheme.c_a(h),
-                                                              scheme.c_a(h / substeps) if substeps else None)
+    if L.sparse:         # large mesh (sparse.py): fast diagonalization, factors in JAX, or the host's LU;
+        #                  face-normal tanks: their Schur complement's blocks (face_inverse.py)
+        blocks = face_solver_blocks if isinstance(L, FluxLiquid) else sparse_solver_blocks
+        step_inv, mass_inv, sub_inv, K = blocks(L, scheme.c_a(h), scheme.c_a(h / substeps) if substeps else None)
         step_inv = damped(step_inv, system, scheme, h)
         sub_inv = damped(sub_inv, system, scheme, h / substeps) if substeps else None
         scale = np.asarray(jax.lax.stop_gradient(system.scales()[6:]))
-        noise = np.finfo(np.float64).eps * np.max(np.asarray(abs(K).sum(axis=1)).reshape(-1) / scale)
+        rowsum = K if isinstance(K, np.ndarray) else abs(K).sum(axis=1)
+        noise = np.finfo(np.float64).eps * np.max(np.asarray(rowsum).reshape(-1) / scale)
         return Solver(step_inv, mass_inv, jnp.asarray(h, dtype=float), scheme, tol, max_iter, substeps, sub_inv,
                       noise=noise, reuse=reuse, adaptive=adaptive)
     M_ff, K_ff = jax.lax.stop_gradient(L).constant_blocks()

@@ -208,14 +208,15 @@ height = 1.0
 
 def test_the_default_element_is_rt_where_the_stabilized_one_locks(tmp_path, capsys):
     """Left out, the element is "rt" for a tank with baffles (and a mesh file that is not a box grid,
-    tests/fem/test_liquid_element_rt.py's U-tube), "stabilized" for a plain box, a box grid given as a
-    mesh file and a baffled tank too large for rt at full order; "rt" for prismatic and cylindrical
+    tests/fem/test_liquid_element_rt.py's U-tube) on any mesh (a large one at full order through the
+    blocks without dense matrices on the faces), "stabilized" for a plain box and a box grid given as
+    a mesh file; "rt" for prismatic and cylindrical
     tanks on modes, "stabilized" at full order; `check` says which and why; a given element stays."""
     from jaxslosh.cli.main import main
     small = js.load_scene(BAFFLED.format(mesh="[10, 4, 6]", extra=""))
     assert small.tanks[0].fluid.element == "rt" and "baffles" in small.tanks[0].fluid.element_default
     big = js.load_scene(BAFFLED.format(mesh="[40, 20, 12]", extra=""))
-    assert big.tanks[0].fluid.element == "stabilized"
+    assert big.tanks[0].fluid.element == "rt"
     reduced = js.load_scene(BAFFLED.format(mesh="[40, 20, 12]", extra="[tanks.reduction]\nmodes = 6"))
     assert reduced.tanks[0].fluid.element == "rt"
     given = js.load_scene(BAFFLED.format(mesh="[10, 4, 6]", extra='[tanks.fluid]\nelement = "stabilized"'))
