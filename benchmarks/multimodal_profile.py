@@ -11,7 +11,8 @@ residual R(x), the Newton preconditioner (the exact Jacobian of the small block 
 energies), and for the multimodal tank its integrals and its rows alone. XLA's cost analysis gives
 the flops and transcendental functions of each compiled piece. Derived: the share of the step spent
 in residual evaluations and the rest (the preconditioner formed again when convergence slows, the
-predictor, the update)."""
+predictor, the update). Last, Newton's scaled residual per evaluation with a fresh exact Jacobian
+from three predictors (the worst of three steps): how few evaluations a step could take."""
 from __future__ import annotations
 
 import argparse
@@ -99,7 +100,35 @@ def profile(text, steps, repeats):
         rows[INTEGRALS] = timed(lambda be: t.integrals(be), (be,), n, repeats)
         rows["tank's rows (jvp and grad)"] = timed(lambda be: t.rows(Vb, k.omega, be, bd, Vb, k.a6[3:6], bdd, k.g_b),
                                                    (be,), n, repeats)
-    return evals, rows
+    return evals, rows, predictors(sysm, solver, carry.s, equations)
+
+
+def predictors(sysm, solver, s0, equations, steps=3):
+    """The scaled residual per evaluation of Newton with a fresh exact Jacobian, from today's
+    predictor (the accelerations a_n of the last step) and from their linear and quadratic
+    extrapolations, a few steps on from s0: how many evaluations a step needs at best."""
+    L, h, b = sysm.layout(), solver.h, solver.scheme.beta
+    f = solver.scheme.c_d(h)
+    gsc, alg_sc = sysm.alg_scales(f, lambda itf: jnp.maximum(1.0 / f, 1e-13 * itf.L_ref / solver.tol))
+    scale = L.to_x(sysm.unknown_scales(), alg_sc)
+    R = jax.jit(lambda s, x: equations(s)[0](x))
+    J = jax.jit(lambda s, x: jax.jacfwd(lambda y: equations(s)[0](y))(x))
+    advance1 = jax.jit(lambda s: int_step(sysm, solver, s)[0])
+    out = {"a_n": [], "2 a_n - a_(n-1)": [], "3 a_n - 3 a_(n-1) + a_(n-2)": []}
+    s2, s1 = s0, advance1(s0)
+    s = advance1(s1)
+    for _ in range(steps):
+        s2, s1, s = s1, s, advance1(s)
+        Js = J(s, equations(s)[2])
+        base = h * s.v + h * h * (0.5 - b) * s.a
+        for name, a in zip(out, (s.a, 2 * s.a - s1.a, 3 * s.a - 3 * s1.a + s2.a)):
+            x, errs = L.to_x(base + h * h * b * a, s.alg), []
+            for _ in range(3):
+                r = R(s, x)
+                errs.append(float(jnp.max(jnp.abs(r / scale))))
+                x = x - jnp.linalg.solve(Js, r)
+            out[name].append(errs)
+    return {name: np.max(np.asarray(e), axis=0) for name, e in out.items()}
 
 
 def main():
@@ -108,8 +137,9 @@ def main():
     ap.add_argument("--repeats", type=int, default=5)
     args = ap.parse_args()
     text = open("scenes/paper_ship_tank.toml").read().replace("duration = 20.0", "duration = 3.0")
-    out = {name: profile(edit(text), args.steps, args.repeats) for name, edit in VARIANTS.items()}
-    for name, (evals, rows) in out.items():
+    out = {}
+    for name, edit in VARIANTS.items():          # printed as each variant ends (a long run keeps its first table)
+        evals, rows, pred = out[name] = profile(edit(text), args.steps, args.repeats)
         print(f"\n{name}: {evals:.2f} residual evaluations per step (after {args.steps} steps)")
         print(f"  {'piece':<36} {'us':>9} {'flops':>10} {'transc.':>8}")
         for piece, (sec, fl, tr) in rows.items():
@@ -117,6 +147,9 @@ def main():
         step, res = rows["loop step"][0], evals * rows["residual R(x)"][0]
         print(f"  residual evaluations: {1e6 * res:.1f} us per step ({res / step:.0%} of the loop's step); "
               f"the rest (preconditioner refreshes, predictor, update): {1e6 * (step - res):.1f} us")
+        print(f"  scaled residual per evaluation, fresh exact Jacobian (tolerance {1e-10:g}), by predictor:")
+        for p, e in pred.items():
+            print(f"    {p:<28} " + " ".join(f"{v:.1e}" for v in e), flush=True)
     mm, fe = out["multimodal, 6 modes"][1], out["fem, 20 modes"][1]
     print(f"\nloop step, multimodal / 20 modes: {mm['loop step'][0] / fe['loop step'][0]:.1f}; "
           f"the multimodal tank's integrals alone / the 20-mode step: "
