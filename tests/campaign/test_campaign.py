@@ -484,7 +484,7 @@ def test_headings_in_degrees_are_refused(tmp_path, capsys):
     assert js.load_scene(scene_text() + f"[campaign]\nheadings = [-3.0, {2 * np.pi!r}]\n").campaign.headings[1] > 6
 
 
-FAILING_SCATTER = "hs,tp,probability\n0.3,7.0,0.5\n100.0,7.0,0.5\n"     # Hs 100 m: Newton gives up near t = 8 s
+FAILING_SCATTER = "hs,tp,probability\n0.3,7.0,0.5\n1000.0,7.0,0.5\n"    # Hs 1000 m: Newton gives up near t = 5 s
 LIMITS = "[campaign]\nheadings = [1.5707963267948966]\n[campaign.limits]\nroll = 1.0\nheave = 5.0\n"
 
 
@@ -504,8 +504,9 @@ def _main(argv):
 @pytest.fixture(scope="module")
 def failing(tmp_path_factory):
     """Three small campaigns of the box in beam seas, one process each, limits roll 1 rad and heave
-    5 m from the scene: `mixed`, Hs 0.3 m and Hs 100 m at 50 % each (the second fails); `resumed`,
-    that file resumed with --limits "" (the failed case run again); `lost`, Hs 100 m alone."""
+    5 m from the scene: `mixed`, Hs 0.3 m and Hs 1000 m at 50 % each (the second fails: Hs 100 m runs
+    to the end); `resumed`, that file resumed with --limits "" (the failed case run again); `lost`,
+    Hs 1000 m alone."""
     d = tmp_path_factory.mktemp("failing")
     with pytest.MonkeyPatch.context() as mp:
         mp.setenv("PYTHONPATH", os.pathsep.join([str(ROOT), str(ROOT / "tests"), os.environ.get("PYTHONPATH", "")]))
@@ -515,7 +516,7 @@ def failing(tmp_path_factory):
         p.write_text(scene_text(40.0).replace('title = "box alone in irregular seas"',
                                               'title = "box alone (Hs 0.3 m, Tp 7 s)"') + LIMITS)
         (d / "mixed.csv").write_text(FAILING_SCATTER)
-        (d / "lost.csv").write_text("hs,tp,probability\n100.0,7.0,1.0\n")
+        (d / "lost.csv").write_text("hs,tp,probability\n1000.0,7.0,1.0\n")
         common = ["--workers", "1", "--batch", "2", "--no-progress"]
         runs = {"mixed": _main(["campaign", str(p), "--scatter", str(d / "mixed.csv"), "-o", str(d / "mixed.h5")]
                                + common)}
@@ -549,7 +550,7 @@ def test_a_failed_cases_reason_is_printed(failing):
     _, runs = failing
     code, out, err = runs["mixed"]
     line = [ln for ln in err.splitlines() if ln.startswith("failed:")]
-    assert len(line) == 1 and line[0].startswith("failed: case 1 (hs 100 m, tp 7 s, heading 1.571 rad, seed 0): step ")
+    assert len(line) == 1 and line[0].startswith("failed: case 1 (hs 1000 m, tp 7 s, heading 1.571 rad, seed 0): step ")
     assert "Newton did not converge" in line[0]
     assert out.splitlines()[-1].startswith("done: 2 cases run now, 0 already done, 1 failed")
 
@@ -568,7 +569,7 @@ def test_a_campaign_whose_every_case_fails_exits_3_with_its_summary_and_reasons(
     assert code == 3 and "Traceback" not in err and "KeyError" not in err
     assert "operability: 0.00 % of the scatter's weight within every limit; 100.00 % of it in failed cases" in out
     assert out.splitlines()[-1].startswith("done: 1 cases run now, 0 already done, 1 failed")
-    assert "failed: case 0 (hs 100 m" in err and "Newton" in err
+    assert "failed: case 0 (hs 1000 m" in err and "Newton" in err
 
 
 def test_the_figure_of_a_campaign_with_failures(failing, tmp_path):
@@ -602,7 +603,7 @@ def test_the_figure_of_a_campaign_with_failures(failing, tmp_path):
         assert ax.get_ylim()[0] >= 1e-6 * top                   # not down to round-off
     assert any(f"resolution {w[1] - w[0]:.3g} rad/s" in ax.get_title() for ax in fig.axes)
     sup = fig._suptitle.get_text()
-    assert "Hs 0.3 to 100 m, Tp 7 s" in sup and "(Hs 0.3 m, Tp 7 s)" not in sup
+    assert "Hs 0.3 to 1000 m, Tp 7 s" in sup and "(Hs 0.3 m, Tp 7 s)" not in sup
     r = fig.canvas.get_renderer()
     box = fig._suptitle.get_window_extent(r)
     assert all(not box.overlaps(ax.get_tightbbox(r)) for ax in fig.axes)
