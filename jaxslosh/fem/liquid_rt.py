@@ -35,6 +35,7 @@ import numpy as np
 import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 
+from .face_schur import mixed_operators
 from .mesh import GAUSS8, HEX_CORNERS
 from .slip import HEX_FACES
 
@@ -270,15 +271,8 @@ def face_modes(model: FaceLiquid, n: int = 10) -> FaceModes:
     modes are the pools' uniform pressures). Shift-invert Lanczos about sigma < 0 on that problem:
     (G - sigma W^-1) x = r is the sparse saddle-point system [[M, -B^T], [B, -sigma W^-1]] [w; x] =
     [0; r], factorised once (`_SaddleSolver`); q = w."""
-    f = np.flatnonzero(model.free)
-    M = model.mass[f][:, f].tocsc()
+    f, B, M, winv = mixed_operators(model)
     E, T = len(model.elements), len(model.top)
-    D = sp.coo_matrix((model.signs.reshape(-1), (np.repeat(np.arange(E), 6), model.element_faces.reshape(-1))),
-                      shape=(E, len(model.faces))).tocsr()
-    Tsel = sp.coo_matrix((np.ones(T), (np.arange(T), model.top)), shape=(T, len(model.faces))).tocsr()
-    B = sp.vstack([D, Tsel]).tocsr()[:, f]
-    rho, c, g = model.density, model.sound_speed, model.gravity
-    winv = np.concatenate([model.volume / (rho * c * c), model.top_area / (rho * g)])
     pools = model.pools
     nf, ny = len(f), E + T
     n_ker = nf - (ny - pools)                                       # rank of B is E + T - pools
