@@ -136,15 +136,11 @@ class AbstractTerm(eqx.Module):
         return Unknowns()
 
     def prescribes(self) -> bool:
-        """Whether it prescribes the vessel's rigid motion (static): its `prescribed_rows` are then
-        the vessel's rows of the step (System.hold); a System holds at most one such term."""
+        """Whether it prescribes the vessel's rigid motion (static). Such a term also defines
+        `prescribed_rows(a6, t, scale)`: the vessel's six rows of the step, the constraint on its rigid
+        accelerations a6 at time t (`scale()`: the rows' masses), which System.hold puts in place of
+        the vessel's rows; a System holds at most one such term (vessel.AbstractPrescribedMotion)."""
         return False
-
-    def prescribed_rows(self, a6, t, scale):
-        """The vessel's six rows of a term that `prescribes` its motion: the constraint on its rigid
-        accelerations a6 at time t (`scale()`: the rows' masses, so that a row over its scale is an
-        acceleration error). Never called on a term that prescribes nothing."""
-        raise NotImplementedError(f"{type(self).__name__} prescribes no motion")
 
     def update_inverse(self, inv, c_v):
         """The inverse of the step matrix's deformable block with this term's c_v dR/d(d_dot) added

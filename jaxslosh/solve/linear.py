@@ -102,7 +102,7 @@ def _liquid_solver(system: System, h, scheme: Scheme, tol, max_iter, substeps, r
         step_inv = damped(step_inv, system, scheme, h)
         sub_inv = damped(sub_inv, system, scheme, h / substeps) if substeps else None
         scale = np.asarray(jax.lax.stop_gradient(system.scales()[6:]))
-        rowsum = K if isinstance(K, np.ndarray) else abs(K).sum(axis=1)
+        rowsum = K if isinstance(K, np.ndarray) else abs(K).sum(axis=1)   # face blocks: K is its row sums (never formed)
         noise = np.finfo(np.float64).eps * np.max(np.asarray(rowsum).reshape(-1) / scale)
         return Solver(step_inv, mass_inv, jnp.asarray(h, dtype=float), scheme, tol, max_iter, substeps, sub_inv,
                       noise=noise, reuse=reuse, adaptive=adaptive)
