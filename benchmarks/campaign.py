@@ -1,7 +1,7 @@
 """A campaign on a local Dask cluster against the same cases one by one in one process.
 
     PYTHONPATH=. python benchmarks/campaign.py [--cells 20] [--headings 5] [--seeds 2] [--duration 600]
-        [--workers 2] [--batch 8[,1,...]] [--serial-cases N | --skip-serial] [-o CAMPAIGN.h5]
+        [--workers 2] [--batch 8[,1,...]] [--serial-cases N | --skip-serial] [-o CAMPAIGN.h5 [--resume]]
         [--nonlinear] [--hs 1.0,1.5] [--tp 5,6] [--yaw-damping 0] [--components 50]
 
 Issue 19 item 5: the paper's ship in irregular seas (scenes/paper_ship_waves.toml, its tank reduced
@@ -174,6 +174,9 @@ def main(argv=None):
     p.add_argument("--serial-cases", type=int, help="run this many of the cases one by one (default all)")
     p.add_argument("--skip-serial", action="store_true")
     p.add_argument("-o", "--output", help="keep the campaign file here (with several --batch: NAME_b8.h5, ...)")
+    p.add_argument("--resume", action="store_true",
+                   help="keep the ok cases of an existing -o file and run the others (its wall row then "
+                        "counts only those)")
     p.add_argument("--nonlinear", action="store_true",
                    help='[vessel.hydrostatics] model = "nonlinear" on the box with a depth of 5 m')
     p.add_argument("--hs", help="comma-separated Hs (m) of the scatter's rows (default 0.2,0.4,0.6,0.8)")
@@ -213,7 +216,8 @@ def main(argv=None):
                    else f"{os.path.splitext(a.output)[0]}_b{b}.h5")
             t0 = time.perf_counter()
             r = js.campaign(scene, csv_path, headings=heads, seeds=a.seeds, duration=a.duration, workers=a.workers,
-                            batch=b, output=out, progress=False)
+                            batch=b, output=out, progress=False,
+                            resume=a.resume and bool(a.output))
             wall = time.perf_counter() - t0
             results[b] = r
             capsized = sum(st.startswith("capsized") for st in r.status)
