@@ -203,3 +203,31 @@ def test_uniform_motion_does_not_drive_sloshing():
     r0, r1 = rows(t, Z3), rows(t, jnp.array([3.0, 1.0, -1.0]))
     np.testing.assert_allclose(r1[2], r0[2], rtol=1e-10, atol=1e-9)
     np.testing.assert_allclose(r1[0], r0[0], rtol=1e-10, atol=1e-9)
+
+
+def test_cylinder_turning_about_its_axis_keeps_its_waves_still():
+    """An upright cylinder turning steadily at Omega about its axis leaves its liquid's absolute motion
+    alone (a potential flow has no way to take up the turning): a wave pattern standing still in space
+    turns at -Omega in the tank, so the rows linearised about rest at that rate split each m-th pair
+    of modes to omega_m -+ m Omega, the axisymmetric modes unmoved. This is the second-order coupling
+    of the rotation and the waves (the one that moves a rolling square tank's centre line, in the
+    paper example's probe B)."""
+    t = _cylinder()
+    om = jnp.array([0.0, 0.0, 0.7])
+    z = jnp.zeros(t.n)
+
+    @eqx.filter_jit
+    def lin(t):
+        r = lambda be, bd, bdd: t.rows(Z3, om, be, bd, Z3, Z3, bdd, GB)[2]  # noqa: E731
+        return (r(z, z, z), jax.jacfwd(lambda a: r(z, z, a))(z), jax.jacfwd(lambda a: r(z, a, z))(z),
+                jax.jacfwd(lambda a: r(a, z, z))(z))
+    r0, M, C, K = (np.asarray(a) for a in lin(t))
+    assert np.abs(r0).max() < 1e-9 * np.abs(K).max()          # rest stays rest while it turns
+    n = t.n
+    A = np.block([[np.zeros((n, n)), np.eye(n)], [-np.linalg.solve(M, K), -np.linalg.solve(M, C)]])
+    ev = np.linalg.eigvals(A)
+    assert np.abs(ev.real).max() < 1e-9 * np.abs(ev).max()
+    w = np.asarray(t.omega_linear(G))
+    expect = np.sort([wn + (0.0 if m == 0 else (-m if c == 0 else m) * 0.7) for wn, (m, _, c) in zip(w, t.modes)])
+    got = np.sort(np.abs(ev.imag))[::2]
+    np.testing.assert_allclose(got, expect, rtol=1e-8)
