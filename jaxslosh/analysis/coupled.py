@@ -164,8 +164,9 @@ def penalty_shares(lin: Linearisation, shapes) -> np.ndarray:
     parts = [tb.model.parts.get("rotation") if getattr(tb.model, "parts", None) else None for tb in b.tanks]
     if not pen or k == 0 or any(p is None for p in parts):
         return np.zeros(k)
-    labels = np.asarray(lin.labels)
-    liq = np.flatnonzero(labels == "liquid")
+    lay = b.system.layout()
+    start = lay.n_small                         # the deformable block (vessel-frame structures too: linear.py)
+    liq = np.arange(start, start + lay.nf)
     L = b.system.liquid
     nodal = jax.jit(jax.vmap(lambda d: L.nodal_fields(L.frame_field(d)), in_axes=1))
     D = np.asarray(nodal(jnp.asarray(shapes[liq].real))) + 1j * np.asarray(nodal(jnp.asarray(shapes[liq].imag)))

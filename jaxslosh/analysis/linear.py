@@ -27,6 +27,7 @@ import jax
 import jax.numpy as jnp
 import numpy as np
 
+from ..assemble.effects import structure_unknowns
 from ..assemble.system import Built
 from ..physics.seakeeping import AddedMass
 from ..run.loop import probe_positions
@@ -74,11 +75,14 @@ def rest_scene(scene: Scene) -> Scene:
     return dataclasses.replace(scene, vessel=dataclasses.replace(ves, initial=Initial()))
 
 
-def _labels(b: Built, L: Layout) -> tuple:
+def _labels(b: Built, L: Layout, scene: Scene) -> tuple:
     names = list(DOFS)
     for s in b.structures:
         names += [f"structure {s.name}"] * 6
-    names += ["interface"] * L.n_alg + ["liquid"] * L.nf
+    # the structures in the vessel's frame: their nodal dofs the deformable block's last, in order
+    held = [f"structure {s.name}" for s in scene.structures if s.frame == "vessel"
+            for _ in range(structure_unknowns(s))] if L.nf else []
+    names += ["interface"] * L.n_alg + ["liquid"] * (L.nf - len(held)) + held
     for s in b.structures:
         names += [f"structure {s.name}"] * s.model.Phi.shape[1]
     return tuple(names)
@@ -143,4 +147,4 @@ def linearise(scene: Scene, params=None) -> Linearisation:
     for term in sysm.terms:
         if isinstance(term, AddedMass):
             Ainf = np.asarray(term.matrix)
-    return Linearisation(M, C, K, dynamic, P, b.probes.names, _labels(b, L), Ainf, b)
+    return Linearisation(M, C, K, dynamic, P, b.probes.names, _labels(b, L, scene), Ainf, b)

@@ -17,6 +17,7 @@ from scipy.linalg import block_diag
 
 from ..fem.face_schur import face_schur, mass_bounds
 from ..fem.liquid_rt import ROTATION_PENALTY_RATIO, FaceLiquid, _gauss, _loads, _Mixed, face_modes
+from ..fem.mesh import box_gauss_points
 from ..fem.walls_rt import build_face_tank_with_walls, wall_points
 from ..physics.face_blocks import FaceOps, FaceStiffness
 from ..physics.face_liquid import FluxLiquid
@@ -191,7 +192,7 @@ def traced_depth_blocks(model: FaceLiquid, origin, s, gauss=None):
     return x, w, phys, M, Kac, kappa * 0.5 * (MP + MP.T), kappa * MPc, kappa * (Pc.T @ MPc)
 
 
-def face_full_liquid(tanks, models, scales=None, depths=None, sparse=False):
+def face_full_liquid(tanks, models, scales=None, depths=None, sparse=False, structures=()):
     """The FluxLiquid of every tank (all face-normal, full order), stacked, the (K_dt, K_tt) of the
     absolute-rotation penalty (physics/liquid.py RotationPenalty), and per tank its elastic walls
     (fem/walls.py WallModel) or None. `scales`: per tank None or its (rho, rho c^2, rho g) over its
@@ -199,7 +200,9 @@ def face_full_liquid(tanks, models, scales=None, depths=None, sparse=False):
     free-surface blocks scale with them. `depths`: per tank None or a plain box's fill depth over its
     model's (traced): `traced_depth_blocks`. A tank with elastic walls (fem/walls_rt.py) adds its
     walls' free nodal dofs after its free faces, and its walls' Gauss points after every tank's liquid
-    points; its values are the scene's."""
+    points; its values are the scene's. `structures` (assemble/structures.py HeldStructure, frame =
+    "vessel"): their free nodal dofs after every tank's unknowns, their Gauss points last, as the
+    walls' but with no face's flux tied to them (the dense blocks only)."""
     scales = scales or [None] * len(models)
     depths = depths or [None] * len(models)
     xp = jnp if any(isinstance(v, jax.core.Tracer) for sc in scales if sc for v in sc) \
@@ -213,11 +216,14 @@ def face_full_liquid(tanks, models, scales=None, depths=None, sparse=False):
         sr, sc, sg = fs if fs is not None else (1.0, 1.0, 1.0)
         f = np.flatnonzero(model.free)
         if f.size > MAX_FULL_FACES and not sparse:
+            dense_only = structures or any(u.wall_spec is not None for u in tanks)
+            hint = ("elastic walls and structures in the vessel's frame take the dense blocks only: use a coarser "
+                    "mesh, or set element = \"stabilized\"") if dense_only else \
+                ("leave simulation.linear_solver at \"auto\" (or \"sparse\"), add a [tanks.reduction] table (modes = "
+                 "N), or set element = \"stabilized\"")
             raise SceneError(f"tanks[{i}].fluid.element", f"a full-order \"rt\" tank holds {f.size} free faces on "
                                                           f"this mesh, more than {MAX_FULL_FACES} for the dense "
-                                                          "blocks: leave simulation.linear_solver at \"auto\" (or "
-                                                          "\"sparse\"), add a [tanks.reduction] table (modes = N), or "
-                                                          "set element = \"stabilized\"")
+                                                          f"blocks: {hint}")
         gauss = _gauss(model)
         E, P = gauss[0].shape[:2]
         slot = np.full(len(model.faces), HELD)
@@ -278,6 +284,21 @@ def face_full_liquid(tanks, models, scales=None, depths=None, sparse=False):
         rec_w.append(w_)
         off += f.size if Mf is None else Mf.shape[0]
         node_off += node_slots[-1].shape[0]
+    if structures and sparse:
+        raise ValueError("structures in the vessel's frame take the dense blocks")
+    for hs in structures:               # block-diagonal: no flux of theirs, the liquid meets them through the vessel
+        slot_of = np.full(3 * len(hs.nodes), HELD)
+        slot_of[hs.free] = off + np.arange(hs.free.size)
+        xs, mst, Ns, sls = box_gauss_points(hs.nodes, hs.elements, hs.density, slot_of)
+        none = np.zeros(0, dtype=int)
+        wall_parts.append((none, none, np.zeros(0), xs + hs.origin, mst, Ns, sls))
+        node_slots.append(slot_of.reshape(-1, 3))
+        Ks.append(hs.stiffness)
+        Ms.append(np.kron(hs.mass, np.eye(3))[np.ix_(hs.free, hs.free)])
+        Kdts.append(np.zeros((hs.free.size, 3)))
+        row_scales.append(np.repeat(hs.mass.sum(axis=1), 3)[hs.free])     # its lumped mass per dof
+        off += hs.free.size
+        node_off += len(hs.nodes)
     fix = lambda a: np.where(a == HELD, off, np.where(a <= -2, off + 1 + (-2 - a), a)).astype(np.int32)  # noqa: E731
     slot = fix(np.concatenate(slots))
     if sparse:

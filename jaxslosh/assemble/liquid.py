@@ -14,8 +14,7 @@ from scipy.linalg import block_diag
 
 from ..fem.liquid import build_liquid, surface_bending_scale
 from ..fem.liquid_rt import FaceLiquid, build_face_liquid
-from ..fem.mesh import box_mesh, face_nodes, grid_nodes
-from ..fem.structure import assemble, box_element, centrifugal_stiffness
+from ..fem.mesh import grid_nodes
 from ..fem.walls import build_tank_with_walls, shell_mesh
 from ..physics.liquid import AbstractLiquid, Liquid, NoLiquid
 from ..scene.types import FACE_FORMS, Scene, SceneError
@@ -23,6 +22,7 @@ from ..solve.sparse import SPARSE_AUTO, host_sparse
 from .effects import liquid_unknowns
 from .face_liquid import RT_SPARSE_AUTO, face_full_liquid
 from .reduced import reduce_liquid
+from .structures import held_spin_stiffness, held_structure
 
 
 class LiquidBlock(NamedTuple):
@@ -30,7 +30,8 @@ class LiquidBlock(NamedTuple):
     liquid: AbstractLiquid
     tanks: tuple = ()                   # TankBlock per tank
     penalty: Optional[tuple] = None     # (K_dt, K_tt) of the stabilized element's rotation penalty
-    Kg: Optional[jax.Array] = None      # (6, nf, nf) centrifugal stiffening of vessel-frame structures
+    Kg: Optional[jax.Array] = None      # (6, n, n) centrifugal stiffening of vessel-frame structures
+    Kg_offset: int = 0                  # on the unknowns Kg_offset ... (the structures', after the liquid's)
     vstructs: tuple = ()                # VesselFrameStructure per structure in the vessel's frame
     carried: tuple = ()                 # rigid_part of the elastic walls and vessel-frame structures
 
@@ -83,19 +84,20 @@ def build_liquid_block(scene: Scene, params: Optional[dict] = None, gravity=None
     reduced = [t.reduction is not None for t in rigid]
     elastic = [t.wall_spec is not None for t in rigid]
     faces = bool(models) and all(isinstance(m, FaceLiquid) for m in models)
-    if any(elastic) and faces and not in_vessel_frame:     # "rt" in elastic walls: fem/walls_rt.py, full order
+    if (any(elastic) or in_vessel_frame) and faces:     # "rt": fem/walls_rt.py, assemble/face_liquid.py, full order
         for i, t in enumerate(rigid):
             if reduced[i]:
                 raise SceneError(f"tanks[{i}].walls" if elastic[i] else f"tanks[{i}].reduction",
-                                 "elastic walls need the full-order liquid (no [tanks.reduction] in any tank)")
+                                 "elastic walls, and structures in the vessel's frame, need the full-order liquid "
+                                 "(no [tanks.reduction] in any tank)")
     elif any(elastic) or in_vessel_frame:
         for i, t in enumerate(rigid):
             if isinstance(models[i], FaceLiquid):
+                other = next(m.element for m in models if not isinstance(m, FaceLiquid))
                 raise SceneError(f"tanks[{i}].fluid.element",
-                                 f"{t.fluid.element!r} does not take structures in the vessel's frame yet, nor elastic "
-                                 "walls beside a nodal tank; use \"stabilized\"" if in_vessel_frame or not elastic[i]
-                                 else f"{t.fluid.element!r} in elastic walls goes with other \"rt\" tanks only; "
-                                      "give every tank the same element")
+                                 f"{t.fluid.element!r} takes elastic walls and structures in the vessel's frame only "
+                                 f"when every tank is \"rt\" (another tank's is {other!r}): give every tank the "
+                                 "same element")
             if models[i].frames is not None:
                 raise SceneError(f"tanks[{i}].shape", "structures in the vessel's frame go with box tanks (and "
                                                       "shapes whose walls are all along the axes) only")
@@ -112,7 +114,8 @@ def build_liquid_block(scene: Scene, params: Optional[dict] = None, gravity=None
         depths = [params.get(f"tanks.{t.name}.fill_depth", t.fill_depth) / t.fill_depth
                   if isinstance(m, FaceLiquid) and isinstance(params.get(f"tanks.{t.name}.fill_depth"), jax.core.Tracer)
                   else None for t, m in zip(rigid, models)]
-        return _face_full(rigid, models, scales, depths, face_sparse(scene, models, scales, depths))
+        return _face_full(rigid, models, scales, depths, face_sparse(scene, models, scales, depths),
+                          [held_structure(st) for st in in_vessel_frame])
 
     blocks, rs, Ms_list, K_list, free_list, Kdt_list, Ktt = [], [], [], [], [], [], xp.zeros((3, 3))
     coupled = False
@@ -178,7 +181,7 @@ def _liquid_with_walls(tanks, models, structures=()):
     (fem/walls.py) or some structure has frame = "vessel": every tank's nodes (liquid, then its
     walls'), then those structures' nodes; the map from nodal dofs to unknowns (held ones map to the
     zero slot); the matrices on the unknowns; and the structures' centrifugal stiffness."""
-    blocks, rs, Ms_list, K_list, maps, reps, Kdt_list, Kg_parts = [], [], [], [], [], [], [], []
+    blocks, rs, Ms_list, K_list, maps, reps, Kdt_list = [], [], [], [], [], [], []
     carried_idx = []      # (block index, first carried node): elastic walls and vessel-frame structures
     coupled = False
     Ktt = np.zeros((3, 3))
@@ -209,48 +212,33 @@ def _liquid_with_walls(tanks, models, structures=()):
             Kdt_list.append(np.zeros((rep.size, 3)))
         node_off += nodes.shape[0]
         free_off += rep.size
-    vstructs = []
-    for st in structures:
-        mat = st.material
-        nodes, elements = box_mesh(st.size, st.mesh)
-        hs = tuple(a / n for a, n in zip(st.size, st.mesh))
-        Ke, Mse = box_element(*hs, mat.young, mat.poisson, mat.density)
-        Kfull, Ms = assemble(nodes, elements, Ke, Mse)
-        held = np.zeros(nodes.shape[0], dtype=bool)
-        held[face_nodes(nodes, st.size, st.attach)] = True
-        fr = ~np.repeat(held, 3)
+    vstructs, held = [], [held_structure(st) for st in structures]
+    first_held = free_off
+    for hs in held:
+        nodes = hs.nodes
+        fr = np.zeros(3 * nodes.shape[0], dtype=bool)
+        fr[hs.free] = True
         dmap = np.where(fr, np.cumsum(fr) - 1, -1)
-        rep = np.flatnonzero(fr)
-        if st.stiffening == "centrifugal":     # spin about axes through the vessel's COG
-            sizes = np.tile(np.asarray(hs), (elements.shape[0], 1))
-            Kg = centrifugal_stiffness(nodes, elements, sizes, Kfull, Ms, held, mat.young, mat.poisson,
-                                       axis_point=-np.asarray(st.origin, dtype=float))
-            Kg_parts.append((free_off, [k[np.ix_(rep, rep)] for k in Kg]))
-        vstructs.append(VesselFrameStructure(st.name, node_off, nodes, elements))
+        vstructs.append(VesselFrameStructure(hs.name, node_off, nodes, hs.elements))
         carried_idx.append((len(rs), 0))
-        rs.append(nodes + np.asarray(st.origin)[None, :])
-        Ms_list.append(Ms)
-        K_list.append(Kfull[np.ix_(rep, rep)])
+        rs.append(nodes + hs.origin[None, :])
+        Ms_list.append(hs.mass)
+        K_list.append(hs.stiffness)
         maps.append(np.where(dmap >= 0, dmap + free_off, -1))
-        reps.append(rep + 3 * node_off)
-        Kdt_list.append(np.zeros((rep.size, 3)))
+        reps.append(hs.free + 3 * node_off)
+        Kdt_list.append(np.zeros((hs.free.size, 3)))
         node_off += nodes.shape[0]
-        free_off += rep.size
+        free_off += hs.free.size
     dof_map = np.concatenate(maps)
     dof_map = np.where(dof_map >= 0, dof_map, free_off)          # the zero slot after the unknowns
-    Kg = None
-    if Kg_parts:
-        Kg = np.zeros((6, free_off, free_off))
-        for off, parts in Kg_parts:
-            n = parts[0].shape[0]
-            for k in range(6):
-                Kg[k, off:off + n, off:off + n] = parts[k]
+    Kg = held_spin_stiffness(held)
     liquid = Liquid(r=jnp.asarray(np.concatenate(rs)), Ms=jnp.asarray(block_diag(*Ms_list)),
                     K=jnp.asarray(block_diag(*K_list)), free=jnp.asarray(np.concatenate(reps)), n_nodes=node_off,
                     dof_map=jnp.asarray(dof_map))
     carried = tuple(rigid_part(Ms_list[k], rs[k][n0:], n0) for k, n0 in carried_idx)
     penalty = (jnp.asarray(np.concatenate(Kdt_list)), jnp.asarray(Ktt)) if coupled else None
-    return LiquidBlock(liquid, tuple(blocks), penalty, None if Kg is None else jnp.asarray(Kg), tuple(vstructs), carried)
+    return LiquidBlock(liquid, tuple(blocks), penalty, Kg=None if Kg is None else jnp.asarray(Kg), Kg_offset=first_held,
+                       vstructs=tuple(vstructs), carried=carried)
 
 
 def rigid_part(Ms, r, n0=0):
@@ -306,8 +294,8 @@ def face_sparse(scene, models, scales, depths) -> bool:
     speed, gravity or fill depth from params, traced or not: the dense blocks scale with them), and
     `simulation.linear_solver` "sparse" or "sparse-host", or "auto" above RT_SPARSE_AUTO free faces."""
     values = [v for sc in scales if sc for v in sc]
-    if any(t.wall_spec is not None for t in scene.tanks):     # elastic walls: their dense blocks
-        return False
+    if any(t.wall_spec is not None for t in scene.tanks) or any(s.frame == "vessel" for s in scene.structures):
+        return False                    # elastic walls, structures in the vessel's frame: their dense blocks
     if any(isinstance(v, jax.core.Tracer) for v in values) or any(d is not None for d in depths) \
             or any(abs(float(np.asarray(v)) - 1.0) > 1e-12 for v in values):    # blocks at the scene's values
         return False
@@ -316,21 +304,37 @@ def face_sparse(scene, models, scales, depths) -> bool:
     return choice in ("sparse", "sparse-host") or (choice == "auto" and faces > RT_SPARSE_AUTO)
 
 
-def _face_full(tanks, models, scales, depths=None, sparse=False):
-    """Face-normal tanks at full order (assemble/face_liquid.py): every tank's, none of the nodal ones."""
+def _face_full(tanks, models, scales, depths=None, sparse=False, structures=()):
+    """Face-normal tanks at full order (assemble/face_liquid.py): every tank's, none of the nodal ones;
+    then the structures in the vessel's frame (assemble/structures.py HeldStructure), their nodal
+    dofs after every tank's unknowns."""
     for i, m in enumerate(models):
         if not isinstance(m, FaceLiquid):
             raise SceneError(f"tanks[{i}].fluid.element", "a full-order \"rt\" tank goes with other \"rt\" tanks "
                                                           "only: give this one element = \"rt\" too, or give every "
                                                           "tank a [tanks.reduction] table")
+        traced = any(isinstance(v, jax.core.Tracer) for v in (scales[i] or ())) or (depths or [None] * len(models))[i] \
+            is not None
+        if structures and traced:
+            raise SceneError(f"tanks[{i}]", "structures in the vessel's frame need the liquid with the scene's own "
+                                            "values (no traced fill depth, density, sound speed or gravity in params "
+                                            "or a sweep)")
     blocks, offset = [], 0
     for t, m in zip(tanks, models):
         blocks.append(_host_block(t, m, offset))
         offset += m.n_nodes + (0 if t.wall_spec is None else wall_node_count(t))    # a tank's walls follow its liquid
-    liquid, penalty, walls = face_full_liquid(tanks, models, scales, depths, sparse)
+    liquid, penalty, walls = face_full_liquid(tanks, models, scales, depths, sparse, structures)
     carried = tuple(rigid_part(w.mass, w.nodes + np.asarray(t.origin)[None, :]) for t, w in zip(tanks, walls)
                     if w is not None)           # the walls are part of the ship's mass (SPEC)
-    return LiquidBlock(liquid, tuple(blocks), penalty, carried=carried)
+    vstructs = []
+    for hs in structures:                       # after every tank's nodes, in the stacked nodal fields
+        vstructs.append(VesselFrameStructure(hs.name, offset, hs.nodes, hs.elements))
+        carried += (rigid_part(hs.mass, hs.nodes + hs.origin[None, :]),)
+        offset += hs.nodes.shape[0]
+    Kg = held_spin_stiffness(structures)
+    n_held = sum(hs.free.size for hs in structures)
+    return LiquidBlock(liquid, tuple(blocks), penalty, Kg=None if Kg is None else jnp.asarray(Kg),
+                       Kg_offset=liquid.nf - n_held, vstructs=tuple(vstructs), carried=carried)
 
 
 def _host_block(t, m, offset) -> TankBlock:

@@ -2,13 +2,13 @@
 tied at its `attach` face to an interface frame that the vessel (or another structure) is tied to."""
 from __future__ import annotations
 
-from typing import NamedTuple
+from typing import NamedTuple, Optional
 
 import jax.numpy as jnp
 import numpy as np
 
-from ..fem.mesh import face_nodes
-from ..fem.structure import build_structure, centrifugal_stiffness
+from ..fem.mesh import box_mesh, face_nodes
+from ..fem.structure import assemble, box_element, build_structure, centrifugal_stiffness
 from ..physics.structures import Body, Interface, Side, Structures
 from ..scene.types import Scene
 
@@ -62,3 +62,57 @@ def build_structures(scene: Scene):
         interfaces.append(Interface(sides=(other, Side(i, jnp.asarray(nodes), jnp.asarray(points))),
                                     m_ref=jnp.asarray(m_ref), L_ref=L_ref))
     return Structures(bodies=tuple(bodies), interfaces=tuple(interfaces)), tuple(blocks)
+
+
+class HeldStructure(NamedTuple):
+    """A structure with frame = "vessel" as the vessel-frame block takes it (the nodal liquid's
+    assemble/liquid.py, the face-normal one's assemble/face_liquid.py): its deformation in the
+    vessel's frame on its nodal dofs, the attachment face held."""
+    name: str
+    origin: np.ndarray      # (3,) its min corner in the vessel frame
+    nodes: np.ndarray       # (N, 3) block-local, from its min corner
+    elements: np.ndarray    # (E, 8)
+    mass: np.ndarray        # (N, N) scalar consistent mass
+    stiffness: np.ndarray   # (n, n) on the free dofs
+    free: np.ndarray        # (n,) the free dofs' indices in its node-major 3 N vector
+    density: float
+    Kg: Optional[list] = None   # 6 (n, n) centrifugal stiffness parts (stiffening = "centrifugal")
+
+
+def held_structure(st) -> HeldStructure:
+    """The hexahedra of a structure in the vessel's frame, held at its `attach` face; with
+    `stiffening = "centrifugal"` the geometric stiffness of a spin about axes through the vessel's
+    COG (fem/structure.py centrifugal_stiffness)."""
+    mat = st.material
+    nodes, elements = box_mesh(st.size, st.mesh)
+    hs = tuple(a / n for a, n in zip(st.size, st.mesh))
+    Ke, Mse = box_element(*hs, mat.young, mat.poisson, mat.density)
+    Kfull, Ms = assemble(nodes, elements, Ke, Mse)
+    held = np.zeros(nodes.shape[0], dtype=bool)
+    held[face_nodes(nodes, st.size, st.attach)] = True
+    free = np.flatnonzero(~np.repeat(held, 3))
+    Kg = None
+    if st.stiffening == "centrifugal":
+        sizes = np.tile(np.asarray(hs), (elements.shape[0], 1))
+        Kg = [k[np.ix_(free, free)] for k in centrifugal_stiffness(nodes, elements, sizes, Kfull, Ms, held, mat.young,
+                                                                    mat.poisson, axis_point=-np.asarray(st.origin,
+                                                                                                        dtype=float))]
+    return HeldStructure(st.name, np.asarray(st.origin, dtype=float), nodes, elements, Ms, Kfull[np.ix_(free, free)],
+                         free, float(mat.density), Kg)
+
+
+def held_spin_stiffness(parts) -> Optional[np.ndarray]:
+    """(6, n, n) the centrifugal stiffness of the held structures `parts` (stacked in order, their
+    free dofs last among the unknowns), zero for those without; None when none has it."""
+    if all(p.Kg is None for p in parts):
+        return None
+    n = sum(p.free.size for p in parts)
+    Kg = np.zeros((6, n, n))
+    off = 0
+    for p in parts:
+        k = p.free.size
+        if p.Kg is not None:
+            for c in range(6):
+                Kg[c, off:off + k, off:off + k] = p.Kg[c]
+        off += k
+    return Kg

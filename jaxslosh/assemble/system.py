@@ -179,7 +179,8 @@ def _model(scene: Scene, params: dict, outline: bool = False) -> _Model:
     if block.penalty is not None:
         terms.append(RotationPenalty(Kdt=block.penalty[0], Ktt=block.penalty[1], q_ref=q0))
     if block.Kg is not None:
-        terms.append(SpinStiffening(None if outline else block.Kg, about=stiffening_about(scene, "vessel")))
+        terms.append(SpinStiffening(None if outline else block.Kg, about=stiffening_about(scene, "vessel"),
+                                    offset=block.Kg_offset))
     if structures is not None:
         terms.append(structures)
     damping = None

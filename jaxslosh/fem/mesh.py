@@ -67,3 +67,17 @@ def face_nodes(nodes, size, face: str, tol=1e-9) -> np.ndarray:
 def count_nodes(mesh) -> int:
     nx, ny, nz = mesh
     return (nx + 1) * (ny + 1) * (nz + 1)
+
+
+def box_gauss_points(nodes, elements, density, slot_of):
+    """Box hexahedra as particles at their 2 x 2 x 2 Gauss points, which carry their consistent
+    (trilinear) mass exactly: (x (G, 3), m (G,), N (G, 8) the corners' shape values, slots (G, 8, 3)
+    the unknown of each corner dof, `slot_of` (3 N,) by node-major dof)."""
+    X = nodes[elements]                                                   # (E, 8, 3) boxes
+    h = X.max(axis=1) - X.min(axis=1)
+    N = np.prod(1.0 + HEX_CORNERS[None] * GAUSS8[:, None, :], axis=2) / 8.0       # (P, 8)
+    x = np.einsum("pa,eai->epi", N, X).reshape(-1, 3)
+    m = np.repeat(density * np.prod(h, axis=1) / 8.0, 8)
+    dofs = 3 * elements[:, :, None] + np.arange(3)                        # (E, 8, 3)
+    slots = np.repeat(np.asarray(slot_of)[dofs][:, None], 8, axis=1).reshape(-1, 8, 3)
+    return x, m, np.tile(N, (len(X), 1)), slots

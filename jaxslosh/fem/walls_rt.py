@@ -32,7 +32,7 @@ import scipy.linalg as sl
 import scipy.sparse as sp
 
 from .liquid_rt import ROTATION_PENALTY_RATIO, FaceLiquid, _gauss, _loads, _Mixed, face_modes
-from .mesh import GAUSS8, HEX_CORNERS
+from .mesh import box_gauss_points
 from .modes import Modes
 from .walls import WallModel, build_walls
 
@@ -181,17 +181,11 @@ def wall_points(walls: WallModel, wall_dofs, offset: int, zero_slot: int):
     """The walls as particles at their elements' 2 x 2 x 2 Gauss points (their consistent mass
     exactly): (x (G, 3) tank-local, m (G,), N (G, 8) the corners' shape values, slots (G, 8, 3) each
     corner dof's unknown, offset + its index among the free wall dofs, or zero_slot where held)."""
-    X = walls.nodes[walls.elements]                                       # (E, 8, 3) boxes
-    h = X.max(axis=1) - X.min(axis=1)
-    N = np.prod(1.0 + HEX_CORNERS[None] * GAUSS8[:, None, :], axis=2) / 8.0       # (P, 8)
-    x = np.einsum("pa,eai->epi", N, X).reshape(-1, 3)
-    rho = float(walls.total_mass / np.prod(h, axis=1).sum())             # the walls' density
-    m = np.repeat(rho * np.prod(h, axis=1) / 8.0, 8)
+    X = walls.nodes[walls.elements]
+    rho = float(walls.total_mass / np.prod(X.max(axis=1) - X.min(axis=1), axis=1).sum())    # the walls' density
     slot_of = np.full(3 * len(walls.nodes), zero_slot)
     slot_of[wall_dofs] = offset + np.arange(len(wall_dofs))
-    dofs = 3 * walls.elements[:, :, None] + np.arange(3)                  # (E, 8, 3)
-    slots = np.repeat(slot_of[dofs][:, None], 8, axis=1).reshape(-1, 8, 3)
-    return x, m, np.tile(N, (len(X), 1)), slots
+    return box_gauss_points(walls.nodes, walls.elements, rho, slot_of)
 
 
 def face_tank_modes(tw: FaceTankWithWalls, n: int = 10) -> Modes:

@@ -27,6 +27,10 @@ face's flux is a fixed combination of them (`wall_rows`, `wall_cols`, `wall_coef
 triplets), and the walls are particles too, at their elements' Gauss points (`n_liquid_points`
 splits r and m), each moving with the trilinear interpolation of its element's nodal unknowns.
 Their nodes follow each tank's liquid nodes in the nodal fields.
+
+Structures in the vessel's frame (assemble/structures.py HeldStructure) take the same road without
+the faces: their free nodal dofs are unknowns after every tank's, their Gauss points particles
+after the walls', and no face's flux is tied to them. Their nodes come last in the nodal fields.
 """
 from __future__ import annotations
 
@@ -61,9 +65,10 @@ class FluxLiquid(AbstractLiquid):
     Minv: Any = None
     start: Any = None
     sparse: bool = eqx.field(static=True, default=False)
-    # elastic walls (None without): the wall faces' fluxes qw = segment_sum(coef * d[cols], rows), held
-    # in slots nf + 1 + j of the liquid points' gathers; the wall points' shape values (Gw, 8) and
-    # their corners' unknowns (Gw, 8, 3); each node's own unknown (n_nodes, 3) (nf: a liquid node)
+    # elastic walls and structures in the vessel's frame (None without): the wall faces' fluxes
+    # qw = segment_sum(coef * d[cols], rows), held in slots nf + 1 + j of the liquid points' gathers;
+    # the wall (and structure) points' shape values (Gw, 8) and their corners' unknowns (Gw, 8, 3);
+    # each node's own unknown (n_nodes, 3) (nf: a liquid node or a held one)
     wall_rows: Optional[jax.Array] = None
     wall_cols: Optional[jax.Array] = None
     wall_coef: Optional[jax.Array] = None

@@ -310,13 +310,19 @@ class RotationPenalty(AbstractTerm):
 class SpinStiffening(AbstractTerm):
     """Structures in the vessel's frame with centrifugal stiffening: the geometric stiffness of the
     stress the spin causes, K_G(omega) = sum_k (omega omega^T)_k K_k (fem/structure.py). It follows
-    the current spin, so it has no potential of its own."""
-    Kg: jax.Array         # (6, nf, nf)
+    the current spin, so it has no potential of its own. The structures' unknowns are the block's
+    last ones, from `offset` on (the liquid's come first)."""
+    Kg: jax.Array         # (6, n, n) on the unknowns offset ... offset + n
     about: About = eqx.field(static=True, default=About())     # the stiffened structures
+    offset: int = eqx.field(static=True, default=0)
 
     def rows(self, k: Kin) -> Rows:
         W = jnp.stack(spin_tensor_components(k.omega))
-        return Rows(jnp.zeros(6), jnp.einsum("k,kij,j->i", W, self.Kg, k.c.d))
+        d = k.c.d
+        n = self.Kg.shape[1]
+        f = jnp.einsum("k,kij,j->i", W, self.Kg, d[self.offset:self.offset + n])
+        return Rows(jnp.zeros(6), jnp.concatenate([jnp.zeros(self.offset, d.dtype), f,
+                                                   jnp.zeros(d.shape[0] - self.offset - n, d.dtype)]))
 
     def describe(self) -> tuple:
         return self.about.lines
