@@ -11,17 +11,31 @@ the measured crests rise about 1.5 times as high as the troughs fall; the multim
 that asymmetry. It does not reproduce the measured heights within 10 % at the forcing as documented
 (benchmarks/sloshing_experiments.py), and neither does the fully nonlinear potential flow, which the
 multimodal tank follows: already in the first half-period, where the motion is still linear, the
-documented forcing gives a trough 30 % deeper than the measured one."""
+documented forcing gives a trough 30 % deeper than the measured one.
+
+The rig's start-up is not published. Identified on the first half-period alone (t < 0.8 s, least
+squares of linear theory), a start with a delay reproduces that half-period but puts the later beats
+out of phase; the later record is in phase with a clean harmonic start from rest, whose one unknown is
+then the amplitude. With it, linear theory is itself within 15 % rms, and no amplitude brings the
+multimodal tank within 10 % of the scored record: the issue's target is not reachable with this
+record (benchmarks/sloshing_experiments.py prints the numbers)."""
 from functools import lru_cache
 from pathlib import Path
 
 import numpy as np
+import pytest
 
 import jaxslosh as js
 from hos_sloshing import hos_tank
+from scipy.optimize import minimize
+from scipy.signal import fftconvolve
 
 ROOT = Path(__file__).resolve().parents[2]
 L, H, G, A, W, X = 1.73, 0.6, 9.81, 0.032, 2 * np.pi / 1.3, 0.05
+EARLY = 0.8                 # the first half-period (the first trough, linear): the fit window
+#: the batch of clean harmonic starts run with the multimodal tank: the documented amplitude and three
+#: around the one that the first trough gives (24.5 mm)
+AMPLITUDES = (0.032, 0.0235, 0.0245, 0.0255)
 
 
 def _measured():
@@ -51,6 +65,38 @@ def _multimodal_first_beat():
     r = js.simulate(js.load_scene(text))
     assert r.status == "ok"
     return np.asarray(r.time), np.asarray(r.probes["wall"].displacement)[:, 2]
+
+
+def _multimodal_runs():
+    """The scene's multimodal tank over the record (10 s) at each of AMPLITUDES, one batch:
+    (t, elevations at the probe, one row per amplitude)."""
+    scene = js.load_scene(ROOT / "scenes" / "sloshing_experiment.toml")
+    result, status = js.simulate_batch(scene, {"vessel.forced.amplitude": np.array(AMPLITUDES)})
+    assert list(status) == ["ok"] * len(AMPLITUDES)
+    t = np.asarray(result.time)
+    t = t[0] if t.ndim == 2 else t
+    return t, np.asarray(result.probes["wall"].displacement)[..., 2]
+
+
+def _linear_response(acceleration, t):
+    """Linear theory for any surge acceleration a (sampled on the even grid t from 0, the liquid at rest
+    at t = 0): beta_n'' + w_n^2 beta_n = -F_n a / (A W^2) by convolution with sin(w_n t) / w_n, with
+    _linear's modes."""
+    n = np.arange(1, 61)
+    k = n * np.pi / L
+    wn = np.sqrt(G * k * np.tanh(k * H))
+    gain = ((-1.0) ** n - 1.0) / k ** 2 / (0.5 * L / (k * np.tanh(k * H)))
+    dt = t[1] - t[0]
+    # the trapezoidal rule (the end at t carries sin 0 = 0, the one at 0 half its weight)
+    beta = np.array([(fftconvolve(acceleration, np.sin(w * t))[:t.size] - 0.5 * acceleration[0] * np.sin(w * t)) / w
+                     for w in wn]) * dt
+    return np.cos(k * X) @ (-gain[:, None] * beta)
+
+
+def _scored_rms(t, z, tm, zm):
+    """rms difference from the measurement over the scored window (t >= EARLY) over the measured maximum."""
+    late = tm >= EARLY
+    return np.sqrt(np.mean((np.interp(tm[late], t, z) - zm[late]) ** 2)) / zm.max()
 
 
 def test_linear_theory_misses_the_measured_elevation():
@@ -102,3 +148,59 @@ def test_documented_forcing_misses_the_linear_first_half_period():
     multimodal, linear, measured = z[early].min(), _linear(t[early]).min(), zm[tm < 0.8].min()
     assert abs(multimodal / linear - 1) < 0.02, (multimodal, linear)
     assert multimodal < 1.25 * measured and linear < 1.25 * measured, (multimodal, linear, measured)
+
+
+def test_linear_response_is_the_closed_form():
+    """The convolution of _linear_response against _linear's closed form, the documented start: within
+    0.05 mm over 10 s (so the identifications below use linear theory itself)."""
+    t = np.arange(0.0, 10.0, 0.002)
+    z = _linear_response(-A * W ** 2 * np.cos(W * t), t)
+    assert np.max(np.abs(z - _linear(t))) < 5e-5
+
+
+def test_a_start_identified_on_the_first_half_period_puts_the_beats_out_of_phase():
+    """An amplitude and a delay (the tank at rest until the delay), least squares of linear theory over the
+    first half-period: it reproduces that half-period within 3 % rms of the measured maximum (the
+    documented start: 12 %), but over the rest of the record linear theory is then off by more than
+    20 % (the documented start: 17 %); the measured beats are in phase with a start at t = 0."""
+    tm, zm = _measured()
+    t = np.arange(0.0, 10.0, 0.004)
+    early = tm < EARLY
+
+    def response(p):
+        return _linear_response(np.where(t >= p[1], -p[0] * W ** 2 * np.cos(W * (t - p[1])), 0.0), t)
+
+    def misfit(p):
+        return np.sqrt(np.mean((np.interp(tm[early], t, response(p)) - zm[early]) ** 2)) / zm.max()
+    fit = minimize(misfit, [0.025, 0.05], method="Nelder-Mead")
+    assert fit.fun < 0.03 and misfit([A, 0.0]) > 0.10, (fit.x, fit.fun)
+    assert 0.05 < fit.x[1] < 0.15, fit.x
+    assert _scored_rms(t, response(fit.x), tm, zm) > 0.20
+    assert 0.15 < _scored_rms(t, response([A, 0.0]), tm, zm) < 0.20
+
+
+def test_with_the_amplitude_identified_linear_theory_is_within_15_percent():
+    """The clean start from rest at the amplitude that makes the first trough the measured one (24.5 mm):
+    linear theory is within 15 % rms of the measured maximum over the scored record (0.8 to 9.9 s), so
+    the target's premise (linear theory off by more than 15 %) holds only at the documented forcing."""
+    tm, zm = _measured()
+    t = np.arange(0.0, 10.0, 0.002)
+    zl = _linear(t)
+    amplitude = A * zm[tm < EARLY].min() / zl[t < EARLY].min()
+    assert abs(amplitude - 0.0245) < 0.0005, amplitude
+    assert _scored_rms(t, amplitude / A * zl, tm, zm) < 0.15
+    assert _scored_rms(t, zl, tm, zm) > 0.15
+
+
+@pytest.mark.slow
+def test_no_clean_start_brings_the_multimodal_tank_within_10_percent():
+    """The multimodal tank over the scored record (0.8 to 9.9 s): 18 % rms of the measured maximum at the
+    documented 32 mm, 11 % at the 24.5 mm of the first trough, and more than 10 % at 23.5 and 25.5 mm
+    on either side (the rms is least near 24.5 mm: the floor of a clean harmonic start, chosen even on
+    the scored window itself, is above the target)."""
+    tm, zm = _measured()
+    t, z = _multimodal_runs()
+    rms = [_scored_rms(t, zi, tm, zm) for zi in z]
+    assert rms[0] > 0.15, rms
+    assert rms[2] < 0.12 and min(rms[1:]) > 0.10, rms
+    assert rms[2] <= min(rms[1], rms[3]), rms
