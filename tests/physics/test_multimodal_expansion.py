@@ -13,7 +13,9 @@ import jaxslosh as js
 from jaxslosh.physics.multimodal import modal_tank
 from jaxslosh.physics.multimodal_expansion import third_order
 from jaxslosh.physics.multimodal3d import cylinder_tank
-from test_multimodal_tank import FORCED, FREE
+from test_multimodal3d_tank import BOX, _transfer
+from test_multimodal3d_tank import FORCED as FORCED_3D
+from test_multimodal_tank import FORCED, FREE, _amplitude
 
 G = 9.81
 Z3 = jnp.zeros(3)
@@ -121,6 +123,18 @@ def test_small_amplitude_frequencies_are_linear_theory(make):
     np.testing.assert_allclose(w, np.sort(np.asarray(t.omega_linear(G))), rtol=1e-9)
 
 
+@pytest.mark.slow      # the three-dimensional coefficients' program and the scene's: a minute of CPU
+def test_three_dimensional_box_in_a_scene_is_linear_theory_at_small_amplitude():
+    """A `flow = "3d"` box on its third-order system, 1 mm of surge: the steady elevation at the wall
+    on the surge axis is linear theory's (within 1 %, as the exact tank's test asks)."""
+    w = 4.0
+    text = FORCED_3D.format(duration=7.0, dt=0.04, amplitude=0.001, w=w, ratio=0.4, shape=BOX)
+    r = js.simulate(js.load_scene(text.replace("modes = 5", 'modes = 5\nexpansion = "third-order"')))
+    assert r.status == "ok"
+    t, z = np.asarray(r.time), np.asarray(r.probes["wall"].displacement)[:, 2]
+    assert _amplitude(t, z, w, 4.5) == pytest.approx(0.001 * _transfer(BOX, w, 0.4), rel=1e-2)
+
+
 def _wall(text, expansion):
     r = js.simulate(js.load_scene(text.replace("modes = 5", f'modes = 5\nexpansion = "{expansion}"')))
     assert r.status == "ok"
@@ -156,3 +170,14 @@ def test_gradient_through_a_run_matches_finite_differences():
     fd = (float(f(h + eps)) - float(f(h - eps))) / (2 * eps)
     assert g == pytest.approx(fd, rel=1e-4, abs=1e-9)
     assert abs(g) > 1e-4
+
+
+def test_expansion_key():
+    """`expansion` is read for multimodal tanks only, "exact" by default, and a wrong value names the key."""
+    base = FORCED.format(duration=1.0, amplitude=0.001, w=4.0, ratio=0.1)
+    assert js.load_scene(base).tanks[0].expansion == "exact"
+    with pytest.raises(js.SceneError, match=r"tanks\[0\]\.expansion"):
+        js.load_scene(base.replace("modes = 5", 'modes = 5\nexpansion = "second-order"'))
+    fem = base.replace('model = "multimodal"\nmodes = 5', 'expansion = "third-order"')
+    with pytest.raises(js.SceneError, match=r"tanks\[0\]\.expansion"):
+        js.load_scene(fem)
