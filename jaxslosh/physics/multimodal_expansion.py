@@ -31,12 +31,9 @@ import jax
 import jax.numpy as jnp
 
 
-# one program run once per tank: compiled without XLA's costly optimisations (it halves the compile)
-@functools.partial(jax.jit, compiler_options={"xla_backend_optimization_level": 0,
-                                               "xla_llvm_disable_expensive_passes": True})
 def _coefficients(tank):
     """(M0, M1, M2, S0, S1, S2): the Taylor coefficients of M(beta) and S(beta) at beta = 0 (M2 and
-    S2 half the Hessians, symmetric in their last two indices), in one compiled program."""
+    S2 half the Hessians, symmetric in their last two indices)."""
     z = jnp.zeros(tank.n)
     M = tank.mass_matrix
     M1 = jax.jacfwd(M)(z)
@@ -45,6 +42,12 @@ def _coefficients(tank):
     S2 = 0.5 * jax.jacfwd(jax.jacfwd(S))(z)
     sym = lambda a: 0.5 * (a + jnp.swapaxes(a, -1, -2))  # noqa: E731
     return M(z), M1, sym(M2), S(z), jax.jacfwd(S)(z), sym(S2)
+
+
+# a concrete tank's coefficients: one program, run once, compiled without XLA's costly optimisations
+# (it halves the compile); a traced tank's (traced `params`) are part of the caller's program
+_compiled_coefficients = functools.partial(jax.jit, compiler_options={
+    "xla_backend_optimization_level": 0, "xla_llvm_disable_expensive_passes": True})(_coefficients)
 
 
 class ExpandedTank(eqx.Module):
@@ -119,4 +122,5 @@ class ExpandedTank(eqx.Module):
 
 def third_order(tank) -> ExpandedTank:
     """The tank on its third-order system (module docstring)."""
-    return ExpandedTank(tank, *_coefficients(tank))
+    traced = any(isinstance(x, jax.core.Tracer) for x in jax.tree_util.tree_leaves(tank))
+    return ExpandedTank(tank, *(_coefficients if traced else _compiled_coefficients)(tank))
