@@ -29,6 +29,8 @@ VARIANTS = {
     "fem (5x5x5)": lambda t: t,
     "fem, 20 modes": lambda t: t.replace('walls = "rigid"', 'walls = "rigid"\n[tanks.reduction]\nmodes = 20'),
     "multimodal, 6 modes": lambda t: t.replace('mesh = [5, 5, 5]\nwalls = "rigid"', 'model = "multimodal"\nmodes = 6'),
+    "multimodal, 6 modes, third-order": lambda t: t.replace('mesh = [5, 5, 5]\nwalls = "rigid"',
+                                                            'model = "multimodal"\nmodes = 6\nexpansion = "third-order"'),
 }
 REFERENCE = "fem, 20 modes"
 

@@ -41,8 +41,9 @@ def tank_line(t) -> tuple[str, str]:
     """One tank's liquid, as the liquid term holds it."""
     if t.model == "multimodal":
         flow = "three-dimensional" if t.flow == "3d" else "two-dimensional along x"
+        system = "its third-order system" if t.expansion == "third-order" else "exact integrals"
         return (f"liquid in tank {t.name!r}", f"{shape_words(t)}multimodal ({flow}), {t.modes} free-surface "
-                                              f"modes, {t.liquid_mass:.6g} kg; its inertial loads (Coriolis and "
+                                              f"modes, {system}, {t.liquid_mass:.6g} kg; its inertial loads (Coriolis and "
                                               "centrifugal among them) are the modal Lagrangian's, not switched by "
                                               "[effects]")
     return (f"liquid in tank {t.name!r}", f"{shape_words(t)}{mesh_words(t, short=True)}, {t.liquid_mass:.6g} kg, "

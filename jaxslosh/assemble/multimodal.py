@@ -10,6 +10,7 @@ import numpy as np
 
 from ..physics.damping import ModalDamping
 from ..physics.multimodal import MultimodalLiquid, modal_tank
+from ..physics.multimodal_expansion import third_order
 from ..scene.types import Scene, SceneError
 from .multimodal3d import probe_row, sample_points, tank_3d, three_dimensional
 
@@ -33,6 +34,8 @@ def build_multimodal(scene: Scene, params: Optional[dict], gravity) -> Multimoda
         tanks.append(modal_tank(t.size[0], t.size[1], P("fill_depth", t.fill_depth), P("fluid.density", t.fluid.density),
                                 t.origin, t.modes, D=t.size[2]))
         rows.append(np.cos(np.outer(np.linspace(0.0, t.size[0], SAMPLES), np.arange(1, t.modes + 1) * np.pi / t.size[0])))
+    # the third-order system's coefficients are the exact tank's derivatives at rest
+    tanks = [third_order(mt) if t.expansion == "third-order" else mt for t, mt in zip(scene.tanks, tanks)]
     sizes = tuple(r.shape[1] for r in rows)
     samples = np.zeros((SAMPLES * len(tanks), sum(sizes)))
     off = 0

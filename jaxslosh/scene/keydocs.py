@@ -164,6 +164,10 @@ KEYS = (
                              "cylinder's cos/sin pairs)."),
     ("tanks.flow", '"2d" ("3d" cylinder)', "", 'Multimodal: "2d", waves along a box\'s length, or "3d", across '
                                               "its whole base (swirl included); a cylinder's are \"3d\"."),
+    ("tanks.expansion", '"exact"', "", 'Multimodal: "exact", the liquid\'s integrals evaluated exactly in the '
+                                       'modal amplitudes at every step, or "third-order", their Taylor polynomial '
+                                       "(the classical third-order modal system: several times cheaper, within a "
+                                       "few per cent of the exact tank for crests below a tenth of its length)."),
     ("tanks.fluid.density", "1000.0", "kg/m^3", "Liquid density."),
     ("tanks.fluid.sound_speed", "1500.0", "m/s", "Liquid sound speed."),
     ("tanks.fluid.element", '"rt" for mesh files, baffles and shapes on modes, else "stabilized"', "",

@@ -43,6 +43,7 @@ LINEAR_SOLVERS = ("auto", "dense", "sparse", "sparse-host")      # [simulation] 
 WALLS = ("rigid", "elastic")
 TANK_MODELS = ("fem", "multimodal")
 MULTIMODAL_FLOWS = ("2d", "3d")         # a multimodal box's waves along its length, or across its whole base
+MULTIMODAL_EXPANSIONS = ("exact", "third-order")    # the integrals exact, or their third-order polynomial
 #: below this fill depth over length the multimodal method's ordering fails (shallow water, bores)
 MULTIMODAL_SHALLOW = 0.1
 PROBE_TOLERANCE = 1e-9                           # m: how far outside its owner a probe may lie
@@ -300,13 +301,14 @@ def _tank(table, where: str, base_dir: str = "") -> Tank:
         "shape": ("str", one_of(SHAPES)), "chamfers": ("any", None), "axis": ("str", one_of(AXES)),
         "file": ("str", None), "baffles": ("tables", None), "model": ("str", one_of(TANK_MODELS)),
         "modes": ("int", at_least(1)), "flow": ("str", one_of(MULTIMODAL_FLOWS)),
+        "expansion": ("str", one_of(MULTIMODAL_EXPANSIONS)),
     }, required=("name", "origin", "size"))
     model = v.get("model", "fem")
     if model == "multimodal":
         _multimodal_tank(table, where)
         v.setdefault("mesh", (2, 2, 1))          # the multimodal tank has no mesh
     else:
-        for key in ("modes", "flow"):
+        for key in ("modes", "flow", "expansion"):
             if key in table:
                 raise SceneError(f"{where}.{key}", 'is the multimodal tank\'s: it needs model = "multimodal"')
     fill_and_mesh(table, v, where, base_dir)
@@ -345,7 +347,7 @@ def _tank(table, where: str, base_dir: str = "") -> Tank:
         fluid = dataclasses.replace(fluid, element=element, element_default=why)
     return Tank(name=v["name"], origin=v["origin"], size=v["size"], fill_depth=depth, mesh=v["mesh"],
                 walls=walls, fluid=fluid, wall_spec=wall_spec, reduction=reduction, damping=damping,
-                model=model, modes=v.get("modes", 6),
+                model=model, modes=v.get("modes", 6), expansion=v.get("expansion", "exact"),
                 flow=v.get("flow", geo.modal_flow), geometry=geo, **shape)
 
 

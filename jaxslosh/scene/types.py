@@ -174,6 +174,7 @@ class Tank:
     model: str = "fem"                      # "fem" | "multimodal" (physics/multimodal.py)
     modes: int = 6                          # multimodal: free-surface modes (the lowest, whole degenerate groups)
     flow: str = "2d"                        # multimodal: "2d" along a box's length | "3d" (a cylinder's always)
+    expansion: str = "exact"                # multimodal: "exact" integrals | "third-order" (physics/multimodal_expansion.py)
 
     #: the shape (jaxslosh/geometry), built by the loader from the keys above; a Tank made by hand
     #: gets it from them
