@@ -77,7 +77,8 @@ def build_liquid_block(scene: Scene, params: Optional[dict] = None, gravity=None
         if sparse and models[-1].traced:
             raise SceneError(f"tanks[{i}]", "a traced tank value (fill depth, density, sound speed or gravity in "
                                             "params or a sweep) needs the dense liquid matrices; this mesh uses the "
-                                            "sparse solver: set simulation.linear_solver = \"dense\" if they fit")
+                                            "sparse solver: set simulation.linear_solver = \"dense\" if they fit (element = "
+                                            "\"rt\" takes a traced density, sound speed or gravity at any size)")
     traced = any(m.traced for m in models)
     xp = jnp if traced else np
     reduced = [t.reduction is not None for t in rigid]
@@ -90,6 +91,10 @@ def build_liquid_block(scene: Scene, params: Optional[dict] = None, gravity=None
                                  "elastic walls need the full-order liquid (no [tanks.reduction] in any tank)")
     elif any(elastic) or in_vessel_frame:
         for i, t in enumerate(rigid):
+            if isinstance(models[i], FaceLiquid) and in_vessel_frame and t.geometry.sloped(t.fill_depth):
+                raise SceneError(f"tanks[{i}].shape", "structures in the vessel's frame go with box tanks (and "
+                                                      "shapes whose liquid touches only walls along the axes) "
+                                                      "only, with either element")
             if isinstance(models[i], FaceLiquid):
                 raise SceneError(f"tanks[{i}].fluid.element",
                                  f"{t.fluid.element!r} does not take structures in the vessel's frame yet, nor elastic "
@@ -98,7 +103,7 @@ def build_liquid_block(scene: Scene, params: Optional[dict] = None, gravity=None
                                       "give every tank the same element")
             if models[i].frames is not None:
                 raise SceneError(f"tanks[{i}].shape", "structures in the vessel's frame go with box tanks (and "
-                                                      "shapes whose walls are all along the axes) only")
+                                                      "shapes whose liquid touches only walls along the axes) only")
             if reduced[i] or sparse or models[i].traced:
                 raise SceneError(f"tanks[{i}].walls" if elastic[i] else f"tanks[{i}]",
                                  "elastic walls, and structures in the vessel's frame, need the full-order dense "
@@ -302,14 +307,13 @@ def face_scales(scene, t, params, g):
 
 def face_sparse(scene, models, scales, depths) -> bool:
     """Whether full-order face-normal tanks take the blocks without dense matrices on the faces
-    (assemble/face_liquid.py sparse_tank_blocks): the scene's own values only (no density, sound
-    speed, gravity or fill depth from params, traced or not: the dense blocks scale with them), and
-    `simulation.linear_solver` "sparse" or "sparse-host", or "auto" above RT_SPARSE_AUTO free faces."""
-    values = [v for sc in scales if sc for v in sc]
+    (assemble/face_liquid.py sparse_tank_blocks; density, sound speed and gravity from params, traced
+    or not, scale them: `stack_sparse`): no elastic walls, no traced fill depth (a plain box's depth
+    reshapes its blocks: the dense `traced_depth_blocks`), and `simulation.linear_solver` "sparse" or
+    "sparse-host", or "auto" above RT_SPARSE_AUTO free faces."""
     if any(t.wall_spec is not None for t in scene.tanks):     # elastic walls: their dense blocks
         return False
-    if any(isinstance(v, jax.core.Tracer) for v in values) or any(d is not None for d in depths) \
-            or any(abs(float(np.asarray(v)) - 1.0) > 1e-12 for v in values):    # blocks at the scene's values
+    if any(d is not None for d in depths):
         return False
     choice = scene.simulation.linear_solver
     faces = sum(int(np.count_nonzero(m.free)) for m in models)

@@ -177,6 +177,23 @@ def face_topology(elements):
     return faces, inv.reshape(E, 6), signs, counts == 1, collapsed
 
 
+def _free_faces(nodes, faces, on_boundary, collapsed, depth):
+    """(free (F,) bool, top (T,)): the interior faces and the free surface's."""
+    scale = float(np.ptp(nodes, axis=0).max())
+    flat_top = np.all(np.abs(nodes[faces][:, :, 2] - depth) < 1e-9 * scale, axis=1)
+    # a top face must open upwards: its element lies below it
+    top = np.flatnonzero(on_boundary & flat_top & ~collapsed)
+    free = ~on_boundary & ~collapsed
+    free[top] = True
+    return free, top
+
+
+def free_face_count(nodes, elements, depth) -> int:
+    """The unknowns of the face-normal liquid on this mesh (its free faces), from the topology only."""
+    faces, _, _, on_boundary, collapsed = face_topology(np.asarray(elements, dtype=int))
+    return int(_free_faces(np.asarray(nodes, dtype=float), faces, on_boundary, collapsed, depth)[0].sum())
+
+
 def build_face_liquid(nodes, elements, depth, density, sound_speed, gravity, geometry=None) -> FaceLiquid:
     """The face-normal model of the liquid meshed by hexahedra ``elements`` (positively oriented;
     a collapsed face allowed) at rest below the free surface z = ``depth``."""
@@ -184,13 +201,8 @@ def build_face_liquid(nodes, elements, depth, density, sound_speed, gravity, geo
     elements = np.asarray(elements, dtype=int)
     rho, c, g = float(density), float(sound_speed), float(gravity)
     faces, element_faces, signs, on_boundary, collapsed = face_topology(elements)
-    scale = float(np.ptp(nodes, axis=0).max())
+    free, top = _free_faces(nodes, faces, on_boundary, collapsed, depth)
     Xf = nodes[faces]
-    flat_top = np.all(np.abs(Xf[:, :, 2] - depth) < 1e-9 * scale, axis=1)
-    # a top face must open upwards: its element lies below it
-    top = np.flatnonzero(on_boundary & flat_top & ~collapsed)
-    free = ~on_boundary & ~collapsed
-    free[top] = True
     normal = 0.5 * np.cross(Xf[top, 2] - Xf[top, 0], Xf[top, 3] - Xf[top, 1])
     top_area = np.abs(normal[:, 2])
 
