@@ -5,7 +5,7 @@ from __future__ import annotations
 
 import os
 
-from ..fem.liquid_rt import free_face_count
+from ..fem.face_mesh import free_face_count
 from ..fem.walls import shell_mesh
 from ..scene.types import EFFECTS, FACE_FORMS, Scene
 
