@@ -5,8 +5,9 @@ from __future__ import annotations
 
 import os
 
+from ..fem.face_mesh import free_face_count
 from ..fem.walls import shell_mesh
-from ..scene.types import EFFECTS, Scene
+from ..scene.types import EFFECTS, FACE_FORMS, Scene
 
 
 def describe(scene: Scene) -> str:
@@ -98,7 +99,15 @@ def tank_notes(t) -> list[str]:
 
 
 def free_liquid_dofs(tank) -> int:
-    """A tank's free liquid dofs: three per node, less the wall-normal ones the slip walls hold."""
+    """A tank's free liquid unknowns at full order: the nodal elements' three dofs per node, less the
+    wall-normal ones the slip walls hold; the face-normal element's free faces (the interior ones and
+    the free surface's, fem/liquid_rt.py)."""
+    if tank.fluid.element in FACE_FORMS:
+        nx, ny, nz = tank.mesh
+        if tank.geometry.plain_box:         # interior faces along x, y and z, and the nx ny top faces
+            return 3 * nx * ny * nz - ny * nz - nx * nz
+        tm = tank.geometry.mesh(tank.fill_depth, tuple(tank.mesh))
+        return free_face_count(tm.nodes, tm.elements, tm.depth)
     if not tank.geometry.plain_box:
         return tank.geometry.free_count(tank.fill_depth, tuple(tank.mesh))
     nx, ny, nz = tank.mesh
@@ -111,7 +120,8 @@ def liquid_unknowns(scene: Scene) -> int:
     n = 0
     for t in scene.tanks:
         n += free_liquid_dofs(t)
-        if t.wall_spec is not None:       # the walls' free nodes (the liquid's normal dofs share theirs)
+        if t.wall_spec is not None:       # the walls' free nodes (the liquid's wall-normal dofs, or its
+            #                               wall faces' fluxes, follow theirs)
             _, _, _, held = shell_mesh(t.size, t.fill_depth, t.mesh, t.wall_spec.thickness, t.wall_spec.mesh)
             n += 3 * int((~held).sum())
     return n

@@ -2,8 +2,8 @@
 models (fem/liquid_rt.py): the Gauss points' fields and masses, the blocks, the absolute-rotation
 penalty and the nodal recovery's weights, host-side NumPy. The blocks are either kept without dense
 matrices on the faces (`sparse_tank_blocks`: the mass element by element and the penalty's dense
-part on the elements and top faces, fem/face_schur.py), or dense on the free faces (scaled by traced
-density, sound speed or gravity where given). A plain box's fill depth may be traced too on the
+part on the elements and top faces, fem/face_schur.py), or dense on the free faces; both scale with
+density, sound speed and gravity given in params (traced or not). A plain box's fill depth may be traced too on the
 dense blocks: its layers scale with the depth, so every block is a closed function of h / h0
 (`traced_depth_blocks`)."""
 from __future__ import annotations
@@ -22,7 +22,7 @@ from ..fem.walls_rt import build_face_tank_with_walls, wall_points
 from ..physics.face_blocks import FaceOps, FaceStiffness
 from ..physics.face_liquid import FluxLiquid
 from ..scene.types import RT_FULL_FACES, SceneError
-from ..solve.face_inverse import mass_inverse
+from ..solve.face_inverse import mass_inverse, project_pools
 
 #: free faces above which a full-order "rt" tank is refused on the dense path (its dense blocks: M, K
 #: and two inverses); the sparse path (fem/face_schur.py) has no such limit
@@ -97,7 +97,9 @@ def sparse_tank_blocks(model: FaceLiquid, origin, gauss=None) -> dict:
     Pc = sch.kernel_part(sch.minv(_loads(model, gauss, rot)[sch.f]))
     MPc = sch.M @ Pc
     uniform = np.stack([np.broadcast_to(np.eye(3)[k], x.shape) for k in range(3)])
-    start = sch.static_solve(_loads(model, gauss, uniform)[sch.f], kappa)
+    load = _loads(model, gauss, uniform)[sch.f]
+    start = sch.static_solve(load, kappa)
+    u0 = sch.minv(load)                 # M^-1 F and B M^-1 F: the start at scaled values (`scaled_start`)
     Y = np.diag(1.0 / sch.winv) - kappa * sch.Gp
     Me = model.density * np.einsum("epfi,epgi,ep->efg", phys, phys, w)        # phys carries the signs
     nf = sch.f.size
@@ -110,12 +112,17 @@ def sparse_tank_blocks(model: FaceLiquid, origin, gauss=None) -> dict:
     slot[sch.f] = np.arange(nf)
     return dict(nf=nf, kappa=kappa, Y=Y, winv=sch.winv, Kdt=kappa * MPc, Ktt=kappa * (Pc.T @ MPc), start=start,
                 Me=Me, slots=slot[model.element_faces], signs=model.signs, top=slot[model.top], rowsum=rowsum,
-                diag=sch.M.diagonal(), bounds=mass_bounds(sch.M, sch.Mlu))
+                diag=sch.M.diagonal(), bounds=mass_bounds(sch.M, sch.Mlu), pools=sch.N, u0=u0, z0=sch.B @ u0,
+                E=len(model.elements))
 
 
-def stack_sparse(parts: list) -> tuple:
+def stack_sparse(parts: list, scales=None) -> tuple:
     """(FaceStiffness, MassInverse, start (n, 3)) of the tanks' `sparse_tank_blocks`, stacked (tank
-    after tank)."""
+    after tank). `scales`: per tank None or its (rho, rho c^2, rho g) over its model's
+    (assemble/liquid.py face_scales), traced or not: the mass M and the penalty kappa M P scale with
+    the first (G^+ with it, as G = B M^-1 B^T scales inversely), W's elements (the compression) with
+    the second and its top faces (the free surface) with the third, as the dense blocks do."""
+    scales = [(1.0, 1.0, 1.0) if sc is None else sc for sc in (scales or [None] * len(parts))]
     n = sum(p["nf"] for p in parts)
     slots, tops, elements, top_ranges, off, e0, t0 = [], [], [], [], 0, 0, 0
     for p in parts:
@@ -128,17 +135,54 @@ def stack_sparse(parts: list) -> tuple:
     ops = FaceOps(jnp.asarray(np.concatenate(slots).astype(np.int32)),
                   jnp.asarray(np.concatenate([p["signs"] for p in parts])),
                   jnp.asarray(np.concatenate(tops).astype(np.int32)), n, tuple(elements), tuple(top_ranges))
-    Me = np.concatenate([p["Me"] for p in parts])
-    kM = np.concatenate([p["kappa"] * p["Me"] for p in parts])
     kappa_n = np.concatenate([np.full(p["nf"], p["kappa"]) for p in parts])
-    K = FaceStiffness(ops, jnp.asarray(kM), tuple(jnp.asarray(p["Y"]) for p in parts),
-                      jnp.asarray(np.concatenate([p["rowsum"] for p in parts])),
-                      tuple(jnp.asarray(p["winv"]) for p in parts), jnp.asarray(kappa_n),
-                      jnp.asarray([p["kappa"] for p in parts]))
     lo = min(p["bounds"][0] for p in parts)
     hi = max(p["bounds"][1] for p in parts)
-    Minv = mass_inverse(ops, Me, np.concatenate([p["diag"] for p in parts]), lo, hi)
-    return K, Minv, np.concatenate([p["start"] for p in parts])
+    if all(_unit(v) for sc in scales for v in sc):      # the scene's values: every block on the host
+        Me = np.concatenate([p["Me"] for p in parts])
+        kM = np.concatenate([p["kappa"] * p["Me"] for p in parts])
+        K = FaceStiffness(ops, jnp.asarray(kM), tuple(jnp.asarray(p["Y"]) for p in parts),
+                          jnp.asarray(np.concatenate([p["rowsum"] for p in parts])),
+                          tuple(jnp.asarray(p["winv"]) for p in parts), jnp.asarray(kappa_n),
+                          jnp.asarray([p["kappa"] for p in parts]))
+        Minv = mass_inverse(ops, Me, np.concatenate([p["diag"] for p in parts]), lo, hi)
+        return K, Minv, np.concatenate([p["start"] for p in parts])
+    sr = [jnp.asarray(sc[0], dtype=float) for sc in scales]
+    # W_s = diag(sc on the elements, sg on the top faces) W; Y_s = W_s - sr kappa G^+ = sr Y + (W_s - sr W)
+    ws = [jnp.concatenate([jnp.full(p["E"], sc[1], dtype=float), jnp.full(len(p["top"]), sc[2], dtype=float)])
+          for p, sc in zip(parts, scales)]
+    Y = tuple(r * p["Y"] + jnp.diag((w - r) / p["winv"]) for p, r, w in zip(parts, sr, ws))
+    winv = tuple(p["winv"] / w for p, w in zip(parts, ws))
+    # sum_j |K_ij| bounded by the largest of the three factors (a round-off floor, not a value)
+    rowsum = jnp.concatenate([jnp.max(jnp.abs(jnp.stack([jnp.asarray(v, dtype=float) for v in sc]))) * p["rowsum"]
+                              for p, sc in zip(parts, scales)])
+    K = FaceStiffness(ops, jnp.concatenate([r * p["kappa"] * p["Me"] for p, r in zip(parts, sr)]), Y, rowsum,
+                      winv, jnp.asarray(kappa_n), jnp.asarray([p["kappa"] for p in parts]), rho=tuple(sr),
+                      pools=tuple(jnp.asarray(p["pools"]) for p in parts))
+    Minv = mass_inverse(ops, jnp.concatenate([r * p["Me"] for p, r in zip(parts, sr)]),
+                        jnp.concatenate([r * p["diag"] for p, r in zip(parts, sr)]), lo, hi)
+    return K, Minv, scaled_start(parts, K, Minv)
+
+
+def _unit(v) -> bool:
+    return not isinstance(v, jax.core.Tracer) and abs(float(np.asarray(v)) - 1.0) <= 1e-12
+
+
+def scaled_start(parts, K, Minv):
+    """The static start's columns K_s^-1 F_s (F_s = rho_s F: the loads scale with the mass) at scaled
+    values: K_s = rho_s K', K' = kappa M + B^T (W' - kappa G^+) B with W' = W_s / rho_s, so the start is
+    K'^-1 F = M^-1 (F / kappa - B^T H_0 B M^-1 F), H_0 = G'^+ / kappa - G'^+ W'^-1 G'^+ with G^+
+    projected onto W'^-1's complement of the pools (fem/face_schur.py static_solve). M^-1 F and
+    B M^-1 F come from the host; the last M^-1 is the Chebyshev iteration's (rho_s M^-1_s)."""
+    ys, u0, rho_n = [], [], []
+    for p, Y, wi, r, N in zip(parts, K.Y, K.winv, K.rho, K.pools):
+        w1 = r * wi                                                        # W'^-1
+        Gp = project_pools((jnp.diag(1.0 / wi) - Y) / (r * p["kappa"]), w1, N)
+        Gz = Gp @ p["z0"]
+        ys.append(Gz / p["kappa"] - Gp @ (w1[:, None] * Gz))
+        u0.append(p["u0"] / p["kappa"])
+        rho_n.append(jnp.full(p["nf"], r))
+    return jnp.concatenate(u0) - jnp.concatenate(rho_n)[:, None] * (Minv @ K.ops.BT(ys))
 
 
 def _component_masses(model, w, phys):
@@ -216,6 +260,11 @@ def face_full_liquid(tanks, models, scales=None, depths=None, sparse=False, stru
         sr, sc, sg = fs if fs is not None else (1.0, 1.0, 1.0)
         f = np.flatnonzero(model.free)
         if f.size > MAX_FULL_FACES and not sparse:
+            if ds is not None:
+                raise SceneError(f"tanks[{i}].fill_depth", f"a traced fill depth of a full-order \"rt\" tank needs "
+                                                           f"the dense blocks, and this mesh holds {f.size} free "
+                                                           f"faces, more than {MAX_FULL_FACES} for them: trace the "
+                                                           "fill depth on a coarser mesh")
             dense_only = structures or any(u.wall_spec is not None for u in tanks)
             hint = ("elastic walls and structures in the vessel's frame take the dense blocks only: use a coarser "
                     "mesh, or set element = \"stabilized\"") if dense_only else \
@@ -302,7 +351,7 @@ def face_full_liquid(tanks, models, scales=None, depths=None, sparse=False, stru
     fix = lambda a: np.where(a == HELD, off, np.where(a <= -2, off + 1 + (-2 - a), a)).astype(np.int32)  # noqa: E731
     slot = fix(np.concatenate(slots))
     if sparse:
-        K, Minv, start = stack_sparse(parts)
+        K, Minv, start = stack_sparse(parts, scales)
         blocks = dict(K=K, Mff=None, Minv=Minv, start=jnp.asarray(start), sparse=True)
     else:
         stack = jax_block_diag if xp is jnp else block_diag

@@ -78,7 +78,8 @@ def build_liquid_block(scene: Scene, params: Optional[dict] = None, gravity=None
         if sparse and models[-1].traced:
             raise SceneError(f"tanks[{i}]", "a traced tank value (fill depth, density, sound speed or gravity in "
                                             "params or a sweep) needs the dense liquid matrices; this mesh uses the "
-                                            "sparse solver: set simulation.linear_solver = \"dense\" if they fit")
+                                            "sparse solver: set simulation.linear_solver = \"dense\" if they fit (element = "
+                                            "\"rt\" takes a traced density, sound speed or gravity at any size)")
     traced = any(m.traced for m in models)
     xp = jnp if traced else np
     reduced = [t.reduction is not None for t in rigid]
@@ -99,8 +100,9 @@ def build_liquid_block(scene: Scene, params: Optional[dict] = None, gravity=None
                                  f"when every tank is \"rt\" (another tank's is {other!r}): give every tank the "
                                  "same element")
             if models[i].frames is not None:
-                raise SceneError(f"tanks[{i}].shape", "structures in the vessel's frame go with box tanks (and "
-                                                      "shapes whose walls are all along the axes) only")
+                raise SceneError(f"tanks[{i}].shape", f"structures in the vessel's frame go with the {t.fluid.element!r} "
+                                                      "element in box tanks (and shapes whose liquid touches only walls "
+                                                      "along the axes) only: element = \"rt\" takes them in any tank")
             if reduced[i] or sparse or models[i].traced:
                 raise SceneError(f"tanks[{i}].walls" if elastic[i] else f"tanks[{i}]",
                                  "elastic walls, and structures in the vessel's frame, need the full-order dense "
@@ -290,14 +292,14 @@ def face_scales(scene, t, params, g):
 
 def face_sparse(scene, models, scales, depths) -> bool:
     """Whether full-order face-normal tanks take the blocks without dense matrices on the faces
-    (assemble/face_liquid.py sparse_tank_blocks): the scene's own values only (no density, sound
-    speed, gravity or fill depth from params, traced or not: the dense blocks scale with them), and
-    `simulation.linear_solver` "sparse" or "sparse-host", or "auto" above RT_SPARSE_AUTO free faces."""
-    values = [v for sc in scales if sc for v in sc]
+    (assemble/face_liquid.py sparse_tank_blocks; density, sound speed and gravity from params, traced
+    or not, scale them: `stack_sparse`): no elastic walls or structures in the vessel's frame (their
+    dense blocks), no traced fill depth (a plain box's depth reshapes its blocks: the dense
+    `traced_depth_blocks`), and `simulation.linear_solver` "sparse" or "sparse-host", or "auto" above
+    RT_SPARSE_AUTO free faces."""
     if any(t.wall_spec is not None for t in scene.tanks) or any(s.frame == "vessel" for s in scene.structures):
         return False                    # elastic walls, structures in the vessel's frame: their dense blocks
-    if any(isinstance(v, jax.core.Tracer) for v in values) or any(d is not None for d in depths) \
-            or any(abs(float(np.asarray(v)) - 1.0) > 1e-12 for v in values):    # blocks at the scene's values
+    if any(d is not None for d in depths):
         return False
     choice = scene.simulation.linear_solver
     faces = sum(int(np.count_nonzero(m.free)) for m in models)

@@ -37,7 +37,7 @@ import scipy.sparse.linalg as spla
 
 from .face_schur import mixed_operators
 from .mesh import GAUSS8, HEX_CORNERS
-from .slip import HEX_FACES
+from .face_mesh import face_topology, free_faces
 
 #: the reference face of each row of HEX_FACES: (axis, side)
 _FACE_AXIS = np.array([2, 2, 1, 0, 1, 0])
@@ -159,24 +159,6 @@ def _reference_fields(xi):
     return out
 
 
-def face_topology(elements):
-    """(faces (F, 4), element_faces (E, 6), signs (E, 6), boundary (F,) bool, collapsed (F,) bool)."""
-    E = len(elements)
-    local = elements[:, HEX_FACES].reshape(-1, 4)
-    key = np.sort(local, axis=1)
-    uniq, first, inv, counts = np.unique(key, axis=0, return_index=True, return_inverse=True, return_counts=True)
-    inv = inv.reshape(-1)
-    faces = local[first]
-    collapsed = np.array([len(set(f)) < 3 for f in uniq])
-    owner = np.repeat(np.arange(E), 6)
-    # the unknown is the outward flux of the face's first element (lowest index) -- np.unique's
-    # `first` is the first occurrence, which is that element's
-    signs = np.where(owner == owner[first][inv], 1.0, -1.0).reshape(E, 6)
-    if np.any((counts > 2) & ~collapsed):
-        raise ValueError("the mesh has a face shared by more than two elements")
-    return faces, inv.reshape(E, 6), signs, counts == 1, collapsed
-
-
 def build_face_liquid(nodes, elements, depth, density, sound_speed, gravity, geometry=None) -> FaceLiquid:
     """The face-normal model of the liquid meshed by hexahedra ``elements`` (positively oriented;
     a collapsed face allowed) at rest below the free surface z = ``depth``."""
@@ -184,13 +166,8 @@ def build_face_liquid(nodes, elements, depth, density, sound_speed, gravity, geo
     elements = np.asarray(elements, dtype=int)
     rho, c, g = float(density), float(sound_speed), float(gravity)
     faces, element_faces, signs, on_boundary, collapsed = face_topology(elements)
-    scale = float(np.ptp(nodes, axis=0).max())
+    free, top = free_faces(nodes, faces, on_boundary, collapsed, depth)
     Xf = nodes[faces]
-    flat_top = np.all(np.abs(Xf[:, :, 2] - depth) < 1e-9 * scale, axis=1)
-    # a top face must open upwards: its element lies below it
-    top = np.flatnonzero(on_boundary & flat_top & ~collapsed)
-    free = ~on_boundary & ~collapsed
-    free[top] = True
     normal = 0.5 * np.cross(Xf[top, 2] - Xf[top, 0], Xf[top, 3] - Xf[top, 1])
     top_area = np.abs(normal[:, 2])
 

@@ -57,7 +57,8 @@ class AbstractShape(abc.ABC):
     #: when the tank leaves `flow` out
     modal: ClassVar[bool] = False
     modal_flow: ClassVar[str] = "2d"
-    # the loader's default element on modes is "rt" (its higher modes at sloping and curved walls)
+    # the loader's default element on modes is "rt" (its higher modes at sloping and curved walls),
+    # and at full order where the liquid touches such a wall (`sloped`)
     rt_on_modes: ClassVar[bool] = False
 
     size: tuple
@@ -165,6 +166,11 @@ class AbstractShape(abc.ABC):
         """The counts of the box grid this shape's liquid is, meshed as the box (a mesh file that is
         one), else None."""
         return None
+
+    def sloped(self, fill_depth: float) -> bool:
+        """Whether the liquid at rest touches a wall that is not along the tank's axes (the nodal
+        elements then work in node frames, and the stabilized element's modes are off there)."""
+        return False
 
     def locks(self, fill_depth: float) -> tuple[bool, str]:
         """(whether the stabilized element locks in this shape, why): the loader's default element."""

@@ -37,6 +37,9 @@ class Cylinder(AbstractShape):
     axis: str = "x"
     baffles: tuple = ()
 
+    def sloped(self, fill_depth: float) -> bool:
+        return True
+
     @classmethod
     def read_own(cls, table, v, where: str, base_dir: str, reader: Reader) -> dict:
         return {"axis": v.get("axis", "x")}

@@ -48,6 +48,11 @@ class Prismatic(AbstractShape):
             return "fill_depth", "the liquid reaches the ridge where the top chamfers meet"
         return None
 
+    def sloped(self, fill_depth: float) -> bool:
+        (_, ch), (_, th) = self.chamfers
+        H = self.size[2]
+        return ch > 0 or (th > 0 and fill_depth > H - th + 1e-12 * H)
+
     def volume(self, fill_depth: float) -> float:
         a, b, H = self.size
         h = fill_depth

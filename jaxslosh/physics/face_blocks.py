@@ -9,6 +9,8 @@ and vmap as jnp code does.
 """
 from __future__ import annotations
 
+from typing import Optional
+
 import equinox as eqx
 import jax
 import jax.numpy as jnp
@@ -63,6 +65,11 @@ class FaceStiffness(eqx.Module):
     winv: tuple             # per tank (ny_t,) W^-1 (the Newton block's inverse is formed from Y, W, kappa)
     kappa_n: jax.Array      # (n,) each unknown's tank's kappa
     kappas: jax.Array       # (tanks,) each tank's kappa (an array: a static float would name the program)
+    # at values other than the model's (traced density, sound speed, gravity): per tank its mass scale
+    # rho_s and its pools' null vectors (ny_t, pools), from which the Newton block's inverse is formed
+    # in JAX (solve/face_inverse.py); None: the model's values, the inverse formed on the host
+    rho: Optional[tuple] = None
+    pools: Optional[tuple] = None
 
     @property
     def shape(self):

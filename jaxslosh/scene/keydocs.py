@@ -170,12 +170,13 @@ KEYS = (
                                        "few per cent of the exact tank for crests below a tenth of its length)."),
     ("tanks.fluid.density", "1000.0", "kg/m^3", "Liquid density."),
     ("tanks.fluid.sound_speed", "1500.0", "m/s", "Liquid sound speed."),
-    ("tanks.fluid.element", '"rt" for mesh files, baffles and shapes on modes, else "stabilized"', "",
+    ("tanks.fluid.element", '"rt" for mesh files, baffles, cylinders and chamfered prismatic tanks, else '
+                            '"stabilized"', "",
      'The liquid element: "stabilized", the paper\'s literal "paper", or "rt", the face-normal '
      '(Raviart-Thomas) element that does not lock on re-entrant tanks (U-tubes, baffles, hoppers). Left '
-     'out: "rt" for a mesh file that is not a box grid and for a tank with baffles (unless it runs at '
-     'full order on more than about 4,000 faces) and for a prismatic or cylindrical tank on modes '
-     '([tanks.reduction]), "stabilized" otherwise; `check` says which and why. With elastic walls, every '
+     'out: "rt" for a mesh file that is not a box grid, for a tank with baffles, for a cylindrical tank and a prismatic tank whose liquid '
+     'touches a chamfer (at full order and on modes), for any prismatic tank on modes ([tanks.reduction]), '
+     '"stabilized" otherwise; `check` says which and why. With elastic walls, every '
      'element runs at full order only.'),
     ("tanks.walls.thickness", _REQ, "m", "Wall thickness (one element through it)."),
     ("tanks.walls.mesh", "the liquid mesh", "", "Wall elements along the tank's length, breadth and height."),

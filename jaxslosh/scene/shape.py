@@ -54,16 +54,18 @@ def read_multimodal_shape(table, where: str) -> None:
 
 def default_element(geo: AbstractShape, fill_depth, mesh, reduced: bool) -> tuple[str, str]:
     """(element, why) for a tank whose [tanks.fluid] leaves `element` out: the face-normal "rt" where
-    the stabilized element locks (a mesh file that is not a box grid, a tank with baffles: issue 30),
-    at full order on any mesh (its blocks without dense matrices on the faces, assemble/face_liquid.py);
-    "rt" for the shapes that prefer it on modes ([tanks.reduction]: prismatic and cylindrical tanks);
-    else "stabilized" (boxes keep their fast diagonalization; shapes at full order their quicker steps)."""
+    the stabilized element locks (a mesh file that is not a box grid, a tank with baffles: issue 30);
+    "rt" for prismatic and cylindrical tanks on modes ([tanks.reduction]) and, at full order, where
+    their liquid touches a sloping or curved wall (the stabilized element's modes are off there, an
+    LNG section's first by +16 % at 30 % fill: docs/guide/liquid-element.md); else "stabilized"
+    (boxes keep their fast diagonalization, and a prismatic tank whose liquid touches no chamfer is
+    a box)."""
     locks, why = geo.locks(float(fill_depth))
     if not locks:
         if geo.rt_on_modes and reduced:
-            # on modes "rt" costs about what the stabilized element does and holds the higher modes at
-            # sloping and curved walls better; at full order its dense blocks step several times slower
-            # (docs/guide/liquid-element.md, "Prismatic and cylindrical tanks")
             return "rt", f"a {geo.name} tank on modes: its higher modes are more accurate with \"rt\""
+        if geo.rt_on_modes and geo.sloped(float(fill_depth)):
+            return "rt", (f"a {geo.name} tank whose liquid touches sloping or curved walls: the stabilized "
+                          "element's modes are off there")
         return "stabilized", why
     return "rt", f"{why}: the stabilized element locks there"

@@ -101,9 +101,13 @@ def _liquid_solver(system: System, h, scheme: Scheme, tol, max_iter, substeps, r
         step_inv, mass_inv, sub_inv, K = blocks(L, scheme.c_a(h), scheme.c_a(h / substeps) if substeps else None)
         step_inv = damped(step_inv, system, scheme, h)
         sub_inv = damped(sub_inv, system, scheme, h / substeps) if substeps else None
-        scale = np.asarray(jax.lax.stop_gradient(system.scales()[6:]))
-        rowsum = K if isinstance(K, np.ndarray) else abs(K).sum(axis=1)   # face blocks: K is its row sums (never formed)
-        noise = np.finfo(np.float64).eps * np.max(np.asarray(rowsum).reshape(-1) / scale)
+        scale = jax.lax.stop_gradient(system.scales()[6:])
+        rowsum = K if isinstance(L, FluxLiquid) else abs(K).sum(axis=1)   # face blocks: K is its row sums (never formed)
+        if isinstance(rowsum, jax.core.Tracer) or isinstance(scale, jax.core.Tracer):   # face blocks at traced values
+            noise = jnp.finfo(jnp.float64).eps * jnp.max(jnp.asarray(rowsum).reshape(-1) / scale)
+        else:
+            scale = np.asarray(scale)
+            noise = np.finfo(np.float64).eps * np.max(np.asarray(rowsum).reshape(-1) / scale)
         return Solver(step_inv, mass_inv, jnp.asarray(h, dtype=float), scheme, tol, max_iter, substeps, sub_inv,
                       noise=noise, reuse=reuse, adaptive=adaptive)
     M_ff, K_ff = jax.lax.stop_gradient(L).constant_blocks()

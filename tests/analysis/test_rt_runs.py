@@ -211,7 +211,9 @@ def test_the_default_element_is_rt_where_the_stabilized_one_locks(tmp_path, caps
     tests/fem/test_liquid_element_rt.py's U-tube) on any mesh (a large one at full order through the
     blocks without dense matrices on the faces), "stabilized" for a plain box and a box grid given as
     a mesh file; "rt" for prismatic and cylindrical
-    tanks on modes, "stabilized" at full order; `check` says which and why; a given element stays."""
+    tanks on modes and at full order where the liquid touches a chamfer or a curved wall (a prismatic
+    tank filled below its top chamfers, with no bottom ones, is a box: "stabilized"); `check` says
+    which and why; a given element stays."""
     from jaxslosh.cli.main import main
     small = js.load_scene(BAFFLED.format(mesh="[10, 4, 6]", extra=""))
     assert small.tanks[0].fluid.element == "rt" and "baffles" in small.tanks[0].fluid.element_default
@@ -223,7 +225,8 @@ def test_the_default_element_is_rt_where_the_stabilized_one_locks(tmp_path, caps
     assert given.tanks[0].fluid.element == "stabilized" and given.tanks[0].fluid.element_default == ""
     plain = js.load_scene(BAFFLED.format(mesh="[10, 4, 6]", extra="").split("[[tanks.baffles]]")[0])
     assert plain.tanks[0].fluid.element == "stabilized"
-    # prismatic and cylindrical tanks: "rt" on modes, "stabilized" at full order (quicker steps)
+    # prismatic and cylindrical tanks: "rt" on modes and at full order (the stabilized element's modes
+    # are off at sloping and curved walls)
     for shape in ('shape = "prismatic"\nchamfers = [[1.0, 1.0], [1.0, 1.0]]', 'shape = "cylinder"\naxis = "z"\n'
                   'size = [5.0, 5.0, 4.0]'):
         text = BAFFLED.format(mesh="[6, 6, 4]", extra="").split("[[tanks.baffles]]")[0].replace(
@@ -232,8 +235,15 @@ def test_the_default_element_is_rt_where_the_stabilized_one_locks(tmp_path, caps
             text += "size = [5.0, 5.0, 4.0]\n"
         full = js.load_scene(text)
         on_modes = js.load_scene(text + "[tanks.reduction]\nmodes = 6\n")
-        assert full.tanks[0].fluid.element == "stabilized" and on_modes.tanks[0].fluid.element == "rt", shape
+        assert full.tanks[0].fluid.element == "rt" and on_modes.tanks[0].fluid.element == "rt", shape
         assert "on modes" in on_modes.tanks[0].fluid.element_default
+        assert "sloping or curved walls" in full.tanks[0].fluid.element_default
+        given = js.load_scene(text + '[tanks.fluid]\nelement = "stabilized"\n')
+        assert given.tanks[0].fluid.element == "stabilized"
+    boxlike = BAFFLED.format(mesh="[6, 6, 4]", extra="").split("[[tanks.baffles]]")[0] + \
+        'shape = "prismatic"\nchamfers = [[0.0, 0.0], [1.0, 0.5]]\n'
+    assert js.load_scene(boxlike).tanks[0].fluid.element == "stabilized"         # filled to 3 m of 4 m
+    assert js.load_scene(boxlike.replace("fill_depth = 3.0", "fill_depth = 3.8")).tanks[0].fluid.element == "rt"
     path = tmp_path / "s.toml"
     path.write_text(BAFFLED.format(mesh="[10, 4, 6]", extra=""))
     assert main(["check", str(path)]) == 0
@@ -241,6 +251,26 @@ def test_the_default_element_is_rt_where_the_stabilized_one_locks(tmp_path, caps
     assert "element 'rt' at full order (by default: a tank with baffles" in out
     r = js.simulate(small)
     assert r.status == "ok"
+
+
+def test_structures_in_the_vessel_frame_with_a_sloped_tank():
+    """A chamfered prismatic tank beside a structure in the vessel's frame: the default "rt" takes it
+    (the structure's dofs sit beside the faces, tests/physics/test_rt_vessel_structures.py), the
+    stabilized element, whose node frames do not go with those structures, is refused naming the
+    shape; a prismatic tank whose liquid touches no chamfer stays "stabilized" and takes it."""
+    mast = ('[[structures]]\nname = "mast"\norigin = [0.5, 0.5, 4.0]\nsize = [0.3, 0.3, 2.0]\nmesh = [1, 1, 2]\n'
+            'attach = "z-"\nframe = "vessel"\n[structures.material]\nyoung = 2.1e11\npoisson = 0.3\n'
+            'density = 7850.0\n')
+    base = BAFFLED.format(mesh="[2, 4, 3]", extra="").split("[[tanks.baffles]]")[0]
+    sloped = base + 'shape = "prismatic"\nchamfers = [[1.0, 1.0], [0.0, 0.0]]\n'
+    rt = js.load_scene(sloped + mast)
+    assert rt.tanks[0].fluid.element == "rt"
+    assert build_liquid_block(rt).liquid is not None
+    with pytest.raises(js.SceneError, match=r"tanks\[0\]\.shape: .*liquid touches only walls along the axes"):
+        build_liquid_block(js.load_scene(sloped + '[tanks.fluid]\nelement = "stabilized"\n' + mast))
+    boxlike = js.load_scene(base + 'shape = "prismatic"\nchamfers = [[0.0, 0.0], [1.0, 0.5]]\n' + mast)
+    assert boxlike.tanks[0].fluid.element == "stabilized"
+    assert build_liquid_block(boxlike).liquid.n_nodes > 0
 
 
 def test_rt_with_elastic_walls_check_names_the_element(tmp_path, capsys):

@@ -8,6 +8,7 @@ from types import SimpleNamespace
 import jax
 import jax.numpy as jnp
 import numpy as np
+import pytest
 
 import jaxslosh as js
 from jaxslosh.assemble.face_liquid import face_full_liquid
@@ -134,3 +135,62 @@ def test_a_run_through_the_sparse_blocks_equals_the_dense_run():
     assert np.abs(np.asarray(a.vessel.roll_pitch_yaw) - np.asarray(b.vessel.roll_pitch_yaw)).max() < 1e-10
     ia, ib = np.asarray(a.solver.iterations), np.asarray(b.solver.iterations)
     assert np.abs(ia - ib).max() <= 1 and np.count_nonzero(ia != ib) <= 2
+
+
+def test_scaled_sparse_blocks_equal_the_dense_ones():
+    """Density, sound speed and gravity other than the model's (assemble/liquid.py face_scales: the
+    mass, the compression and the free surface scale with rho, rho c^2 and rho g): the sparse blocks
+    equal the dense blocks at those values, the stiffness, row sums (a bound within the factors'
+    spread), the static start and the Newton blocks' inverses; and traced (jit, grad) as well."""
+    models = _models()
+    tanks = [SimpleNamespace(origin=(0.3, -1.0, -0.5), wall_spec=None), SimpleNamespace(origin=(-1.0, 0.5, -0.2), wall_spec=None)]
+    scales = [(1.1, 0.9, 1.2), (0.8, 1.3, 0.95)]
+    dense, (Kdt0, Ktt0), _ = face_full_liquid(tanks, models, scales)
+    sparse, (Kdt1, Ktt1), _ = face_full_liquid(tanks, models, scales, sparse=True)
+    V = np.random.default_rng(0).standard_normal((dense.nf, 5))
+    K0, M0 = np.asarray(dense.K), np.asarray(dense.Mff)
+    rel = lambda a, b: np.abs(np.asarray(a) - np.asarray(b)).max() / np.abs(np.asarray(b)).max()  # noqa: E731
+    assert rel(sparse.K @ jnp.asarray(V), K0 @ V) < 1e-13
+    exact = np.abs(K0).sum(axis=1)
+    assert np.all(np.asarray(sparse.K.abs_rowsum) >= 0.8 * exact) and np.all(np.asarray(sparse.K.abs_rowsum) <= 1.4 * exact)
+    assert rel(Kdt1, Kdt0) < 1e-11 and rel(Ktt1, Ktt0) < 1e-11
+    g = jnp.asarray([0.3, -0.2, -9.81])
+    assert rel(sparse.static_start(g), np.linalg.solve(K0, np.asarray(dense.free_part(dense.m[:, None] * g)))) < 1e-8
+    c = 4.0 / 0.01 ** 2
+    step, mass, _, _ = face_solver_blocks(sparse, c)
+    assert rel(step @ jnp.asarray(V), np.linalg.solve(c * M0 + K0, V)) < 1e-10
+    assert rel(mass @ jnp.asarray(V), np.linalg.solve(M0, V)) < 1e-13
+
+    def both(a, sparse):
+        liquid, _, _ = face_full_liquid(tanks, models, [(a, 1.3 * a, 0.9), (1.0, a, a)], sparse=sparse)
+        start = liquid.static_start(g)
+        if sparse:
+            x = face_solver_blocks(liquid, c)[0] @ jnp.ones(liquid.nf)
+        else:
+            x = jnp.linalg.solve(c * liquid.Mff + liquid.K, jnp.ones(liquid.nf))
+        return jnp.sum(start ** 2), x
+    a, b = jax.jit(lambda s: both(s, True))(1.2), both(1.2, False)
+    assert rel(a[0], b[0]) < 1e-9 and rel(a[1], b[1]) < 1e-10
+    grad = jax.grad(lambda s: both(s, True)[0])(1.2)
+    assert abs(grad - jax.grad(lambda s: both(s, False)[0])(1.2)) < 1e-8 * abs(grad)
+
+
+@pytest.mark.slow
+def test_a_run_with_traced_tank_values_through_the_sparse_blocks():
+    """Density, sound speed and gravity from params (traced) on the sparse blocks: the run equals the
+    dense one (the free-surface probe and the roll within 1e-12), and the gradient with respect to
+    the density agrees with central differences within 1e-5."""
+    dense, sparse = (js.load_scene(ROLLING.format(solver=s).replace("duration = 0.2", "duration = 0.05"))
+                     for s in ("dense", "sparse"))
+    p0 = {"tanks.tank.fluid.density": 500.0, "tanks.tank.fluid.sound_speed": 1300.0, "environment.gravity": 9.5}
+    assert build_liquid_block(sparse, p0).liquid.sparse
+
+    def value(scene, p):
+        r = js.simulate(scene, params=p)
+        return r.probes["wall"].displacement[-1, 2] + r.vessel.roll_pitch_yaw[-1, 0]
+    a, b = value(sparse, p0), value(dense, p0)
+    assert abs(float(a)) > 1e-3 and abs(float(a - b)) < 1e-12
+    key, h = "tanks.tank.fluid.density", 0.5
+    grad = float(jax.grad(lambda x: value(sparse, {**p0, key: x}))(p0[key]))
+    fd = float(value(sparse, {**p0, key: p0[key] + h}) - value(sparse, {**p0, key: p0[key] - h})) / (2 * h)
+    assert abs(grad - fd) < 1e-5 * abs(fd)

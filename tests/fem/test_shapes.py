@@ -253,8 +253,9 @@ def test_box_written_by_gmsh_runs_as_the_box(tmp_path):
 
 def test_shaped_tank_sparse_solver_agrees_with_dense():
     """Full order through the shaped tank's JAX factors (solve/factored.py; the box's fast
-    diagonalization needs the box grid)."""
+    diagonalization needs the box grid): the stabilized element, given (the default there is "rt")."""
     text = _scene_text('shape = "cylinder"\naxis = "z"', mesh="[6, 6, 3]", duration="0.2")
+    text = text.replace("[tanks.fluid]", '[tanks.fluid]\nelement = "stabilized"')
     dense = js.simulate(js.load_scene(text.replace("save_every = 1", 'save_every = 1\nlinear_solver = "dense"')))
     sparse = js.simulate(js.load_scene(text.replace("save_every = 1", 'save_every = 1\nlinear_solver = "sparse"')))
     assert dense.status == sparse.status == "ok"

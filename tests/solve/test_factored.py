@@ -70,6 +70,7 @@ def _scene_text(solver, duration="0.15", extra=""):
     t = t.replace("point = [4.5, 2.5, 0.0]", "point = [1.5, 3.0, 0.0]").replace("point = [4.5, 2.5, 3.0]",
                                                                                    "point = [1.5, 5.0, 3.5]")
     t = t.replace('walls = "rigid"\n', 'walls = "rigid"\n' + CHAMFERS + "\n")
+    t = t.replace("[tanks.fluid]", '[tanks.fluid]\nelement = "stabilized"')      # the nodal blocks' factors
     return t.replace("[simulation]", f'[simulation]\nlinear_solver = "{solver}"\n{extra}', 1)
 
 
