@@ -312,6 +312,7 @@ def test_rao_of_an_rt_tank_full_and_reduced():
     assert abs(peak(full) / peak(st) - 1) < 0.01, (peak(full), peak(st))
 
 
+@pytest.mark.slow          # the sweep over density and sound speed covers rt tank values in a batch
 def test_a_sweep_of_the_damping_ratio_on_an_rt_tank_equals_the_single_runs():
     """js.simulate_batch (what `jaxslosh sweep` runs) over tanks.<name>.damping.ratio on an rt tank,
     full order and reduced: each run equals its single run."""

@@ -205,6 +205,7 @@ def test_uniform_motion_does_not_drive_sloshing():
     np.testing.assert_allclose(r1[0], r0[0], rtol=1e-10, atol=1e-9)
 
 
+@pytest.mark.slow
 def test_cylinder_turning_about_its_axis_keeps_its_waves_still():
     """An upright cylinder turning steadily at Omega about its axis leaves its liquid's absolute motion
     alone (a potential flow has no way to take up the turning): a wave pattern standing still in space
