@@ -15,14 +15,14 @@ import scipy.sparse as sp
 from jax.scipy.linalg import block_diag as jax_block_diag
 from scipy.linalg import block_diag
 
-from ..fem.face_schur import face_schur, mass_bounds
+from ..fem.face_schur import face_schur, mass_bounds, project_pools
 from ..fem.liquid_rt import ROTATION_PENALTY_RATIO, FaceLiquid, _gauss, _loads, _Mixed, face_modes
 from ..fem.mesh import box_gauss_points
 from ..fem.walls_rt import build_face_tank_with_walls, wall_points
 from ..physics.face_blocks import FaceOps, FaceStiffness
 from ..physics.face_liquid import FluxLiquid
 from ..scene.types import RT_FULL_FACES, SceneError
-from ..solve.face_inverse import mass_inverse, project_pools
+from ..solve.face_inverse import mass_inverse
 
 #: free faces above which a full-order "rt" tank is refused on the dense path (its dense blocks: M, K
 #: and two inverses); the sparse path (fem/face_schur.py) has no such limit
@@ -177,7 +177,7 @@ def scaled_start(parts, K, Minv):
     ys, u0, rho_n = [], [], []
     for p, Y, wi, r, N in zip(parts, K.Y, K.winv, K.rho, K.pools):
         w1 = r * wi                                                        # W'^-1
-        Gp = project_pools((jnp.diag(1.0 / wi) - Y) / (r * p["kappa"]), w1, N)
+        Gp = project_pools((jnp.diag(1.0 / wi) - Y) / (r * p["kappa"]), w1, N, jnp)
         Gz = Gp @ p["z0"]
         ys.append(Gz / p["kappa"] - Gp @ (w1[:, None] * Gz))
         u0.append(p["u0"] / p["kappa"])

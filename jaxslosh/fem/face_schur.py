@@ -115,27 +115,37 @@ def face_schur(model) -> FaceSchur:
     a = float(np.trace(G)) / ny
     cho = sl.cho_factor(G + a * (N @ N.T), lower=True, check_finite=False)
     Gp = sl.cho_solve(cho, np.eye(ny), check_finite=False) - (N @ N.T) / a      # Moore-Penrose
-    # onto the W^-1-orthogonal complement of the pools: Q G^+ Q^T, Q = I - N (N^T W^-1 N)^-1 N^T W^-1
+    return FaceSchur(f=f, B=B, winv=winv, M=M, Mlu=Mlu, G=G, Gp=project_pools(Gp, winv, N), N=N)
+
+
+def project_pools(Gp, winv, N, xp=np):
+    """Q G^+ Q^T, Q = I - N (N^T W^-1 N)^-1 N^T W^-1: the generalized inverse onto the W^-1-orthogonal
+    complement of the pools, whose closed forms hold for this W (`xp` = jax.numpy where W is traced:
+    solve/face_inverse.py, assemble/face_liquid.py)."""
     WN = winv[:, None] * N
-    C = np.linalg.inv(N.T @ WN)
+    C = xp.linalg.inv(N.T @ WN)
     Z = Gp @ WN @ C
-    Gp = Gp - Z @ N.T - N @ Z.T + N @ (C @ (WN.T @ Z)) @ N.T
-    return FaceSchur(f=f, B=B, winv=winv, M=M, Mlu=Mlu, G=G, Gp=0.5 * (Gp + Gp.T), N=N)
+    out = Gp - Z @ N.T - N @ Z.T + N @ (C @ (WN.T @ Z)) @ N.T
+    return 0.5 * (out + out.T)
 
 
-def schur_inverse(Y, winv, kappa: float, c: float) -> np.ndarray:
+def schur_inverse(Y, winv, kappa, c: float, r=1.0, N=None, xp=np, linalg=sl):
     """H_c of the module's docstring from Y = W - kappa G^+ (the stiffness's dense block), W^-1 and
-    kappa: C^-1 r = M^-1 (r / (c + kappa) - B^T H_c B M^-1 r). c > 0."""
-    Y = np.asarray(Y)
-    Gp = (np.diag(1.0 / winv) - Y) / kappa
-    s = np.sqrt(winv)
+    kappa: C^-1 r = M^-1 (r / (c + kappa) - B^T H_c B M^-1 r). c > 0. At scaled values (mass rho_s =
+    r, W'^-1 = r W_s^-1, with the pools' null vectors N): r H'_c, so that C^-1 r = M_s^-1 (r / (c +
+    kappa) - B^T (r H'_c) B M_s^-1 r); `xp`, `linalg`: jax.numpy and jax.scipy.linalg for traced
+    values."""
+    w1 = r * winv
+    Gp = (xp.diag(1.0 / winv) - xp.asarray(Y)) / (r * kappa)
+    if N is not None:
+        Gp = project_pools(Gp, w1, N, xp)
+    s = xp.sqrt(w1)
     S = s[:, None] * Gp * s[None, :]
     n = S.shape[0]
-    cho = sl.cho_factor(np.eye(n) + c * S, lower=True, check_finite=False)
-    R = sl.cho_solve(cho, np.eye(n), check_finite=False)              # (I + c S)^-1
-    H = (np.eye(n) - R) / (c * c) - (kappa / (c * (c + kappa))) * S
-    H = H / s[:, None] / s[None, :]
-    return 0.5 * (H + H.T)
+    cho = linalg.cho_factor(xp.eye(n) + c * S, lower=True)
+    R = linalg.cho_solve(cho, xp.eye(n))                                # (I + c S)^-1
+    H = ((xp.eye(n) - R) / (c * c) - (kappa / (c * (c + kappa))) * S) / s[:, None] / s[None, :]
+    return r * 0.5 * (H + H.T)
 
 
 def mass_bounds(M, Mlu=None) -> tuple[float, float]:

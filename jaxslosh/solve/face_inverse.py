@@ -97,31 +97,6 @@ class BlockInverse(eqx.Module):
         return self.minv @ (s * r - ops.BT([H @ y for H, y in zip(self.H, ys)]))
 
 
-def project_pools(Gp, winv, N):
-    """Q G^+ Q^T, Q = I - N (N^T W^-1 N)^-1 N^T W^-1: the generalized inverse whose closed forms
-    (fem/face_schur.py) hold for this W (JAX: W may be traced)."""
-    WN = winv[:, None] * N
-    C = jnp.linalg.inv(N.T @ WN)
-    Z = Gp @ WN @ C
-    out = Gp - Z @ N.T - N @ Z.T + N @ (C @ (WN.T @ Z)) @ N.T
-    return 0.5 * (out + out.T)
-
-
-def scaled_schur_inverse(Y, winv, kappa, c: float, r, N):
-    """r H'_c: fem/face_schur.py schur_inverse (in JAX) of a tank at scaled values, its mass rho_s = r
-    (c M_s + K_s = r (c M + K'), K' = kappa M + B^T (Y / r) B, W'^-1 = r W_s^-1), so that
-    C^-1 r = M_s^-1 (r / (c + kappa) - B^T (r H'_c) B M_s^-1 r)."""
-    w1 = r * winv
-    Gp = project_pools((jnp.diag(1.0 / winv) - Y) / (r * kappa), w1, N)
-    s = jnp.sqrt(w1)
-    S = s[:, None] * Gp * s[None, :]
-    n = S.shape[0]
-    cho = jax.scipy.linalg.cho_factor(jnp.eye(n) + c * S, lower=True)
-    R = jax.scipy.linalg.cho_solve(cho, jnp.eye(n))                      # (I + c S)^-1
-    H = ((jnp.eye(n) - R) / (c * c) - (kappa / (c * (c + kappa))) * S) / s[:, None] / s[None, :]
-    return r * 0.5 * (H + H.T)
-
-
 def face_solver_blocks(liquid, c_step: float, c_sub=None):
     """(Cinv_step, Cinv_mass, Cinv_sub or None, sum_j |K_ij| per row) of a sparse FluxLiquid
     (solve/linear.make_solver): H_c per tank from its Y, W^-1 and kappa (host, float64; in JAX from
@@ -137,7 +112,7 @@ def face_solver_blocks(liquid, c_step: float, c_sub=None):
             H = tuple(jnp.asarray(schur_inverse(np.asarray(Y), np.asarray(wi), float(k), c))
                       for Y, wi, k in zip(K.Y, K.winv, np.asarray(K.kappas)))
             return BlockInverse(mi, jnp.asarray(1.0 / (c + np.asarray(K.kappa_n))), H)
-        H = tuple(scaled_schur_inverse(sg(Y), sg(wi), sg(K.kappas[i]), c, sg(r), sg(N))
+        H = tuple(schur_inverse(sg(Y), sg(wi), sg(K.kappas[i]), c, sg(r), sg(N), jnp, jax.scipy.linalg)
                   for i, (Y, wi, r, N) in enumerate(zip(K.Y, K.winv, K.rho, K.pools)))
         return BlockInverse(mi, 1.0 / (c + sg(K.kappa_n)), H)
 
