@@ -16,6 +16,11 @@ still linear and the tank models agree) the measured one: a calibration on the f
 the other nine seconds predicted; a third adds to it the laminar boundary-layer damping (ratio
 0.003) that the tank's walls give the first mode.
 
+After the documented forcing's rows it prints each record's components over the scored window
+(tests/record_components.py: the forced wave, the free first mode and their second-order products,
+frequencies fitted): what the rig's start sets (the free wave against the forced one) apart from what
+the liquid does with them.
+
 The rig's start-up is not published, so the cases after the first identify it on the first half-period
 alone (t < 0.8 s, the first trough: the linear regime, where linear theory, the multimodal tank and the
 fully nonlinear potential flow agree), by least squares with the closed form of linear theory (60
@@ -53,6 +58,7 @@ import jaxslosh as js  # noqa: E402
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT / "tests"))
 from hos_sloshing import hos_tank  # noqa: E402
+from record_components import COMPONENTS, components, fitted_components  # noqa: E402
 from scipy.optimize import minimize  # noqa: E402
 from scipy.signal import fftconvolve  # noqa: E402
 
@@ -129,6 +135,15 @@ def scored_errors(t, z, tm, zm):
         return np.sqrt(np.mean((zi[sel] - zm[sel]) ** 2)) / top
     return (rms(early), rms(~early), (z[window].max() - zm[~early].max()) / top,
             (z[window].min() - zm[~early].min()) / top, z[window].max() / -z[window].min())
+
+
+def record_components(t, z, t0=EARLY, t1=9.9, w=None):
+    """The record's components (tests/record_components.py) over t0 to t1, its two frequencies
+    fitted from the forcing's and linear theory's first mode's unless given."""
+    if w is not None:
+        return components(t, z, t0, t1, w)
+    k = np.pi / L
+    return fitted_components(t, z, t0, t1, [W, np.sqrt(G * k * np.tanh(k * H))])
 
 
 def linear_theory(acceleration, n=60):
@@ -224,6 +239,8 @@ def main():
     for model, label in (("multimodal", mm), ("fem", fem)):
         row(documented, label, *elevation(scene_text(model, A)))
     row(documented, nl, *hos(lambda s: -A * W ** 2 * np.cos(W * s)))
+    print_components(tm, zm, {**{label: tz for (case, label), tz in runs.items() if case == documented},
+                              "linear theory (closed form)": (T, linear_theory(harmonic_acceleration(A)))})
 
     # 1. the amplitude that makes the first trough the measured one
     zl = linear_theory(harmonic_acceleration(A))
@@ -277,6 +294,25 @@ def main():
 
     if args.plot:
         plot(args.plot, runs, tm, zm)
+
+
+def print_components(tm, zm, records):
+    """The components of the measured record and of each model's at the documented forcing, over the
+    scored window and (the free wave's) over its two halves: what the rig's start sets (the free wave
+    against the forced one) apart from what the liquid does with them (frequencies, products)."""
+    half = 0.5 * (EARLY + tm[-1])
+    print(f"\ncomponents over {EARLY} to {tm[-1]} s (amplitudes in mm; the free wave also over each half, at the "
+          "whole window's frequencies):")
+    print(f"{'record':<44} {'w forced':>9} {'w free':>8} " + " ".join(f"{c:>10}" for c in COMPONENTS)
+          + f" {'free/forced':>12} {'free, 1st half':>15} {'2nd half':>9}")
+    for label, (t, z) in {"measured": (tm, zm), **records}.items():
+        w, a, _ = record_components(t, z)
+        first = record_components(t, z, EARLY, half, w)[1][1]
+        second = record_components(t, z, half, tm[-1], w)[1][1]
+        print(f"{label:<44} {w[0]:>9.4f} {w[1]:>8.4f} " + " ".join(f"{1000 * x:>10.1f}" for x in a)
+              + f" {a[1] / a[0]:>12.2f} {1000 * first:>15.1f} {1000 * second:>9.1f}")
+    print("(every start of a harmonic forcing from rest sets the free wave against the forced one; the "
+          "models agree on it, the measured record does not)\n")
 
 
 def plot(path, runs, tm, zm):

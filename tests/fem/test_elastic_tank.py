@@ -49,12 +49,12 @@ def test_liquid_follows_the_walls_in_the_normal_direction_only():
 
 
 def test_sloshing_frequencies_tend_to_the_rigid_tank_values_as_the_walls_stiffen():
-    """The first five sloshing frequencies with 10 cm walls of E = 2e9 ... 2.1e13 Pa: the error
-    against the rigid tank falls monotonically and ends below 1e-4 (measured errors of the first
-    mode: -0.69 %, -0.068 %, -0.0071 %, -7e-7)."""
+    """The first five sloshing frequencies with 10 cm walls of E = 2e9, 2.1e11 and 2.1e13 Pa: the
+    error against the rigid tank falls monotonically and ends below 1e-4 (measured errors of the
+    first mode: -0.69 %, -0.0071 %, -7e-7)."""
     rigid = liquid_modes(_liquid(), n=5).omega
     errs = []
-    for E in (2e9, 2.1e10, 2.1e11, 2.1e13):
+    for E in (2e9, 2.1e11, 2.1e13):
         md = tank_modes(build_tank_with_walls(_tank(E), _liquid()), n=8)
         slosh = md.omega[[k == "sloshing" for k in md.kind]][:5]
         errs.append(np.max(np.abs(slosh / rigid - 1)))
