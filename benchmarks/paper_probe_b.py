@@ -134,7 +134,9 @@ def _table(stats):
             r0 = ref.get(("peak", "rms")[j])
             base = r0[0] if r0 is not None else (stats[finest][j] if finest else np.nan)
             cols.append(100 * (v / base - 1))
-        d = 100 * np.sqrt(np.mean((z - stats[finest][2]) ** 2)) / stats[finest][1] if finest else np.nan
+        zf = stats[finest][2] if finest else None
+        n = min(len(z), len(zf)) if finest else 0     # a run that stopped early: over its steps
+        d = 100 * np.sqrt(np.mean((z[:n] - zf[:n]) ** 2)) / stats[finest][1] if finest else np.nan
         print(f"{name:<40} {pk:9.5f} {rms:9.5f} {cols[0]:+11.2f}% {cols[1]:+10.2f}% {d:18.2f}%")
     for what in ("peak", "rms"):
         if what in ref:
