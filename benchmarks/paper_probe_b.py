@@ -4,7 +4,16 @@ the run, the finite elements' converged value by Richardson extrapolation (where
 monotone), and each variant's difference from it. Prints a table.
 
     python benchmarks/paper_probe_b.py [--duration T] [--meshes 5,8,10] [--modes 6,12] [--flow3d 5,8,12]
-                                       [--no-coriolis 8] [--omega 0.1,0.05,0]
+                                       [--no-coriolis 8] [--omega 0.1,0.05,0] [--scale s]
+                                       [--expansion third-order] [--save out.npz]
+    python benchmarks/paper_probe_b.py --table a.npz,b.npz,...
+
+--element sets the finite elements' `tanks.fluid.element` ("rt": the face-normal element).
+--scale multiplies the initial angular velocity and divides the elevations by it (s = 0.01: the
+linear limit, where the second-order part of the response vanishes). --expansion is the multimodal
+tanks' `tanks.expansion`. --save writes every variant's record as soon as it has run (one .npz,
+rewritten after each), and --table prints the table of saved records without running anything
+(their variants in the order given; the finite elements' meshes among them give the reference).
 
 --modes are two-dimensional multimodal tanks (waves along x only), --flow3d three-dimensional ones
 (flow = "3d": the lowest modes of the square base, whole degenerate pairs), --no-coriolis finite
@@ -55,19 +64,41 @@ def main():
     ap.add_argument("--no-coriolis", default="", help="finite-element meshes run without the Coriolis load (comma list)")
     ap.add_argument("--save", default="", help="write probe B's vertical displacement of every variant here (.npz)")
     ap.add_argument("--omega", default="0.1,0.05,0.0", help="the initial angular velocity (rad/s; the paper's)")
+    ap.add_argument("--scale", type=float, default=1.0, help="multiplies the initial angular velocity; "
+                    "the elevations are divided by it")
+    ap.add_argument("--expansion", default="exact", help="the multimodal tanks' tanks.expansion")
+    ap.add_argument("--element", default="", help="the finite elements' tanks.fluid.element (the scene's "
+                    "default: \"stabilized\")")
+    ap.add_argument("--table", default="", help="print the table of these saved records (comma list) and stop")
     args = ap.parse_args()
+    if args.table:
+        stats, t = {}, None
+        for f in args.table.split(","):
+            with np.load(f) as d:
+                t = d["time"] if t is None else t
+                for k in d.files:
+                    if k != "time":
+                        z = d[k]
+                        stats[k] = (np.abs(z).max(), np.sqrt(np.mean(z ** 2)), z)
+        _table(stats)
+        return
     text = open("scenes/paper_ship_tank.toml").read().replace("duration = 20.0", f"duration = {args.duration}")
-    omega = [float(x) for x in args.omega.split(",")]
+    omega = [args.scale * float(x) for x in args.omega.split(",")]
+    mm = "" if args.expansion == "exact" else f'\nexpansion = "{args.expansion}"'
+    tag = "" if args.expansion == "exact" else f", {args.expansion}"
     text = text.replace("angular_velocity = [0.1, 0.05, 0.0]", f"angular_velocity = {omega}")
+    fe_text = text.replace("sound_speed = 1500.0", f'sound_speed = 1500.0\nelement = "{args.element}"') \
+        if args.element else text
+    el = f", {args.element}" if args.element else ""
     variants = {}
     for n in [int(x) for x in args.meshes.split(",") if x]:
-        variants[f"fem {n}x{n}x{n}"] = text.replace("mesh = [5, 5, 5]", f"mesh = [{n}, {n}, {n}]")
+        variants[f"fem {n}x{n}x{n}{el}"] = fe_text.replace("mesh = [5, 5, 5]", f"mesh = [{n}, {n}, {n}]")
     for m in [int(x) for x in args.modes.split(",") if x]:
-        variants[f"multimodal 2d, {m} modes"] = text.replace('mesh = [5, 5, 5]\nwalls = "rigid"',
-                                                            f'model = "multimodal"\nmodes = {m}')
+        variants[f"multimodal 2d, {m} modes{tag}"] = text.replace('mesh = [5, 5, 5]\nwalls = "rigid"',
+                                                                 f'model = "multimodal"\nmodes = {m}{mm}')
     for m in [int(x) for x in args.flow3d.split(",") if x]:
-        variants[f"multimodal 3d, {m} modes"] = text.replace('mesh = [5, 5, 5]\nwalls = "rigid"',
-                                                            f'model = "multimodal"\nflow = "3d"\nmodes = {m}')
+        variants[f"multimodal 3d, {m} modes{tag}"] = text.replace(
+            'mesh = [5, 5, 5]\nwalls = "rigid"', f'model = "multimodal"\nflow = "3d"\nmodes = {m}{mm}')
     for n in [int(x) for x in args.no_coriolis.split(",") if x]:
         variants[f"fem {n}x{n}x{n}, no Coriolis"] = (text.replace("mesh = [5, 5, 5]", f"mesh = [{n}, {n}, {n}]")
                                                     + "\n[effects]\ncoriolis = false\n")
@@ -75,13 +106,18 @@ def main():
     for name, t in variants.items():
         t0 = time.perf_counter()
         r = js.simulate(js.load_scene(t))
-        z = np.asarray(r.probes["B"].displacement)[:, 2]
+        z = np.asarray(r.probes["B"].displacement)[:, 2] / args.scale
         stats[name] = (np.abs(z).max(), np.sqrt(np.mean(z ** 2)), z)
         print(f"# {name}: {r.status}, {time.perf_counter() - t0:.0f} s, peak {stats[name][0]:.5f} m, "
               f"rms {stats[name][1]:.5f} m", flush=True)
-    if args.save:
-        np.savez(args.save, time=np.asarray(r.time), **{k: v[2] for k, v in stats.items()})
-    fem = [k for k in stats if k.startswith("fem") and "Coriolis" not in k]
+        if args.save:
+            np.savez(args.save, time=np.asarray(r.time), **{k: v[2] for k, v in stats.items()})
+    _table(stats)
+
+
+def _table(stats):
+    fem = sorted((k for k in stats if k.startswith("fem") and "Coriolis" not in k),
+                 key=lambda k: int(k.split()[1].split("x")[0]))
     ref = {}
     if len(fem) >= 3:
         h = [1.0 / int(k.split()[1].split("x")[0]) for k in fem[-3:]]
@@ -90,7 +126,7 @@ def main():
             if ex is not None:
                 ref[what] = ex
     finest = fem[-1] if fem else None
-    print(f"\n{'tank':<26} {'peak m':>9} {'rms m':>9} {'peak vs ref':>12} {'rms vs ref':>11} "
+    print(f"\n{'tank':<40} {'peak m':>9} {'rms m':>9} {'peak vs ref':>12} {'rms vs ref':>11} "
           f"{'rms diff vs finest':>19}")
     for name, (pk, rms, z) in stats.items():
         cols = []
@@ -98,13 +134,16 @@ def main():
             r0 = ref.get(("peak", "rms")[j])
             base = r0[0] if r0 is not None else (stats[finest][j] if finest else np.nan)
             cols.append(100 * (v / base - 1))
-        d = 100 * np.sqrt(np.mean((z - stats[finest][2]) ** 2)) / stats[finest][1] if finest else np.nan
-        print(f"{name:<26} {pk:9.5f} {rms:9.5f} {cols[0]:+11.2f}% {cols[1]:+10.2f}% {d:18.2f}%")
+        zf = stats[finest][2] if finest else None
+        n = min(len(z), len(zf)) if finest else 0     # a run that stopped early: over its steps
+        d = 100 * np.sqrt(np.mean((z[:n] - zf[:n]) ** 2)) / stats[finest][1] if finest else np.nan
+        print(f"{name:<40} {pk:9.5f} {rms:9.5f} {cols[0]:+11.2f}% {cols[1]:+10.2f}% {d:18.2f}%")
     for what in ("peak", "rms"):
         if what in ref:
             print(f"# {what}: Richardson over {', '.join(fem[-3:])}: {ref[what][0]:.5f} m (order {ref[what][1]:.2f})")
         else:
-            why = "not monotone" if len(fem) >= 3 else "fewer than three meshes"
+            why = ("not monotone, or no order p in (0.05, 8) fits" if len(fem) >= 3
+                   else "fewer than three meshes")
             print(f"# {what}: the finite elements' sequence: {why}: no extrapolation; differences against {finest}")
 
 
