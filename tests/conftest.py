@@ -58,7 +58,19 @@ def _cache_folder_off():
 
 @pytest.fixture(autouse=True, scope="module")
 def _free_compiled_code():
-    """Each test module compiles its own scenes; dropping the compiled executables after a module
-    keeps the suite's memory flat (a whole run otherwise grows past several GB)."""
+    """Dropping the compiled executables after a module keeps the suite's memory flat (a whole run
+    otherwise grows past several GB), but costs every later module its compiles again, the many
+    small programs of eager operations during model building included (seconds per module). So
+    they are dropped only once the worker holds more than _KEEP_BYTES."""
     yield
-    jax.clear_caches()
+    if _resident_bytes() > _KEEP_BYTES:
+        jax.clear_caches()
+
+
+#: a worker's resident memory above which the compiled executables are dropped after a module
+_KEEP_BYTES = 3 << 30
+
+
+def _resident_bytes():
+    with open("/proc/self/statm") as f:
+        return int(f.read().split()[1]) * os.sysconf("SC_PAGE_SIZE")

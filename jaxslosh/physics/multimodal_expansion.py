@@ -37,9 +37,17 @@ def _coefficients(tank):
     z = jnp.zeros(tank.n)
     M = tank.mass_matrix
     M1 = jax.jacfwd(M)(z)
-    M2 = 0.5 * jax.jacfwd(jax.jacfwd(M))(z)
     S = tank.first_moment
-    S2 = 0.5 * jax.jacfwd(jax.jacfwd(S))(z)
+
+    def hessian(f):
+        # one mode's column of second derivatives at a time (lax.map): nested jacfwd would carry all
+        # N^2 directions through the quadrature at once, whose memory grows as N^2 (a 30-mode
+        # three-dimensional tank took 20 GB); by columns it grows as N, for the same arithmetic
+        def column(e):
+            return jax.jacfwd(lambda b: jax.jvp(f, (b,), (e,))[1])(z)
+        return jnp.moveaxis(jax.lax.map(column, jnp.eye(tank.n)), 0, -2)
+    M2 = 0.5 * hessian(M)
+    S2 = 0.5 * hessian(S)
     sym = lambda a: 0.5 * (a + jnp.swapaxes(a, -1, -2))  # noqa: E731
     return M(z), M1, sym(M2), S(z), jax.jacfwd(S)(z), sym(S2)
 
