@@ -334,26 +334,39 @@ def test_a_sweep_over_density_and_sound_speed_of_an_rt_tank_equals_the_single_ru
     """Traced tank values with "rt": the model is built at the scene's values and its mass,
     compression and free-surface blocks scale with the density, rho c^2 and rho g. At full order a
     batch over the density and the sound speed equals the single runs with those values (1e-6 of
-    the peak); on modes (whose shapes do not depend on the density) a batch over the density does.
-    The fill depth on modes (their shapes are the scene's fill's) is refused naming the key."""
-    base = HELD.format(duration=1.0, dt=0.01, scheme="newmark", alpha=0.0).replace(
-        'dof = "surge"\namplitude = 0.0', 'dof = "roll"\namplitude = 0.02').replace("frequency = 1.0", "frequency = 5.0")
-    base += '[[probes]]\nname = "c"\ntank = "tank"\npoint = [0.0, 0.0, 0.5]\n'
-    for extra, keys in (("", {"fluid.density": [1000.0, 1300.0], "fluid.sound_speed": [1500.0, 900.0]}),
-                        ("[tanks.reduction]\nmodes = 6\n", {"fluid.density": [1000.0, 1300.0]})):
-        text = base + FULL.replace("[tanks.fluid]\n", "[tanks.fluid]\ndensity = 1000.0\nsound_speed = 1500.0\n") + extra
-        batch, statuses = js.simulate_batch(js.load_scene(text), {f"tanks.tank.{k}": np.array(v) for k, v in keys.items()})
-        assert statuses == ["ok", "ok"]
-        one_text = text
-        for k, v in keys.items():
-            name = k.split(".")[-1]
-            one_text = one_text.replace(f"{name} = {v[0]}", f"{name} = {v[1]}")
-        one = js.simulate(js.load_scene(one_text))
-        za = np.asarray(one.probes["c"].displacement)[:, 2]
-        zb = np.asarray(batch.probes["c"].displacement)[1, :, 2]
-        assert np.abs(zb - za).max() < 1e-6 * np.abs(za).max(), (extra, np.abs(zb - za).max(), np.abs(za).max())
-        ra, rb = np.asarray(one.energy.kinetic), np.asarray(batch.energy.kinetic)[1]
-        assert np.abs(ra - rb).max() < 1e-6 * np.abs(ra).max()
+    the peak). The fill depth on modes (their shapes are the scene's fill's) is refused naming the key."""
+    base = _sweep_base()
+    _sweep_equals_single_runs(base, "", {"fluid.density": [1000.0, 1300.0], "fluid.sound_speed": [1500.0, 900.0]})
     with pytest.raises(js.SceneError, match=r"tanks\[0\].fill_depth"):      # on modes (full order: test_gradients_rt)
         js.simulate_batch(js.load_scene(base + FULL + "[tanks.reduction]\nmodes = 6\n"),
                           {"tanks.tank.fill_depth": np.array([0.5, 0.45])})
+
+
+# slow, to keep the default suite within its budget: the full-order sweep above stays in it
+@pytest.mark.slow
+def test_a_density_sweep_of_a_reduced_rt_tank_equals_the_single_runs():
+    """On modes, whose shapes do not depend on the density, a batch over it equals the single runs."""
+    _sweep_equals_single_runs(_sweep_base(), "[tanks.reduction]\nmodes = 6\n", {"fluid.density": [1000.0, 1300.0]})
+
+
+def _sweep_base():
+    base = HELD.format(duration=1.0, dt=0.01, scheme="newmark", alpha=0.0).replace(
+        'dof = "surge"\namplitude = 0.0', 'dof = "roll"\namplitude = 0.02').replace("frequency = 1.0", "frequency = 5.0")
+    return base + '[[probes]]\nname = "c"\ntank = "tank"\npoint = [0.0, 0.0, 0.5]\n'
+
+
+def _sweep_equals_single_runs(base, extra, keys):
+    """A batch over the tank's `keys` (two values each) equals the single run with the second values."""
+    text = base + FULL.replace("[tanks.fluid]\n", "[tanks.fluid]\ndensity = 1000.0\nsound_speed = 1500.0\n") + extra
+    batch, statuses = js.simulate_batch(js.load_scene(text), {f"tanks.tank.{k}": np.array(v) for k, v in keys.items()})
+    assert statuses == ["ok", "ok"]
+    one_text = text
+    for k, v in keys.items():
+        name = k.split(".")[-1]
+        one_text = one_text.replace(f"{name} = {v[0]}", f"{name} = {v[1]}")
+    one = js.simulate(js.load_scene(one_text))
+    za = np.asarray(one.probes["c"].displacement)[:, 2]
+    zb = np.asarray(batch.probes["c"].displacement)[1, :, 2]
+    assert np.abs(zb - za).max() < 1e-6 * np.abs(za).max(), (extra, np.abs(zb - za).max(), np.abs(za).max())
+    ra, rb = np.asarray(one.energy.kinetic), np.asarray(batch.energy.kinetic)[1]
+    assert np.abs(ra - rb).max() < 1e-6 * np.abs(ra).max()

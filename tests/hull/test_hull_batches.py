@@ -120,6 +120,9 @@ def test_seas_of_a_batch_equal_the_cases_run_alone():
     assert heave[1].std() > 1.5 * heave[0].std()
 
 
+# slow: the default suite has a batch of seas of the nonlinear model equal to the cases run alone
+# (test_seas_of_a_batch_equal_the_cases_run_alone) and campaigns on local clusters (tests/campaign)
+@pytest.mark.slow
 def test_campaign_on_a_local_cluster_equals_the_cases_run_alone(tmp_path, monkeypatch):
     from dask.distributed import Client, LocalCluster
     monkeypatch.setenv("PYTHONPATH", os.pathsep.join([str(ROOT), str(ROOT / "tests"),

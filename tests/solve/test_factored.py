@@ -164,6 +164,9 @@ sound_speed = 1500.0
 """
 
 
+# slow: the default suite has a batch through this tank (test_a_batch_through_a_prismatic_tank_is_its_single_runs)
+# and the campaign worker's batches of a box (tests/campaign)
+@pytest.mark.slow
 def test_a_campaign_batch_through_a_prismatic_tank_gives_the_statistics_of_its_single_run(tmp_path):
     """A campaign worker's batch (two sea states, vmapped) through a shaped tank: each case's roll
     statistics are those of `js.simulate` of the case's own scene (measured: 3e-10 relative; the
