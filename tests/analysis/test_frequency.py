@@ -282,6 +282,9 @@ def test_vessel_with_a_stiff_mast_linearises_with_its_multipliers():
     assert np.abs(P @ u - rigid).max() < 1e-6 * np.abs(rigid).max()
 
 
+# slow, for the default suite's budget: it keeps the elastic walls' sloshing frequencies against the rigid
+# tank's (tests/fem/test_elastic_tank.py)
+@pytest.mark.slow
 def test_elastic_tank_walls_leave_the_coupled_sloshing_mode():
     """The paper's tank with 5 cm steel walls (scenes/paper_ship_elastic_tank.toml): the coupled
     roll and first sloshing frequencies within 0.5 % of the rigid tank's."""

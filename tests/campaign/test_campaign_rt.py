@@ -5,6 +5,7 @@ import os
 from pathlib import Path
 
 import numpy as np
+import pytest
 from dask.distributed import Client, LocalCluster
 
 import jaxslosh as js
@@ -36,6 +37,9 @@ ratio = 0.05
 SCATTER = "hs,tp,occurrences\n0.6,7.0,100\n"
 
 
+# slow, for the default suite's budget: it keeps an rt tank's batches equal to its single runs
+# (tests/analysis/test_rt_runs.py) and campaigns on local clusters (tests/campaign/test_campaign.py)
+@pytest.mark.slow
 def test_a_campaign_with_an_rt_tank_gives_the_statistics_of_single_runs(tmp_path, monkeypatch):
     monkeypatch.setenv("PYTHONPATH", os.pathsep.join([str(ROOT), os.environ.get("PYTHONPATH", "")]))
     monkeypatch.setenv("JAXSLOSH_PROGRESS", "0")

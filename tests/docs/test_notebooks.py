@@ -28,6 +28,8 @@ def test_accuracy_vs_cost_notebook_runs():
     assert "Pareto front (probe B)" in text and "machine" in text
 
 
+# slow, for the default suite's budget: the quickstart notebook and the fitting one run in it
+@pytest.mark.slow
 def test_waves_notebook_runs():
     text = printed(run_notebook("waves.ipynb", {"JAXSLOSH_NOTEBOOK_SMALL": "1"}))
     assert "with liquid: ok | frozen: ok" in text and "roll std" in text and "ok" in text

@@ -169,6 +169,9 @@ def test_keys_and_warnings(tmp_path, capsys):
     assert "roof" in err and "multimodal" in err, err
 
 
+# slow, for the default suite's budget: it keeps a batch of multimodal tanks equal to its single runs
+# (tests/solve/test_batch_fresh_redo.py)
+@pytest.mark.slow
 def test_batch_of_fill_depths_matches_single_runs():
     """simulate_batch takes a multimodal tank: each run of a batch is the single run's."""
     scene = js.load_scene(FORCED.format(duration=1.0, amplitude=0.005, w=5.0, ratio=0.02))

@@ -148,6 +148,9 @@ def test_density_sweep_finishes_and_equals_single_runs(tmp_path):
     assert np.abs(probe[0] - probe[-1]).max() > 1e-7          # the runs did get their own densities
 
 
+# slow, for the default suite's budget (it compiles a batch program only to read it): the density
+# batches below run in it
+@pytest.mark.slow
 def test_no_batched_lapack_call_in_a_density_batch():
     """What made the deadlock possible, checked on the compiled program (whatever the machine): no
     LAPACK kernel gets a batch that it would split over the thread pool (jaxlib splits above 2e5

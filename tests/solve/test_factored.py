@@ -89,6 +89,9 @@ def test_a_prismatic_tank_moves_as_with_the_host_lu():
     np.testing.assert_array_equal(jx.solver.iterations, host.solver.iterations)
 
 
+# slow, for the default suite's budget: it keeps gradients through runs with finite differences of a
+# box's tank (tests/run/test_gradients_liquid.py) and of an rt tank's fill depth (tests/run/test_gradients_rt.py)
+@pytest.mark.slow
 def test_a_gradient_through_a_prismatic_tank_agrees_with_finite_differences():
     scene = js.load_scene(_scene_text("sparse", duration="0.1"))
     key = "vessel.hydrostatics.gm_t"
