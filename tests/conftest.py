@@ -72,5 +72,10 @@ _KEEP_BYTES = 3 << 30
 
 
 def _resident_bytes():
-    with open("/proc/self/statm") as f:
-        return int(f.read().split()[1]) * os.sysconf("SC_PAGE_SIZE")
+    """The worker's resident memory; where /proc is not there (not Linux), as if above the limit (the
+    executables are dropped after every module, as before)."""
+    try:
+        with open("/proc/self/statm") as f:
+            return int(f.read().split()[1]) * os.sysconf("SC_PAGE_SIZE")
+    except OSError:
+        return _KEEP_BYTES + 1
