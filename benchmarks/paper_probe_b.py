@@ -105,7 +105,7 @@ def main():
     stats = {}
     for name, t in variants.items():
         t0 = time.perf_counter()
-        r = js.simulate(js.load_scene(t))
+        r = js.simulate(js.load_scene(t), throw=False)
         z = np.asarray(r.probes["B"].displacement)[:, 2] / args.scale
         stats[name] = (np.abs(z).max(), np.sqrt(np.mean(z ** 2)), z)
         print(f"# {name}: {r.status}, {time.perf_counter() - t0:.0f} s, peak {stats[name][0]:.5f} m, "

@@ -26,7 +26,7 @@ from ._version import __version__
 _PUBLIC = {
     "sloshing_modes": ".analysis.modes", "structure_modes": ".analysis.modes", "rao": ".analysis.rao",
 "identify": ".fit.identify", "Result": ".io.result", "load_result": ".io.result",
-    "save_result": ".io.result", "Status": ".io.status", "simulate_batch": ".run.batch",
+    "save_result": ".io.result", "Status": ".io.status", "RunResult": ".io.status", "simulate_batch": ".run.batch",
     "NumericalFailure": ".run.simulate", "simulate": ".run.simulate", "Stepper": ".run.stepper", "Scene": ".scene",
     "SceneError": ".scene", "load_scene": ".scene", "stability": ".analysis.stability",
 }

@@ -162,7 +162,8 @@ class Problem:
         # traced under jit: what does not depend on theta (the host-side assembly of the liquid
         # matrices, in NumPy) is evaluated while tracing, as it would be outside jit
         with jax.ensure_compile_time_eval():
-            return simulate(self.scene, params=self.sim_params(theta), duration=self.duration)
+            # a failed run is a point the fit steps back from (`ok` below), not an error
+            return simulate(self.scene, params=self.sim_params(theta), duration=self.duration, throw=False)
 
     def model_channels(self, r: Result, t_measured) -> dict:
         ch = channels_of(r, self.active)
@@ -177,7 +178,7 @@ class Problem:
         ch = self.model_channels(r, t_measured)
         model = jnp.stack([ch[k] for k in self.active])
         res = (w[:, None] * (model - meas)).reshape(-1)
-        ok = jnp.all(jnp.isfinite(res)) & (jnp.max(r.solver.residual) <= 100.0 * self.tol)
+        ok = r.ok & jnp.all(jnp.isfinite(res)) & (jnp.max(r.solver.residual) <= 100.0 * self.tol)
         return res, ok
 
     def _residual_jac(self, theta, data):

@@ -18,7 +18,7 @@ import numpy as np
 
 from .._version import __version__
 from .output import OutputLock, ensure_room
-from .status import Status, code_of
+from .status import TEXT, RunResult, Status, code_of, failure_text, outcome_of
 
 FORMAT = "jaxslosh.result"
 FORMAT_VERSION = 1
@@ -57,17 +57,69 @@ class TankField(eqx.Module):
     displacement: jax.Array      # (k, m, 3) tank frame, deformational
 
 
+class Failure(eqx.Module):
+    """Where a run's first numerical failure happened (leaves: traced under `jax.jit`): the step
+    (0 while none, or for the initial accelerations), its scaled residual and Newton iterations."""
+    step: jax.Array
+    residual: jax.Array
+    iterations: jax.Array
+
+
+def _is_traced(x) -> bool:
+    return any(isinstance(v, jax.core.Tracer) for v in jax.tree_util.tree_leaves(x))
+
+
 class Result(eqx.Module):
+    """A run's frames and how it ended. `outcome` (io.status.RunResult) is a leaf: right under
+    `jax.jit` and `vmap`, where a string cannot be; `status` and `status_code` read it (and
+    `failure`) once it is concrete. `steps` is the steps done, a leaf too (`steps_done` as an int)."""
     time: jax.Array
     vessel: VesselHistory
     probes: dict
     energy: Energy
     solver: SolverHistory
     tanks: dict
-    status: str = eqx.field(static=True, default="ok")
-    steps_done: int = eqx.field(static=True, default=0)
+    outcome: RunResult = eqx.field(default_factory=lambda: RunResult.ok)
+    steps: jax.Array = 0
+    failure: Optional[Failure] = None
+    note: str = eqx.field(static=True, default="")       # the host's own text of the ending, where it has one
     scene_text: str = eqx.field(static=True, default="")
-    status_code: int = eqx.field(static=True, default=0)     # io.status.Status
+    dt: float = eqx.field(static=True, default=0.0)       # to put the failed step's time in the text
+    tolerance: float = eqx.field(static=True, default=0.0)
+
+    @property
+    def status(self) -> str:
+        """"ok" or why the run stopped (SPEC's `status`: its step, time and residual). Inside a
+        transformation, where the outcome is not known yet, a sentence saying to read `outcome`."""
+        if self.note:
+            return self.note
+        if _is_traced(self.outcome):
+            return "traced: read result.outcome (io.status.RunResult) once the run is computed"
+        code = self.status_code
+        if code == Status.OK:
+            return "ok"
+        if Status(code).numerical and self.failure is not None and not _is_traced(self.failure):
+            f = self.failure
+            return failure_text(code, int(np.asarray(f.step).reshape(-1)[0]), self.dt,
+                                float(np.asarray(f.residual).reshape(-1)[0]),
+                                int(np.asarray(f.iterations).reshape(-1)[0]), self.tolerance)
+        return TEXT[Status(code)]
+
+    @property
+    def status_code(self) -> int:
+        """The outcome's io.status.Status code (the first failed run's, for a batch)."""
+        v = np.asarray(self.outcome._value).reshape(-1)
+        bad = v[v != 0]
+        return int(bad[0]) if bad.size else 0
+
+    @property
+    def steps_done(self) -> int:
+        return int(np.max(np.asarray(self.steps)))
+
+    @property
+    def ok(self):
+        """Whether the run ended well (a traced boolean inside a transformation)."""
+        return self.outcome == RunResult.ok
 
 
 def schema(probe_names=(), tank_nodes: Optional[dict] = None) -> dict:
@@ -136,20 +188,24 @@ def result_frames(r: Result) -> dict:
     return {k: np.asarray(v) for k, v in d.items()}
 
 
-def result_from(d: dict, probe_names=(), tanks: Optional[dict] = None, *, status: str = "ok", steps_done: int = 0,
-                scene_text: str = "", status_code: Optional[int] = None) -> Result:
+def result_from(d: dict, probe_names=(), tanks: Optional[dict] = None, *, status: str = "ok", steps_done=0,
+                scene_text: str = "", status_code=None, failure: Optional[Failure] = None, dt: float = 0.0,
+                tolerance: float = 0.0) -> Result:
     """A Result from {dataset: array} (the file's names; a leading batch axis is kept as it is) and
-    the tanks' meshes {name: (nodes, elements)} of the fields `d` holds."""
+    the tanks' meshes {name: (nodes, elements)} of the fields `d` holds. `status`: the host's text of
+    the ending ("" to read it from `status_code` and `failure`, which may be traced); `status_code`:
+    an io.status.Status code or array of them (from `status` when not given)."""
     probes = {p: ProbeHistory(d[f"probes/{p}/position"], d[f"probes/{p}/displacement"]) for p in probe_names}
     fields = {n: TankField(nodes, elements, d[f"tanks/{n}/displacement"]) for n, (nodes, elements) in (tanks or {}).items()
               if f"tanks/{n}/displacement" in d}
+    code = code_of(status) if status_code is None else status_code
     return Result(time=d["time"],
                   vessel=VesselHistory(d["vessel/position"], d["vessel/quaternion"], d["vessel/angular_velocity"],
                                        d["vessel/roll_pitch_yaw"]),
                   probes=probes, energy=Energy(d["energy/kinetic"], d["energy/potential"]),
                   solver=SolverHistory(d["solver/iterations"], d["solver/residual"], d.get("solver/constraint")),
-                  tanks=fields, status=status, steps_done=steps_done, scene_text=scene_text,
-                  status_code=int(code_of(status) if status_code is None else status_code))
+                  tanks=fields, outcome=outcome_of(code), steps=steps_done, failure=failure, note=status,
+                  scene_text=scene_text, dt=float(dt), tolerance=float(tolerance))
 
 
 class ResultWriter:
@@ -352,9 +408,8 @@ def load_result(path: str) -> Result:
 def truncated(r: Result, n: int) -> Result:
     """The first n frames of a result."""
     cut = lambda x: x[:n]  # noqa: E731
-    return Result(
-        time=cut(r.time), vessel=jax.tree_util.tree_map(cut, r.vessel),
-        probes={k: jax.tree_util.tree_map(cut, p) for k, p in r.probes.items()},
-        energy=jax.tree_util.tree_map(cut, r.energy), solver=jax.tree_util.tree_map(cut, r.solver),
-        tanks={k: TankField(t.nodes, t.elements, cut(t.displacement)) for k, t in r.tanks.items()},
-        status=r.status, steps_done=r.steps_done, scene_text=r.scene_text, status_code=r.status_code)
+    return eqx.tree_at(lambda x: (x.time, x.vessel, x.probes, x.energy, x.solver, x.tanks), r,
+                       (cut(r.time), jax.tree_util.tree_map(cut, r.vessel),
+                        {k: jax.tree_util.tree_map(cut, p) for k, p in r.probes.items()},
+                        jax.tree_util.tree_map(cut, r.energy), jax.tree_util.tree_map(cut, r.solver),
+                        {k: TankField(t.nodes, t.elements, cut(t.displacement)) for k, t in r.tanks.items()}))

@@ -9,6 +9,10 @@ from __future__ import annotations
 import enum
 import math
 
+import equinox as eqx
+import jax
+import jax.numpy as jnp
+
 
 class Status(enum.IntEnum):
     OK = 0
@@ -29,6 +33,36 @@ class Status(enum.IntEnum):
 TEXT = {Status.OK: "ok", Status.NEWTON: "Newton did not converge", Status.NONFINITE: "non-finite values (NaN or Inf)",
         Status.INITIAL: "the initial accelerations could not be solved", Status.INTERRUPTED: "interrupted",
         Status.DISK_FULL: "disk full", Status.ERROR: "error", Status.RUNNING: "running"}
+
+
+class RunResult(eqx.Enumeration):
+    """How a run ended, as a leaf of its result (traced under `jax.jit` and batched under `vmap`,
+    as optimistix's and diffrax's RESULTS): `result.outcome == RunResult.ok`. The items are in the
+    order of `Status`, so an item's index is its code."""
+    ok = "ok"
+    newton = "jaxslosh: the run failed: Newton did not converge in a step"
+    nonfinite = "jaxslosh: the run failed: non-finite values (NaN or Inf) in a step's solution"
+    initial = "jaxslosh: the run failed: the initial accelerations could not be solved"
+    interrupted = "jaxslosh: the run was interrupted"
+    disk_full = "jaxslosh: the result file could not be written further (disk full)"
+    error = "jaxslosh: another error stopped the run"
+    running = "jaxslosh: the result file is still being written"
+
+
+_ITEMS = (RunResult.ok, RunResult.newton, RunResult.nonfinite, RunResult.initial, RunResult.interrupted,
+          RunResult.disk_full, RunResult.error, RunResult.running)
+assert all(int(_ITEMS[c]._value) == int(c) for c in Status)     # an item's index is its Status code
+
+
+def outcome_of(code) -> RunResult:
+    """The RunResult item of a Status code (an int, or a traced or batched integer array)."""
+    code = jnp.asarray(code)
+    if code.ndim:           # a batch's codes: one item per run (RunResult.where takes a scalar)
+        return jax.vmap(outcome_of)(code)
+    out = RunResult.ok
+    for c, item in enumerate(_ITEMS[1:], start=1):
+        out = RunResult.where(code == c, item, out)
+    return out
 
 
 def failure_text(code: int, step: int, h: float, err: float, iterations: int, tol: float) -> str:

@@ -24,11 +24,11 @@ def plot_fit(scene: Scene, measured, fit_result: FitResult, out_png: Optional[st
     names = [k for k, w in fit_result.channels.items() if w > 0] or [
         k for k in ("roll", "pitch", "heave") if np.std(meas[k]) > 0]
     params_of = lambda vals: {k: param_value(scene, k, v) for k, v in vals.items()}  # noqa: E731
-    fitted = simulate(scene, params=params_of(fit_result.values), duration=max(T, scene.simulation.dt))
+    fitted = simulate(scene, params=params_of(fit_result.values), duration=max(T, scene.simulation.dt), throw=False)
     ch_fit = {k: np.asarray(v) for k, v in channels_of(fitted).items()}
     ch_start = None
     if start and fit_result.start:
-        r0 = simulate(scene, params=params_of(fit_result.start), duration=max(T, scene.simulation.dt))
+        r0 = simulate(scene, params=params_of(fit_result.start), duration=max(T, scene.simulation.dt), throw=False)
         ch_start = {k: np.asarray(v) for k, v in channels_of(r0).items()}
     t_f = np.asarray(fitted.time)
 

@@ -28,6 +28,9 @@ class Carry(NamedTuple):
     fail_it: jax.Array
     n: jax.Array          # steps attempted, failed or not: the same for every run of a batch (never batched)
     code: jax.Array       # io.status.Status of the first failure (OK while none)
+    end: jax.Array        # the run's last step: the steps of a last chunk past it are skipped (not
+    #                       run, not counted); never batched, so a batch's skip stays a branch
+
 
     @property
     def status(self):
@@ -101,7 +104,16 @@ def _first_carry(s0, info) -> Carry:
     failed = ~info.ok
     code = jnp.where(failed, int(Status.INITIAL), int(Status.OK))
     return Carry(s0, jnp.array(0), failed, jnp.where(failed, 0, -1), info.residual, info.iterations, jnp.array(0),
-                 code)
+                 code, jnp.array(NO_END, dtype=jnp.array(0).dtype))
+
+
+#: the `end` of a run that has none set (Stepper, simulate: their scans end with the run)
+NO_END = 2 ** 31 - 1
+
+
+def ending_at(carry: Carry, n_steps: int) -> Carry:
+    """The carry of a run of n_steps stepped in chunks: a last chunk's steps past n_steps are skipped."""
+    return carry._replace(end=jnp.asarray(n_steps, dtype=carry.end.dtype))
 
 
 def carry_shapes(b: Built, solver: Solver) -> Carry:
@@ -113,19 +125,27 @@ def carry_shapes(b: Built, solver: Solver) -> Carry:
 
 def step(b: Built, solver: Solver, c: Carry) -> tuple[Carry, tuple]:
     """One step of the loop: the integrator's step (retried as sub-steps where the scene asks);
-    a step that fails freezes the state and records the first failure's step, residual and code."""
-    s_new, info = step_or_retry(b.system, solver, c.s, c.n, ~c.failed)
-    # the time from the step index, t = (k + 1) h (runs start at t = 0), not the running sum of h:
-    # summing rounds at every step (2000 steps of 0.01 s ended at 20.000000000000327)
-    s_new = s_new._replace(t=(c.k + 1).astype(s_new.t.dtype) * solver.h)
-    bad = ~info.ok & ~c.failed
-    keep = c.failed | ~info.ok
-    s = _select(keep, c.s, s_new)
-    why = jnp.where(jnp.isfinite(info.residual), int(Status.NEWTON), int(Status.NONFINITE))
-    c2 = Carry(s, c.k + jnp.where(keep, 0, 1), c.failed | ~info.ok,
-               jnp.where(bad, c.k + 1, c.fail_step), jnp.where(bad, info.residual, c.fail_err),
-               jnp.where(bad, info.iterations, c.fail_it), c.n + 1, jnp.where(bad, why, c.code))
-    return c2, (info.iterations, info.residual)
+    a step that fails freezes the state and records the first failure's step, residual and code.
+    A step past the run's `end` is skipped: the state stays, nothing is counted."""
+
+    def go(c: Carry):
+        s_new, info = step_or_retry(b.system, solver, c.s, c.n, ~c.failed)
+        # the time from the step index, t = (k + 1) h (runs start at t = 0), not the running sum of h:
+        # summing rounds at every step (2000 steps of 0.01 s ended at 20.000000000000327)
+        s_new = s_new._replace(t=(c.k + 1).astype(s_new.t.dtype) * solver.h)
+        bad = ~info.ok & ~c.failed
+        keep = c.failed | ~info.ok
+        s = _select(keep, c.s, s_new)
+        why = jnp.where(jnp.isfinite(info.residual), int(Status.NEWTON), int(Status.NONFINITE))
+        c2 = Carry(s, c.k + jnp.where(keep, 0, 1), c.failed | ~info.ok,
+                   jnp.where(bad, c.k + 1, c.fail_step), jnp.where(bad, info.residual, c.fail_err),
+                   jnp.where(bad, info.iterations, c.fail_it), c.n + 1, jnp.where(bad, why, c.code), c.end)
+        return c2, (info.iterations.astype(jnp.int32), info.residual.astype(c.fail_err.dtype))
+
+    def idle(c: Carry):
+        return c, (jnp.zeros((), jnp.int32), jnp.zeros((), c.fail_err.dtype))
+
+    return jax.lax.cond(c.n < c.end, go, idle, c)
 
 
 def observe(b: Built, c: Carry, iterations=None, residual=None) -> Frame:

@@ -11,13 +11,13 @@ from __future__ import annotations
 import dataclasses
 from typing import NamedTuple, Optional
 
-import equinox as eqx
 import jax
+import jax.numpy as jnp
 import numpy as np
 
 from ..assemble.system import Built, build
-from ..io.status import TEXT, Status, failure_text
-from ..io.result import Result, result_from, truncated
+from ..io.status import failure_text, outcome_of
+from ..io.result import Failure, Result, result_from, truncated
 from ..scene.keys import check_values, with_overrides
 from ..scene.types import Scene
 from ..solve.linear import Solver, make_solver
@@ -91,10 +91,15 @@ def is_traced(value) -> bool:
     return any(isinstance(x, jax.core.Tracer) for x in jax.tree_util.tree_leaves(value))
 
 
-def to_result(b: Built, fr: Frame, scene_text: str, status: str, steps_done: int, code: int = 0) -> Result:
+def to_result(b: Built, fr: Frame, scene_text: str, status: str, carry: Carry, solver: Solver) -> Result:
+    """The result of a run's frames and its final carry: the outcome, steps done and first failure
+    are the carry's (leaves, traced inside a transformation); `status` the host's text ("" where the
+    carry is traced: the result reads its outcome once computed)."""
     tanks = {t.name: (t.nodes, t.elements) for t in b.tanks}
-    return result_from(frame_datasets(b, fr), b.probes.names, tanks, status=status, steps_done=steps_done,
-                       scene_text=scene_text, status_code=code)
+    failure = Failure(carry.fail_step, carry.fail_err, carry.fail_it)
+    return result_from(frame_datasets(b, fr), b.probes.names, tanks, status=status, steps_done=carry.k,
+                       scene_text=scene_text, status_code=carry.code, failure=failure, dt=float(solver.h),
+                       tolerance=float(solver.tol))
 
 
 def failure_message(carry: Carry, h: float, tol: float) -> str:
@@ -102,8 +107,30 @@ def failure_message(carry: Carry, h: float, tol: float) -> str:
     return failure_text(int(carry.code), int(carry.fail_step), float(h), float(carry.fail_err), int(carry.fail_it), tol)
 
 
+def _raise_on_derivatives(res: Result, failed, code) -> Result:
+    """`res` with its derivatives tied to the failure check: a gradient of a function of the frames
+    needs no frame's value (d sum(x) / dx is 1), so the compiler drops the check on the values and
+    the gradient of a failed run came back as a number. Each tangent is scaled by 1 + 0 * (the
+    checked failure flag), a factor the derivative's program must compute, so it raises too."""
+    import equinox as eqx
+
+    @jax.custom_jvp
+    def tie(x, failed, code):
+        return x
+
+    @tie.defjvp
+    def _(primals, tangents):
+        x, failed, code = primals
+        token = outcome_of(code).error_if(jnp.zeros((), x.dtype), failed)
+        return x, tangents[0] * (1.0 + 0.0 * token)
+
+    floats, rest = eqx.partition(res, eqx.is_inexact_array)
+    floats = jax.tree_util.tree_map(lambda x: tie(x, failed, code), floats)
+    return eqx.combine(floats, rest)
+
+
 def simulate(scene: Scene, params: Optional[dict] = None, *, duration: Optional[float] = None,
-             dt: Optional[float] = None, throw: bool = False, check: bool = True) -> Result:
+             dt: Optional[float] = None, throw: bool = True, check: bool = True) -> Result:
     """Run a scene; the result holds every `save_every`-th step, t = 0 included.
 
     `params` maps dotted scene keys to replacement values, which may be JAX tracers:
@@ -111,10 +138,16 @@ def simulate(scene: Scene, params: Optional[dict] = None, *, duration: Optional[
     are checked as the scene file with them would be (SceneError naming the key); `check=False`
     takes them as they are (a numerical experiment: a coefficient set to zero to switch its term
     off, say).
-    A numerical failure truncates the result to the frames before it and sets `status` (its text)
-    and `status_code` (io.status.Status); with `throw=True` it raises NumericalFailure instead, and
-    inside `jax.jit` (where the status cannot be read) the compiled run raises an error naming the
-    failure (equinox's error_if) when it happens.
+
+    How the run ended is the result's `outcome` (io.status.RunResult), a leaf: right inside
+    `jax.jit`, `jax.grad` and `vmap`. A numerical failure (a step's Newton iterations that do not
+    converge, non-finite values) raises by default: NumericalFailure (with the truncated result)
+    when called outside a transformation, and inside one an error when the compiled run reaches it
+    (equinox's error_if), so that neither a value nor a gradient of a failed run comes back
+    silently. With `throw=False` the run returns: outside a transformation its frames are cut at
+    the failure and `status` names the step; inside one the frames after the failure repeat the
+    last good state (the values and their gradients are those of the run up to the failure) and
+    `result.outcome`, `result.failure.step` and `result.steps` say what happened.
     """
     scene = with_overrides(scene, duration=duration, dt=dt)
     setup = prepare(scene, params, check=check)
@@ -128,18 +161,16 @@ def simulate(scene: Scene, params: Optional[dict] = None, *, duration: Optional[
         carry, f0, run = compile_run(bc, solver, n_frames, setup.save_every)
         carry, frames = run(bc, solver, carry, n_frames, setup.save_every)
     fr = concat_frames([jax.tree_util.tree_map(lambda x: x[None], f0), frames])
-    traced = isinstance(carry.failed, jax.core.Tracer)
-    if traced:
+    if isinstance(carry.failed, jax.core.Tracer):
+        res = to_result(b, fr, scene.text, "", carry, solver)
         if throw:
-            fr = eqx.branched_error_if(fr, carry.failed, carry.code,
-                                       [f"jaxslosh: the run failed: {TEXT[s]}" for s in Status])
-        return to_result(b, fr, scene.text, "ok", setup.n_steps)
+            res = _raise_on_derivatives(res.outcome.error_if(res, carry.failed), carry.failed, carry.code)
+        return res
     if bool(carry.failed):
         msg = failure_message(carry, solver.h, solver.tol)
         n_ok = int(np.sum(~np.asarray(fr.failed)))
-        res = to_result(b, fr, scene.text, msg, int(carry.k), int(carry.code))
-        res = truncated(res, n_ok)
+        res = truncated(to_result(b, fr, scene.text, msg, carry, solver), n_ok)
         if throw:
             raise NumericalFailure(msg, res)
         return res
-    return to_result(b, fr, scene.text, "ok", int(carry.k))
+    return to_result(b, fr, scene.text, "ok", carry, solver)

@@ -23,7 +23,7 @@ from ..scene.types import Scene
 from .guard import Interrupted, interrupts
 from .capsize import vanishing_angles
 from ..cache.compiled import compile_run
-from .loop import core, frame_datasets
+from .loop import core, ending_at, frame_datasets
 from .progress import Progress
 from .simulate import failure_message, prepare
 from .validity import Watch
@@ -70,6 +70,7 @@ def run_to_file(scene: Scene, out: str, *, progress: bool = True,
             bar.phase("compile", "compiling the step")
             bc = core(b)
             carry, f0, chunk = compile_run(bc, solver, chunk_frames, se)
+            carry = ending_at(carry, setup.n_steps)     # a last chunk's steps past the end are skipped
             stop.check()
             bar.phase("stepping", "stepping", total=setup.n_steps)
             pending = jax.tree_util.tree_map(lambda x: np.asarray(x)[None], f0)

@@ -37,14 +37,14 @@ def test_stepping_by_hand_gives_the_states_of_simulate():
 
 def test_a_failure_is_a_code_with_its_text_in_the_result_and_the_file(tmp_path):
     scene = _failing()
-    r = js.simulate(scene)
+    r = js.simulate(scene, throw=False)
     assert r.status_code == js.Status.NEWTON and r.status != "ok"
     assert "step 1" in r.status and "Newton did not converge" in r.status
     stepper = js.Stepper(scene)
     state = stepper.step(stepper.init())
     assert int(state.code) == js.Status.NEWTON and stepper.status(state) == r.status
     with pytest.raises(js.NumericalFailure, match="Newton did not converge"):
-        js.simulate(scene, throw=True)
+        js.simulate(scene)          # throw=True by default
     path = str(tmp_path / "r.h5")
     js.save_result(r, path)
     with h5py.File(path, "r") as f:
@@ -57,7 +57,7 @@ def test_a_batch_gives_each_failed_run_the_status_of_its_single_run():
     scene = _failing()
     gm = [1.2, 1.7]
     _, statuses = js.simulate_batch(scene, {"vessel.hydrostatics.gm_t": np.asarray(gm)})
-    singles = [js.simulate(scene, params={"vessel.hydrostatics.gm_t": g}).status for g in gm]
+    singles = [js.simulate(scene, params={"vessel.hydrostatics.gm_t": g}, throw=False).status for g in gm]
     assert statuses == singles and all("step 1" in s and "Newton did not converge" in s for s in statuses)
 
 
@@ -120,3 +120,49 @@ def test_api_messages_name_what_the_caller_can_give(tmp_path):
     with pytest.raises(js.SceneError, match=r"gives 60 damping ratios, but the 48 lowest modes searched on this "
                                             r"mesh hold \d+ sloshing modes"):
         prepare(js.load_scene(text))
+
+
+def test_a_failed_run_under_jit_says_so_raising_by_default_or_as_its_outcome():
+    """Under jax.jit the outcome is a leaf: the same failed run that eager code reports as a
+    NumericalFailure raises by default, and with throw=False returns its code and step (not "ok"
+    and every step done)."""
+    scene = _failing(duration=0.5)
+    eager = js.simulate(scene, throw=False)
+    assert eager.status_code == js.Status.NEWTON
+    f = jax.jit(lambda gm: js.simulate(scene, params={"vessel.hydrostatics.gm_t": gm}).vessel.roll_pitch_yaw)
+    with pytest.raises(Exception, match="Newton did not converge"):
+        jax.block_until_ready(f(1.5))
+    g = jax.jit(lambda gm: js.simulate(scene, params={"vessel.hydrostatics.gm_t": gm}, throw=False))
+    r = g(1.5)
+    assert bool(r.outcome == js.RunResult.newton) and not bool(r.ok)
+    assert r.status_code == js.Status.NEWTON and r.status == eager.status      # the step, time and residual
+    assert int(r.failure.step) == 1 and r.steps_done == 0
+    # a gradient through the failed run is not a silent number: it raises too
+    loss = jax.jit(jax.grad(lambda gm: js.simulate(scene, params={"vessel.hydrostatics.gm_t": gm}
+                                                   ).vessel.roll_pitch_yaw[:, 0].sum()))
+    with pytest.raises(Exception, match="Newton did not converge"):
+        jax.block_until_ready(loss(1.5))
+
+
+def test_a_good_run_under_jit_is_ok_with_every_step():
+    good = vessel_scene(duration=0.1, omega=(0.05, 0.02, 0.0))
+    r = jax.jit(lambda gm: js.simulate(good, params={"vessel.hydrostatics.gm_t": gm}))(1.5)
+    assert bool(r.ok) and r.status == "ok" and r.steps_done == 10 and int(r.failure.step) == -1
+
+
+@pytest.mark.slow       # about 30 s: the fast tests above hold the same facts on a scene failing at step 1
+def test_the_violent_roll_under_jit_raises_and_reports_its_step():
+    """The paper ship set rolling hard (0.6 rad, [0.5, 0.3, 0.2] rad/s): its step 1114 fails eagerly;
+    under jax.jit it raises by default and, with throw=False, names the same step."""
+    import os
+    path = os.path.join(os.path.dirname(__file__), "..", "..", "scenes", "paper_ship_tank.toml")
+    text = open(path).read().replace("angular_velocity = [0.1, 0.05, 0.0]",
+                                     "angular_velocity = [0.5, 0.3, 0.2]\nroll_pitch_yaw = [0.6, 0.0, 0.0]")
+    scene = js.load_scene(text.replace("duration = 20.0", "duration = 12.0"))
+    with pytest.raises(js.NumericalFailure, match="step 1114"):
+        js.simulate(scene)
+    run = lambda gm, throw: js.simulate(scene, params={"vessel.hydrostatics.gm_t": gm}, throw=throw)  # noqa: E731
+    r = jax.jit(lambda gm: run(gm, False))(1.67)
+    assert r.status_code == js.Status.NEWTON and "step 1114" in r.status and r.steps_done == 1113
+    with pytest.raises(Exception, match="Newton did not converge"):
+        jax.block_until_ready(jax.jit(lambda gm: run(gm, True).time)(1.67))
