@@ -28,7 +28,7 @@ _PUBLIC = {
 "identify": ".fit.identify", "Result": ".io.result", "load_result": ".io.result",
     "save_result": ".io.result", "Status": ".io.status", "RunResult": ".io.status", "simulate_batch": ".run.batch",
     "NumericalFailure": ".run.simulate", "simulate": ".run.simulate", "Stepper": ".run.stepper", "Scene": ".scene",
-    "SceneError": ".scene", "load_scene": ".scene", "stability": ".analysis.stability",
+    "SceneError": ".scene", "load_scene": ".scene", "scene_with": ".scene.variant", "stability": ".analysis.stability",
 }
 
 __all__ = [*_PUBLIC, "campaign", "__version__"]

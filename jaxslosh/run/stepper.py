@@ -15,6 +15,7 @@ from __future__ import annotations
 from typing import Optional
 
 import equinox as eqx
+import jax
 
 from ..assemble.system import Built
 from ..io.status import Status
@@ -34,6 +35,11 @@ def _init(b, solver):
 @eqx.filter_jit
 def _step(b, solver, carry):
     return step(b, solver, carry)[0]
+
+
+@eqx.filter_jit
+def _advance(b, solver, carry, n):
+    return jax.lax.scan(lambda c, _: (step(b, solver, c)[0], None), carry, None, length=n)[0]
 
 
 @eqx.filter_jit
@@ -62,6 +68,16 @@ class Stepper(eqx.Module):
         """One step. A step that fails leaves the state where it was and sets `state.code`
         (io.status.Status); `status(state)` says why."""
         return _step(self.built, self.solver, state)
+
+    def advance(self, state: Carry, n: int) -> Carry:
+        """n steps in one compiled scan (compiled once per n): what `simulate` runs between frames,
+        without keeping any (benchmarks time the step with it)."""
+        return _advance(self.built, self.solver, state, int(n))
+
+    @property
+    def unknowns(self) -> int:
+        """The count of the step's unknowns (the rigid ones, the liquid's and the structures')."""
+        return int(self.built.system.layout().n)
 
     def observe(self, state: Carry) -> Frame:
         """What a result frame keeps of the state: t, X0, q, omega, probes (P, 3), energies, ..."""
