@@ -11,6 +11,7 @@ from __future__ import annotations
 import dataclasses
 from typing import NamedTuple, Optional
 
+import equinox as eqx
 import jax
 import jax.numpy as jnp
 import numpy as np
@@ -112,7 +113,6 @@ def _raise_on_derivatives(res: Result, failed, code) -> Result:
     needs no frame's value (d sum(x) / dx is 1), so the compiler drops the check on the values and
     the gradient of a failed run came back as a number. Each tangent is scaled by 1 + 0 * (the
     checked failure flag), a factor the derivative's program must compute, so it raises too."""
-    import equinox as eqx
 
     @jax.custom_jvp
     def tie(x, failed, code):
