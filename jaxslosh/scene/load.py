@@ -355,10 +355,14 @@ def _multimodal_tank(table, where: str) -> None:
     """A multimodal tank is a plain box (physics/multimodal.py, or multimodal3d.py with flow = "3d") or
     an upright circular cylinder (multimodal3d.py) with rigid walls."""
     read_multimodal_shape(table, where)
-    for key, why in (("shape", "a box or an upright cylinder"), ("baffles", "a tank without baffles"),
+    if "shape" in table and not SHAPES[table["shape"]].modal:
+        allowed = " or ".join(f'shape = "{name}"' + {"box": " (the default)", "cylinder": ' with axis = "z"'}.get(name, "")
+                              for name, cls in SHAPES.items() if cls.modal)
+        raise SceneError(f"{where}.shape", f'a model = "multimodal" tank is a box or an upright cylinder: {allowed}, '
+                                           f'not shape = "{table["shape"]}"')
+    for key, why in (("baffles", "a tank without baffles"),
                      ("walls", "rigid walls"), ("reduction", "its own modes"), ("file", "a box or a cylinder")):
-        if key in table and not (key == "shape" and SHAPES[table[key]].modal) and \
-                not (key == "walls" and table[key] == "rigid"):
+        if key in table and not (key == "walls" and table[key] == "rigid"):
             raise SceneError(f"{where}.{key}", f'a model = "multimodal" tank is {why}: leave {key} out')
     visc = table.get("damping", {}).get("viscosity", 0.0) if isinstance(table.get("damping"), dict) else 0.0
     if visc:
