@@ -10,7 +10,8 @@ import os
 from ..hydro.source import excitation_source
 from ..physics.about import About
 from ..scene.types import Scene
-from .effects import element_why, interface_unknowns, mesh_words, modal_modes, shape_words, structure_modes, structure_unknowns
+from .effects import (element_why, interface_unknowns, mesh_words, modal_modes, shape_words, structure_modes,
+                      structure_unknowns)
 
 
 def weight_about(scene: Scene, nonlinear: bool) -> About:

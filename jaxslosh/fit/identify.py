@@ -16,7 +16,8 @@ Residuals
     its units; a channel without signal gets weight 0 (`no_signal`): zero spread (identically zero,
     e.g. heave in a pure roll decay, or a constant), or a spread at round-off, below 1e-9 of the
     largest among the channels in its unit or below 1e-10 rad (m) (the pitch of a roll decay, 1e-17
-    rad, whose 1 / std would make its round-off outweigh the roll and bias the fit). `weights={"roll": 1e4, "heave": 0.0}` overrides channels by name
+    rad, whose 1 / std would make its round-off outweigh the roll and bias the fit).
+    `weights={"roll": 1e4, "heave": 0.0}` overrides channels by name
     (the natural choice when the noise levels are known: w_c = 1 / noise_c, and then the standard
     errors below are exact for independent Gaussian noise).
 

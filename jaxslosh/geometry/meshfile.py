@@ -122,8 +122,8 @@ class MeshFile(AbstractShape):
         ok = area > 1e-14 * scale ** 2
         gap = np.zeros(len(faces))
         for i in range(0, len(faces), 4096):           # (faces, hull corners) in slices: bounded memory
-            n = normal[i:i + 4096]
-            gap[i:i + 4096] = (corners @ n.T).max(axis=0) - np.einsum("fkj,fj->fk", nodes[faces[i:i + 4096]], n).max(axis=1)
+            n, own = normal[i:i + 4096], nodes[faces[i:i + 4096]]
+            gap[i:i + 4096] = (corners @ n.T).max(axis=0) - np.einsum("fkj,fj->fk", own, n).max(axis=1)
         bad = ok & (gap > 1e-3 * scale)
         if not bad.any():
             return False, ""
