@@ -127,7 +127,7 @@ class MeshFile(AbstractShape):
         bad = ok & (gap > 1e-3 * scale)
         if not bad.any():
             return False, ""
-        return True, f"a re-entrant mesh ({int(bad.sum())} of its {len(faces)} boundary faces off its convex hull)"
+        return True, f"a re-entrant mesh: {int(bad.sum())} of its {len(faces)} boundary faces off its convex hull"
 
     def _outline(self, fill_depth: float, mesh) -> list:
         """The mesh's feature edges (faces meeting at more than 30 degrees)."""
