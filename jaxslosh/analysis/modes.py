@@ -3,7 +3,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..assemble.effects import free_liquid_dofs
+from ..assemble.effects import free_liquid_dofs, modal_modes
+from ..assemble.multimodal3d import sample_points
 from ..fem.liquid import build_liquid
 from ..fem.liquid_rt import build_face_liquid, face_modes
 from ..fem.mesh import face_nodes
@@ -11,6 +12,7 @@ from ..fem.modes import Modes, liquid_modes
 from ..fem.structure import build_structure, clamped_modes
 from ..fem.walls import build_tank_with_walls, tank_modes
 from ..fem.walls_rt import build_face_tank_with_walls, face_tank_modes
+from ..physics.multimodal_modes import DiskBase, RectangleBase
 from ..scene.types import Scene
 from ..solve.sparse import SPARSE_AUTO
 
@@ -34,14 +36,26 @@ def sloshing_modes(scene: Scene, tank=None, n: int = 10):
 
 
 def _multimodal_modes(scene: Scene, t, n: int) -> Modes:
-    """A multimodal tank's own modes, at most its `modes`: the standing waves along its length,
-    omega_n^2 = g k_n tanh(k_n h), k_n = n pi / L (physics/multimodal.py), each a free-surface mode; the
-    shapes are the surface elevation cos(k_n x) at the fill depth's sample points."""
-    n = min(n, t.modes)
-    k = np.arange(1, n + 1) * np.pi / t.size[0]
-    x = np.linspace(0.0, t.size[0], 33)
+    """A multimodal tank's own linear modes, at most as many as it runs on, omega^2 = g k tanh(k h),
+    each a free-surface mode, in frequency order: a two-dimensional box's standing waves along its
+    length, k_i = i pi / L (physics/multimodal.py); a three-dimensional box's k = pi sqrt((i / L)^2 +
+    (j / B)^2), an upright cylinder's k = j'_{m,s} / R (the zeros of the Bessel functions' derivatives),
+    the base's lowest modes completed to whole degenerate pairs (physics/multimodal_modes.py). The
+    shapes are the surface elevation at sample points: along x in two dimensions; round the walls and
+    at the centre in three (assemble/multimodal3d.py)."""
+    modes = modal_modes(t)
+    if t.flow == "3d":
+        base = t.geometry.modal_base(RectangleBase, DiskBase)
+        k = base.wavenumbers(modes)
+        order = np.argsort(k, kind="stable")[:n]
+        x, y = sample_points(t, 33)
+        k, shapes = k[order], base.values([modes[i] for i in order], x, y)[0].T
+    else:
+        k = np.array([i for i, _ in modes[:n]]) * np.pi / t.size[0]
+        shapes = np.cos(np.outer(k, np.linspace(0.0, t.size[0], 33)))
+    n = len(k)
     return Modes(omega=np.sqrt(scene.environment.gravity * k * np.tanh(k * t.fill_depth)), kind=("sloshing",) * n,
-                 free_surface_share=np.ones(n), shapes=np.cos(np.outer(k, x)))
+                 free_surface_share=np.ones(n), shapes=shapes)
 
 
 def _face_modes(scene: Scene, t, n: int) -> Modes:

@@ -10,7 +10,8 @@ import os
 from ..hydro.source import excitation_source
 from ..physics.about import About
 from ..scene.types import Scene
-from .effects import element_why, interface_unknowns, mesh_words, shape_words, structure_modes, structure_unknowns
+from .effects import (element_why, interface_unknowns, mesh_words, modal_modes, shape_words, structure_modes,
+                      structure_unknowns)
 
 
 def weight_about(scene: Scene, nonlinear: bool) -> About:
@@ -19,6 +20,10 @@ def weight_about(scene: Scene, nonlinear: bool) -> About:
     if nonlinear:
         return About(("gravity", "the weight of the ship and its liquid, borne by the hull's pressure"))
     g = scene.environment.gravity
+    if scene.vessel.forced is not None:    # its rows are the prescribed motion's (System.hold): nothing falls
+        liquid = "; the liquid sloshes under gravity" if scene.tanks and g > 0 else ""
+        return About(("gravity", ("the vessel's weight moves nothing: its motion is prescribed ([vessel.forced])" + liquid)
+                                 if g > 0 else "environment.gravity = 0: no weight"))
     return About(("gravity", "no hydrostatics table: the vessel falls freely" if g > 0 else
                              "environment.gravity = 0: no weight"))
 
@@ -42,7 +47,7 @@ def tank_line(t) -> tuple[str, str]:
     if t.model == "multimodal":
         flow = "three-dimensional" if t.flow == "3d" else "two-dimensional along x"
         system = "its third-order system" if t.expansion == "third-order" else "exact integrals"
-        return (f"liquid in tank {t.name!r}", f"{shape_words(t)}multimodal ({flow}), {t.modes} free-surface "
+        return (f"liquid in tank {t.name!r}", f"{shape_words(t)}multimodal ({flow}), {len(modal_modes(t))} free-surface "
                                               f"modes, {system}, {t.liquid_mass:.6g} kg; its inertial loads (Coriolis and "
                                               "centrifugal among them) are the modal Lagrangian's, not switched by "
                                               "[effects]")

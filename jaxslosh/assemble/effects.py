@@ -18,7 +18,8 @@ def describe(scene: Scene) -> str:
     h = ves.hydrostatics
     hydro = (f"A_w {h.waterplane_area:g} m^2, V {h.displaced_volume:g} m^3, GM_T {h.gm_t:g} m, GM_L {h.gm_l:g} m"
              + (" (the hull's at rest; the restoring is nonlinear)" if h.nonlinear else "")
-             if h is not None else "no hydrostatics (free body)")
+             if h is not None else "no hydrostatics (its motion prescribed by [vessel.forced])"
+             if ves.forced is not None else "no hydrostatics (free body)")
     lines.append(f"vessel: mass {ves.mass:.4g} kg, inertia diagonal [{diag}] kg m^2; {hydro}")
     for t in scene.tanks:
         walls = t.walls if t.wall_spec is None else f"elastic, {t.wall_spec.thickness:g} m thick"
@@ -73,10 +74,32 @@ def switched_off(scene: Scene) -> list[str]:
     return [k for k in EFFECTS if not getattr(scene.effects, k)]
 
 
+def modal_modes(t) -> tuple:
+    """The modes a multimodal tank runs on: cos(i pi x / L), i = 1..N, along a two-dimensional box
+    ((i, 0) each); the base's lowest, completed to whole degenerate groups, in three dimensions
+    (physics/multimodal_modes.py, as assemble/multimodal3d.py builds them)."""
+    if t.flow != "3d":
+        return tuple((i, 0) for i in range(1, t.modes + 1))
+    from ..physics.multimodal_modes import DiskBase, RectangleBase   # scipy's Bessel zeros, when asked
+    return t.geometry.modal_base(RectangleBase, DiskBase).lowest(t.modes)
+
+
+def modal_words(t) -> str:
+    """What a multimodal tank is instead of a mesh: its free-surface modes."""
+    n = len(modal_modes(t))
+    if t.flow != "3d":
+        return f"{n} free-surface modes cos(i pi x / L), i = 1..{n} (multimodal, two-dimensional along x), no mesh"
+    done = f", {t.modes} asked and completed to whole degenerate pairs" if n != t.modes else ""
+    return (f"{n} free-surface modes of its {'disk' if t.geometry.name == 'cylinder' else 'rectangular'} base "
+            f"(multimodal, three-dimensional{done}), no mesh")
+
+
 def mesh_words(t, short: bool = False) -> str:
     """"mesh 5 x 5 x 5 = 125 hexahedra" (a grid, of any shape, or a mesh file that is one), or
     "mesh file of 12 hexahedra on 30 nodes" (a mesh tank's file that is not a grid: its counts
-    along x, y, z mean nothing)."""
+    along x, y, z mean nothing); a multimodal tank's modes (it has no mesh)."""
+    if t.model == "multimodal":
+        return modal_words(t)
     nx, ny, nz = t.mesh
     words = t.geometry.mesh_words()
     if words is not None:
@@ -101,7 +124,9 @@ def tank_notes(t) -> list[str]:
 def free_liquid_dofs(tank) -> int:
     """A tank's free liquid unknowns at full order: the nodal elements' three dofs per node, less the
     wall-normal ones the slip walls hold; the face-normal element's free faces (the interior ones and
-    the free surface's, fem/liquid_rt.py)."""
+    the free surface's, fem/liquid_rt.py); a multimodal tank's modal coordinates."""
+    if tank.model == "multimodal":
+        return len(modal_modes(tank))
     if tank.fluid.element in FACE_FORMS:
         nx, ny, nz = tank.mesh
         if tank.geometry.plain_box:         # interior faces along x, y and z, and the nx ny top faces

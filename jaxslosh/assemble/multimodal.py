@@ -3,7 +3,7 @@ free-surface elevation at their point), its damping and the sample points of the
 run's validity watch reads."""
 from __future__ import annotations
 
-from typing import Optional
+from typing import NamedTuple, Optional
 
 import jax.numpy as jnp
 import numpy as np
@@ -12,6 +12,7 @@ from ..physics.damping import ModalDamping
 from ..physics.multimodal import MultimodalLiquid, modal_tank
 from ..physics.multimodal_expansion import third_order
 from ..scene.types import Scene, SceneError
+from .effects import modal_modes
 from .multimodal3d import probe_row, sample_points, tank_3d, three_dimensional
 
 #: surface samples per tank for the validity watch (walls included, where the extremes are)
@@ -43,7 +44,59 @@ def build_multimodal(scene: Scene, params: Optional[dict], gravity) -> Multimoda
         samples[i * SAMPLES:(i + 1) * SAMPLES, off:off + r.shape[1]] = r
         off += r.shape[1]
     return MultimodalLiquid(tanks=tuple(tanks), sizes=sizes,
-                            samples=jnp.asarray(samples), gravity=jnp.asarray(gravity, dtype=float))
+                            samples=jnp.asarray(samples), gravity=jnp.asarray(gravity, dtype=float),
+                            fields=jnp.asarray(surface_fields(scene, tanks, sizes)))
+
+
+#: elements of a multimodal tank's surface mesh along its base's longest side (at least 4 per
+#: wavelength of its shortest mode)
+SURFACE_CELLS = 24
+
+
+class ModalSurface(NamedTuple):
+    """A multimodal tank as a result keeps it (its `tanks/NAME` fields, which `plot --surface` draws
+    and `export --paraview` writes): one layer of hexahedra from the bottom to the fill depth over
+    its base, the top nodes displaced by the free surface's elevation reconstructed from the modal
+    coordinates, the bottom ones at rest (the modes say nothing of the particles' paths)."""
+    name: str
+    nodes: np.ndarray             # (N, 3) tank-local, at rest
+    elements: np.ndarray          # (E, 8) hex8, the top face the last four corners
+    node_offset: int
+    model: object = None          # no finite-element model (analysis/coupled.py reads a model's parts)
+
+
+def _surface_counts(t) -> tuple:
+    if not three_dimensional(t):          # waves along x: one element across
+        return (max(SURFACE_CELLS, 4 * t.modes), 1, 1)
+    top = max(max(m[:2]) for m in modal_modes(t))
+    n = max(SURFACE_CELLS, 4 * top)
+    L, B = t.size[0], t.size[1]
+    return (max(2, round(n * L / max(L, B))), max(2, round(n * B / max(L, B))), 1)
+
+
+def surface_meshes(scene: Scene) -> tuple:
+    """Per multimodal tank, its surface mesh (ModalSurface), the nodes numbered on across tanks."""
+    out, off = [], 0
+    for t in scene.tanks:
+        m = t.geometry.mesh(t.fill_depth, _surface_counts(t))
+        out.append(ModalSurface(t.name, np.asarray(m.nodes), np.asarray(m.elements), off))
+        off += m.nodes.shape[0]
+    return tuple(out)
+
+
+def surface_fields(scene: Scene, tanks, sizes) -> np.ndarray:
+    """(N, nf): each surface mesh node's vertical displacement per modal coordinate: the elevation's
+    rows at its (x, y), times z / fill depth (1 on the free surface, 0 on the bottom)."""
+    meshes = surface_meshes(scene)
+    F = np.zeros((sum(m.nodes.shape[0] for m in meshes), int(sum(sizes))))
+    off = 0
+    for t, mt, n, m in zip(scene.tanks, tanks, sizes, meshes):
+        x, y, z = m.nodes.T
+        rows = (mt.surface_rows(x, y) if three_dimensional(t)
+                else np.cos(np.outer(x, np.arange(1, n + 1) * np.pi / t.size[0])))
+        F[m.node_offset:m.node_offset + len(x), off:off + n] = (z / t.fill_depth)[:, None] * rows
+        off += n
+    return F
 
 
 def surfaces(scene: Scene) -> tuple:

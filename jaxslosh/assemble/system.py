@@ -32,7 +32,7 @@ from .about import damping_about, flex_about, liquid_about, record_about, stiffe
 from .damping import build_damping
 from .hull import build_hull_pressure
 from .liquid import LiquidBlock, build_liquid_block, outline_liquid_block, rigid_part
-from .multimodal import build_multimodal, multimodal_damping, multimodal_scene, probe_modal, surfaces
+from .multimodal import build_multimodal, multimodal_damping, multimodal_scene, probe_modal, surface_meshes, surfaces
 from .probes import Probes, build_probes
 from .seakeeping import build_seakeeping, outline_seakeeping
 from .structures import build_structures
@@ -94,13 +94,15 @@ def build(scene: Scene, params: Optional[dict] = None) -> Built:
     c0, v0, alg0 = _start(system, c0, v0) if system.owners() else (c0, v0, jnp.zeros(0))
     probes = build_probes(scene, block.tanks, liquid, blocks, block.vstructs)
     probes = probes._replace(modal=liquid.probe_modal(probes.weights))    # a modal liquid: probes from eta
+    tanks = block.tanks
     if multimodal:
         probes = probes._replace(modal=probe_modal(scene, liquid))
         tops = surfaces(scene)
+        tanks = surface_meshes(scene)      # the fields a result keeps: the free surface on its mesh
     else:
         tops = tuple(jnp.asarray(t.node_offset + np.flatnonzero(np.isclose(t.nodes[:, 2], t.nodes[:, 2].max())))
                      for t in block.tanks)
-    return Built(system, c0, v0, probes, block.tanks, alg0, blocks, tops)
+    return Built(system, c0, v0, probes, tanks, alg0, blocks, tops)
 
 
 def outline(scene: Scene) -> System:

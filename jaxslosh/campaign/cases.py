@@ -59,7 +59,7 @@ def read_scatter(path_or_text: str) -> Scatter:
     """A scatter CSV (a header row with hs, tp and probability or occurrences; more columns set
     the [waves] keys of SEA_COLUMNS). ScatterError names the bad column or row."""
     if "\n" not in path_or_text and os.path.exists(path_or_text):
-        with open(path_or_text, newline="") as f:
+        with open(path_or_text, newline="", encoding="utf-8-sig") as f:     # a spreadsheet's byte-order mark
             text = f.read()
     elif "\n" in path_or_text:
         text = path_or_text

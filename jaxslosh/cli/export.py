@@ -6,7 +6,7 @@ import sys
 import time
 
 from ..io.output import OutputError, OutputLock
-from ..io.paraview import export_paraview
+from ..io.paraview import export_paraview, no_fields_why
 from ..io.result import load_result
 from .common import COMMANDS, EXIT_OK, InputError, read, output_folder
 
@@ -40,7 +40,7 @@ def cmd_export(a):
     finally:
         lock.release()
     if not r.tanks:
-        print("note: the result keeps no liquid fields (a run without tanks, or with --no-fields)", file=sys.stderr)
+        print(f"note: the result keeps no liquid fields: {no_fields_why(r)}", file=sys.stderr)
     n = len(r.time[::a.every])
     print(f"done: {n} frames in {time.perf_counter() - t0:.2f} s -> {', '.join(files)}")
     return EXIT_OK

@@ -150,6 +150,10 @@ def cmd_identify(a) -> int:
     for k, v in fr.implied.items():       # not fitted: what the fitted values imply (GM0 = KM - KG)
         s = fr.implied_standard_errors[k]
         print(f"{k:<{width}} = {format_value(v)} +- {format_value(s)}   (implied: KM - KG of the hull at rest)")
+    for k, spread in fr.no_signal.items():     # weight 0 by default: said, so that no one wonders
+        unit = "rad" if k in ("roll", "pitch") else "m"
+        print(f"{k}: left out (weight 0): its spread, {spread:.3g} {unit}, is round-off, no signal to fit "
+              f"(--weights {k}=W weighs it anyway)")
     print(f"{fr.method}: {fr.status} after {fr.iterations} iterations ({fr.evaluations} simulations, "
           f"{fr.wall_time:.1f} s); loss {fr.loss_history[0]:.4g} -> {fr.loss_history[-1]:.4g} ({fr.message})")
     fr.to_json(out)

@@ -5,6 +5,7 @@ from __future__ import annotations
 import os
 
 from ..io.campaign import CAMPAIGN_FORMAT, file_limits, load_campaign
+from ..io.paraview import no_fields_why
 from ..io.result import FORMAT, ResultFileError, file_format, load_result, open_h5
 from ..io.sweep import SWEEP_FORMAT, load_sweep
 from ..plot.campaign import plot_campaign
@@ -65,7 +66,7 @@ def cmd_plot(a):
     r = read(load_result, a.result)
     for flag, path in (("--surface", a.surface), ("--animate", a.animate)):
         if path and not r.tanks:
-            raise InputError(f"{flag}: {a.result} holds no liquid fields (a scene with tanks, run without --no-fields)")
+            raise InputError(f"{flag}: {a.result} holds no liquid fields: {no_fields_why(r)}")
     plot_result(r, out)
     print(f"wrote {out}")
     if a.surface:

@@ -13,8 +13,11 @@ Residuals
     they are compared frame by frame, otherwise the model is interpolated (linearly) to the measured
     times (so a measured record sampled more finely or more coarsely than the model still fits).
     Default weights: w_c = 1 / std(measured_c), every channel counts as much as any other whatever
-    its units; a channel with zero spread (identically zero, e.g. heave in a pure roll decay, or a
-    constant) gets weight 0. `weights={"roll": 1e4, "heave": 0.0}` overrides channels by name
+    its units; a channel without signal gets weight 0 (`no_signal`): zero spread (identically zero,
+    e.g. heave in a pure roll decay, or a constant), or a spread at round-off, below 1e-9 of the
+    largest among the channels in its unit or below 1e-10 rad (m) (the pitch of a roll decay, 1e-17
+    rad, whose 1 / std would make its round-off outweigh the roll and bias the fit).
+    `weights={"roll": 1e4, "heave": 0.0}` overrides channels by name
     (the natural choice when the noise levels are known: w_c = 1 / noise_c, and then the standard
     errors below are exact for independent Gaussian noise).
 
@@ -141,6 +144,7 @@ class FitResult:
     data_scene: str = ""
     implied: dict = dataclasses.field(default_factory=dict)
     implied_standard_errors: dict = dataclasses.field(default_factory=dict)
+    no_signal: dict = dataclasses.field(default_factory=dict)     # channel -> spread: left out (weight 0)
 
     @property
     def loss(self) -> float:
@@ -260,4 +264,4 @@ def identify(scene: Scene, measured, fit: Sequence[str], *, weights: Optional[di
                      evaluations=pb.evaluations, n_residuals=pb.n, channels=dict(pb.weights), start=start,
                      wall_time=_time.perf_counter() - t0, compile_time=pb.compile_time, solve_time=solve_time,
                      correlation=corr, r2=r2, residual_to_noise=noise, quality=quality,
-                     data_scene=mismatch)       # kept, whatever data_scene says: the record of the fit
+                     data_scene=mismatch, no_signal=dict(pb.no_signal))       # kept, whatever data_scene says: the record of the fit

@@ -70,6 +70,27 @@ def add_noise(r: Result, noise: dict, seed: int = 0, keep_probes: bool = True) -
     return dataclasses.replace(r, vessel=vessel, probes=probes)
 
 
+#: a channel whose spread is at most this share of the largest spread among the channels in its unit
+#: is round-off of a motion the record does not hold (the pitch of a pure roll decay, 1e-17 rad):
+#: by default it gets weight 0, since 1 / std would make that round-off outweigh every signal
+ROUNDOFF = 1e-9
+#: ... and so is a spread below this in the channel's unit (rad, m): no record resolves it
+SIGNAL_FLOOR = 1e-10
+
+
+def channel_unit(name: str) -> str:
+    return "rad" if name in ("roll", "pitch") else "m"
+
+
+def no_signal(name: str, x, spread: dict) -> bool:
+    """Whether a measured channel holds nothing to fit (weight 0 by default): a constant (its spread
+    round-off of its own level), a spread below SIGNAL_FLOOR, or one at round-off (ROUNDOFF) of the
+    largest spread among the channels measured in its unit."""
+    s = spread[name]
+    same = max(v for k, v in spread.items() if channel_unit(k) == channel_unit(name))
+    return not (s > 1e-12 * float(np.max(np.abs(x))) and s >= SIGNAL_FLOOR and s > ROUNDOFF * same)
+
+
 class Problem:
     """The residual r(theta) of one identification, compiled once."""
 
@@ -99,16 +120,17 @@ class Problem:
                                                  f"(channels: {', '.join(names)})")
         self.weights = {}
         for k in names:
-            x = meas[k]
-            if not np.all(np.isfinite(x)):
+            if not np.all(np.isfinite(meas[k])):
                 raise SceneError("measured", f"channel {k} holds non-finite values")
+        spread = {k: float(np.std(meas[k])) for k in names}
+        self.no_signal = {k: spread[k] for k in names if k not in weights and no_signal(k, meas[k], spread)}
+        for k in names:
             if k in weights:
                 w = float(weights[k])
                 if not (w >= 0 and math.isfinite(w)):
                     raise SceneError(f"weights.{k}", f"must be finite and >= 0, got {weights[k]}")
             else:
-                s = float(np.std(x))
-                w = 1.0 / s if s > 1e-300 and s > 1e-12 * float(np.max(np.abs(x))) else 0.0
+                w = 0.0 if k in self.no_signal else 1.0 / spread[k]
             self.weights[k] = w
         self.active = [k for k in names if self.weights[k] > 0]
         if not self.active:

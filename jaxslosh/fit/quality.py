@@ -18,13 +18,15 @@ Goodness of fit
     parameters: R^2_c = 1 - sum r_c^2 / sum (w_c (measured_c - mean))^2, the share of the measured
     signal's variance the model explains (the weight cancels; with the default weights 1 / std the
     loss is the mean over channels of 1 - R^2_c). A low R^2 alone does not make a fit poor: noisy
-    data cap it at 1 - noise^2 / variance. So the noise is estimated from the record itself, from
+    data cap it at 1 - noise^2 / variance; nor does a high one make it good: a clean record fitted
+    1 % off keeps R^2 at 0.99. So the noise is estimated from the record itself, from
     its second differences (white noise of standard deviation s gives differences of standard
     deviation s sqrt(6); a signal sampled well above its frequencies adds little; the median
     absolute deviation ignores a few outliers), and a channel is a poor fit when R^2_c < R2_POOR
     and its residual's RMS exceeds NOISE_FACTOR times that noise: the model leaves out structure,
-    not noise. On smooth, sparse or noise-free records the estimate is small or zero and the test
-    is R^2 alone.
+    not noise; and whatever R^2, when its residual exceeds NOISE_FAR times the noise. On smooth,
+    noise-free records the estimate is the signal's own curvature (larger than the noise, so the
+    test errs towards "good"); on sparse ones it may be zero and the test is R^2 alone.
 """
 from __future__ import annotations
 
@@ -40,6 +42,8 @@ from .params import implied_keys
 
 R2_POOR = 0.9          # below: the model explains less than 90 % of the channel's variance
 NOISE_FACTOR = 3.0     # ... and the residual is this many times the noise estimated from the record
+NOISE_FAR = 10.0       # a residual this many times the noise is poor whatever R^2: a fit 1 % off leaves
+#                        R^2 at 0.99 on a clean record, its residual far above the noise floor
 MAX_LISTED = 8         # differences named in the message, the rest counted
 
 
@@ -90,4 +94,6 @@ def goodness(res, measured, weights, names) -> tuple[dict, dict, str]:
         ratio[name] = rms / s if s > 0 else (math.inf if rms > 0 else 0.0)
         if r2[name] < R2_POOR and ratio[name] > NOISE_FACTOR:
             poor.append(f"{r2[name]:.2f} on {name}")
+        elif s > 0 and ratio[name] > NOISE_FAR:
+            poor.append(f"{r2[name]:.4f} on {name} (residual {ratio[name]:.3g} times the noise)")
     return r2, ratio, ("poor fit: R^2 " + ", ".join(poor)) if poor else ""

@@ -178,6 +178,13 @@ class AbstractShape(abc.ABC):
             return True, "a tank with baffles"
         return False, ""
 
+    def reentrant(self, fill_depth: float) -> tuple[bool, str]:
+        """(whether the liquid at rest has re-entrant edges, what they are): there the nodal elements
+        lose whole modes (docs/guide/liquid-element.md, "Why rt"), which the loader warns of. The
+        shapes drawn from numbers are convex but for their baffles (each reaches into the liquid)."""
+        n = len(self.baffles)
+        return (True, f"{n} baffle{'s' if n > 1 else ''} in the liquid") if n else (False, "")
+
     # ------------------------------------------------------------------------------ drawing, words
     def outline(self, fill_depth: float, mesh=None) -> list:
         """The outline to draw: polylines (k, 3) in tank-local coordinates, each baffle's plate

@@ -13,7 +13,7 @@ import numpy as np
 from ..fem.mesh import grid_nodes
 from ..fem.meshfile import read_mesh_file
 from ..fem.shapes import TankMesh, as_grid, finish, grid_counts, hex_volumes, read_mesh
-from ..fem.slip import boundary
+from ..fem.slip import _boundary_faces as boundary_faces, _face_normals as face_normals, boundary
 from ..hull.tanks import mesh_surface
 from .base import AbstractShape, Reader
 
@@ -100,6 +100,34 @@ class MeshFile(AbstractShape):
         if self.box_counts(float(fill_depth)) is not None:
             return False, "a mesh file that is a box grid builds as the box"
         return True, "a mesh tank"
+
+    def reentrant(self, fill_depth: float) -> tuple[bool, str]:
+        """A mesh is re-entrant where a boundary face is not on the liquid's convex hull: its plane is
+        no supporting plane, nodes lie beyond it along its outward normal (a U-tube's duct roof, a
+        slit baffle's faces). Features under 0.1 % of the mesh's extent are let pass."""
+        if self.box_counts(float(fill_depth)) is not None:
+            return False, ""
+        from scipy.spatial import ConvexHull, QhullError     # here: the loader's import stays light
+        nodes, elements = read_mesh(self.file)
+        faces, owner = boundary_faces(elements)
+        normal, area = face_normals(nodes, faces)
+        centre = nodes[elements[owner]].mean(axis=1)
+        normal = np.where((np.einsum("ij,ij->i", normal, nodes[faces].mean(axis=1) - centre) >= 0)[:, None],
+                          normal, -normal)
+        scale = float(np.ptp(nodes, axis=0).max())
+        try:
+            corners = nodes[ConvexHull(nodes).vertices]
+        except QhullError:               # a flat mesh: nothing to say here (the loader refuses it elsewhere)
+            return False, ""
+        ok = area > 1e-14 * scale ** 2
+        gap = np.zeros(len(faces))
+        for i in range(0, len(faces), 4096):           # (faces, hull corners) in slices: bounded memory
+            n, own = normal[i:i + 4096], nodes[faces[i:i + 4096]]
+            gap[i:i + 4096] = (corners @ n.T).max(axis=0) - np.einsum("fkj,fj->fk", own, n).max(axis=1)
+        bad = ok & (gap > 1e-3 * scale)
+        if not bad.any():
+            return False, ""
+        return True, f"a re-entrant mesh: {int(bad.sum())} of its {len(faces)} boundary faces off its convex hull"
 
     def _outline(self, fill_depth: float, mesh) -> list:
         """The mesh's feature edges (faces meeting at more than 30 degrees)."""

@@ -5,7 +5,8 @@ every one; ParaView opens them together), all over one HDF5 file `STEM_paraview.
 
 * `STEM.xdmf`: the liquid of every tank (without tanks: the vessel), hexahedra in the inertial frame (the tank moved with the
   vessel, plus the liquid's displacement), point data `displacement` (the result's deformational
-  displacement, tank frame, m) and `elevation` (its vertical part);
+  displacement, tank frame, m) and `elevation` (its vertical part); a multimodal tank's is one
+  layer of hexahedra over its base, its top at the free surface the modal coordinates give;
 * `STEM_surface.xdmf`: the free surfaces (the top faces of the liquid meshes), quadrilaterals,
   `elevation`;
 * `STEM_vessel.xdmf`: the hull as its wetted box (a `[vessel.hull]` box: keel to waterline), or
@@ -72,6 +73,18 @@ def _scene(text: str) -> dict:
         return tomllib.loads(text or "")
     except (tomllib.TOMLDecodeError, TypeError, ValueError):
         return {}
+
+
+def no_fields_why(r: Result) -> str:
+    """Why a result keeps no liquid fields, as far as its scene says (what `plot --surface` and
+    `export --paraview` tell a user who expected them)."""
+    tanks = _scene(r.scene_text).get("tanks", [])
+    if not tanks:
+        return "its scene has no tanks"
+    why = "it was run with --no-fields, or its fields would have passed 200 MB (`jaxslosh run` then leaves them out)"
+    if any(t.get("model") == "multimodal" for t in tanks):
+        why += ", or it is a multimodal run made before jaxslosh kept the multimodal free surface: run it again"
+    return why
 
 
 def _tank_origins(scene: dict) -> dict:

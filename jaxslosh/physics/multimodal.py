@@ -43,7 +43,7 @@ liquid's momentum: they are the rigid rows.
 """
 from __future__ import annotations
 
-from typing import NamedTuple
+from typing import NamedTuple, Optional
 
 import equinox as eqx
 import jax
@@ -401,12 +401,18 @@ class MultimodalLiquid(AbstractLiquid):
     samples: jax.Array                # (Ns, nf) surface elevation at sample points of every tank (validity)
     gravity: jax.Array                # m/s^2, for the rest stiffness
     about: About = eqx.field(static=True, default=About())     # its tanks
+    # (N, nf): the vertical displacement of the nodes of the tanks' surface meshes per modal coordinate
+    # (assemble/multimodal.py surface_meshes: what a result keeps to draw and export); None: no fields
+    fields: Optional[jax.Array] = None
     sparse = False
 
     def describe(self) -> tuple:
         return self.about.lines
-    n_nodes = 0
     nonlinear = True
+
+    @property
+    def n_nodes(self) -> int:
+        return 0 if self.fields is None else int(self.fields.shape[0])
 
     @property
     def nf(self) -> int:
@@ -468,7 +474,11 @@ class MultimodalLiquid(AbstractLiquid):
         return d
 
     def nodal_fields(self, D):
-        return D
+        """Modal coordinates (..., nf) -> the surface meshes' nodal displacements (..., N, 3), vertical."""
+        if self.fields is None:
+            return D
+        z = D @ self.fields.T
+        return jnp.stack([jnp.zeros_like(z), jnp.zeros_like(z), z], axis=-1)
 
     def probe_displacements(self, weights, modal, d):
         return jnp.einsum("pkc,k->pc", modal, d)

@@ -112,6 +112,7 @@ def parse_scene(mapping: Mapping[str, Any], text: str = "", path: str = "") -> S
     _unique_names(tanks, "tanks", "tank")
     _multimodal_scene(tanks, warnings)
     _overlapping_tanks(tanks, warnings)
+    _locking_elements(tanks, warnings)
     _unique_names(structures, "structures", "structure")
     _attachments(structures)
     _unique_names(probes, "probes", "probe")
@@ -151,6 +152,21 @@ def _multimodal_scene(tanks, warnings: list[str]) -> None:
             warnings.append(f"tanks[{i}] ({t.name!r}): fill depth / length = {ratio:.3g} is below "
                             f"{MULTIMODAL_SHALLOW}: shallow-water sloshing (bores, hydraulic jumps), outside the "
                             "multimodal method's validity")
+
+
+def _locking_elements(tanks, warnings: list[str]) -> None:
+    """A nodal element (given: the loader never chooses one there) in a tank with re-entrant edges
+    locks: every line of held nodes along such an edge removes a whole mode (a U-tube has no U-tube
+    mode, a baffle's mode is too stiff), with no error to show for it (docs/guide/liquid-element.md)."""
+    for i, t in enumerate(tanks):
+        if t.model != "fem" or t.fluid.element not in ELEMENT_FORMS:
+            continue
+        reentrant, what = t.geometry.reentrant(t.fill_depth)
+        if reentrant:
+            warnings.append(f'tanks[{i}] ({t.name!r}): element = "{t.fluid.element}" locks in this tank ({what}): '
+                            'its nodal displacements lose whole sloshing modes there (a U-tube\'s U-tube mode, the '
+                            'modes a baffle shapes); element = "rt" (face-normal) holds there, and is the default '
+                            'where tanks.fluid.element is left out')
 
 
 def _conservative(scene: Scene) -> None:
@@ -355,10 +371,14 @@ def _multimodal_tank(table, where: str) -> None:
     """A multimodal tank is a plain box (physics/multimodal.py, or multimodal3d.py with flow = "3d") or
     an upright circular cylinder (multimodal3d.py) with rigid walls."""
     read_multimodal_shape(table, where)
-    for key, why in (("shape", "a box or an upright cylinder"), ("baffles", "a tank without baffles"),
+    if "shape" in table and not SHAPES[table["shape"]].modal:
+        allowed = " or ".join(f'shape = "{name}"' + {"box": " (the default)", "cylinder": ' with axis = "z"'}.get(name, "")
+                              for name, cls in SHAPES.items() if cls.modal)
+        raise SceneError(f"{where}.shape", f'a model = "multimodal" tank is a box or an upright cylinder: {allowed}, '
+                                           f'not shape = "{table["shape"]}"')
+    for key, why in (("baffles", "a tank without baffles"),
                      ("walls", "rigid walls"), ("reduction", "its own modes"), ("file", "a box or a cylinder")):
-        if key in table and not (key == "shape" and SHAPES[table[key]].modal) and \
-                not (key == "walls" and table[key] == "rigid"):
+        if key in table and not (key == "walls" and table[key] == "rigid"):
             raise SceneError(f"{where}.{key}", f'a model = "multimodal" tank is {why}: leave {key} out')
     visc = table.get("damping", {}).get("viscosity", 0.0) if isinstance(table.get("damping"), dict) else 0.0
     if visc:

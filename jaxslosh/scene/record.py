@@ -34,7 +34,9 @@ def read_record(path: str, where: str, shown: str) -> tuple[tuple[float, ...], t
 @functools.lru_cache(maxsize=8)
 def _read_record(path, where, shown, mtime_ns, size):
     try:
-        with open(path, newline="", encoding="utf-8") as fh:
+        # utf-8-sig: a spreadsheet's "CSV UTF-8" starts with a byte-order mark, which would otherwise
+        # stick to the first header name; newline="" lets the csv reader take \n, \r\n or \r line ends
+        with open(path, newline="", encoding="utf-8-sig") as fh:
             lines = [(n, row) for n, row in enumerate(csv.reader(fh), start=1)
                      if row and any(c.strip() for c in row) and not row[0].lstrip().startswith("#")]
     except FileNotFoundError:
