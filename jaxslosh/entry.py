@@ -15,6 +15,7 @@ import sys
 from importlib import import_module
 
 from .cache import executables
+from .run.guard import stop_on_signals
 
 
 #: the commands whose one positional argument is a scene file (jaxslosh/cli/common.COMMANDS)
@@ -22,6 +23,8 @@ SCENE_COMMANDS = ("run", "check", "modes", "identify", "sweep", "hydro", "rao", 
 
 
 def main() -> int:
+    # first: Ctrl-C from here on stops the command with one line and exit 130, JAX's import included
+    stop_on_signals()
     args = sys.argv[1:]
     code = check_scene_first(args)
     if code is not None:

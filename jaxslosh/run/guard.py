@@ -7,7 +7,9 @@ signal therefore only asks, and the loop looks between chunks (`Stop.check`)."""
 from __future__ import annotations
 
 import contextlib
+import os
 import signal
+import sys
 import threading
 from typing import Optional
 
@@ -48,3 +50,83 @@ def interrupts():
     finally:
         for s, h in old.items():
             signal.signal(s, h)
+
+
+# The command line's own regime (jaxslosh/entry.py, for the whole process): a signal stops the
+# command at once, with one line and exit status 130. Where no command asks otherwise (a run or a
+# campaign enters `interrupts` above, which keeps its file and says how it ended), a KeyboardInterrupt
+# would land wherever Python was (JAX's import: a 40-line traceback; a callback of XLA's garbage
+# collection: ignored, and the command went on to write its figure and exit 0). And Python runs a
+# handler only between its own bytecodes, not while XLA computes: a thread woken through the
+# signal's wakeup file descriptor stops the process then. A file being written when the signal
+# comes is finished first (`finishing`), never left half-written.
+
+#: what `finishing` blocks hold off: their depth, and the signals that came meanwhile
+_FINISHING = [0]
+_ASKED: list = []
+_EXITING = threading.Lock()
+#: the exit status of an interrupted command (128 + SIGINT, the shell's convention; cli/common.py's)
+EXIT_INTERRUPTED = 130
+
+
+def _stop_now():
+    if not _EXITING.acquire(blocking=False):        # the other path (handler or watcher) is on it
+        return
+    try:
+        sys.stderr.write("interrupted\n")
+        sys.stderr.flush()
+    finally:
+        os._exit(EXIT_INTERRUPTED)
+
+
+def _stop_handler(signum, frame):
+    if _FINISHING[0]:
+        _ASKED.append(signum)
+    else:
+        _stop_now()
+
+
+def _watch(fd):
+    """The signals' wakeup bytes, read while the main thread may be inside XLA (which does not
+    hold Python's lock): ours stop the process; those of a handler a command set are left to it."""
+    while True:
+        try:
+            data = os.read(fd, 64)
+        except OSError:
+            return
+        if not data:
+            return
+        for signum in data:
+            try:
+                ours = signal.getsignal(signum) is _stop_handler
+            except (ValueError, OSError):
+                ours = False
+            if ours and not _FINISHING[0]:
+                _stop_now()
+
+
+def stop_on_signals():
+    """From now on, in this process (the main thread only), SIGINT and SIGTERM stop it at once:
+    "interrupted" on stderr and exit status 130, except inside `finishing` blocks (which end
+    first) and while `interrupts` has the signals."""
+    if threading.current_thread() is not threading.main_thread():
+        return
+    for s in (signal.SIGINT, signal.SIGTERM):
+        signal.signal(s, _stop_handler)
+    r, w = os.pipe()
+    os.set_blocking(w, False)
+    signal.set_wakeup_fd(w, warn_on_full_buffer=False)
+    threading.Thread(target=_watch, args=(r,), name="signal-watch", daemon=True).start()
+
+
+@contextlib.contextmanager
+def finishing():
+    """A block that writes a file: a signal under `stop_on_signals` waits for its end, then stops the
+    process (the file whole). Elsewhere, nothing changes."""
+    _FINISHING[0] += 1
+    try:
+        yield
+    finally:
+        _FINISHING[0] -= 1
+        if _ASKED and not _FINISHING[0]:
+            _stop_now()
