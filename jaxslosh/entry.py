@@ -1,7 +1,7 @@
 """The `jaxslosh` program (and `python -m jaxslosh`): what it does before the package is imported.
 
 A second `jaxslosh run` of a command line spends most of its start importing jaxslosh and loading
-the executables of its two programs (README "Compile time"). Both take about as long; the loading
+the executables of its two programs (docs/guide/compilation-cache.md). Both take about as long; the loading
 is XLA's work, outside Python's lock. So the executables the last run of the same command line used
 start loading here (executables.preload), and the package is imported while they load.
 

@@ -2,7 +2,7 @@
 
 A program's file (cache/programs.py) keeps, beside the exported program, the executable XLA compiled for
 this host. Loading it is XLA's work, outside Python's lock, and the largest part of what a second
-`jaxslosh run` of a scene does before its first step (README "Compile time"). So the command line
+`jaxslosh run` of a scene does before its first step (docs/guide/compilation-cache.md). So the command line
 starts loading the executables its last run of the same command line used (`preload`, called by
 jaxslosh/entry.py before the package's modules are imported), and the run's `lower_program` takes
 them loaded or still loading (`take`).
@@ -22,7 +22,7 @@ import threading
 
 
 def cache_folder() -> tuple[str | None, str | None]:
-    """The command line's cache folders (README "Compilation"): JAX's persistent compilation cache
+    """The command line's cache folders (docs/guide/compilation-cache.md): JAX's persistent compilation cache
     in $JAXSLOSH_CACHE_DIR, else $XDG_CACHE_HOME/jaxslosh/xla (JAXSLOSH_CACHE_DIR="" turns both
     off), and the programs' folder in it; where the user set JAX_COMPILATION_CACHE_DIR, JAX's is
     theirs (None here) and the programs' folder lies beside it."""

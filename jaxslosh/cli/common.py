@@ -19,8 +19,9 @@ from ..scene.keys import with_overrides
 from ..scene.load import load_scene
 from ..scene.types import Scene, SceneError
 
-#: exit statuses: done, bad input (one line), numerical failure (SPEC section 2); interrupted by a
-#: signal (128 + SIGINT, the shell's convention); the output could not be written (a full disk)
+#: exit statuses (docs/guide/exit-status-and-warnings.md): done, bad input (one line), numerical
+#: failure; interrupted by a signal (128 + SIGINT, the shell's convention); the output could not be
+#: written (a full disk)
 EXIT_OK, EXIT_INPUT, EXIT_NUMERICAL, EXIT_INTERRUPTED, EXIT_IO = 0, 2, 3, 130, 1
 
 
@@ -30,7 +31,7 @@ class InputError(Exception):
 
 #: every command: the module (jaxslosh/cli/<module>.py, whose cmd_<command> runs it) and its help. main.py
 #: imports only the module of the command asked for, so `jaxslosh run` loads neither Dask nor SciPy's
-#: signal and statistics modules (README "Compilation": what a run costs before its first step)
+#: signal and statistics modules (docs/guide/compilation-cache.md: what a run costs before its first step)
 COMMANDS = {
     "run": ("simulate", "simulate a scene, write the result file"),
     "check": ("simulate", "validate a scene; list what it will simulate and what it will cost"),

@@ -52,7 +52,7 @@ class _Tanks:
             if name in shapes:
                 depth, geo = float(shapes[name].fill_depth), shapes[name].geometry
             else:
-                # a mesh tank gives no fill_depth: its free surface is its mesh's highest plane (SPEC 5)
+                # a mesh tank gives no fill_depth: its free surface is its mesh's top (docs/guide/tank-meshes.md)
                 depth = float(t["fill_depth"]) if "fill_depth" in t else float(nodes[:, 2].max())
                 geo = SHAPES.get(t.get("shape", "box"), SHAPES["box"]).sketch(t)
             s, tri = _surface_triangles(nodes, elements, depth)
