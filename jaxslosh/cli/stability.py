@@ -9,7 +9,6 @@ import numpy as np
 
 from ..analysis.stability import DEFAULT_DEGREES, StabilityFailure, stability
 from ..plot.stability import plot_stability
-from ..run.guard import finishing
 from .common import COMMANDS, EXIT_NUMERICAL, EXIT_OK, InputError, load, output_folder, setup_jax
 
 
@@ -51,8 +50,7 @@ def cmd_stability(a):
         print(f"error: {e}", file=sys.stderr)
         return EXIT_NUMERICAL
     if a.output:
-        with finishing():               # Ctrl-C meanwhile: the figure whole, then exit 130
-            plot_stability(s, a.output, title=scene.title)
+        plot_stability(s, a.output, title=scene.title)
     if a.json:
         print(json.dumps(s.as_dict()))
         return EXIT_OK

@@ -14,6 +14,7 @@ from ..geometry import SHAPES
 from ..physics.kinematics import rotation_matrix
 from ..scene.load import load_scene, tomllib
 from ..scene.types import SceneError
+from ..run.guard import finishing
 from .results import figure
 
 
@@ -135,7 +136,8 @@ def plot_free_surface(r, out: str, times=None, scale: float = 1.0):
     fig.suptitle(_surface_title(scale), fontsize=10)
     fig.tight_layout(rect=(0, 0, 0.9, 1))
     tanks.colour_bar(fig, scale)
-    fig.savefig(out, dpi=100)
+    with finishing():           # Ctrl-C meanwhile: the figure whole, then exit 130 (run/guard.py)
+        fig.savefig(out, dpi=100)
     return fig
 
 
