@@ -38,14 +38,15 @@ def main() -> int:
 def scene_argument(args) -> str | None:
     """The scene file a command line names, found without the command's parser (which imports the
     command's module, and JAX): the one word after a scene command that is neither an option nor
-    an option's value, where that is an existing file. None where it is not that plain (help asked
-    for, a flag before the scene, ...): the command's own parser then reads the line."""
+    an option's value (a missing file too: that is answered at once as well). None where it is not
+    that plain (help asked for, a flag before the scene, ...): the command's own parser then reads
+    the line."""
     words = list(args)
     if not words or words[0] not in SCENE_COMMANDS or any(w in ("-h", "--help") for w in words):
         return None
     found = [w for prev, w in zip(words, words[1:])
              if not w.startswith("-") and not (prev.startswith("-") and "=" not in prev)]
-    return found[0] if len(found) == 1 and os.path.isfile(found[0]) else None
+    return found[0] if len(found) == 1 else None
 
 
 def check_scene_first(args) -> int | None:

@@ -11,6 +11,7 @@ import os
 import signal
 import sys
 import threading
+import time
 from typing import Optional
 
 
@@ -39,6 +40,7 @@ def interrupts():
         return
 
     def handler(signum, frame):
+        _HANDLED[0] += 1                # this signal is answered here, not by `stop_on_signals`' watcher
         name = signal.Signals(signum).name
         if stop.signal is not None:
             raise Interrupted(name)
@@ -64,6 +66,13 @@ def interrupts():
 #: what `finishing` blocks hold off: their depth, and the signals that came meanwhile
 _FINISHING = [0]
 _ASKED: list = []
+#: SIGINT and SIGTERM: how many a Python handler of this module has run for, and how many wakeup
+#: bytes the watcher has read (one a signal; Python may run one handler call for two quick ones)
+_HANDLED = [0]
+_READ = [0]
+#: how long the watcher leaves the main thread to run a handler itself, in seconds: longer means a
+#: computation in XLA that keeps it from Python
+GRACE = 0.25
 _EXITING = threading.Lock()
 #: the exit status of an interrupted command (128 + SIGINT, the shell's convention; cli/common.py's)
 EXIT_INTERRUPTED = 130
@@ -80,6 +89,7 @@ def _stop_now():
 
 
 def _stop_handler(signum, frame):
+    _HANDLED[0] += 1
     if _FINISHING[0]:
         _ASKED.append(signum)
     else:
@@ -88,7 +98,9 @@ def _stop_handler(signum, frame):
 
 def _watch(fd):
     """The signals' wakeup bytes, read while the main thread may be inside XLA (which does not
-    hold Python's lock): ours stop the process; those of a handler a command set are left to it."""
+    hold Python's lock). A signal that no handler has answered within GRACE, while ours is the
+    handler, stops the process; one that `interrupts` answered (a run, a campaign) is left to it,
+    even where its block has ended and ours is back by the time the byte is read."""
     while True:
         try:
             data = os.read(fd, 64)
@@ -97,6 +109,15 @@ def _watch(fd):
         if not data:
             return
         for signum in data:
+            if signum not in (signal.SIGINT, signal.SIGTERM):
+                continue
+            _READ[0] += 1
+            deadline = time.monotonic() + GRACE
+            while _HANDLED[0] < _READ[0] and time.monotonic() < deadline:
+                time.sleep(0.01)
+            if _HANDLED[0] >= _READ[0]:
+                continue
+            _HANDLED[0] = _READ[0]          # counted answered: the counts stay in step
             try:
                 ours = signal.getsignal(signum) is _stop_handler
             except (ValueError, OSError):

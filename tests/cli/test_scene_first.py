@@ -28,15 +28,19 @@ def imported(stderr):
     return set(re.findall(r"^import time:\s+\d+ \|\s+\d+ \|\s+([A-Za-z_][\w]*)\s*$", stderr, re.M))
 
 
-@pytest.mark.parametrize("command", [["check"], ["run", "-o", "out.h5"]])
+@pytest.mark.parametrize("command", [["check"], ["run", "-o", "out.h5"], ["check", "missing"]])
 def test_bad_scene_is_refused_before_jax(tmp_path, command):
     path = bad_scene(tmp_path)
+    expected = "error: vessel.mass: must be positive, got -1.0"
+    if command[-1] == "missing":
+        command, path = command[:1], str(tmp_path / "missing.toml")
+        expected = f"error: {path}: no such file"
     env = dict(os.environ, PYTHONPATH=ROOT + os.pathsep + os.environ.get("PYTHONPATH", ""))
     p = subprocess.run([sys.executable, "-X", "importtime", "-m", "jaxslosh", command[0], path, *command[1:]],
                        cwd=tmp_path, env=env, capture_output=True, text=True, timeout=300)
     errors = [ln for ln in p.stderr.splitlines() if not ln.startswith("import time:")]
     assert p.returncode == 2, p.stderr[-2000:]
-    assert errors == ["error: vessel.mass: must be positive, got -1.0"]
+    assert errors == [expected]
     mods = imported(p.stderr)
     assert "numpy" in mods and "jaxslosh" in mods        # the parse of importtime's lines works
     assert not mods & {"jax", "jaxlib", "equinox"}
@@ -70,5 +74,6 @@ def test_scene_argument(tmp_path):
     assert scene_argument(["run", "--no-progress", s]) is None       # a flag, or an option's value?
     assert scene_argument(["run", s, "--help"]) is None
     assert scene_argument(["plot", s]) is None                          # a result file, not a scene
-    assert scene_argument(["check", str(tmp_path / "absent.toml")]) is None
+    assert scene_argument(["check", str(tmp_path / "absent.toml")]) == str(tmp_path / "absent.toml")
+    assert scene_argument(["run", s, "extra"]) is None                  # the parser's to refuse
     assert scene_argument([]) is None
