@@ -6,7 +6,10 @@
   its arguments' help;
 - `reference/api.md`: the public names of `jaxslosh` (its `__init__`), rendered by mkdocstrings;
 - the guides: every `docs/guide/*.md` that mkdocs.yml's nav does not list is added to its "Guides"
-  section, so a new guide needs no edit of mkdocs.yml.
+  section, so a new guide needs no edit of mkdocs.yml;
+- the notebooks' math: the `$...$` and `$$...$$` of their Markdown cells written as MathML at build
+  time (`render_math`), which browsers draw without a script: the site loads nothing from elsewhere
+  (no MathJax or KaTeX from a CDN, no web fonts: mkdocs.yml `theme.font: false`) and reads offline.
 
 The generators are plain functions returning Markdown, so tests/docs/test_docs.py checks them without
 running mkdocs.
@@ -14,7 +17,9 @@ running mkdocs.
 from __future__ import annotations
 
 import argparse
+import html as _html
 import os
+import re
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 GENERATED = ("reference/scene.md", "reference/commands.md", "reference/api.md")
@@ -194,3 +199,45 @@ def on_files(files, config, **kwargs):
     for uri, make in pages.items():
         files.append(File.generated(config, uri, content=make()))
     return files
+
+
+#: mkdocs-jupyter's (nbconvert's) block that would load MathJax from a URL it leaves empty
+_MATHJAX_BLOCK = re.compile(r"<!-- Load mathjax -->.*?<!-- End of mathjax configuration -->", re.S)
+_TAG = re.compile(r"(<[^>]*>)")
+_RAW = ("pre", "code", "script", "style", "textarea", "math")
+_DISPLAY = re.compile(r"\$\$(.+?)\$\$", re.S)
+_INLINE = re.compile(r"(?<![\\$])\$([^$\n]+?)\$")
+
+
+def _mathml(latex: str, display: str) -> str:
+    from latex2mathml.converter import convert
+
+    return convert(_html.unescape(latex).strip(), display=display)
+
+
+def render_math(page_html: str) -> str:
+    """The `$$...$$` (display) and `$...$` (inline) TeX of a notebook page's text as MathML, outside
+    code, scripts and styles; mkdocs-jupyter's MathJax loader removed. A page without math comes
+    back as it was, but for that loader."""
+    page_html = _MATHJAX_BLOCK.sub("", page_html)
+    parts = _TAG.split(page_html)
+    raw = []                        # the enclosing elements whose text is not prose
+    for i, part in enumerate(parts):
+        if i % 2:                   # a tag
+            m = re.match(r"<(/?)([a-zA-Z][\w-]*)", part)
+            if m and m.group(2).lower() in _RAW and not part.endswith("/>"):
+                if m.group(1):
+                    if raw and raw[-1] == m.group(2).lower():
+                        raw.pop()
+                else:
+                    raw.append(m.group(2).lower())
+        elif not raw and "$" in part:
+            part = _DISPLAY.sub(lambda t: _mathml(t.group(1), "block"), part)
+            parts[i] = _INLINE.sub(lambda t: _mathml(t.group(1), "inline"), part)
+    return "".join(parts)
+
+
+def on_post_page(output, page, config, **kwargs):
+    if page.file.src_uri.endswith(".ipynb"):
+        return render_math(output)
+    return output

@@ -1,6 +1,6 @@
 """Writes parametric_roll_hull.obj: a 10 m hull, wall-sided amidships and flared towards both ends
 (V-shaped below the waterline there), the shape whose stability changes with the wave crest's
-position along it (PHYSICS.md section 5). File coordinates: waterline at z = 0 (draft 1 m), keel
+position along it (docs/guide/large-angles.md). File coordinates: waterline at z = 0 (draft 1 m), keel
 at z = -1, deck at z = +1. Run from the repository root: python scenes/parametric_roll_hull.py"""
 import os
 

@@ -1,4 +1,4 @@
-"""Response amplitude operators of the coupled vessel (SPEC section 7): the linearised scene
+"""Response amplitude operators of the coupled vessel (docs/guide/frequency-domain.md): the linearised scene
 (linear.py) in regular waves of unit amplitude,
 
     [K - w^2 (M - A_inf + A(w)) + i w (C + B(w))] X = F(w, beta),      x(t) = Re(X e^{i w t}),

@@ -1,4 +1,4 @@
-"""Large-angle statical stability (SPEC section 8, PHYSICS section 5): the righting lever GZ at
+"""Large-angle statical stability (docs/guide/stability.md): the righting lever GZ at
 fixed heels, the vessel free to sink and trim at the scene's displacement, with the tank liquids
 frozen at rest and level at each heel; GM0 both ways, the angle of vanishing stability and the
 IS Code 2008 Part A 2.2 criteria.
@@ -67,7 +67,7 @@ class Criterion:
 
 @dataclass(frozen=True)
 class Stability:
-    """What `js.stability` returns: SPEC section 8's fields (also as `s["gz"]` and `s.as_dict()`).
+    """What `js.stability` returns: the fields docs/guide/stability.md lists (also as `s["gz"]` and `s.as_dict()`).
     Angles in rad, levers in m; `gz` with the liquids level, `gz_frozen` with them frozen at rest."""
     angle: np.ndarray
     gz: np.ndarray
@@ -81,7 +81,7 @@ class Stability:
     trim: np.ndarray = field(default=None, repr=False)      # rad: the free angle (pitch at a roll heel, roll at a pitch heel)
 
     def as_dict(self):
-        """SPEC's JSON object."""
+        """The JSON object of `jaxslosh stability --json` (docs/guide/stability.md)."""
         return {"angle": [float(a) for a in self.angle], "gz": [float(g) for g in self.gz],
                 "gz_frozen": [float(g) for g in self.gz_frozen], "gm0": float(self.gm0),
                 "gm0_frozen": float(self.gm0_frozen),

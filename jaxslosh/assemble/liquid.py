@@ -327,7 +327,7 @@ def _face_full(tanks, models, scales, depths=None, sparse=False, structures=()):
         offset += m.n_nodes + (0 if t.wall_spec is None else wall_node_count(t))    # a tank's walls follow its liquid
     liquid, penalty, walls = face_full_liquid(tanks, models, scales, depths, sparse, structures)
     carried = tuple(rigid_part(w.mass, w.nodes + np.asarray(t.origin)[None, :]) for t, w in zip(tanks, walls)
-                    if w is not None)           # the walls are part of the ship's mass (SPEC)
+                    if w is not None)           # the walls are part of the ship's mass (docs/reference/scene.md)
     vstructs = []
     for hs in structures:                       # after every tank's nodes, in the stacked nodal fields
         vstructs.append(VesselFrameStructure(hs.name, offset, hs.nodes, hs.elements))

@@ -1,4 +1,4 @@
-"""Probes: material points recorded in the result (SPEC section 1), as interpolation weights over
+"""Probes: material points recorded in the result (docs/guide/tanks-and-shapes.md), as interpolation weights over
 the liquid's nodes (or a structure's), computed once."""
 from __future__ import annotations
 
@@ -83,7 +83,7 @@ def block_weights(point, nodes, elements, tol=1e-9):
 
 
 def probe_weights(point, size, depth, nodes, elements, eps=1e-9):
-    """SPEC section 1: a probe at the fill depth follows the free surface (even at a wall), a probe
+    """docs/guide/tanks-and-shapes.md: a probe at the fill depth follows the free surface (even at a wall), a probe
     inside the liquid follows the liquid particle, a probe on the bottom or on a wall below the
     surface (or in the air above the liquid) follows the tank. Between nodes, the hexahedron's
     trilinear shape functions interpolate."""

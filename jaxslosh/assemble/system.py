@@ -1,6 +1,6 @@
 """From a validated scene to the static model: `System`, probes and the initial state.
 
-Only what the scene has is built (STYLE.md: Python branches on static model data): a vessel
+Only what the scene has is built (docs/design.md: Python branches on static model data): a vessel
 without tanks has no liquid block, a scene without `[vessel.hydrostatics]` no buoyancy.
 Numbers named in `params` (dotted TOML paths, scene/keys.py) replace the scene's values and may be
 JAX tracers, which is what makes `jax.grad` through `simulate(scene, params=...)` work.
@@ -167,7 +167,7 @@ def _model(scene: Scene, params: dict, outline: bool = False) -> _Model:
     hull_S = None
     carried = block.carried + tuple(rigid_part(b.model.mass, b.model.nodes + np.asarray(scene.structure(b.name).origin))
                                     for b in blocks)
-    if carried:       # the ship's mass and inertia include these parts: the hull is the rest (SPEC)
+    if carried:       # the ship's mass and inertia include these parts: the hull is the rest (docs/reference/scene.md)
         mass, inertia, hull_S = _hull(mass, inertia, carried)
     body = RigidBody(mass=mass, inertia=inertia, S=hull_S)
     balanced = ves.hydrostatics is not None and not nonlinear
@@ -234,7 +234,7 @@ def _hull(mass, inertia, parts):
 
 
 def _hydrostatic_start(system: System, q0):
-    """Discrete hydrostatic equilibrium K d0 = F_g under the initial gravity direction (PHYSICS.md
+    """Discrete hydrostatic equilibrium K d0 = F_g under the initial gravity direction (docs/theory.md
     item 6), so that the stiff acoustic modes are not excited by the start."""
     if system.liquid.sparse and not isinstance(system.liquid, FluxLiquid):   # face-normal: columns of its own
         return hydrostatic_start(system.liquid, system.gravity_body(rotation_matrix(q0)))

@@ -2,13 +2,14 @@
 
 A program's file (cache/programs.py) keeps, beside the exported program, the executable XLA compiled for
 this host. Loading it is XLA's work, outside Python's lock, and the largest part of what a second
-`jaxslosh run` of a scene does before its first step (README "Compile time"). So the command line
+`jaxslosh run` of a scene does before its first step (docs/guide/compilation-cache.md). So the command line
 starts loading the executables its last run of the same command line used (`preload`, called by
 jaxslosh/entry.py before the package's modules are imported), and the run's `lower_program` takes
 them loaded or still loading (`take`).
 
-This module imports only the standard library and JAX: it runs before the rest of jaxslosh is
-imported.
+This module imports only the standard library, and JAX only when it has an executable to load: it
+runs before the rest of jaxslosh is imported, and before the command line has checked the scene
+(which it does without JAX, so that a bad scene is answered at once).
 """
 from __future__ import annotations
 
@@ -19,12 +20,9 @@ import pickle
 import tempfile
 import threading
 
-import jax
-from jax.experimental import serialize_executable
-
 
 def cache_folder() -> tuple[str | None, str | None]:
-    """The command line's cache folders (README "Compilation"): JAX's persistent compilation cache
+    """The command line's cache folders (docs/guide/compilation-cache.md): JAX's persistent compilation cache
     in $JAXSLOSH_CACHE_DIR, else $XDG_CACHE_HOME/jaxslosh/xla (JAXSLOSH_CACHE_DIR="" turns both
     off), and the programs' folder in it; where the user set JAX_COMPILATION_CACHE_DIR, JAX's is
     theirs (None here) and the programs' folder lies beside it."""
@@ -70,6 +68,7 @@ def host() -> str:
     except OSError:
         import platform
         cpu = platform.processor() or platform.machine()
+    import jax
     return hashlib.sha256(f"{jax.default_backend()} {jax.devices()[0].device_kind} {cpu}".encode()).hexdigest()
 
 
@@ -105,6 +104,7 @@ class Load:
     def _load(self):
         try:
             _lapack_ready()
+            from jax.experimental import serialize_executable
             self._done.append((serialize_executable.deserialize_and_load(*self.saved["executable"]), None))
         except BaseException as e:      # handed to the thread that asks for the result
             self._done.append((None, e))
@@ -119,6 +119,7 @@ class Load:
 def _lapack_ready():
     """jaxlib's LAPACK kernels find LAPACK (SciPy's) when a program that calls them is first lowered;
     an executable read back is never lowered, and would call through null pointers."""
+    import jax
     try:
         from jax._src.lax.linalg import initialize_lapack
         initialize_lapack()

@@ -19,7 +19,7 @@ Once XLA has compiled the program, its executable is added to the file (`jax.exp
 serialize_executable`), marked with the host it was compiled for (backend, processor and its
 instruction set). A later process on that host loads the executable and neither lowers the program
 nor asks XLA's cache: on the mast scene, that lowering and XLA's cache lookup took about half a
-second of a second process's start (README "Compile time"). Another host compiles the exported
+second of a second process's start (docs/guide/compilation-cache.md). Another host compiles the exported
 program, through XLA's cache. An executable XLA's cache gave back is not kept (see `_HITS`).
 
 `cached` keeps a value the same way: `jaxslosh run` keeps the model it built from a scene (meshes,

@@ -1,6 +1,9 @@
 """What every command shares: exit codes, the one-line input error, the scene loader that prints
 its warnings. The library raises (SceneError, NumericalFailure); the commands turn that into
-messages and exit codes."""
+messages and exit codes.
+
+This module imports no JAX (nor what imports it): the command line reads and checks a scene before
+JAX is imported (jaxslosh/entry.py), and `setup_jax` imports it."""
 from __future__ import annotations
 
 import argparse
@@ -8,19 +11,17 @@ import math
 import os
 import sys
 import tempfile
+from importlib import import_module
 
-import jax
-
-from ..cache import programs
 from ..cache.executables import cache_folder
 from ..io.output import OutputError, check_output
-from ..io.result import ResultFileError
 from ..scene.keys import with_overrides
 from ..scene.load import load_scene
 from ..scene.types import Scene, SceneError
 
-#: exit statuses: done, bad input (one line), numerical failure (SPEC section 2); interrupted by a
-#: signal (128 + SIGINT, the shell's convention); the output could not be written (a full disk)
+#: exit statuses (docs/guide/exit-status-and-warnings.md): done, bad input (one line), numerical
+#: failure; interrupted by a signal (128 + SIGINT, the shell's convention); the output could not be
+#: written (a full disk)
 EXIT_OK, EXIT_INPUT, EXIT_NUMERICAL, EXIT_INTERRUPTED, EXIT_IO = 0, 2, 3, 130, 1
 
 
@@ -30,7 +31,7 @@ class InputError(Exception):
 
 #: every command: the module (jaxslosh/cli/<module>.py, whose cmd_<command> runs it) and its help. main.py
 #: imports only the module of the command asked for, so `jaxslosh run` loads neither Dask nor SciPy's
-#: signal and statistics modules (README "Compilation": what a run costs before its first step)
+#: signal and statistics modules (docs/guide/compilation-cache.md: what a run costs before its first step)
 COMMANDS = {
     "run": ("simulate", "simulate a scene, write the result file"),
     "check": ("simulate", "validate a scene; list what it will simulate and what it will cost"),
@@ -50,6 +51,8 @@ COMMANDS = {
 def read(load, path):
     """`load(path)` for a command: a file that is not of the kind asked for, or cannot be read, is
     bad input (one line naming the file and the fault; exit 2)."""
+    # imported with the command (it imports JAX), not with this module
+    ResultFileError = import_module("..io.result", __package__).ResultFileError
     try:
         return load(path)
     except ResultFileError as e:
@@ -68,6 +71,9 @@ CACHE_MAX_ENV = "JAXSLOSH_CACHE_MAX_MB"
 def setup_jax():
     """float64, JAX's persistent compilation cache and the exported programs beside it (cache/programs.py):
     a second run of a scene skips tracing and XLA."""
+    import jax
+
+    programs = import_module("..cache.programs", __package__)
     jax.config.update("jax_enable_x64", True)
     d, kept = cache_folder()
     limit = cache_max_bytes() if d is not None else None     # a bad limit changes nothing
@@ -94,8 +100,37 @@ def cache_max_bytes() -> int:
     return int(mb * (1 << 20))
 
 
+#: the scene jaxslosh/entry.py read before JAX was imported (`read_first`): (path, the file's size and
+#: time) -> the scene. The command's own `load` takes it from here, once
+_READ_FIRST: dict = {}
+
+
+def _stamp(path):
+    try:
+        st = os.stat(path)
+    except OSError:
+        return None                     # load_scene says what is wrong with the path
+    return os.path.abspath(path), st.st_size, st.st_mtime_ns
+
+
+def read_first(path) -> Scene:
+    """Read and check a command's scene before JAX is imported (jaxslosh/entry.py): a bad scene is
+    answered in a second (SceneError), a good one is kept for the command's `load`."""
+    scene = load(path)
+    stamp = _stamp(path)
+    if stamp is not None:
+        _READ_FIRST[stamp] = scene
+    return scene
+
+
 def load(path) -> Scene:
-    """The scene, its warnings printed to stderr."""
+    """The scene, its warnings printed to stderr (once: the scene `read_first` read, from a file
+    unchanged since, is that scene)."""
+    if _READ_FIRST:
+        scene = _READ_FIRST.pop(_stamp(path), None)
+        _READ_FIRST.clear()
+        if scene is not None:
+            return scene
     scene = load_scene(path)
     for w in scene.warnings:
         print(f"warning: {w}", file=sys.stderr)

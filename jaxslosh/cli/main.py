@@ -1,4 +1,4 @@
-"""The `jaxslosh` command (SPEC section 2): the parser of every subcommand and the one place where
+"""The `jaxslosh` command (docs/reference/commands.md): the parser of every subcommand and the one place where
 exceptions become messages and exit codes (0 done, 2 bad input, 3 numerical failure).
 
 Only the module of the command asked for is imported (common.COMMANDS): the others appear in the

@@ -41,7 +41,7 @@ def cmd_modes(a):
     # without --tank, every tank in the scene's order, each labelled (`--tank NAME` for one)
     found = [_tank_json(name, sloshing_modes(scene, tank=name, n=a.n)) for name in names]
     if a.json:
-        # one object: the first tank's fields at the top (SPEC's form), every tank's under "tanks"
+        # one object: the first tank's fields at the top (the documented form), every tank's under "tanks"
         print(json.dumps(dict(found[0], tanks=found) if a.tank is None else found[0]))
         return EXIT_OK
     for j, m in enumerate(found):

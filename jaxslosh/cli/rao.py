@@ -1,4 +1,4 @@
-"""`jaxslosh rao`: the scene's RAOs from its linearisation about rest (SPEC section 7)."""
+"""`jaxslosh rao`: the scene's RAOs from its linearisation about rest (docs/guide/frequency-domain.md)."""
 from __future__ import annotations
 
 import os

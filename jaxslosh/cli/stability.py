@@ -1,5 +1,5 @@
 """`jaxslosh stability`: GZ curves with the tank liquids frozen and level, GM0, the angle of vanishing
-stability and the IS Code 2008 Part A 2.2 criteria (SPEC section 8)."""
+stability and the IS Code 2008 Part A 2.2 criteria (docs/guide/stability.md)."""
 from __future__ import annotations
 
 import json

@@ -3,7 +3,7 @@
 Element forms (``ELEMENT_FORMS``)
 ---------------------------------
 ``"paper"`` -- the literal eqs. (30)-(31): mean dilatation plus ``int p0 grad(phi)^T grad(phi) dV``
-(full 2x2x2 Gauss), with the gauge pressure ``p0 = rho g (h - z)`` (PHYSICS.md traps 1-2) and a
+(full 2x2x2 Gauss), with the gauge pressure ``p0 = rho g (h - z)`` (docs/theory.md items 1-2) and a
 consistent mass. The literal term equals the consistent pre-stress energy (which, by parts, is the
 free-surface energy ``1/2 rho g int_FS u_z^2``) plus ``p0 (div u)^2 + p0 |curl u|^2``: a rotation
 penalty that vanishes at the free surface. Known defects (measured, see tests): a circulation mode
@@ -15,8 +15,8 @@ at 2.90 rad/s inside the sloshing band of the 5x5x3 m tank on the 5x5x5 mesh, sl
 enters the sloshing band. Its stiffness is the sum of
 
 1. acoustic: mean dilatation, eq. (30) (one pressure per element, "P0");
-2. free surface: the by-parts form of the consistent pre-stress with the gauge p0 (PHYSICS.md
-   trap 3): ``1/2 rho g sum_faces A (mean u_z)^2`` -- the gravity energy of the volume each top
+2. free surface: the by-parts form of the consistent pre-stress with the gauge p0 (docs/theory.md
+   item 3): ``1/2 rho g sum_faces A (mean u_z)^2`` -- the gravity energy of the volume each top
    face displaces -- plus the small volume coupling ``-rho g int u_z (mean div u)``. The face mean
    (rather than the nodal field) is what matches the P0 pressure: for a linear pressure the balance
    of every surface node is then exact, so under a static tilt the free surface stays level;
@@ -30,7 +30,7 @@ enters the sloshing band. Its stiffness is the sum of
    alternating-sum condition; the nodal surface of a tilt would carry a zig-zag of relative size
    1/n^2), so in the top layer the two wall elements of each such row are penalised on the
    difference of their curls only (see ``_rotation_penalty``). ``theta`` is the small body rotation
-   (PHYSICS.md trap 5): ``stiffness`` holds the d-d block, ``rotation_coupling`` the d-theta block
+   (docs/theory.md item 5): ``stiffness`` holds the d-d block, ``rotation_coupling`` the d-theta block
    and ``rotation_stiffness`` the theta-theta block;
 4. surface hourglass control that is zero on every linear surface field (so tilts stay exact):
    ``1/2 rho g A (h.u_z/4)^2`` per top face (h = (1,-1,1,-1)), and a weak surface "bending"

@@ -16,7 +16,7 @@ Engrg. 119 (1994) 355-370; Bermúdez, Durán, Muschietti, Rodríguez, Solomin, S
   through that face, none through the others), mapped by ``u = J u_ref / det J``, which keeps every
   face's flux. Its normal component is continuous across faces, its tangential components are not:
   the liquid slides freely along walls and plates, whatever their shape, with no node frames;
-* energies (PHYSICS.md section 2): compression ``1/2 rho c^2 (sum_f s_ef q_f)^2 / V_e`` (the flux
+* energies (docs/theory.md, what the paper leaves out): compression ``1/2 rho c^2 (sum_f s_ef q_f)^2 / V_e`` (the flux
   out of an element is its volume change, exactly); free surface ``1/2 rho g q_f^2 / A_f`` on each
   top face (the gravity energy of the volume it raises, as the stabilized element's face mean);
   kinetic energy ``1/2 rho int |u|^2`` with 2 x 2 x 2 Gauss points (the consistent RT0 mass);

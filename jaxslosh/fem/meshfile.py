@@ -67,7 +67,7 @@ def read_mesh_file(path) -> MeshFile:
 def _read(path, mtime_ns, size) -> MeshFile:
     try:
         import meshio
-    except ImportError as e:                        # an optional dependency: say how to get it
+    except ImportError as e:   # a core dependency (pyproject.toml); an install that skipped it gets one line
         raise ValueError("reading a tank mesh needs meshio: pip install meshio") from e
     said = io.StringIO()
     try:

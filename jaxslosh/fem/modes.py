@@ -140,7 +140,7 @@ def others_in_band(kinds) -> list:
 
 def analytic_sloshing_table(a: float, b: float, h: float, g: float, n: int):
     """The n lowest (omega, m, n) of a rigid a x b tank filled to h: omega^2 = g k tanh(k h),
-    k = pi sqrt((m/a)^2 + (n/b)^2), m, n >= 0 not both zero (PHYSICS.md section 3)."""
+    k = pi sqrt((m/a)^2 + (n/b)^2), m, n >= 0 not both zero (docs/theory.md, closed forms)."""
     top = int(n) + 1
     rows = []
     for m in range(top + 1):
@@ -169,7 +169,7 @@ def effective_roll_inertia(size, mesh, element="stabilized", density=1000.0, sou
     Returns (I_eff, I_frozen_discrete, I_frozen_exact) in kg m^2. With `absolute_rotation=False`
     the rotation penalty acts on the relative rotation only (the liquid turns with the tank).
     An inviscid liquid does not spin up: Stokes-Joukowski gives 0.1565 I_frozen for a square
-    section, 0.45 for a 2:1 one (PHYSICS.md item 5)."""
+    section, 0.45 for a 2:1 one (docs/theory.md item 5)."""
     a, b, h = (float(s) for s in size)
     m = build_liquid((a, b, h), h, mesh, density, sound_speed, gravity, element=element)
     nodes = np.asarray(m.nodes)

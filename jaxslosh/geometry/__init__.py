@@ -7,7 +7,7 @@ from .cylinder import Cylinder
 from .meshfile import MeshFile
 from .prismatic import Prismatic
 
-#: the shapes by the value of a tank's `shape` key, in SPEC's order
+#: the shapes by the value of a tank's `shape` key, in the order docs/reference/scene.md lists them
 SHAPES = {cls.name: cls for cls in (Box, Prismatic, Cylinder, MeshFile)}
 
 __all__ = ["AXES", "AbstractShape", "Baffle", "Box", "Cylinder", "MeshFile", "Prismatic", "Reader", "SHAPES"]

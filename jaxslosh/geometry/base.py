@@ -275,7 +275,7 @@ def read_baffles(table, v, where: str, reader: Reader) -> tuple:
 
 def _old_baffle_keys(b, bw: str, H: float, reader: Reader) -> None:
     """An earlier form (`at`, `mount`, `height` as the plate's extent from the bottom or the roof) is
-    refused with its translation to SPEC's keys: its `height` means another length, so reading it
+    refused with its translation to the keys of docs/guide/baffles.md: its `height` means another length, so reading it
     silently either way would put the edge where the user did not mean it."""
     if not isinstance(b, dict) or not ({"at", "mount"} & set(b)):
         return

@@ -32,7 +32,7 @@ class MeshFile(AbstractShape):
     @classmethod
     def read_fill_and_mesh(cls, table, v, where: str, base_dir: str, reader: Reader) -> None:
         """(fill_depth, mesh counts) from the file: the free surface's height, and the box grid's
-        counts if the mesh is one, else (elements, 1, 1). SPEC: neither key is given."""
+        counts if the mesh is one, else (elements, 1, 1). docs/guide/tank-meshes.md: neither key is given."""
         show = reader.show
         if "mesh" in table:
             raise reader.error(f"{where}.mesh", 'a shape = "mesh" tank is meshed by its file: leave mesh out')

@@ -76,7 +76,7 @@ class Prismatic(AbstractShape):
 
 
 def _chamfers(value, where, reader: Reader):
-    """SPEC's [[bottom width, height], [top width, height]], or {bottom = [w, h], top = [w, h]}."""
+    """[[bottom width, height], [top width, height]], or {bottom = [w, h], top = [w, h]}."""
     show = reader.show
     if isinstance(value, dict):
         c = reader.read(value, where, {"bottom": ("numbers", None), "top": ("numbers", None)})

@@ -1,4 +1,4 @@
-"""The box hull's closed surface (SPEC section 8: `[vessel.hull]` length, beam, draft, kg, depth)."""
+"""The box hull's closed surface (docs/guide/large-angles.md: `[vessel.hull]` length, beam, draft, kg, depth)."""
 from __future__ import annotations
 
 import numpy as np

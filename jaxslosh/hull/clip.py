@@ -1,4 +1,4 @@
-"""A closed triangulated surface cut by a plane, in pure JAX (PHYSICS section 5).
+"""A closed triangulated surface cut by a plane, in pure JAX (docs/guide/large-angles.md).
 
 Triangles are an array (n, 3, 3): n triangles, 3 vertices, xyz; counter-clockwise seen from
 outside, so that (b - a) x (c - a) points outward. The plane keeps the points with

@@ -1,6 +1,6 @@
 """The still-water pressure on a closed hull (n, 3, 3) in its own frame (origin at the COG), the
 sea below Z = z_water in the inertial frame: its resultant, the linear model of the same hull at
-rest, and the righting lever at fixed heels (for the capsize check of a run). PHYSICS.md section 5."""
+rest, and the righting lever at fixed heels (for the capsize check of a run). docs/guide/large-angles.md."""
 from __future__ import annotations
 
 import functools

@@ -1,4 +1,4 @@
-"""The hull as a closed triangulated surface for the large-angle hydrostatics (SPEC section 8):
+"""The hull as a closed triangulated surface for the large-angle hydrostatics (docs/guide/large-angles.md):
 a box with its deck, or a closed mesh file, as triangles (n, 3, 3) in the vessel frame (COG at
 the origin), outward normals (counter-clockwise seen from outside).
 

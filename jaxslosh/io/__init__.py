@@ -1,1 +1,1 @@
-"""The project's files: result files (SPEC section 3) and sweep files."""
+"""The project's files: result files (docs/reference/files.md) and sweep files."""

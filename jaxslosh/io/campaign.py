@@ -1,4 +1,4 @@
-"""The campaign file (SPEC section 6): every case created "pending" when the campaign starts, its
+"""The campaign file (docs/reference/files.md): every case created "pending" when the campaign starts, its
 statistics and spectra written as it finishes. The file is opened, written and closed for each
 finished batch, so that a reader (or a --resume after a kill) always finds a consistent file."""
 from __future__ import annotations

@@ -1,4 +1,4 @@
-"""The RAO file (SPEC section 7): complex responses per unit wave amplitude over frequency and
+"""The RAO file (docs/reference/files.md): complex responses per unit wave amplitude over frequency and
 heading, written by `jaxslosh rao`.
 
     /                  attrs: format = "jaxslosh.rao", format_version = 1, scene, jaxslosh_version

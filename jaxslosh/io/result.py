@@ -1,4 +1,4 @@
-"""The result of a run: a pytree mirroring the HDF5 result file (SPEC section 3), and its file io.
+"""The result of a run: a pytree mirroring the HDF5 result file (docs/reference/files.md), and its file io.
 
 The file's datasets are written down once (`schema`); the writer, the reader, `result_frames` (a
 Result as datasets) and `result_from` (datasets as a Result) all follow it. The file is written in
@@ -380,7 +380,7 @@ def check_required(d: dict, probe_names, path: str) -> None:
 
 
 def load_result(path: str) -> Result:
-    """The result file at `path` (SPEC section 3). A file that is not one, cannot be read, lacks a
+    """The result file at `path` (docs/reference/files.md). A file that is not one, cannot be read, lacks a
     dataset or has a newer format_version raises ResultFileError (a ValueError) with a one-line
     message naming the file and the fault."""
     with open_h5(path) as f:

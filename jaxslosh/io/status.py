@@ -1,7 +1,7 @@
 """How a run ended, as a code (like diffrax's RESULTS) with its text.
 
 The compiled loop carries the code of its first failure; the host turns it into the sentence that
-the result file's `status` attribute holds (SPEC section 3: "ok" or a reason) and keeps the code
+the result file's `status` attribute holds (docs/reference/files.md: "ok" or a reason) and keeps the code
 beside it (`status_code`). Codes are stable: files written by one version are read by the next.
 """
 from __future__ import annotations

@@ -1,4 +1,4 @@
-"""The sweep file (`jaxslosh sweep`): the datasets of a result file (SPEC section 3) with a leading
+"""The sweep file (`jaxslosh sweep`): the datasets of a result file (docs/reference/files.md) with a leading
 run axis, the grid under /sweep/<key> (one value per run) and one status per run (attribute
 `statuses`)."""
 from __future__ import annotations

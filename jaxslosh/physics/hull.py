@@ -1,5 +1,5 @@
 """The restoring of the hull's instantaneous wetted surface (`vessel.hydrostatics.model = "nonlinear"`,
-SPEC section 8, PHYSICS.md section 5), and the incident-wave (Froude-Krylov) pressure on it.
+docs/guide/large-angles.md), and the incident-wave (Froude-Krylov) pressure on it.
 
 The hull is a closed triangulated surface in the vessel frame (COG at the origin, hull/surface.py).
 The still water lies at Z = z_water in the inertial frame (the rest COG at the origin). In the body

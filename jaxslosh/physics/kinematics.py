@@ -5,7 +5,7 @@ inertial frame (X = X0 + A (r + d), eq. 1). G(q) is the 3x4 matrix with omega = 
 (body-frame angular velocity); G q = 0 and G G^T = I.
 
 Rotations are advanced on the group (q_{n+1} = q_n * exp(Theta)), so |q| = 1 holds by construction;
-the unit-norm constraint of eq. (25) needs no multiplier (PHYSICS.md section 2, item 8).
+the unit-norm constraint of eq. (25) needs no multiplier (docs/theory.md item 8).
 """
 from __future__ import annotations
 

@@ -9,7 +9,7 @@ particle kinematics keep d in the rotational terms (eqs. 1-4), so the coupled sy
 
 with g_b gravity in the body frame (turning with the body: the load of eq. 32). The frozen liquid's
 own weight and moment are balanced with the hull's by the displaced water (hydrostatics), or are the
-vessel's Weight term; PHYSICS.md item 9: GM_T and GM_L are for the frozen liquid, so only d adds a
+vessel's Weight term; docs/theory.md item 9: GM_T and GM_L are for the frozen liquid, so only d adds a
 gravity moment here.
 """
 from __future__ import annotations
@@ -181,7 +181,7 @@ class Liquid(AbstractLiquid):
 
     def for_batch(self) -> "Liquid":
         # Under vmap, XLA's batched gather of the nodal field (`slot`) made the residual 35-45 %
-        # slower than the scatter (README "Compile time"); a single run keeps the gather, whose
+        # slower than the scatter (docs/benchmarks.md, compile time); a single run keeps the gather, whose
         # program compiles faster.
         return eqx.tree_at(lambda liquid: liquid.slot, self, None, is_leaf=lambda x: x is None)
 
@@ -267,13 +267,13 @@ class Liquid(AbstractLiquid):
         return T.T @ np.kron(Ms, np.eye(3)) @ T, self.K
 
     def static_start(self, g_b):
-        """The discrete hydrostatic equilibrium K d0 = F_g under the body gravity g_b (PHYSICS.md
+        """The discrete hydrostatic equilibrium K d0 = F_g under the body gravity g_b (docs/theory.md
         item 6), dense (large meshes: solve/sparse.py)."""
         return solve(self.K, self.free_part(self.m_nodes[:, None] * g_b[None, :]))
 
 
 class RotationPenalty(AbstractTerm):
-    """The stabilized liquid element's penalty on the absolute rotation curl d + 2 theta (PHYSICS.md
+    """The stabilized liquid element's penalty on the absolute rotation curl d + 2 theta (docs/theory.md
     item 5): d^T K_dt theta + 1/2 theta^T K_tt theta (its d-d block is in the liquid's K), with theta
     the small rotation of the body since the attitude at which the liquid is irrotational (the start).
     Rows by JAX from this potential."""
@@ -282,7 +282,7 @@ class RotationPenalty(AbstractTerm):
     q_ref: jax.Array      # (4,)
 
     def describe(self) -> tuple:
-        return (("rotation penalty", "the liquid's absolute rotation held at zero by a penalty (PHYSICS.md item 5): "
+        return (("rotation penalty", "the liquid's absolute rotation held at zero (docs/theory.md item 5): "
                                      "no spurious rotational modes of the element"),)
 
     def rotation(self, q):

@@ -24,7 +24,7 @@ for each side tied to it, its own multipliers in that side's body frame (eq. 24)
 
 Constraint forces are the transposed constraint Jacobian times the multipliers (a vector-Jacobian
 product through the configuration update, so rotations are varied on the group like every other
-row). Constraint rows are scaled to forces by m_ref / (beta h^2) (PHYSICS.md item 8).
+row). Constraint rows are scaled to forces by m_ref / (beta h^2) (docs/theory.md item 8).
 
 Gravity: with hydrostatics (a floating vessel whose GM_T, GM_L are for the whole frozen ship) the
 structures' weight is balanced like the liquid's: its potential is -m_s g . (X_s - X_v - A_v c_s),

@@ -1,7 +1,7 @@
 """The assembled model: a rigid vessel (floating frame at its COG) carrying liquid, as the sum of the
 terms its scene has (terms.py).
 
-Static model, dynamic state (STYLE.md habit 3): `System` holds everything that is constant in the
+Static model, dynamic state (docs/design.md, the step): `System` holds everything that is constant in the
 body frame; `terms.Config` and the velocity vector are the dynamic unknowns. Generalised
 coordinates: X0 (inertial position of the vessel COG), q (Euler parameters), d (the deformable
 block: liquid displacement relative to the tank on the dofs the slip walls leave free, or its modal

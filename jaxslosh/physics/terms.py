@@ -1,6 +1,6 @@
 """The one interface of the physics: a term of the virtual work (eq. 26) and what every term reads.
 
-A System (system.py) is the sum of its terms: each is an equinox module, abstract or final (STYLE.md),
+A System (system.py) is the sum of its terms: each is an equinox module, abstract or final (docs/design.md),
 built once from the scene with only what the scene has (assemble/), and evaluated inside the jitted
 step. A term gives
 

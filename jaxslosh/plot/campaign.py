@@ -11,6 +11,7 @@ import numpy as np
 
 from ..campaign.stats import operability
 from ..io.campaign import PENDING
+from ..run.guard import finishing
 from .results import figure, scene_title
 
 #: the spectra are drawn where some channel's density is above this share of its peak (and a
@@ -131,7 +132,8 @@ def plot_campaign(c, out: str, limits: Optional[dict] = None, case: Optional[int
     axp.tick_params(labelsize=6)
     _spectra(fig, bottom, c, chans, ok, case, heads, hs_all, tp_all)
     fig.suptitle(title or _title(c, heads), fontsize=10)
-    fig.savefig(out, dpi=90)
+    with finishing():           # Ctrl-C meanwhile: the figure whole, then exit 130 (run/guard.py)
+        fig.savefig(out, dpi=90)
     return fig
 
 

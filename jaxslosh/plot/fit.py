@@ -10,6 +10,7 @@ from ..fit.params import param_value
 from ..fit.problem import as_result, channels_of
 from ..run.simulate import simulate
 from ..scene.types import Scene
+from ..run.guard import finishing
 from .results import figure
 
 
@@ -54,7 +55,8 @@ def plot_fit(scene: Scene, measured, fit_result: FitResult, out_png: Optional[st
     fig.suptitle(f"identify ({fit_result.method}, {fit_result.iterations} iterations): {vals}{quality}", fontsize=9)
     fig.tight_layout()
     if out_png is not None:
-        fig.savefig(out_png, dpi=110)
+        with finishing():           # Ctrl-C meanwhile: the figure whole, then exit 130 (run/guard.py)
+            fig.savefig(out_png, dpi=110)
     return fig
 
 

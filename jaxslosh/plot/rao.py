@@ -5,6 +5,7 @@ from __future__ import annotations
 import numpy as np
 
 from ..scene.types import DOFS
+from ..run.guard import finishing
 from .results import figure, scene_title
 
 UNITS = ("m/m", "m/m", "m/m", "deg/m", "deg/m", "deg/m")
@@ -36,5 +37,6 @@ def plot_rao(r, out: str, title: str = ""):
     ax[-1, 1].set_xlabel("frequency (rad/s)")
     fig.suptitle(title or f"RAOs: {scene_title(r.scene_text, 'jaxslosh scene')}", fontsize=10)
     fig.tight_layout()
-    fig.savefig(out, dpi=100)
+    with finishing():           # Ctrl-C meanwhile: the figure whole, then exit 130 (run/guard.py)
+        fig.savefig(out, dpi=100)
     return fig

@@ -7,6 +7,7 @@ from matplotlib.backends.backend_agg import FigureCanvasAgg
 from matplotlib.figure import Figure
 
 from ..scene.load import tomllib
+from ..run.guard import finishing
 
 #: a sweep's figure names each run in its legend up to this many runs (more would hide the curves)
 MAX_LEGEND = 12
@@ -43,7 +44,8 @@ def _axes(r):
 def _finish(fig, title: str, out: str) -> Figure:
     fig.suptitle(title, fontsize=10)
     fig.tight_layout()
-    fig.savefig(out, dpi=110)
+    with finishing():           # Ctrl-C meanwhile: the figure whole, then exit 130 (run/guard.py)
+        fig.savefig(out, dpi=110)
     return fig
 
 

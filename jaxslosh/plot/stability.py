@@ -3,6 +3,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from ..run.guard import finishing
 from .results import figure
 
 
@@ -37,5 +38,6 @@ def plot_stability(s, out: str, title: str = ""):
     fig.legend(*ax.get_legend_handles_labels(), fontsize=7, loc="lower left", bbox_to_anchor=(0.69, 0.02))
     ax.grid(alpha=0.3)
     ax.set_title(title or "righting lever", fontsize=10)
-    fig.savefig(out, dpi=100)
+    with finishing():           # Ctrl-C meanwhile: the figure whole, then exit 130 (run/guard.py)
+        fig.savefig(out, dpi=100)
     return fig

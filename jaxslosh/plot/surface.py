@@ -14,6 +14,7 @@ from ..geometry import SHAPES
 from ..physics.kinematics import rotation_matrix
 from ..scene.load import load_scene, tomllib
 from ..scene.types import SceneError
+from ..run.guard import finishing
 from .results import figure
 
 
@@ -52,7 +53,7 @@ class _Tanks:
             if name in shapes:
                 depth, geo = float(shapes[name].fill_depth), shapes[name].geometry
             else:
-                # a mesh tank gives no fill_depth: its free surface is its mesh's highest plane (SPEC 5)
+                # a mesh tank gives no fill_depth: its free surface is its mesh's top (docs/guide/tank-meshes.md)
                 depth = float(t["fill_depth"]) if "fill_depth" in t else float(nodes[:, 2].max())
                 geo = SHAPES.get(t.get("shape", "box"), SHAPES["box"]).sketch(t)
             s, tri = _surface_triangles(nodes, elements, depth)
@@ -135,7 +136,8 @@ def plot_free_surface(r, out: str, times=None, scale: float = 1.0):
     fig.suptitle(_surface_title(scale), fontsize=10)
     fig.tight_layout(rect=(0, 0, 0.9, 1))
     tanks.colour_bar(fig, scale)
-    fig.savefig(out, dpi=100)
+    with finishing():           # Ctrl-C meanwhile: the figure whole, then exit 130 (run/guard.py)
+        fig.savefig(out, dpi=100)
     return fig
 
 

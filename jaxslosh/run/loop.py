@@ -181,7 +181,7 @@ def _advance(b: Built, solver: Solver, carry: Carry, n_frames: int, save_every: 
     # Reverse mode through long runs: blocks of K ~ sqrt(n) frames are checkpointed (jax.checkpoint
     # keeps only the block boundaries and recomputes a block's steps when its gradient is taken), so
     # a gradient's memory stops growing with the steps; the checkpointed program is larger, so only
-    # runs of REMAT_MIN_STEPS or more take it (README "Gradient memory" has the measurements).
+    # runs of REMAT_MIN_STEPS or more take it (docs/benchmarks.md, gradient memory, has the measurements).
     K = _block_size(n_frames)
     if n_frames * save_every < REMAT_MIN_STEPS or K < 4:
         return frames(carry, n_frames)

@@ -1,4 +1,4 @@
-"""The scene: a TOML file (SPEC sections 1 and 5) read into a validated, immutable `Scene` of plain
+"""The scene: a TOML file (docs/reference/scene.md) read into a validated, immutable `Scene` of plain
 Python values (no JAX), and the registry of its keys."""
 from .load import load_scene, parse_scene
 from .types import Scene, SceneError

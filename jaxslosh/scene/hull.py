@@ -3,9 +3,10 @@ closed mesh, validated here so that a bad file is an input error) and the linear
 hull (eqs. 33-38), which the scene's other readers (check, the frequency domain) keep using."""
 from __future__ import annotations
 
+from importlib import import_module
+
 import numpy as np
 
-from ..hull.hydrostatics import rest_hydrostatics
 from ..hull.surface import HullMeshError, hull_triangles, water_height
 from ..hydro.box import box_hydrostatics
 from .fields import one_of, positive, read, show
@@ -44,6 +45,10 @@ def nonlinear_hydrostatics(v: dict, hull, environment, warnings: list[str]) -> d
 
 
 def mesh_hydrostatics(hull, environment, warnings: list[str]) -> dict:
+    # imported here: it integrates with JAX, and the loader must not import JAX for other scenes (the
+    # command line reads and checks a scene before it imports JAX: docs/guide/exit-status-and-warnings.md)
+    rest_hydrostatics = import_module("..hull.hydrostatics", __package__).rest_hydrostatics
+
     try:
         tris = hull_triangles(hull)
     except HullMeshError as e:

@@ -30,7 +30,7 @@ TABLES = (
                         "or none."),
     ("tanks.damping", "Damping of the tank's sloshing modes (none when absent)."),
     ("tanks.baffles", "Zero or more `[[tanks.baffles]]`: thin rigid plates across a box or prismatic tank."),
-    ("tanks.chamfers", "Prismatic tanks' corner cuts written as a table (the list form is SPEC's)."),
+    ("tanks.chamfers", "Prismatic tanks' corner cuts written as a table (or as a list: `[[w, h], [w, h]]`)."),
     ("structures", "Zero or more `[[structures]]`: flexible blocks of linear elastic hexahedra."),
     ("structures.material", "The structure's linear elastic material."),
     ("probes", "Zero or more `[[probes]]`: material points recorded in the result."),

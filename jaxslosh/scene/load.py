@@ -1,4 +1,4 @@
-"""Scene loader: a TOML file (SPEC.md section 1) to a validated, immutable `Scene`.
+"""Scene loader: a TOML file (docs/reference/scene.md) to a validated, immutable `Scene`.
 
 Every input error is raised as one `SceneError` whose message starts with the dotted key of the
 offending value (`tanks[0].fill_depth: 4.5 m is above the tank height 4.0 m`); nothing is built
@@ -77,7 +77,7 @@ def load_scene(path_or_text: str | os.PathLike) -> Scene:
 
 
 def _toml_hint(text: str, message: str) -> str:
-    """A hint for the one TOML error SPEC's own wording invites: `walls = "elastic"` plus `[tanks.walls]`."""
+    """A hint for the one TOML error a natural wording invites: `walls = "elastic"` plus `[tanks.walls]`."""
     m = re.search(r"at line (\d+)", message)
     lines = text.splitlines()
     if m and "overwrite" in message and 0 < int(m.group(1)) <= len(lines):
@@ -328,7 +328,7 @@ def _tank(table, where: str, base_dir: str = "") -> Tank:
             if key in table:
                 raise SceneError(f"{where}.{key}", 'is the multimodal tank\'s: it needs model = "multimodal"')
     fill_and_mesh(table, v, where, base_dir)
-    # SPEC writes `walls = "elastic"` and a `[tanks.walls]` table, but TOML cannot hold both under
+    # one would write `walls = "elastic"` and a `[tanks.walls]` table, but TOML cannot hold both under
     # one key: `walls` is either the string "rigid" or the table, which makes the walls elastic.
     raw_walls = table.get("walls", "rigid")
     if isinstance(raw_walls, dict):

@@ -1,5 +1,5 @@
 """`[vessel.forced]` read and checked: the harmonic and spin-up profiles' keys, and a motion record
-(`file = "motion.csv"`, SPEC section 9).
+(`file = "motion.csv"`, docs/guide/tank-tests.md).
 
 The file is comma-separated text: a header row with `t` and any of surge, sway, heave (m), roll,
 pitch, yaw (rad), then one row per sample. Blank lines and lines starting with `#` are skipped.

@@ -1,4 +1,4 @@
-"""A tank's shape keys (SPEC section 5: `shape`, `chamfers`, `axis`, `file`, `[[tanks.baffles]]`): the
+"""A tank's shape keys (docs/guide/tanks-and-shapes.md: `shape`, `chamfers`, `axis`, `file`, `[[tanks.baffles]]`): the
 shape's class (jaxslosh/geometry) reads and checks its own; here what is common to them all."""
 from __future__ import annotations
 
@@ -37,8 +37,8 @@ def read_shape(table, v, where: str, base_dir: str, elastic: bool = False) -> tu
 
 
 def fill_and_mesh(table, v, where: str, base_dir: str) -> None:
-    """Set v["fill_depth"] and v["mesh"]: required keys, except where the shape gives them (SPEC
-    section 5: a mesh tank's file gives both)."""
+    """Set v["fill_depth"] and v["mesh"]: required keys, except where the shape gives them (docs/guide/tank-meshes.md:
+    a mesh tank's file gives both)."""
     shape_class(v).read_fill_and_mesh(table, v, where, base_dir, READER)
     for key in ("fill_depth", "mesh"):
         if key not in v:

@@ -1,7 +1,7 @@
 """The validated, immutable scene: plain frozen dataclasses of Python numbers and tuples.
 
 A scene is what `load_scene` returns (see `scene.py` for the loader and its validation rules,
-SPEC.md section 1 for the file format). Everything here is static model data: nothing is traced.
+docs/reference/scene.md for the file format). Everything here is static model data: nothing is traced.
 Values that `simulate(scene, params=...)` may override are looked up by their dotted TOML path
 (`vessel.hydrostatics.gm_t`, `tanks.tank.fill_depth` or `tanks[0].fill_depth`) in `Scene.values()`.
 """
@@ -265,7 +265,7 @@ class Hull:
     kg: float = 0.0                  # m, COG above the keel (box)
     file: str = ""                   # mesh file (type = "mesh"), relative to the scene's folder
     cog: tuple[float, float, float] = (0.0, 0.0, 0.0)   # the COG in the mesh's coordinates (type = "mesh")
-    depth: Optional[float] = None    # m, keel to deck (box; SPEC section 8): large angles immerse the deck edge
+    depth: Optional[float] = None    # m, keel to deck (docs/guide/large-angles.md): large angles immerse the deck edge
     base_dir: str = ""               # the scene's folder (a mesh file is relative to it)
 
     def path(self) -> str:

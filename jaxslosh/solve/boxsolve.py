@@ -2,7 +2,7 @@
 
 A Newton iteration on a large mesh solves with the constant liquid block C = c_a M + K (and the
 initial accelerations with M). A sparse LU factor of the 20 x 20 x 12 mesh holds 24 million
-entries, which every solve streams; here a solve is a few small dense transforms (README "Design"
+entries, which every solve streams; here a solve is a few small dense transforms (docs/guide/linear-solvers.md
 has the timings).
 
 Why it works. The tank is a box on a uniform grid, and every term of the liquid's energy is the same

@@ -12,7 +12,7 @@ For linear systems this is exactly Chung & Hulbert's generalized-alpha (and HHT 
 so the spectral radius and period error follow their theory. Rotations are advanced on the group,
 q_{n+1} = q_n exp(Theta) with Theta the rotational part of Delta in the body frame: |q| = 1 by
 construction and the free rigid body reduces to the trapezoidal rule on Euler's equations
-(PHYSICS.md section 2, item 8), stable as the step shrinks.
+(docs/theory.md item 8), stable as the step shrinks.
 
 Each step solves R(Delta) = 0 by Newton iterations (newton.py) wrapped in `lax.custom_root`, so
 gradients use the implicit function theorem instead of running back through the iterations.
@@ -169,7 +169,7 @@ def step_equations(system: System, solver: Solver, s: State):
 
 def static_equilibrium(system: System, solver: Solver, c0: Config, v0, alg0):
     """The owners' unknowns (the structures) in static equilibrium under gravity, the vessel and
-    the liquid held where they are (the counterpart of the liquid's hydrostatic start, PHYSICS.md
+    the liquid held where they are (the counterpart of the liquid's hydrostatic start, docs/theory.md
     item 6: a mast that starts undeformed would ring with its own weight). Returns the
     configuration, velocities in which every structure moves rigidly with the vessel, and the
     frames and multipliers of the equilibrium. Nothing to solve without owners: the static layout

@@ -44,7 +44,7 @@ class Newmark(Scheme):
 
 
 class HHT(Scheme):
-    """HHT-alpha: gamma = 1/2 + alpha, beta = (1 + alpha)^2 / 4 (PHYSICS.md item 7); alpha > 0
+    """HHT-alpha: gamma = 1/2 + alpha, beta = (1 + alpha)^2 / 4 (docs/theory.md item 7); alpha > 0
     damps the high frequencies."""
     name = "hht"
 

@@ -49,7 +49,7 @@ from .factored import cached_factored_inverse
 
 #: `linear_solver = "auto"` goes sparse above this many liquid unknowns (free dofs of all tanks):
 #: above it the dense inverses' products cost more than the sparse path and their memory grows as
-#: the square (README "Speed" has the measurements)
+#: the square (docs/guide/linear-solvers.md has the measurements)
 SPARSE_AUTO = 1500
 
 _REGISTRY: dict = {}

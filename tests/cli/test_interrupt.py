@@ -1,0 +1,64 @@
+"""Ctrl-C stops every command at once: exit status 130, one line ("interrupted"), no traceback, no
+file half-written (jaxslosh/run/guard.py stop_on_signals, installed by jaxslosh/entry.py). It once
+printed a 40-line traceback during JAX's import, and later landed in a callback of XLA's garbage
+collection, where Python ignores it: the stability command went on, wrote its figure and exited 0."""
+import os
+import signal
+import subprocess
+import sys
+import textwrap
+import time
+
+ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
+ENV = dict(os.environ, PYTHONPATH=ROOT + os.pathsep + os.environ.get("PYTHONPATH", ""))
+
+
+def interrupt_after(args, seconds, cwd):
+    p = subprocess.Popen([sys.executable, "-m", "jaxslosh", *args], cwd=cwd, env=ENV,
+                         stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    time.sleep(seconds)
+    ran_on = p.poll() is None
+    p.send_signal(signal.SIGINT)
+    out, err = p.communicate(timeout=120)
+    return ran_on, p.returncode, out, err
+
+
+def test_stability_stops_on_ctrl_c(tmp_path):
+    """At 1 s the command imports (the scene checked, JAX loading); at 3.5 s and 7 s it computes the
+    GZ curves (about 15 s in all on a 2-core machine)."""
+    scene = os.path.join(ROOT, "scenes", "paper_ship_stability.toml")
+    stopped = 0
+    for seconds in (1.0, 3.5, 7.0):
+        fig = tmp_path / f"gz{seconds}.png"
+        ran_on, code, out, err = interrupt_after(["stability", scene, "-o", str(fig)], seconds, tmp_path)
+        if not ran_on:              # done before the signal (a fast machine): nothing to see
+            continue
+        stopped += 1
+        assert code == 130, (seconds, code, err[-2000:])
+        assert err.strip().splitlines() == ["interrupted"], (seconds, err[-2000:])
+        assert "Traceback" not in out + err
+        assert not fig.exists()
+        assert list(tmp_path.iterdir()) == []           # nothing else either
+    assert stopped >= 2
+
+
+FINISHING = textwrap.dedent("""
+    import os, signal, sys, time
+    from jaxslosh.run.guard import finishing, stop_on_signals
+    stop_on_signals()
+    with finishing():
+        os.kill(os.getpid(), signal.SIGINT)
+        time.sleep(0.3)                         # the handler has run: the block holds it off
+        with open(sys.argv[1], "w") as f:
+            f.write("whole")
+    print("not reached")
+""")
+
+
+def test_a_file_being_written_is_finished_first(tmp_path):
+    out = tmp_path / "file.txt"
+    p = subprocess.run([sys.executable, "-c", FINISHING, str(out)], env=ENV, capture_output=True, text=True,
+                       timeout=60)
+    assert p.returncode == 130
+    assert p.stderr.strip() == "interrupted" and p.stdout == ""
+    assert out.read_text() == "whole"
