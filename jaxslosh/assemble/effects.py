@@ -7,6 +7,7 @@ import os
 
 from ..fem.face_mesh import free_face_count
 from ..fem.walls import shell_mesh
+from ..physics.multimodal_modes import DiskBase, RectangleBase
 from ..scene.types import EFFECTS, FACE_FORMS, Scene
 
 
@@ -80,7 +81,6 @@ def modal_modes(t) -> tuple:
     (physics/multimodal_modes.py, as assemble/multimodal3d.py builds them)."""
     if t.flow != "3d":
         return tuple((i, 0) for i in range(1, t.modes + 1))
-    from ..physics.multimodal_modes import DiskBase, RectangleBase   # scipy's Bessel zeros, when asked
     return t.geometry.modal_base(RectangleBase, DiskBase).lowest(t.modes)
 
 

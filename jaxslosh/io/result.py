@@ -89,7 +89,7 @@ class Result(eqx.Module):
 
     @property
     def status(self) -> str:
-        """"ok" or why the run stopped (SPEC's `status`: its step, time and residual). Inside a
+        """"ok" or why the run stopped (the result file's `status`: its step, time and residual). Inside a
         transformation, where the outcome is not known yet, a sentence saying to read `outcome`."""
         if self.note:
             return self.note

@@ -31,6 +31,7 @@ from .campaign import read_campaign
 from .fields import (at_least, counts, flat_list, non_negative, one_of, poisson_ratio, positive, read, show, sizes,
                      valid_name)
 from .record import forced_span, read_forced
+from .rules import conservative as _conservative, locking_elements as _locking_elements
 from .hull import read_hydrostatics
 from .shape import default_element, fill_and_mesh, read_multimodal_shape, read_shape
 from .types import (EFFECTS, ELEMENT_FORMS, FACE_FORMS, FACES, Damping, Effects, Environment, Fluid,
@@ -152,44 +153,6 @@ def _multimodal_scene(tanks, warnings: list[str]) -> None:
             warnings.append(f"tanks[{i}] ({t.name!r}): fill depth / length = {ratio:.3g} is below "
                             f"{MULTIMODAL_SHALLOW}: shallow-water sloshing (bores, hydraulic jumps), outside the "
                             "multimodal method's validity")
-
-
-def _locking_elements(tanks, warnings: list[str]) -> None:
-    """A nodal element (given: the loader never chooses one there) in a tank with re-entrant edges
-    locks: every line of held nodes along such an edge removes a whole mode (a U-tube has no U-tube
-    mode, a baffle's mode is too stiff), with no error to show for it (docs/guide/liquid-element.md)."""
-    for i, t in enumerate(tanks):
-        if t.model != "fem" or t.fluid.element not in ELEMENT_FORMS:
-            continue
-        reentrant, what = t.geometry.reentrant(t.fill_depth)
-        if reentrant:
-            warnings.append(f'tanks[{i}] ({t.name!r}): element = "{t.fluid.element}" locks in this tank ({what}): '
-                            'its nodal displacements lose whole sloshing modes there (a U-tube\'s U-tube mode, the '
-                            'modes a baffle shapes); element = "rt" (face-normal) holds there, and is the default '
-                            'where tanks.fluid.element is left out')
-
-
-def _conservative(scene: Scene) -> None:
-    """`simulation.energy_projection` holds the total energy at its initial value: only right when
-    nothing in the scene adds or removes energy and the equations are those of that energy."""
-    v, e = scene.vessel, scene.effects
-    why = []
-    if v.forced is not None:
-        why.append("[vessel.forced] prescribes motion (it does work)")
-    if scene.waves is not None or v.hydrodynamics is not None or v.hull is not None:
-        why.append("waves and hull hydrodynamics add and radiate energy")
-    if any(t.damping is not None for t in scene.tanks):
-        why.append("[tanks.damping] removes energy")
-    if scene.structures:
-        why.append("flexible structures are not covered by the projection")
-    if v.hydrostatics is not None and v.hydrostatics.moment != "conservative":
-        why.append('vessel.hydrostatics.moment = "paper" is not the gradient of a potential')
-    off = [k for k in ("coriolis", "centrifugal", "gravity_turning") if not getattr(e, k)]
-    if off:
-        why.append(f"effects {', '.join(off)} off: the equations are no longer those of the total energy")
-    if why:
-        raise SceneError("simulation.energy_projection",
-                         "needs a conservative scene (the total energy must stay constant), but " + "; ".join(why))
 
 
 # --------------------------------------------------------------------------------------------
