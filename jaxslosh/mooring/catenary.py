@@ -240,7 +240,8 @@ def solve(XF, ZF, L, w, EA, CB=0.0, hA=0.0):
 
 
 @jax.jit
-def catenary(span, length, weight, ea, seabed_friction=0.0, anchor_height=0.0) -> Catenary:
+def catenary(span: tuple, length: float, weight: float, ea: float, seabed_friction: float = 0.0,
+             anchor_height: float = 0.0) -> Catenary:
     """One elastic catenary line (docs/guide/moorings.md).
 
     Args:
