@@ -85,12 +85,15 @@ class MooringLines(AbstractTerm):
         return self.about.lines
 
 
-def build_mooring(scene, balanced: bool, outline: bool = False) -> MooringLines:
+def build_mooring(scene, balanced: bool, outline: bool = False, params: Optional[dict] = None) -> MooringLines:
     """The term of the scene's `[[mooring]]` lines; `balanced`: the vessel's hydrostatics are linear
-    springs about the rest position (then the buoyancy carries the lines' vertical pull at rest)."""
+    springs about the rest position (then the buoyancy carries the lines' vertical pull at rest);
+    `params`: canonical keys `mooring.<name>.<key>` that replace the scene's values (tracers too)."""
     lines = scene.mooring
     cog = scene.vessel.cog_height
-    col = lambda key: jnp.asarray([getattr(m, key) for m in lines], dtype=float)  # noqa: E731
+    P = (params or {}).get
+    col = lambda key: jnp.stack([jnp.asarray(P(f"mooring.{m.name}.{key}", getattr(m, key)), dtype=float)  # noqa: E731
+                                 for m in lines])
     anchor = np.array([m.anchor for m in lines], dtype=float) - np.array([0.0, 0.0, cog])
     carried_words = (" (the buoyancy carries their vertical pull at rest: linear hydrostatics)" if balanced else "")
     about = About(("mooring", f"{len(lines)} quasi-static elastic catenary line(s) "
