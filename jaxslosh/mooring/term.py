@@ -127,8 +127,11 @@ def mooring_datasets(system, X0, q) -> dict:
     whose vessel positions X0 (..., 3) and attitudes q (..., 4) are given (the lines are
     quasi-static: their tensions are functions of the pose)."""
     term = mooring_term(system)
-    if term is None:
-        return {}
+    return {} if term is None else line_datasets(term, X0, q)
+
+
+def line_datasets(term: MooringLines, X0, q) -> dict:
+    """mooring_datasets of one term."""
     lead = X0.shape[:-1]
     tf, ta = _tensions(term, jnp.reshape(X0, (-1, 3)), jnp.reshape(q, (-1, 4)))
     d = {}

@@ -63,3 +63,25 @@ def test_coupled_yaw_mode_from_the_lines_stiffness():
     modes = coupled_modes(scene, n=6)
     yaw = modes.omega[list(modes.dominant).index("yaw")]
     assert yaw == pytest.approx(np.sqrt(K66 / 1.7e7), rel=1e-6)
+
+
+@pytest.mark.slow
+def test_batch_over_a_line_length_records_each_runs_tensions():
+    from jaxslosh.mooring.catenary import catenary
+    from jaxslosh.physics.kinematics import rotation_matrix
+    scene = js.load_scene(SMALL.replace("duration = 60.0", "duration = 0.5").replace("dt = 0.2", "dt = 0.25")
+                          + _lines())
+    lengths = np.array([415.0, 425.0])
+    res, statuses = js.simulate_batch(scene, {"mooring[0].length": lengths})
+    assert statuses == ["ok", "ok"]
+    for i, L in enumerate(lengths):
+        X = np.asarray(res.vessel.position)[i, -1]
+        p = X + np.asarray(rotation_matrix(res.vessel.quaternion[i, -1])) @ np.array([5.0, 0.0, 0.0])
+        c = catenary((np.hypot(400.0 - p[0], p[1]), p[2] + 100.0), L, 600.0, 3.0e8)
+        assert float(res.mooring["l0"].fairlead_tension[i, -1]) == pytest.approx(
+            float(np.hypot(c.fairlead_horizontal, c.fairlead_vertical)), rel=1e-8)
+
+
+def test_bad_traced_line_value_names_the_key():
+    with pytest.raises(js.SceneError, match=r"^mooring\.l0\.length: must be positive"):
+        js.simulate(_scene(), params={"mooring.l0.length": -1.0})
