@@ -172,3 +172,20 @@ def test_vessel_name_and_taut_line_warning():
     assert scene.mooring[0].body == "barge"
     assert any("mooring[0].length" in w and "stretched" in w for w in scene.warnings)
     assert not any("mooring[1]" in w for w in scene.warnings)
+
+
+def test_mooring_command_json_and_figure(tmp_path, capsys):
+    import json
+    path = tmp_path / "moored.toml"
+    path.write_text(SMALL + _lines(z=-1.0))
+    fig = tmp_path / "lines.png"
+    assert main(["mooring", str(path), "--offsets", "0,2,4", "--direction", "90", "--json", "-o", str(fig)]) == 0
+    d = json.loads(capsys.readouterr().out)
+    assert {"equilibrium", "lines", "stiffness", "offsets", "restoring", "max_tension"} <= set(d)
+    assert [x["name"] for x in d["lines"]] == ["l0", "l1", "l2"]
+    assert np.shape(d["stiffness"]) == (6, 6) and d["offsets"] == [0.0, 2.0, 4.0]
+    assert d["restoring"][2] > d["restoring"][1] > 0          # along +Y the lines pull back
+    assert d["stiffness"][1][1] == pytest.approx(d["stiffness"][0][0], rel=1e-6)    # three lines: isotropic
+    assert fig.stat().st_size > 0
+    assert main(["mooring", str(path), "--offsets", "0,x"]) == 2
+    assert "--offsets" in capsys.readouterr().err
