@@ -144,8 +144,8 @@ def public_api() -> dict[str, str]:
     for name in jaxslosh.__all__:
         if name == "__version__":
             continue
-        if name == "campaign":
-            out[name] = "jaxslosh.campaign.run.campaign"
+        if name in ("campaign", "mooring"):      # functions named as their sub-packages
+            out[name] = {"campaign": "jaxslosh.campaign.run.campaign", "mooring": "jaxslosh.mooring.statics.mooring"}[name]
             continue
         out[name] = "jaxslosh" + jaxslosh._PUBLIC[name] + "." + name
     return out

@@ -20,6 +20,7 @@ from importlib import import_module
 # the campaign sub-package (its __init__ imports nothing) is bound now, so that the function
 # `campaign` below keeps its name when a module of the sub-package is imported later
 from . import campaign as _campaign_package  # noqa: F401
+from . import mooring as _mooring_package  # noqa: F401
 from ._version import __version__
 
 #: public name -> the module that defines it
@@ -29,15 +30,22 @@ _PUBLIC = {
     "save_result": ".io.result", "Status": ".io.status", "RunResult": ".io.status", "simulate_batch": ".run.batch",
     "NumericalFailure": ".run.simulate", "simulate": ".run.simulate", "Stepper": ".run.stepper", "Scene": ".scene",
     "SceneError": ".scene", "load_scene": ".scene", "scene_with": ".scene.variant", "stability": ".analysis.stability",
+    "catenary": ".mooring.catenary",
 }
 
-__all__ = [*_PUBLIC, "campaign", "__version__"]
+__all__ = [*_PUBLIC, "campaign", "mooring", "__version__"]
 
 
 def campaign(*args, **kwargs):
     """`js.campaign`: jaxslosh.campaign.run.campaign (docs/guide/campaigns.md), imported on first call
     (it loads Dask)."""
     return import_module(".campaign.run", __name__).campaign(*args, **kwargs)
+
+
+def mooring(*args, **kwargs):
+    """`js.mooring`: jaxslosh.mooring.statics.mooring (docs/guide/moorings.md), imported on first call
+    (the name is also the sub-package's, bound above, as for `campaign`)."""
+    return import_module(".mooring.statics", __name__).mooring(*args, **kwargs)
 
 
 def __getattr__(name):

@@ -14,6 +14,7 @@ import jax
 import jax.numpy as jnp
 import numpy as np
 
+from ..mooring.term import build_mooring
 from ..physics.damping import ModalDamping
 from ..physics.face_liquid import FluxLiquid
 from ..physics.kinematics import quat_from_rpy, rotation_matrix
@@ -178,6 +179,8 @@ def _model(scene: Scene, params: dict, outline: bool = False) -> _Model:
         else:
             S = liquid.rigid_first_moment() if hull_S is None else hull_S + liquid.rigid_first_moment()
             terms.append(Weight(mass=mass + liquid.total_mass(), S=S, gravity=g, about=weight))
+    if scene.mooring:          # quasi-static catenary lines (jaxslosh/mooring/term.py)
+        terms.append(build_mooring(scene, balanced, outline, params))
     if block.penalty is not None:
         terms.append(RotationPenalty(Kdt=block.penalty[0], Ktt=block.penalty[1], q_ref=q0))
     if block.Kg is not None:

@@ -45,6 +45,7 @@ COMMANDS = {
     "export": ("export", "write a result for ParaView (XDMF 3 time series over one HDF5 file)"),
     "campaign": ("campaign", "run a scatter of sea states x headings x seeds on Dask, write statistics"),
     "stability": ("stability", "GZ curves (liquids frozen and level), GM0, vanishing angle, IS Code 2008 criteria"),
+    "mooring": ("mooring", "mooring lines: static equilibrium, tensions, stiffness matrix, offset curve"),
 }
 
 

@@ -8,6 +8,7 @@ updated after each chunk, so a file left by a killed run opens and holds the ste
 from __future__ import annotations
 
 import contextlib
+import dataclasses
 import os
 from typing import Optional
 
@@ -69,6 +70,11 @@ def _is_traced(x) -> bool:
     return any(isinstance(v, jax.core.Tracer) for v in jax.tree_util.tree_leaves(x))
 
 
+class LineHistory(eqx.Module):
+    fairlead_tension: jax.Array  # (n,) N
+    anchor_tension: jax.Array    # (n,) N
+
+
 class Result(eqx.Module):
     """A run's frames and how it ended. `outcome` (io.status.RunResult) is a leaf: right under
     `jax.jit` and `vmap`, where a string cannot be; `status` and `status_code` read it (and
@@ -120,9 +126,10 @@ class Result(eqx.Module):
     def ok(self):
         """Whether the run ended well (a traced boolean inside a transformation)."""
         return self.outcome == RunResult.ok
+    mooring: Optional[dict] = None     # {line: LineHistory} of a moored scene
 
 
-def schema(probe_names=(), tank_nodes: Optional[dict] = None) -> dict:
+def schema(probe_names=(), tank_nodes: Optional[dict] = None, lines=()) -> dict:
     """{dataset: shape of one frame} of a result file, in the file's order."""
     spec = {"time": (), "vessel/position": (3,), "vessel/quaternion": (4,), "vessel/angular_velocity": (3,),
             "vessel/roll_pitch_yaw": (3,), "energy/kinetic": (), "energy/potential": (),
@@ -132,6 +139,9 @@ def schema(probe_names=(), tank_nodes: Optional[dict] = None) -> dict:
         spec[f"probes/{p}/displacement"] = (3,)
     for name, n in (tank_nodes or {}).items():
         spec[f"tanks/{name}/displacement"] = (n, 3)
+    for name in lines:
+        spec[f"mooring/{name}/fairlead_tension"] = ()
+        spec[f"mooring/{name}/anchor_tension"] = ()
     return spec
 
 
@@ -140,7 +150,8 @@ def schema(probe_names=(), tank_nodes: Optional[dict] = None) -> dict:
 UNITS = {"time": "s", "vessel/position": "m", "vessel/quaternion": "1", "vessel/angular_velocity": "rad/s",
          "vessel/roll_pitch_yaw": "rad", "energy/kinetic": "J", "energy/potential": "J", "solver/iterations": "1",
          "solver/residual": "m/s^2", "solver/constraint": "m", "probes/position": "m", "probes/displacement": "m",
-         "tanks/displacement": "m", "tanks/nodes": "m", "tanks/elements": "1"}
+         "tanks/displacement": "m", "tanks/nodes": "m", "tanks/elements": "1", "mooring/fairlead_tension": "N",
+         "mooring/anchor_tension": "N"}
 
 #: a `description` attribute where the unit alone does not say what a dataset holds
 DESCRIPTIONS = {
@@ -159,7 +170,7 @@ DESCRIPTIONS = {
 def units_of(key: str) -> str:
     """The `units` attribute of a result dataset (see UNITS)."""
     parts = key.split("/")
-    if parts[0] in ("probes", "tanks") and len(parts) == 3:
+    if parts[0] in ("probes", "tanks", "mooring") and len(parts) == 3:
         key = f"{parts[0]}/{parts[2]}"
     return UNITS.get(key, "1")
 
@@ -185,6 +196,9 @@ def result_frames(r: Result) -> dict:
         d[f"probes/{name}/displacement"] = p.displacement
     for name, t in r.tanks.items():
         d[f"tanks/{name}/displacement"] = t.displacement
+    for name, m in (r.mooring or {}).items():
+        d[f"mooring/{name}/fairlead_tension"] = m.fairlead_tension
+        d[f"mooring/{name}/anchor_tension"] = m.anchor_tension
     return {k: np.asarray(v) for k, v in d.items()}
 
 
@@ -199,20 +213,23 @@ def result_from(d: dict, probe_names=(), tanks: Optional[dict] = None, *, status
     fields = {n: TankField(nodes, elements, d[f"tanks/{n}/displacement"]) for n, (nodes, elements) in (tanks or {}).items()
               if f"tanks/{n}/displacement" in d}
     code = code_of(status) if status_code is None else status_code
+    lines = [k.split("/")[1] for k in d if k.startswith("mooring/") and k.endswith("/fairlead_tension")]
+    mooring = {n: LineHistory(d[f"mooring/{n}/fairlead_tension"], d[f"mooring/{n}/anchor_tension"]) for n in lines}
     return Result(time=d["time"],
                   vessel=VesselHistory(d["vessel/position"], d["vessel/quaternion"], d["vessel/angular_velocity"],
                                        d["vessel/roll_pitch_yaw"]),
                   probes=probes, energy=Energy(d["energy/kinetic"], d["energy/potential"]),
                   solver=SolverHistory(d["solver/iterations"], d["solver/residual"], d.get("solver/constraint")),
                   tanks=fields, outcome=outcome_of(code), steps=steps_done, failure=failure, note=status,
-                  scene_text=scene_text, dt=float(dt), tolerance=float(tolerance))
+                  scene_text=scene_text, dt=float(dt), tolerance=float(tolerance),
+                  mooring=mooring or None)
 
 
 class ResultWriter:
     """Appends frames to an HDF5 result file as a run goes on. It holds the output's lock from
     before the file is truncated until it is closed (a second writer gets io.output.OutputError)."""
 
-    def __init__(self, path: str, scene_text: str, probe_names, tanks=()):
+    def __init__(self, path: str, scene_text: str, probe_names, tanks=(), lines=()):
         self.path = path
         self.lock = OutputLock(path)
         try:
@@ -232,7 +249,7 @@ class ResultWriter:
         for t in tanks:
             label(self.f.create_dataset(f"tanks/{t.name}/nodes", data=t.nodes), f"tanks/{t.name}/nodes")
             label(self.f.create_dataset(f"tanks/{t.name}/elements", data=t.elements), f"tanks/{t.name}/elements")
-        for k, shape in schema(probe_names, {t.name: t.nodes.shape[0] for t in tanks}).items():
+        for k, shape in schema(probe_names, {t.name: t.nodes.shape[0] for t in tanks}, lines).items():
             dtype = "i8" if k == "solver/iterations" else "f8"
             label(self.f.create_dataset(k, shape=(0, *shape), maxshape=(None, *shape), dtype=dtype,
                                         chunks=(max(1, min(1024, 2 ** 20 // (8 * max(1, int(np.prod(shape)))))),
@@ -276,7 +293,8 @@ class _Mesh:
 
 
 def save_result(r: Result, path: str) -> None:
-    w = ResultWriter(path, r.scene_text, list(r.probes), [_Mesh(n, t.nodes, t.elements) for n, t in r.tanks.items()])
+    w = ResultWriter(path, r.scene_text, list(r.probes), [_Mesh(n, t.nodes, t.elements) for n, t in r.tanks.items()],
+                     list(r.mooring or {}))
     w.append(result_frames(r), r.steps_done)
     w.close(r.status, r.steps_done, r.status_code)
 
@@ -397,7 +415,8 @@ def load_result(path: str) -> Result:
                 if f"tanks/{name}/{part}" not in f:
                     raise ResultFileError(f"{path}: the dataset /tanks/{name}/{part} is missing")
             tanks[name] = (np.asarray(f[f"tanks/{name}/nodes"]), np.asarray(f[f"tanks/{name}/elements"]))
-        d = read_frames(f, schema(probes, {name: 0 for name in tanks}))
+        lines = list(f["mooring"]) if "mooring" in f else []
+        d = read_frames(f, schema(probes, {name: 0 for name in tanks}, lines))
         check_required(d, probes, path)
         status = attr_str(a.get("status", "ok"))
         code = int(a["status_code"]) if "status_code" in a else None
@@ -408,8 +427,9 @@ def load_result(path: str) -> Result:
 def truncated(r: Result, n: int) -> Result:
     """The first n frames of a result."""
     cut = lambda x: x[:n]  # noqa: E731
-    return eqx.tree_at(lambda x: (x.time, x.vessel, x.probes, x.energy, x.solver, x.tanks), r,
-                       (cut(r.time), jax.tree_util.tree_map(cut, r.vessel),
-                        {k: jax.tree_util.tree_map(cut, p) for k, p in r.probes.items()},
-                        jax.tree_util.tree_map(cut, r.energy), jax.tree_util.tree_map(cut, r.solver),
-                        {k: TankField(t.nodes, t.elements, cut(t.displacement)) for k, t in r.tanks.items()}))
+    return dataclasses.replace(
+        r, time=cut(r.time), vessel=jax.tree_util.tree_map(cut, r.vessel),
+        probes={k: jax.tree_util.tree_map(cut, p) for k, p in r.probes.items()},
+        energy=jax.tree_util.tree_map(cut, r.energy), solver=jax.tree_util.tree_map(cut, r.solver),
+        tanks={k: TankField(t.nodes, t.elements, cut(t.displacement)) for k, t in r.tanks.items()},
+        mooring=None if r.mooring is None else {k: jax.tree_util.tree_map(cut, m) for k, m in r.mooring.items()})

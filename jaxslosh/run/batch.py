@@ -12,9 +12,10 @@ import numpy as np
 from jax.sharding import Mesh, NamedSharding, PartitionSpec
 
 from ..io.result import Result, result_from
+from ..mooring.term import build_mooring, line_datasets
 from ..physics.hull import HullPressure
 from ..physics.seakeeping import Excitation, WaveExcitation
-from ..scene.keys import check_values, with_overrides
+from ..scene.keys import check_values, resolve_params, with_overrides
 from ..scene.types import Scene, SceneError
 from ..staging import XLA_OPTIONS
 from .capsize import vanishing_angles
@@ -186,7 +187,21 @@ def simulate_batch(scene: Scene, params: dict, *, duration: Optional[float] = No
                 for v in vals]
     setup0 = _setup0(scene)
     carry, fr = _batch_fn(scene, tuple(keys), mesh)(*vals)
-    return _batch_result(scene, setup0, carry, fr, B)
+    res, statuses = _batch_result(scene, setup0, carry, fr, B)
+    return _batch_lines(scene, res, fr, params), statuses
+
+
+def _batch_lines(scene: Scene, res: Result, fr, params: dict) -> Result:
+    """A batch that varies the mooring lines' values: each run's line tensions from its own lines
+    (_batch_result's come from the scene's)."""
+    runs = [resolve_params(scene, {k: np.asarray(v)[i] for k, v in params.items()}) for i in range(len(res.time))]
+    if not res.mooring or not any(k.startswith("mooring.") for k in runs[0]):
+        return res
+    per_run = [line_datasets(build_mooring(scene, False, True, run), fr.X0[i], fr.q[i]) for i, run in enumerate(runs)]
+    d = {k: jnp.stack([p[k] for p in per_run]) for k in per_run[0]}
+    lines = {n: type(m)(d[f"mooring/{n}/fairlead_tension"], d[f"mooring/{n}/anchor_tension"])
+             for n, m in res.mooring.items()}
+    return dataclasses.replace(res, mooring=lines)
 
 
 def capsize_angles(scene: Scene):

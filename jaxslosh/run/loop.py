@@ -12,6 +12,7 @@ import jax.numpy as jnp
 
 from ..assemble.system import Built
 from ..io.status import Status
+from ..mooring.term import mooring_datasets
 from ..physics.kinematics import rotation_matrix, rpy_from_quat
 from ..physics.terms import Config
 from ..solve.integrator import State, initial_state, initial_state_like, step_or_retry
@@ -230,6 +231,7 @@ def frame_datasets(b: Built, fr: Frame, p0=None, fields: bool = True) -> dict:
     for i, name in enumerate(b.probes.names):
         d[f"probes/{name}/position"] = P[..., i, :]
         d[f"probes/{name}/displacement"] = P[..., i, :] - p0[..., i, :]
+    d.update(mooring_datasets(b.system, fr.X0, fr.q))        # quasi-static lines: from the pose
     if fields and b.tanks:
         D = nodal(b, fr.D)
         for t in b.tanks:

@@ -30,7 +30,8 @@ _TOML_NAME = {("Tank", "wall_spec"): "walls", ("Tank", "walls"): None,      # th
               ("Waves", "omega"): "frequency", ("Waves", "omega_range"): "frequency_range",
               ("Hydrodynamics", "base_dir"): None, ("Hull", "base_dir"): None,   # where the scene file lay
               ("Fluid", "element_default"): None,                                 # the loader's note
-              ("Tank", "geometry"): None}                                         # the shape keys, as a shape
+              ("Tank", "geometry"): None,                                         # the shape keys, as a shape
+              ("MooringLine", "anchor_height"): None}                             # the anchor's z and the depth
 
 _TABLE = object()      # a table that is present (its keys follow)
 

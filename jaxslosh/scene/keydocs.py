@@ -36,6 +36,7 @@ TABLES = (
     ("probes", "Zero or more `[[probes]]`: material points recorded in the result."),
     ("effects", "Switches to leave an effect out (to measure what it contributes); all on by default."),
     ("waves", "Incident linear (Airy) waves."),
+    ("mooring", "Zero or more `[[mooring]]` lines from the seabed to the vessel (guide: Moorings)."),
     ("campaign", "A campaign's defaults (`jaxslosh campaign`, `js.campaign`); `jaxslosh run` ignores it."),
     ("campaign.limits", "Operability limits per channel."),
 )
@@ -48,6 +49,7 @@ KEYS = (
     # environment
     ("environment.gravity", "9.81", "m/s^2", "Gravity along -Z; 0 for a body without gravity."),
     ("environment.water_density", "1025.0", "kg/m^3", "The sea water that gives buoyancy."),
+    ("environment.depth", "infinite", "m", "Water depth: the seabed of mooring lines (required with `[[mooring]]`)."),
     # simulation
     ("simulation.duration", _REQ, "s", "Simulated time."),
     ("simulation.dt", _REQ, "s", "The fixed time step."),
@@ -71,6 +73,9 @@ KEYS = (
     ("simulation.energy_projection", "false", "", 'scheme = "newmark" in a conservative scene only: after each '
      "step the velocities are scaled back onto the initial energy."),
     # vessel
+    ("vessel.name", '"vessel"', "", "How mooring lines (`mooring.body`) name the vessel."),
+    ("vessel.cog_height", "box hull: kg - draft; else 0", "m", "The COG's height above the still-water level at "
+                                                                "rest (it places the mooring fairleads)."),
     ("vessel.mass", _REQ, "kg", "The whole ship without its tank liquid (structures and elastic walls "
                                 "included)."),
     ("vessel.inertia", _REQ, "kg m^2", "About the COG in body axes: 3 diagonal values or a 3 x 3 list "
@@ -240,6 +245,18 @@ KEYS = (
     ("waves.depth", "deep water", "m", "Water depth."),
     ("waves.spreading", "0 (long-crested)", "", "cos-2s directional spreading exponent s."),
     ("waves.directions", "15", "", "Headings of a spread sea (odd: one on the mean heading)."),
+    # mooring
+    ("mooring.name", '"line<i>"', "", "The line's name (result datasets `/mooring/<name>/...`)."),
+    ("mooring.body", '"vessel"', "", 'The body the fairlead is on: "vessel" or the vessel\'s `name`.'),
+    ("mooring.fairlead", _REQ, "m", "The fairlead in the body's frame, from its COG."),
+    ("mooring.anchor", _REQ, "m", "The anchor: x, y inertial from the vessel's COG at rest, z from the still-water "
+                                  "level (on the seabed at z = -depth, or above it)."),
+    ("mooring.length", _REQ, "m", "Unstretched length."),
+    ("mooring.weight", _REQ, "N/m", "Submerged weight per unstretched metre (negative: buoyant)."),
+    ("mooring.ea", _REQ, "N", "Axial stiffness EA."),
+    ("mooring.model", '"catenary"', "", '"catenary": the quasi-static elastic catenary with seabed contact '
+                                        '("lumped" is not available yet).'),
+    ("mooring.seabed_friction", "0", "", "Friction coefficient of the part on the seabed (anchor on the seabed)."),
     # campaign
     ("campaign.headings", "waves.heading", "rad", "The campaign's headings."),
     ("campaign.seeds", "1", "", "Seeds per cell and heading."),

@@ -52,6 +52,8 @@ class _Keys(tuple):
 # a traced damping ratio scales the modal damping, whose modes come from the scene's values; the
 # harmonic forced motion's amplitude, frequency and phase are leaves of its term).
 TANK_TRACEABLE = ("fill_depth", "fluid.density", "fluid.sound_speed", "damping.ratio")
+# a mooring line's values, leaves of the lines' term (jaxslosh/mooring/term.py)
+MOORING_TRACEABLE = ("length", "weight", "ea", "seabed_friction")
 
 
 TRACEABLE = _Keys((
@@ -61,7 +63,8 @@ TRACEABLE = _Keys((
     "vessel.initial.position", "vessel.initial.velocity", "vessel.initial.angular_velocity",
     "vessel.initial.roll_pitch_yaw", "vessel.hull.kg", "vessel.hull.cog",
     "vessel.forced.amplitude", "vessel.forced.frequency", "vessel.forced.phase",
-) + tuple(f"tanks.<name>.{k}" for k in TANK_TRACEABLE) + ("waves.amplitude", "waves.hs"))
+) + tuple(f"tanks.<name>.{k}" for k in TANK_TRACEABLE) + ("waves.amplitude", "waves.hs")
+  + tuple(f"mooring.<name>.{k}" for k in MOORING_TRACEABLE))
 
 # keys traced by the nonlinear hydrostatics alone (assemble/hull.py moves the hull's surface against the
 # COG); the linear model's GM springs were derived from them when the scene was loaded
@@ -127,6 +130,11 @@ def scene_values(scene: Scene) -> dict[str, Any]:
     for i, p in enumerate(scene.probes):
         for prefix in (f"probes.{p.name}", f"probes[{i}]"):
             v[f"{prefix}.point"] = p.point
+    for i, m in enumerate(scene.mooring):
+        own = {"length": m.length, "weight": m.weight, "ea": m.ea, "seabed_friction": m.seabed_friction,
+               "fairlead": m.fairlead, "anchor": m.anchor}
+        for prefix in (f"mooring.{m.name}", f"mooring[{i}]"):
+            v.update({f"{prefix}.{k}": x for k, x in own.items()})
     if scene.campaign is not None:   # a campaign's settings (never traced: they change no run)
         if scene.campaign.duration is not None:
             v["campaign.duration"] = scene.campaign.duration
@@ -137,7 +145,8 @@ def scene_values(scene: Scene) -> dict[str, Any]:
 
 def canonical_key(scene: Scene, key: str) -> str:
     """The name form of a dotted key: `tanks[0].fill_depth` -> `tanks.tank.fill_depth` (others unchanged)."""
-    for group, items in (("tanks", scene.tanks), ("structures", scene.structures), ("probes", scene.probes)):
+    for group, items in (("tanks", scene.tanks), ("structures", scene.structures), ("probes", scene.probes),
+                         ("mooring", scene.mooring)):
         if key.startswith(group + "["):
             index, sep, rest = key[len(group) + 1:].partition("]")
             if sep and index.isdigit() and int(index) < len(items):
@@ -276,7 +285,8 @@ def _plain(value):
 
 def _toml_path(scene: Scene, key: str) -> list:
     """The path of a canonical key in the TOML mapping: `tanks.tank.fill_depth` -> ["tanks", 0, "fill_depth"]."""
-    for group, items in (("tanks", scene.tanks), ("structures", scene.structures), ("probes", scene.probes)):
+    for group, items in (("tanks", scene.tanks), ("structures", scene.structures), ("probes", scene.probes),
+                         ("mooring", scene.mooring)):
         for i, item in enumerate(items):
             head = f"{group}.{item.name}."
             if key.startswith(head):

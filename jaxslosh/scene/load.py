@@ -30,6 +30,7 @@ from ..geometry import AXES, SHAPES
 from .campaign import read_campaign
 from .fields import (at_least, counts, flat_list, non_negative, one_of, poisson_ratio, positive, read, show, sizes,
                      valid_name)
+from .mooring import read_mooring
 from .record import forced_span, read_forced
 from .rules import conservative as _conservative, locking_elements as _locking_elements
 from .hull import read_hydrostatics
@@ -95,7 +96,7 @@ def parse_scene(mapping: Mapping[str, Any], text: str = "", path: str = "") -> S
         "title": ("str", None), "environment": ("table", None), "simulation": ("table", None),
         "vessel": ("table", None), "tanks": ("tables", None), "structures": ("tables", None),
         "probes": ("tables", None), "effects": ("table", None), "waves": ("table", None),
-        "campaign": ("table", None),
+        "campaign": ("table", None), "mooring": ("tables", None),
     }, required=("simulation", "vessel"))
     warnings: list[str] = []
     title = top.get("title", Path(path).stem if path else "")
@@ -119,7 +120,8 @@ def parse_scene(mapping: Mapping[str, Any], text: str = "", path: str = "") -> S
     _unique_names(probes, "probes", "probe")
     for i, probe in enumerate(probes):
         _place_probe(probe, f"probes[{i}]", tanks, structures)
-    _mass_balance(vessel, tanks, environment, warnings, structures)
+    mooring = read_mooring(mapping.get("mooring", []), environment.depth, vessel.name, vessel.cog_height, warnings)
+    _mass_balance(vessel, tanks, environment, warnings, structures, mooring)
     effects = Effects(**read(mapping.get("effects", {}), "effects", {k: ("bool", None) for k in EFFECTS}))
     waves = None
     if "waves" in mapping:   # incident waves (waves.py)
@@ -129,7 +131,7 @@ def parse_scene(mapping: Mapping[str, Any], text: str = "", path: str = "") -> S
         campaign = read_campaign(mapping["campaign"], probes, waves, simulation.dt, warnings)
     scene = Scene(title=title, environment=environment, simulation=simulation, vessel=vessel, tanks=tanks,
                   structures=structures, probes=probes, effects=effects, text=text, path=path,
-                  warnings=tuple(warnings), waves=waves, campaign=campaign)
+                  warnings=tuple(warnings), waves=waves, campaign=campaign, mooring=mooring)
     if waves is not None or vessel.hull is not None or vessel.hydrodynamics is not None:
         scene = check_waves(scene, path, warnings)
         scene = dataclasses.replace(scene, warnings=tuple(warnings))
@@ -159,7 +161,7 @@ def _multimodal_scene(tanks, warnings: list[str]) -> None:
 # Tables
 def _environment(table) -> Environment:
     v = read(table, "environment", {
-        "gravity": ("float", non_negative), "water_density": ("float", positive),
+        "gravity": ("float", non_negative), "water_density": ("float", positive), "depth": ("float", positive),
     })
     return Environment(**v)
 
@@ -233,7 +235,7 @@ def _vessel(table, environment: Environment, warnings: list[str], files=None) ->
     v = read(table, "vessel", {
         "mass": ("float", positive), "inertia": ("inertia", None), "hydrostatics": ("table", None),
         "initial": ("table", None), "forced": ("table", None), "hull": ("table", None),
-        "hydrodynamics": ("table", None),
+        "hydrodynamics": ("table", None), "name": ("str", valid_name), "cog_height": ("float", None),
     }, required=("mass", "inertia"))
     inertia = v["inertia"]
     _inertia_warnings(inertia, warnings)
@@ -255,8 +257,11 @@ def _vessel(table, environment: Environment, warnings: list[str], files=None) ->
     }))
     forced = read_forced(table["forced"], files.base_dir if files is not None else os.getcwd()) \
         if "forced" in table else None
+    # the COG's height above the still-water level (it places mooring fairleads): given, or a box
+    # hull's kg - draft, else 0
+    cog = v.get("cog_height", hull.kg - hull.draft if hull is not None and hull.type == "box" else 0.0)
     return Vessel(mass=v["mass"], inertia=inertia, hydrostatics=hydrostatics, initial=initial, forced=forced,
-                  hull=hull, hydrodynamics=hydrodynamics)
+                  hull=hull, hydrodynamics=hydrodynamics, name=v.get("name", "vessel"), cog_height=cog)
 
 
 def _inertia_warnings(inertia, warnings: list[str]) -> None:
@@ -455,7 +460,8 @@ def _place_probe(probe: Probe, where: str, tanks, structures) -> None:
                 f"on no wall of tank {owner_name!r}: no material point is there to follow"))
 
 
-def _mass_balance(vessel: Vessel, tanks, environment: Environment, warnings: list[str], structures=()) -> None:
+def _mass_balance(vessel: Vessel, tanks, environment: Environment, warnings: list[str], structures=(),
+                  mooring=()) -> None:
     h = vessel.hydrostatics
     if h is None or environment.gravity == 0:
         return
@@ -469,6 +475,9 @@ def _mass_balance(vessel: Vessel, tanks, environment: Environment, warnings: lis
             f"differs from the water the hull displaces at rest, {buoyant:.6g} kg, by "
             f"{100 * (total - buoyant) / buoyant:+.2f} %: the vessel starts out of equilibrium and "
             f"{'sinks' if total > buoyant else 'rises'} to its own draft (heaving about it) from t = 0")
+    elif mooring and 0.0 <= (buoyant - total) * environment.gravity <= sum(max(m.weight, 0.0) * m.length
+                                                                          for m in mooring) * (1 + MASS_BALANCE_TOLERANCE):
+        return      # the buoyancy in excess may carry the lines' weight (docs/guide/moorings.md)
     elif abs(total - buoyant) > MASS_BALANCE_TOLERANCE * buoyant:
         imbalance = (total - buoyant) * environment.gravity
         warnings.append(

@@ -38,6 +38,7 @@ class SceneError(ValueError):
 class Environment:
     gravity: float = 9.81            # m/s^2, >= 0 (0: no gravity, e.g. a torque-free body)
     water_density: float = 1025.0    # kg/m^3, > 0
+    depth: Optional[float] = None    # m, > 0: the water depth (the seabed of mooring lines); None: infinite
 
 
 @dataclass(frozen=True)
@@ -115,6 +116,24 @@ class Vessel:
     forced: Optional[Forced] = None  # prescribed motion instead of free motion
     hull: Optional["Hull"] = None    # hull geometry: Froude-Krylov forces, Capytaine (waves, hydrodynamics.py)
     hydrodynamics: Optional["Hydrodynamics"] = None   # added mass, radiation damping, excitation tables
+    name: str = "vessel"             # how mooring lines (`body`) name it
+    cog_height: float = 0.0          # m, the COG's height above the still-water level at rest
+
+
+@dataclass(frozen=True)
+class MooringLine:
+    """A `[[mooring]]` line (docs/guide/moorings.md): the fairlead in its body's frame (from the
+    COG), the anchor inertial (x, y from the vessel's COG at rest, z from the still-water level)."""
+    name: str
+    fairlead: Vec3
+    anchor: Vec3
+    length: float                    # m, unstretched, > 0
+    weight: float                    # N/m submerged (negative: buoyant)
+    ea: float                        # N, > 0
+    body: str = "vessel"
+    model: str = "catenary"
+    seabed_friction: float = 0.0
+    anchor_height: float = 0.0       # m above the seabed (anchor z + depth)
 
 
 @dataclass(frozen=True)
@@ -340,6 +359,7 @@ class Scene:
     warnings: tuple[str, ...] = ()   # physically doubtful but legal choices, said once at load
     waves: Optional["Waves"] = None  # the [waves] table: incident regular waves or a JONSWAP sea
     campaign: CampaignTable | None = None      # the [campaign] table: a campaign's limits and defaults
+    mooring: tuple["MooringLine", ...] = ()    # the [[mooring]] lines
 
     def tank(self, name: str) -> Tank:
         for t in self.tanks:

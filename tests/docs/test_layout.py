@@ -19,13 +19,15 @@ LAYERS = [
     {"scene"},
     {"fem"},
     {"physics"},
+    # mooring lines: the catenary and the lines' term, below the assembly that adds it
+    {"mooring"},
     {"solve"},
     {"assemble"},
     {"run.loop"},
     # the compile cache: a wing above the loop it compiles, below the runs that use it
     {"cache"},
     {"run"},
-    {"analysis", "campaign", "fit"},
+    {"analysis", "campaign", "fit", "mooring.statics"},
     {"plot"},
     {"cli"},
     {"entry"},
@@ -77,11 +79,15 @@ def _imports(module, path):
 
 
 def _layer(module):
+    """The layer of a module: that of the longest prefix naming it (`mooring.statics` above `mooring`)."""
+    best = None
     for i, layer in enumerate(LAYERS):
-        for prefix in sorted(layer, key=len, reverse=True):
-            if module == prefix or module.startswith(prefix + "."):
-                return i, prefix
-    raise AssertionError(f"{module} is in no layer")
+        for prefix in layer:
+            if (module == prefix or module.startswith(prefix + ".")) and (best is None or len(prefix) > len(best[1])):
+                best = (i, prefix)
+    if best is None:
+        raise AssertionError(f"{module} is in no layer")
+    return best
 
 
 MODULES = _modules()

@@ -1,0 +1,263 @@
+"""The quasi-static elastic catenary of one mooring line (docs/guide/moorings.md).
+
+Given the fairlead's horizontal and vertical distance from the anchor (XF, ZF), the unstretched
+length L, the submerged weight per unstretched metre w (negative: buoyant), the axial stiffness EA,
+the seabed friction coefficient CB and the anchor's height hA above the seabed, the line's
+profile equations give (XF, ZF) as closed-form functions of the fairlead tension's horizontal and
+vertical components (H, V) (Jonkman's form, as FAST, MAP++ and MoorPy use it). One function
+`profile` covers every branch, chosen from (H, V) alone so that the branches meet continuously:
+
+* suspended (no seabed contact; buoyant lines, taut lines, raised anchors whose sag stays above
+  the seabed);
+* touchdown (anchor on the seabed, L_B = L - V/w on the seabed, with Coulomb friction CB w per
+  metre: the tension falls linearly along the seabed portion and may reach zero before the anchor);
+* U-shaped (raised anchor, the line dips to the seabed between anchor and fairlead).
+
+`solve` finds (H, V) by Newton from the inextensible estimate of Peyrot & Goulois (the start
+MAP++ and MoorPy use) or, for a line stretched beyond its length, the straight elastic bar; the
+iterations run in a `lax.while_loop` and the gradients come from the implicit function theorem
+(`jax.lax.custom_root`), not from the iterations.
+"""
+from __future__ import annotations
+
+from typing import NamedTuple
+
+import jax
+import jax.numpy as jnp
+
+#: Newton stops when both profile residuals are below this fraction of the line's length
+TOL = 1e-13
+MAX_ITER = 200
+
+
+class Catenary(NamedTuple):
+    """One line's solution (N, m): the tension's components at the fairlead (H towards the anchor,
+    V > 0 when the line pulls the fairlead down) and at the anchor (horizontal towards the
+    fairlead, vertical > 0 lifting the anchor), the unstretched length on the seabed and the 2x2
+    stiffness [[dH/dXF, dH/dZF], [dV/dXF, dV/dZF]]."""
+    fairlead_horizontal: jax.Array
+    fairlead_vertical: jax.Array
+    anchor_horizontal: jax.Array
+    anchor_vertical: jax.Array
+    seabed_length: jax.Array
+    stiffness: jax.Array
+
+
+
+def _asinh_chord(a, b):
+    """(asinh a - asinh b) / (a - b), smooth through a = b (a weightless or taut line): the
+    Taylor series about the midpoint where the difference would cancel."""
+    d = a - b
+    m = 0.5 * (a + b)
+    small = jnp.abs(d) < 1e-2
+    d_safe = jnp.where(small, 1.0, d)
+    direct = (jnp.arcsinh(jnp.where(small, m + 0.5, a)) - jnp.arcsinh(jnp.where(small, m - 0.5, b))) / d_safe
+    s = 1.0 + m * m
+    series = (s ** -0.5 + (2 * m * m - 1) * s ** -2.5 * d * d / 24.0
+              + (24 * m ** 4 - 72 * m * m + 9) * s ** -4.5 * d ** 4 / 1920.0)
+    return jnp.where(small, series, direct)
+
+
+def _suspended(H, V, L, w, EA):
+    a = V / H
+    b = (V - w * L) / H
+    xf = L * _asinh_chord(a, b) + H * L / EA
+    zf = L * (a + b) / (jnp.sqrt(1 + a * a) + jnp.sqrt(1 + b * b)) + (V * L - 0.5 * w * L * L) / EA
+    return xf, zf
+
+
+def _rise_slope(H, h, w, EA):
+    """The slope sinh at the top of a catenary that rises h from its lowest point (zero slope) with
+    horizontal tension H: H/w (cosh - 1) + H^2 sinh^2 / (2 EA w) = h is a quadratic in y = cosh - 1,
+    solved in its cancellation-free form."""
+    ae = H * H / (2 * EA * w)
+    B = H / w + 2 * ae
+    y = 2 * h / (B + jnp.sqrt(B * B + 4 * ae * h))
+    # sqrt's slope is infinite at 0 (an anchor on the seabed): kept out of the gradient there
+    pos = y > 0
+    return jnp.where(pos, jnp.sqrt(jnp.where(pos, y * (y + 2), 1.0)), 0.0)
+
+
+def _contact(H, V, L, w, EA, CB, hA):
+    """The line on the seabed: (XF, ZF, L_B, the anchor's horizontal and vertical force), w > 0."""
+    # the part between a raised anchor and the seabed
+    u = _rise_slope(H, hA, w, EA)
+    s1 = H * u / w
+    s2 = V / w
+    LB = L - s1 - s2
+    # friction acts only where the seabed portion ends at the anchor (a raised anchor's U-shaped
+    # line slides towards its middle from both sides: taken frictionless)
+    cbw = jnp.where(hA > 0, 0.0, CB) * w
+    cbw_safe = jnp.where(cbw > 0, cbw, 1.0)
+    slack_part = jnp.maximum(cbw * LB - H, 0.0)
+    friction = (-cbw * LB * LB + jnp.where(cbw > 0, slack_part ** 2 / cbw_safe, 0.0)) / (2 * EA)
+    xf = (LB + H / w * jnp.arcsinh(u) + H / w * jnp.arcsinh(V / H) + H * L / EA + friction)
+    zf = H / w * (jnp.sqrt(1 + (V / H) ** 2) - 1) + V * V / (2 * EA * w) - hA
+    return xf, zf, LB, jnp.maximum(H - cbw * LB, 0.0), -w * s1
+
+
+def profile(H, V, L, w, EA, CB=0.0, hA=0.0):
+    """(XF, ZF, seabed length, anchor horizontal, anchor vertical) of the line whose fairlead
+    tension is (H, V), H > 0, on whichever branch (H, V) lies."""
+    wc = jnp.where(w > 0, w, 1.0)
+    xc, zc, LB, HA, VA = _contact(H, V, L, wc, EA, CB, hA)
+    contact = (w > 0) & (LB > 0)
+    xs, zs = _suspended(H, V, L, w, EA)
+    LB = jnp.where(contact, LB, 0.0)
+    # the anchor's vertical force: minus the weight of the line between a raised anchor and the
+    # seabed (0 on the touchdown branch), V - wL when suspended: equal where the branches meet
+    return (jnp.where(contact, xc, xs), jnp.where(contact, zc, zs), LB,
+            jnp.where(contact, HA, H), jnp.where(contact, VA, V - w * L))
+
+
+def _start(XF, ZF, L, w, EA):
+    """Peyrot & Goulois's inextensible estimate (a buoyant line as the mirror image of a hanging
+    one); for a line longer stretched than its length, the straight elastic bar carrying half its
+    weight at each end."""
+    sign = jnp.where(w < 0, -1.0, 1.0)
+    ws = jnp.maximum(jnp.abs(w), 1e-12 * EA / L)
+    zs = ZF * sign
+    dist = jnp.sqrt(XF * XF + ZF * ZF)
+    xsafe = jnp.where(XF > 0, XF, 1.0)
+    ratio = jnp.maximum((L * L - zs * zs) / (xsafe * xsafe) - 1.0, 1e-6)
+    lam = jnp.where(XF <= 0, 1e6, jnp.where(dist >= L, 0.2, jnp.sqrt(3 * ratio)))
+    H0 = jnp.maximum(jnp.abs(0.5 * ws * XF / lam), 1e-6 * ws * L)
+    V0 = sign * 0.5 * ws * (zs / jnp.tanh(lam) + L)
+    T = EA * (dist / L - 1.0)
+    dsafe = jnp.where(dist > 0, dist, 1.0)
+    taut = dist > L
+    H0 = jnp.where(taut, jnp.maximum(H0, T * XF / dsafe), H0)
+    V0 = jnp.where(taut, T * ZF / dsafe + 0.5 * w * L, V0)
+    return jnp.stack([H0, V0])
+
+
+def _newton(residual, x0, scale):
+    jac = jax.jacfwd(residual)
+
+    def step(state):
+        x, _, it = state
+        r = residual(x)
+        J = jac(x)
+        det = J[0, 0] * J[1, 1] - J[0, 1] * J[1, 0]
+        dx = -jnp.array([J[1, 1] * r[0] - J[0, 1] * r[1], J[0, 0] * r[1] - J[1, 0] * r[0]]) / det
+        # a backtracking line search, all trial steps at once (no Python or traced loop over
+        # them): the longest step of 1, 1/2, ..., 1/2^11 that lowers the residual (Armijo),
+        # else the one that lowers it most; H stays positive (a step that would cross zero goes
+        # a tenth of the way there instead)
+        norm0 = jnp.sum(r * r)
+        alpha = 0.5 ** jnp.arange(12.0)
+        H = jnp.maximum(x[0] + alpha * dx[0], 0.1 * x[0])
+        trial = jnp.stack([H, x[1] + alpha * dx[1]], axis=1)
+        norms = jax.vmap(lambda y: jnp.sum(residual(y) ** 2))(trial)
+        norms = jnp.where(jnp.isfinite(norms), norms, jnp.inf)
+        ok = norms <= (1 - 1e-4 * alpha) * norm0
+        pick = jnp.where(jnp.any(ok), jnp.argmax(ok), jnp.argmin(norms))
+        x = trial[pick]
+        return x, jnp.max(jnp.abs(residual(x))) / scale, it + 1
+
+    def cond(state):
+        _, err, it = state
+        return (err > TOL) & (it < MAX_ITER)
+
+    err0 = jnp.max(jnp.abs(residual(x0))) / scale
+    x, err, _ = jax.lax.while_loop(cond, step, (x0, err0, 0))
+    # a line that did not converge gives NaN, which the caller's own Newton reports with its step
+    return jnp.where(err <= 1e3 * TOL, x, jnp.nan)
+
+
+def _contact_solve(XF, ZF, L, w, EA, CB, hA):
+    """The solution on the seabed branch, found as a one-dimensional problem: there the vertical
+    span fixes V for each H (the fairlead's part rises ZF + hA from the seabed), and XF grows
+    with H. Newton on log H inside a bracket that bisection keeps (a flat or steep profile
+    cannot throw it out)."""
+    def parts(logH):
+        H = jnp.exp(logH)
+        V = H * _rise_slope(H, ZF + hA, w, EA)
+        return _contact(H, V, L, w, EA, CB, hA)[0] - XF, V
+
+    f = lambda h: parts(h)[0]
+    df = jax.grad(f)
+    scale = jnp.log(jnp.abs(w) * L)
+
+    def step(state):
+        h, lo, hi, _, it = state
+        r = f(h)
+        lo = jnp.where(r < 0, h, lo)
+        hi = jnp.where(r > 0, h, hi)
+        new = h - r / df(h)
+        inside = jnp.isfinite(new) & (new > lo) & (new < hi)
+        new = jnp.where(inside, new, 0.5 * (lo + hi))
+        return new, lo, hi, jnp.abs(f(new)) / L, it + 1
+
+    cond = lambda state: (state[3] > TOL) & (state[4] < MAX_ITER)
+    lo, hi = scale - 40.0, jnp.log(EA) + 10.0
+    h0 = jnp.clip(jnp.log(_start(XF, ZF, L, w, EA)[0]), lo + 1.0, hi - 1.0)
+    h, *_ = jax.lax.while_loop(cond, step, (h0, lo, hi, jnp.abs(f(h0)) / L, 0))
+    H = jnp.exp(h)
+    return jnp.stack([H, parts(h)[1]])
+
+
+def _slack(XF, ZF, L, w, EA, CB, hA):
+    """(whether the line is slack, the tiny H that stands for zero there): a line anchored so
+    close that even with no horizontal tension its seabed portion would reach past the anchor
+    lies piled on the seabed: H = 0, and V carries the part hanging from the fairlead."""
+    wc = jnp.where(w > 0, w, 1.0)
+    H0 = jnp.abs(wc) * L * jnp.exp(-40.0)
+    V0 = H0 * _rise_slope(H0, ZF + hA, wc, EA)
+    return (w > 0) & (_contact(H0, V0, L, wc, EA, CB, hA)[0] >= XF), H0
+
+
+def _solve_iterations(residual, XF, ZF, L, w, EA, CB, hA):
+    """(H, V) by the seabed branch's one-dimensional solve where it lands on that branch, else by
+    Newton on the whole profile from the inextensible or taut estimate."""
+    wc = jnp.where(w > 0, w, 1.0)
+    slack, H0 = _slack(XF, ZF, L, w, EA, CB, hA)
+    xc = _contact_solve(XF, ZF, L, wc, EA, CB, hA)
+    on_seabed = (w > 0) & (profile(xc[0], xc[1], L, w, EA, CB, hA)[2] > 0) & jnp.all(jnp.isfinite(xc))
+    xs = _newton(residual, _start(XF, ZF, L, w, EA), 1.0)
+    x_slack = jnp.stack([H0, H0 * _rise_slope(H0, ZF + hA, wc, EA)])
+    return jnp.where(slack, x_slack, jnp.where(on_seabed, xc, xs))
+
+
+def solve(XF, ZF, L, w, EA, CB=0.0, hA=0.0):
+    """The fairlead tension (H, V) of the line with spans (XF, ZF); differentiable in every
+    argument through the implicit function theorem."""
+    XF, ZF, L, w, EA, CB, hA = (jnp.asarray(v, dtype=float) for v in (XF, ZF, L, w, EA, CB, hA))
+    slack, H0 = jax.lax.stop_gradient(_slack(XF, ZF, L, w, EA, CB, hA))
+
+    def residual(x):
+        xf, zf = profile(x[0], x[1], L, w, EA, CB, hA)[:2]
+        # a slack line has no horizontal tension (H0 stands for zero): XF no longer matters
+        first = jnp.where(slack, (x[0] - H0) / jnp.abs(w), xf - XF)
+        return jnp.stack([first, zf - ZF]) / L
+
+    def tangent_solve(g, y):
+        return jnp.linalg.solve(jax.jacfwd(g)(y), y)
+
+    spans = jax.lax.stop_gradient((XF, ZF, L, w, EA, CB, hA))
+    x0 = jnp.zeros(2)
+    return jax.lax.custom_root(residual, x0, lambda f, _: _solve_iterations(f, *spans), tangent_solve)
+
+
+@jax.jit
+def catenary(span: tuple, length: float, weight: float, ea: float, seabed_friction: float = 0.0,
+             anchor_height: float = 0.0) -> Catenary:
+    """One elastic catenary line (docs/guide/moorings.md).
+
+    Args:
+        span: (XF, ZF), the fairlead's horizontal and vertical distance from the anchor, m.
+        length: unstretched length L, m.
+        weight: submerged weight per unstretched metre w, N/m (negative: buoyant).
+        ea: axial stiffness EA, N.
+        seabed_friction: Coulomb friction coefficient of the part on the seabed.
+        anchor_height: the anchor's height above the seabed, m (the seabed still below it).
+
+    Returns:
+        A `Catenary` (a NamedTuple of arrays), differentiable in every argument.
+    """
+    XF, ZF = span
+    args = tuple(jnp.asarray(v, dtype=float) for v in (XF, ZF, length, weight, ea, seabed_friction, anchor_height))
+    H, V = solve(*args)
+    _, _, LB, HA, VA = profile(H, V, *args[2:])
+    K = jax.jacfwd(lambda s: solve(s[0], s[1], *args[2:]))(jnp.stack(args[:2]))
+    return Catenary(H, V, HA, VA, LB, K)
