@@ -1,0 +1,157 @@
+"""A lumped-mass mooring line as a term of the vessel's residual (docs/guide/moorings-lumped.md).
+
+The line's moving nodes and their velocities are the term's integrator states (terms.AbstractTerm's
+hooks): every step advances them from t_n to t_{n+1} with the fairlead's positions and velocities
+at both ends (`state_advance_config`: the vessel's configuration and velocities at t_n and at the
+step's unknown t_{n+1}), sub-stepped inside the step (lumped.advance). The force on the vessel is
+the line's load on the fairlead at t_{n+1} (the last segment's tension with the fairlead node's
+half segment of weight and drag, lumped.fairlead_force), applied at the fairlead: translation
+rows in the inertial frame, the moment p x (A^T F) about the COG in the body frame. Being a
+function of the states at t_{n+1}, which follow the unknown configuration, it is implicit in the
+step as the radiation memory is: the Newton iterations see the line's response to the vessel's
+motion within the step.
+
+Frames: `fairlead` is in the body frame from the COG; the line's anchor and seabed in the frame of
+the vessel's COG position X0 (its origin the COG's rest position, z up): `lumped_line_term` shifts
+the scene's anchor (x, y from the COG at rest, z from the still-water level) by the COG's height.
+"""
+from __future__ import annotations
+
+import math
+from typing import Optional
+
+import equinox as eqx
+import jax
+import jax.numpy as jnp
+
+from ..physics.kinematics import rotation_matrix
+from ..physics.terms import AbstractTerm, Config, Kin, Rows
+from . import lumped as lm
+
+#: the lumped-only keys of a `[[mooring]]` table and their defaults (mass: from weight and diameter)
+LUMPED_KEYS = {"segments": 20, "diameter": 0.09, "mass": None, "cd": (1.6, 0.1), "ca": (1.0, 0.0),
+               "internal_damping": -0.8, "seabed_stiffness": 3.0e6, "seabed_damping": 3.0e5}
+
+
+def _fairlead(p_b, c: Config, V0, omega):
+    """The fairlead's inertial position and velocity for the body point p_b."""
+    A = rotation_matrix(c.q)
+    return c.X0 + A @ p_b, V0 + A @ jnp.cross(omega, p_b)
+
+
+class LumpedLineTerm(AbstractTerm):
+    """One lumped-mass line from a fixed anchor to a fairlead on the vessel. States: the moving
+    nodes' positions and velocities, flattened ((N - 1) * 6,). `substeps` (static): the line's
+    sub-steps per vessel step, from the step given at construction (a smaller step, such as a
+    retried step's sub-steps, only makes them smaller)."""
+    line: lm.LumpedLine
+    fairlead: jax.Array      # (3,) body frame, from the COG
+    nodes0: jax.Array        # (N - 1, 3) the static shape at the start
+    name: str = eqx.field(static=True, default="line")
+    substeps: int = eqx.field(static=True, default=1)
+
+    # ------------------------------------------------------------ states
+    def state_init(self):
+        return jnp.concatenate([self.nodes0.reshape(-1), jnp.zeros(self.nodes0.size)])
+
+    def split(self, z) -> lm.LineState:
+        n = self.nodes0.size
+        return lm.LineState(z[:n].reshape(-1, 3), z[n:].reshape(-1, 3))
+
+    def state_coefficients(self, h):
+        return jnp.asarray(h)
+
+    def state_advance(self, z, v_old, v_new, coef):
+        raise TypeError("a lumped line's states follow the vessel's configuration: state_advance_config")
+
+    def state_advance_config(self, z, c_old, v_old, c_new, v_new, coef):
+        p0, u0 = _fairlead(self.fairlead, c_old, v_old[:3], v_old[3:6])
+        p1, u1 = _fairlead(self.fairlead, c_new, v_new[:3], v_new[3:6])
+        s = lm.advance(self.line, self.split(z), p0, u0, p1, u1, coef, self.substeps)
+        return jnp.concatenate([s.r.reshape(-1), s.v.reshape(-1)])
+
+    # ------------------------------------------------------------ forces
+    def force(self, c: Config, V0, omega, z):
+        """The line's force on the fairlead (3,), inertial, for the vessel at (c, V0, omega) and the
+        line's states z."""
+        p, u = _fairlead(self.fairlead, c, V0, omega)
+        s = self.split(z)
+        return lm.fairlead_force(self.line, s.r, s.v, p, u)
+
+    def rows(self, k: Kin) -> Rows:
+        F = self.force(k.c, k.V0, k.omega, k.z)
+        M_b = jnp.cross(self.fairlead, k.A.T @ F)
+        return Rows(-jnp.concatenate([F, M_b]))
+
+    def tension(self, c: Config, V0, omega, z):
+        """|force on the fairlead| (N)."""
+        return jnp.linalg.norm(self.force(c, V0, omega, z))
+
+    def nodes(self, c: Config, z):
+        """Every node (N + 1, 3) in the X0 frame: anchor, moving nodes, fairlead (the result file's
+        `/mooring/<line>/nodes`)."""
+        A = rotation_matrix(c.q)
+        s = self.split(z)
+        return jnp.concatenate([self.line.anchor[None], s.r, (c.X0 + A @ self.fairlead)[None]], axis=0)
+
+    def describe(self) -> tuple:
+        ln = self.line
+        return (("mooring", f"lumped line {self.name}: {ln.segments} segments, {self.substeps} sub-steps "
+                 f"of the step (symplectic Euler, stable sub-step {ln.substep_max:.3g} s)"),)
+
+
+def lumped_line_term(c0: Config, dt: float, *, name: str, fairlead, anchor, length, weight, ea,
+                     depth: Optional[float] = None, cog_height: float = 0.0, gravity: float = 9.81,
+                     water_density: float = 1025.0, current=(0.0, 0.0, 0.0), **lumped) -> LumpedLineTerm:
+    """The term of one `[[mooring]]` table with `model = "lumped"`: the scene's values (fairlead in
+    the body frame from the COG; anchor x, y from the COG at rest and z from the still-water level;
+    `depth` the water depth, None without a seabed; `cog_height` the COG's height above the
+    still-water level at rest) and the lumped-only keys (LUMPED_KEYS), for the vessel starting at
+    c0 (its lines start in their static shape there) and stepped at dt. Bad values raise
+    ValueError naming the key (`mooring.<name>.<key>`)."""
+    unknown = set(lumped) - set(LUMPED_KEYS)
+    if unknown:
+        raise ValueError(f"mooring.{name}.{sorted(unknown)[0]}: not a key of a lumped line")
+    kw = dict(LUMPED_KEYS, **lumped)
+    checks = {"segments": kw["segments"] >= 2 and int(kw["segments"]) == kw["segments"],
+              "diameter": kw["diameter"] > 0, "length": length > 0, "ea": ea > 0,
+              "seabed_stiffness": kw["seabed_stiffness"] >= 0, "seabed_damping": kw["seabed_damping"] >= 0,
+              "mass": kw["mass"] is None or kw["mass"] > 0,
+              "cd": len(kw["cd"]) == 2 and min(kw["cd"]) >= 0, "ca": len(kw["ca"]) == 2 and min(kw["ca"]) >= 0}
+    for key, ok in checks.items():
+        if not ok:
+            raise ValueError(f"mooring.{name}.{key}: out of range ({kw.get(key, locals().get(key))!r})")
+    shift = jnp.array([0.0, 0.0, -cog_height])
+    seabed = -math.inf if depth is None else -float(depth) - cog_height
+    line = lm.lumped_line(jnp.asarray(anchor, dtype=float) + shift, length, weight, ea,
+                          segments=int(kw["segments"]), diameter=kw["diameter"], mass=kw["mass"],
+                          cd=tuple(kw["cd"]), ca=tuple(kw["ca"]), internal_damping=kw["internal_damping"],
+                          seabed_z=seabed, seabed_stiffness=kw["seabed_stiffness"],
+                          seabed_damping=kw["seabed_damping"], rho=water_density, gravity=gravity,
+                          current=current)
+    p_b = jnp.asarray(fairlead, dtype=float)
+    fair0, _ = _fairlead(p_b, c0, jnp.zeros(3), jnp.zeros(3))
+    nodes0, ok = jax.jit(lm.static_shape)(line, fair0)
+    if not bool(ok):
+        raise ValueError(f"mooring.{name}: the line's static shape did not converge")
+    return LumpedLineTerm(line, p_b, nodes0, name, line.substeps(dt))
+
+
+def with_lines(stepper, terms):
+    """A Stepper (run/stepper.py) whose System has the given line terms added beside its own
+    (how a test or a user adds lumped lines before the scene's keys are wired)."""
+    return eqx.tree_at(lambda s: s.built.system.terms, stepper, stepper.built.system.terms + tuple(terms))
+
+
+def line_states(stepper, state, term_index: Optional[int] = None):
+    """The integrator states of the System's LumpedLineTerms in a Stepper's state, by term: a dict
+    name -> (term, z)."""
+    system = stepper.built.system
+    out = {}
+    for i, (term, z) in enumerate(zip(system.all_terms(), state.s.z, strict=True)):
+        if isinstance(term, LumpedLineTerm) and (term_index is None or term_index == i):
+            out[term.name] = (term, z)
+    return out
+
+
+__all__ = ["LumpedLineTerm", "lumped_line_term", "with_lines", "line_states", "LUMPED_KEYS"]
