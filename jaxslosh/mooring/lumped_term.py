@@ -47,6 +47,9 @@ class LumpedLineTerm(AbstractTerm):
     line: lm.LumpedLine
     fairlead: jax.Array      # (3,) body frame, from the COG
     nodes0: jax.Array        # (N - 1, 3) the static shape at the start
+    # (3,) a constant force added to the line's: with linear hydrostatics (springs about the rest
+    # position) the buoyancy carries the line's vertical pull at rest, as for the catenary lines
+    carried: jax.Array = eqx.field(default_factory=lambda: jnp.zeros(3))
     name: str = eqx.field(static=True, default="line")
     substeps: int = eqx.field(static=True, default=1)
 
@@ -81,7 +84,7 @@ class LumpedLineTerm(AbstractTerm):
     def rows(self, k: Kin) -> Rows:
         F = self.force(k.c, k.V0, k.omega, k.z)
         M_b = jnp.cross(self.fairlead, k.A.T @ F)
-        return Rows(-jnp.concatenate([F, M_b]))
+        return Rows(-jnp.concatenate([F + self.carried, M_b]))
 
     def tension(self, c: Config, V0, omega, z):
         """|force on the fairlead| (N)."""
@@ -102,13 +105,16 @@ class LumpedLineTerm(AbstractTerm):
 
 def lumped_line_term(c0: Config, dt: float, *, name: str, fairlead, anchor, length, weight, ea,
                      depth: Optional[float] = None, cog_height: float = 0.0, gravity: float = 9.81,
-                     water_density: float = 1025.0, current=(0.0, 0.0, 0.0), **lumped) -> LumpedLineTerm:
+                     water_density: float = 1025.0, current=(0.0, 0.0, 0.0), balanced: bool = False,
+                     **lumped) -> LumpedLineTerm:
     """The term of one `[[mooring]]` table with `model = "lumped"`: the scene's values (fairlead in
     the body frame from the COG; anchor x, y from the COG at rest and z from the still-water level;
     `depth` the water depth, None without a seabed; `cog_height` the COG's height above the
     still-water level at rest) and the lumped-only keys (LUMPED_KEYS), for the vessel starting at
-    c0 (its lines start in their static shape there) and stepped at dt. Bad values raise
-    ValueError naming the key (`mooring.<name>.<key>`)."""
+    c0 (its lines start in their static shape there) and stepped at dt. `balanced`: the vessel's
+    hydrostatics are linear springs about the rest position, whose buoyancy then carries the line's
+    vertical pull at rest (`carried`). Bad values raise ValueError naming the key
+    (`mooring.<name>.<key>`)."""
     unknown = set(lumped) - set(LUMPED_KEYS)
     if unknown:
         raise ValueError(f"mooring.{name}.{sorted(unknown)[0]}: not a key of a lumped line")
@@ -134,7 +140,80 @@ def lumped_line_term(c0: Config, dt: float, *, name: str, fairlead, anchor, leng
     nodes0, ok = jax.jit(lm.static_shape)(line, fair0)
     if not bool(ok):
         raise ValueError(f"mooring.{name}: the line's static shape did not converge")
-    return LumpedLineTerm(line, p_b, nodes0, name, line.substeps(dt))
+    carried = jnp.zeros(3)
+    if balanced:
+        F = lm.fairlead_force(line, nodes0, jnp.zeros_like(nodes0), fair0, jnp.zeros(3))
+        carried = jnp.array([0.0, 0.0, -F[2]])
+    return LumpedLineTerm(line, p_b, nodes0, carried, name, line.substeps(dt))
+
+
+# ---------------------------------------------------------------------------- the scene's tables
+def read_lumped(table: dict, where: str) -> tuple[dict, tuple]:
+    """A `[[mooring]]` table with `model = "lumped"`, split for the loader: (the table without its
+    lumped-only keys, for the lines' common reader; the lumped values as sorted (key, value) pairs,
+    checked: SceneError naming the key). Keys left out take LUMPED_KEYS' defaults when built."""
+    from ..scene.fields import at_least, non_negative, positive, read
+    from ..scene.types import SceneError
+
+    rest = {k: v for k, v in table.items() if k not in LUMPED_KEYS}
+    mine = {k: v for k, v in table.items() if k in LUMPED_KEYS and k not in ("cd", "ca")}
+    v = read(mine, where, {"segments": ("int", at_least(2)), "diameter": ("float", positive),
+                           "mass": ("float", positive), "internal_damping": ("float", None),
+                           "seabed_stiffness": ("float", non_negative), "seabed_damping": ("float", non_negative)})
+    for key in ("cd", "ca"):
+        if key in table:
+            x = table[key]
+            ok = (isinstance(x, list) and len(x) == 2
+                  and all(isinstance(c, (int, float)) and not isinstance(c, bool) and c >= 0 for c in x))
+            if not ok:
+                raise SceneError(f"{where}.{key}", f"must be [normal, tangential], two numbers >= 0, got {x!r}")
+            v[key] = (float(x[0]), float(x[1]))
+    return rest, tuple(sorted(v.items()))
+
+
+def build_lumped_lines(scene, balanced: bool, q0=None) -> tuple:
+    """The terms of the scene's `[[mooring]]` lines with `model = "lumped"` (each line's lumped
+    values in its `lumped` attribute, read_lumped's pairs; absent: the defaults), each in its static
+    shape with the vessel at its initial position and attitude q0 (identity when None), sub-stepped
+    for the scene's dt."""
+    from ..scene.types import SceneError
+
+    lines = [m for m in scene.mooring if getattr(m, "model", "catenary") == "lumped"]
+    if not lines:
+        return ()
+    if getattr(scene.simulation, "energy_projection", False):
+        raise SceneError("simulation.energy_projection", "cannot hold the energy with lumped mooring lines "
+                                                         "(their drag and damping take energy out of the vessel)")
+    env = scene.environment
+    X0 = jnp.asarray(scene.vessel.initial.position, dtype=float)
+    q = jnp.array([1.0, 0.0, 0.0, 0.0]) if q0 is None else jnp.asarray(q0, dtype=float)
+    c0 = Config(X0, q, jnp.zeros(0))
+    terms = []
+    for m in lines:
+        try:
+            terms.append(lumped_line_term(
+                c0, scene.simulation.dt, name=m.name, fairlead=m.fairlead, anchor=m.anchor, length=m.length,
+                weight=m.weight, ea=m.ea, depth=env.depth, cog_height=getattr(scene.vessel, "cog_height", 0.0),
+                gravity=env.gravity, water_density=env.water_density, balanced=balanced,
+                **dict(getattr(m, "lumped", ()))))
+        except ValueError as e:
+            raise SceneError(f"mooring.{m.name}", str(e)) from e
+    return tuple(terms)
+
+
+def lumped_observe(system, z: tuple, c: Config, V0, omega) -> dict:
+    """For the result file, at one frame (the integrator state's configuration c, velocities and the
+    terms' states z, as State.z): `mooring/<line>/fairlead_tension`, `anchor_tension` (N) and
+    `nodes` ((N + 1, 3), in the frame of the vessel's position X0) of each lumped line."""
+    out = {}
+    for term, zi in zip(system.all_terms(), z, strict=True):
+        if isinstance(term, LumpedLineTerm):
+            p, u = _fairlead(term.fairlead, c, V0, omega)
+            s = term.split(zi)
+            out[f"mooring/{term.name}/fairlead_tension"] = jnp.linalg.norm(lm.fairlead_force(term.line, s.r, s.v, p, u))
+            out[f"mooring/{term.name}/anchor_tension"] = jnp.linalg.norm(lm.anchor_force(term.line, s.r, s.v, p, u))
+            out[f"mooring/{term.name}/nodes"] = term.nodes(c, zi)
+    return out
 
 
 def with_lines(stepper, terms):
@@ -154,4 +233,5 @@ def line_states(stepper, state, term_index: Optional[int] = None):
     return out
 
 
-__all__ = ["LumpedLineTerm", "lumped_line_term", "with_lines", "line_states", "LUMPED_KEYS"]
+__all__ = ["LumpedLineTerm", "lumped_line_term", "read_lumped", "build_lumped_lines", "lumped_observe",
+           "with_lines", "line_states", "LUMPED_KEYS"]
