@@ -112,8 +112,8 @@ def lumped_line_term(c0: Config, dt: float, *, name: str, fairlead, anchor, leng
     `depth` the water depth, None without a seabed; `cog_height` the COG's height above the
     still-water level at rest) and the lumped-only keys (LUMPED_KEYS), for the vessel starting at
     c0 (its lines start in their static shape there) and stepped at dt. `balanced`: the vessel's
-    hydrostatics are linear springs about the rest position, whose buoyancy then carries the line's
-    vertical pull at rest (`carried`). Bad values raise ValueError naming the key
+    hydrostatics are linear springs about the rest position (X0 = 0, level), whose buoyancy then
+    carries the line's vertical pull there (`carried`, as the catenary lines' term does). Bad values raise ValueError naming the key
     (`mooring.<name>.<key>`)."""
     unknown = set(lumped) - set(LUMPED_KEYS)
     if unknown:
@@ -141,8 +141,11 @@ def lumped_line_term(c0: Config, dt: float, *, name: str, fairlead, anchor, leng
     if not bool(ok):
         raise ValueError(f"mooring.{name}: the line's static shape did not converge")
     carried = jnp.zeros(3)
-    if balanced:
-        F = lm.fairlead_force(line, nodes0, jnp.zeros_like(nodes0), fair0, jnp.zeros(3))
+    if balanced:       # the pull at the rest position (X0 = 0, level), where the springs are balanced
+        rest = Config(jnp.zeros(3), jnp.array([1.0, 0.0, 0.0, 0.0]), c0.d)
+        fair_r, _ = _fairlead(p_b, rest, jnp.zeros(3), jnp.zeros(3))
+        nodes_r, _ = jax.jit(lm.static_shape)(line, fair_r)
+        F = lm.fairlead_force(line, nodes_r, jnp.zeros_like(nodes_r), fair_r, jnp.zeros(3))
         carried = jnp.array([0.0, 0.0, -F[2]])
     return LumpedLineTerm(line, p_b, nodes0, carried, name, line.substeps(dt))
 
