@@ -134,7 +134,7 @@ def lumped_line(anchor, length, weight, ea, *, segments=20, diameter=0.09, mass=
         return math.inf if w == 0.0 else 2.0 / w * (math.sqrt(1.0 + z * z) - z)
 
     dt = SAFETY * min(limit(w_ax, z_ax), limit(w_sb, z_sb))
-    f = lambda x: jnp.asarray(x, dtype=jnp.float64)  # noqa: E731
+    f = lambda x: jnp.asarray(x, dtype=float)  # noqa: E731
     return LumpedLine(f(anchor), f(length), f(weight), f(ea), f(diameter), f(m), f(cd), f(ca), f(ba),
                       f(seabed_z), f(seabed_stiffness), f(seabed_damping), f(rho), f(current),
                       int(segments), float(dt))

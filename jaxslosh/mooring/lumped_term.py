@@ -23,6 +23,7 @@ from typing import Optional
 import equinox as eqx
 import jax
 import jax.numpy as jnp
+import numpy as np
 
 from ..physics.kinematics import rotation_matrix
 from ..physics.terms import AbstractTerm, Config, Kin, Rows
@@ -103,6 +104,21 @@ class LumpedLineTerm(AbstractTerm):
                  f"of the step (symplectic Euler, stable sub-step {ln.substep_max:.3g} s)"),)
 
 
+def _static(line, p_b, X0, q, name):
+    """The line's static shape with the vessel at (X0, q), solved in float64 whatever the caller's
+    precision (a description, `jaxslosh check`, may build the model in float32, where the energy's
+    round-off stops the solve short of its tolerance), in the caller's precision."""
+    with jax.enable_x64(True):
+        line64 = jax.tree_util.tree_map(lambda x: jnp.asarray(x, dtype=jnp.float64), line)
+        c = Config(jnp.asarray(X0, dtype=jnp.float64), jnp.asarray(q, dtype=jnp.float64), jnp.zeros(0))
+        fair, _ = _fairlead(jnp.asarray(p_b, dtype=jnp.float64), c, jnp.zeros(3), jnp.zeros(3))
+        nodes, ok = jax.jit(lm.static_shape)(line64, fair)
+        nodes, ok = np.asarray(nodes), bool(ok)
+    if not ok:
+        raise ValueError(f"mooring.{name}: the line's static shape did not converge")
+    return jnp.asarray(nodes, dtype=float)
+
+
 def lumped_line_term(c0: Config, dt: float, *, name: str, fairlead, anchor, length, weight, ea,
                      depth: Optional[float] = None, cog_height: float = 0.0, gravity: float = 9.81,
                      water_density: float = 1025.0, current=(0.0, 0.0, 0.0), balanced: bool = False,
@@ -136,15 +152,12 @@ def lumped_line_term(c0: Config, dt: float, *, name: str, fairlead, anchor, leng
                           seabed_damping=kw["seabed_damping"], rho=water_density, gravity=gravity,
                           current=current)
     p_b = jnp.asarray(fairlead, dtype=float)
-    fair0, _ = _fairlead(p_b, c0, jnp.zeros(3), jnp.zeros(3))
-    nodes0, ok = jax.jit(lm.static_shape)(line, fair0)
-    if not bool(ok):
-        raise ValueError(f"mooring.{name}: the line's static shape did not converge")
+    nodes0 = _static(line, p_b, c0.X0, c0.q, name)
     carried = jnp.zeros(3)
     if balanced:       # the pull at the rest position (X0 = 0, level), where the springs are balanced
-        rest = Config(jnp.zeros(3), jnp.array([1.0, 0.0, 0.0, 0.0]), c0.d)
-        fair_r, _ = _fairlead(p_b, rest, jnp.zeros(3), jnp.zeros(3))
-        nodes_r, _ = jax.jit(lm.static_shape)(line, fair_r)
+        q_rest = jnp.array([1.0, 0.0, 0.0, 0.0])
+        nodes_r = _static(line, p_b, jnp.zeros(3), q_rest, name)
+        fair_r, _ = _fairlead(p_b, Config(jnp.zeros(3), q_rest, c0.d), jnp.zeros(3), jnp.zeros(3))
         F = lm.fairlead_force(line, nodes_r, jnp.zeros_like(nodes_r), fair_r, jnp.zeros(3))
         carried = jnp.array([0.0, 0.0, -F[2]])
     return LumpedLineTerm(line, p_b, nodes0, carried, name, line.substeps(dt))
@@ -238,3 +251,8 @@ def line_states(stepper, state, term_index: Optional[int] = None):
 
 __all__ = ["LumpedLineTerm", "lumped_line_term", "read_lumped", "build_lumped_lines", "lumped_observe",
            "with_lines", "line_states", "LUMPED_KEYS"]
+
+
+def lumped_terms(system) -> tuple:
+    """The system's lumped lines' terms, in its terms' order."""
+    return tuple(t for t in system.all_terms() if isinstance(t, LumpedLineTerm))
