@@ -150,3 +150,29 @@ def test_build_from_the_scene_tables():
 def Config0():
     from jaxslosh.physics.terms import Config
     return Config(jnp.zeros(3), jnp.array([1.0, 0.0, 0.0, 0.0]), jnp.zeros(0))
+
+
+@pytest.mark.slow
+def test_gradient_through_a_moored_run():
+    """d(surge after 3 s)/d(the line's drag coefficients' scale), reverse mode through the vessel's
+    steps (the implicit function theorem on each step's Newton solve) and each line's sub-steps,
+    against central differences (about 2 min, its reverse-mode compilation; the default suite's
+    test_advance_gradient_matches_finite_differences checks the sub-steps' gradient)."""
+    import dataclasses
+
+    import equinox as eqx
+    import jax
+
+    st, _ = moored_stepper(0.5)
+    st = eqx.tree_at(lambda s: s.solver, st, dataclasses.replace(st.solver, implicit=True))
+    s0 = st.init()
+
+    def surge(scale):
+        b = eqx.tree_at(lambda s: s.built.system.terms[-1].line.cd, st, st.built.system.terms[-1].line.cd * scale)
+        return b.advance(s0, 30).s.c.X0[0]
+
+    g = jax.grad(surge)(1.0)
+    e = 1e-4
+    fd = (surge(1 + e) - surge(1 - e)) / (2 * e)
+    assert float(g) == pytest.approx(float(fd), rel=1e-5)
+    assert float(g) < 0      # more drag: less far
