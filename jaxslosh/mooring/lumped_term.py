@@ -28,10 +28,7 @@ import numpy as np
 from ..physics.kinematics import rotation_matrix
 from ..physics.terms import AbstractTerm, Config, Kin, Rows
 from . import lumped as lm
-
-#: the lumped-only keys of a `[[mooring]]` table and their defaults (mass: from weight and diameter)
-LUMPED_KEYS = {"segments": 20, "diameter": 0.09, "mass": None, "cd": (1.6, 0.1), "ca": (1.0, 0.0),
-               "internal_damping": -0.8, "seabed_stiffness": 3.0e6, "seabed_damping": 3.0e5}
+from .lumped_keys import LUMPED_KEYS, read_lumped  # noqa: F401  (the loader's reader, JAX-free)
 
 
 def _fairlead(p_b, c: Config, V0, omega):
@@ -164,29 +161,6 @@ def lumped_line_term(c0: Config, dt: float, *, name: str, fairlead, anchor, leng
 
 
 # ---------------------------------------------------------------------------- the scene's tables
-def read_lumped(table: dict, where: str) -> tuple[dict, tuple]:
-    """A `[[mooring]]` table with `model = "lumped"`, split for the loader: (the table without its
-    lumped-only keys, for the lines' common reader; the lumped values as sorted (key, value) pairs,
-    checked: SceneError naming the key). Keys left out take LUMPED_KEYS' defaults when built."""
-    from ..scene.fields import at_least, non_negative, positive, read
-    from ..scene.types import SceneError
-
-    rest = {k: v for k, v in table.items() if k not in LUMPED_KEYS}
-    mine = {k: v for k, v in table.items() if k in LUMPED_KEYS and k not in ("cd", "ca")}
-    v = read(mine, where, {"segments": ("int", at_least(2)), "diameter": ("float", positive),
-                           "mass": ("float", positive), "internal_damping": ("float", None),
-                           "seabed_stiffness": ("float", non_negative), "seabed_damping": ("float", non_negative)})
-    for key in ("cd", "ca"):
-        if key in table:
-            x = table[key]
-            ok = (isinstance(x, list) and len(x) == 2
-                  and all(isinstance(c, (int, float)) and not isinstance(c, bool) and c >= 0 for c in x))
-            if not ok:
-                raise SceneError(f"{where}.{key}", f"must be [normal, tangential], two numbers >= 0, got {x!r}")
-            v[key] = (float(x[0]), float(x[1]))
-    return rest, tuple(sorted(v.items()))
-
-
 def build_lumped_lines(scene, balanced: bool, q0=None) -> tuple:
     """The terms of the scene's `[[mooring]]` lines with `model = "lumped"` (each line's lumped
     values in its `lumped` attribute, read_lumped's pairs; absent: the defaults), each in its static
@@ -249,10 +223,10 @@ def line_states(stepper, state, term_index: Optional[int] = None):
     return out
 
 
-__all__ = ["LumpedLineTerm", "lumped_line_term", "read_lumped", "build_lumped_lines", "lumped_observe",
-           "with_lines", "line_states", "LUMPED_KEYS"]
-
-
 def lumped_terms(system) -> tuple:
     """The system's lumped lines' terms, in its terms' order."""
     return tuple(t for t in system.all_terms() if isinstance(t, LumpedLineTerm))
+
+
+__all__ = ["LumpedLineTerm", "lumped_line_term", "read_lumped", "build_lumped_lines", "lumped_observe",
+           "lumped_terms", "with_lines", "line_states", "LUMPED_KEYS"]
