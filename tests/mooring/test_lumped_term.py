@@ -176,3 +176,25 @@ def test_gradient_through_a_moored_run():
     fd = (surge(1 + e) - surge(1 - e)) / (2 * e)
     assert float(g) == pytest.approx(float(fd), rel=1e-5)
     assert float(g) < 0      # more drag: less far
+
+
+def test_quasi_static_lines_turn_lumped_lines_into_catenaries():
+    from dataclasses import dataclass
+
+    from jaxslosh.mooring.lumped_keys import quasi_static_lines
+
+    @dataclass(frozen=True)
+    class Line:
+        name: str
+        model: str = "catenary"
+        lumped: tuple = ()
+
+    @dataclass(frozen=True)
+    class Scene:
+        mooring: tuple = ()
+
+    s = Scene((Line("a", "lumped", (("segments", 10),)), Line("b")))
+    out = quasi_static_lines(s)
+    assert [(m.model, m.lumped) for m in out.mooring] == [("catenary", ()), ("catenary", ())]
+    plain = Scene((Line("b"),))
+    assert quasi_static_lines(plain) is plain
