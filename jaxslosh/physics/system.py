@@ -203,9 +203,10 @@ class System(eqx.Module):
     def states_coefficients(self, h) -> tuple:
         return tuple(term.state_coefficients(h) for term in self.all_terms())
 
-    def states_advance(self, z: tuple, v_old, v_new, coef: tuple) -> tuple:
-        """The terms' states at t_{n+1} (rigid velocities (6,) at t_n and t_{n+1})."""
-        return tuple(term.state_advance(zi, v_old, v_new, ci)
+    def states_advance(self, z: tuple, v_old, v_new, coef: tuple, c_old=None, c_new=None) -> tuple:
+        """The terms' states at t_{n+1} (rigid velocities (6,) at t_n and t_{n+1}; the configurations
+        at both ends for the terms that follow them, AbstractTerm.state_advance_config)."""
+        return tuple(term.state_advance_config(zi, c_old, v_old, c_new, v_new, ci)
                      for term, zi, ci in zip(self.all_terms(), z, coef, strict=True))
 
     # ---------------------------------------------------------------- equations of motion

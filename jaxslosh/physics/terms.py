@@ -16,7 +16,9 @@ for every term and never asks which term has what):
 
 * integrator states (`state_init`, `state_coefficients`, `state_advance`): states of the term's
   own that the step advances from t_n to t_{n+1} (the radiation memory); the default is none, a
-  zero-size array. A term reads its states at the evaluation's time as `k.z`;
+  zero-size array. A term reads its states at the evaluation's time as `k.z`. The step calls
+  `state_advance_config`, which also has the configurations at both ends (a lumped mooring line's
+  nodes follow its fairlead) and by default calls `state_advance`;
 * `update_inverse(inv, c_v)`: the inverse of the deformable block of the step matrix with this
   term's constant velocity tangent added (the modal damping's low-rank update); the default
   leaves it as it is;
@@ -130,6 +132,13 @@ class AbstractTerm(eqx.Module):
         """Its states at t_{n+1} from those at t_n and the rigid velocities (6,) at both ends (v_new
         is the step's unknown: the states enter the residual through it)."""
         return z
+
+    def state_advance_config(self, z, c_old, v_old, c_new, v_new, coef):
+        """`state_advance` for a term whose states follow the vessel's configuration as well as its
+        velocities (a lumped mooring line's nodes follow the fairlead's positions at t_n and
+        t_{n+1}): the configurations (Config) at both ends are given too, c_new the step's unknown.
+        The default ignores them."""
+        return self.state_advance(z, v_old, v_new, coef)
 
     def unknowns(self) -> Unknowns:
         """Its own unknowns: none (see unknowns.AbstractOwner for a term that has some)."""

@@ -125,10 +125,11 @@ def project_energy(system: System, c: Config, v, e0):
     return v * jnp.sqrt(jnp.where(ok, room / jnp.where(ok, T, 1.0), 1.0))
 
 
-def states_next(system: System, solver: Solver, s: State, v_new):
+def states_next(system: System, solver: Solver, s: State, v_new, c_new=None):
     """The terms' integrator states at t_{n+1} (the radiation memory's: exact for a rigid velocity
-    linear over the step, so they are a linear function of the step's unknown new velocity)."""
-    return system.states_advance(s.z, s.v[:6], v_new[:6], system.states_coefficients(solver.h))
+    linear over the step, so they are a linear function of the step's unknown new velocity; a
+    lumped mooring line's also follow the configuration c_new)."""
+    return system.states_advance(s.z, s.v[:6], v_new[:6], system.states_coefficients(solver.h), s.c, c_new)
 
 
 def step_equations(system: System, solver: Solver, s: State):
@@ -158,8 +159,9 @@ def step_equations(system: System, solver: Solver, s: State):
     def parts(y, z):
         vy, ay, _ = rates(y, slice(0, r))
         vz, az, _ = rates(z, slice(r, None))
-        states = system.states_advance(s.z, s.v[:6], vy[:6], coef)
-        return system.step_rows_parts(system.advance_parts(s.c, y, z), vy, vz, ay, az, s.t + h, states)
+        c_new = system.advance_parts(s.c, y, z)
+        states = system.states_advance(s.z, s.v[:6], vy[:6], coef, s.c, c_new)
+        return system.step_rows_parts(c_new, vy, vz, ay, az, s.t + h, states)
 
     def R(delta):
         return jnp.concatenate(parts(delta[:r], delta[r:]))
@@ -238,7 +240,7 @@ def step(system: System, solver: Solver, s: State, fresh=None) -> tuple[State, S
         dyn, alg = L.from_x(x)
         c, v, acc, a = unpack(dyn)
         ok = ok & jnp.all(jnp.isfinite(x))
-        z = states_next(system, solver, s, v)
+        z = states_next(system, solver, s, v, c)
         if solver.project:
             v = project_energy(system, c, v, s.e0)
     return (State(c, v, acc, a, s.t + solver.h, alg, z, pre_new if solver.reuse else s.pre, s.e0),

@@ -1,0 +1,232 @@
+"""A lumped-mass mooring line as a term of the vessel's residual (docs/guide/moorings-lumped.md).
+
+The line's moving nodes and their velocities are the term's integrator states (terms.AbstractTerm's
+hooks): every step advances them from t_n to t_{n+1} with the fairlead's positions and velocities
+at both ends (`state_advance_config`: the vessel's configuration and velocities at t_n and at the
+step's unknown t_{n+1}), sub-stepped inside the step (lumped.advance). The force on the vessel is
+the line's load on the fairlead at t_{n+1} (the last segment's tension with the fairlead node's
+half segment of weight and drag, lumped.fairlead_force), applied at the fairlead: translation
+rows in the inertial frame, the moment p x (A^T F) about the COG in the body frame. Being a
+function of the states at t_{n+1}, which follow the unknown configuration, it is implicit in the
+step as the radiation memory is: the Newton iterations see the line's response to the vessel's
+motion within the step.
+
+Frames: `fairlead` is in the body frame from the COG; the line's anchor and seabed in the frame of
+the vessel's COG position X0 (its origin the COG's rest position, z up): `lumped_line_term` shifts
+the scene's anchor (x, y from the COG at rest, z from the still-water level) by the COG's height.
+"""
+from __future__ import annotations
+
+import math
+from typing import Optional
+
+import equinox as eqx
+import jax
+import jax.numpy as jnp
+import numpy as np
+
+from ..physics.kinematics import rotation_matrix
+from ..physics.terms import AbstractTerm, Config, Kin, Rows
+from . import lumped as lm
+from .lumped_keys import LUMPED_KEYS, read_lumped  # noqa: F401  (the loader's reader, JAX-free)
+
+
+def _fairlead(p_b, c: Config, V0, omega):
+    """The fairlead's inertial position and velocity for the body point p_b."""
+    A = rotation_matrix(c.q)
+    return c.X0 + A @ p_b, V0 + A @ jnp.cross(omega, p_b)
+
+
+class LumpedLineTerm(AbstractTerm):
+    """One lumped-mass line from a fixed anchor to a fairlead on the vessel. States: the moving
+    nodes' positions and velocities, flattened ((N - 1) * 6,). `substeps` (static): the line's
+    sub-steps per vessel step, from the step given at construction (a smaller step, such as a
+    retried step's sub-steps, only makes them smaller)."""
+    line: lm.LumpedLine
+    fairlead: jax.Array      # (3,) body frame, from the COG
+    nodes0: jax.Array        # (N - 1, 3) the static shape at the start
+    # (3,) a constant force added to the line's: with linear hydrostatics (springs about the rest
+    # position) the buoyancy carries the line's vertical pull at rest, as for the catenary lines
+    carried: jax.Array = eqx.field(default_factory=lambda: jnp.zeros(3))
+    name: str = eqx.field(static=True, default="line")
+    substeps: int = eqx.field(static=True, default=1)
+
+    # ------------------------------------------------------------ states
+    def state_init(self):
+        return jnp.concatenate([self.nodes0.reshape(-1), jnp.zeros(self.nodes0.size)])
+
+    def split(self, z) -> lm.LineState:
+        n = self.nodes0.size
+        return lm.LineState(z[:n].reshape(-1, 3), z[n:].reshape(-1, 3))
+
+    def state_coefficients(self, h):
+        return jnp.asarray(h)
+
+    def state_advance(self, z, v_old, v_new, coef):
+        raise TypeError("a lumped line's states follow the vessel's configuration: state_advance_config")
+
+    def state_advance_config(self, z, c_old, v_old, c_new, v_new, coef):
+        p0, u0 = _fairlead(self.fairlead, c_old, v_old[:3], v_old[3:6])
+        p1, u1 = _fairlead(self.fairlead, c_new, v_new[:3], v_new[3:6])
+        s = lm.advance(self.line, self.split(z), p0, u0, p1, u1, coef, self.substeps)
+        return jnp.concatenate([s.r.reshape(-1), s.v.reshape(-1)])
+
+    # ------------------------------------------------------------ forces
+    def force(self, c: Config, V0, omega, z):
+        """The line's force on the fairlead (3,), inertial, for the vessel at (c, V0, omega) and the
+        line's states z."""
+        p, u = _fairlead(self.fairlead, c, V0, omega)
+        s = self.split(z)
+        return lm.fairlead_force(self.line, s.r, s.v, p, u)
+
+    def rows(self, k: Kin) -> Rows:
+        F = self.force(k.c, k.V0, k.omega, k.z)
+        M_b = jnp.cross(self.fairlead, k.A.T @ F)
+        return Rows(-jnp.concatenate([F + self.carried, M_b]))
+
+    def tension(self, c: Config, V0, omega, z):
+        """|force on the fairlead| (N)."""
+        return jnp.linalg.norm(self.force(c, V0, omega, z))
+
+    def nodes(self, c: Config, z):
+        """Every node (N + 1, 3) in the X0 frame: anchor, moving nodes, fairlead (the result file's
+        `/mooring/<line>/nodes`)."""
+        A = rotation_matrix(c.q)
+        s = self.split(z)
+        return jnp.concatenate([self.line.anchor[None], s.r, (c.X0 + A @ self.fairlead)[None]], axis=0)
+
+    def describe(self) -> tuple:
+        ln = self.line
+        return (("mooring", f"lumped line {self.name}: {ln.segments} segments, {self.substeps} sub-steps "
+                 f"of the step (symplectic Euler, stable sub-step {ln.substep_max:.3g} s)"),)
+
+
+def _static(line, p_b, X0, q, name):
+    """The line's static shape with the vessel at (X0, q), solved in float64 whatever the caller's
+    precision (a description, `jaxslosh check`, may build the model in float32, where the energy's
+    round-off stops the solve short of its tolerance), in the caller's precision."""
+    with jax.enable_x64(True):
+        line64 = jax.tree_util.tree_map(lambda x: jnp.asarray(x, dtype=jnp.float64), line)
+        c = Config(jnp.asarray(X0, dtype=jnp.float64), jnp.asarray(q, dtype=jnp.float64), jnp.zeros(0))
+        fair, _ = _fairlead(jnp.asarray(p_b, dtype=jnp.float64), c, jnp.zeros(3), jnp.zeros(3))
+        nodes, ok = jax.jit(lm.static_shape)(line64, fair)
+        nodes, ok = np.asarray(nodes), bool(ok)
+    if not ok:
+        raise ValueError(f"mooring.{name}: the line's static shape did not converge")
+    return jnp.asarray(nodes, dtype=float)
+
+
+def lumped_line_term(c0: Config, dt: float, *, name: str, fairlead, anchor, length, weight, ea,
+                     depth: Optional[float] = None, cog_height: float = 0.0, gravity: float = 9.81,
+                     water_density: float = 1025.0, current=(0.0, 0.0, 0.0), balanced: bool = False,
+                     **lumped) -> LumpedLineTerm:
+    """The term of one `[[mooring]]` table with `model = "lumped"`: the scene's values (fairlead in
+    the body frame from the COG; anchor x, y from the COG at rest and z from the still-water level;
+    `depth` the water depth, None without a seabed; `cog_height` the COG's height above the
+    still-water level at rest) and the lumped-only keys (LUMPED_KEYS), for the vessel starting at
+    c0 (its lines start in their static shape there) and stepped at dt. `balanced`: the vessel's
+    hydrostatics are linear springs about the rest position (X0 = 0, level), whose buoyancy then
+    carries the line's vertical pull there (`carried`, as the catenary lines' term does). Bad values raise ValueError naming the key
+    (`mooring.<name>.<key>`)."""
+    unknown = set(lumped) - set(LUMPED_KEYS)
+    if unknown:
+        raise ValueError(f"mooring.{name}.{sorted(unknown)[0]}: not a key of a lumped line")
+    kw = dict(LUMPED_KEYS, **lumped)
+    checks = {"segments": kw["segments"] >= 2 and int(kw["segments"]) == kw["segments"],
+              "diameter": kw["diameter"] > 0, "length": length > 0, "ea": ea > 0,
+              "seabed_stiffness": kw["seabed_stiffness"] >= 0, "seabed_damping": kw["seabed_damping"] >= 0,
+              "mass": kw["mass"] is None or kw["mass"] > 0,
+              "cd": len(kw["cd"]) == 2 and min(kw["cd"]) >= 0, "ca": len(kw["ca"]) == 2 and min(kw["ca"]) >= 0}
+    for key, ok in checks.items():
+        if not ok:
+            raise ValueError(f"mooring.{name}.{key}: out of range ({kw.get(key, locals().get(key))!r})")
+    shift = jnp.array([0.0, 0.0, -cog_height])
+    seabed = -math.inf if depth is None else -float(depth) - cog_height
+    line = lm.lumped_line(jnp.asarray(anchor, dtype=float) + shift, length, weight, ea,
+                          segments=int(kw["segments"]), diameter=kw["diameter"], mass=kw["mass"],
+                          cd=tuple(kw["cd"]), ca=tuple(kw["ca"]), internal_damping=kw["internal_damping"],
+                          seabed_z=seabed, seabed_stiffness=kw["seabed_stiffness"],
+                          seabed_damping=kw["seabed_damping"], rho=water_density, gravity=gravity,
+                          current=current)
+    p_b = jnp.asarray(fairlead, dtype=float)
+    nodes0 = _static(line, p_b, c0.X0, c0.q, name)
+    carried = jnp.zeros(3)
+    if balanced:       # the pull at the rest position (X0 = 0, level), where the springs are balanced
+        q_rest = jnp.array([1.0, 0.0, 0.0, 0.0])
+        nodes_r = _static(line, p_b, jnp.zeros(3), q_rest, name)
+        fair_r, _ = _fairlead(p_b, Config(jnp.zeros(3), q_rest, c0.d), jnp.zeros(3), jnp.zeros(3))
+        F = lm.fairlead_force(line, nodes_r, jnp.zeros_like(nodes_r), fair_r, jnp.zeros(3))
+        carried = jnp.array([0.0, 0.0, -F[2]])
+    return LumpedLineTerm(line, p_b, nodes0, carried, name, line.substeps(dt))
+
+
+# ---------------------------------------------------------------------------- the scene's tables
+def build_lumped_lines(scene, balanced: bool, q0=None) -> tuple:
+    """The terms of the scene's `[[mooring]]` lines with `model = "lumped"` (each line's lumped
+    values in its `lumped` attribute, read_lumped's pairs; absent: the defaults), each in its static
+    shape with the vessel at its initial position and attitude q0 (identity when None), sub-stepped
+    for the scene's dt."""
+    from ..scene.types import SceneError
+
+    lines = [m for m in scene.mooring if getattr(m, "model", "catenary") == "lumped"]
+    if not lines:
+        return ()
+    if getattr(scene.simulation, "energy_projection", False):
+        raise SceneError("simulation.energy_projection", "cannot hold the energy with lumped mooring lines "
+                                                         "(their drag and damping take energy out of the vessel)")
+    env = scene.environment
+    X0 = jnp.asarray(scene.vessel.initial.position, dtype=float)
+    q = jnp.array([1.0, 0.0, 0.0, 0.0]) if q0 is None else jnp.asarray(q0, dtype=float)
+    c0 = Config(X0, q, jnp.zeros(0))
+    terms = []
+    for m in lines:
+        try:
+            terms.append(lumped_line_term(
+                c0, scene.simulation.dt, name=m.name, fairlead=m.fairlead, anchor=m.anchor, length=m.length,
+                weight=m.weight, ea=m.ea, depth=env.depth, cog_height=getattr(scene.vessel, "cog_height", 0.0),
+                gravity=env.gravity, water_density=env.water_density, balanced=balanced,
+                **dict(getattr(m, "lumped", ()))))
+        except ValueError as e:
+            raise SceneError(f"mooring.{m.name}", str(e)) from e
+    return tuple(terms)
+
+
+def lumped_observe(system, z: tuple, c: Config, V0, omega) -> dict:
+    """For the result file, at one frame (the integrator state's configuration c, velocities and the
+    terms' states z, as State.z): `mooring/<line>/fairlead_tension`, `anchor_tension` (N) and
+    `nodes` ((N + 1, 3), in the frame of the vessel's position X0) of each lumped line."""
+    out = {}
+    for term, zi in zip(system.all_terms(), z, strict=True):
+        if isinstance(term, LumpedLineTerm):
+            p, u = _fairlead(term.fairlead, c, V0, omega)
+            s = term.split(zi)
+            out[f"mooring/{term.name}/fairlead_tension"] = jnp.linalg.norm(lm.fairlead_force(term.line, s.r, s.v, p, u))
+            out[f"mooring/{term.name}/anchor_tension"] = jnp.linalg.norm(lm.anchor_force(term.line, s.r, s.v, p, u))
+            out[f"mooring/{term.name}/nodes"] = term.nodes(c, zi)
+    return out
+
+
+def with_lines(stepper, terms):
+    """A Stepper (run/stepper.py) whose System has the given line terms added beside its own
+    (how a test or a user adds lumped lines before the scene's keys are wired)."""
+    return eqx.tree_at(lambda s: s.built.system.terms, stepper, stepper.built.system.terms + tuple(terms))
+
+
+def line_states(stepper, state, term_index: Optional[int] = None):
+    """The integrator states of the System's LumpedLineTerms in a Stepper's state, by term: a dict
+    name -> (term, z)."""
+    system = stepper.built.system
+    out = {}
+    for i, (term, z) in enumerate(zip(system.all_terms(), state.s.z, strict=True)):
+        if isinstance(term, LumpedLineTerm) and (term_index is None or term_index == i):
+            out[term.name] = (term, z)
+    return out
+
+
+def lumped_terms(system) -> tuple:
+    """The system's lumped lines' terms, in its terms' order."""
+    return tuple(t for t in system.all_terms() if isinstance(t, LumpedLineTerm))
+
+
+__all__ = ["LumpedLineTerm", "lumped_line_term", "read_lumped", "build_lumped_lines", "lumped_observe",
+           "lumped_terms", "with_lines", "line_states", "LUMPED_KEYS"]
