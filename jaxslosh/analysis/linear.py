@@ -29,6 +29,7 @@ import numpy as np
 
 from ..assemble.effects import structure_unknowns
 from ..assemble.system import Built
+from ..mooring.lumped_keys import quasi_static_lines
 from ..physics.seakeeping import AddedMass
 from ..run.loop import probe_positions
 from ..run.simulate import is_traced, prepare
@@ -72,7 +73,9 @@ def rest_scene(scene: Scene) -> Scene:
     if ves.hydrostatics is None:
         raise SceneError("vessel.hydrostatics", "the frequency domain needs a floating vessel at rest; without "
                                                 "hydrostatics it falls")
-    return dataclasses.replace(scene, vessel=dataclasses.replace(ves, initial=Initial()))
+    # lumped mooring lines as their catenary: linearised with their nodes held, their last segment's
+    # axial stiffness would stand for the line's (docs/guide/moorings-lumped.md)
+    return quasi_static_lines(dataclasses.replace(scene, vessel=dataclasses.replace(ves, initial=Initial())))
 
 
 def _labels(b: Built, L: Layout, scene: Scene) -> tuple:

@@ -14,6 +14,7 @@ import jax
 import jax.numpy as jnp
 import numpy as np
 
+from ..mooring.lumped_term import build_lumped_lines
 from ..mooring.term import build_mooring
 from ..physics.damping import ModalDamping
 from ..physics.face_liquid import FluxLiquid
@@ -179,8 +180,9 @@ def _model(scene: Scene, params: dict, outline: bool = False) -> _Model:
         else:
             S = liquid.rigid_first_moment() if hull_S is None else hull_S + liquid.rigid_first_moment()
             terms.append(Weight(mass=mass + liquid.total_mass(), S=S, gravity=g, about=weight))
-    if scene.mooring:          # quasi-static catenary lines (jaxslosh/mooring/term.py)
+    if any(m.model == "catenary" for m in scene.mooring):   # quasi-static catenary lines (jaxslosh/mooring/term.py)
         terms.append(build_mooring(scene, balanced, outline, params))
+    terms.extend(build_lumped_lines(scene, balanced, q0))    # dynamic lumped-mass lines (mooring/lumped_term.py)
     if block.penalty is not None:
         terms.append(RotationPenalty(Kdt=block.penalty[0], Ktt=block.penalty[1], q_ref=q0))
     if block.Kg is not None:

@@ -73,6 +73,7 @@ def _is_traced(x) -> bool:
 class LineHistory(eqx.Module):
     fairlead_tension: jax.Array  # (n,) N
     anchor_tension: jax.Array    # (n,) N
+    nodes: Optional[jax.Array] = None   # (n, s + 1, 3) m: a lumped line's nodes, anchor to fairlead
 
 
 class Result(eqx.Module):
@@ -129,7 +130,7 @@ class Result(eqx.Module):
     mooring: Optional[dict] = None     # {line: LineHistory} of a moored scene
 
 
-def schema(probe_names=(), tank_nodes: Optional[dict] = None, lines=()) -> dict:
+def schema(probe_names=(), tank_nodes: Optional[dict] = None, lines=(), line_nodes: Optional[dict] = None) -> dict:
     """{dataset: shape of one frame} of a result file, in the file's order."""
     spec = {"time": (), "vessel/position": (3,), "vessel/quaternion": (4,), "vessel/angular_velocity": (3,),
             "vessel/roll_pitch_yaw": (3,), "energy/kinetic": (), "energy/potential": (),
@@ -142,6 +143,8 @@ def schema(probe_names=(), tank_nodes: Optional[dict] = None, lines=()) -> dict:
     for name in lines:
         spec[f"mooring/{name}/fairlead_tension"] = ()
         spec[f"mooring/{name}/anchor_tension"] = ()
+    for name, n in (line_nodes or {}).items():       # lumped lines: their nodes (s + 1 of them)
+        spec[f"mooring/{name}/nodes"] = (n, 3)
     return spec
 
 
@@ -151,7 +154,7 @@ UNITS = {"time": "s", "vessel/position": "m", "vessel/quaternion": "1", "vessel/
          "vessel/roll_pitch_yaw": "rad", "energy/kinetic": "J", "energy/potential": "J", "solver/iterations": "1",
          "solver/residual": "m/s^2", "solver/constraint": "m", "probes/position": "m", "probes/displacement": "m",
          "tanks/displacement": "m", "tanks/nodes": "m", "tanks/elements": "1", "mooring/fairlead_tension": "N",
-         "mooring/anchor_tension": "N"}
+         "mooring/anchor_tension": "N", "mooring/nodes": "m"}
 
 #: a `description` attribute where the unit alone does not say what a dataset holds
 DESCRIPTIONS = {
@@ -199,6 +202,8 @@ def result_frames(r: Result) -> dict:
     for name, m in (r.mooring or {}).items():
         d[f"mooring/{name}/fairlead_tension"] = m.fairlead_tension
         d[f"mooring/{name}/anchor_tension"] = m.anchor_tension
+        if m.nodes is not None:
+            d[f"mooring/{name}/nodes"] = m.nodes
     return {k: np.asarray(v) for k, v in d.items()}
 
 
@@ -214,7 +219,8 @@ def result_from(d: dict, probe_names=(), tanks: Optional[dict] = None, *, status
               if f"tanks/{n}/displacement" in d}
     code = code_of(status) if status_code is None else status_code
     lines = [k.split("/")[1] for k in d if k.startswith("mooring/") and k.endswith("/fairlead_tension")]
-    mooring = {n: LineHistory(d[f"mooring/{n}/fairlead_tension"], d[f"mooring/{n}/anchor_tension"]) for n in lines}
+    mooring = {n: LineHistory(d[f"mooring/{n}/fairlead_tension"], d[f"mooring/{n}/anchor_tension"],
+                              d.get(f"mooring/{n}/nodes")) for n in lines}
     return Result(time=d["time"],
                   vessel=VesselHistory(d["vessel/position"], d["vessel/quaternion"], d["vessel/angular_velocity"],
                                        d["vessel/roll_pitch_yaw"]),
@@ -229,7 +235,7 @@ class ResultWriter:
     """Appends frames to an HDF5 result file as a run goes on. It holds the output's lock from
     before the file is truncated until it is closed (a second writer gets io.output.OutputError)."""
 
-    def __init__(self, path: str, scene_text: str, probe_names, tanks=(), lines=()):
+    def __init__(self, path: str, scene_text: str, probe_names, tanks=(), lines=(), line_nodes=None):
         self.path = path
         self.lock = OutputLock(path)
         try:
@@ -249,7 +255,7 @@ class ResultWriter:
         for t in tanks:
             label(self.f.create_dataset(f"tanks/{t.name}/nodes", data=t.nodes), f"tanks/{t.name}/nodes")
             label(self.f.create_dataset(f"tanks/{t.name}/elements", data=t.elements), f"tanks/{t.name}/elements")
-        for k, shape in schema(probe_names, {t.name: t.nodes.shape[0] for t in tanks}, lines).items():
+        for k, shape in schema(probe_names, {t.name: t.nodes.shape[0] for t in tanks}, lines, line_nodes).items():
             dtype = "i8" if k == "solver/iterations" else "f8"
             label(self.f.create_dataset(k, shape=(0, *shape), maxshape=(None, *shape), dtype=dtype,
                                         chunks=(max(1, min(1024, 2 ** 20 // (8 * max(1, int(np.prod(shape)))))),
@@ -294,7 +300,8 @@ class _Mesh:
 
 def save_result(r: Result, path: str) -> None:
     w = ResultWriter(path, r.scene_text, list(r.probes), [_Mesh(n, t.nodes, t.elements) for n, t in r.tanks.items()],
-                     list(r.mooring or {}))
+                     list(r.mooring or {}),
+                     {n: m.nodes.shape[-2] for n, m in (r.mooring or {}).items() if m.nodes is not None})
     w.append(result_frames(r), r.steps_done)
     w.close(r.status, r.steps_done, r.status_code)
 
@@ -416,7 +423,8 @@ def load_result(path: str) -> Result:
                     raise ResultFileError(f"{path}: the dataset /tanks/{name}/{part} is missing")
             tanks[name] = (np.asarray(f[f"tanks/{name}/nodes"]), np.asarray(f[f"tanks/{name}/elements"]))
         lines = list(f["mooring"]) if "mooring" in f else []
-        d = read_frames(f, schema(probes, {name: 0 for name in tanks}, lines))
+        line_nodes = {n: f[f"mooring/{n}/nodes"].shape[1] for n in lines if f"mooring/{n}/nodes" in f}
+        d = read_frames(f, schema(probes, {name: 0 for name in tanks}, lines, line_nodes))
         check_required(d, probes, path)
         status = attr_str(a.get("status", "ok"))
         code = int(a["status_code"]) if "status_code" in a else None

@@ -1,36 +1,10 @@
-"""The lumped-only keys of a `[[mooring]]` table with `model = "lumped"` (docs/guide/moorings-lumped.md),
-read and checked for the scene loader: plain Python, no JAX (the loader imports no JAX)."""
+"""Lumped lines seen as their quasi-static limit, the catenary (docs/guide/moorings-lumped.md); the
+lumped-only keys' reader is the loader's (scene/lumped_keys.py)."""
 from __future__ import annotations
 
 import dataclasses
 
-#: the lumped-only keys of a `[[mooring]]` table and their defaults (mass: from weight and diameter)
-LUMPED_KEYS = {"segments": 20, "diameter": 0.09, "mass": None, "cd": (1.6, 0.1), "ca": (1.0, 0.0),
-               "internal_damping": -0.8, "seabed_stiffness": 3.0e6, "seabed_damping": 3.0e5}
-
-
-def read_lumped(table: dict, where: str) -> tuple[dict, tuple]:
-    """A `[[mooring]]` table with `model = "lumped"`, split for the loader: (the table without its
-    lumped-only keys, for the lines' common reader; the lumped values as sorted (key, value) pairs,
-    checked: SceneError naming the key). Keys left out take LUMPED_KEYS' defaults when built."""
-    from ..scene.fields import at_least, non_negative, positive, read
-    from ..scene.types import SceneError
-
-    rest = {k: v for k, v in table.items() if k not in LUMPED_KEYS}
-    mine = {k: v for k, v in table.items() if k in LUMPED_KEYS and k not in ("cd", "ca")}
-    v = read(mine, where, {"segments": ("int", at_least(2)), "diameter": ("float", positive),
-                           "mass": ("float", positive), "internal_damping": ("float", None),
-                           "seabed_stiffness": ("float", non_negative), "seabed_damping": ("float", non_negative)})
-    for key in ("cd", "ca"):
-        if key in table:
-            x = table[key]
-            ok = (isinstance(x, list) and len(x) == 2
-                  and all(isinstance(c, (int, float)) and not isinstance(c, bool) and c >= 0 for c in x))
-            if not ok:
-                raise SceneError(f"{where}.{key}", f"must be [normal, tangential], two numbers >= 0, got {x!r}")
-            v[key] = (float(x[0]), float(x[1]))
-    return rest, tuple(sorted(v.items()))
-
+from ..scene.lumped_keys import LUMPED_KEYS, read_lumped  # noqa: F401
 
 def quasi_static_lines(scene):
     """The scene with its lumped lines as catenary lines, their quasi-static limit (within 0.13 % at

@@ -28,6 +28,7 @@ import numpy as np
 from ..physics.kinematics import rotation_matrix
 from ..physics.terms import AbstractTerm, Config, Kin, Rows
 from . import lumped as lm
+from ..scene.types import SceneError
 from .lumped_keys import LUMPED_KEYS, read_lumped  # noqa: F401  (the loader's reader, JAX-free)
 
 
@@ -166,8 +167,6 @@ def build_lumped_lines(scene, balanced: bool, q0=None) -> tuple:
     values in its `lumped` attribute, read_lumped's pairs; absent: the defaults), each in its static
     shape with the vessel at its initial position and attitude q0 (identity when None), sub-stepped
     for the scene's dt."""
-    from ..scene.types import SceneError
-
     lines = [m for m in scene.mooring if getattr(m, "model", "catenary") == "lumped"]
     if not lines:
         return ()

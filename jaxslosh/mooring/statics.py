@@ -17,6 +17,7 @@ from ..physics.kinematics import quat_exp, rotation_matrix, rpy_from_quat
 from ..physics.terms import Config
 from ..physics.vessel import Hydrostatics, Weight
 from ..scene.types import Scene, SceneError
+from .lumped_keys import quasi_static_lines
 from .term import MooringLines, mooring_term
 
 #: Newton on the six rigid dofs: iterations, and the force (N) and moment (N m) per unit of the
@@ -138,6 +139,7 @@ def mooring(scene: Scene, offsets: Optional[Sequence[float]] = None, direction: 
     """
     if not scene.mooring:
         raise SceneError("mooring", "the scene has no [[mooring]] lines")
+    scene = quasi_static_lines(scene)        # lumped lines at rest: their catenary
     if offsets is None:
         offsets = np.linspace(0.0, 0.1 * scene.environment.depth, 11)
     offsets = np.asarray(offsets, dtype=float)

@@ -20,7 +20,7 @@ import numpy as np
 from ..physics.about import About
 from ..physics.kinematics import rotation_matrix
 from ..physics.terms import AbstractTerm, Kin, Rows
-from .catenary import profile, solve
+from .catenary import profile, solve_lines
 
 #: m^2: keeps the horizontal direction defined (and differentiable) with the fairlead right above its anchor
 _XF_EPS2 = 1e-12
@@ -66,7 +66,7 @@ class MooringLines(AbstractTerm):
         d = p - self.anchor
         XF = jnp.sqrt(d[:, 0] ** 2 + d[:, 1] ** 2 + _XF_EPS2)
         ZF = d[:, 2]
-        H, V = jax.vmap(solve)(XF, ZF, self.length, self.weight, self.ea, self.friction, self.anchor_height).T
+        H, V = solve_lines(XF, ZF, self.length, self.weight, self.ea, self.friction, self.anchor_height).T
         _, _, LB, HA, VA = jax.vmap(profile)(H, V, self.length, self.weight, self.ea, self.friction, self.anchor_height)
         force = jnp.stack([-H * d[:, 0] / XF, -H * d[:, 1] / XF, -V], axis=1)
         return LineState(H, V, HA, VA, LB, force, p)
@@ -89,7 +89,7 @@ def build_mooring(scene, balanced: bool, outline: bool = False, params: Optional
     """The term of the scene's `[[mooring]]` lines; `balanced`: the vessel's hydrostatics are linear
     springs about the rest position (then the buoyancy carries the lines' vertical pull at rest);
     `params`: canonical keys `mooring.<name>.<key>` that replace the scene's values (tracers too)."""
-    lines = scene.mooring
+    lines = [m for m in scene.mooring if m.model == "catenary"]
     cog = scene.vessel.cog_height
     P = (params or {}).get
     col = lambda key: jnp.stack([jnp.asarray(P(f"mooring.{m.name}.{key}", getattr(m, key)), dtype=float)  # noqa: E731

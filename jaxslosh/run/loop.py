@@ -12,6 +12,7 @@ import jax.numpy as jnp
 
 from ..assemble.system import Built
 from ..io.status import Status
+from ..mooring.lumped_term import lumped_observe
 from ..mooring.term import mooring_datasets
 from ..physics.kinematics import rotation_matrix, rpy_from_quat
 from ..physics.terms import Config
@@ -52,6 +53,7 @@ class Frame(NamedTuple):
     failed: jax.Array
     gmax: jax.Array       # max |g| of the interface constraints (m), 0 without structures
     surface: jax.Array    # (tanks, 2): lowest and highest vertical displacement of each free surface (m)
+    lines: dict = {}      # the lumped mooring lines' datasets (mooring/lumped_term.lumped_observe), empty without
 
 
 def probe_positions(b: Built, c: Config):
@@ -80,8 +82,9 @@ def _frame(b: Built, s: State, it, err, failed) -> Frame:
     gmax = jnp.max(jnp.abs(sysm.constraint(s.c, s.alg)), initial=0.0)
     heave = [sysm.liquid.surface_heave(s.c.d, idx) for idx in b.surfaces]
     surface = jnp.array([[h.min(), h.max()] for h in heave]).reshape(len(heave), 2)
+    lines = lumped_observe(sysm, s.z, s.c, s.v[:3], s.v[3:6])
     return Frame(s.t, s.c.X0, s.c.q, s.v[3:6], probes, ke, pe, it, err, sysm.liquid.frame_field(s.c.d), failed, gmax,
-                 surface)
+                 surface, lines)
 
 
 def core(b: Built) -> Built:
@@ -232,6 +235,7 @@ def frame_datasets(b: Built, fr: Frame, p0=None, fields: bool = True) -> dict:
         d[f"probes/{name}/position"] = P[..., i, :]
         d[f"probes/{name}/displacement"] = P[..., i, :] - p0[..., i, :]
     d.update(mooring_datasets(b.system, fr.X0, fr.q))        # quasi-static lines: from the pose
+    d.update(fr.lines)                                       # lumped lines: from their states
     if fields and b.tanks:
         D = nodal(b, fr.D)
         for t in b.tanks:

@@ -23,6 +23,7 @@ from ..scene.types import Scene
 from .guard import Interrupted, interrupts
 from .capsize import vanishing_angles
 from ..cache.compiled import compile_run
+from ..mooring.lumped_term import lumped_terms
 from ..mooring.term import mooring_term
 from .loop import core, ending_at, frame_datasets
 from .progress import Progress
@@ -66,8 +67,10 @@ def run_to_file(scene: Scene, out: str, *, progress: bool = True,
             if save_fields is None:
                 save_fields = N * 3 * 8 * (n_frames + 1) < 200e6
             chunk_frames = scene.simulation.chunk or max(1, min(n_frames, max(1, 500 // se)))
+            lumped = lumped_terms(b.system)
             writer = ResultWriter(out, scene.text, b.probes.names, b.tanks if save_fields else (),
-                                  getattr(mooring_term(b.system), "names", ()))
+                                  (*getattr(mooring_term(b.system), "names", ()), *(t.name for t in lumped)),
+                                  {t.name: t.line.segments + 1 for t in lumped})
             stop.check()
             bar.phase("compile", "compiling the step")
             bc = core(b)

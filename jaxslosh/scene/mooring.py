@@ -9,6 +9,7 @@ from __future__ import annotations
 import math
 
 from .fields import non_negative, one_of, positive, read, show, valid_name
+from .lumped_keys import read_lumped
 from .types import MooringLine, SceneError
 
 MODELS = ("catenary", "lumped")
@@ -22,9 +23,12 @@ def read_mooring(tables, depth, vessel_name: str, cog_z: float, warnings: list[s
     lines = []
     for i, table in enumerate(tables):
         where = f"mooring[{i}]"
+        lumped = ()
         if isinstance(table, dict) and table.get("model") == "lumped":
-            raise SceneError(f"{where}.model", '"lumped" (dynamic lumped-mass lines) is not available yet; '
-                                               'use model = "catenary" (the quasi-static elastic catenary)')
+            if "seabed_friction" in table:
+                raise SceneError(f"{where}.seabed_friction", "applies to catenary lines only (a lumped line's "
+                                                              "seabed has no friction)")
+            table, lumped = read_lumped(table, where)
         v = read(table, where, {
             "name": ("str", valid_name), "body": ("str", None), "fairlead": ("vec3", None), "anchor": ("vec3", None),
             "length": ("float", positive), "weight": ("float", None), "ea": ("float", positive),
@@ -58,7 +62,8 @@ def read_mooring(tables, depth, vessel_name: str, cog_z: float, warnings: list[s
                             f"(strain {100 * strain:.3g} %, about {v['ea'] * strain:.4g} N)")
         lines.append(MooringLine(name=name, body=body, fairlead=v["fairlead"], anchor=v["anchor"], length=v["length"],
                                  weight=v["weight"], ea=v["ea"], model=v.get("model", "catenary"),
-                                 seabed_friction=v.get("seabed_friction", 0.0), anchor_height=max(az + depth, 0.0)))
+                                 seabed_friction=v.get("seabed_friction", 0.0), anchor_height=max(az + depth, 0.0),
+                                 lumped=lumped))
     names = [line.name for line in lines]
     for i, n in enumerate(names):
         if n in names[:i]:

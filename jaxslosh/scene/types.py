@@ -134,6 +134,7 @@ class MooringLine:
     model: str = "catenary"
     seabed_friction: float = 0.0
     anchor_height: float = 0.0       # m above the seabed (anchor z + depth)
+    lumped: tuple = ()               # model = "lumped": its lumped-only values, (key, value) pairs (mooring/lumped_term.py)
 
 
 @dataclass(frozen=True)

@@ -147,7 +147,10 @@ def test_moored_run_records_line_tensions(tmp_path):
     (SMALL + _lines(extra='body = "barge"\n'), "mooring[0].body"),
     (SMALL + _lines().replace("length = 420.0", "length = 0.0", 1), "mooring[0].length"),
     (SMALL + _lines().replace("weight = 600.0", "weight = 0.0", 1), "mooring[0].weight"),
-    (SMALL + _lines(extra='model = "lumped"\nsegments = 20\n'), "mooring[0].model"),
+    (SMALL + _lines(extra='model = "lumped"\nsegments = 1\n'), "mooring[0].segments"),
+    (SMALL + _lines(extra='model = "lumped"\ncd = [1.0]\n'), "mooring[0].cd"),
+    (SMALL + _lines(extra='model = "lumped"\nseabed_friction = 0.5\n'), "mooring[0].seabed_friction"),
+    (SMALL + _lines(extra='segments = 20\n'), "mooring[0].segments"),
     (SMALL + _lines().replace('name = "l1"', 'name = "l0"'), "mooring[1].name"),
 ])
 def test_bad_mooring_input_names_the_key(text, key):
