@@ -54,6 +54,7 @@ from .kinematics import mv3, tv3
 from .about import About
 from .liquid import AbstractLiquid
 from .multimodal_modes import odd_powers
+from .multimodal_steep import steep_damping
 from .terms import Kin, Rows
 
 #: quadrature points along the tank (Gauss-Legendre; at least, and 8 per mode: the integrands hold
@@ -427,7 +428,8 @@ class MultimodalLiquid(AbstractLiquid):
         for t, be, bd, bdd in zip(self.tanks, self._split(k.c.d), self._split(k.d_dot), self._split(k.d_acc)):
             ft, mt, rt = t.rows(Vb, omega, be, bd, Vb_dot, k.a6[3:6], bdd, k.g_b)
             f, m = f + ft, m + mt
-            rd.append(rt)
+            # past the method's range, the steep waves' damping (zero within it: multimodal_steep.py)
+            rd.append(rt + steep_damping(t, be, bd, self.gravity))
         return Rows(jnp.concatenate([mv3(A, f), m]), jnp.concatenate(rd))
 
     def kinetic(self, k: Kin):
