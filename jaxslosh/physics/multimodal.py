@@ -38,7 +38,8 @@ The equations are Kirchhoff's for the body's velocities
     d/dt dT/dbeta_dot - dT/dbeta + dV/dbeta                  = 0     (modal rows)
 
 with V = -g_b . (S(beta) - S0) (the frozen liquid's weight and its moment are the vessel's: the
-same convention as the finite-element liquid). The force and moment on the tank follow from the
+same convention as the finite-element liquid). Past the method's range (crests higher than the N
+modes resolve) the modal rows take the steep-wave damping of multimodal_steep.py, zero within it. The force and moment on the tank follow from the
 liquid's momentum: they are the rigid rows.
 """
 from __future__ import annotations
