@@ -55,7 +55,7 @@ from .kinematics import mv3, tv3
 from .about import About
 from .liquid import AbstractLiquid
 from .multimodal_modes import odd_powers
-from .multimodal_steep import steep_damping
+from .multimodal_steep import roundoff_floor, steep_damping
 from .terms import Kin, Rows
 
 #: quadrature points along the tank (Gauss-Legendre; at least, and 8 per mode: the integrands hold
@@ -469,6 +469,13 @@ class MultimodalLiquid(AbstractLiquid):
 
     def frame_field(self, d):
         return d
+
+    def roundoff(self, d):
+        """The rows' round-off floor (scaled: an acceleration, m/s^2): their largest terms grow under the
+        highest crest as exp(2 k_N zeta_max) (the integrals' products of cosh(k_n H) / cosh(k_n h)) over
+        the stiffness term omega_N^2 beta of a row at rest, and cancel; past crest index 2 the
+        iterations stall there (`roundoff_floor`, multimodal_steep.py)."""
+        return sum((roundoff_floor(t, be, self.gravity) for t, be in zip(self.tanks, self._split(d))), jnp.zeros(()))
 
     def nodal_fields(self, D):
         return D

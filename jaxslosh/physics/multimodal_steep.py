@@ -70,3 +70,18 @@ def steep_damping(tank, beta, beta_dot, g):
     omN = jnp.max(om)
     ratio = steep_switch(crest_index(tank, beta)) * STEEP_RATIO * (t.k / kN) ** 2 * (omN / om)
     return 2.0 * ratio * om * t.modal_mass() * beta_dot
+
+
+def roundoff_floor(tank, beta, g):
+    """The round-off level of the tank's scaled modal rows (accelerations, m/s^2) at beta: eps
+    omega_N^2 max|beta| exp(2 k_N zeta_max), zeta_max the highest surface at the quadrature points.
+    The rows' integrals hold products of cosh(k_n H) / cosh(k_n h) that grow under the crest as
+    exp(2 k_N zeta) and cancel: a 1 m tank with 0.5 m of water on 10 modes stalls at 1.2e-8 with a
+    0.24 m crest (the estimate 4e-8) and at 1.4e-6 with 0.32 m (9e-6). Below crest index 2 it is under
+    3e-11 there, below the default tolerance."""
+    table, _ = surface_table(tank)
+    t = getattr(tank, "exact", tank)
+    kN = jnp.max(t.k)
+    omN2 = g * kN * jnp.tanh(kN * t.h)
+    eps = jnp.finfo(beta.dtype).eps
+    return eps * omN2 * jnp.max(jnp.abs(beta)) * jnp.exp(2.0 * kN * jnp.max(table @ beta))

@@ -33,8 +33,8 @@ SLOPE_SAMPLES = 65
 def _surface_tables(scene: Scene):
     """Per multimodal tank, (offset of its modal amplitudes, the slope's rows (P, modes) or its x and y
     rows for a three-dimensional tank, the elevation's rows at the liquid's quadrature points (Q,
-    modes), their weights (Q,), k_N): what the slope and the crest index (physics/multimodal_steep.py)
-    are read from, the crest index at the points and weights the liquid itself uses."""
+    modes), their weights (Q,), k_N, omega_N^2): what the slope, the crest index and the round-off
+    floor (physics/multimodal_steep.py) are read from, at the points and weights the liquid uses."""
     from ..assemble.multimodal3d import tank_3d, three_dimensional
     out, off = [], 0
     for t in scene.tanks:
@@ -43,16 +43,21 @@ def _surface_tables(scene: Scene):
         if three_dimensional(t):
             mt = tank_3d(t, t.fill_depth, t.fluid.density)
             F, Fx, Fy = (np.asarray(a) for a in (mt.F, mt.Fx, mt.Fy))
-            out.append((off, (Fx, Fy), F, np.asarray(mt.wq), float(np.max(np.asarray(mt.k)))))
+            kN = float(np.max(np.asarray(mt.k)))
+            out.append((off, (Fx, Fy), F, np.asarray(mt.wq), kN, _omega2(scene, t, kN)))
             off += F.shape[1]
             continue
         k = np.arange(1, t.modes + 1) * np.pi / t.size[0]
         xg, wg = np.polynomial.legendre.leggauss(max(NX, 8 * t.modes))
         xq = 0.5 * t.size[0] * (xg + 1.0)
         out.append((off, (-k * np.sin(np.outer(np.linspace(0.0, t.size[0], SLOPE_SAMPLES), k)),),
-                    np.cos(np.outer(xq, k)), 0.5 * t.size[0] * wg, float(k[-1])))
+                    np.cos(np.outer(xq, k)), 0.5 * t.size[0] * wg, float(k[-1]), _omega2(scene, t, k[-1])))
         off += t.modes
     return out
+
+
+def _omega2(scene: Scene, t, kN):
+    return float(scene.environment.gravity * kN * np.tanh(kN * t.fill_depth))
 
 
 def _crest_index(Z, w, kN, d):
@@ -112,7 +117,7 @@ class Watch:
                 self.high[i], self.t_high[i] = surface[k, i, 1], time[k]
         if field is not None and self.tables:
             d = np.asarray(field, float).reshape(time.size, -1)
-            for i, (off, rows, Z, w, kN) in enumerate(self.tables):
+            for i, (off, rows, Z, w, kN, _) in enumerate(self.tables):
                 di = d[:, off:off + Z.shape[1]]
                 s = np.sqrt(sum((di @ r.T) ** 2 for r in rows)).max(axis=1)
                 j = int(np.argmax(s))
@@ -128,6 +133,14 @@ class Watch:
             d = np.abs(np.asarray(field, float).reshape(time.size, -1))
             if d.shape[1]:
                 level = np.maximum(level, self.noise * d.max(axis=1))
+        if field is not None:
+            # a multimodal tank's own floor under high crests, as its Newton iterations take it
+            # (physics/multimodal_steep.roundoff_floor)
+            raw = np.asarray(field, float).reshape(time.size, -1)
+            for off, _, Z, _, kN, om2 in self.tables:
+                b = raw[:, off:off + Z.shape[1]]
+                level = np.maximum(level, np.finfo(float).eps * om2 * np.abs(b).max(axis=1)
+                                   * np.exp(2.0 * kN * (b @ Z.T).max(axis=1)))
         r = int(np.argmax(residual / level))
         if residual[r] / level[r] > self.residual / self.level:
             self.residual, self.t_residual, self.level = float(residual[r]), float(time[r]), float(level[r])

@@ -108,7 +108,7 @@ def test_watch_reads_the_crest_index_as_the_liquid():
     from jaxslosh.physics.multimodal_steep import STEEP_ON, crest_index
     from jaxslosh.run.validity import Watch, _crest_index, _surface_tables
     scene = js.load_scene(RESONANT.format(duration=1.0, amplitude=0.001))
-    (off, _, Z, w, kN), = _surface_tables(scene)
+    (off, _, Z, w, kN, _), = _surface_tables(scene)
     t = _tank()
     betas = np.array([[0.05, 0.0, 0.0, 0.0, 0.0, 0.0], [0.25, 0.06, 0.03, 0.015, 0.007, 0.003]])
     np.testing.assert_allclose(_crest_index(Z, w, kN, betas), [float(crest_index(t, jnp.asarray(b))) for b in betas],
