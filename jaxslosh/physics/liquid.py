@@ -62,6 +62,11 @@ class AbstractLiquid(AbstractTerm):
     def d_scale(self):
         """(nf,) a mass per row, so that a row over it is an acceleration."""
 
+    def roundoff(self, d):
+        """The round-off floor of its scaled rows at d beyond the solver's own (solve/linear.Solver.noise),
+        which the Newton iterations aim at when it is above the tolerance: none for a linear liquid."""
+        return jnp.zeros(())
+
     @abc.abstractmethod
     def frame_field(self, d):
         """What a saved frame keeps of d (the nodal field, or modal coordinates)."""

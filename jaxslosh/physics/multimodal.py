@@ -38,7 +38,8 @@ The equations are Kirchhoff's for the body's velocities
     d/dt dT/dbeta_dot - dT/dbeta + dV/dbeta                  = 0     (modal rows)
 
 with V = -g_b . (S(beta) - S0) (the frozen liquid's weight and its moment are the vessel's: the
-same convention as the finite-element liquid). The force and moment on the tank follow from the
+same convention as the finite-element liquid). Past the method's range (crests higher than the N
+modes resolve) the modal rows take the steep-wave damping of multimodal_steep.py, zero within it. The force and moment on the tank follow from the
 liquid's momentum: they are the rigid rows.
 """
 from __future__ import annotations
@@ -54,6 +55,7 @@ from .kinematics import mv3, tv3
 from .about import About
 from .liquid import AbstractLiquid
 from .multimodal_modes import odd_powers
+from .multimodal_steep import roundoff_floor, steep_damping
 from .terms import Kin, Rows
 
 #: quadrature points along the tank (Gauss-Legendre; at least, and 8 per mode: the integrands hold
@@ -433,7 +435,8 @@ class MultimodalLiquid(AbstractLiquid):
         for t, be, bd, bdd in zip(self.tanks, self._split(k.c.d), self._split(k.d_dot), self._split(k.d_acc)):
             ft, mt, rt = t.rows(Vb, omega, be, bd, Vb_dot, k.a6[3:6], bdd, k.g_b)
             f, m = f + ft, m + mt
-            rd.append(rt)
+            # past the method's range, the steep waves' damping (zero within it: multimodal_steep.py)
+            rd.append(rt + steep_damping(t, be, bd, self.gravity))
         return Rows(jnp.concatenate([mv3(A, f), m]), jnp.concatenate(rd))
 
     def kinetic(self, k: Kin):
@@ -472,6 +475,13 @@ class MultimodalLiquid(AbstractLiquid):
 
     def frame_field(self, d):
         return d
+
+    def roundoff(self, d):
+        """The rows' round-off floor (scaled: an acceleration, m/s^2): their largest terms grow under the
+        highest crest as exp(2 k_N zeta_max) (the integrals' products of cosh(k_n H) / cosh(k_n h)) over
+        the stiffness term omega_N^2 beta of a row at rest, and cancel; past crest index 2 the
+        iterations stall there (`roundoff_floor`, multimodal_steep.py)."""
+        return sum((roundoff_floor(t, be, self.gravity) for t, be in zip(self.tanks, self._split(d))), jnp.zeros(()))
 
     def nodal_fields(self, D):
         """Modal coordinates (..., nf) -> the surface meshes' nodal displacements (..., N, 3), vertical."""

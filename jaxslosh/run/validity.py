@@ -15,6 +15,8 @@ from __future__ import annotations
 import numpy as np
 
 from ..physics.kinematics import rpy_from_quat
+from ..physics.multimodal import NX
+from ..physics.multimodal_steep import STEEP_ON
 from ..scene.types import Scene
 
 #: a frame residual this many times its level, max(tolerance, round-off floor), is reported (the
@@ -28,17 +30,41 @@ STEEP_SLOPE = float(np.tan(np.radians(30.0)))
 SLOPE_SAMPLES = 65
 
 
-def _slope_rows(scene: Scene):
-    """Per multimodal tank, (offset of its modal amplitudes, (SLOPE_SAMPLES, modes) dzeta/dbeta_n at
-    the points): zeta = sum beta_n cos(k_n x), so its slope is -sum beta_n k_n sin(k_n x)."""
+def _surface_tables(scene: Scene):
+    """Per multimodal tank, (offset of its modal amplitudes, the slope's rows (P, modes) or its x and y
+    rows for a three-dimensional tank, the elevation's rows at the liquid's quadrature points (Q,
+    modes), their weights (Q,), k_N, omega_N^2): what the slope, the crest index and the round-off
+    floor (physics/multimodal_steep.py) are read from, at the points and weights the liquid uses."""
+    from ..assemble.multimodal3d import tank_3d, three_dimensional
     out, off = [], 0
     for t in scene.tanks:
         if t.model != "multimodal":
             return []
+        if three_dimensional(t):
+            mt = tank_3d(t, t.fill_depth, t.fluid.density)
+            F, Fx, Fy = (np.asarray(a) for a in (mt.F, mt.Fx, mt.Fy))
+            kN = float(np.max(np.asarray(mt.k)))
+            out.append((off, (Fx, Fy), F, np.asarray(mt.wq), kN, _omega2(scene, t, kN)))
+            off += F.shape[1]
+            continue
         k = np.arange(1, t.modes + 1) * np.pi / t.size[0]
-        out.append((off, -k * np.sin(np.outer(np.linspace(0.0, t.size[0], SLOPE_SAMPLES), k))))
+        xg, wg = np.polynomial.legendre.leggauss(max(NX, 8 * t.modes))
+        xq = 0.5 * t.size[0] * (xg + 1.0)
+        out.append((off, (-k * np.sin(np.outer(np.linspace(0.0, t.size[0], SLOPE_SAMPLES), k)),),
+                    np.cos(np.outer(xq, k)), 0.5 * t.size[0] * wg, float(k[-1]), _omega2(scene, t, k[-1])))
         off += t.modes
     return out
+
+
+def _omega2(scene: Scene, t, kN):
+    return float(scene.environment.gravity * kN * np.tanh(kN * t.fill_depth))
+
+
+def _crest_index(Z, w, kN, d):
+    """(k,): ln(mean exp(k_N zeta)) of each frame's amplitudes d (k, modes), as the liquid forms it."""
+    e = kN * (d @ Z.T)
+    m = e.max(axis=1, keepdims=True)
+    return m[:, 0] + np.log(np.exp(e - m) @ (w / w.sum()))
 
 
 class Watch:
@@ -57,9 +83,11 @@ class Watch:
         self.heel = np.zeros(2)                  # largest |roll|, |pitch| seen past them, and when
         self.t_heel = np.zeros(2)
         self.capsized = [False, False]
-        self.slope_rows = _slope_rows(scene) if n else []
-        self.slope = np.zeros(len(self.slope_rows))     # steepest free surface of each multimodal tank, and when
-        self.t_slope = np.zeros(len(self.slope_rows))
+        self.tables = _surface_tables(scene) if n else []
+        self.slope = np.zeros(len(self.tables))     # steepest free surface of each multimodal tank, and when
+        self.t_slope = np.zeros(len(self.tables))
+        self.crest = np.zeros(len(self.tables))     # largest crest index of each, and when it first passed STEEP_ON
+        self.t_crest = np.full(len(self.tables), np.nan)
 
     def watch_capsize(self, angles) -> None:
         """Check the frames' roll and pitch against these angles of vanishing stability (rad; None
@@ -87,19 +115,32 @@ class Watch:
                 self.low[i], self.t_low[i] = surface[j, i, 0], time[j]
             if surface[k, i, 1] > self.high[i]:
                 self.high[i], self.t_high[i] = surface[k, i, 1], time[k]
-        if field is not None and self.slope_rows:
+        if field is not None and self.tables:
             d = np.asarray(field, float).reshape(time.size, -1)
-            for i, (off, rows) in enumerate(self.slope_rows):
-                s = np.abs(d[:, off:off + rows.shape[1]] @ rows.T).max(axis=1)
+            for i, (off, rows, Z, w, kN, _) in enumerate(self.tables):
+                di = d[:, off:off + Z.shape[1]]
+                s = np.sqrt(sum((di @ r.T) ** 2 for r in rows)).max(axis=1)
                 j = int(np.argmax(s))
                 if s[j] > self.slope[i]:
                     self.slope[i], self.t_slope[i] = s[j], time[j]
+                a = _crest_index(Z, w, kN, di)
+                self.crest[i] = max(self.crest[i], float(a.max()))
+                if np.isnan(self.t_crest[i]) and (a > STEEP_ON).any():
+                    self.t_crest[i] = time[int(np.argmax(a > STEEP_ON))]
         residual = np.asarray(residual, float)
         level = np.full(time.size, self.scene.simulation.tolerance)
         if field is not None and self.noise > 0:
             d = np.abs(np.asarray(field, float).reshape(time.size, -1))
             if d.shape[1]:
                 level = np.maximum(level, self.noise * d.max(axis=1))
+        if field is not None:
+            # a multimodal tank's own floor under high crests, as its Newton iterations take it
+            # (physics/multimodal_steep.roundoff_floor)
+            raw = np.asarray(field, float).reshape(time.size, -1)
+            for off, _, Z, _, kN, om2 in self.tables:
+                b = raw[:, off:off + Z.shape[1]]
+                level = np.maximum(level, np.finfo(float).eps * om2 * np.abs(b).max(axis=1)
+                                   * np.exp(2.0 * kN * (b @ Z.T).max(axis=1)))
         r = int(np.argmax(residual / level))
         if residual[r] / level[r] > self.residual / self.level:
             self.residual, self.t_residual, self.level = float(residual[r]), float(time[r]), float(level[r])
@@ -125,10 +166,20 @@ class Watch:
                 out.append(f"{where}: the free surface fell {-self.low[i]:.3g} m at t = {self.t_low[i]:.4g} s, "
                            f"below the floor ({t.fill_depth:.3g} m deep): {model} is outside its validity")
         for i, s in enumerate(self.slope):
+            # one message per tank: the breaking slope, the crests past the modes' range, or both
+            t, said = self.scene.tanks[i], []
             if s > STEEP_SLOPE:
-                out.append(f"tanks[{i}] ({self.scene.tanks[i].name!r}): the free surface's slope reached {s:.3g} at "
-                           f"t = {self.t_slope[i]:.4g} s, steeper than {STEEP_SLOPE:.3g} (the 120 degree crest "
-                           f"where waves break): the multimodal liquid is outside its validity")
+                said.append(f"the free surface's slope reached {s:.3g} at t = {self.t_slope[i]:.4g} s, steeper than "
+                            f"{STEEP_SLOPE:.3g} (the 120 degree crest where waves break)")
+            if not np.isnan(self.t_crest[i]):
+                said.append(f"from t = {self.t_crest[i]:.4g} s its crests were higher than its modes resolve (crest "
+                            f"index up to {self.crest[i]:.3g}, past {STEEP_ON:.3g}): the steep-wave damping of its "
+                            f"higher modes acted from then on, and the results are that model's "
+                            f"(docs/guide/nonlinear-sloshing.md, \"Past the method's range\")")
+            if said and np.isnan(self.t_crest[i]):
+                out.append(f"tanks[{i}] ({t.name!r}): {said[0]}: the multimodal liquid is outside its validity")
+            elif said:
+                out.append(f"tanks[{i}] ({t.name!r}): " + "; ".join(said))
         tol = self.scene.simulation.tolerance
         if self.residual > RESIDUAL_FACTOR * self.level:
             floor = "" if self.level <= tol else \

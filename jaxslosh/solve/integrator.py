@@ -230,7 +230,9 @@ def step(system: System, solver: Solver, s: State, fresh=None) -> tuple[State, S
             return system.constraint_residual(x, lambda dyn: unpack(dyn)[0], gsc)
 
         R, split = _split_newton(system, Rm_parts, Rc, L.n_rigid)
-        floor = solver.noise * jnp.max(jnp.abs(s.c.d), initial=0.0)
+        # the liquid's own floor: a multimodal tank's rows lose digits as exp(2 k_N zeta) under high crests
+        floor = jnp.maximum(solver.noise * jnp.max(jnp.abs(s.c.d), initial=0.0),
+                            jax.lax.stop_gradient(system.liquid.roundoff(s.c.d)))
     pre = s.pre if solver.reuse else None
     with jax.named_scope("newton"):
         x, (it, err, ok), pre_new = solve_root_carried(R, L.to_x(pred, s.alg), solver.Cinv_step, scale, solver.tol,
