@@ -24,6 +24,7 @@ from .guard import Interrupted, interrupts
 from .capsize import vanishing_angles
 from ..cache.compiled import compile_run
 from ..mooring.term import mooring_term
+from ..physics.bodies import bodies_term
 from .loop import core, ending_at, frame_datasets
 from .progress import Progress
 from .simulate import failure_message, prepare
@@ -67,7 +68,9 @@ def run_to_file(scene: Scene, out: str, *, progress: bool = True,
                 save_fields = N * 3 * 8 * (n_frames + 1) < 200e6
             chunk_frames = scene.simulation.chunk or max(1, min(n_frames, max(1, 500 // se)))
             writer = ResultWriter(out, scene.text, b.probes.names, b.tanks if save_fields else (),
-                                  getattr(mooring_term(b.system), "names", ()))
+                                  getattr(mooring_term(b.system), "names", ()),
+                                  getattr(bodies_term(b.system), "names", ()),
+                                  getattr(bodies_term(b.system), "link_names", ()))
             stop.check()
             bar.phase("compile", "compiling the step")
             bc = core(b)
