@@ -94,6 +94,17 @@ def test_a_body_far_away_behaves_as_the_same_body_alone():
     assert np.max(np.abs(np.asarray(r.bodies["barge"].position[:, :2]))) < 1e-9   # no drift
 
 
+def test_coupled_modes_of_a_body_beside_the_vessel():
+    """Linearised about rest (JAX's derivative of the same residual): a body far from the vessel,
+    of the same values, heaves and rolls at the single body's frequencies, and the mode names it."""
+    from jaxslosh.analysis.coupled import coupled_modes
+    modes = coupled_modes(js.load_scene(head() + body(position=(0.0, 200.0))), n=6)
+    w = dict(zip(modes.dominant, modes.omega))
+    assert w["barge heave"] == pytest.approx(math.sqrt(RHO * G * AW / M), rel=1e-8)
+    assert w["barge roll"] == pytest.approx(math.sqrt(RHO * G * VOL * GMT / IXX), rel=1e-8)
+    assert w["heave"] == pytest.approx(w["barge heave"], rel=1e-10)
+
+
 def _bouncing(kind_second="fender", duration=170.0, dt=0.0025, stiffness=1.0e7, damping=0.0):
     """A body on a spring to a fixed point, released in surge towards a fender on a fixed point:
     one contact per oscillation (about 1.3 s)."""
