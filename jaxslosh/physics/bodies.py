@@ -18,7 +18,9 @@ fixed (inertial). Their force derives from a potential U(e) of the extension e =
 points' distance), so an undamped contact conserves energy, and the contact's switch is smoothed:
 a hawser's potential is W(rho(e)), a fender's W(rho(-e)), with W the force curve's integral and
 rho(x) = max(x, 0) blended by a quadratic over |x| < BAND / 2 (rho and rho' continuous): the force
-W'(rho) rho' is exactly zero below -BAND/2 and exactly the curve's beyond BAND/2.
+W'(rho) rho' is exactly zero below -BAND/2 and exactly the curve's beyond BAND/2. The damping
+c de/dt acts through the same contact factor rho' and never more than cancels the elastic force (a
+hawser does not push, a fender does not pull).
 """
 from __future__ import annotations
 
@@ -96,8 +98,13 @@ class Link(eqx.Module):
         n = dv / d
         e = d - self.length
         U, dU, contact = self.law(e)
-        T = dU + self.damping * contact * (n @ (Vb - Va))
-        return T, e, U, n
+        Td = self.damping * contact * (n @ (Vb - Va))
+        # a hawser's damping cancels its elastic pull at most (a rope does not push), a fender's its push
+        if self.kind == "hawser":
+            Td = jnp.maximum(Td, -dU)
+        elif self.kind == "fender":
+            Td = jnp.minimum(Td, -dU)
+        return dU + Td, e, U, n
 
     def forces(self, poses, rows: dict):
         """Add its generalized forces (translation inertial, rotation body) to rows[end] (6,)."""
