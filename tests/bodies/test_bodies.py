@@ -171,6 +171,21 @@ def test_a_hawsers_force_is_zero_when_slack_and_k_times_the_extension_beyond_the
     assert float(Tf) == (0.0 if e > 0 else pytest.approx(k * e, rel=1e-12))
 
 
+@pytest.mark.parametrize("kind", ["hawser", "fender"])
+def test_a_damped_contact_never_pushes_a_hawser_or_pulls_a_fender(kind):
+    """A hawser 1 cm taut (a fender 1 cm in) whose points close (open) fast: the damping would
+    reverse the force; it cancels it at most."""
+    link = _link(kind, k=1.0e5, c=1.0e6)
+    sign = 1.0 if kind == "hawser" else -1.0
+    for rate in (-1.0, -1e-4, 1e-4, 1.0):
+        pose = {VESSEL: (jnp.array([-sign * 0.01, 0.0, 0.0]), jnp.eye(3), jnp.array([sign * rate, 0.0, 0.0]),
+                         jnp.zeros(3))}
+        T = float(link.state(pose)[0])
+        assert sign * T >= 0.0
+        expected = max(0.0, 1.0e3 - 1.0e6 * rate) if rate else 1.0e3
+        assert sign * T == pytest.approx(expected, rel=1e-9, abs=1e-9)
+
+
 def test_the_contact_force_is_the_derivative_of_its_energy_and_continuous():
     link = _link("hawser")
     xs = jnp.linspace(-2 * BAND, 2 * BAND, 401)
