@@ -105,6 +105,33 @@ def test_coupled_modes_of_a_body_beside_the_vessel():
     assert w["heave"] == pytest.approx(w["barge heave"], rel=1e-10)
 
 
+def test_the_vessel_alone_on_springs_to_fixed_points():
+    """Without [[bodies]] the connections act on the vessel alone (no unknowns of their own): two
+    springs fore and aft of it, along x, give surge the period 2 pi sqrt(m / 2 k)."""
+    k = 2.0e5
+    scene = js.load_scene(head(duration=12.0, dt=0.01, vessel_position=(0.2, 0, 0)) + f"""
+[[connections]]
+name = "fore"
+kind = "spring"
+bodies = ["vessel", "fixed"]
+points = [[10.0, 0.0, 0.0], [30.0, 0.0, 0.0]]
+length = 20.0
+stiffness = {k}
+[[connections]]
+name = "aft"
+kind = "spring"
+bodies = ["vessel", "fixed"]
+points = [[-10.0, 0.0, 0.0], [-30.0, 0.0, 0.0]]
+length = 20.0
+stiffness = {k}
+""")
+    r = js.simulate(scene)
+    x = np.asarray(r.vessel.position[:, 0])
+    assert _period(np.asarray(r.time), x) == pytest.approx(2 * math.pi * math.sqrt(M / (2 * k)), rel=1e-3)
+    np.testing.assert_allclose(np.asarray(r.connections["fore"].force), -k * x, rtol=1e-9, atol=1e-6)
+    assert r.bodies is None
+
+
 def _bouncing(kind_second="fender", duration=170.0, dt=0.0025, stiffness=1.0e7, damping=0.0):
     """A body on a spring to a fixed point, released in surge towards a fender on a fixed point:
     one contact per oscillation (about 1.3 s)."""
