@@ -32,7 +32,7 @@ import jax.numpy as jnp
 
 from .about import About
 from .kinematics import quat_exp, quat_multiply, rotation_matrix
-from .terms import AbstractTerm, Config, Kin, Rows, Unknowns
+from .terms import Config, Kin, Rows, Unknowns
 from .unknowns import AbstractOwner
 
 #: m: the width of the smoothed contact switch of hawsers and fenders (centred on first contact)

@@ -11,13 +11,11 @@ import math
 
 import numpy as np
 
-from .fields import non_negative, numbers, one_of, positive, read, show, valid_name
+from .fields import non_negative, one_of, positive, read, show, valid_name
 from .types import Body, Connection, Hydrostatics, Initial, SceneError
 
 KINDS = ("hawser", "fender", "spring")
-#: what a body's table may hold; the vessel's keys it cannot have yet are refused by name below
-BODY_KEYS = ("name", "position", "heading", "cog_height", "mass", "inertia", "hydrostatics", "hydrodynamics",
-             "initial")
+#: the vessel's keys a body cannot have yet, refused by name (not as unknown keys)
 NOT_YET = {"hull": "hull meshes (and the waves' and the nonlinear hydrostatics' forces on them)",
            "forced": "prescribed motions"}
 #: names a body cannot take: the words that name the vessel and an inertial point in `bodies = [...]`
@@ -189,3 +187,22 @@ def _curve(x, where: str) -> tuple:
     if np.any(np.diff(a[:, 0]) <= 0) or np.any(np.diff(a[:, 1]) <= 0):
         raise SceneError(where, f"must be increasing in both deflection and force, got {a.tolist()}")
     return tuple((float(d), float(f)) for d, f in a)
+
+
+def bodies_scene(bodies, vessel_name, structures, mapping, warnings: list[str]) -> None:
+    """What the scene's other parts cannot do with [[bodies]] yet (docs/guide/bodies-and-connections.md)."""
+    for i, t in enumerate(mapping.get("tanks", [])):
+        body = t.get("body", "vessel") if isinstance(t, dict) else "vessel"
+        if body not in ("vessel", vessel_name, *[b.name for b in bodies]):
+            raise SceneError(f"tanks[{i}].body", f"{body!r} is not a body of the scene")
+        if body in [b.name for b in bodies]:
+            raise SceneError(f"tanks[{i}].body", f"{body!r}: tanks on [[bodies]] are not available yet; "
+                                                 "tanks ride on the vessel")
+    if not bodies:
+        return
+    if any(s.frame == "own" for s in structures):
+        raise SceneError("bodies", "[[bodies]] together with [[structures]] in their own frames are not available "
+                                   "yet (a model holds one of them)")
+    if "waves" in mapping:
+        warnings.append(f"waves: the incident waves act on the vessel only; the [[bodies]] "
+                        f"({', '.join(repr(b.name) for b in bodies)}) feel no wave excitation (not available yet)")

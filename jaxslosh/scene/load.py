@@ -30,7 +30,7 @@ from ..geometry import AXES, SHAPES
 from .campaign import read_campaign
 from .fields import (at_least, counts, flat_list, non_negative, one_of, poisson_ratio, positive, read, show, sizes,
                      valid_name)
-from .bodies import read_bodies, read_connections
+from .bodies import bodies_scene, read_bodies, read_connections
 from .mooring import read_mooring
 from .record import forced_span, read_forced
 from .rules import conservative as _conservative, locking_elements as _locking_elements
@@ -124,7 +124,7 @@ def parse_scene(mapping: Mapping[str, Any], text: str = "", path: str = "") -> S
         _place_probe(probe, f"probes[{i}]", tanks, structures)
     bodies = read_bodies(mapping.get("bodies", []), vessel, environment, warnings)
     connections = read_connections(mapping.get("connections", []), vessel.name, bodies)
-    _bodies_scene(bodies, vessel.name, structures, mapping, warnings)
+    bodies_scene(bodies, vessel.name, structures, mapping, warnings)
     mooring = read_mooring(mapping.get("mooring", []), environment.depth, vessel.name, vessel.cog_height, warnings,
                            tuple(b.name for b in bodies))
     _mass_balance(vessel, tanks, environment, warnings, structures, mooring)
@@ -145,25 +145,6 @@ def parse_scene(mapping: Mapping[str, Any], text: str = "", path: str = "") -> S
     if simulation.energy_projection:
         _conservative(scene)
     return scene
-
-
-def _bodies_scene(bodies, vessel_name, structures, mapping, warnings: list[str]) -> None:
-    """What the scene's other parts cannot do with [[bodies]] yet (docs/guide/bodies-and-connections.md)."""
-    for i, t in enumerate(mapping.get("tanks", [])):
-        body = t.get("body", "vessel") if isinstance(t, dict) else "vessel"
-        if body not in ("vessel", vessel_name, *[b.name for b in bodies]):
-            raise SceneError(f"tanks[{i}].body", f"{body!r} is not a body of the scene")
-        if body in [b.name for b in bodies]:
-            raise SceneError(f"tanks[{i}].body", f"{body!r}: tanks on [[bodies]] are not available yet; "
-                                                 "tanks ride on the vessel")
-    if not bodies:
-        return
-    if any(s.frame == "own" for s in structures):
-        raise SceneError("bodies", "[[bodies]] together with [[structures]] in their own frames are not available "
-                                   "yet (a model holds one of them)")
-    if "waves" in mapping:
-        warnings.append(f"waves: the incident waves act on the vessel only; the [[bodies]] "
-                        f"({', '.join(repr(b.name) for b in bodies)}) feel no wave excitation (not available yet)")
 
 
 def _multimodal_scene(tanks, warnings: list[str]) -> None:

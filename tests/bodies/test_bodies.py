@@ -165,11 +165,14 @@ def test_an_undamped_fender_contact_conserves_the_energy():
 
 
 def test_a_damped_fender_loses_energy_only_in_contact():
+    """(Where its damping cancels its push, while the body leaves it faster than it expands, the
+    energy it still holds is lost too: a fender does not pull.)"""
     r = js.simulate(_bouncing(duration=3.0, damping=2.0e5))
-    f = np.asarray(r.connections["fender"].force)
+    e = np.asarray(r.connections["fender"].extension)
     E = np.asarray(r.energy.kinetic) + np.asarray(r.energy.potential)
     dE = np.diff(E)
-    slack = (f[:-1] == 0.0) & (f[1:] == 0.0)
+    slack = (e[:-1] > BAND) & (e[1:] > BAND)
+    assert slack.sum() > 100
     assert np.max(np.abs(dE[slack])) < 1e-6 * E[0]
     assert E[-1] < 0.99 * E[0]
 
