@@ -297,6 +297,28 @@ def test_the_gradient_of_the_connections_rows_in_the_stiffness():
     np.testing.assert_allclose(g, fd, rtol=1e-6, atol=1e-9 * np.max(np.abs(g)))
 
 
+def test_the_connections_forces_are_the_gradient_of_their_energy_along_the_increments():
+    """Translations and body-frame rotations of the vessel and the barge (q exp(theta)), at a
+    turned pose with the hawser taut: the forces (moment arms included) are minus the gradient of
+    the connections' potential."""
+    from jaxslosh.assemble.bodies import build_bodies
+    from jaxslosh.physics.kinematics import quat_exp, quat_from_rpy, quat_multiply
+    from jaxslosh.physics.terms import Config
+    term = build_bodies(_pair(), {}, jnp.asarray(G))
+    c = Config(jnp.array([0.1, 0.3, -0.05]), quat_from_rpy(jnp.array([0.02, -0.01, 0.05])), jnp.zeros(0),
+               Xs=jnp.array([[0.0, 29.6, 0.02]]), qs=quat_from_rpy(jnp.array([-0.03, 0.01, 0.02]))[None, :])
+    zero = jnp.zeros(12)
+
+    def energy(x):
+        moved = c._replace(X0=c.X0 + x[:3], q=quat_multiply(c.q, quat_exp(x[3:6])), Xs=c.Xs + x[None, 6:9],
+                           qs=quat_multiply(c.qs[0], quat_exp(x[9:12]))[None, :])
+        return term.link_potential(term.poses(moved, zero))
+
+    F = np.asarray(term.link_forces(term.poses(c, zero)))
+    assert np.max(np.abs(F)) > 1e4
+    np.testing.assert_allclose(F, -np.asarray(jax.grad(energy)(zero)), rtol=1e-9, atol=1e-6)
+
+
 BAD = [
     ("unknown body", 'bodies = ["vessel", "barge"]', 'bodies = ["vessel", "tug"]', "connections[0].bodies"),
     ("fixed first", 'bodies = ["vessel", "barge"]', 'bodies = ["fixed", "barge"]', "connections[0].bodies"),
