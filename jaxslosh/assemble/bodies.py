@@ -81,10 +81,12 @@ def _about(scene) -> About:
                                        f"{b.heading:g} rad, mass {b.mass:g} kg; rigid-body inertia and linear "
                                        f"hydrostatics (A_w {h.waterplane_area:g} m^2, GM_T {h.gm_t:g} m, GM_L "
                                        f"{h.gm_l:g} m){damp}"))
+    shown = {"vessel": scene.vessel.name}       # the ends as the scene names them
     for c in scene.connections:
         law = f"stiffness {c.stiffness:g} N/m" if c.stiffness is not None else f"a {len(c.curve)}-point force curve"
         band = f", contact smoothed over {1e3 * BAND:g} mm" if c.kind != "spring" else ""
         damp = f", damping {c.damping:g} N s/m" if c.damping else ""
-        lines.append(("connection", f"{c.name!r}: {c.kind} {c.ends[0]} - {c.ends[1]}, length {c.length:g} m, "
+        lines.append(("connection", f"{c.name!r}: {c.kind} {shown.get(c.ends[0], c.ends[0])} - "
+                                    f"{shown.get(c.ends[1], c.ends[1])}, length {c.length:g} m, "
                                     f"{law}{damp}{band}"))
     return About(*lines)

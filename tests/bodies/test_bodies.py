@@ -365,3 +365,13 @@ def test_what_a_body_cannot_have_yet_exits_2_naming_the_key(tmp_path, capsys, ex
     p.write_text(_pair_text() + extra)
     assert main(["check", str(p)]) == 2
     assert key in capsys.readouterr().err
+
+
+def test_check_lists_the_bodies_and_the_connections(tmp_path, capsys):
+    p = tmp_path / "pair.toml"
+    p.write_text(_pair_text())
+    assert main(["check", str(p)]) == 0
+    out = capsys.readouterr().out
+    assert "floating body: 'barge': 6 unknowns of its own floating frame" in out
+    assert "connection: 'hawser': hawser vessel - barge, length 19 m, stiffness 100000 N/m" in out
+    assert "unknowns per step: 12" in out
