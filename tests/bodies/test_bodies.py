@@ -375,3 +375,17 @@ def test_check_lists_the_bodies_and_the_connections(tmp_path, capsys):
     assert "floating body: 'barge': 6 unknowns of its own floating frame" in out
     assert "connection: 'hawser': hawser vessel - barge, length 19 m, stiffness 100000 N/m" in out
     assert "unknowns per step: 12" in out
+
+
+def test_a_bodys_viscous_damping_gives_its_roll_decay():
+    """Roll damped by B44 = 2 zeta sqrt(K I): successive peaks shrink by exp(-2 pi zeta / sqrt(1 - zeta^2))."""
+    K = RHO * G * VOL * GMT
+    zeta = 0.05
+    B = 2 * zeta * math.sqrt(K * IXX)
+    r = js.simulate(js.load_scene(head(duration=15.0, dt=0.005) + body(omega=(0.02, 0, 0))
+                                  + f"[bodies.hydrodynamics]\nviscous_damping = [0, 0, 0, {B}, 0, 0]\n"))
+    roll = np.asarray(r.bodies["barge"].roll_pitch_yaw[:, 0])
+    i = np.flatnonzero((roll[1:-1] > roll[:-2]) & (roll[1:-1] >= roll[2:])) + 1
+    ratio = roll[i[1]] / roll[i[0]]
+    assert ratio == pytest.approx(math.exp(-2 * math.pi * zeta / math.sqrt(1 - zeta ** 2)), rel=2e-3)
+    assert np.max(np.abs(np.asarray(r.vessel.roll_pitch_yaw))) == 0.0      # the vessel is left at rest
