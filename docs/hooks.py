@@ -41,8 +41,9 @@ def _table_of(key: str, tables) -> str:
 
 def _traceable(key: str) -> bool:
     from jaxslosh.scene.keys import TRACEABLE
-    if key.startswith("tanks."):
-        return ("tanks.T." + key[len("tanks."):]) in TRACEABLE
+    for group in ("tanks", "mooring", "connections"):    # named tables: any name stands for <name>
+        if key.startswith(group + "."):
+            return (f"{group}.T." + key[len(group) + 1:]) in TRACEABLE
     return key in TRACEABLE
 
 

@@ -73,15 +73,17 @@ def rest_scene(scene: Scene) -> Scene:
     if ves.hydrostatics is None:
         raise SceneError("vessel.hydrostatics", "the frequency domain needs a floating vessel at rest; without "
                                                 "hydrostatics it falls")
+    bodies = tuple(dataclasses.replace(b, initial=Initial()) for b in scene.bodies)
     # lumped mooring lines as their catenary: linearised with their nodes held, their last segment's
     # axial stiffness would stand for the line's (docs/guide/moorings-lumped.md)
-    return quasi_static_lines(dataclasses.replace(scene, vessel=dataclasses.replace(ves, initial=Initial())))
+    return quasi_static_lines(dataclasses.replace(scene, vessel=dataclasses.replace(ves, initial=Initial()), bodies=bodies))
 
 
 def _labels(b: Built, L: Layout, scene: Scene) -> tuple:
     names = list(DOFS)
     for s in b.structures:
         names += [f"structure {s.name}"] * 6
+    names += [f"{body.name} {dof}" for body in scene.bodies for dof in DOFS]   # [[bodies]]: their own frames
     # the structures in the vessel's frame: their nodal dofs the deformable block's last, in order
     held = [f"structure {s.name}" for s in scene.structures if s.frame == "vessel"
             for _ in range(structure_unknowns(s))] if L.nf else []

@@ -153,7 +153,7 @@ def liquid_unknowns(scene: Scene) -> int:
 
 
 def count_unknowns(scene: Scene) -> int:
-    n = 6 + sum(structure_unknowns(s) for s in scene.structures)
+    n = 6 + sum(structure_unknowns(s) for s in scene.structures) + 6 * len(scene.bodies)
     if not scene.effects.liquid:
         return n
     return n + liquid_unknowns(scene)

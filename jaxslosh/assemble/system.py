@@ -24,13 +24,14 @@ from ..physics.multimodal import MultimodalLiquid
 from ..physics.structures import Structures
 from ..physics.system import System
 from ..physics.terms import Config
-from ..physics.vessel import (HarmonicMotion, Hydrostatics, PaperHydrostatics, RecordedMotion, RigidBody, SpinUpMotion,
+from ..physics.vessel import (HarmonicMotion, RecordedMotion, RigidBody, SpinUpMotion,
                               Weight, record_coefficients)
 from ..staging import staged
 from ..scene.keys import resolve_params
 from ..scene.types import DOFS, Scene, SceneError
 from ..solve.sparse import hydrostatic_start
 from .about import damping_about, flex_about, liquid_about, record_about, stiffening_about, weight_about
+from .bodies import build_bodies, linear_hydrostatics
 from .damping import build_damping
 from .hull import build_hull_pressure
 from .liquid import LiquidBlock, build_liquid_block, outline_liquid_block, rigid_part
@@ -126,14 +127,9 @@ def _model(scene: Scene, params: dict, outline: bool = False) -> _Model:
     if nonlinear:              # the hull's wetted surface (assemble/hull.py); the weight below
         terms.append(build_hull_pressure(scene, params, g))
     elif ves.hydrostatics is not None and eff.buoyancy:
-        h = ves.hydrostatics
-        f = lambda k, v: jnp.asarray(P(k, v), dtype=float)  # noqa: E731
-        form = PaperHydrostatics if h.moment == "paper" else Hydrostatics
-        terms.append(form(
-            rho_w=f("environment.water_density", env.water_density), gravity=g,
-            waterplane_area=f("vessel.hydrostatics.waterplane_area", h.waterplane_area),
-            displaced_volume=f("vessel.hydrostatics.displaced_volume", h.displaced_volume),
-            gm_t=f("vessel.hydrostatics.gm_t", h.gm_t), gm_l=f("vessel.hydrostatics.gm_l", h.gm_l)))
+        # the one function that makes every floating body's restoring (assemble/bodies.py)
+        terms.append(linear_hydrostatics(ves.hydrostatics, P("environment.water_density", env.water_density), g,
+                                         lambda k, v: P(f"vessel.hydrostatics.{k}", v)))
     multimodal = eff.liquid and multimodal_scene(scene)
     if multimodal and outline:
         block = LiquidBlock(MultimodalLiquid(tanks=(), sizes=(), samples=None, gravity=g))
@@ -183,6 +179,9 @@ def _model(scene: Scene, params: dict, outline: bool = False) -> _Model:
     if any(m.model == "catenary" for m in scene.mooring):   # quasi-static catenary lines (jaxslosh/mooring/term.py)
         terms.append(build_mooring(scene, balanced, outline, params))
     terms.extend(build_lumped_lines(scene, balanced, q0))    # dynamic lumped-mass lines (mooring/lumped_term.py)
+    bodies = build_bodies(scene, params, g)   # [[bodies]] and [[connections]] (physics/bodies.py)
+    if bodies is not None:
+        terms.append(bodies)
     if block.penalty is not None:
         terms.append(RotationPenalty(Kdt=block.penalty[0], Ktt=block.penalty[1], q_ref=q0))
     if block.Kg is not None:

@@ -76,6 +76,11 @@ class LineHistory(eqx.Module):
     nodes: Optional[jax.Array] = None   # (n, s + 1, 3) m: a lumped line's nodes, anchor to fairlead
 
 
+class ConnectionHistory(eqx.Module):
+    force: jax.Array             # (n,) N, positive when it pulls
+    extension: jax.Array         # (n,) m: the points' distance less the length
+
+
 class Result(eqx.Module):
     """A run's frames and how it ended. `outcome` (io.status.RunResult) is a leaf: right under
     `jax.jit` and `vmap`, where a string cannot be; `status` and `status_code` read it (and
@@ -128,9 +133,12 @@ class Result(eqx.Module):
         """Whether the run ended well (a traced boolean inside a transformation)."""
         return self.outcome == RunResult.ok
     mooring: Optional[dict] = None     # {line: LineHistory} of a moored scene
+    bodies: Optional[dict] = None      # {body: VesselHistory} of the [[bodies]] (position: offset from rest)
+    connections: Optional[dict] = None  # {connection: ConnectionHistory} of the [[connections]]
 
 
-def schema(probe_names=(), tank_nodes: Optional[dict] = None, lines=(), line_nodes: Optional[dict] = None) -> dict:
+def schema(probe_names=(), tank_nodes: Optional[dict] = None, lines=(), line_nodes: Optional[dict] = None,
+           bodies=(), connections=()) -> dict:
     """{dataset: shape of one frame} of a result file, in the file's order."""
     spec = {"time": (), "vessel/position": (3,), "vessel/quaternion": (4,), "vessel/angular_velocity": (3,),
             "vessel/roll_pitch_yaw": (3,), "energy/kinetic": (), "energy/potential": (),
@@ -145,6 +153,14 @@ def schema(probe_names=(), tank_nodes: Optional[dict] = None, lines=(), line_nod
         spec[f"mooring/{name}/anchor_tension"] = ()
     for name, n in (line_nodes or {}).items():       # lumped lines: their nodes (s + 1 of them)
         spec[f"mooring/{name}/nodes"] = (n, 3)
+    for name in bodies:
+        spec[f"bodies/{name}/position"] = (3,)
+        spec[f"bodies/{name}/quaternion"] = (4,)
+        spec[f"bodies/{name}/angular_velocity"] = (3,)
+        spec[f"bodies/{name}/roll_pitch_yaw"] = (3,)
+    for name in connections:
+        spec[f"connections/{name}/force"] = ()
+        spec[f"connections/{name}/extension"] = ()
     return spec
 
 
@@ -154,7 +170,10 @@ UNITS = {"time": "s", "vessel/position": "m", "vessel/quaternion": "1", "vessel/
          "vessel/roll_pitch_yaw": "rad", "energy/kinetic": "J", "energy/potential": "J", "solver/iterations": "1",
          "solver/residual": "m/s^2", "solver/constraint": "m", "probes/position": "m", "probes/displacement": "m",
          "tanks/displacement": "m", "tanks/nodes": "m", "tanks/elements": "1", "mooring/fairlead_tension": "N",
-         "mooring/anchor_tension": "N", "mooring/nodes": "m"}
+         "mooring/anchor_tension": "N", "mooring/nodes": "m",
+         "bodies/position": "m", "bodies/quaternion": "1",
+         "bodies/angular_velocity": "rad/s", "bodies/roll_pitch_yaw": "rad", "connections/force": "N",
+         "connections/extension": "m"}
 
 #: a `description` attribute where the unit alone does not say what a dataset holds
 DESCRIPTIONS = {
@@ -167,13 +186,18 @@ DESCRIPTIONS = {
     "solver/constraint": "largest interface constraint violation of flexible structures (0 without them)",
     "tanks/displacement": "the liquid's deformational displacement at the nodes, tank frame",
     "tanks/elements": "hexahedra: 8 node indices each (0-based)",
+    "bodies/position": "offset of the body's centre of gravity from its rest position, inertial",
+    "bodies/quaternion": "Euler parameters of the body's attitude (its heading included), scalar first",
+    "bodies/angular_velocity": "angular velocity in the body's frame",
+    "connections/force": "the connection's force, positive when it pulls its points together",
+    "connections/extension": "the distance of the connection's points less its length",
 }
 
 
 def units_of(key: str) -> str:
     """The `units` attribute of a result dataset (see UNITS)."""
     parts = key.split("/")
-    if parts[0] in ("probes", "tanks", "mooring") and len(parts) == 3:
+    if parts[0] in ("probes", "tanks", "mooring", "bodies", "connections") and len(parts) == 3:
         key = f"{parts[0]}/{parts[2]}"
     return UNITS.get(key, "1")
 
@@ -182,7 +206,8 @@ def label(ds, key: str) -> None:
     """Write a dataset's `units` (and `description`, where one is known) attributes."""
     ds.attrs["units"] = units_of(key)
     parts = key.split("/")
-    short = f"{parts[0]}/{parts[2]}" if parts[0] in ("probes", "tanks") and len(parts) == 3 else key
+    short = f"{parts[0]}/{parts[2]}" if parts[0] in ("probes", "tanks", "bodies", "connections") and len(parts) == 3 \
+        else key
     if short in DESCRIPTIONS:
         ds.attrs["description"] = DESCRIPTIONS[short]
 
@@ -204,6 +229,14 @@ def result_frames(r: Result) -> dict:
         d[f"mooring/{name}/anchor_tension"] = m.anchor_tension
         if m.nodes is not None:
             d[f"mooring/{name}/nodes"] = m.nodes
+    for name, b in (r.bodies or {}).items():
+        d[f"bodies/{name}/position"] = b.position
+        d[f"bodies/{name}/quaternion"] = b.quaternion
+        d[f"bodies/{name}/angular_velocity"] = b.angular_velocity
+        d[f"bodies/{name}/roll_pitch_yaw"] = b.roll_pitch_yaw
+    for name, c in (r.connections or {}).items():
+        d[f"connections/{name}/force"] = c.force
+        d[f"connections/{name}/extension"] = c.extension
     return {k: np.asarray(v) for k, v in d.items()}
 
 
@@ -221,6 +254,11 @@ def result_from(d: dict, probe_names=(), tanks: Optional[dict] = None, *, status
     lines = [k.split("/")[1] for k in d if k.startswith("mooring/") and k.endswith("/fairlead_tension")]
     mooring = {n: LineHistory(d[f"mooring/{n}/fairlead_tension"], d[f"mooring/{n}/anchor_tension"],
                               d.get(f"mooring/{n}/nodes")) for n in lines}
+    bodies = {n: VesselHistory(*(d[f"bodies/{n}/{k}"] for k in ("position", "quaternion", "angular_velocity",
+                                                                 "roll_pitch_yaw")))
+              for n in dict.fromkeys(k.split("/")[1] for k in d if k.startswith("bodies/"))}
+    connections = {n: ConnectionHistory(d[f"connections/{n}/force"], d[f"connections/{n}/extension"])
+                   for n in dict.fromkeys(k.split("/")[1] for k in d if k.startswith("connections/"))}
     return Result(time=d["time"],
                   vessel=VesselHistory(d["vessel/position"], d["vessel/quaternion"], d["vessel/angular_velocity"],
                                        d["vessel/roll_pitch_yaw"]),
@@ -228,14 +266,15 @@ def result_from(d: dict, probe_names=(), tanks: Optional[dict] = None, *, status
                   solver=SolverHistory(d["solver/iterations"], d["solver/residual"], d.get("solver/constraint")),
                   tanks=fields, outcome=outcome_of(code), steps=steps_done, failure=failure, note=status,
                   scene_text=scene_text, dt=float(dt), tolerance=float(tolerance),
-                  mooring=mooring or None)
+                  mooring=mooring or None, bodies=bodies or None, connections=connections or None)
 
 
 class ResultWriter:
     """Appends frames to an HDF5 result file as a run goes on. It holds the output's lock from
     before the file is truncated until it is closed (a second writer gets io.output.OutputError)."""
 
-    def __init__(self, path: str, scene_text: str, probe_names, tanks=(), lines=(), line_nodes=None):
+    def __init__(self, path: str, scene_text: str, probe_names, tanks=(), lines=(), line_nodes=None, bodies=(),
+                 connections=()):
         self.path = path
         self.lock = OutputLock(path)
         try:
@@ -255,7 +294,8 @@ class ResultWriter:
         for t in tanks:
             label(self.f.create_dataset(f"tanks/{t.name}/nodes", data=t.nodes), f"tanks/{t.name}/nodes")
             label(self.f.create_dataset(f"tanks/{t.name}/elements", data=t.elements), f"tanks/{t.name}/elements")
-        for k, shape in schema(probe_names, {t.name: t.nodes.shape[0] for t in tanks}, lines, line_nodes).items():
+        for k, shape in schema(probe_names, {t.name: t.nodes.shape[0] for t in tanks}, lines, line_nodes, bodies,
+                               connections).items():
             dtype = "i8" if k == "solver/iterations" else "f8"
             label(self.f.create_dataset(k, shape=(0, *shape), maxshape=(None, *shape), dtype=dtype,
                                         chunks=(max(1, min(1024, 2 ** 20 // (8 * max(1, int(np.prod(shape)))))),
@@ -301,7 +341,8 @@ class _Mesh:
 def save_result(r: Result, path: str) -> None:
     w = ResultWriter(path, r.scene_text, list(r.probes), [_Mesh(n, t.nodes, t.elements) for n, t in r.tanks.items()],
                      list(r.mooring or {}),
-                     {n: m.nodes.shape[-2] for n, m in (r.mooring or {}).items() if m.nodes is not None})
+                     {n: m.nodes.shape[-2] for n, m in (r.mooring or {}).items() if m.nodes is not None},
+                     list(r.bodies or {}), list(r.connections or {}))
     w.append(result_frames(r), r.steps_done)
     w.close(r.status, r.steps_done, r.status_code)
 
@@ -424,7 +465,9 @@ def load_result(path: str) -> Result:
             tanks[name] = (np.asarray(f[f"tanks/{name}/nodes"]), np.asarray(f[f"tanks/{name}/elements"]))
         lines = list(f["mooring"]) if "mooring" in f else []
         line_nodes = {n: f[f"mooring/{n}/nodes"].shape[1] for n in lines if f"mooring/{n}/nodes" in f}
-        d = read_frames(f, schema(probes, {name: 0 for name in tanks}, lines, line_nodes))
+        bodies = list(f["bodies"]) if "bodies" in f else []
+        connections = list(f["connections"]) if "connections" in f else []
+        d = read_frames(f, schema(probes, {name: 0 for name in tanks}, lines, line_nodes, bodies, connections))
         check_required(d, probes, path)
         status = attr_str(a.get("status", "ok"))
         code = int(a["status_code"]) if "status_code" in a else None
@@ -440,4 +483,7 @@ def truncated(r: Result, n: int) -> Result:
         probes={k: jax.tree_util.tree_map(cut, p) for k, p in r.probes.items()},
         energy=jax.tree_util.tree_map(cut, r.energy), solver=jax.tree_util.tree_map(cut, r.solver),
         tanks={k: TankField(t.nodes, t.elements, cut(t.displacement)) for k, t in r.tanks.items()},
-        mooring=None if r.mooring is None else {k: jax.tree_util.tree_map(cut, m) for k, m in r.mooring.items()})
+        mooring=None if r.mooring is None else {k: jax.tree_util.tree_map(cut, m) for k, m in r.mooring.items()},
+        bodies=None if r.bodies is None else {k: jax.tree_util.tree_map(cut, m) for k, m in r.bodies.items()},
+        connections=None if r.connections is None else {k: jax.tree_util.tree_map(cut, m)
+                                                        for k, m in r.connections.items()})

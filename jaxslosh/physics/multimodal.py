@@ -10,10 +10,7 @@ surface
     H(x, t) = h + zeta(x, t),   zeta = sum_i beta_i(t) cos(k_i x),   k_i = i pi / L,  i = 1..N
 
 (each cosine has zero mean: the volume is conserved exactly), and the potential of the liquid's
-velocity relative to the tank
-
-    phi = sum_n R_n(t) phi_n,   phi_n = cos(k_n x) cosh(k_n u) / cosh(k_n h)
-
+velocity relative to the tank  phi = sum_n R_n(t) phi_n,  phi_n = cos(k_n x) cosh(k_n u) / cosh(k_n h)
 (the natural modes: phi_n has no normal flux through the walls and the bottom). The kinematic free
 surface condition, projected on each phi_n, is Faltinsen et al.'s  dA_n/dt = sum_k A_nk R_k  with
 A_n = integral of phi_n over the liquid and A_nk = integral of grad phi_n . grad phi_k; so
@@ -30,8 +27,7 @@ liquid's absolute motion irrotational (Kelvin; `ModalTank.vortical`, the Stokes-
 of the tank's section less its rigid rotation), as the finite-element liquid's rotation penalty keeps
 it. Across the tank (roll, yaw) the liquid turns with the tank.
 
-The equations are Kirchhoff's for the body's velocities
-(V_b = A^T V0, omega) with the modal coordinates as internal unknowns:
+The equations are Kirchhoff's for the body's velocities (V_b = A^T V0, omega), modal coordinates inside:
 
     d/dt dT/dV_b + omega x dT/dV_b                           = F_b   (translation rows, then A F_b)
     d/dt dT/domega + omega x dT/domega + V_b x dT/dV_b       = M_b   (rotation rows)
@@ -477,10 +473,8 @@ class MultimodalLiquid(AbstractLiquid):
         return d
 
     def roundoff(self, d):
-        """The rows' round-off floor (scaled: an acceleration, m/s^2): their largest terms grow under the
-        highest crest as exp(2 k_N zeta_max) (the integrals' products of cosh(k_n H) / cosh(k_n h)) over
-        the stiffness term omega_N^2 beta of a row at rest, and cancel; past crest index 2 the
-        iterations stall there (`roundoff_floor`, multimodal_steep.py)."""
+        """The rows' round-off floor, m/s^2 (`roundoff_floor`, multimodal_steep.py: their terms grow as
+        exp(2 k_N zeta_max) under the highest crest and cancel)."""
         return sum((roundoff_floor(t, be, self.gravity) for t, be in zip(self.tanks, self._split(d))), jnp.zeros(()))
 
     def nodal_fields(self, D):

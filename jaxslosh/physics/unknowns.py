@@ -10,7 +10,8 @@ The dynamic vectors (velocities, accelerations) are [y, z]. Without an owner, al
 x = [vessel, liquid]: one step serves every system (solve/integrator.py), the owners' constraints
 entering it as the cheap part Rc of R = Rm + Rc (an empty set of constraints without them).
 The layout holds one owner's unknowns after the vessel's and the liquid's (the flexible
-structures, physics/structures.py, which tie any number of bodies through one term).
+structures, physics/structures.py, which tie any number of bodies through one term; or the rigid
+floating bodies and their connections, physics/bodies.py).
 """
 from __future__ import annotations
 
@@ -77,6 +78,12 @@ class AbstractOwner(AbstractTerm):
     @abc.abstractmethod
     def start(self, system, c0: Config, v0):
         """(c, v, alg) at t = 0 from the vessel-and-liquid c0, v0 (before any equilibrium)."""
+
+    def settles(self) -> bool:
+        """Whether its unknowns start at their static equilibrium (the vessel and the liquid held):
+        the structures' do (a mast that starts undeformed would ring with its own weight); the
+        floating bodies' start where the scene puts them (physics/bodies.py)."""
+        return True
 
     @abc.abstractmethod
     def carried_velocities(self, system, c: Config, v):

@@ -14,6 +14,7 @@ from ..assemble.system import Built
 from ..io.status import Status
 from ..mooring.lumped_term import lumped_observe
 from ..mooring.term import mooring_datasets
+from ..physics.bodies import bodies_term
 from ..physics.kinematics import rotation_matrix, rpy_from_quat
 from ..physics.terms import Config
 from ..solve.integrator import State, initial_state, initial_state_like, step_or_retry
@@ -54,6 +55,9 @@ class Frame(NamedTuple):
     gmax: jax.Array       # max |g| of the interface constraints (m), 0 without structures
     surface: jax.Array    # (tanks, 2): lowest and highest vertical displacement of each free surface (m)
     lines: dict = {}      # the lumped mooring lines' datasets (mooring/lumped_term.lumped_observe), empty without
+    bodies: jax.Array = None   # (S, 10): each [[bodies]] body's COG offset from its rest position (3, inertial),
+    #                            quaternion (4), angular velocity (3, body frame); (0, 10) without
+    links: jax.Array = None    # (n, 2): each connection's force (positive when it pulls) and extension
 
 
 def probe_positions(b: Built, c: Config):
@@ -82,9 +86,26 @@ def _frame(b: Built, s: State, it, err, failed) -> Frame:
     gmax = jnp.max(jnp.abs(sysm.constraint(s.c, s.alg)), initial=0.0)
     heave = [sysm.liquid.surface_heave(s.c.d, idx) for idx in b.surfaces]
     surface = jnp.array([[h.min(), h.max()] for h in heave]).reshape(len(heave), 2)
+    bodies, links = body_frames(sysm, s.c, s.v)
     lines = lumped_observe(sysm, s.z, s.c, s.v[:3], s.v[3:6])
     return Frame(s.t, s.c.X0, s.c.q, s.v[3:6], probes, ke, pe, it, err, sysm.liquid.frame_field(s.c.d), failed, gmax,
-                 surface, lines)
+                 surface, lines, bodies, links)
+
+
+def body_frames(sysm, c: Config, v):
+    """((S, 10) the bodies' offsets, attitudes and rates, (n, 2) the connections' forces and
+    extensions) of a state (physics/bodies.py)."""
+    term = bodies_term(sysm)
+    if term is None:
+        return jnp.zeros((0, 10)), jnp.zeros((0, 2))
+    S = term.S
+    vy = v[:6 + 6 * S]
+    bodies = jnp.zeros((0, 10))
+    if S:
+        rest = jnp.stack([b.rest for b in term.bodies])
+        bodies = jnp.concatenate([c.Xs - rest, c.qs, vy[6:].reshape(S, 6)[:, 3:]], axis=1)
+    T, e = term.link_states(c, vy)
+    return bodies, jnp.stack([T, e], axis=1).reshape(-1, 2)
 
 
 def core(b: Built) -> Built:
@@ -236,6 +257,17 @@ def frame_datasets(b: Built, fr: Frame, p0=None, fields: bool = True) -> dict:
         d[f"probes/{name}/displacement"] = P[..., i, :] - p0[..., i, :]
     d.update(mooring_datasets(b.system, fr.X0, fr.q))        # quasi-static lines: from the pose
     d.update(fr.lines)                                       # lumped lines: from their states
+    term = bodies_term(b.system)
+    if term is not None:
+        for i, name in enumerate(term.names):
+            B = fr.bodies[..., i, :]
+            d[f"bodies/{name}/position"] = B[..., :3]
+            d[f"bodies/{name}/quaternion"] = B[..., 3:7]
+            d[f"bodies/{name}/angular_velocity"] = B[..., 7:]
+            d[f"bodies/{name}/roll_pitch_yaw"] = rpy_from_quat(B[..., 3:7])
+        for i, name in enumerate(term.link_names):
+            d[f"connections/{name}/force"] = fr.links[..., i, 0]
+            d[f"connections/{name}/extension"] = fr.links[..., i, 1]
     if fields and b.tanks:
         D = nodal(b, fr.D)
         for t in b.tanks:

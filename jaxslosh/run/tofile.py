@@ -25,6 +25,7 @@ from .capsize import vanishing_angles
 from ..cache.compiled import compile_run
 from ..mooring.lumped_term import lumped_terms
 from ..mooring.term import mooring_term
+from ..physics.bodies import bodies_term
 from .loop import core, ending_at, frame_datasets
 from .progress import Progress
 from .simulate import failure_message, prepare
@@ -70,7 +71,9 @@ def run_to_file(scene: Scene, out: str, *, progress: bool = True,
             lumped = lumped_terms(b.system)
             writer = ResultWriter(out, scene.text, b.probes.names, b.tanks if save_fields else (),
                                   (*getattr(mooring_term(b.system), "names", ()), *(t.name for t in lumped)),
-                                  {t.name: t.line.segments + 1 for t in lumped})
+                                  {t.name: t.line.segments + 1 for t in lumped},
+                                  bodies=getattr(bodies_term(b.system), "names", ()),
+                                  connections=getattr(bodies_term(b.system), "link_names", ()))
             stop.check()
             bar.phase("compile", "compiling the step")
             bc = core(b)

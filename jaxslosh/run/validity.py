@@ -14,6 +14,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from ..assemble.multimodal3d import tank_3d, three_dimensional
 from ..physics.kinematics import rpy_from_quat
 from ..physics.multimodal import NX
 from ..physics.multimodal_steep import STEEP_ON
@@ -35,7 +36,6 @@ def _surface_tables(scene: Scene):
     rows for a three-dimensional tank, the elevation's rows at the liquid's quadrature points (Q,
     modes), their weights (Q,), k_N, omega_N^2): what the slope, the crest index and the round-off
     floor (physics/multimodal_steep.py) are read from, at the points and weights the liquid uses."""
-    from ..assemble.multimodal3d import tank_3d, three_dimensional
     out, off = [], 0
     for t in scene.tanks:
         if t.model != "multimodal":

@@ -37,6 +37,13 @@ TABLES = (
     ("effects", "Switches to leave an effect out (to measure what it contributes); all on by default."),
     ("waves", "Incident linear (Airy) waves."),
     ("mooring", "Zero or more `[[mooring]]` lines from the seabed to the vessel (guide: Moorings)."),
+    ("bodies", "Zero or more `[[bodies]]`: rigid floating bodies beside the vessel, each in its own frame "
+               "(guide: Bodies and connections)."),
+    ("bodies.hydrostatics", "The body's linear restoring about its rest pose, as `[vessel.hydrostatics]`."),
+    ("bodies.hydrodynamics", "The body's linear viscous damping (no tables or files yet)."),
+    ("bodies.initial", "The body's initial state, as `[vessel.initial]`; every key optional, zero by default."),
+    ("connections", "Zero or more `[[connections]]`: hawsers, fenders and springs between two bodies, or a "
+                    "body and a fixed point (guide: Bodies and connections)."),
     ("campaign", "A campaign's defaults (`jaxslosh campaign`, `js.campaign`); `jaxslosh run` ignores it."),
     ("campaign.limits", "Operability limits per channel."),
 )
@@ -73,7 +80,8 @@ KEYS = (
     ("simulation.energy_projection", "false", "", 'scheme = "newmark" in a conservative scene only: after each '
      "step the velocities are scaled back onto the initial energy."),
     # vessel
-    ("vessel.name", '"vessel"', "", "How mooring lines (`mooring.body`) name the vessel."),
+    ("vessel.name", '"vessel"', "", "How mooring lines (`mooring.body`), connections (`connections.bodies`) and "
+                                    "tanks (`tanks.body`) name the vessel (\"vessel\" names it too)."),
     ("vessel.cog_height", "box hull: kg - draft; else 0", "m", "The COG's height above the still-water level at "
                                                                 "rest (it places the mooring fairleads)."),
     ("vessel.mass", _REQ, "kg", "The whole ship without its tank liquid (structures and elastic walls "
@@ -148,6 +156,8 @@ KEYS = (
     ("vessel.hydrodynamics.length_scale", "1", "m", "WAMIT's ULEN."),
     # tanks
     ("tanks.name", _REQ, "", "The tank's name (no '.', '[', ']' or '/')."),
+    ("tanks.body", '"vessel"', "", "The body that carries the tank: the vessel (tanks on `[[bodies]]` are not "
+                                   "available yet)."),
     ("tanks.origin", _REQ, "m", "The min corner of the tank's bounding box in the vessel frame."),
     ("tanks.size", _REQ, "m", "The bounding box: inner length (x), breadth (y), height (z)."),
     ("tanks.fill_depth", "required (not for mesh)", "m", "Liquid depth at rest from the tank's lowest point."),
@@ -257,6 +267,44 @@ KEYS = (
     ("mooring.model", '"catenary"', "", '"catenary": the quasi-static elastic catenary with seabed contact '
                                         '("lumped" is not available yet).'),
     ("mooring.seabed_friction", "0", "", "Friction coefficient of the part on the seabed (anchor on the seabed)."),
+    # bodies
+    ("bodies.name", _REQ, "", 'The body\'s name (result datasets `/bodies/<name>/...`); not "vessel", "fixed" '
+                              "or the vessel's `name`."),
+    ("bodies.position", "[0, 0]", "m", "Its COG at rest, horizontally from the vessel's COG at rest, inertial "
+                                       "[x, y]; their waterplanes (as circles of their areas) must not overlap."),
+    ("bodies.heading", "0", "rad", "Its x axis from the inertial X axis at rest."),
+    ("bodies.cog_height", "0", "m", "Its COG's height above the still-water level at rest."),
+    ("bodies.mass", _REQ, "kg", "The body's mass."),
+    ("bodies.inertia", _REQ, "kg m^2", "About its COG, its body axes: 3 diagonal values or 3 x 3."),
+    ("bodies.hydrostatics.waterplane_area", _REQ, "m^2", "A_w: heave restoring rho g A_w."),
+    ("bodies.hydrostatics.displaced_volume", _REQ, "m^3", "Displaced volume at rest (its buoyancy balances its "
+                                                          "weight there)."),
+    ("bodies.hydrostatics.gm_t", _REQ, "m", "Transverse metacentric height."),
+    ("bodies.hydrostatics.gm_l", _REQ, "m", "Longitudinal metacentric height."),
+    ("bodies.hydrostatics.moment", '"conservative"', "", 'As `vessel.hydrostatics.moment`.'),
+    ("bodies.hydrostatics.model", '"linear"', "", '"linear" only (the nonlinear hydrostatics of a hull are not '
+                                                  "available yet for bodies)."),
+    ("bodies.hydrodynamics.viscous_damping", "none", "N s/m, N m s", "Linear damping (6 or 6 x 6) about its COG, "
+                                                                     "its axes."),
+    ("bodies.initial.position", "[0, 0, 0]", "m", "Inertial offset of its COG from its rest position."),
+    ("bodies.initial.velocity", "[0, 0, 0]", "m/s", "Inertial velocity of its COG."),
+    ("bodies.initial.angular_velocity", "[0, 0, 0]", "rad/s", "Its body frame."),
+    ("bodies.initial.roll_pitch_yaw", "[0, 0, 0]", "rad", "Initial attitude from its rest attitude (the yaw is "
+                                                          "added to its heading)."),
+    # connections
+    ("connections.name", '"connection<i>"', "", "The connection's name (result datasets `/connections/<name>/...`)."),
+    ("connections.kind", _REQ, "", '"hawser": pulls only | "fender": pushes only | "spring": both.'),
+    ("connections.bodies", _REQ, "", 'The two bodies it ties: "vessel" (or the vessel\'s `name`), a body\'s '
+                                     'name, or "fixed" as the second (an inertial point).'),
+    ("connections.points", _REQ, "m", "One point per body in that body's frame, from its COG; a fixed point "
+                                      "inertial, from the vessel's COG at rest."),
+    ("connections.length", _REQ, "m", "Unstretched length (hawser, spring), or the points' distance at first "
+                                      "contact (fender)."),
+    ("connections.stiffness", "required unless curve", "N/m", "Linear stiffness."),
+    ("connections.curve", "required unless stiffness", "m, N", "[[deflection, force], ...], both increasing, "
+                                                               "from (0, 0): piecewise linear, extended with its "
+                                                               "last slope."),
+    ("connections.damping", "0", "N s/m", "Along the line, while in contact for a hawser or a fender."),
     # campaign
     ("campaign.headings", "waves.heading", "rad", "The campaign's headings."),
     ("campaign.seeds", "1", "", "Seeds per cell and heading."),

@@ -54,6 +54,8 @@ class _Keys(tuple):
 TANK_TRACEABLE = ("fill_depth", "fluid.density", "fluid.sound_speed", "damping.ratio")
 # a mooring line's values, leaves of the lines' term (jaxslosh/mooring/term.py)
 MOORING_TRACEABLE = ("length", "weight", "ea", "seabed_friction")
+# a connection's values, leaves of its link (physics/bodies.py)
+CONNECTION_TRACEABLE = ("length", "stiffness", "damping")
 
 
 TRACEABLE = _Keys((
@@ -64,7 +66,8 @@ TRACEABLE = _Keys((
     "vessel.initial.roll_pitch_yaw", "vessel.hull.kg", "vessel.hull.cog",
     "vessel.forced.amplitude", "vessel.forced.frequency", "vessel.forced.phase",
 ) + tuple(f"tanks.<name>.{k}" for k in TANK_TRACEABLE) + ("waves.amplitude", "waves.hs")
-  + tuple(f"mooring.<name>.{k}" for k in MOORING_TRACEABLE))
+  + tuple(f"mooring.<name>.{k}" for k in MOORING_TRACEABLE)
+  + tuple(f"connections.<name>.{k}" for k in CONNECTION_TRACEABLE))
 
 # keys traced by the nonlinear hydrostatics alone (assemble/hull.py moves the hull's surface against the
 # COG); the linear model's GM springs were derived from them when the scene was loaded
@@ -135,6 +138,12 @@ def scene_values(scene: Scene) -> dict[str, Any]:
                "fairlead": m.fairlead, "anchor": m.anchor}
         for prefix in (f"mooring.{m.name}", f"mooring[{i}]"):
             v.update({f"{prefix}.{k}": x for k, x in own.items()})
+    for i, c in enumerate(scene.connections):
+        own = {"length": c.length, "damping": c.damping}
+        if c.stiffness is not None:
+            own["stiffness"] = c.stiffness
+        for prefix in (f"connections.{c.name}", f"connections[{i}]"):
+            v.update({f"{prefix}.{k}": x for k, x in own.items()})
     if scene.campaign is not None:   # a campaign's settings (never traced: they change no run)
         if scene.campaign.duration is not None:
             v["campaign.duration"] = scene.campaign.duration
@@ -146,7 +155,7 @@ def scene_values(scene: Scene) -> dict[str, Any]:
 def canonical_key(scene: Scene, key: str) -> str:
     """The name form of a dotted key: `tanks[0].fill_depth` -> `tanks.tank.fill_depth` (others unchanged)."""
     for group, items in (("tanks", scene.tanks), ("structures", scene.structures), ("probes", scene.probes),
-                         ("mooring", scene.mooring)):
+                         ("mooring", scene.mooring), ("connections", scene.connections)):
         if key.startswith(group + "["):
             index, sep, rest = key[len(group) + 1:].partition("]")
             if sep and index.isdigit() and int(index) < len(items):
@@ -286,7 +295,7 @@ def _plain(value):
 def _toml_path(scene: Scene, key: str) -> list:
     """The path of a canonical key in the TOML mapping: `tanks.tank.fill_depth` -> ["tanks", 0, "fill_depth"]."""
     for group, items in (("tanks", scene.tanks), ("structures", scene.structures), ("probes", scene.probes),
-                         ("mooring", scene.mooring)):
+                         ("mooring", scene.mooring), ("connections", scene.connections)):
         for i, item in enumerate(items):
             head = f"{group}.{item.name}."
             if key.startswith(head):

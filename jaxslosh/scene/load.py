@@ -30,6 +30,7 @@ from ..geometry import AXES, SHAPES
 from .campaign import read_campaign
 from .fields import (at_least, counts, flat_list, non_negative, one_of, poisson_ratio, positive, read, show, sizes,
                      valid_name)
+from .bodies import bodies_scene, read_bodies, read_connections
 from .mooring import read_mooring
 from .record import forced_span, read_forced
 from .rules import conservative as _conservative, locking_elements as _locking_elements
@@ -96,7 +97,8 @@ def parse_scene(mapping: Mapping[str, Any], text: str = "", path: str = "") -> S
         "title": ("str", None), "environment": ("table", None), "simulation": ("table", None),
         "vessel": ("table", None), "tanks": ("tables", None), "structures": ("tables", None),
         "probes": ("tables", None), "effects": ("table", None), "waves": ("table", None),
-        "campaign": ("table", None), "mooring": ("tables", None),
+        "campaign": ("table", None), "mooring": ("tables", None), "bodies": ("tables", None),
+        "connections": ("tables", None),
     }, required=("simulation", "vessel"))
     warnings: list[str] = []
     title = top.get("title", Path(path).stem if path else "")
@@ -120,7 +122,11 @@ def parse_scene(mapping: Mapping[str, Any], text: str = "", path: str = "") -> S
     _unique_names(probes, "probes", "probe")
     for i, probe in enumerate(probes):
         _place_probe(probe, f"probes[{i}]", tanks, structures)
-    mooring = read_mooring(mapping.get("mooring", []), environment.depth, vessel.name, vessel.cog_height, warnings)
+    bodies = read_bodies(mapping.get("bodies", []), vessel, environment, warnings)
+    connections = read_connections(mapping.get("connections", []), vessel.name, bodies)
+    bodies_scene(bodies, vessel.name, structures, mapping, warnings)
+    mooring = read_mooring(mapping.get("mooring", []), environment.depth, vessel.name, vessel.cog_height, warnings,
+                           tuple(b.name for b in bodies))
     _mass_balance(vessel, tanks, environment, warnings, structures, mooring)
     effects = Effects(**read(mapping.get("effects", {}), "effects", {k: ("bool", None) for k in EFFECTS}))
     waves = None
@@ -131,7 +137,8 @@ def parse_scene(mapping: Mapping[str, Any], text: str = "", path: str = "") -> S
         campaign = read_campaign(mapping["campaign"], probes, waves, simulation.dt, warnings)
     scene = Scene(title=title, environment=environment, simulation=simulation, vessel=vessel, tanks=tanks,
                   structures=structures, probes=probes, effects=effects, text=text, path=path,
-                  warnings=tuple(warnings), waves=waves, campaign=campaign, mooring=mooring)
+                  warnings=tuple(warnings), waves=waves, campaign=campaign, mooring=mooring, bodies=bodies,
+                  connections=connections)
     if waves is not None or vessel.hull is not None or vessel.hydrodynamics is not None:
         scene = check_waves(scene, path, warnings)
         scene = dataclasses.replace(scene, warnings=tuple(warnings))
@@ -279,7 +286,7 @@ def _material(table, where: str) -> Material:
 
 def _tank(table, where: str, base_dir: str = "") -> Tank:
     v = read(table, where, {
-        "name": ("str", valid_name), "origin": ("vec3", None), "size": ("vec3", sizes),
+        "name": ("str", valid_name), "origin": ("vec3", None), "size": ("vec3", sizes), "body": ("str", None),
         "fill_depth": ("float", None), "mesh": ("mesh", counts), "walls": ("str_or_table", None),
         "fluid": ("table", None), "reduction": ("table", None), "damping": ("table", None),
         "shape": ("str", one_of(SHAPES)), "chamfers": ("any", None), "axis": ("str", one_of(AXES)),

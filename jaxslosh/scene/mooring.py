@@ -17,7 +17,8 @@ MODELS = ("catenary", "lumped")
 SEABED_TOLERANCE = 1e-6
 
 
-def read_mooring(tables, depth, vessel_name: str, cog_z: float, warnings: list[str]) -> tuple[MooringLine, ...]:
+def read_mooring(tables, depth, vessel_name: str, cog_z: float, warnings: list[str],
+                 bodies: tuple = ()) -> tuple[MooringLine, ...]:
     """The lines of a scene; `depth` is `[environment] depth` (None when absent), `cog_z` the
     vessel's COG height above the still-water level."""
     lines = []
@@ -38,6 +39,9 @@ def read_mooring(tables, depth, vessel_name: str, cog_z: float, warnings: list[s
             raise SceneError("environment.depth", f"is required by the mooring lines ({where}): the water depth "
                                                   "in m, which places the seabed")
         body = v.get("body", "vessel")
+        if body in bodies:
+            raise SceneError(f"{where}.body", f"{show(body)}: mooring lines on [[bodies]] are not available yet; "
+                                              "moor the vessel, or tie the body with [[connections]]")
         if body not in ("vessel", vessel_name):
             raise SceneError(f"{where}.body", f"{show(body)} is not a body of the scene (the vessel is "
                                               f"{show(vessel_name)}; \"vessel\" names it too)")

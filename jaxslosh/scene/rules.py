@@ -33,6 +33,10 @@ def conservative(scene: Scene) -> None:
         why.append("[tanks.damping] removes energy")
     if scene.structures:
         why.append("flexible structures are not covered by the projection")
+    if any(b.viscous_damping is not None for b in scene.bodies) or any(c.damping for c in scene.connections):
+        why.append("the bodies' viscous damping and the connections' damping remove energy")
+    if any(b.hydrostatics.moment != "conservative" for b in scene.bodies):
+        why.append('a body\'s hydrostatics.moment = "paper" is not the gradient of a potential')
     if v.hydrostatics is not None and v.hydrostatics.moment != "conservative":
         why.append('vessel.hydrostatics.moment = "paper" is not the gradient of a potential')
     off = [k for k in ("coriolis", "centrifugal", "gravity_turning") if not getattr(e, k)]

@@ -121,6 +121,38 @@ class Vessel:
 
 
 @dataclass(frozen=True)
+class Body:
+    """A `[[bodies]]` rigid floating body beside the vessel (docs/guide/bodies-and-connections.md):
+    its COG at rest `position` (x, y) horizontally from the vessel's, inertial, and `cog_height`
+    above the still-water level; its x axis `heading` rad from the inertial X axis."""
+    name: str
+    mass: float                      # kg, > 0
+    inertia: Mat3                    # kg m^2 about its COG, its body axes
+    hydrostatics: Hydrostatics       # linear GM springs about its rest pose
+    position: tuple = (0.0, 0.0)     # m
+    heading: float = 0.0             # rad
+    cog_height: float = 0.0          # m
+    initial: Initial = field(default_factory=Initial)   # offsets from its rest pose (attitude after the heading)
+    viscous_damping: Optional[tuple] = None   # (6, 6) linear damping, N s/m and N m s, its COG and axes
+
+
+@dataclass(frozen=True)
+class Connection:
+    """A `[[connections]]` hawser, fender or spring between two bodies, or a body and a fixed point
+    (docs/guide/bodies-and-connections.md). `ends`: two names, "vessel", a body's or "fixed"
+    (second only); `points` one per end in that end's frame from its COG (a fixed end's inertial,
+    from the vessel's COG at rest); `curve` ((deflection m, force N), ...) from (0, 0), increasing."""
+    name: str
+    kind: str                        # "hawser" | "fender" | "spring"
+    ends: tuple                      # (str, str)
+    points: tuple                    # (Vec3, Vec3)
+    length: float                    # m, >= 0
+    stiffness: Optional[float] = None   # N/m (None: the curve)
+    curve: tuple = ()                # ((deflection, force), ...), starting at (0, 0)
+    damping: float = 0.0             # N s/m, >= 0
+
+
+@dataclass(frozen=True)
 class MooringLine:
     """A `[[mooring]]` line (docs/guide/moorings.md): the fairlead in its body's frame (from the
     COG), the anchor inertial (x, y from the vessel's COG at rest, z from the still-water level)."""
@@ -361,6 +393,8 @@ class Scene:
     waves: Optional["Waves"] = None  # the [waves] table: incident regular waves or a JONSWAP sea
     campaign: CampaignTable | None = None      # the [campaign] table: a campaign's limits and defaults
     mooring: tuple["MooringLine", ...] = ()    # the [[mooring]] lines
+    bodies: tuple["Body", ...] = ()            # the [[bodies]]: rigid floating bodies beside the vessel
+    connections: tuple["Connection", ...] = () # the [[connections]]: hawsers, fenders, springs
 
     def tank(self, name: str) -> Tank:
         for t in self.tanks:

@@ -177,7 +177,7 @@ def static_equilibrium(system: System, solver: Solver, c0: Config, v0, alg0):
     frames and multipliers of the equilibrium. Nothing to solve without owners: the static layout
     says so (a Python branch on static model data, as MJX's stages skip what a model lacks)."""
     L = system.layout()
-    if not system.owners():
+    if not any(o.settles() for o in system.owners()):
         return c0, v0, alg0, StepInfo(jnp.zeros((), jnp.int32), jnp.zeros(()), jnp.array(True))
     r, nf = L.n_rigid, L.nf
     held = jnp.zeros(L.n_dyn, dtype=bool).at[:6].set(True).at[r:r + nf].set(True)

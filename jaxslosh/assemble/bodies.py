@@ -1,0 +1,92 @@
+"""The `[[bodies]]` and `[[connections]]` of a scene as the term physics/bodies.py defines
+(docs/guide/bodies-and-connections.md). A body's rigid terms come from the functions that make the
+vessel's (`rigid_terms`): its inertia, its linear hydrostatics and its viscous damping."""
+from __future__ import annotations
+
+from typing import Optional
+
+import jax.numpy as jnp
+import numpy as np
+
+from ..physics.about import About
+from ..physics.bodies import BAND, FIXED, VESSEL, Bodies, Floating, Link
+from ..physics.kinematics import quat_from_rpy
+from ..physics.seakeeping import LinearDamping
+from ..physics.vessel import Hydrostatics, PaperHydrostatics, RigidBody
+
+
+def linear_hydrostatics(h, rho_w, g, value=lambda key, v: v) -> Hydrostatics:
+    """The linear restoring term of a `hydrostatics` table (the vessel's or a body's); `value(name,
+    v)` may replace a value (the vessel's traced params)."""
+    f = lambda k, v: jnp.asarray(value(k, v), dtype=float)  # noqa: E731
+    form = PaperHydrostatics if h.moment == "paper" else Hydrostatics
+    return form(rho_w=jnp.asarray(rho_w, dtype=float), gravity=g,
+                waterplane_area=f("waterplane_area", h.waterplane_area),
+                displaced_volume=f("displaced_volume", h.displaced_volume), gm_t=f("gm_t", h.gm_t),
+                gm_l=f("gm_l", h.gm_l))
+
+
+def rigid_terms(mass, inertia, hydrostatics, rho_w, g, viscous=None) -> tuple:
+    """A floating body's rigid terms, as the vessel has them: inertia with its gyroscopic terms
+    (RigidBody), linear hydrostatics about the rest pose (its weight balanced by the buoyancy at
+    rest), and linear viscous damping (6 x 6) where given."""
+    I = jnp.asarray(inertia, dtype=float)
+    terms = [RigidBody(mass=jnp.asarray(mass, dtype=float), inertia=jnp.diag(I) if I.ndim == 1 else I),
+             linear_hydrostatics(hydrostatics, rho_w, g)]
+    if viscous is not None:
+        terms.append(LinearDamping(jnp.asarray(viscous, dtype=float)))
+    return tuple(terms)
+
+
+def build_bodies(scene, params: dict, g) -> Optional[Bodies]:
+    """The term of the scene's bodies and connections, or None without either."""
+    if not scene.bodies and not scene.connections:
+        return None
+    P = params.get
+    rho = P("environment.water_density", scene.environment.water_density)
+    cog = scene.vessel.cog_height
+    floating = []
+    for b in scene.bodies:
+        rest = np.array([b.position[0], b.position[1], b.cog_height - cog])
+        ini = b.initial
+        roll, pitch, yaw = ini.roll_pitch_yaw
+        floating.append(Floating(
+            terms=rigid_terms(b.mass, b.inertia, b.hydrostatics, rho, g, b.viscous_damping),
+            rest=jnp.asarray(rest), x0=jnp.asarray(rest + np.asarray(ini.position)),
+            q0=quat_from_rpy(jnp.array([roll, pitch, yaw + b.heading])),
+            v0=jnp.asarray(np.concatenate([ini.velocity, ini.angular_velocity]), dtype=float)))
+    index = {b.name: s for s, b in enumerate(scene.bodies)} | {"vessel": VESSEL, "fixed": FIXED}
+    links = []
+    for c in scene.connections:
+        key = f"connections.{c.name}"
+        if c.stiffness is not None:       # a straight curve, extended with its slope
+            xs = jnp.array([0.0, 1.0])
+            fs = jnp.stack([jnp.zeros(()), jnp.asarray(P(f"{key}.stiffness", c.stiffness), dtype=float)])
+        else:
+            xs, fs = jnp.asarray([p[0] for p in c.curve]), jnp.asarray([p[1] for p in c.curve])
+        links.append(Link(ends=tuple(index[e] for e in c.ends), kind=c.kind, pa=jnp.asarray(c.points[0]),
+                          pb=jnp.asarray(c.points[1]), length=jnp.asarray(P(f"{key}.length", c.length), dtype=float),
+                          xs=xs, fs=fs, damping=jnp.asarray(P(f"{key}.damping", c.damping), dtype=float)))
+    return Bodies(bodies=tuple(floating), links=tuple(links), gravity=g, names=tuple(b.name for b in scene.bodies),
+                  link_names=tuple(c.name for c in scene.connections), about=_about(scene))
+
+
+def _about(scene) -> About:
+    lines = []
+    for b in scene.bodies:
+        h = b.hydrostatics
+        damp = ", viscous damping" if b.viscous_damping is not None else ""
+        lines.append(("floating body", f"{b.name!r}: 6 unknowns of its own floating frame at "
+                                       f"({b.position[0]:g}, {b.position[1]:g}) m from the vessel, heading "
+                                       f"{b.heading:g} rad, mass {b.mass:g} kg; rigid-body inertia and linear "
+                                       f"hydrostatics (A_w {h.waterplane_area:g} m^2, GM_T {h.gm_t:g} m, GM_L "
+                                       f"{h.gm_l:g} m){damp}"))
+    shown = {"vessel": scene.vessel.name}       # the ends as the scene names them
+    for c in scene.connections:
+        law = f"stiffness {c.stiffness:g} N/m" if c.stiffness is not None else f"a {len(c.curve)}-point force curve"
+        band = f", contact smoothed over {1e3 * BAND:g} mm" if c.kind != "spring" else ""
+        damp = f", damping {c.damping:g} N s/m" if c.damping else ""
+        lines.append(("connection", f"{c.name!r}: {c.kind} {shown.get(c.ends[0], c.ends[0])} - "
+                                    f"{shown.get(c.ends[1], c.ends[1])}, length {c.length:g} m, "
+                                    f"{law}{damp}{band}"))
+    return About(*lines)

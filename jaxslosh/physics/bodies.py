@@ -1,0 +1,260 @@
+"""Rigid floating bodies beside the vessel and the connections between them: one term that owns
+unknowns (`Bodies`, an unknowns.AbstractOwner), docs/guide/bodies-and-connections.md.
+
+Bodies as one family: each body is a floating frame of its own (6 rigid unknowns, rotations on the
+group) whose rows are the sum of the *same term classes* as the vessel's rigid part (vessel.py:
+`RigidBody`, the linear `Hydrostatics` about its own rest pose, seakeeping.py's `LinearDamping`),
+evaluated with the body's own kinematics (`Floating.kin`): a body is built by the functions that
+build the vessel's rigid terms. What the vessel has and a body has not yet: tanks, hull meshes and
+nonlinear hydrostatics, hydrodynamic databases and waves.
+
+Positions are in the frame whose origin is the vessel's COG at rest, axes inertial (the vessel's X0):
+a body's frame origin is its COG, at `rest` when it floats at rest; its hydrostatic restoring reads
+its offset from there (its heave) and its attitude's tilt (g = A^T e_z, independent of its heading).
+Like the vessel's, a body's weight is balanced by its static buoyancy at rest.
+
+Connections (hawsers, fenders, springs) act between two points, each on the vessel, on a body or
+fixed (inertial). Their force derives from a potential U(e) of the extension e = d - L (d the
+points' distance), so an undamped contact conserves energy, and the contact's switch is smoothed:
+a hawser's potential is W(rho(e)), a fender's W(rho(-e)), with W the force curve's integral and
+rho(x) = max(x, 0) blended by a quadratic over |x| < BAND / 2 (rho and rho' continuous): the force
+W'(rho) rho' is exactly zero below -BAND/2 and exactly the curve's beyond BAND/2. The damping
+c de/dt acts through the same contact factor rho' and never more than cancels the elastic force (a
+hawser does not push, a fender does not pull).
+"""
+from __future__ import annotations
+
+from typing import Optional
+
+import equinox as eqx
+import jax
+import jax.numpy as jnp
+
+from .about import About
+from .kinematics import quat_exp, quat_multiply, rotation_matrix
+from .terms import Config, Kin, Rows, Unknowns
+from .unknowns import AbstractOwner
+
+#: m: the width of the smoothed contact switch of hawsers and fenders (centred on first contact)
+BAND = 1e-3
+#: the end index of the vessel and of a fixed (inertial) point in `Link.ends`
+VESSEL, FIXED = -1, -2
+_D_EPS2 = 1e-24      # m^2: keeps the direction defined (and differentiable) where the points meet
+
+
+def ramp(x, band=BAND):
+    """(rho, rho'): max(x, 0) with its corner replaced by (x + band/2)^2 / (2 band) on |x| < band/2."""
+    h = 0.5 * band
+    inside = (x + h) ** 2 / (2.0 * band)
+    rho = jnp.where(x <= -h, 0.0, jnp.where(x >= h, x, inside))
+    slope = jnp.where(x <= -h, 0.0, jnp.where(x >= h, 1.0, (x + h) / band))
+    return rho, slope
+
+
+class Link(eqx.Module):
+    """One connection: ends (VESSEL, a body's index or FIXED), a point in each end's frame, its
+    unstretched length and force curve (deflection xs, force fs from (0, 0), extended with the last
+    slope) and its damping."""
+    ends: tuple = eqx.field(static=True)
+    kind: str = eqx.field(static=True)          # "hawser" | "fender" | "spring"
+    pa: jax.Array = None
+    pb: jax.Array = None
+    length: jax.Array = None
+    xs: jax.Array = None
+    fs: jax.Array = None
+    damping: jax.Array = None
+
+    def curve(self, x):
+        """(W(x), F(x)): the curve's energy and force at deflection x >= 0."""
+        xs, fs = self.xs, self.fs
+        i = jnp.clip(jnp.searchsorted(xs, x, side="right") - 1, 0, xs.shape[0] - 2)
+        slope = (fs[1:] - fs[:-1]) / (xs[1:] - xs[:-1])
+        W_nodes = jnp.concatenate([jnp.zeros(1), jnp.cumsum(0.5 * (fs[1:] + fs[:-1]) * (xs[1:] - xs[:-1]))])
+        s = x - xs[i]
+        return W_nodes[i] + fs[i] * s + 0.5 * slope[i] * s * s, fs[i] + slope[i] * s
+
+    def law(self, e):
+        """(U(e), dU/de, the contact factor of the damping) at extension e."""
+        if self.kind == "spring":       # W(|e|) is C1: F(0) = 0
+            W, F = self.curve(jnp.abs(e))
+            return W, jnp.sign(e) * F, jnp.ones_like(e)
+        sign = 1.0 if self.kind == "hawser" else -1.0
+        rho, slope = ramp(sign * e)
+        W, F = self.curve(rho)
+        return W, sign * F * slope, slope
+
+    def state(self, poses):
+        """(tension T (> 0 pulls), extension e, U, the two points, their velocities, the unit vector a -> b)
+        of this link, `poses[end]` = (X, A, V, omega) (omega body frame)."""
+        def point(end, p):
+            if end == FIXED:
+                return p, jnp.zeros(3)
+            X, A, V, w = poses[end]
+            return X + A @ p, V + A @ jnp.cross(w, p)
+        Pa, Va = point(self.ends[0], self.pa)
+        Pb, Vb = point(self.ends[1], self.pb)
+        dv = Pb - Pa
+        d = jnp.sqrt(dv @ dv + _D_EPS2)
+        n = dv / d
+        e = d - self.length
+        U, dU, contact = self.law(e)
+        Td = self.damping * contact * (n @ (Vb - Va))
+        # a hawser's damping cancels its elastic pull at most (a rope does not push), a fender's its push
+        if self.kind == "hawser":
+            Td = jnp.maximum(Td, -dU)
+        elif self.kind == "fender":
+            Td = jnp.minimum(Td, -dU)
+        return dU + Td, e, U, n
+
+    def forces(self, poses, rows: dict):
+        """Add its generalized forces (translation inertial, rotation body) to rows[end] (6,)."""
+        T, _, _, n = self.state(poses)
+        for end, p, f in ((self.ends[0], self.pa, T * n), (self.ends[1], self.pb, -T * n)):
+            if end == FIXED:
+                continue
+            A = poses[end][1]
+            rows[end] = rows[end] + jnp.concatenate([f, jnp.cross(p, A.T @ f)])
+        return rows
+
+
+class Floating(eqx.Module):
+    """One body's floating frame: its rigid terms (the vessel's classes, evaluated with its own
+    kinematics), its rest pose and its initial state."""
+    terms: tuple
+    rest: jax.Array        # (3,) its COG at rest, in the vessel-at-rest frame
+    x0: jax.Array          # (3,) its COG at t = 0, same frame
+    q0: jax.Array          # (4,) its attitude at t = 0 (its heading included)
+    v0: jax.Array          # (6,) V (inertial), omega (body) at t = 0
+
+    def kin(self, X, q, v, a, gravity, t) -> Kin:
+        """The body's Kin: its offset from rest as the configuration's X0 (what the hydrostatics read)."""
+        A = rotation_matrix(q)
+        g_b = A.T @ jnp.array([0.0, 0.0, -gravity])
+        return Kin(Config(X - self.rest, q, jnp.zeros(0)), v[:3], v[3:], jnp.zeros(0), a,
+                   None if a is None else jnp.zeros(0), jnp.asarray(t), jnp.zeros((0,)), A, g_b)
+
+    def rows(self, k: Kin):
+        return sum((t.rows(k).rigid for t in self.terms), jnp.zeros(6))
+
+
+class Bodies(AbstractOwner):
+    """The `[[bodies]]` (S floating frames beside the vessel's) and the `[[connections]]`. Without
+    bodies (connections from the vessel to fixed points only) it owns no unknowns and is a plain
+    term: its rows and potential are then the connections' on the vessel."""
+    bodies: tuple
+    links: tuple
+    gravity: jax.Array
+    names: tuple = eqx.field(static=True, default=())
+    link_names: tuple = eqx.field(static=True, default=())
+    about: About = eqx.field(static=True, default=About())
+
+    @property
+    def S(self) -> int:
+        return len(self.bodies)
+
+    def describe(self) -> tuple:
+        return self.about.lines
+
+    def unknowns(self) -> Unknowns:
+        return Unknowns(frames=self.S)
+
+    def settles(self) -> bool:
+        """Its unknowns start where the scene puts them, not at a static equilibrium (a body held by a
+        hawser alone has none in surge)."""
+        return False
+
+    # ------------------------------------------------------------ poses and connections
+    def poses(self, c: Config, vy):
+        """{end: (X, A, V, omega)} of the vessel (-1) and the bodies from the configuration and the
+        rigid velocities (vessel's six, then six per body)."""
+        out = {VESSEL: (c.X0, rotation_matrix(c.q), vy[:3], vy[3:6])}
+        for s in range(self.S):
+            out[s] = (c.Xs[s], rotation_matrix(c.qs[s]), vy[6 + 6 * s:9 + 6 * s], vy[9 + 6 * s:12 + 6 * s])
+        return out
+
+    def link_forces(self, poses):
+        """(6 + 6 S,) the connections' generalized forces on the vessel and the bodies."""
+        rows = {e: jnp.zeros(6) for e in poses}
+        for link in self.links:
+            rows = link.forces(poses, rows)
+        return jnp.concatenate([rows[VESSEL]] + [rows[s] for s in range(self.S)])
+
+    def link_potential(self, poses):
+        return sum((link.state(poses)[2] for link in self.links), jnp.zeros(()))
+
+    def link_states(self, c: Config, vy):
+        """(tensions (n,), extensions (n,)) of the connections."""
+        p = self.poses(c, vy)
+        st = [link.state(p) for link in self.links]
+        return jnp.stack([s[0] for s in st]) if st else jnp.zeros(0), jnp.stack([s[1] for s in st]) if st else jnp.zeros(0)
+
+    # ------------------------------------------------------------ a plain term without bodies
+    def rows(self, k: Kin) -> Rows:
+        if self.S:
+            return Rows(jnp.zeros(6))
+        return Rows(-self.link_forces({VESSEL: (k.c.X0, k.A, k.V0, k.omega)}))
+
+    def potential(self, k: Kin):
+        if self.S:
+            return jnp.zeros(())
+        return self.link_potential({VESSEL: (k.c.X0, k.A, k.V0, k.omega)})
+
+    # ------------------------------------------------------------ the owner's hooks
+    def start(self, system, c0: Config, v0):
+        c = c0._replace(Xs=jnp.stack([b.x0 for b in self.bodies]), qs=jnp.stack([b.q0 for b in self.bodies]),
+                        eta=jnp.zeros(0))
+        v = jnp.concatenate([v0[:6], *[b.v0 for b in self.bodies], v0[6:]])
+        return c, v, jnp.zeros(0)
+
+    def carried_velocities(self, system, c: Config, v):
+        return v
+
+    def advance(self, c: Config, out: Config, y, z) -> Config:
+        st = y.reshape(self.S, 6)
+        qs = jax.vmap(lambda q, th: quat_multiply(q, quat_exp(th)))(c.qs, st[:, 3:])
+        return out._replace(Xs=c.Xs + st[:, :3], qs=qs, eta=c.eta)
+
+    def body_kins(self, system, c: Config, vy, ay=None, t=0.0):
+        return [b.kin(c.Xs[s], c.qs[s], vy[6 + 6 * s:12 + 6 * s], None if ay is None else ay[6 + 6 * s:12 + 6 * s],
+                      system.gravity, t) for s, b in enumerate(self.bodies)]
+
+    def add_rows(self, system, c: Config, core_y, core_z, vy, vz, ay, az):
+        own = [b.rows(k) for b, k in zip(self.bodies, self.body_kins(system, c, vy, ay))]
+        return jnp.concatenate([core_y, *own]) - self.link_forces(self.poses(c, vy)), core_z
+
+    def extra_kinetic(self, system, c: Config, v):
+        vy = v[:6 + 6 * self.S]
+        return sum((t.kinetic(k) for b, k in zip(self.bodies, self.body_kins(system, c, vy)) for t in b.terms),
+                   jnp.zeros(()))
+
+    def extra_potential(self, system, c: Config):
+        vy = jnp.zeros(6 + 6 * self.S)
+        V = sum((t.potential(k) for b, k in zip(self.bodies, self.body_kins(system, c, vy)) for t in b.terms),
+                jnp.zeros(()))
+        return V + self.link_potential(self.poses(c, vy))
+
+    def add_scales(self, y, z):
+        return jnp.concatenate([y, *[sum((t.mass_scale() for t in b.terms), jnp.zeros(6)) for b in self.bodies]]), z
+
+    def constraint(self, system, c: Config, alg):
+        return jnp.zeros(0)
+
+    def constraint_rows(self, system, c: Config, alg, g_rows, gscale):
+        return jnp.zeros(system.layout().n)
+
+    def alg_scales(self, row_factor, err_factor):
+        return [], jnp.zeros(0)
+
+    def block_diagonal(self, c_m, c_k):
+        return jnp.zeros(0)
+
+    def initial_constraint_rows(self, system, c: Config, v, alg0, mscale):
+        return lambda x: jnp.zeros_like(x)
+
+    def initial_alg(self, alg0, alg_a):
+        return alg_a
+
+
+def bodies_term(system) -> Optional[Bodies]:
+    """The system's bodies-and-connections term, or None."""
+    return next((t for t in system.terms if isinstance(t, Bodies)), None)

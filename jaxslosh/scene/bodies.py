@@ -1,0 +1,208 @@
+"""The `[[bodies]]` and `[[connections]]` tables: rigid floating bodies beside the vessel and the
+hawsers, fenders and springs between them (docs/guide/bodies-and-connections.md).
+
+Read and checked here, with what the rest of the scene says about them (the vessel's name, its
+waterplane, the tanks' and lines' `body`). No JAX: the terms are built later (physics/bodies.py).
+What a body cannot have yet is refused by its key, never silently dropped.
+"""
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from .fields import non_negative, one_of, positive, read, show, valid_name
+from .types import Body, Connection, Hydrostatics, Initial, SceneError
+
+KINDS = ("hawser", "fender", "spring")
+#: the vessel's keys a body cannot have yet, refused by name (not as unknown keys)
+NOT_YET = {"hull": "hull meshes (and the waves' and the nonlinear hydrostatics' forces on them)",
+           "forced": "prescribed motions"}
+#: names a body cannot take: the words that name the vessel and an inertial point in `bodies = [...]`
+RESERVED = ("vessel", "fixed")
+
+
+def read_bodies(tables, vessel, environment, warnings: list[str]) -> tuple[Body, ...]:
+    """The `[[bodies]]` of a scene (`vessel`: the scene's types.Vessel)."""
+    out = []
+    for i, table in enumerate(tables):
+        where = f"bodies[{i}]"
+        if isinstance(table, dict):
+            for key, what in NOT_YET.items():
+                if key in table and what:
+                    raise SceneError(f"{where}.{key}", f"{what} are not available yet for [[bodies]] "
+                                                       "(docs/guide/bodies-and-connections.md, what is not yet)")
+        v = read(table, where, {
+            "name": ("str", valid_name), "position": ("any", None), "heading": ("float", None),
+            "cog_height": ("float", None), "mass": ("float", positive), "inertia": ("inertia", None),
+            "hydrostatics": ("table", None), "hydrodynamics": ("table", None), "initial": ("table", None),
+        }, required=("name", "mass", "inertia", "hydrostatics"))
+        name = v["name"]
+        if name in RESERVED or name == vessel.name:
+            raise SceneError(f"{where}.name", f"{show(name)} names the vessel or a fixed point in [[connections]]; "
+                                              "give the body another name")
+        if name in [b.name for b in out]:
+            raise SceneError(f"{where}.name", f"{show(name)} is the name of another body")
+        pos = table.get("position", [0.0, 0.0])
+        if not (isinstance(pos, list) and len(pos) == 2 and all(isinstance(c, (int, float)) and not isinstance(c, bool)
+                                                                  and math.isfinite(c) for c in pos)):
+            raise SceneError(f"{where}.position", f"must be a list of 2 numbers [x, y] (m, horizontally from the "
+                                                  f"vessel's COG at rest), got {show(pos)}")
+        hs = _hydrostatics(table["hydrostatics"], f"{where}.hydrostatics", warnings)
+        damping = None
+        if "hydrodynamics" in table:
+            other = [k for k in (table["hydrodynamics"] if isinstance(table["hydrodynamics"], dict) else ())
+                     if k != "viscous_damping"]
+            if other:
+                raise SceneError(f"{where}.hydrodynamics.{other[0]}", "hydrodynamic tables and files (added mass, "
+                                 "radiation, wave excitation) are not available yet for [[bodies]]: only "
+                                 "viscous_damping is")
+            hd = read(table["hydrodynamics"], f"{where}.hydrodynamics", {"viscous_damping": ("numbers", None)})
+            if "viscous_damping" in hd:
+                damping = _matrix6(hd["viscous_damping"], f"{where}.hydrodynamics.viscous_damping")
+        initial = Initial(**read(table.get("initial", {}), f"{where}.initial", {
+            "position": ("vec3", None), "velocity": ("vec3", None), "angular_velocity": ("vec3", None),
+            "roll_pitch_yaw": ("vec3", None),
+        }))
+        body = Body(name=name, mass=v["mass"], inertia=v["inertia"], hydrostatics=hs,
+                    position=(float(pos[0]), float(pos[1])), heading=v.get("heading", 0.0),
+                    cog_height=v.get("cog_height", 0.0), initial=initial, viscous_damping=damping)
+        buoyant = environment.water_density * hs.displaced_volume
+        if environment.gravity > 0 and abs(body.mass - buoyant) > 0.01 * buoyant:
+            warnings.append(f"{where}.hydrostatics.displaced_volume: the body's mass {body.mass:.6g} kg differs from "
+                            f"water_density * displaced_volume = {buoyant:.6g} kg by "
+                            f"{100 * (body.mass - buoyant) / buoyant:+.2f} %; its hydrostatic restoring is taken "
+                            "about its rest pose as if it were the equilibrium (the imbalance is ignored)")
+        out.append(body)
+    _overlaps(out, vessel)
+    return tuple(out)
+
+
+def _hydrostatics(table, where: str, warnings: list[str]) -> Hydrostatics:
+    if isinstance(table, dict) and table.get("model") == "nonlinear":
+        raise SceneError(f"{where}.model", '"nonlinear" hydrostatics (a hull\'s wetted surface) are not available '
+                                           'yet for [[bodies]]: give the linear values')
+    v = read(table, where, {
+        "waterplane_area": ("float", positive), "displaced_volume": ("float", positive), "gm_t": ("float", None),
+        "gm_l": ("float", None), "moment": ("str", one_of(("conservative", "paper"))),
+        "model": ("str", one_of(("linear",))),
+    }, required=("waterplane_area", "displaced_volume", "gm_t", "gm_l"))
+    h = Hydrostatics(**v)
+    for key, value, motion in (("gm_t", h.gm_t, "roll"), ("gm_l", h.gm_l, "pitch")):
+        if value <= 0:
+            warnings.append(f"{where}.{key} = {show(value)} m <= 0: the body is statically unstable in {motion}; "
+                            "it will capsize or loll")
+    return h
+
+
+def _matrix6(x, where: str):
+    a = np.asarray(x, dtype=float)
+    if a.shape not in ((6,), (6, 6)):
+        raise SceneError(where, f"must be 6 values or a 6 x 6 array, got shape {a.shape}")
+    a = np.diag(a) if a.ndim == 1 else a
+    if np.min(np.linalg.eigvalsh(0.5 * (a + a.T))) < -1e-9 * max(np.max(np.abs(a)), 1.0):
+        raise SceneError(where, "must be positive semi-definite (damping dissipates)")
+    return tuple(tuple(float(c) for c in row) for row in a)
+
+
+def footprint_radius(area: float) -> float:
+    """The radius of the circle of a waterplane's area: the footprint the overlap check compares."""
+    return math.sqrt(area / math.pi)
+
+
+def _overlaps(bodies, vessel) -> None:
+    """Two bodies whose waterplanes, as circles of their areas about their COGs at rest, intersect
+    are refused: they would float through each other (no contact is modelled but by fenders)."""
+    disks = []
+    if vessel.hydrostatics is not None:
+        disks.append(("vessel", (0.0, 0.0), footprint_radius(vessel.hydrostatics.waterplane_area)))
+    disks += [(b.name, b.position, footprint_radius(b.hydrostatics.waterplane_area)) for b in bodies]
+    for j, (nb, pb, rb) in enumerate(disks):
+        for na, pa, ra in disks[:j]:
+            gap = math.dist(pa, pb)
+            if gap < ra + rb:
+                i = [b.name for b in bodies].index(nb)
+                raise SceneError(f"bodies[{i}].position", (
+                    f"{show(list(pb))} puts {nb!r} {gap:.6g} m from {na!r}: their waterplanes (as circles of their "
+                    f"areas, radii {rb:.4g} and {ra:.4g} m) overlap at rest; place the bodies at least "
+                    f"{ra + rb:.6g} m apart"))
+
+
+def read_connections(tables, vessel_name: str, bodies) -> tuple[Connection, ...]:
+    """The `[[connections]]` of a scene, their ends among "vessel" (or the vessel's name), the
+    bodies' names and "fixed"."""
+    names = [b.name for b in bodies]
+    out = []
+    for i, table in enumerate(tables):
+        where = f"connections[{i}]"
+        v = read(table, where, {
+            "name": ("str", valid_name), "kind": ("str", one_of(KINDS)), "bodies": ("any", None),
+            "points": ("any", None), "length": ("float", non_negative), "stiffness": ("float", positive),
+            "curve": ("numbers", None), "damping": ("float", non_negative),
+        }, required=("kind", "bodies", "points", "length"))
+        name = v.get("name", f"connection{i + 1}")
+        if name in [c.name for c in out]:
+            raise SceneError(f"{where}.name", f"{show(name)} is the name of another connection")
+        ends = table["bodies"]
+        if not (isinstance(ends, list) and len(ends) == 2 and all(isinstance(e, str) for e in ends)):
+            raise SceneError(f"{where}.bodies", f"must be a list of 2 names, got {show(ends)}")
+        known = ["vessel", vessel_name, *names]
+        for k, e in enumerate(ends):
+            if e == "fixed" and k == 0:
+                raise SceneError(f"{where}.bodies", '"fixed" may only be the second end (the first is a body: '
+                                                    '"vessel" or one of [[bodies]])')
+            if e not in known and e != "fixed":
+                raise SceneError(f"{where}.bodies", f"{show(e)} is not a body of the scene (bodies: "
+                                                    f"{', '.join(repr(n) for n in dict.fromkeys(known))}; or \"fixed\")")
+        canon = tuple("vessel" if e == vessel_name else e for e in ends)
+        if canon[0] == canon[1]:
+            raise SceneError(f"{where}.bodies", f"{show(ends)} ties a body to itself")
+        pts = table["points"]
+        if not (isinstance(pts, list) and len(pts) == 2 and all(
+                isinstance(p, list) and len(p) == 3 and all(isinstance(c, (int, float)) and not isinstance(c, bool)
+                                                            and math.isfinite(c) for c in p) for p in pts)):
+            raise SceneError(f"{where}.points", f"must be 2 points [[x, y, z], [x, y, z]] (m), one in each body's "
+                                                f"frame, got {show(pts)}")
+        if ("stiffness" in v) == ("curve" in v):
+            raise SceneError(f"{where}.stiffness", "give either stiffness (N/m) or curve = [[deflection, force], ...]")
+        if v["length"] <= 0 and v["kind"] == "hawser":
+            raise SceneError(f"{where}.length", f"must be positive for a hawser, got {show(v['length'])}")
+        curve = _curve(v["curve"], f"{where}.curve") if "curve" in v else ()
+        out.append(Connection(name=name, kind=v["kind"], ends=canon,
+                              points=tuple(tuple(float(c) for c in p) for p in pts), length=v["length"],
+                              stiffness=v.get("stiffness"), curve=curve, damping=v.get("damping", 0.0)))
+    return tuple(out)
+
+
+def _curve(x, where: str) -> tuple:
+    """((deflection, force), ...) starting at (0, 0) (prepended when the first deflection is positive),
+    both columns increasing."""
+    a = np.asarray(x, dtype=float)
+    if a.ndim != 2 or a.shape[1] != 2 or a.shape[0] < 1:
+        raise SceneError(where, f"must be a list of [deflection m, force N] pairs, got shape {a.shape}")
+    if a[0, 0] < 0 or (a[0, 0] == 0 and a[0, 1] != 0):
+        raise SceneError(where, f"starts at {a[0].tolist()}: deflections are >= 0 and the force at 0 is 0")
+    if a[0, 0] > 0:
+        a = np.vstack([[0.0, 0.0], a])
+    if np.any(np.diff(a[:, 0]) <= 0) or np.any(np.diff(a[:, 1]) <= 0):
+        raise SceneError(where, f"must be increasing in both deflection and force, got {a.tolist()}")
+    return tuple((float(d), float(f)) for d, f in a)
+
+
+def bodies_scene(bodies, vessel_name, structures, mapping, warnings: list[str]) -> None:
+    """What the scene's other parts cannot do with [[bodies]] yet (docs/guide/bodies-and-connections.md)."""
+    for i, t in enumerate(mapping.get("tanks", [])):
+        body = t.get("body", "vessel") if isinstance(t, dict) else "vessel"
+        if body not in ("vessel", vessel_name, *[b.name for b in bodies]):
+            raise SceneError(f"tanks[{i}].body", f"{body!r} is not a body of the scene")
+        if body in [b.name for b in bodies]:
+            raise SceneError(f"tanks[{i}].body", f"{body!r}: tanks on [[bodies]] are not available yet; "
+                                                 "tanks ride on the vessel")
+    if not bodies:
+        return
+    if any(s.frame == "own" for s in structures):
+        raise SceneError("bodies", "[[bodies]] together with [[structures]] in their own frames are not available "
+                                   "yet (a model holds one of them)")
+    if "waves" in mapping:
+        warnings.append(f"waves: the incident waves act on the vessel only; the [[bodies]] "
+                        f"({', '.join(repr(b.name) for b in bodies)}) feel no wave excitation (not available yet)")
