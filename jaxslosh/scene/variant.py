@@ -72,9 +72,12 @@ def _path(mapping: dict, key: str) -> list:
 
 
 def _plain(key: str, value):
-    """A value as TOML holds it (NumPy and JAX scalars and arrays as Python numbers and lists)."""
+    """A value as TOML holds it (NumPy and JAX scalars and arrays as Python numbers and lists; a
+    mapping as a table, for keys a dotted name cannot spell: `{"campaign.limits": {"probe.B": 0.5}}`)."""
     if isinstance(value, (str, bool, int, float)):
         return value
+    if isinstance(value, Mapping):
+        return {str(k): _plain(f"{key}.{k}", v) for k, v in value.items()}
     if isinstance(value, (list, tuple)):
         return [_plain(key, v) for v in value]
     if hasattr(value, "tolist"):
@@ -128,7 +131,7 @@ def _value(v) -> str:
             return "nan"
         if math.isinf(v):
             return "inf" if v > 0 else "-inf"
-        return repr(v)
+        return repr(float(v))
     if isinstance(v, str):
         return _string(v)
     if isinstance(v, (list, tuple)):

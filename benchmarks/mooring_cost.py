@@ -1,0 +1,53 @@
+"""What three catenary mooring lines add to the paper example's step.
+
+    python benchmarks/mooring_cost.py [--steps 200] [--rounds 3]
+
+The paper example (scenes/paper_ship_tank.toml) free and moored on three catenary lines spread at
+120 degrees in 100 m of water (420 m long, 600 N/m, EA 3e8 N, anchors 400 m out: every line
+touches the seabed, as moored lines in their working range do). Each scene's step is timed with
+`js.Stepper.advance` (steps in one compiled scan) after compilation, the rounds interleaved, the
+best kept; process CPU time (all threads) and wall time. Prints the table and the moored/free
+ratio. No assertion.
+"""
+import argparse
+import time
+
+import jax
+
+jax.config.update("jax_enable_x64", True)
+
+import numpy as np  # noqa: E402
+
+import jaxslosh as js  # noqa: E402
+
+LINES = [{"name": f"l{i}", "fairlead": [5.0 * np.cos(a), 5.0 * np.sin(a), -1.0],
+          "anchor": [400.0 * np.cos(a), 400.0 * np.sin(a), -100.0], "length": 420.0, "weight": 600.0, "ea": 3.0e8}
+         for i, a in enumerate(np.radians([0.0, 120.0, 240.0]))]
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--steps", type=int, default=200)
+    ap.add_argument("--rounds", type=int, default=3)
+    a = ap.parse_args()
+    free = js.load_scene("scenes/paper_ship_tank.toml")
+    moored = js.scene_with(free, {"environment.depth": 100.0, "mooring": LINES})
+    steppers = {"free": js.Stepper(free), "three catenary lines": js.Stepper(moored)}
+    starts = {k: s.init() for k, s in steppers.items()}
+    for k, s in steppers.items():                  # compile
+        jax.block_until_ready(s.advance(starts[k], a.steps))
+    best = {k: (np.inf, np.inf) for k in steppers}
+    for _ in range(a.rounds):
+        for k, s in steppers.items():
+            c0, w0 = time.process_time(), time.perf_counter()
+            jax.block_until_ready(s.advance(starts[k], a.steps))
+            cpu, wall = (time.process_time() - c0) / a.steps, (time.perf_counter() - w0) / a.steps
+            best[k] = (min(best[k][0], cpu), min(best[k][1], wall))
+    print(f"{'scene':<22} {'unknowns':>8} {'CPU us/step':>12} {'wall us/step':>13} {'CPU / free':>11}")
+    for k, (cpu, wall) in best.items():
+        print(f"{k:<22} {steppers[k].unknowns:>8} {cpu * 1e6:>12.1f} {wall * 1e6:>13.1f} "
+              f"{cpu / best['free'][0]:>11.2f}")
+
+
+if __name__ == "__main__":
+    main()
