@@ -71,26 +71,58 @@ class Record:
         return self.steps / self.run_s
 
 
+class _Timed:
+    """A scene's stepper, compiled (its first call timed), then its runs timed one call at a time."""
+
+    def __init__(self, name, scene, steps, params=None, dt=None):
+        self.name, self.steps = name, int(steps)
+        t0 = time.perf_counter()
+        self.stepper = js.Stepper(scene, params, dt=dt)
+        t1 = time.perf_counter()
+        self.state = jax.block_until_ready(self.stepper.init())
+        self.end = jax.block_until_ready(self.stepper.advance(self.state, self.steps))    # compiles, then runs
+        self.build, self.first = t1 - t0, time.perf_counter() - t1
+        self.wall, self.cpu = [], []
+
+    def run(self):
+        w, c = time.perf_counter(), time.process_time()
+        self.end = jax.block_until_ready(self.stepper.advance(self.state, self.steps))
+        self.wall.append(time.perf_counter() - w)
+        self.cpu.append(time.process_time() - c)
+
+    def record(self) -> Record:
+        run = min(self.wall)
+        return Record(name=self.name, unknowns=self.stepper.unknowns, steps=self.steps, build_s=self.build,
+                      compile_s=max(self.first - run, 0.0), run_s=run, cpu_s=min(self.cpu),
+                      ok=self.stepper.status(self.end) == "ok")
+
+
 def time_scene(name: str, scene: js.Scene, steps: int, repeat: int = 2, *, params: Optional[dict] = None,
                dt: Optional[float] = None) -> Record:
     """Time `steps` steps of the scene (`params`, `dt` as for `js.Stepper`): build the stepper,
     compile and run once, then run `repeat` more times from the same start; the best wall and the
     best CPU time of those runs. Compile s is the first call's wall time less the best run's."""
-    t0 = time.perf_counter()
-    stepper = js.Stepper(scene, params, dt=dt)
-    t1 = time.perf_counter()
-    state = jax.block_until_ready(stepper.init())
-    end = jax.block_until_ready(stepper.advance(state, steps))        # compiles, then runs
-    first = time.perf_counter() - t1
-    wall, cpu = [], []
+    timed = _Timed(name, scene, steps, params, dt)
     for _ in range(max(1, repeat)):
-        w, c = time.perf_counter(), time.process_time()
-        end = jax.block_until_ready(stepper.advance(state, steps))
-        wall.append(time.perf_counter() - w)
-        cpu.append(time.process_time() - c)
-    run = min(wall)
-    return Record(name=name, unknowns=stepper.unknowns, steps=int(steps), build_s=t1 - t0,
-                  compile_s=max(first - run, 0.0), run_s=run, cpu_s=min(cpu), ok=stepper.status(end) == "ok")
+        timed.run()
+    return timed.record()
+
+
+def time_scenes(cases: Sequence[tuple[str, js.Scene]], steps: int, repeat: int = 2, progress=None) -> list[Record]:
+    """time_scene of several scenes, compiled all first and then timed round by round (each scene
+    once per round), so that a shared machine's changing load falls on every scene alike.
+    `progress(text)`, if given, hears of each compilation and round."""
+    timed = []
+    for name, sc in cases:
+        timed.append(_Timed(name, sc, steps))
+        if progress:
+            progress(f"compiled {name}: {timed[-1].first:.2f} s")
+    for k in range(max(1, repeat)):
+        for t in timed:
+            t.run()
+        if progress:
+            progress(f"round {k + 1} of {repeat} timed")
+    return [t.record() for t in timed]
 
 
 def best_of(fn, repeat: int = 3) -> tuple[float, float, Any]:
