@@ -72,9 +72,12 @@ def _path(mapping: dict, key: str) -> list:
 
 
 def _plain(key: str, value):
-    """A value as TOML holds it (NumPy and JAX scalars and arrays as Python numbers and lists)."""
+    """A value as TOML holds it (NumPy and JAX scalars and arrays as Python numbers and lists; a
+    mapping as a table, for keys a dotted name cannot spell: `{"campaign.limits": {"probe.B": 0.5}}`)."""
     if isinstance(value, (str, bool, int, float)):
         return value
+    if isinstance(value, Mapping):
+        return {str(k): _plain(f"{key}.{k}", v) for k, v in value.items()}
     if isinstance(value, (list, tuple)):
         return [_plain(key, v) for v in value]
     if hasattr(value, "tolist"):
