@@ -13,8 +13,12 @@ import tempfile
 
 import numpy as np
 
-import sloshing_reference as ref
-from section_meshes import u_tube_hex
+try:
+    import sloshing_reference as ref
+    from section_meshes import u_tube_hex
+except ImportError:     # imported as tests.shape_cases from the repository root (benchmarks/validation/)
+    from tests import sloshing_reference as ref
+    from tests.section_meshes import u_tube_hex
 
 G = 9.81
 N = 6
