@@ -4,37 +4,29 @@ against the stabilized element, in elastic and in rigid walls: peaks of roll, pi
 as a share of the stabilized run's peak, and the walls' own effect (elastic minus rigid) in each
 element. Then the energy of the "rt" run with the trapezoidal rule and no damping.
 
-    python benchmarks/rt_elastic_tank.py [--meshes 5x5x5,10x10x6] [--duration 4]
+    python -m benchmarks.validation.rt_elastic_tank [--meshes 5x5x5,10x10x6] [--duration 4] [--quick]
 
 Then, with --modes, the coupled modes of the tank held still (`jaxslosh modes`): the first sloshing
-modes and the first modes of the walls (strain share above one half) of both elements.
+modes and the first modes of the walls (strain share above one half) of both elements (the tank's
+blocks and modes are jaxslosh's fem/ internals, what `jaxslosh modes` prints). `--quick`: 0.2 s.
 """
-import argparse
-import os
+import numpy as np
 
-import jax
-
-jax.config.update("jax_enable_x64", True)
-
-import numpy as np  # noqa: E402
-
-import jaxslosh as js  # noqa: E402
-from jaxslosh.fem.liquid import build_liquid  # noqa: E402
-from jaxslosh.fem.liquid_rt import build_face_liquid  # noqa: E402
-from jaxslosh.fem.walls import build_tank_with_walls, tank_modes  # noqa: E402
-from jaxslosh.fem.walls_rt import build_face_tank_with_walls, face_tank_modes  # noqa: E402
-
-SCENE = os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "scenes", "paper_ship_elastic_tank.toml")
+import jaxslosh as js
+from jaxslosh.fem.liquid import build_liquid
+from jaxslosh.fem.liquid_rt import build_face_liquid
+from jaxslosh.fem.walls import build_tank_with_walls, tank_modes
+from jaxslosh.fem.walls_rt import build_face_tank_with_walls, face_tank_modes
+from benchmarks.harness import parser, scene
 
 
-def scene_text(mesh, element, elastic=True, duration=4.0, newmark=False):
-    text = open(SCENE).read().replace("mesh = [5, 5, 5]", f"mesh = [{', '.join(map(str, mesh))}]")
-    text = text.replace("duration = 20.0", f"duration = {duration!r}")
+def tank_scene(mesh, element, elastic=True, duration=4.0, newmark=False) -> js.Scene:
+    keys = {"tanks[0].mesh": list(mesh), "simulation.duration": duration, "tanks[0].fluid.element": element}
     if newmark:
-        text = text.replace('scheme = "hht"\nalpha = 0.01', 'scheme = "newmark"')
+        keys.update({"simulation.scheme": "newmark", "simulation.alpha": None})
     if not elastic:
-        text = text[:text.index("[tanks.walls]")] + text[text.index("[tanks.fluid]"):]
-    return text.replace("[tanks.fluid]", f'[tanks.fluid]\nelement = "{element}"')
+        keys["tanks[0].walls"] = None
+    return js.scene_with(scene("paper_ship_elastic_tank"), keys)
 
 
 def channels(r):
@@ -47,7 +39,7 @@ def runs(mesh, duration):
     out = {}
     for element in ("rt", "stabilized"):
         for elastic in (True, False):
-            out[element, elastic] = channels(js.simulate(js.load_scene(scene_text(mesh, element, elastic, duration))))
+            out[element, elastic] = channels(js.simulate(tank_scene(mesh, element, elastic, duration)))
     print(f"\nmesh {'x'.join(map(str, mesh))}, {duration:g} s (HHT alpha 0.01, as shipped):")
     print("| channel | peak rt | peak stabilized | rt - stabilized (of peak) | walls' effect rt | walls' effect "
           "stabilized | same with rigid walls: rt - stabilized |")
@@ -59,13 +51,13 @@ def runs(mesh, duration):
         print(f"| {k} | {np.abs(a).max():.5g} | {peak:.5g} | {np.abs(a - b).max() / peak:.4f} | "
               f"{np.abs(a - ar).max() / peak:.4f} | {np.abs(b - br).max() / peak:.4f} | "
               f"{np.abs(ar - br).max() / np.abs(br).max():.4f} |")
-    r = js.simulate(js.load_scene(scene_text(mesh, "rt", True, duration, newmark=True)))
+    r = js.simulate(tank_scene(mesh, "rt", True, duration, newmark=True))
     E = np.asarray(r.energy.kinetic) + np.asarray(r.energy.potential)
     print(f"rt, trapezoidal rule, no damping: energy within {np.abs(E / E[0] - 1).max():.2e} of its start")
 
 
 def modes(mesh):
-    s = js.load_scene(scene_text(mesh, "rt"))
+    s = tank_scene(mesh, "rt")
     t = s.tanks[0]
     tm = t.geometry.mesh(t.fill_depth, t.mesh)
     fm = face_tank_modes(build_face_tank_with_walls(t, build_face_liquid(tm.nodes, tm.elements, tm.depth, 1000.0,
@@ -80,15 +72,21 @@ def modes(mesh):
         print(f"| {name} | {', '.join(f'{w:.4f}' for w in slosh)} | {walls} |")
 
 
-if __name__ == "__main__":
-    p = argparse.ArgumentParser()
+def main():
+    p = parser(__doc__)
     p.add_argument("--meshes", default="5x5x5")
     p.add_argument("--duration", type=float, default=4.0)
     p.add_argument("--modes", action="store_true")
     a = p.parse_args()
+    if a.quick:
+        a.duration = 0.2
     for m in a.meshes.split(","):
         mesh = tuple(int(x) for x in m.split("x"))
         if a.modes:
             modes(mesh)
         else:
             runs(mesh, a.duration)
+
+
+if __name__ == "__main__":
+    main()
