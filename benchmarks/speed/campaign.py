@@ -44,7 +44,8 @@ compilation included in every row. Cases per core-hour: cases / (wall x cores). 
 campaign file is checked (every case "ok", statistics finite), the serial loop's statistics are
 compared with the cluster's, and the throughput of a 300-cell scatter of 3-hour sea states on 100
 cores is projected from each row. `--serial-cases N` runs N of the cases (evenly spaced) one by
-one instead of all. `--quick`: 2 cases of 2 s, 1 worker, 1 of them one by one. No assertion.
+one instead of all. `--quick`: 2 cases of 22 s (just past the
+waves' 20 s ramp), 1 worker, 1 of them one by one. No assertion.
 """
 import argparse
 import json
@@ -179,7 +180,7 @@ def main(argv=None):
                a.serial_child[2])
         return
     if a.quick:
-        a.cells, a.headings, a.seeds, a.duration, a.serial_cases, a.workers = 1, 2, 1, 2.0, 1, 1
+        a.cells, a.headings, a.seeds, a.duration, a.serial_cases, a.workers = 1, 2, 1, 22.0, 1, 1
     os.environ["PYTHONPATH"] = os.pathsep.join([ROOT, os.environ.get("PYTHONPATH", "")])
     heads = np.linspace(0.0, np.pi, a.headings) if a.headings > 1 else np.array([np.pi / 2])
     batches = [int(b) for b in a.batch.split(",")]

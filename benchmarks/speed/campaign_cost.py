@@ -29,7 +29,7 @@ only on an idle machine with 2 free cores.
 The batch's phases are timed one by one through the campaign worker's own pieces
 (jaxslosh.campaign.worker, campaign.cases, campaign.stats, and run/batch.py's `_setup0`,
 `_batch_fn`, `_batch_result`): internals, as no public API splits a batch into its phases.
-`--quick`: 2 cases of 2 s per batch, one repeat. No assertion.
+`--quick`: 2 cases of 22 s per batch, one repeat. No assertion.
 """
 import os
 import tempfile
@@ -126,7 +126,7 @@ def main(argv=None):
     p.add_argument("--cases", type=int, default=80)
     a = p.parse_args(argv)
     if a.quick:
-        a.duration, a.batch, a.repeat = 2.0, 2, 1
+        a.duration, a.batch, a.repeat = 22.0, 2, 1       # just past the waves' 20 s ramp
     d = tempfile.mkdtemp()
     scene_path, csv_path = os.path.join(d, "ship.toml"), os.path.join(d, "scatter.csv")
     with open(scene_path, "w") as f:

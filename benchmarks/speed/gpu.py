@@ -38,8 +38,8 @@ def main():
     ap.add_argument("--duration", type=float, default=60.0, help="s of each campaign case")
     ap.add_argument("--only", default="paper,tank20,lng,batch,campaign")
     a = ap.parse_args()
-    if a.quick:         # a few steps of each, small batches
-        a.steps, a.tank_steps, a.batch_steps, a.batch, a.cases, a.duration = 10, 5, 10, 4, 2, 1.0
+    if a.quick:         # a few steps of each, small batches; campaign cases just past the waves' 20 s ramp
+        a.steps, a.tank_steps, a.batch_steps, a.batch, a.cases, a.duration = 10, 5, 10, 4, 2, 22.0
         a.only = "paper,batch,campaign" if a.only == ap.get_default("only") else a.only
     only = a.only.split(",")
     dev = jax.devices()[0]
