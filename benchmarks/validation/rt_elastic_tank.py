@@ -17,7 +17,7 @@ from jaxslosh.fem.liquid import build_liquid
 from jaxslosh.fem.liquid_rt import build_face_liquid
 from jaxslosh.fem.walls import build_tank_with_walls, tank_modes
 from jaxslosh.fem.walls_rt import build_face_tank_with_walls, face_tank_modes
-from benchmarks.harness import parser, scene
+from benchmarks.harness import Table, parser, scene
 
 
 def tank_scene(mesh, element, elastic=True, duration=4.0, newmark=False) -> js.Scene:
@@ -35,22 +35,22 @@ def channels(r):
             "B": np.asarray(r.probes["B"].displacement)[:, 2]}
 
 
-def runs(mesh, duration):
+def runs(mesh, duration, markdown=False):
     out = {}
     for element in ("rt", "stabilized"):
         for elastic in (True, False):
             out[element, elastic] = channels(js.simulate(tank_scene(mesh, element, elastic, duration)))
     print(f"\nmesh {'x'.join(map(str, mesh))}, {duration:g} s (HHT alpha 0.01, as shipped):")
-    print("| channel | peak rt | peak stabilized | rt - stabilized (of peak) | walls' effect rt | walls' effect "
-          "stabilized | same with rigid walls: rt - stabilized |")
-    print("|---|---|---|---|---|---|---|")
+    table = Table(("channel", "{}"), ("peak rt", "{:.5g}"), ("peak stabilized", "{:.5g}"),
+                  ("rt - stabilized (of peak)", "{:.4f}"), ("walls' effect rt", "{:.4f}"),
+                  ("walls' effect stabilized", "{:.4f}"), ("same with rigid walls: rt - stabilized", "{:.4f}"))
     for k in ("roll", "pitch", "A", "B"):
         a, b = out["rt", True][k], out["stabilized", True][k]
         ar, br = out["rt", False][k], out["stabilized", False][k]
         peak = np.abs(b).max()
-        print(f"| {k} | {np.abs(a).max():.5g} | {peak:.5g} | {np.abs(a - b).max() / peak:.4f} | "
-              f"{np.abs(a - ar).max() / peak:.4f} | {np.abs(b - br).max() / peak:.4f} | "
-              f"{np.abs(ar - br).max() / np.abs(br).max():.4f} |")
+        table.add(k, np.abs(a).max(), peak, np.abs(a - b).max() / peak, np.abs(a - ar).max() / peak,
+                  np.abs(b - br).max() / peak, np.abs(ar - br).max() / np.abs(br).max())
+    table.print(markdown)
     r = js.simulate(tank_scene(mesh, "rt", True, duration, newmark=True))
     E = np.asarray(r.energy.kinetic) + np.asarray(r.energy.potential)
     print(f"rt, trapezoidal rule, no damping: energy within {np.abs(E / E[0] - 1).max():.2e} of its start")
@@ -85,7 +85,7 @@ def main():
         if a.modes:
             modes(mesh)
         else:
-            runs(mesh, a.duration)
+            runs(mesh, a.duration, a.markdown)
 
 
 if __name__ == "__main__":

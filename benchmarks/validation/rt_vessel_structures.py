@@ -17,7 +17,7 @@ import numpy as np
 
 import jaxslosh as js
 from jaxslosh.analysis.coupled import coupled_modes
-from benchmarks.harness import parser
+from benchmarks.harness import Table, parser
 from tests.physics.test_rt_vessel_structures import _text
 
 
@@ -36,16 +36,17 @@ def main():
     if a.quick:
         a.mesh, a.n = "4,2,3", 6
     mesh = tuple(int(x) for x in a.mesh.split(","))
-    print(f"| tank, {'x'.join(map(str, mesh))} | element | roll, pitch, heave | first 4 liquid modes | mast's first 2 |")
-    print("|---|---|---|---|---|")
+    table = Table((f"tank, {'x'.join(map(str, mesh))}", "{}"), ("element", "{}"), ("roll, pitch, heave", "{}"),
+                  ("first 4 liquid modes", "{}"), ("mast's first 2", "{}"))
     for baffle in (False, True):
         for element in ("rt", "stabilized"):
             cm = coupled_modes(case_scene(mesh, element, baffle), n=a.n)
             dom = np.asarray(cm.dominant)
             cols = [cm.omega[np.isin(dom, ("roll", "pitch", "heave"))][:3], cm.omega[dom == "liquid"][:4],
                     cm.omega[dom == "structure mast"][:2]]
-            cells = " | ".join(", ".join(f"{w:.4f}" for w in c) or f"above the {a.n} modes" for c in cols)
-            print(f"| {'baffle' if baffle else 'plain'} | `\"{element}\"` | {cells} |", flush=True)
+            table.add("baffle" if baffle else "plain", f'`"{element}"`',
+                      *(", ".join(f"{w:.4f}" for w in c) or f"above the {a.n} modes" for c in cols))
+    table.print(a.markdown)
 
 
 if __name__ == "__main__":

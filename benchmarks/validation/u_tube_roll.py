@@ -20,7 +20,7 @@ import meshio
 import numpy as np
 
 import jaxslosh as js
-from benchmarks.harness import parser
+from benchmarks.harness import Table, parser
 from tests import sloshing_reference as ref
 from tests.analysis.test_rt_runs import U_TUBE
 from tests.section_meshes import u_tube_hex
@@ -52,7 +52,7 @@ def main():
     expected, _ = roll_exchange(section, 1.0, (-4.0, -0.5), 0.5, 7.5, Ws, ZETA)
     print(f"U-tube frequency {w_u:.5f} rad/s; theory (exchange per radian): "
           + ", ".join(f"{abs(e):.2f}" for e in expected))
-    print("| mesh | run | 0.9 | 1.0 | 1.1 |\n|---|---|---|---|---|")
+    table = Table(("mesh", "{}"), ("run", "{}"), ("0.9", "{:+.2f} %"), ("1.0", "{:+.2f} %"), ("1.1", "{:+.2f} %"))
     with tempfile.TemporaryDirectory() as tmp:
         for mesh in a.meshes.split(","):
             ny, nz = (int(v) for v in mesh.split("x"))
@@ -73,10 +73,11 @@ def main():
                         sc = js.scene_with(js.load_scene(U_TUBE.format(frequency=W, file=path)), keys)
                         errs.append(100 * (exchange(sc, W) / abs(e) - 1))
                     except js.SceneError as err:         # a full order above rt's dense limit
-                        print(f"| 2x{ny}x{nz} | {run} | {err} |")
+                        table.add(f"2x{ny}x{nz}", run, str(err), "", "")
                         break
                 else:
-                    print(f"| 2x{ny}x{nz} | {run} | " + " | ".join(f"{x:+.2f} %" for x in errs) + " |", flush=True)
+                    table.add(f"2x{ny}x{nz}", run, *errs)
+    table.print(a.markdown)
 
 
 if __name__ == "__main__":

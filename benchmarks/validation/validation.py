@@ -11,7 +11,6 @@ import os
 import sys
 import time
 
-import jax
 import numpy as np
 from scipy.integrate import solve_ivp
 
@@ -21,7 +20,7 @@ from jaxslosh.assemble.system import build
 from jaxslosh.physics.kinematics import rotation_matrix
 from jaxslosh.fem.liquid import build_liquid
 from jaxslosh.fem.modes import analytic_sloshing_omegas, liquid_modes
-from benchmarks.harness import ROOT, parser, scene
+from benchmarks.harness import ROOT, Table, machine, parser, scene
 from tests.helpers import vessel_scene, zero_crossing_period
 
 
@@ -36,7 +35,7 @@ rows = []
 
 def row(check, reference, measured):
     rows.append((check, reference, measured))
-    print(f"| {check} | {reference} | {measured} |")
+    print(f"  {check}: {measured}", file=sys.stderr, flush=True)       # progress; the table at the end
     sys.stdout.flush()
 
 
@@ -148,8 +147,6 @@ def waves():
 def main():
     a = parser(__doc__).parse_args()
     t0 = time.perf_counter()
-    print("| check | reference | measured |")
-    print("| --- | --- | --- |")
     vessel_periods()
     torque_free()
     sloshing()
@@ -157,7 +154,11 @@ def main():
     inertia()
     if not a.quick:
         waves()
-    print(f"\n({time.perf_counter() - t0:.0f} s; jax {jax.__version__}, {os.cpu_count()} cpu)")
+    table = Table(("check", "{}"), ("reference", "{}"), ("measured", "{}"))
+    for r in rows:
+        table.add(*r)
+    table.print(a.markdown)
+    print(f"\n({time.perf_counter() - t0:.0f} s; {machine()})")
 
 
 if __name__ == "__main__":
