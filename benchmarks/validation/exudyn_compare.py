@@ -51,7 +51,7 @@ frame body built from OUR matrices (`exudyn_paper`):
   * buoyancy: the vessel-only springs above.
 Not representable in a floating-frame body with a constant stiffness: our rotation penalty acts on
 the ABSOLUTE rotation of the liquid, curl d + 2 theta with theta the body's rotation since t = 0
-(PHYSICS.md item 5: an inviscid liquid does not spin up with the tank). Exudyn's body can only hold
+(docs/theory.md item 5: an inviscid liquid does not spin up with the tank). Exudyn's body can only hold
 its d-d block (the penalty on curl d: the liquid is pushed to turn with the tank). So Exudyn is
 compared with our runs with that coupling dropped ("relative penalty", `relative_penalty()`), which
 mean the same model, and with our real runs, which shows the size of the effect. The reduced bodies
@@ -161,7 +161,7 @@ PAPER = os.path.join(ROOT, "scenes", "paper_ship_tank.toml")
 @contextlib.contextmanager
 def relative_penalty():
     """Our liquid with its rotation penalty on the RELATIVE rotation (curl d) only: the coupling to
-    the body rotation theta (Liquid.Kdt, Ktt; PHYSICS.md item 5) dropped. This is what a floating-
+    the body rotation theta (Liquid.Kdt, Ktt; docs/theory.md item 5) dropped. This is what a floating-
     frame body with a constant stiffness matrix can hold, so it is the model Exudyn is given."""
     import jaxslosh.fem.liquid as lq
     import jaxslosh.fem.reduction as rd
