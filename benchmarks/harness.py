@@ -38,12 +38,6 @@ def scene(name: str) -> js.Scene:
     return js.load_scene(os.path.join(ROOT, "scenes", name if name.endswith(".toml") else name + ".toml"))
 
 
-def scene_text(name: str) -> str:
-    """The TOML text of a scene of scenes/ (for the few scripts that write scene files)."""
-    with open(os.path.join(ROOT, "scenes", name if name.endswith(".toml") else name + ".toml")) as f:
-        return f.read()
-
-
 @dataclasses.dataclass(frozen=True)
 class Record:
     """One timed scene: its step's cost and what it took to get there."""
