@@ -19,6 +19,7 @@ from __future__ import annotations
 import argparse
 import dataclasses
 import os
+import re
 import sys
 import time
 from typing import Any, Optional, Sequence
@@ -131,6 +132,10 @@ def best_of(fn, repeat: int = 3) -> tuple[float, float, Any]:
     return min(wall), min(cpu), out
 
 
+#: a cell that is a number (a sign, digits, separators, an exponent, a unit of %, x or s after it)
+_NUMBER = re.compile(r"^[+-]?(\d[\d,]*\.?\d*|\.\d+|nan|inf)(e[+-]?\d+)?( ?(%|x|s))?( FAILED)?$", re.IGNORECASE)
+
+
 class Table:
     """Rows printed as aligned text (the default) or as a Markdown table (`--markdown`: what the
     docs' pages hold). Columns are (header, format) pairs; a cell that is a string is printed as it is."""
@@ -149,13 +154,16 @@ class Table:
     def text(self, markdown: bool = False) -> str:
         rows = [self.headers] + self.rows
         widths = [max(len(r[i]) for r in rows) for i in range(len(self.headers))]
-        # the first column (names) left-aligned, the numbers right-aligned
+        # numbers right-aligned (a column of them), names and words left-aligned
+        right = [bool(self.rows) and all(_NUMBER.match(r[i]) for r in self.rows if r[i])
+                 for i in range(len(self.headers))]
+
         def line(r):
-            return [c.ljust(w) if i == 0 else c.rjust(w) for i, (c, w) in enumerate(zip(r, widths))]
+            return [c.rjust(w) if right[i] else c.ljust(w) for i, (c, w) in enumerate(zip(r, widths))]
         out = [] if self.title is None else [self.title, ""]
         if markdown:
             out.append("| " + " | ".join(line(self.headers)) + " |")
-            out.append("|" + "|".join(("-" * (w + 1) + ":") if i else (":" + "-" * (w + 1))
+            out.append("|" + "|".join(("-" * (w + 1) + ":") if right[i] else (":" + "-" * (w + 1))
                                       for i, w in enumerate(widths)) + "|")
             out += ["| " + " | ".join(line(r)) + " |" for r in self.rows]
         else:
