@@ -73,8 +73,8 @@ if sys.argv[3] == "1":     # the traced programs' sizes (equations, counted into
     eqns["chunk_eqns"] = count(eqx.filter_make_jaxpr(lambda st, c: st.advance(c, chunk * se))(stepper, carry)[0].jaxpr)
 executables.settle()        # as `jaxslosh run` does at its end: the executables compiled are kept
 t_build, t_first = t_import + ph["build"], t_import + ph["build"] + ph["compile"]
-print(json.dumps({**eqns, "import": t_import - T0, "build": ph["build"], "compile": ph["compile"], "first_step": t_first - T0,
-                  "first_chunk": t_first + ph.get("stepping", 0.0) - T0, "steps": chunk * se,
+print(json.dumps({**eqns, "import": t_import - T0, "build": ph["build"], "compile": ph["compile"],
+                  "first_step": t_first - T0, "first_chunk": t_first + ph.get("stepping", 0.0) - T0, "steps": chunk * se,
                   "trace": events["jaxpr_trace_duration"], "lower": events["jaxpr_to_mlir_module_duration"],
                   "xla": events["backend_compile_duration"]}))
 """

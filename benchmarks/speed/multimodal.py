@@ -55,7 +55,8 @@ def main():
     ref = zB.get("fem (5x5x5)", zB[REFERENCE])
     for name, z in zB.items():
         d = z - ref
-        print(f"probe B, {name} vs {'fem' if 'fem (5x5x5)' in zB else REFERENCE}: rms difference / rms {np.sqrt(np.mean(d ** 2) / np.mean(ref ** 2)):.3f}")
+        against = "fem" if "fem (5x5x5)" in zB else REFERENCE
+        print(f"probe B, {name} vs {against}: rms difference / rms {np.sqrt(np.mean(d ** 2) / np.mean(ref ** 2)):.3f}")
 
 
 if __name__ == "__main__":

@@ -30,7 +30,8 @@ def test_the_folders_hold_the_scripts():
 @pytest.mark.parametrize("folder,name", SCRIPTS)
 def test_a_script_says_its_command_line(folder, name):
     doc = ast.get_docstring(_tree(folder, name)) or ""
-    assert f"python -m benchmarks.{folder}.{name}" in doc, f"benchmarks/{folder}/{name}.py: no command line in its docstring"
+    assert f"python -m benchmarks.{folder}.{name}" in doc, \
+        f"benchmarks/{folder}/{name}.py: no command line in its docstring"
 
 
 @pytest.mark.parametrize("folder,name", SCRIPTS)
