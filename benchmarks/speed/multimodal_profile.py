@@ -92,8 +92,8 @@ def profile(sc, steps, repeats, n=200):
     rows = {"residual R(x)": timed(lambda s, x: equations(s)[0](x), (s, x0), n, repeats),
             "preconditioner (Jacobian, inverse)": timed(precondition, (s, x0), n // 10, repeats),
             "integrator step": timed(lambda s: int_step(sysm, solver, s)[0], (s,), n // 4, repeats),
-            "loop step": timed(stepper.step, (carry,), n // 4, repeats),
-            "saved frame": timed(stepper.observe, (carry,), n, repeats)}
+            "loop step": timed(lambda c: stepper.step(c), (carry,), n // 4, repeats),
+            "saved frame": timed(lambda c: stepper.observe(c), (carry,), n, repeats)}
     liq = sysm.liquid
     if liq.nonlinear:
         t, k = liq.tanks[0], sysm.kin(s.c, s.v[:3], s.v[3:6], s.v[6:], s.acc[:6], s.acc[6:])
