@@ -41,7 +41,7 @@ from jaxslosh.fem.liquid import build_liquid
 from jaxslosh.fem.liquid_rt import build_face_liquid, face_modes
 from jaxslosh.fem.modes import liquid_modes
 from jaxslosh.geometry import Baffle, Box, MeshFile, Prismatic
-from benchmarks.harness import parser
+from benchmarks.harness import Table, parser
 from tests.section_meshes import hopper_baffle_hex, u_tube_hex
 from tests.sloshing_reference import (Baffle as RefBaffle, prismatic, rectangle, rectilinear_sloshing_omegas,
                                       section_sloshing_omegas, u_tube)
@@ -116,10 +116,9 @@ def omegas(element, geo, depth, counts, n=3):
     return w[:n], len(model.elements)
 
 
-def shapes(elements):
+def shapes(elements, markdown=False):
     from tests import shape_cases
-    print("| tank | elements | " + " | ".join(f"{e}, modes 1-6 (%)" for e in elements) + " |")
-    print("|---|---|" + "---|" * len(elements))
+    table = Table(("tank", "{}"), ("elements", "{:d}"), *((f"{e}, modes 1-6 (%)", "{}") for e in elements))
     for name in shape_cases.CASES:
         geo, depth, mesh, _, ref_w = shape_cases.case(name)
         cells = []
@@ -128,17 +127,17 @@ def shapes(elements):
             other = sum(k != "sloshing" for k in kinds)
             cells.append(", ".join(f"{e:+.2f}" for e in (w / ref_w[:len(w)] - 1) * 100)
                          + (f" ({other} other modes among them)" if other else ""))
-        print(f"| {name} | {ne} | " + " | ".join(cells) + " |", flush=True)
+        table.add(name, ne, *cells)
+    table.print(markdown)
 
 
-def six(elements, names):
+def six(elements, names, markdown=False):
     """Per shape, the worst of the first six sloshing modes' errors (%) and which mode, per element,
     and the element a scene gets when it leaves `element` out, on modes and at full order."""
     from tests import shape_cases
     from jaxslosh.scene.shape import default_element
-    print("| tank | elements | default on modes / full order | "
-          + " | ".join(f"{e}: worst of modes 1-6 (%)" for e in elements) + " |")
-    print("|---|---|---|" + "---|" * len(elements))
+    table = Table(("tank", "{}"), ("elements", "{:d}"), ("default on modes / full order", "{}"),
+                  *((f"{e}: worst of modes 1-6 (%)", "{}") for e in elements))
     for name in names:
         geo, depth, mesh, _, ref_w = shape_cases.case(name)
         cells = []
@@ -151,13 +150,14 @@ def six(elements, names):
                          + (f", {other} other modes among them" if other else ""))
         counts = mesh or (1, 1, ne)
         default = "/".join(default_element(geo, depth, counts, reduced)[0] for reduced in (True, False))
-        print(f"| {name} | {ne} | {default} | " + " | ".join(cells) + " |", flush=True)
+        table.add(name, ne, default, *cells)
+    table.print(markdown)
 
 
-def cost(meshes):
+def cost(meshes, markdown=False):
     from jaxslosh.fem.liquid_rt import face_basis, face_invariants
-    print("| mesh | face unknowns | build | face_modes (10) | face_basis (20 + correction) | invariants |")
-    print("|---|---|---|---|---|---|")
+    table = Table(("mesh", "{}"), ("face unknowns", "{:,}"), ("build", "{:.1f}"), ("face_modes (10)", "{:.1f}"),
+                  ("face_basis (20 + correction)", "{:.1f}"), ("invariants", "{:.1f}"))
     for mesh in meshes:
         counts = tuple(int(v) for v in mesh.split("x"))
         t = [time.perf_counter()]
@@ -171,7 +171,8 @@ def cost(meshes):
         face_invariants(m, V, (0.0, 0.0, 0.0))
         t.append(time.perf_counter())
         dt = np.diff(t)
-        print(f"| {mesh} | {int(m.free.sum()):,} | " + " | ".join(f"{v:.1f}" for v in dt) + " |", flush=True)
+        table.add(mesh, int(m.free.sum()), *dt)
+    table.print(markdown)
 
 
 def main():
@@ -181,27 +182,29 @@ def main():
     p.add_argument("--meshes", default=None, help="cost: 10x10x6,20x20x12,30x30x16; lng: " + LNG_MESHES)
     a = p.parse_args()
     if a.cases == "cost":
-        return cost((a.meshes or "10x10x6,20x20x12,30x30x16").split(","))
+        return cost((a.meshes or "10x10x6,20x20x12,30x30x16").split(","), a.markdown)
     if a.cases == "shapes":
-        return shapes(a.elements.split(","))
+        return shapes(a.elements.split(","), a.markdown)
     if a.cases == "six":
         from tests import shape_cases
-        return six(a.elements.split(","), shape_cases.CASES[:3] + shape_cases.LNG_FILLS + shape_cases.CASES[3:])
+        return six(a.elements.split(","), shape_cases.CASES[:3] + shape_cases.LNG_FILLS + shape_cases.CASES[3:],
+                   a.markdown)
     if a.quick:
         a.cases = "standing"
     cases = [c for name in a.cases.split(",") for c in (LNG_FILLS if name == "lng" else (name,))]
     for case in cases:
         ref = reference(case)
         print(f"\n{case}: reference omega = {', '.join(f'{w:.5f}' for w in ref)} rad/s")
-        print("| mesh | elements | " + " | ".join(f"{e} err % (modes 1, 2, 3)" for e in a.elements.split(",")) + " |")
-        print("|---|---|" + "---|" * len(a.elements.split(",")))
+        table = Table(("mesh", "{}"), ("elements", "{:d}"),
+                      *((f"{e} err % (modes 1, 2, 3)", "{}") for e in a.elements.split(",")))
         for label, geo, depth, counts in meshes(case, a.meshes or LNG_MESHES)[:1 if a.quick else None]:
             cells = []
             for element in a.elements.split(","):
                 w, ne = omegas(element, geo, depth, counts)
                 err = (w / ref[:len(w)] - 1) * 100
                 cells.append(", ".join(f"{e:+.2f}" for e in err) + ("" if len(w) == 3 else " (missing)"))
-            print(f"| {label} | {ne} | " + " | ".join(cells) + " |")
+            table.add(label, ne, *cells)
+        table.print(a.markdown)
 
 
 if __name__ == "__main__":

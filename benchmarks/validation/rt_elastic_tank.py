@@ -56,7 +56,7 @@ def runs(mesh, duration, markdown=False):
     print(f"rt, trapezoidal rule, no damping: energy within {np.abs(E / E[0] - 1).max():.2e} of its start")
 
 
-def modes(mesh):
+def modes(mesh, markdown=False):
     s = tank_scene(mesh, "rt")
     t = s.tanks[0]
     tm = t.geometry.mesh(t.fill_depth, t.mesh)
@@ -65,11 +65,13 @@ def modes(mesh):
     nodal = tank_modes(build_tank_with_walls(t, build_liquid(t.size, t.fill_depth, t.mesh, 1000.0, 1500.0, 9.81)),
                        n=600)
     print(f"\nmesh {'x'.join(map(str, mesh))}: coupled modes (rad/s)")
+    table = Table(("element", "{}"), ("first 5 sloshing modes", "{}"), ("first 6 wall modes", "{}"))
     for name, m, wall in (("rt", fm, np.array([k == "wall" for k in fm.kind])),
                           ("stabilized", nodal, nodal.wall_share > 0.5)):
         slosh = m.omega[[k == "sloshing" for k in m.kind]][:5]
         walls = ", ".join(f"{w:.2f}" for w in m.omega[wall][:6])
-        print(f"| {name} | {', '.join(f'{w:.4f}' for w in slosh)} | {walls} |")
+        table.add(name, ", ".join(f"{w:.4f}" for w in slosh), walls)
+    table.print(markdown)
 
 
 def main():
@@ -83,7 +85,7 @@ def main():
     for m in a.meshes.split(","):
         mesh = tuple(int(x) for x in m.split("x"))
         if a.modes:
-            modes(mesh)
+            modes(mesh, a.markdown)
         else:
             runs(mesh, a.duration, a.markdown)
 
