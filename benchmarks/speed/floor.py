@@ -126,13 +126,14 @@ def framed(stepper, c, n):
 
 def counts(stepper, carry, steps=2000):
     """Newton iterations and preconditioner formations per step, on `steps` steps of the example
-    (the integrator's step in a scan of its own: a fresh trace, which sees the counter)."""
+    (the integrator's step in a scan of its own: a fresh trace, which sees the counter on
+    `StructuredNewton.precondition`, whichever form of the factors it builds)."""
     formed = [0]
-    original = newton._precond_data_parts
+    original = newton.StructuredNewton.precondition
 
-    def counted(parts, x, Cinv, ns):
+    def counted(self, R, x):
         jax.debug.callback(lambda: formed.__setitem__(0, formed[0] + 1))
-        return original(parts, x, Cinv, ns)
+        return original(self, R, x)
 
     def run(system, solver, s):
         def body(s, _):
@@ -140,11 +141,11 @@ def counts(stepper, carry, steps=2000):
             return s, info.iterations
         return jax.lax.scan(body, s, None, length=steps)[1]
 
-    newton._precond_data_parts = counted
+    newton.StructuredNewton.precondition = counted
     try:
         its = jax.block_until_ready(eqx.filter_jit(run)(stepper.built.system, stepper.solver, carry.s))
     finally:
-        newton._precond_data_parts = original
+        newton.StructuredNewton.precondition = original
     return float(np.mean(its)), formed[0] / steps
 
 
