@@ -5,7 +5,7 @@ sum and their difference are the second-order products. Both frequencies are fit
 squares (the amplitudes, linear in the basis, by linear least squares at each trial), or given.
 
 A harmonic start from rest sets the free wave against the forced one; the liquid's nonlinearity shows
-in the frequencies and the products. The benchmark (benchmarks/sloshing_experiments.py) and the
+in the frequencies and the products. The benchmark (benchmarks/validation/sloshing_experiments.py) and the
 experiment's tests use it on the measured record and the models' alike."""
 from __future__ import annotations
 

@@ -2,7 +2,7 @@
 "every shape: the first 6 sloshing modes within 2.5 %"): closed forms for the box and the vertical
 cylinder, tests/sloshing_reference.py's prism modes (a section's modes times cos(m pi x / L), every
 m) for the prismatic tanks, the horizontal cylinders, the U-tube and the baffled tanks. Shared by
-tests/fem/test_liquid_element_shapes.py and benchmarks/liquid_element.py (``--cases shapes``).
+tests/fem/test_liquid_element_shapes.py and benchmarks/validation/liquid_element.py (``--cases shapes``).
 
 Each case: (geometry, fill depth, mesh counts or None for a mesh file, the element to use,
 reference omega (6,) in rad/s)."""
@@ -13,14 +13,18 @@ import tempfile
 
 import numpy as np
 
-import sloshing_reference as ref
-from section_meshes import u_tube_hex
+try:
+    import sloshing_reference as ref
+    from section_meshes import u_tube_hex
+except ImportError:     # imported as tests.shape_cases from the repository root (benchmarks/validation/)
+    from tests import sloshing_reference as ref
+    from tests.section_meshes import u_tube_hex
 
 G = 9.81
 N = 6
 
 #: the element each shape is checked with: "rt" wherever the stabilized one misses 2.5 % on these
-#: meshes (benchmarks/liquid_element.py --cases shapes prints both)
+#: meshes (benchmarks/validation/liquid_element.py --cases shapes prints both)
 ELEMENT = {"box": "stabilized", "low_hopper": "stabilized"}
 
 

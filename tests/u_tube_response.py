@@ -26,7 +26,10 @@ from __future__ import annotations
 import numpy as np
 import scipy.sparse.linalg as spla
 
-import sloshing_reference as ref
+try:
+    import sloshing_reference as ref
+except ImportError:     # imported as tests.u_tube_response from the repository root (benchmarks/validation/)
+    from tests import sloshing_reference as ref
 
 
 def section_modes(rects, fill_depth: float, n: int, h_target: float, g: float = ref.G):

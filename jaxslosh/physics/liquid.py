@@ -32,7 +32,7 @@ from .terms import AbstractTerm, Config, Kin, Rows
 def nodal_product(Ms, a):
     """Ms @ a for a nodal field a (N, 3): three matrix-vector products. XLA's CPU product of a dense
     (N, N) by an (N, 3) takes a general matrix-product path that costs about twice the three
-    products (benchmarks/floor.py: the paper example's residual evaluates it at every Newton
+    products (benchmarks/speed/floor.py: the paper example's residual evaluates it at every Newton
     iteration). The sparse paths' matrices (solve/sparse.HostSparse) keep their own product."""
     if not isinstance(Ms, (jax.Array, np.ndarray)) or a.ndim != 2:
         return Ms @ a

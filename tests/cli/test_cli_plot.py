@@ -300,10 +300,9 @@ def test_a_sweep_file_is_plotted_with_its_runs_overlaid(tmp_path, capsys):
 
 # -- the accuracy-cost map --------------------------------------------------------------------------
 
-def test_the_accuracy_cost_maps_labels_do_not_overlap(tmp_path):
-    spec = importlib.util.spec_from_file_location("accuracy_cost", os.path.join(ROOT, "benchmarks", "accuracy_cost.py"))
-    mod = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(mod)
+def test_the_accuracy_cost_maps_labels_do_not_overlap(tmp_path, monkeypatch):
+    monkeypatch.syspath_prepend(ROOT)      # the benchmarks are a package of the repository root
+    mod = importlib.import_module("benchmarks.speed.accuracy_cost")
     rows, host = mod.read_csv(os.path.join(ROOT, "docs", "accuracy_cost.csv"))
     assert len(rows) == 12 and "cores" in host
     fig = mod.plot(rows, str(tmp_path / "map.png"), host)

@@ -4,7 +4,7 @@ circulation modes, exactly at zero and left out), and its sloshing frequencies a
 forms and the project's independent 2-D reference (tests/sloshing_reference.py) on the sections
 where the nodal elements lock: a U-tube, hanging and standing baffles, a baffle in a hopper, a
 30 %-filled LNG section. Small meshes (two elements thick); the full tables are
-benchmarks/liquid_element.py's (docs/design/liquid-element.md)."""
+benchmarks/validation/liquid_element.py's (docs/design/liquid-element.md)."""
 import json
 import os
 import sys

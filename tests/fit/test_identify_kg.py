@@ -15,7 +15,10 @@ from jaxslosh.fit.identify import identify
 from jaxslosh.fit.params import make_params
 from jaxslosh.fit.problem import Problem, add_noise
 
-from helpers import area_centroid, clip_polygon
+try:
+    from helpers import area_centroid, clip_polygon
+except ImportError:     # imported as tests.fit.test_identify_kg from the repository root (benchmarks/validation/)
+    from tests.helpers import area_centroid, clip_polygon
 
 RHO, G = 1025.0, 9.81
 L, B, T, D = 20.0, 10.0, 3.0, 6.0

@@ -1,5 +1,5 @@
 """The paper example (scenes/paper_ship_tank.toml) with its tank as a `flow = "3d"` multimodal tank
-against the finite elements: probe B's elevation on the free surface (benchmarks/paper_probe_b.py
+against the finite elements: probe B's elevation on the free surface (benchmarks/validation/paper_probe_b.py
 runs the mesh and mode sequences the tolerances rest on)."""
 from pathlib import Path
 

@@ -21,8 +21,12 @@ from jaxslosh.physics.kinematics import spin_tensor_components
 from jaxslosh.physics.liquid import SpinStiffening
 from jaxslosh.physics.terms import Kin
 
-from helpers import mast, multibody_vessel
-from test_rt_elastic_walls import _text as walls_text
+try:
+    from helpers import mast, multibody_vessel
+    from test_rt_elastic_walls import _text as walls_text
+except ImportError:     # imported as tests.physics.test_rt_vessel_structures from the repository root (benchmarks/)
+    from tests.helpers import mast, multibody_vessel
+    from tests.physics.test_rt_elastic_walls import _text as walls_text
 
 BAFFLED = ('[[tanks]]\nname = "tank"\norigin = [-1.5, -1.0, -2.0]\nsize = [3.0, 2.0, 2.0]\nfill_depth = 1.2\n'
            'mesh = [4, 2, 3]\n[[tanks.baffles]]\nnormal = "x"\nposition = 1.5\nfrom = "bottom"\nheight = 0.6\n'

@@ -9,7 +9,7 @@ tests/hos_sloshing.py (independent of the multimodal liquid). What the measureme
 theory is off by more than 15 % rms of the measured maximum and makes crests and troughs equal, where
 the measured crests rise about 1.5 times as high as the troughs fall; the multimodal tank reproduces
 that asymmetry. It does not reproduce the measured heights within 10 % at the forcing as documented
-(benchmarks/sloshing_experiments.py), and neither does the fully nonlinear potential flow, which the
+(benchmarks/validation/sloshing_experiments.py), and neither does the fully nonlinear potential flow, which the
 multimodal tank follows: already in the first half-period, where the motion is still linear, the
 documented forcing gives a trough 30 % deeper than the measured one.
 
@@ -18,7 +18,7 @@ squares of linear theory), a start with a delay reproduces that half-period but 
 out of phase; the later record is in phase with a clean harmonic start from rest, whose one unknown is
 then the amplitude. With it, linear theory is itself within 15 % rms, and no amplitude brings the
 multimodal tank within 10 % of the scored record: the issue's target is not reachable with this
-record (benchmarks/sloshing_experiments.py prints the numbers)."""
+record (benchmarks/validation/sloshing_experiments.py prints the numbers)."""
 from functools import lru_cache
 from pathlib import Path
 

@@ -48,3 +48,12 @@ def test_advance_is_the_steps_one_by_one():
         b = st.step(b)
     np.testing.assert_allclose(np.asarray(a.s.c.q), np.asarray(b.s.c.q), rtol=0, atol=1e-14)
     assert int(a.k) == 7 and st.unknowns == 6
+
+
+def test_a_mapping_sets_a_table_whose_keys_a_dotted_name_cannot_spell():
+    """`{"campaign.limits": {"probe.B": 0.5}}`: the probe's limit key holds a dot (benchmarks/speed/campaign.py)."""
+    scene = js.load_scene(TANKED)
+    v = js.scene_with(scene, {"campaign.limits": {"roll": 0.1, "probe.B": 0.5}})
+    assert tomllib.loads(v.text)["campaign"]["limits"] == {"roll": 0.1, "probe.B": 0.5}
+    with pytest.raises(js.SceneError, match="campaign.limits.roll"):
+        js.scene_with(scene, {"campaign.limits": {"roll": object()}})

@@ -1,4 +1,4 @@
-"""Hard cases (issue 7), short versions; the long ones are in benchmarks/stress.py.
+"""Hard cases (issue 7), short versions; the long ones are in benchmarks/validation/stress.py.
 
 - long runs: energy of the paper example (coarse mesh) with HHT and with the trapezoidal rule;
 - stiffness: c = 1500 m/s at dt = 0.0025 ... 0.05 s stays bounded, and HHT removes the acoustic
@@ -75,7 +75,7 @@ def hht(alpha):
 
 
 # ------------------------------------------------------------------------------------------------
-# Long runs (20 s of the paper example on a 3 x 3 x 2 mesh; 300 s on 5 x 5 x 5 in benchmarks/stress.py)
+# Long runs (20 s of the paper example on a 3 x 3 x 2 mesh; 300 s on 5 x 5 x 5 in benchmarks/validation/stress.py)
 
 
 def test_paper_example_with_hht_loses_energy_slowly_and_never_gains_it():

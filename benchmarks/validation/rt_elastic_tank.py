@@ -4,37 +4,29 @@ against the stabilized element, in elastic and in rigid walls: peaks of roll, pi
 as a share of the stabilized run's peak, and the walls' own effect (elastic minus rigid) in each
 element. Then the energy of the "rt" run with the trapezoidal rule and no damping.
 
-    python benchmarks/rt_elastic_tank.py [--meshes 5x5x5,10x10x6] [--duration 4]
+    python -m benchmarks.validation.rt_elastic_tank [--meshes 5x5x5,10x10x6] [--duration 4] [--quick]
 
 Then, with --modes, the coupled modes of the tank held still (`jaxslosh modes`): the first sloshing
-modes and the first modes of the walls (strain share above one half) of both elements.
+modes and the first modes of the walls (strain share above one half) of both elements (the tank's
+blocks and modes are jaxslosh's fem/ internals, what `jaxslosh modes` prints). `--quick`: 0.2 s.
 """
-import argparse
-import os
+import numpy as np
 
-import jax
-
-jax.config.update("jax_enable_x64", True)
-
-import numpy as np  # noqa: E402
-
-import jaxslosh as js  # noqa: E402
-from jaxslosh.fem.liquid import build_liquid  # noqa: E402
-from jaxslosh.fem.liquid_rt import build_face_liquid  # noqa: E402
-from jaxslosh.fem.walls import build_tank_with_walls, tank_modes  # noqa: E402
-from jaxslosh.fem.walls_rt import build_face_tank_with_walls, face_tank_modes  # noqa: E402
-
-SCENE = os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "scenes", "paper_ship_elastic_tank.toml")
+import jaxslosh as js
+from jaxslosh.fem.liquid import build_liquid
+from jaxslosh.fem.liquid_rt import build_face_liquid
+from jaxslosh.fem.walls import build_tank_with_walls, tank_modes
+from jaxslosh.fem.walls_rt import build_face_tank_with_walls, face_tank_modes
+from benchmarks.harness import Table, parser, scene
 
 
-def scene_text(mesh, element, elastic=True, duration=4.0, newmark=False):
-    text = open(SCENE).read().replace("mesh = [5, 5, 5]", f"mesh = [{', '.join(map(str, mesh))}]")
-    text = text.replace("duration = 20.0", f"duration = {duration!r}")
+def tank_scene(mesh, element, elastic=True, duration=4.0, newmark=False) -> js.Scene:
+    keys = {"tanks[0].mesh": list(mesh), "simulation.duration": duration, "tanks[0].fluid.element": element}
     if newmark:
-        text = text.replace('scheme = "hht"\nalpha = 0.01', 'scheme = "newmark"')
+        keys.update({"simulation.scheme": "newmark", "simulation.alpha": None})
     if not elastic:
-        text = text[:text.index("[tanks.walls]")] + text[text.index("[tanks.fluid]"):]
-    return text.replace("[tanks.fluid]", f'[tanks.fluid]\nelement = "{element}"')
+        keys["tanks[0].walls"] = None
+    return js.scene_with(scene("paper_ship_elastic_tank"), keys)
 
 
 def channels(r):
@@ -43,29 +35,29 @@ def channels(r):
             "B": np.asarray(r.probes["B"].displacement)[:, 2]}
 
 
-def runs(mesh, duration):
+def runs(mesh, duration, markdown=False):
     out = {}
     for element in ("rt", "stabilized"):
         for elastic in (True, False):
-            out[element, elastic] = channels(js.simulate(js.load_scene(scene_text(mesh, element, elastic, duration))))
+            out[element, elastic] = channels(js.simulate(tank_scene(mesh, element, elastic, duration)))
     print(f"\nmesh {'x'.join(map(str, mesh))}, {duration:g} s (HHT alpha 0.01, as shipped):")
-    print("| channel | peak rt | peak stabilized | rt - stabilized (of peak) | walls' effect rt | walls' effect "
-          "stabilized | same with rigid walls: rt - stabilized |")
-    print("|---|---|---|---|---|---|---|")
+    table = Table(("channel", "{}"), ("peak rt", "{:.5g}"), ("peak stabilized", "{:.5g}"),
+                  ("rt - stabilized (of peak)", "{:.4f}"), ("walls' effect rt", "{:.4f}"),
+                  ("walls' effect stabilized", "{:.4f}"), ("same with rigid walls: rt - stabilized", "{:.4f}"))
     for k in ("roll", "pitch", "A", "B"):
         a, b = out["rt", True][k], out["stabilized", True][k]
         ar, br = out["rt", False][k], out["stabilized", False][k]
         peak = np.abs(b).max()
-        print(f"| {k} | {np.abs(a).max():.5g} | {peak:.5g} | {np.abs(a - b).max() / peak:.4f} | "
-              f"{np.abs(a - ar).max() / peak:.4f} | {np.abs(b - br).max() / peak:.4f} | "
-              f"{np.abs(ar - br).max() / np.abs(br).max():.4f} |")
-    r = js.simulate(js.load_scene(scene_text(mesh, "rt", True, duration, newmark=True)))
+        table.add(k, np.abs(a).max(), peak, np.abs(a - b).max() / peak, np.abs(a - ar).max() / peak,
+                  np.abs(b - br).max() / peak, np.abs(ar - br).max() / np.abs(br).max())
+    table.print(markdown)
+    r = js.simulate(tank_scene(mesh, "rt", True, duration, newmark=True))
     E = np.asarray(r.energy.kinetic) + np.asarray(r.energy.potential)
     print(f"rt, trapezoidal rule, no damping: energy within {np.abs(E / E[0] - 1).max():.2e} of its start")
 
 
-def modes(mesh):
-    s = js.load_scene(scene_text(mesh, "rt"))
+def modes(mesh, markdown=False):
+    s = tank_scene(mesh, "rt")
     t = s.tanks[0]
     tm = t.geometry.mesh(t.fill_depth, t.mesh)
     fm = face_tank_modes(build_face_tank_with_walls(t, build_face_liquid(tm.nodes, tm.elements, tm.depth, 1000.0,
@@ -73,22 +65,30 @@ def modes(mesh):
     nodal = tank_modes(build_tank_with_walls(t, build_liquid(t.size, t.fill_depth, t.mesh, 1000.0, 1500.0, 9.81)),
                        n=600)
     print(f"\nmesh {'x'.join(map(str, mesh))}: coupled modes (rad/s)")
+    table = Table(("element", "{}"), ("first 5 sloshing modes", "{}"), ("first 6 wall modes", "{}"))
     for name, m, wall in (("rt", fm, np.array([k == "wall" for k in fm.kind])),
                           ("stabilized", nodal, nodal.wall_share > 0.5)):
         slosh = m.omega[[k == "sloshing" for k in m.kind]][:5]
         walls = ", ".join(f"{w:.2f}" for w in m.omega[wall][:6])
-        print(f"| {name} | {', '.join(f'{w:.4f}' for w in slosh)} | {walls} |")
+        table.add(name, ", ".join(f"{w:.4f}" for w in slosh), walls)
+    table.print(markdown)
 
 
-if __name__ == "__main__":
-    p = argparse.ArgumentParser()
+def main():
+    p = parser(__doc__)
     p.add_argument("--meshes", default="5x5x5")
     p.add_argument("--duration", type=float, default=4.0)
     p.add_argument("--modes", action="store_true")
     a = p.parse_args()
+    if a.quick:
+        a.duration = 0.2
     for m in a.meshes.split(","):
         mesh = tuple(int(x) for x in m.split("x"))
         if a.modes:
-            modes(mesh)
+            modes(mesh, a.markdown)
         else:
-            runs(mesh, a.duration)
+            runs(mesh, a.duration, a.markdown)
+
+
+if __name__ == "__main__":
+    main()

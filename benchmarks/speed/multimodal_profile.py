@@ -1,7 +1,7 @@
 """Where the multimodal tank's step goes, against the finite-element tank reduced to 20 modes, on the
 paper example (scenes/paper_ship_tank.toml). Prints a table.
 
-    python benchmarks/multimodal_profile.py [--steps K] [--repeats R]
+    python -m benchmarks.speed.multimodal_profile [--steps K] [--repeats R] [--quick]
 
 Each variant runs K steps of its compiled loop (the Newton evaluations per step are read from the
 frames), then each piece is jitted alone at the state reached and timed as a `lax.scan` of many
@@ -13,39 +13,38 @@ and its rows alone. XLA's cost analysis gives
 the flops and transcendental functions of each compiled piece. Derived: the share of the step spent
 in residual evaluations and the rest (the preconditioner formed again when convergence slows, the
 predictor, the update). Last, Newton's scaled residual per evaluation with a fresh exact Jacobian
-from three predictors (the worst of three steps): how few evaluations a step could take."""
+from three predictors (the worst of three steps): how few evaluations a step could take.
+
+The pieces are the step's own internals (jaxslosh.solve.integrator, solve.newton, physics): timing one
+piece of the step needs them, and no public API exposes them; the state, the model and the step
+come from the public `js.Stepper` (`built`, `solver`, `step`, `observe`), the Newton evaluations
+per step from `js.simulate`'s `solver.iterations`."""
 from __future__ import annotations
 
-import argparse
 import time
 
 import jax
+import jax.numpy as jnp
+import numpy as np
 
-jax.config.update("jax_enable_x64", True)
-
-import jax.numpy as jnp  # noqa: E402
-import numpy as np  # noqa: E402
-
-import jaxslosh as js  # noqa: E402
-from jaxslosh.physics.kinematics import tv3  # noqa: E402
-from jaxslosh.physics.multimodal_expansion import ExpandedTank  # noqa: E402
-from jaxslosh.run.loop import advance, core, observe, start  # noqa: E402
-from jaxslosh.run.loop import step as loop_step  # noqa: E402
-from jaxslosh.run.simulate import prepare  # noqa: E402
-from jaxslosh.solve.integrator import _split_newton, step_equations  # noqa: E402
-from jaxslosh.solve.integrator import step as int_step  # noqa: E402
-from jaxslosh.solve.newton import StructuredNewton  # noqa: E402
+import jaxslosh as js
+from jaxslosh.physics.kinematics import tv3
+from jaxslosh.physics.multimodal_expansion import ExpandedTank
+from jaxslosh.solve.integrator import _split_newton, step_equations
+from jaxslosh.solve.integrator import step as int_step
+from jaxslosh.solve.newton import StructuredNewton
+from benchmarks.harness import parser, scene
+from benchmarks.speed.multimodal import MULTIMODAL
 
 VARIANTS = {
-    "fem, 20 modes": lambda t: t.replace('walls = "rigid"', 'walls = "rigid"\n[tanks.reduction]\nmodes = 20'),
-    "multimodal, 6 modes": lambda t: t.replace('mesh = [5, 5, 5]\nwalls = "rigid"', 'model = "multimodal"\nmodes = 6'),
-    "multimodal, 6 modes, third-order": lambda t: t.replace('mesh = [5, 5, 5]\nwalls = "rigid"',
-                                                            'model = "multimodal"\nmodes = 6\nexpansion = "third-order"'),
+    "fem, 20 modes": {"tanks[0].reduction.modes": 20},
+    "multimodal, 6 modes": MULTIMODAL,
+    "multimodal, 6 modes, third-order": {**MULTIMODAL, "tanks[0].expansion": "third-order"},
 }
 INTEGRALS = "tank's integrals"
 
 
-def timed(f, args, n, repeats):
+def timed(f, args, n, repeats, cost=True):
     """(seconds per evaluation of f(*args), flops, transcendentals): n evaluations in one jitted scan
     (the first argument nudged by a round-off-free amount so that XLA cannot hoist them)."""
     def many(args):
@@ -63,18 +62,20 @@ def timed(f, args, n, repeats):
         t0 = time.process_time()
         run(args).block_until_ready()
         best = min(best, time.process_time() - t0)
+    if not cost:            # --quick: XLA's cost analysis compiles each piece again
+        return best / n, 0.0, 0.0
     ca = jax.jit(f).lower(*args).compile().cost_analysis()
     ca = ca[0] if isinstance(ca, list) else ca
     return best / n, ca.get("flops", 0.0), ca.get("transcendentals", 0.0)
 
 
-def profile(text, steps, repeats):
-    setup = prepare(js.load_scene(text))
-    b, solver = core(setup.built), setup.solver
-    carry, _ = start(b, solver)
-    carry, fr = advance(b, solver, carry, steps, 1)
-    evals = float(np.mean(np.asarray(fr.iterations))) + 1.0        # the frames count those after the first
-    s, sysm = carry.s, b.system
+def profile(sc, steps, repeats, n=200, quick=False):
+    stepper = js.Stepper(sc)
+    solver = stepper.solver
+    carry = stepper.advance(stepper.init(), steps)
+    r = js.simulate(js.scene_with(sc, {"simulation.duration": steps * sc.simulation.dt}))
+    evals = float(np.mean(np.asarray(r.solver.iterations))) + 1.0    # the frames count those after the first
+    s, sysm = carry.s, stepper.built.system
     L = sysm.layout()
 
     def equations(s):
@@ -90,12 +91,11 @@ def profile(text, steps, repeats):
         return StructuredNewton(solver.Cinv_step, jnp.ones_like(x), 1e-10, 25, True, solver.ns, split).precondition(R, x)
 
     x0 = equations(s)[2]
-    n = 200
-    rows = {"residual R(x)": timed(lambda s, x: equations(s)[0](x), (s, x0), n, repeats),
-            "preconditioner (Jacobian, inverse)": timed(precondition, (s, x0), n // 10, repeats),
-            "integrator step": timed(lambda s: int_step(sysm, solver, s)[0], (s,), n // 4, repeats),
-            "loop step": timed(lambda c: loop_step(b, solver, c)[0], (carry,), n // 4, repeats),
-            "saved frame": timed(lambda c: observe(b, c), (carry,), n, repeats)}
+    rows = {"residual R(x)": timed(lambda s, x: equations(s)[0](x), (s, x0), n, repeats, not quick),
+            "preconditioner (Jacobian, inverse)": timed(precondition, (s, x0), n // 10, repeats, not quick),
+            "integrator step": timed(lambda s: int_step(sysm, solver, s)[0], (s,), n // 4, repeats, not quick),
+            "loop step": timed(lambda c: stepper.step(c), (carry,), n // 4, repeats, not quick),
+            "saved frame": timed(lambda c: stepper.observe(c), (carry,), n, repeats, not quick)}
     liq = sysm.liquid
     if liq.nonlinear:
         t, k = liq.tanks[0], sysm.kin(s.c, s.v[:3], s.v[3:6], s.v[6:], s.acc[:6], s.acc[6:])
@@ -103,10 +103,10 @@ def profile(text, steps, repeats):
         be, bd, bdd = s.c.d[:t.n], s.v[6:6 + t.n], s.acc[6:6 + t.n]
         # the exact tank's integrals; the third-order tank's polynomial M(beta) in their place
         ints = t.mass_matrix if isinstance(t, ExpandedTank) else t.integrals
-        rows[INTEGRALS] = timed(lambda be: ints(be), (be,), n, repeats)
+        rows[INTEGRALS] = timed(lambda be: ints(be), (be,), n, repeats, not quick)
         rows["tank's rows (jvp and grad)"] = timed(lambda be: t.rows(Vb, k.omega, be, bd, Vb, k.a6[3:6], bdd, k.g_b),
-                                                   (be,), n, repeats)
-    return evals, rows, predictors(sysm, solver, carry.s, equations)
+                                                   (be,), n, repeats, not quick)
+    return evals, rows, {} if quick else predictors(sysm, solver, carry.s, equations)
 
 
 def predictors(sysm, solver, s0, equations, steps=3):
@@ -138,14 +138,18 @@ def predictors(sysm, solver, s0, equations, steps=3):
 
 
 def main():
-    ap = argparse.ArgumentParser()
+    ap = parser(__doc__)
     ap.add_argument("--steps", type=int, default=150)
     ap.add_argument("--repeats", type=int, default=5)
     args = ap.parse_args()
-    text = open("scenes/paper_ship_tank.toml").read().replace("duration = 20.0", "duration = 3.0")
+    if args.quick:          # the 20-mode tank alone: a few steps, one timing, no cost analysis nor predictors
+        args.steps, args.repeats = 5, 1
+    base = js.scene_with(scene("paper_ship_tank"), {"simulation.duration": 3.0})
     out = {}
-    for name, edit in VARIANTS.items():          # printed as each variant ends (a long run keeps its first table)
-        evals, rows, pred = out[name] = profile(edit(text), args.steps, args.repeats)
+    variants = {"fem, 20 modes": VARIANTS["fem, 20 modes"]} if args.quick else VARIANTS
+    for name, keys in variants.items():          # printed as each variant ends (a long run keeps its first table)
+        evals, rows, pred = out[name] = profile(js.scene_with(base, keys), args.steps, args.repeats,
+                                                20 if args.quick else 200, args.quick)
         print(f"\n{name}: {evals:.2f} residual evaluations per step (after {args.steps} steps)")
         print(f"  {'piece':<36} {'us':>9} {'flops':>10} {'transc.':>8}")
         for piece, (sec, fl, tr) in rows.items():
@@ -156,12 +160,15 @@ def main():
         print(f"  scaled residual per evaluation, fresh exact Jacobian (tolerance {1e-10:g}), by predictor:")
         for p, e in pred.items():
             print(f"    {p:<28} " + " ".join(f"{v:.1e}" for v in e), flush=True)
+    if args.quick:
+        return
     fe = out["fem, 20 modes"][1]
     for name in ("multimodal, 6 modes", "multimodal, 6 modes, third-order"):
         mm = out[name][1]
         print(f"\nloop step, {name} / 20 modes: {mm['loop step'][0] / fe['loop step'][0]:.2f}; "
               f"its {INTEGRALS} (third-order: M(beta)) alone / the 20-mode step: "
               f"{mm[INTEGRALS][0] / fe['loop step'][0]:.2f}")
+
 
 if __name__ == "__main__":
     main()

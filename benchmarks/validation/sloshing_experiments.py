@@ -4,7 +4,7 @@ Faltinsen, Rognebakke, Lukovsky & Timokha (2000, J. Fluid Mech. 407), figure 7, 
 1.3 s, from rest (scenes/sloshing_experiment.toml; the measured elevation, as digitised by the PySPH
 project, in benchmarks/data/faltinsen2000_fig7.csv).
 
-    python benchmarks/sloshing_experiments.py [--plot docs/sloshing_experiment.png]
+    python -m benchmarks.validation.sloshing_experiments [--plot docs/sloshing_experiment.png] [--quick]
 
 Prints, for each tank model, over the measured window (0.1 to 9.9 s): the rms difference from the
 measurement (the model interpolated at the measured times) over the measured maximum; the error of
@@ -34,40 +34,35 @@ score it on the rest of the record (0.8 to 9.9 s), which no fit has seen:
   with a time constant tau (the rig's period varying at the start: a motion record through
   `[vessel.forced] file`).
 
-    python benchmarks/sloshing_experiments.py --floor
+    python -m benchmarks.validation.sloshing_experiments --floor
 
 adds a diagnostic that is not a prediction: the multimodal tank's scored rms at the amplitude that
 minimises it (one batch over amplitudes, chosen on the scored window itself), the least any clean
-harmonic start can reach."""
+harmonic start can reach.
+
+The fully nonlinear potential flow and the records' components are the tests' (tests/hos_sloshing.py,
+tests/record_components.py; run from the repository root). `--quick`: the documented forcing's
+multimodal and finite-element rows only."""
 from __future__ import annotations
 
-import argparse
 import tempfile
 from pathlib import Path
 
-import jax
+import numpy as np
+from scipy.optimize import minimize
+from scipy.signal import fftconvolve
 
-jax.config.update("jax_enable_x64", True)
+import jaxslosh as js
+from benchmarks.harness import ROOT as _ROOT, parser
+from tests.hos_sloshing import hos_tank
+from tests.record_components import COMPONENTS, components, fitted_components
 
-import sys  # noqa: E402
-
-import numpy as np  # noqa: E402
-
-import jaxslosh as js  # noqa: E402
-
-ROOT = Path(__file__).resolve().parents[1]
-sys.path.insert(0, str(ROOT / "tests"))
-from hos_sloshing import hos_tank  # noqa: E402
-from record_components import COMPONENTS, components, fitted_components  # noqa: E402
-from scipy.optimize import minimize  # noqa: E402
-from scipy.signal import fftconvolve  # noqa: E402
-
+ROOT = Path(_ROOT)
 SCENE = ROOT / "scenes" / "sloshing_experiment.toml"
 DATA = ROOT / "benchmarks" / "data" / "faltinsen2000_fig7.csv"
-MULTIMODAL = 'model = "multimodal"\nmodes = 8'
 # the linear finite elements of the same liquid: 16 x 1 x 6 hexahedra (its first and third modes within 0.2 %
 # of linear theory's)
-FEM = 'mesh = [16, 1, 6]\nwalls = "rigid"'
+FEM = {"tanks[0].model": None, "tanks[0].modes": None, "tanks[0].mesh": [16, 1, 6], "tanks[0].walls": "rigid"}
 #: the laminar boundary layers' damping ratio of the first mode (Stokes layers on the bottom, the end and
 #: the side walls of the 0.2 m wide tank: 0.002; 0.004 were it 0.1 m wide)
 WALL_DAMPING = 0.003
@@ -87,26 +82,25 @@ def measured():
     return d[:, 0], d[:, 1]
 
 
-def scene_text(model="multimodal", amplitude=0.032, duration=None, damping=0.0, record=None):
+def experiment_scene(model="multimodal", amplitude=0.032, duration=None, damping=0.0, record=None) -> js.Scene:
     """The experiment's scene: the harmonic forcing of `amplitude`, or the motion record file `record`."""
-    text = SCENE.read_text()
+    keys = {}
     if record is not None:
-        start = text.index("[vessel.forced]")
-        end = text.index("[[tanks]]")
-        text = text[:start] + f'[vessel.forced]\nfile = "{record}"\n\n' + text[end:]
+        keys.update({"vessel.forced": None, "vessel.forced.file": str(record)})
+    else:
+        keys["vessel.forced.amplitude"] = amplitude
     if model == "fem":
-        text = text.replace(MULTIMODAL, FEM)
-    if damping:
-        text = text.replace(MULTIMODAL, f"{MULTIMODAL}\ndamping = {{ ratio = {damping!r} }}")
-    text = text.replace("amplitude = 0.032", f"amplitude = {amplitude!r}")
+        keys.update(FEM)
+    elif damping:
+        keys["tanks[0].damping.ratio"] = damping
     if duration is not None:
-        text = text.replace("duration = 10.0", f"duration = {duration!r}")
-    return text
+        keys["simulation.duration"] = duration
+    return js.scene_with(js.load_scene(str(SCENE)), keys)
 
 
-def elevation(text):
-    """The probe's elevation history of a run of the scene text."""
-    r = js.simulate(js.load_scene(text), throw=False)
+def elevation(sc):
+    """The probe's elevation history of a run of the scene."""
+    r = js.simulate(sc, throw=False)
     if r.status != "ok":
         raise SystemExit(f"run failed: {r.status}")
     return np.asarray(r.time), np.asarray(r.probes["wall"].displacement)[:, 2]
@@ -208,7 +202,7 @@ def shifted(t, z, delay):
 
 
 def main():
-    ap = argparse.ArgumentParser()
+    ap = parser(__doc__)
     ap.add_argument("--plot", help="write the elevation histories to this PNG")
     ap.add_argument("--floor", action="store_true",
                     help="add the multimodal tank's least scored rms over clean harmonic starts (a diagnostic)")
@@ -237,7 +231,9 @@ def main():
     mm, fem, nl = "multimodal, 8 modes", "linear fem, 16 x 1 x 6", "fully nonlinear (HOS, tests/)"
     documented = "documented: 32 mm from rest"
     for model, label in (("multimodal", mm), ("fem", fem)):
-        row(documented, label, *elevation(scene_text(model, A)))
+        row(documented, label, *elevation(experiment_scene(model, A)))
+    if args.quick:
+        return
     row(documented, nl, *hos(lambda s: -A * W ** 2 * np.cos(W * s)))
     print_components(tm, zm, {**{label: tz for (case, label), tz in runs.items() if case == documented},
                               "linear theory (closed form)": (T, linear_theory(harmonic_acceleration(A)))})
@@ -247,16 +243,16 @@ def main():
     amplitude = round(float(A * zm[tm < EARLY].min() / zl[T < EARLY].min()), 4)
     case = f"first trough: amplitude {1000 * amplitude:.1f} mm"
     for model, label in (("multimodal", mm), ("fem", fem)):
-        row(case, label, *elevation(scene_text(model, amplitude)))
+        row(case, label, *elevation(experiment_scene(model, amplitude)))
     row(case, nl, *hos(lambda s: -amplitude * W ** 2 * np.cos(W * s)))
     row(case, f"multimodal, damping {WALL_DAMPING}",
-        *elevation(scene_text("multimodal", amplitude, damping=WALL_DAMPING)))
+        *elevation(experiment_scene("multimodal", amplitude, damping=WALL_DAMPING)))
 
     # 2. an amplitude and a delay, by least squares on the first half-period
     a2, delay = identify(lambda p: harmonic_acceleration(p[0], p[1]), [0.025, 0.05], tm, zm)
     case = f"fit t<{EARLY}s: {1000 * a2:.1f} mm, delay {delay:.3f} s"
     for model, label in (("multimodal", mm), ("fem", fem)):
-        row(case, label, *shifted(*elevation(scene_text(model, float(a2))), delay))
+        row(case, label, *shifted(*elevation(experiment_scene(model, float(a2))), delay))
     row(case, nl, *shifted(*hos(lambda s: -a2 * W ** 2 * np.cos(W * s)), delay))
 
     # 3. the documented amplitude, the excitation frequency varying at the start
@@ -267,7 +263,7 @@ def main():
         record = Path(tmp) / "motion.csv"
         write_record(record, w0, tau)
         for model, label in (("multimodal", mm), ("fem", fem)):
-            row(case, label + " (record)", *elevation(scene_text(model, record=record)))
+            row(case, label + " (record)", *elevation(experiment_scene(model, record=record)))
     row(case, nl, *hos(lambda s: varying_period_acceleration(w0, tau, s)))
 
     print("\nthe target, multimodal within 10 % rms of the measured maximum where linear theory is off by more "
@@ -281,7 +277,7 @@ def main():
     if args.floor:
         amplitudes = np.round(np.arange(0.021, 0.0296, 0.0015), 4)
         for damping in (0.0, WALL_DAMPING):
-            res, status = js.simulate_batch(js.load_scene(scene_text("multimodal", damping=damping)),
+            res, status = js.simulate_batch(experiment_scene("multimodal", damping=damping),
                                             {"vessel.forced.amplitude": amplitudes})
             t = np.asarray(res.time)
             t = t[0] if t.ndim == 2 else t

@@ -9,31 +9,26 @@ roll and pitch, 5 mm on heave; several seeds), then fitted two ways:
   hull's GM0 for KG 3.5 m; the roll alone, which is all the springs can follow), and the KG that
   GM implies, KM - GM.
 
-    python benchmarks/kg_identification.py [--angles 10,20,28] [--seeds 3] [--out DIR]
+    python -m benchmarks.validation.kg_identification [--angles 10,20,28] [--seeds 3] [--out DIR] [--quick]
 
 Prints a table: per release heel the mean (and spread over the seeds) of each fit's error against
 the record's true KG and GM0. With --out, also writes the 28-degree case's files (barge.toml,
-barge_linear.toml, measured.h5) and prints the `jaxslosh identify` commands that fit them.
+barge_linear.toml, measured.h5) and prints the `jaxslosh identify` commands that fit them. The
+barge, its true KG and the record's noise are the test's (tests/fit/test_identify_kg.py; run from
+the repository root); the noise is jaxslosh/fit/problem.add_noise's, as `jaxslosh identify`'s
+tests draw it. `--quick`: one heel (10 degrees), one seed.
 """
-import argparse
 import math
 import os
-import sys
 import warnings
 
-import jax
+import numpy as np
 
-jax.config.update("jax_enable_x64", True)
-
-import numpy as np  # noqa: E402
-
-import jaxslosh as js  # noqa: E402
-from jaxslosh.fit.problem import add_noise  # noqa: E402
-
-# the barge, its true KG and the record's noise are the test's (tests/fit/test_identify_kg.py)
-TESTS = os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "tests")
-sys.path[:0] = [TESTS, os.path.join(TESTS, "fit")]
-from test_identify_kg import B, BARGE, KM, L, MASS, NOISE, T, TRUE_KG  # noqa: E402
+import jaxslosh as js
+from jaxslosh.fit.problem import add_noise
+from benchmarks.harness import Table, parser
+# the barge, its true KG and the record's noise are the test's
+from tests.fit.test_identify_kg import B, BARGE, KM, L, MASS, NOISE, T, TRUE_KG
 
 START_KG = 3.5
 
@@ -77,17 +72,19 @@ def write_case(out):
 
 
 def main():
-    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    ap = parser(__doc__)
     ap.add_argument("--angles", default="10,20,28", help="release heels, degrees (default 10,20,28)")
     ap.add_argument("--seeds", type=int, default=3, help="noise seeds per heel (default 3)")
     ap.add_argument("--out", help="also write the 28-degree case's scene and record files here")
     a = ap.parse_args()
+    if a.quick:
+        a.angles, a.seeds = "10", 1
     gm0 = KM - TRUE_KG
     print(f"box barge {L} x {B} m, draft {T} m: KM {KM:.4f} m, true KG {TRUE_KG} m, GM0 {gm0:.4f} m; "
           f"{a.seeds} noise seeds per heel\n")
-    print("| release heel | KG fit (nonlinear), m | KG error | KG std. error | GM fit (springs), m | GM bias "
-          "| KG = KM - GM, m | its KG error | springs' roll residual / noise |")
-    print("| ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: |")
+    table = Table(("release heel", "{}"), ("KG fit (nonlinear), m", "{:.4f}"), ("KG error", "{}"),
+                  ("KG std. error", "{:.4f}"), ("GM fit (springs), m", "{:.4f}"), ("GM bias", "{}"),
+                  ("KG = KM - GM, m", "{:.4f}"), ("its KG error", "{}"), ("springs' roll residual / noise", "{}"))
     for angle in (float(x) for x in a.angles.split(",")):
         kg, gm = fits(angle, a.seeds)
         ekg = (kg[:, 0] - TRUE_KG) / TRUE_KG * 100
@@ -95,9 +92,10 @@ def main():
         kg_s = KM - gm[:, 0]
         ekg_s = (kg_s - TRUE_KG) / TRUE_KG * 100
         ok = "" if kg[:, 2].all() and gm[:, 2].all() else " (a fit did not converge)"
-        print(f"| {angle:g} deg | {kg[:, 0].mean():.4f} | {ekg.mean():+.3f} % (max {np.abs(ekg).max():.3f} %) "
-              f"| {kg[:, 1].mean():.4f} | {gm[:, 0].mean():.4f} | {bias.mean():+.1f} % | {kg_s.mean():.4f} "
-              f"| {ekg_s.mean():+.2f} % | {gm[:, 3].mean():.1f} |{ok}")
+        table.add(f"{angle:g} deg", kg[:, 0].mean(), f"{ekg.mean():+.3f} % (max {np.abs(ekg).max():.3f} %)",
+                  kg[:, 1].mean(), gm[:, 0].mean(), f"{bias.mean():+.1f} %", kg_s.mean(), f"{ekg_s.mean():+.2f} %",
+                  f"{gm[:, 3].mean():.1f}{ok}")
+    table.print(a.markdown)
     if a.out:
         write_case(a.out)
 

@@ -1,8 +1,8 @@
 """The accuracy-cost map (issue item 3(d)): error against wall time over meshes, steps and modal
 reductions of the paper example, a CSV table and a Pareto plot.
 
-    python benchmarks/accuracy_cost.py [--duration 5] [-o docs/accuracy_cost]
-    python benchmarks/accuracy_cost.py --plot-only [-o docs/accuracy_cost]   # redraw the PNG from the CSV
+    python -m benchmarks.speed.accuracy_cost [--duration 5] [-o docs/accuracy_cost] [--quick]
+    python -m benchmarks.speed.accuracy_cost --plot-only [-o docs/accuracy_cost]   # redraw the PNG from the CSV
 
 Every setting runs the paper scene for `duration` seconds. Errors:
   * first sloshing frequency: the mesh's first natural frequency of the liquid (tank held fixed),
@@ -11,35 +11,25 @@ Every setting runs the paper scene for `duration` seconds. Errors:
   * probe B: the largest difference of its vertical displacement from the reference run's over the
     run, over the reference's peak. Reference: mesh 20 x 20 x 12, full order, dt = 0.0025 s (or
     --ref-dt).
-Wall time: seconds of computing per simulated second, after compilation (a second run of the
-compiled loop), on this machine (named in the CSV and the plot).
+Wall time: seconds of computing per simulated second, after compilation (the run's steps timed by
+benchmarks/harness.py's time_scene: one compiled scan, no frames kept), on this machine (named in
+the CSV and the plot). Probe B's history is `js.simulate`'s.
 """
-import argparse
 import csv
 import os
 import platform
-import sys
-import time
+import tempfile
 
 import jax
+import numpy as np
 from matplotlib.transforms import Bbox
 
-jax.config.update("jax_enable_x64", True)
-
-import numpy as np  # noqa: E402
-
-import jaxslosh as js  # noqa: E402
-from jaxslosh.fem.liquid import build_liquid  # noqa: E402
-from jaxslosh.fem.modes import analytic_sloshing_omegas  # noqa: E402
-from jaxslosh.fem.reduction import tank_basis  # noqa: E402
-from jaxslosh.run.loop import core as _core, advance, start  # noqa: E402
-from jaxslosh.run.simulate import prepare
-from jaxslosh.scene.keys import with_overrides
-
-sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from bench_paper import paper_variant  # noqa: E402
-
-ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+import jaxslosh as js
+from jaxslosh.fem.liquid import build_liquid
+from jaxslosh.fem.modes import analytic_sloshing_omegas
+from jaxslosh.fem.reduction import tank_basis
+from benchmarks.harness import ROOT, parser, scene as load, time_scene
+from benchmarks.speed.bench_paper import paper_variant
 
 
 def machine() -> str:
@@ -54,25 +44,18 @@ def machine() -> str:
     return f"{os.cpu_count()} cores, {name}"
 
 
-def run(text, duration, timed=True):
+def run(sc, duration, timed=True):
     """(time, probe B z-displacement, wall seconds per simulated second, unknowns, steps/s); the
-    reference run (timed=False) is not run a second time for its timing."""
-    scene = js.load_scene(text)
-    setup = prepare(with_overrides(scene, duration=duration))
-    b, solver = _core(setup.built), setup.solver
-    carry, f0 = start(b, solver)
-    c1, fr = advance(b, solver, carry, setup.n_steps, 1)        # compile and run
-    jax.block_until_ready(fr)
-    wall = float("nan")
-    if timed:
-        t0 = time.perf_counter()
-        jax.block_until_ready(advance(b, solver, carry, setup.n_steps, 1))
-        wall = time.perf_counter() - t0
-    assert not bool(c1.failed), "a run failed"
-    i = b.probes.names.index("B")
-    z = np.concatenate([[float(f0.probes[i, 2])], np.asarray(fr.probes[:, i, 2])])
-    t = np.concatenate([[0.0], np.asarray(fr.t)])
-    return t, z - z[0], wall / duration, b.system.n, setup.n_steps / wall
+    reference run (timed=False) is not timed."""
+    sc = js.scene_with(sc, {"simulation.duration": duration})
+    r = js.simulate(sc)
+    assert r.status == "ok", f"a run failed: {r.status}"
+    z = np.asarray(r.probes["B"].position[:, 2])
+    t = np.asarray(r.time)
+    if not timed:
+        return t, z - z[0], float("nan"), 0, float("nan")
+    rec = time_scene("accuracy-cost", sc, int(round(duration / sc.simulation.dt)), repeat=1)
+    return t, z - z[0], rec.run_s / duration, rec.unknowns, rec.steps_per_s
 
 
 def first_omega(mesh, scene):
@@ -88,31 +71,33 @@ def settings(quick):
     dts = [0.04, 0.02, 0.005, 0.0025]
     modes = [2, 8, 20, 40]
     if quick:
-        meshes, dts, modes = [(3, 3, 2), (5, 5, 5), (10, 10, 6)], [0.04, 0.02], [2, 20]
+        meshes, dts, modes = [(3, 3, 2), (5, 5, 5)], [0.02], [2]
     out = [("mesh", m, 0.01, 0) for m in meshes]
     out += [("step", (5, 5, 5), dt, 0) for dt in dts]
-    out += [("modes", (20, 20, 12) if not quick else (10, 10, 6), 0.01, n) for n in modes]
+    out += [("modes", (20, 20, 12) if not quick else (5, 5, 5), 0.01, n) for n in modes]
     return out
 
 
 def main():
-    ap = argparse.ArgumentParser()
-    ap.add_argument("--duration", type=float, default=5.0)
+    ap = parser(__doc__)      # --quick: a few coarse settings, an 8x8x6 reference, 0.5 s (unless --duration)
+    ap.add_argument("--duration", type=float, default=None, help="simulated seconds (5; --quick: 0.5)")
     ap.add_argument("--ref-dt", type=float, default=0.0025)
-    ap.add_argument("--quick", action="store_true", help="a few coarse settings and a 10x10x6 reference")
-    ap.add_argument("-o", "--output", default=os.path.join(ROOT, "docs", "accuracy_cost"))
+    ap.add_argument("-o", "--output", help="the CSV's and PNG's path less its suffix (docs/accuracy_cost; "
+                                           "--quick: a temporary folder, never the docs' map)")
     ap.add_argument("--plot-only", action="store_true", help="redraw OUTPUT.png from OUTPUT.csv, running nothing")
     a = ap.parse_args()
+    a.duration = a.duration or (0.5 if a.quick else 5.0)
+    a.output = a.output or (os.path.join(tempfile.mkdtemp(), "accuracy_cost") if a.quick
+                            else os.path.join(ROOT, "docs", "accuracy_cost"))
     if a.plot_only:
         rows, host = read_csv(a.output + ".csv")
         plot(rows, a.output + ".png", host)
         print(f"wrote {a.output}.png from {a.output}.csv")
         return
-    paper = open(os.path.join(ROOT, "scenes", "paper_ship_tank.toml")).read()
-    scene = js.load_scene(paper)
+    paper = scene = load("paper_ship_tank")
     t = scene.tanks[0]
     exact = float(analytic_sloshing_omegas(t.size[0], t.size[1], t.fill_depth, scene.environment.gravity, 1)[0])
-    ref_mesh = (10, 10, 6) if a.quick else (20, 20, 12)
+    ref_mesh = (8, 8, 6) if a.quick else (20, 20, 12)
     print(f"reference: mesh {ref_mesh}, dt = {a.ref_dt} s, {a.duration} s ...", flush=True)
     t_ref, z_ref, _, _, _ = run(paper_variant(paper, mesh=ref_mesh, dt=a.ref_dt), a.duration, timed=False)
     peak = np.abs(z_ref).max()
@@ -121,8 +106,7 @@ def main():
     print(f"{'family':6} {'mesh':>10} {'dt':>7} {'modes':>5} {'unknowns':>8} {'steps/s':>9} {'wall/sim s':>10} "
           f"{'omega1 err':>10} {'B err':>9}", flush=True)
     for family, mesh, dt, modes in settings(a.quick):
-        text = paper_variant(paper, mesh=mesh, modes=modes or None, dt=dt)
-        tt, z, wall, n, sps = run(text, a.duration)
+        tt, z, wall, n, sps = run(paper_variant(paper, mesh=mesh, modes=modes or None, dt=dt), a.duration)
         if mesh not in omegas:
             omegas[mesh] = first_omega(mesh, scene)
         w = omegas[mesh]

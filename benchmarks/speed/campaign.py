@@ -1,8 +1,8 @@
 """A campaign on a local Dask cluster against the same cases one by one in one process.
 
-    PYTHONPATH=. python benchmarks/campaign.py [--cells 20] [--headings 5] [--seeds 2] [--duration 600]
+    python -m benchmarks.speed.campaign [--cells 20] [--headings 5] [--seeds 2] [--duration 600]
         [--workers 2] [--batch 8[,1,...]] [--serial-cases N | --skip-serial] [-o CAMPAIGN.h5 [--resume]]
-        [--nonlinear] [--hs 1.0,1.5] [--tp 5,6] [--yaw-damping 0] [--components 50]
+        [--nonlinear] [--hs 1.0,1.5] [--tp 5,6] [--yaw-damping 0] [--components 50] [--quick]
 
 Issue 19 item 5: the paper's ship in irregular seas (scenes/paper_ship_waves.toml, its tank reduced
 to 20 modes without static correction, the wave forces Froude-Krylov on its box so that every
@@ -44,7 +44,8 @@ compilation included in every row. Cases per core-hour: cases / (wall x cores). 
 campaign file is checked (every case "ok", statistics finite), the serial loop's statistics are
 compared with the cluster's, and the throughput of a 300-cell scatter of 3-hour sea states on 100
 cores is projected from each row. `--serial-cases N` runs N of the cases (evenly spaced) one by
-one instead of all. No assertion.
+one instead of all. `--quick`: 2 cases of 22 s (just past the
+waves' 20 s ramp), 1 worker, 1 of them one by one. No assertion.
 """
 import argparse
 import json
@@ -55,29 +56,20 @@ import sys
 import tempfile
 import time
 
-import jax
+import numpy as np
 
-jax.config.update("jax_enable_x64", True)
-
-import numpy as np  # noqa: E402
-
-import jaxslosh as js  # noqa: E402
-from jaxslosh.campaign.cases import case_values, make_cases, read_scatter  # noqa: E402
-from jaxslosh.campaign.worker import run_batch  # noqa: E402
+import jaxslosh as js
+from jaxslosh.campaign.cases import case_values, make_cases, read_scatter
+from jaxslosh.campaign.worker import run_batch
 from jaxslosh.io.campaign import load_campaign
+from benchmarks.harness import ROOT, Table, parser, scene as load
 
-ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 #: N m s, the yaw damping that holds the heading (see the module docstring)
 YAW_DAMPING = 2.0e6
 HS = (0.2, 0.4, 0.6, 0.8)
 TP = (5.0, 6.0, 7.0, 8.0, 9.0)
-CAMPAIGN_TABLE = """
-[campaign]
-[campaign.limits]
-roll = 0.1
-pitch = 0.1
-"probe.B" = 0.5
-"""
+#: the campaign's operability limits (roll, pitch in rad, probe B in m)
+LIMITS = {"roll": 0.1, "pitch": 0.1, "probe.B": 0.5}
 #: the projection: a scatter of 300 cells, each a 3-hour sea state, on 100 cores
 PROJECT_CELLS, PROJECT_HOURS, PROJECT_CORES = 300, 3.0, 100
 
@@ -86,27 +78,22 @@ PROJECT_CELLS, PROJECT_HOURS, PROJECT_CORES = 300, 3.0, 100
 DEPTH = 5.0
 
 
-def scene_text(nonlinear: bool = False, yaw_damping: float = YAW_DAMPING, components: int = 0) -> str:
+def campaign_scene(nonlinear: bool = False, yaw_damping: float = YAW_DAMPING, components: int = 0) -> js.Scene:
     """The benchmark's scene; `nonlinear`: the pressure on the box's wetted surface with its deck
     (restoring and Froude-Krylov forces, hull/), `components`: another number of wave components."""
-    with open(os.path.join(ROOT, "scenes", "paper_ship_waves.toml")) as f:
-        text = f.read()
-    text = text.replace("[vessel.hydrodynamics]\n", '[vessel.hydrodynamics]\nexcitation = "froude-krylov"\n', 1)
-    old = "viscous_damping = [0.0, 0.0, 0.0, 4.0e5, 0.0, 0.0]"
-    assert old in text, "scenes/paper_ship_waves.toml's viscous_damping changed: update this benchmark"
-    text = text.replace(old, f"viscous_damping = [0.0, 0.0, 0.0, 4.0e5, 0.0, {yaw_damping:.1e}]", 1)
-    title = next(ln for ln in text.splitlines() if ln.startswith("title ="))
-    text = text.replace(title, 'title = "benchmarks/campaign.py: the paper ship, its tank on 20 modes, Froude-Krylov '
-                               f'forces, {"yaw damping" if yaw_damping else "free yaw"}'
-                               f'{", nonlinear hydrostatics" if nonlinear else ""}"', 1)
+    base = load("paper_ship_waves")
+    roll = base.vessel.hydrodynamics.viscous_damping[3]           # the scene's roll damping, kept
+    keys = {"title": "benchmarks/speed/campaign.py: the paper ship, its tank on 20 modes, Froude-Krylov forces, "
+                     f'{"yaw damping" if yaw_damping else "free yaw"}{", nonlinear hydrostatics" if nonlinear else ""}',
+            "vessel.hydrodynamics.excitation": "froude-krylov",
+            "vessel.hydrodynamics.viscous_damping": [0.0, 0.0, 0.0, float(roll), 0.0, float(yaw_damping)],
+            "tanks[0].reduction.modes": 20, "tanks[0].reduction.static_correction": False,
+            "campaign.limits": LIMITS}
     if nonlinear:
-        old = "kg = 2.9133333333333336\n"
-        assert old in text, "scenes/paper_ship_waves.toml's hull changed: update this benchmark"
-        text = text.replace(old, old + f"depth = {DEPTH}\n\n[vessel.hydrostatics]\nmodel = \"nonlinear\"\n", 1)
+        keys.update({"vessel.hull.depth": DEPTH, "vessel.hydrostatics.model": "nonlinear"})
     if components:
-        assert "components = 200\n" in text, "scenes/paper_ship_waves.toml's components changed: update this benchmark"
-        text = text.replace("components = 200\n", f"components = {components}\n", 1)
-    return text + "\n[tanks.reduction]\nmodes = 20\nstatic_correction = false\n" + CAMPAIGN_TABLE
+        keys["waves.components"] = components
+    return js.scene_with(base, keys)
 
 
 def scatter_csv(cells: int, hs=HS, tp=TP) -> str:
@@ -135,12 +122,12 @@ def serial(scene_path, csv_path, heads, seeds, duration, indices, out_json):
 
 def run_serial_child(scene_path, csv_path, heads, a, indices, d):
     out_json = os.path.join(d, "serial.json")
-    args = [sys.executable, os.path.abspath(__file__), "--serial-child", scene_path, csv_path, out_json,
+    args = [sys.executable, "-m", "benchmarks.speed.campaign", "--serial-child", scene_path, csv_path, out_json,
             "--headings-rad", ",".join(repr(float(h)) for h in heads), "--seeds", str(a.seeds),
             "--duration", repr(a.duration), "--indices", ",".join(map(str, indices))]
     cpu = min(os.sched_getaffinity(0))
     t0 = time.perf_counter()
-    subprocess.run(args, check=True, preexec_fn=lambda: os.sched_setaffinity(0, {cpu}))
+    subprocess.run(args, check=True, cwd=ROOT, preexec_fn=lambda: os.sched_setaffinity(0, {cpu}))
     wall = time.perf_counter() - t0          # the child's start and imports included
     with open(out_json) as f:
         return wall, json.load(f)
@@ -164,7 +151,7 @@ def check_file(path, n):
 
 
 def main(argv=None):
-    p = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    p = parser(__doc__)
     p.add_argument("--cells", type=int, default=20)
     p.add_argument("--headings", type=int, default=5)
     p.add_argument("--seeds", type=int, default=2)
@@ -192,6 +179,8 @@ def main(argv=None):
         serial(*a.serial_child[:2], heads, a.seeds, a.duration, [int(i) for i in a.indices.split(",")],
                a.serial_child[2])
         return
+    if a.quick:
+        a.cells, a.headings, a.seeds, a.duration, a.serial_cases, a.workers = 1, 2, 1, 22.0, 1, 1
     os.environ["PYTHONPATH"] = os.pathsep.join([ROOT, os.environ.get("PYTHONPATH", "")])
     heads = np.linspace(0.0, np.pi, a.headings) if a.headings > 1 else np.array([np.pi / 2])
     batches = [int(b) for b in a.batch.split(",")]
@@ -199,7 +188,7 @@ def main(argv=None):
     with tempfile.TemporaryDirectory() as d:
         scene_path = os.path.join(d, "ship.toml")
         with open(scene_path, "w") as f:
-            f.write(scene_text(a.nonlinear, a.yaw_damping, a.components))
+            f.write(campaign_scene(a.nonlinear, a.yaw_damping, a.components).text)
         csv_path = os.path.join(d, "scatter.csv")
         hs = HS if not a.hs else tuple(float(x) for x in a.hs.split(","))
         tp = TP if not a.tp else tuple(float(x) for x in a.tp.split(","))
@@ -248,11 +237,13 @@ def main(argv=None):
                   f"failed; largest relative "
                   f"difference of a channel's std against the cluster (--batch {batches[0]}): {worst:.2g}",
                   file=sys.stderr)
-    print(f"{'':62} {'cores':>5} {'cases':>6} {'wall s':>8} {'cases/core-hour':>16}")
+    table = Table(("row", "{}"), ("cores", "{:d}"), ("cases", "{:d}"), ("wall s", "{:.1f}"),
+                  ("cases/core-hour", "{:.0f}"))
     rates = []
     for name, cores, wall, cases, _ in rows:
         rates.append(cases / (wall * cores / 3600.0))
-        print(f"{name:62} {cores:5d} {cases:6d} {wall:8.1f} {rates[-1]:16.0f}")
+        table.add(name, cores, cases, wall, rates[-1])
+    table.print(a.markdown)
     if len(rows) > len(batches):
         for b, rate in zip(batches, rates):
             print(f"ratio cluster (--batch {b}) / one by one, per core-hour: {rate / rates[-1]:.2f}; wall-clock "

@@ -1,14 +1,14 @@
 """What a campaign case costs against the stepping of a plain run of the same scene, in one process.
 
-    PYTHONPATH=. python benchmarks/campaign_cost.py [--duration 600] [--batch 8] [--repeat 2]
-        [--parallel [--cases 80]]
+    python -m benchmarks.speed.campaign_cost [--duration 600] [--batch 8] [--repeat 2]
+        [--parallel [--cases 80]] [--quick]
 
-The scene is benchmarks/campaign.py's (scenes/paper_ship_waves.toml: the paper ship, its tank on 20
+The scene is benchmarks/speed/campaign.py's (scenes/paper_ship_waves.toml: the paper ship, its tank on 20
 modes, Froude-Krylov forces on its box, a yaw damping), its cases that benchmark's scatter x 5
 headings x 2 seeds. In one process, compilation excluded from both (each is called once first):
 
-* the plain run: the compiled loop of `js.simulate` (cache/compiled.compile_run) of the first case,
-  stepping alone (the initial state and the result's assembly left out);
+* the plain run: the first case's steps by `js.Stepper.advance` (one compiled scan, no frames
+  kept), stepping alone (the initial state and the result's assembly left out);
 * a campaign batch: `campaign.worker.run_batch` of `--batch` cases as a Dask worker runs it (the
   cases' scenes, their seas drawn on the host, the vmapped loop, the result, the statistics),
   each phase timed; each repeat runs the campaign's next `--batch` cases in its order (the first
@@ -26,30 +26,25 @@ workers (one thread each, a shared persistent compilation cache filled by a firs
 efficiency of whole campaigns (1-worker wall / (2 x 2-worker wall)) and of the throughput past the
 campaign's start-up (the extra cases over the extra wall time, 2 workers against twice 1): meaningful
 only on an idle machine with 2 free cores.
-No assertion.
+The batch's phases are timed one by one through the campaign worker's own pieces
+(jaxslosh.campaign.worker, campaign.cases, campaign.stats, and run/batch.py's `_setup0`,
+`_batch_fn`, `_batch_result`): internals, as no public API splits a batch into its phases.
+`--quick`: 2 cases of 22 s per batch, one repeat. No assertion.
 """
-import argparse
 import os
-import sys
 import tempfile
 import time
 
 import jax
+import numpy as np
 
-jax.config.update("jax_enable_x64", True)
-
-import numpy as np  # noqa: E402
-
-sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-import jaxslosh as js  # noqa: E402
-from campaign import scatter_csv, scene_text  # noqa: E402
-from jaxslosh.campaign import worker  # noqa: E402
-from jaxslosh.campaign.cases import case_scene, case_values, make_cases, read_scatter, sea_arrays  # noqa: E402
-from jaxslosh.campaign.stats import case_statistics, channels  # noqa: E402
-from jaxslosh.run.batch import _batch_fn, _batch_result, _setup0  # noqa: E402
-from jaxslosh.cache.compiled import compile_run  # noqa: E402
-from jaxslosh.run.loop import core  # noqa: E402
-from jaxslosh.run.simulate import prepare  # noqa: E402
+import jaxslosh as js
+from jaxslosh.campaign import worker
+from jaxslosh.campaign.cases import case_scene, case_values, make_cases, read_scatter, sea_arrays
+from jaxslosh.campaign.stats import case_statistics, channels
+from jaxslosh.run.batch import _batch_fn, _batch_result, _setup0      # a batch's phases, one by one
+from benchmarks.harness import parser
+from benchmarks.speed.campaign import campaign_scene, scatter_csv
 
 SEA_STATE_S = 3 * 3600.0
 
@@ -123,17 +118,19 @@ def parallel(scene_path, csv_path, heads, a):
 
 
 def main(argv=None):
-    p = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    p = parser(__doc__)
     p.add_argument("--duration", type=float, default=600.0)
     p.add_argument("--batch", type=int, default=8)
     p.add_argument("--repeat", type=int, default=2)
     p.add_argument("--parallel", action="store_true")
     p.add_argument("--cases", type=int, default=80)
     a = p.parse_args(argv)
+    if a.quick:
+        a.duration, a.batch, a.repeat = 22.0, 2, 1       # just past the waves' 20 s ramp
     d = tempfile.mkdtemp()
     scene_path, csv_path = os.path.join(d, "ship.toml"), os.path.join(d, "scatter.csv")
     with open(scene_path, "w") as f:
-        f.write(scene_text())
+        f.write(campaign_scene().text)
     with open(csv_path, "w") as f:
         f.write(scatter_csv(20))
     scene = js.load_scene(scene_path)
@@ -149,13 +146,11 @@ def main(argv=None):
           f"{a.batch} cases of {a.duration:g} s ({steps} steps) per batch")
 
     s0 = case_scene(scene, values[0], a.duration)
-    st = prepare(s0)
-    bc = core(st.built)
-    n_frames = st.n_steps // st.save_every
     t0 = time.perf_counter()
-    carry, _, run = compile_run(bc, st.solver, n_frames, st.save_every)
-    jax.block_until_ready(carry)
-    print(f"plain run: compile {time.perf_counter() - t0:.1f} s")
+    stepper = js.Stepper(s0)
+    start = stepper.init()
+    jax.block_until_ready(stepper.advance(start, steps))
+    print(f"plain run: build, compile and a first run {time.perf_counter() - t0:.1f} s")
     t0 = time.perf_counter()
     batch(scene, values, a.duration, a.batch, Clock())
     print(f"campaign batch: first call (the worker's compilation and one batch) {time.perf_counter() - t0:.1f} s")
@@ -163,7 +158,7 @@ def main(argv=None):
     best = None
     for rep in range(a.repeat):
         plain = Clock()
-        plain("stepping", lambda: run(bc, st.solver, carry, n_frames, st.save_every))
+        plain("stepping", lambda: stepper.advance(start, steps))
         clock = Clock()
         statuses = batch(scene, batches[rep + 1], a.duration, a.batch, clock)
         pw, pc = plain.wall["stepping"], plain.cpu["stepping"]

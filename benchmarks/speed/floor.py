@@ -1,15 +1,15 @@
 """The paper example's step against its floor, and where the step's time goes.
 
-    python benchmarks/floor.py [--steps 200] [--rounds 7]
+    python -m benchmarks.speed.floor [--steps 200] [--rounds 7] [--quick]
 
 The floor (issue 35): three pre-factored dense solves of the example's 474 unknowns per step. Three
 forms are timed: "floor", a `lax.scan` of products with a pre-formed 474 x 474 inverse (the fastest
 pre-factored dense solve JAX has on the CPU, and the form the step's own solves take); SciPy's
 `lu_solve` on LU factors, called from Python (LAPACK's triangular solves, with a call's overhead);
 and `jax.scipy.linalg.lu_solve` in a scan (XLA's triangular solves, slow on the CPU). Ratios are
-printed against the first and the second. The step is the
-compiled loop of run/loop.py (`advance`), saving a frame every step as the paper scene does, and
-saving one frame at the end (what the output path costs). The breakdown times the step's pieces
+printed against the first and the second. The step is `js.Stepper`'s, in one compiled scan
+saving a frame (`observe`) every step as the paper scene does, and saving one frame at the end
+(`advance`, then `observe`: what the output path costs). The breakdown times the step's pieces
 alone, each in a scan of its own at a state of the running example: the residual R (every Newton
 iteration evaluates it once, and once more to see that the last update converged), the
 preconditioner's application (one per iteration: the liquid block's inverse and the rigid Schur
@@ -21,9 +21,12 @@ rounds interleaved, and the best round is kept (a shared machine: the median is 
 times are the process's CPU time (all its threads), not the wall clock: on a machine shared with
 other work the wall clock counts the time the process waits for a core, CPU time only what it
 computes (caches shared with other work still slow it).
+
+The breakdown needs the step's internals (no public API exposes a piece of the step):
+jaxslosh.solve.integrator's `step_equations` (the residual and the predictor) and `step` (the
+integrator's step, for the counts), and jaxslosh.solve.newton's preconditioner, on the model and
+solver of the public `js.Stepper` (its `built` and `solver`).
 """
-import argparse
-import os
 import time
 
 import equinox as eqx
@@ -32,16 +35,10 @@ import jax.numpy as jnp
 import numpy as np
 import scipy.linalg
 
-jax.config.update("jax_enable_x64", True)
-
-import jaxslosh as js  # noqa: E402
-from jaxslosh.run.loop import advance, core, observe, start, traced_advance  # noqa: E402
-from jaxslosh.run.simulate import prepare  # noqa: E402
-from jaxslosh.scene.keys import with_overrides  # noqa: E402
-from jaxslosh.solve import newton  # noqa: E402
-from jaxslosh.solve.integrator import step_equations  # noqa: E402
-
-ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+import jaxslosh as js
+from jaxslosh.solve import newton                                    # the preconditioner's pieces
+from jaxslosh.solve.integrator import step as integrator_step, step_equations
+from benchmarks.harness import machine, parser, scene
 
 
 def pieces(b, solver, s, n):
@@ -71,9 +68,9 @@ def pieces(b, solver, s, n):
         return jax.lax.scan(body, x0, None, length=n)[0]
 
     @eqx.filter_jit
-    def frame(b, c):
+    def frame(stepper, c):
         def body(cc, _):
-            f = observe(b, cc)
+            f = stepper.observe(cc)
             leaves = jax.tree_util.tree_leaves(f)
             bump = sum(jnp.sum(x.astype(float)) for x in leaves)
             return cc._replace(s=cc.s._replace(c=cc.s.c._replace(d=cc.s.c.d + tiny * bump))), None
@@ -118,49 +115,65 @@ def floors(size, n):
     return (lambda: by_inverse(Ainv, b0)), (lambda: by_lu(lu, b0)), by_scipy
 
 
-def counts(b, solver, carry, steps=2000):
-    """Newton iterations and preconditioner formations per step, on `steps` steps of the example."""
+@eqx.filter_jit
+def framed(stepper, c, n):
+    """n steps in one scan, a frame (`observe`) kept after each, as a run saving every step does."""
+    def body(cc, _):
+        cc = stepper.step(cc)
+        return cc, stepper.observe(cc)
+    return jax.lax.scan(body, c, None, length=n)
+
+
+def counts(stepper, carry, steps=2000):
+    """Newton iterations and preconditioner formations per step, on `steps` steps of the example
+    (the integrator's step in a scan of its own: a fresh trace, which sees the counter on
+    `StructuredNewton.precondition`, whichever form of the factors it builds)."""
     formed = [0]
-    original = newton._precond_data_parts
+    original = newton.StructuredNewton.precondition
 
-    def counted(parts, x, Cinv, ns):
+    def counted(self, R, x):
         jax.debug.callback(lambda: formed.__setitem__(0, formed[0] + 1))
-        return original(parts, x, Cinv, ns)
+        return original(self, R, x)
 
-    newton._precond_data_parts = counted
+    def run(system, solver, s):
+        def body(s, _):
+            s, info = integrator_step(system, solver, s)
+            return s, info.iterations
+        return jax.lax.scan(body, s, None, length=steps)[1]
+
+    newton.StructuredNewton.precondition = counted
     try:
-        # a fresh trace: advance's cache would hold the uncounted program
-        _, fr = eqx.filter_jit(traced_advance)(b, solver, carry, steps, 1)
-        jax.block_until_ready(fr)
+        its = jax.block_until_ready(eqx.filter_jit(run)(stepper.built.system, stepper.solver, carry.s))
     finally:
-        newton._precond_data_parts = original
-    return float(fr.iterations.mean()), formed[0] / steps
+        newton.StructuredNewton.precondition = original
+    return float(np.mean(its)), formed[0] / steps
 
 
 def main():
-    ap = argparse.ArgumentParser()
+    ap = parser(__doc__)
     ap.add_argument("--steps", type=int, default=200, help="steps (or calls) per timing")
     ap.add_argument("--rounds", type=int, default=7, help="interleaved rounds; the best is kept")
     a = ap.parse_args()
+    if a.quick:             # a few calls, one round, a short count
+        a.steps, a.rounds = 5, 1
     n = a.steps
-    scene = js.load_scene(os.path.join(ROOT, "scenes", "paper_ship_tank.toml"))
-    setup = prepare(with_overrides(scene, duration=2000 * scene.simulation.dt))
-    b, solver = core(setup.built), setup.solver
-    carry, _ = start(b, solver)
-    mid, _ = advance(b, solver, carry, 500, 1)          # a state of the running example (t = 5 s)
-    its, formed = counts(b, solver, carry)
+    stepper = js.Stepper(scene("paper_ship_tank"))
+    b, solver = stepper.built, stepper.solver
+    carry = stepper.init()
+    mid = stepper.advance(carry, 50 if a.quick else 500)     # a state of the running example (t = 5 s)
+    its, formed = counts(stepper, carry, 20 if a.quick else 2000)
     residual, apply, form, frame = pieces(b, solver, mid.s, n)
     floor_inv, floor_lu, floor_scipy = floors(b.system.n, n)
     timed = {
         "floor": floor_inv,
         "floor, SciPy lu_solve": floor_scipy,
         "floor, jax lu_solve": floor_lu,
-        "step, a frame every step": lambda: advance(b, solver, mid, n, 1),
-        "step, one frame": lambda: advance(b, solver, mid, 1, n),
+        "step, a frame every step": lambda: framed(stepper, mid, n),
+        "step, one frame": lambda: stepper.observe(stepper.advance(mid, n)),
         "residual R": lambda: residual(b, solver, mid.s),
         "preconditioner applied": lambda: apply(b, solver, mid.s),
         "preconditioner formed": lambda: form(b, solver, mid.s),
-        "frame": lambda: frame(b, mid),
+        "frame": lambda: frame(stepper, mid),
     }
     for f in timed.values():                           # compile
         jax.block_until_ready(f())
@@ -173,7 +186,7 @@ def main():
     best = {k: min(v) for k, v in us.items()}
     spread = {k: sorted(v)[len(v) // 2] for k, v in us.items()}
     fl, st = best["floor"], best["step, a frame every step"]
-    print(f"jax {jax.__version__} on {jax.devices()[0].platform}, {os.cpu_count()} cpu; paper example, "
+    print(f"{machine()}; paper example, "
           f"{b.system.n} unknowns; {n} steps per timing, best of {a.rounds} interleaved rounds (median after /)")
     print(f"{'':34} {'us/step':>9} {'/ median':>9} {'x floor':>8} {'x SciPy':>8}")
     for k in ("floor", "floor, SciPy lu_solve", "floor, jax lu_solve", "step, a frame every step", "step, one frame"):

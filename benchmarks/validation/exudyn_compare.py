@@ -1,8 +1,8 @@
 """Side by side with Exudyn (C++ floating-frame multibody code): same scene, same step, one run.
 
     pip install exudyn          # a benchmark-only dependency, not one of jaxslosh's
-    python benchmarks/exudyn_compare.py [--duration 20] [--repeat 3] [--only all|vessel|ffrf-reduced|ffrf]
-                                        [--modes 8 20] [--full-duration 0.5] [--nodal]
+    python -m benchmarks.validation.exudyn_compare [--duration 20] [--repeat 3] [--modes 8 20]
+        [--only all|vessel|ffrf-reduced|ffrf] [--full-duration 0.5] [--nodal] [--quick]
 
 1. The vessel alone (scenes/vessel_only.toml) on hydrostatic springs: in Exudyn a rigid body (Euler
 parameters) tied to the ground by CreateRigidBodySpringDamper with the heave, roll and pitch
@@ -60,29 +60,22 @@ static_correction = false, relative penalty: then the basis is exactly those mod
 modal-reduction run ([tanks.reduction] modes = 8 or 20, static correction) is listed as well.
 Remaining differences between "the same model" runs: the springs' Tait-Bryan form against our
 conservative restoring potential, and Exudyn's generalized-alpha against our HHT (as in 1.).
-Timings: ours best of --repeat after compilation, Exudyn's SolveDynamic once (modified Newton, as
+Timings: ours best of --repeat after compilation (benchmarks/harness.py: js.Stepper's steps, no
+frames kept; the trajectories are js.simulate's), Exudyn's SolveDynamic once (modified Newton, as
 Exudyn's FFRF examples; it gives the same answer with fewer Jacobians), sensors every step in both.
 """
-import argparse
 import contextlib
 import dataclasses
 import os
 import time
 
 import jax
+import numpy as np
+import scipy.linalg as sl
+import scipy.sparse as sp
 
-jax.config.update("jax_enable_x64", True)
-
-import numpy as np  # noqa: E402
-import scipy.linalg as sl  # noqa: E402
-import scipy.sparse as sp  # noqa: E402
-
-import jaxslosh as js  # noqa: E402
-from jaxslosh.run.loop import core as _core, advance, start  # noqa: E402
-from jaxslosh.run.simulate import prepare
-from jaxslosh.scene.keys import with_overrides
-
-ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+import jaxslosh as js
+from benchmarks.harness import ROOT, parser, time_scene
 
 
 def _settings(exu, scene, duration, dt):
@@ -128,16 +121,13 @@ def exudyn_barge(scene, duration, dt):
 
 
 def jaxslosh_barge(scene, duration):
-    setup = prepare(with_overrides(scene, duration=duration))
-    b, solver = _core(setup.built), setup.solver
-    carry, f0 = start(b, solver)
-    advance(b, solver, carry, setup.n_steps, 1)             # compile
-    t0 = time.perf_counter()
-    c2, fr = advance(b, solver, carry, setup.n_steps, 1)
-    jax.block_until_ready(fr)
-    wall = time.perf_counter() - t0
-    rpy = np.asarray(js.run.rpy_from_quat(fr.q))
-    return wall, setup.n_steps, np.asarray(fr.t), np.asarray(fr.X0)[:, 2], rpy
+    """Our run: the step's wall time (benchmarks/harness.py, best of 1 after compilation) and the
+    trajectory of `js.simulate` (t = 0 included)."""
+    sc = js.scene_with(scene, {"simulation.duration": duration})
+    n = int(round(duration / sc.simulation.dt))
+    rec = time_scene("vessel alone", sc, n, repeat=1)
+    r = js.simulate(sc)
+    return rec.run_s, n, np.asarray(r.time), np.asarray(r.vessel.position)[:, 2], np.asarray(r.vessel.roll_pitch_yaw)
 
 
 def vessel_compare(a):
@@ -189,34 +179,28 @@ def relative_penalty():
         rd._cached_basis.cache_clear()
 
 
-def paper_text(modes=None, static_correction=True):
-    text = open(PAPER).read()
-    if modes is not None:
-        red = f"[tanks.reduction]\nmodes = {modes}\nstatic_correction = {'true' if static_correction else 'false'}\n\n"
-        text = text.replace("[tanks.fluid]", red + "[tanks.fluid]")
-    return text
+def paper_text(modes=None, static_correction=True) -> js.Scene:
+    """The paper example, its tank reduced to `modes` where given (the name kept from the TOML days)."""
+    sc = js.load_scene(PAPER)
+    if modes is None:
+        return sc
+    return js.scene_with(sc, {"tanks[0].reduction.modes": modes,
+                              "tanks[0].reduction.static_correction": static_correction})
 
 
-def jaxslosh_paper(text, duration, repeat, relative=False):
-    """Our run of a paper-example variant: wall time of the compiled loop, roll-pitch-yaw, heave and
-    the vertical displacement of probe B, t = 0 included."""
+def jaxslosh_paper(sc, duration, repeat, relative=False):
+    """Our run of a paper-example variant: the step's wall time (benchmarks/harness.py, best of
+    `repeat` after compilation), roll-pitch-yaw, heave and the vertical displacement of probe B
+    (`js.simulate`), t = 0 included; `built`: the model (js.Stepper's)."""
+    sc = js.scene_with(sc, {"simulation.duration": duration})
+    n = int(round(duration / sc.simulation.dt))
     with relative_penalty() if relative else contextlib.nullcontext():
-        setup = prepare(with_overrides(js.load_scene(text), duration=duration))
-    b, solver = _core(setup.built), setup.solver
-    carry, f0 = start(b, solver)
-    advance(b, solver, carry, setup.n_steps, 1)             # compile
-    walls = []
-    for _ in range(repeat):
-        t0 = time.perf_counter()
-        _, fr = advance(b, solver, carry, setup.n_steps, 1)
-        jax.block_until_ready(fr)
-        walls.append(time.perf_counter() - t0)
-    ib = setup.built.probes.names.index("B")
-    return dict(wall=min(walls), n=setup.n_steps, unknowns=setup.built.system.n, built=setup.built,
-                t=np.concatenate([[0.0], np.asarray(fr.t)]),
-                rpy=np.concatenate([np.zeros((1, 3)), np.asarray(js.run.rpy_from_quat(fr.q))]),
-                z=np.concatenate([[float(setup.built.c0.X0[2])], np.asarray(fr.X0)[:, 2]]),
-                pb=np.concatenate([[0.0], np.asarray(fr.probes)[:, ib, 2] - float(f0.probes[ib, 2])]))
+        stepper = js.Stepper(sc)
+        rec = time_scene("paper", sc, n, repeat)
+        r = js.simulate(sc)
+    zb = np.asarray(r.probes["B"].position)[:, 2]
+    return dict(wall=rec.run_s, n=n, unknowns=rec.unknowns, built=stepper.built, t=np.asarray(r.time),
+                rpy=np.asarray(r.vessel.roll_pitch_yaw), z=np.asarray(r.vessel.position)[:, 2], pb=zb - zb[0])
 
 
 def ship_point_masses(mass, inertia):
@@ -440,7 +424,7 @@ def paper_compare(a, which):
 
 
 def main():
-    ap = argparse.ArgumentParser()
+    ap = parser(__doc__)
     ap.add_argument("--duration", type=float, default=20.0)
     ap.add_argument("--repeat", type=int, default=3)
     ap.add_argument("--only", choices=("all", "vessel", "ffrf-reduced", "ffrf"), default="all")
@@ -450,6 +434,9 @@ def main():
     ap.add_argument("--nodal", action="store_true",
                     help="also ObjectFFRF on the nodal coordinates (the held ones by scalar CoordinateConstraints, see the docstring)")
     a = ap.parse_args()
+    if a.quick:             # 0.5 s, one timing, 8 modes; the vessel alone unless --only says otherwise
+        a.duration, a.repeat, a.modes = 0.5, 1, [8]
+        a.only = "vessel" if a.only == "all" else a.only
     try:
         import exudyn  # noqa: F401
     except ImportError:

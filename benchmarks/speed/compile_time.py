@@ -1,33 +1,34 @@
 """What a run of a scene costs before its first step, in a fresh process: the first call (empty
 caches) and a second process (the caches the first filled), tracing and XLA apart.
 
-    python benchmarks/compile_time.py [SCENE ...] [--repeat 2] [--equations] [--api]
+    python -m benchmarks.speed.compile_time [SCENE ...] [--repeat 2] [--equations] [--api] [--quick] [--markdown]
 
-Each measurement is one fresh Python process that does what `jaxslosh run` does up to the end of
-its first chunk: import, build the model (`build`; a second process reads the model the first kept),
-compile `start` and the chunk (cache/compiled.compile_run: JAX's persistent compilation cache and the
-exported programs, cache/programs.py, in a temporary folder; `start` compiles while the chunk traces) and
+Each measurement is one fresh Python process that runs `jaxslosh run`'s own path
+(jaxslosh/run/tofile.run_to_file, an internal: its report's phases are what is measured) on the
+scene cut to its first chunk: import, build the model (`build`; a second process reads the model
+the first kept), compile `start` and the chunk (JAX's persistent compilation cache and the exported
+programs, cache/programs.py, in a temporary folder; `start` compiles while the chunk traces) and
 run `start` (`compile`), then the first chunk. `1st step` is the process's time to its first
 step (import + build + compile). JAX's compilation events are summed by kind (jax.monitoring):
 tracing (jaxpr_trace_duration), lowering (jaxpr_to_mlir_module_duration) and XLA
 (backend_compile_duration; in a second process, reading XLA's cache). Programs that compile at the
 same time (start and the chunk) are both counted in full: the XLA column can exceed the wall time
 it overlaps. Prints a table; no assertion.
-`--equations` adds the traced programs' sizes; `--api` a table of `js.simulate`'s first call (build,
+`--equations` adds the traced programs' sizes (`js.Stepper`'s `init` and `advance` over the chunk's
+steps, which keeps no frames); `--api` a table of `js.simulate`'s first call (build,
 compile and 50 steps) and second call (build and 50 steps) in a fresh process. Default scenes: the paper example and the paper ship
 with its mast.
 """
-import argparse
 import json
 import os
 import subprocess
 import sys
 import tempfile
 
-ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+from benchmarks.harness import ROOT, Table, parser
 
 CHILD = r"""
-import collections, json, os, sys, time
+import collections, json, os, sys, tempfile, time
 T0 = time.perf_counter()
 os.environ["JAXSLOSH_CACHE_DIR"] = sys.argv[2]
 import jax
@@ -40,29 +41,22 @@ setup_jax()                 # as `jaxslosh run`: float64, XLA's cache and the ex
 events = collections.defaultdict(float)
 jax.monitoring.register_event_duration_secs_listener(
     lambda name, d, **kw: events.__setitem__(name.split("/")[-1], events[name.split("/")[-1]] + d))
-from jaxslosh.run.loop import core
-from jaxslosh.run.simulate import prepare
-from jaxslosh.cache.programs import cached
-from jaxslosh.cache.compiled import compile_run
-from jaxslosh.scene import load_scene
+import jaxslosh as js
+from jaxslosh.run.tofile import run_to_file
 t_import = time.perf_counter()
-scene = load_scene(sys.argv[1])
-setup = cached("model", scene, lambda: prepare(scene))      # as run_to_file: a second process reads the model
-b, solver = core(setup.built), setup.solver
-t_build = time.perf_counter()
-se = setup.save_every
-chunk = scene.simulation.chunk or max(1, min(setup.n_steps // se, max(1, 500 // se)))
-carry, f0, adv = compile_run(b, solver, chunk, se)
-jax.block_until_ready(f0)
-t_first = time.perf_counter()
-carry, fr = adv(b, solver, carry, chunk, se)
-jax.block_until_ready(fr)
-t_chunk = time.perf_counter()
+scene = js.load_scene(sys.argv[1])
+sim = scene.simulation
+se = sim.save_every or 1
+n_steps = int(round(sim.duration / sim.dt))
+chunk = sim.chunk or max(1, min(n_steps // se, max(1, 500 // se)))
+scene = js.scene_with(scene, {"simulation.duration": chunk * se * sim.dt})     # the first chunk only
+with tempfile.TemporaryDirectory() as out:
+    rep = run_to_file(scene, os.path.join(out, "r.h5"), progress=False)
+ph = rep.times
 eqns = {}
 if sys.argv[3] == "1":     # the traced programs' sizes (equations, counted into sub-programs): what XLA compiles
     import equinox as eqx
     from jax.extend import core as jcore
-    from jaxslosh.run.loop import traced_advance, traced_init
 
     def count(jaxpr):
         n = 0
@@ -73,12 +67,14 @@ if sys.argv[3] == "1":     # the traced programs' sizes (equations, counted into
                     n += count(sub.jaxpr) if isinstance(sub, jcore.ClosedJaxpr) else \
                         count(sub) if isinstance(sub, jcore.Jaxpr) else 0
         return n
-    eqns["start_eqns"] = count(eqx.filter_make_jaxpr(traced_init)(b, solver)[0].jaxpr)
-    eqns["chunk_eqns"] = count(eqx.filter_make_jaxpr(lambda b_, s_, c_: traced_advance(b_, s_, c_, chunk, se))(
-        b, solver, carry)[0].jaxpr)
+    stepper = js.Stepper(scene)
+    carry = stepper.init()
+    eqns["start_eqns"] = count(eqx.filter_make_jaxpr(lambda st: st.init())(stepper)[0].jaxpr)
+    eqns["chunk_eqns"] = count(eqx.filter_make_jaxpr(lambda st, c: st.advance(c, chunk * se))(stepper, carry)[0].jaxpr)
 executables.settle()        # as `jaxslosh run` does at its end: the executables compiled are kept
-print(json.dumps({**eqns, "import": t_import - T0, "build": t_build - t_import, "compile": t_first - t_build, "first_step": t_first - T0,
-                  "first_chunk": t_chunk - T0, "steps": chunk * se,
+t_build, t_first = t_import + ph["build"], t_import + ph["build"] + ph["compile"]
+print(json.dumps({**eqns, "import": t_import - T0, "build": ph["build"], "compile": ph["compile"],
+                  "first_step": t_first - T0, "first_chunk": t_first + ph.get("stepping", 0.0) - T0, "steps": chunk * se,
                   "trace": events["jaxpr_trace_duration"], "lower": events["jaxpr_to_mlir_module_duration"],
                   "xla": events["backend_compile_duration"]}))
 """
@@ -124,7 +120,7 @@ def measure(scene, cache, equations=False):
 
 
 def main():
-    ap = argparse.ArgumentParser()
+    ap = parser(__doc__)
     ap.add_argument("scenes", nargs="*", default=[os.path.join(ROOT, "scenes", "paper_ship_tank.toml"),
                                                  os.path.join(ROOT, "scenes", "paper_ship_mast.toml")])
     ap.add_argument("--repeat", type=int, default=1, help="cold/warm pairs per scene (a shared machine varies)")
@@ -134,27 +130,32 @@ def main():
     ap.add_argument("--api", action="store_true",
                     help="also time js.simulate's first and second call in a fresh process (the Python API)")
     a = ap.parse_args()
-    print(f"{'scene':24} {'cache':6} {'import':>7} {'build':>7} {'compile':>8} {'1st step':>9} {'1st chunk':>10} {'trace':>7} "
-          f"{'lower':>7} {'XLA':>7}   (seconds, one fresh process each)")
+    if a.quick:             # the vessel alone, one cold/warm pair
+        a.scenes, a.repeat = [os.path.join(ROOT, "scenes", "vessel_only.toml")], 1
+    table = Table(("scene", "{}"), ("cache", "{}"), ("import", "{:.2f}"), ("build", "{:.2f}"), ("compile", "{:.2f}"),
+                  ("1st step", "{:.2f}"), ("1st chunk", "{:.2f}"), ("trace", "{:.2f}"), ("lower", "{:.2f}"),
+                  ("XLA", "{:.2f}"), ("equations (start, chunk)", "{}"),
+                  title="seconds, one fresh process each")
     for scene in a.scenes:
         for _ in range(a.repeat):
             with tempfile.TemporaryDirectory() as cache:
                 for label in ("cold", "warm"):
                     r = measure(scene, cache, a.equations and label == "warm")
-                    print(f"{os.path.basename(scene)[:24]:24} {label:6} {r['import']:7.2f} {r['build']:7.2f} "
-                          f"{r['compile']:8.2f} {r['first_step']:9.2f} {r['first_chunk']:10.2f} {r['trace']:7.2f} {r['lower']:7.2f} "
-                          f"{r['xla']:7.2f}" + (f"   equations: start {r['start_eqns']}, chunk {r['chunk_eqns']}"
-                                                 if "start_eqns" in r else ""))
-                    sys.stdout.flush()
+                    table.add(os.path.basename(scene)[:24], label, r["import"], r["build"], r["compile"],
+                              r["first_step"], r["first_chunk"], r["trace"], r["lower"], r["xla"],
+                              f"{r['start_eqns']}, {r['chunk_eqns']}" if "start_eqns" in r else "")
+    table.print(a.markdown)
     if a.api:
-        print(f"\n{'scene':24} {'import':>7} {'1st call':>9} {'2nd call':>9} {'trace':>7} {'lower':>7} {'XLA':>7}"
-              f"   (js.simulate, 50 steps, build included; seconds, one fresh process each)")
+        print()
+        table = Table(("scene", "{}"), ("import", "{:.2f}"), ("1st call", "{:.2f}"), ("2nd call", "{:.2f}"),
+                      ("trace", "{:.2f}"), ("lower", "{:.2f}"), ("XLA", "{:.2f}"),
+                      title="js.simulate, 50 steps, build included; seconds, one fresh process each")
         for scene in a.scenes:
             for _ in range(a.repeat):
                 r = measure_api(scene)
-                print(f"{os.path.basename(scene)[:24]:24} {r['import']:7.2f} {r['first']:9.2f} {r['second']:9.2f} "
-                      f"{r['trace']:7.2f} {r['lower']:7.2f} {r['xla']:7.2f}")
-                sys.stdout.flush()
+                table.add(os.path.basename(scene)[:24], r["import"], r["first"], r["second"], r["trace"],
+                          r["lower"], r["xla"])
+        table.print(a.markdown)
 
 
 if __name__ == "__main__":

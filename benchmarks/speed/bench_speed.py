@@ -1,6 +1,7 @@
 """What a step costs, and how that compares with simpler ways of doing the same work, in one run.
 
-    python benchmarks/bench_speed.py [--steps 200] [--batch 64] [--tables newton,gradient,batch,memory]
+    python -m benchmarks.speed.bench_speed [--steps 200] [--batch 64] [--tables newton,gradient,batch,memory]
+        [--quick] [--markdown]
 
 Prints four tables (no assertion; tests never time anything):
   1. the structured quasi-Newton step against a naive Newton (global jax.jacfwd of the residual and a
@@ -8,26 +9,20 @@ Prints four tables (no assertion; tests never time anything):
   2. the cost of jax.grad of a trajectory loss against the forward run;
   3. a vmapped batch of runs against the same runs one after another (compilation timed apart);
   4. the peak memory of one 2,000-step gradient of the paper example.
+The structured step is timed by benchmarks/harness.py's time_scene; the naive Newton is built from
+the step's equations (`jaxslosh.solve.integrator.step_equations`, an internal: the comparison needs
+the very residual the structured step solves) on the `js.Stepper`'s system and solver.
 """
-import argparse
 import os
-import time
 
+import equinox as eqx
 import jax
+import jax.numpy as jnp
+import numpy as np
 
-jax.config.update("jax_enable_x64", True)
-
-import equinox as eqx  # noqa: E402
-import jax.numpy as jnp  # noqa: E402
-import numpy as np  # noqa: E402
-
-import jaxslosh as js  # noqa: E402
-from jaxslosh.solve.integrator import StepInfo, step_equations  # noqa: E402
-from jaxslosh.run.loop import core as _core, advance, start  # noqa: E402
-from jaxslosh.run.simulate import prepare
-from jaxslosh.scene.keys import with_overrides
-
-ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+import jaxslosh as js
+from jaxslosh.solve.integrator import StepInfo, step_equations      # the naive Newton's residual
+from benchmarks.harness import ROOT, Table, best_of, machine, parser, scene as load, time_scene
 
 
 def naive_step(system, solver, s):
@@ -55,29 +50,28 @@ def naive_run(system, solver, s, n):
 
 
 def timed(f, *args):
-    t0 = time.perf_counter()
-    out = f(*args)
-    jax.block_until_ready(out)
-    return time.perf_counter() - t0, out
+    """(wall s, result) of one call (the first: compile and run)."""
+    w, _, out = best_of(lambda: f(*args), 1)
+    return w, out
 
 
-def newton_table(scenes, steps):
+def newton_table(scenes, steps, markdown):
     print(f"\n1. structured quasi-Newton against a naive Newton, {steps} steps")
-    print(f"{'case':26} {'unknowns':>8} {'structured us/step':>19} {'naive us/step':>14} {'ratio':>7}")
+    table = Table(("case", "{}"), ("unknowns", "{:d}"), ("structured us/step", "{:.1f}"), ("naive us/step", "{:.1f}"),
+                  ("ratio", "{:.1f}"))
     for name, scene in scenes:
-        setup = prepare(with_overrides(scene, duration=steps * scene.simulation.dt))
-        b, solver = _core(setup.built), setup.solver
-        carry, _ = start(b, solver)
-        timed(advance, b, solver, carry, steps, 1)
-        t_s, _ = timed(advance, b, solver, carry, steps, 1)
-        timed(naive_run, b.system, solver, carry.s, steps)
-        t_n, _ = timed(naive_run, b.system, solver, carry.s, steps)
-        print(f"{name:26} {b.system.n:8d} {1e6 * t_s / steps:19.1f} {1e6 * t_n / steps:14.1f} {t_n / t_s:7.1f}")
+        r = time_scene(name, scene, steps, repeat=1)
+        stepper = js.Stepper(scene)
+        s0 = stepper.init().s
+        timed(naive_run, stepper.built.system, stepper.solver, s0, steps)
+        t_n, _ = timed(naive_run, stepper.built.system, stepper.solver, s0, steps)
+        table.add(name, r.unknowns, r.us_per_step, 1e6 * t_n / steps, t_n / r.run_s)
+    table.print(markdown)
 
 
-def gradient_table(scenes, steps):
+def gradient_table(scenes, steps, markdown):
     print(f"\n2. gradient of a trajectory loss against the forward run, {steps} steps")
-    print(f"{'case':26} {'forward s':>10} {'grad s':>8} {'ratio':>7}")
+    table = Table(("case", "{}"), ("forward s", "{:.3f}"), ("grad s", "{:.3f}"), ("ratio", "{:.2f}"))
     for name, scene in scenes:
         T = steps * scene.simulation.dt
 
@@ -91,7 +85,8 @@ def gradient_table(scenes, steps):
         timed(g, gm0)
         t_f, _ = timed(f, gm0)
         t_g, _ = timed(g, gm0)
-        print(f"{name:26} {t_f:10.3f} {t_g:8.3f} {t_g / t_f:7.2f}")
+        table.add(name, t_f, t_g, t_g / t_f)
+    table.print(markdown)
 
 
 def memory_table(steps):
@@ -114,10 +109,10 @@ print(float(jax.grad(loss)(1.67)), resource.getrusage(resource.RUSAGE_SELF).ru_m
           f" (dloss/dGM_T = {float(grad):.6g})")
 
 
-def batch_table(scenes, steps, batch):
+def batch_table(scenes, steps, batch, markdown):
     print(f"\n3. a vmapped batch of {batch} runs against the same runs one after another, {steps} steps")
-    print(f"{'case':26} {'compile s':>9} {'batch s':>8} {'singles s':>10} {'runs/s batch':>13} {'runs/s single':>14} "
-          f"{'ratio':>7}")
+    table = Table(("case", "{}"), ("compile s", "{:.2f}"), ("batch s", "{:.2f}"), ("singles s", "{:.2f}"),
+                  ("runs/s batch", "{:.1f}"), ("runs/s single", "{:.1f}"), ("ratio", "{:.2f}"))
     for name, scene in scenes:
         T = steps * scene.simulation.dt
         gm = np.linspace(1.2, 2.0, batch)
@@ -125,33 +120,32 @@ def batch_table(scenes, steps, batch):
         t_b = min(timed(lambda: js.simulate_batch(scene, {"vessel.hydrostatics.gm_t": gm}, duration=T)[0].time)[0]
                   for _ in range(2))
         js.simulate(scene, params={"vessel.hydrostatics.gm_t": gm[0]}, duration=T)   # compile
-        t_s = 1e9
-        for _ in range(2):
-            t0 = time.perf_counter()
-            for g in gm:
-                jax.block_until_ready(js.simulate(scene, params={"vessel.hydrostatics.gm_t": g}, duration=T).time)
-            t_s = min(t_s, time.perf_counter() - t0)
-        print(f"{name:26} {t_c - t_b:9.2f} {t_b:8.2f} {t_s:10.2f} {batch / t_b:13.1f} {batch / t_s:14.1f} "
-              f"{t_s / t_b:7.2f}")
+        t_s = best_of(lambda: [js.simulate(scene, params={"vessel.hydrostatics.gm_t": g}, duration=T).time
+                               for g in gm], 2)[0]
+        table.add(name, t_c - t_b, t_b, t_s, batch / t_b, batch / t_s, t_s / t_b)
+    table.print(markdown)
 
 
 def main():
-    ap = argparse.ArgumentParser()
+    ap = parser(__doc__)
     ap.add_argument("--steps", type=int, default=200)
     ap.add_argument("--batch", type=int, default=64)
     ap.add_argument("--memory-steps", type=int, default=2000)
     ap.add_argument("--tables", default="newton,gradient,batch,memory", help="comma-separated subset to run")
     a = ap.parse_args()
+    if a.quick:             # the vessel alone, a few steps, a batch of 2, no memory table
+        a.steps, a.batch, a.tables = 5, 2, "newton,gradient,batch"
     tables = set(a.tables.split(","))
-    scenes = [("vessel alone", js.load_scene(os.path.join(ROOT, "scenes", "vessel_only.toml"))),
-              ("paper example 5x5x5", js.load_scene(os.path.join(ROOT, "scenes", "paper_ship_tank.toml")))]
-    print(f"jax {jax.__version__} on {jax.devices()[0].platform}, {os.cpu_count()} cpu")
+    scenes = [("vessel alone", load("vessel_only")), ("paper example 5x5x5", load("paper_ship_tank"))]
+    if a.quick:
+        scenes = scenes[:1]
+    print(machine())
     if "newton" in tables:
-        newton_table(scenes, a.steps)
+        newton_table(scenes, a.steps, a.markdown)
     if "gradient" in tables:
-        gradient_table(scenes, a.steps)
+        gradient_table(scenes, a.steps, a.markdown)
     if "batch" in tables:
-        batch_table(scenes, a.steps, a.batch)
+        batch_table(scenes, a.steps, a.batch, a.markdown)
     if "memory" in tables:
         memory_table(a.memory_steps)
 

@@ -1,38 +1,41 @@
 """Print the validation tables (docs/validation.md): what was checked against what, with measured numbers.
 
-    python benchmarks/validation.py
+    python -m benchmarks.validation.validation [--quick]
 
-Each row is computed here, in one run (the tests assert the same facts with tolerances).
+Each row is computed here, in one run (the tests assert the same facts with tolerances). The
+references and scenes the tests share are imported from tests/ (run from the repository root);
+the liquid's blocks and modes from jaxslosh's fem/ and assemble/ (the quantities checked have no
+public API). `--quick`: the rows that take seconds (no waves).
 """
 import os
 import sys
 import time
 
-import jax
+import numpy as np
+from scipy.integrate import solve_ivp
 
-jax.config.update("jax_enable_x64", True)
+import jaxslosh as js
+from jaxslosh.fem.modes import effective_roll_inertia
+from jaxslosh.assemble.system import build
+from jaxslosh.physics.kinematics import rotation_matrix
+from jaxslosh.fem.liquid import build_liquid
+from jaxslosh.fem.modes import analytic_sloshing_omegas, liquid_modes
+from benchmarks.harness import ROOT, Table, machine, parser, scene
+from tests.helpers import vessel_scene, zero_crossing_period
 
-import numpy as np  # noqa: E402
-from scipy.integrate import solve_ivp  # noqa: E402
 
-import jaxslosh as js  # noqa: E402
-from jaxslosh.fem.modes import effective_roll_inertia  # noqa: E402
-from jaxslosh.assemble.system import build  # noqa: E402
-from jaxslosh.physics.kinematics import rotation_matrix  # noqa: E402
-from jaxslosh.fem.liquid import build_liquid  # noqa: E402
-from jaxslosh.fem.modes import analytic_sloshing_omegas, liquid_modes  # noqa: E402
-
-HERE = os.path.dirname(os.path.abspath(__file__))
-sys.path.insert(0, os.path.join(HERE, "..", "tests"))
-from helpers import vessel_scene, zero_crossing_period  # noqa: E402
-from test_coupled import ship_with_tank  # noqa: E402
+def ship_with_tank(mesh, rpy):
+    """The paper example at rest, its tank's liquid the stabilized element on `mesh`, heeled by `rpy`."""
+    return js.scene_with(scene("paper_ship_tank"), {
+        "tanks[0].mesh": list(mesh), "tanks[0].fluid.element": "stabilized", "tanks[0].fluid.sound_speed": None,
+        "vessel.initial.angular_velocity": [0.0, 0.0, 0.0], "vessel.initial.roll_pitch_yaw": list(rpy)})
 
 rows = []
 
 
 def row(check, reference, measured):
     rows.append((check, reference, measured))
-    print(f"| {check} | {reference} | {measured} |")
+    print(f"  {check}: {measured}", file=sys.stderr, flush=True)       # progress; the table at the end
     sys.stdout.flush()
 
 
@@ -49,7 +52,7 @@ def vessel_periods():
 
 
 def torque_free():
-    text = open(os.path.join(HERE, "..", "tests", "test_vessel.py")).read()
+    text = open(os.path.join(ROOT, "tests", "physics", "test_vessel.py")).read()
     free = text.split('FREE = """')[1].split('"""')[0]
     scene = js.load_scene(free)
     I = np.array([1.0, 2.0, 3.0])
@@ -108,7 +111,7 @@ def inertia():
 
 def waves():
     """The rows of tests/hydro/test_waves.py: the regular-wave RAO and the Cummins memory, Capytaine's box."""
-    import test_waves as tw
+    from tests.hydro import test_waves as tw
     from jaxslosh.hydro.capytaine import capytaine_hydrostatics
     from jaxslosh.scene.types import Hull
     w, Bv = 0.9, [0.0, 0.0, 0.0, 8.0e5, 0.0, 0.0]
@@ -142,16 +145,20 @@ def waves():
 
 
 def main():
+    a = parser(__doc__).parse_args()
     t0 = time.perf_counter()
-    print("| check | reference | measured |")
-    print("| --- | --- | --- |")
     vessel_periods()
     torque_free()
     sloshing()
     free_surface_moment()
     inertia()
-    waves()
-    print(f"\n({time.perf_counter() - t0:.0f} s; jax {jax.__version__}, {os.cpu_count()} cpu)")
+    if not a.quick:
+        waves()
+    table = Table(("check", "{}"), ("reference", "{}"), ("measured", "{}"))
+    for r in rows:
+        table.add(*r)
+    table.print(a.markdown)
+    print(f"\n({time.perf_counter() - t0:.0f} s; {machine()})")
 
 
 if __name__ == "__main__":

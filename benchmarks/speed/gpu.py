@@ -2,29 +2,19 @@
 20 x 20 x 12 box tank, the LNG carrier's shaped tanks, a vmapped batch of the paper example, and one campaign batch (the worker's
 `run_batch`: JONSWAP seas of the waves scene, statistics included).
 
-    python benchmarks/gpu.py [--steps 200] [--batch 64] [--cases 64] [--duration 60]
+    python -m benchmarks.speed.gpu [--steps 2000] [--batch 64] [--cases 64] [--duration 60] [--quick]
 
 Prints one table: compile (first call less the second) or the first call, the run (second call,
-the same shapes) per case, and the microseconds per step (per run-step for batches). No assertion; tests never time anything.
+the same shapes) per case, and the microseconds per step (per run-step for batches); the single
+scenes' step by benchmarks/harness.py's time_scene. No assertion; tests never time anything.
 """
-import argparse
-import os
-import sys
 import time
 
 import jax
+import numpy as np
 
-jax.config.update("jax_enable_x64", True)
-
-import numpy as np  # noqa: E402
-
-import jaxslosh as js  # noqa: E402
-from jaxslosh.scene.keys import with_overrides  # noqa: E402
-
-sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from bench_paper import time_scene  # noqa: E402  (the loop alone: compile apart from the run)
-
-ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+import jaxslosh as js
+from benchmarks.harness import Table, parser, scene, time_scene
 
 
 def twice(f):
@@ -39,7 +29,7 @@ def twice(f):
 
 
 def main():
-    ap = argparse.ArgumentParser()
+    ap = parser(__doc__)
     ap.add_argument("--steps", type=int, default=2000, help="steps of the paper example (its 20 s)")
     ap.add_argument("--tank-steps", type=int, default=200, help="steps of the 20 x 20 x 12 tank")
     ap.add_argument("--batch-steps", type=int, default=200, help="steps of each run of the batch")
@@ -48,43 +38,43 @@ def main():
     ap.add_argument("--duration", type=float, default=60.0, help="s of each campaign case")
     ap.add_argument("--only", default="paper,tank20,lng,batch,campaign")
     a = ap.parse_args()
+    if a.quick:         # a few steps of each, small batches; campaign cases just past the waves' 20 s ramp
+        a.steps, a.tank_steps, a.batch_steps, a.batch, a.cases, a.duration = 10, 5, 10, 4, 2, 22.0
+        a.only = "paper,batch,campaign" if a.only == ap.get_default("only") else a.only
     only = a.only.split(",")
     dev = jax.devices()[0]
     print(f"device: {dev.platform} {getattr(dev, 'device_kind', '')}, jax {jax.__version__}", flush=True)
     rows = []
-    paper = js.load_scene(os.path.join(ROOT, "scenes/paper_ship_tank.toml"))
+    paper = scene("paper_ship_tank")
     dt = paper.simulation.dt
     base = paper
     if "paper" in only:
-        t = time_scene(base, a.steps)
-        rows.append(("paper example (125 hexahedra)", t["steps"], t["compile"], t["run"], t["us"],
-                     f"ok, {t['iters']:.2f} Newton its/step" if t["ok"] else "failed"))
+        t = time_scene("paper", base, a.steps)
+        rows.append(("paper example (125 hexahedra)", t.steps, t.compile_s, t.run_s, t.us_per_step,
+                     "ok" if t.ok else "failed"))
         print(rows[-1], flush=True)
     if "tank20" in only:
-        import dataclasses
-        t0 = paper.tanks[0]
-        big = dataclasses.replace(base, tanks=(dataclasses.replace(t0, mesh=(20, 20, 12)),) + base.tanks[1:])
-        t = time_scene(big, a.tank_steps)
-        rows.append((f"paper ship, 20x20x12 tank ({t['unknowns']} unknowns)", t["steps"], t["compile"], t["run"],
-                     t["us"], f"ok, {t['iters']:.2f} Newton its/step" if t["ok"] else "failed"))
+        big = js.scene_with(base, {"tanks[0].mesh": [20, 20, 12]})
+        t = time_scene("tank20", big, a.tank_steps)
+        rows.append((f"paper ship, 20x20x12 tank ({t.unknowns} unknowns)", t.steps, t.compile_s, t.run_s,
+                     t.us_per_step, "ok" if t.ok else "failed"))
         print(rows[-1], flush=True)
     if "lng" in only:
-        lng = js.load_scene(os.path.join(ROOT, "scenes/lng_carrier.toml"))
-        t = time_scene(lng, a.tank_steps)
-        rows.append((f"lng_carrier, two prismatic tanks ({t['unknowns']} unknowns)", t["steps"], t["compile"],
-                     t["run"], t["us"], f"ok, {t['iters']:.2f} Newton its/step" if t["ok"] else "failed"))
+        t = time_scene("lng", scene("lng_carrier"), a.tank_steps)
+        rows.append((f"lng_carrier, two prismatic tanks ({t.unknowns} unknowns)", t.steps, t.compile_s,
+                     t.run_s, t.us_per_step, "ok" if t.ok else "failed"))
         print(rows[-1], flush=True)
     if "batch" in only:
         gm = np.linspace(1.0, 2.0, a.batch)
-        short = with_overrides(base, duration=a.batch_steps * dt)
+        short = js.scene_with(base, {"simulation.duration": a.batch_steps * dt})
         c, r, (res, st) = twice(lambda: js.simulate_batch(short, {"vessel.hydrostatics.gm_t": gm}))
         n = a.batch_steps * a.batch
         rows.append((f"paper example, batch of {a.batch}", n, c, r, 1e6 * r / n, f"{st.count('ok')}/{a.batch} ok"))
         print(rows[-1], flush=True)
     if "campaign" in only:
         from jaxslosh.campaign.worker import run_batch
-        path = os.path.join(ROOT, "scenes/paper_ship_waves.toml")
-        text = open(path).read()
+        waves = scene("paper_ship_waves")
+        path, text = waves.path, waves.text
         hs = np.linspace(0.5, 2.0, a.cases)
         values = [{"hs": float(h), "tp": 6.0, "heading": float(np.pi / 2), "seed": i} for i, h in enumerate(hs)]
         steps = int(round(a.duration / 0.05))
@@ -94,11 +84,11 @@ def main():
                      1e6 * r / (steps * a.cases), f"{ok}/{a.cases} ok"))
         print(rows[-1], flush=True)
     print()
-    print(f"| case ({dev.platform}) | run-steps | compile or first call (s) | second call (s) | us per run-step | status |")
-    print("| --- | --- | --- | --- | --- | --- |")
-    for name, n, c, r, us, st in rows:
-        print(f"| {name} | {n} | {c:.2f} | {r:.3f} | {us:.1f} | {st} |")
-    sys.stdout.flush()
+    table = Table((f"case ({dev.platform})", "{}"), ("run-steps", "{:d}"), ("compile or first call (s)", "{:.2f}"),
+                  ("second call (s)", "{:.3f}"), ("us per run-step", "{:.1f}"), ("status", "{}"))
+    for row in rows:
+        table.add(*row)
+    table.print(a.markdown)
 
 
 if __name__ == "__main__":

@@ -3,10 +3,10 @@ refined meshes and as a multimodal tank: the peak and rms of the free surface's 
 the run, the finite elements' converged value by Richardson extrapolation (where the sequence is
 monotone), and each variant's difference from it. Prints a table.
 
-    python benchmarks/paper_probe_b.py [--duration T] [--meshes 5,8,10] [--modes 6,12] [--flow3d 5,8,12]
-                                       [--no-coriolis 8] [--omega 0.1,0.05,0] [--scale s]
-                                       [--expansion third-order] [--save out.npz]
-    python benchmarks/paper_probe_b.py --table a.npz,b.npz,...
+    python -m benchmarks.validation.paper_probe_b [--duration T] [--meshes 5,8,10] [--modes 6,12]
+        [--flow3d 5,8,12] [--no-coriolis 8] [--omega 0.1,0.05,0] [--scale s] [--expansion third-order]
+        [--save out.npz] [--quick]
+    python -m benchmarks.validation.paper_probe_b --table a.npz,b.npz,...
 
 --element sets the finite elements' `tanks.fluid.element` ("rt": the face-normal element).
 --scale multiplies the initial angular velocity and divides the elevations by it (s = 0.01: the
@@ -21,20 +21,16 @@ elements with `[effects] coriolis = false` (the 2 omega x d_dot load on the liqu
 second order, that makes most of their roll-driven elevation at B).
 
 The elevation is probe B's vertical displacement (B sits on the free surface at the tank's
-centre line, 0.5 m from the wall at x = +2.5 m)."""
+centre line, 0.5 m from the wall at x = +2.5 m). `--quick`: 0.5 s, mesh 5 and 6 modes."""
 from __future__ import annotations
 
-import argparse
 import time
 
-import jax
+import numpy as np
+from scipy.optimize import brentq
 
-jax.config.update("jax_enable_x64", True)
-
-import numpy as np  # noqa: E402
-from scipy.optimize import brentq  # noqa: E402
-
-import jaxslosh as js  # noqa: E402
+import jaxslosh as js
+from benchmarks.harness import parser, scene
 
 
 def _richardson(h, f):
@@ -56,7 +52,7 @@ def _richardson(h, f):
 
 
 def main():
-    ap = argparse.ArgumentParser()
+    ap = parser(__doc__)
     ap.add_argument("--duration", type=float, default=20.0)
     ap.add_argument("--meshes", default="5,8,10")
     ap.add_argument("--modes", default="6,12")
@@ -71,6 +67,8 @@ def main():
                     "default: \"stabilized\")")
     ap.add_argument("--table", default="", help="print the table of these saved records (comma list) and stop")
     args = ap.parse_args()
+    if args.quick:
+        args.duration, args.meshes, args.modes, args.flow3d, args.no_coriolis = 0.5, "5", "6", "", ""
     if args.table:
         stats, t = {}, None
         for f in args.table.split(","):
@@ -82,30 +80,30 @@ def main():
                         stats[k] = (np.abs(z).max(), np.sqrt(np.mean(z ** 2)), z)
         _table(stats)
         return
-    text = open("scenes/paper_ship_tank.toml").read().replace("duration = 20.0", f"duration = {args.duration}")
     omega = [args.scale * float(x) for x in args.omega.split(",")]
-    mm = "" if args.expansion == "exact" else f'\nexpansion = "{args.expansion}"'
+    base = js.scene_with(scene("paper_ship_tank"), {"simulation.duration": args.duration,
+                                                     "vessel.initial.angular_velocity": omega})
     tag = "" if args.expansion == "exact" else f", {args.expansion}"
-    text = text.replace("angular_velocity = [0.1, 0.05, 0.0]", f"angular_velocity = {omega}")
-    fe_text = text.replace("sound_speed = 1500.0", f'sound_speed = 1500.0\nelement = "{args.element}"') \
-        if args.element else text
+    multimodal = {"tanks[0].mesh": None, "tanks[0].walls": None, "tanks[0].model": "multimodal"}
+    if args.expansion != "exact":
+        multimodal["tanks[0].expansion"] = args.expansion
+    fe = {"tanks[0].fluid.element": args.element} if args.element else {}
     el = f", {args.element}" if args.element else ""
     variants = {}
     for n in [int(x) for x in args.meshes.split(",") if x]:
-        variants[f"fem {n}x{n}x{n}{el}"] = fe_text.replace("mesh = [5, 5, 5]", f"mesh = [{n}, {n}, {n}]")
+        variants[f"fem {n}x{n}x{n}{el}"] = js.scene_with(base, {**fe, "tanks[0].mesh": [n, n, n]})
     for m in [int(x) for x in args.modes.split(",") if x]:
-        variants[f"multimodal 2d, {m} modes{tag}"] = text.replace('mesh = [5, 5, 5]\nwalls = "rigid"',
-                                                                 f'model = "multimodal"\nmodes = {m}{mm}')
+        variants[f"multimodal 2d, {m} modes{tag}"] = js.scene_with(base, {**multimodal, "tanks[0].modes": m})
     for m in [int(x) for x in args.flow3d.split(",") if x]:
-        variants[f"multimodal 3d, {m} modes{tag}"] = text.replace(
-            'mesh = [5, 5, 5]\nwalls = "rigid"', f'model = "multimodal"\nflow = "3d"\nmodes = {m}{mm}')
+        variants[f"multimodal 3d, {m} modes{tag}"] = js.scene_with(base, {**multimodal, "tanks[0].flow": "3d",
+                                                                           "tanks[0].modes": m})
     for n in [int(x) for x in args.no_coriolis.split(",") if x]:
-        variants[f"fem {n}x{n}x{n}, no Coriolis"] = (text.replace("mesh = [5, 5, 5]", f"mesh = [{n}, {n}, {n}]")
-                                                    + "\n[effects]\ncoriolis = false\n")
+        variants[f"fem {n}x{n}x{n}, no Coriolis"] = js.scene_with(base, {"tanks[0].mesh": [n, n, n],
+                                                                         "effects.coriolis": False})
     stats = {}
     for name, t in variants.items():
         t0 = time.perf_counter()
-        r = js.simulate(js.load_scene(t), throw=False)
+        r = js.simulate(t, throw=False)
         z = np.asarray(r.probes["B"].displacement)[:, 2] / args.scale
         stats[name] = (np.abs(z).max(), np.sqrt(np.mean(z ** 2)), z)
         print(f"# {name}: {r.status}, {time.perf_counter() - t0:.0f} s, peak {stats[name][0]:.5f} m, "

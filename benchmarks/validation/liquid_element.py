@@ -5,11 +5,11 @@ meshed two elements thick (tests/section_meshes.py, or the loader's own box-with
 prismatic meshes). Prints one table per case: mesh, elements, the first three sloshing
 frequencies' errors (%) per element.
 
-    python benchmarks/liquid_element.py [--elements rt,stabilized] [--cases utube,hanging,...]
-    python benchmarks/liquid_element.py --cases shapes
-    python benchmarks/liquid_element.py --cases six
-    python benchmarks/liquid_element.py --cases cost [--meshes 10x10x6,20x20x12]
-    python benchmarks/liquid_element.py --cases lng [--meshes 24x8,24x16,48x16,48x32]
+    python -m benchmarks.validation.liquid_element [--elements rt,stabilized] [--cases utube,hanging,...] [--quick]
+    python -m benchmarks.validation.liquid_element --cases shapes
+    python -m benchmarks.validation.liquid_element --cases six
+    python -m benchmarks.validation.liquid_element --cases cost [--meshes 10x10x6,20x20x12]
+    python -m benchmarks.validation.liquid_element --cases lng [--meshes 24x8,24x16,48x16,48x32]
 
 ``lng``: the LNG section (1 m square, 0.2 m chamfers at the bottom and the top) filled 10, 30, 50,
 70, 85 and 95 % (one case each: lng10, ..., lng95), on meshes refined across (y) and up (z):
@@ -26,31 +26,25 @@ the non-sloshing modes the nodal elements put among them.
 
 Every case is 2-D (modes uniform across the two-element thickness), so the nodal elements' modes
 are taken as the sloshing modes whose free-surface share is > 0.5, and the first three of those
-matched with the reference's.
+matched with the reference's. The elements' matrices and modes are jaxslosh's fem/ internals (what
+is validated here has no public API); the references are the tests' (tests/sloshing_reference.py,
+tests/section_meshes.py, tests/shape_cases.py; run from the repository root). `--quick`: the
+standing baffle on its coarsest mesh.
 """
-import argparse
 import os
-import sys
 import tempfile
 import time
 
-import jax
+import numpy as np
 
-jax.config.update("jax_enable_x64", True)
-
-import numpy as np  # noqa: E402
-
-HERE = os.path.dirname(os.path.abspath(__file__))
-sys.path.insert(0, os.path.join(HERE, "..", "tests"))
-
-from section_meshes import hopper_baffle_hex, u_tube_hex  # noqa: E402
-from sloshing_reference import (Baffle as RefBaffle, prismatic, rectangle, rectilinear_sloshing_omegas,  # noqa: E402
-                                section_sloshing_omegas, u_tube)
-
-from jaxslosh.fem.liquid import build_liquid  # noqa: E402
-from jaxslosh.fem.liquid_rt import build_face_liquid, face_modes  # noqa: E402
-from jaxslosh.fem.modes import liquid_modes  # noqa: E402
-from jaxslosh.geometry import Baffle, Box, MeshFile, Prismatic  # noqa: E402
+from jaxslosh.fem.liquid import build_liquid
+from jaxslosh.fem.liquid_rt import build_face_liquid, face_modes
+from jaxslosh.fem.modes import liquid_modes
+from jaxslosh.geometry import Baffle, Box, MeshFile, Prismatic
+from benchmarks.harness import Table, parser
+from tests.section_meshes import hopper_baffle_hex, u_tube_hex
+from tests.sloshing_reference import (Baffle as RefBaffle, prismatic, rectangle, rectilinear_sloshing_omegas,
+                                      section_sloshing_omegas, u_tube)
 
 G, RHO, C = 9.81, 1000.0, 1500.0
 T = 0.2          # the sections' thickness (x), two elements
@@ -122,10 +116,9 @@ def omegas(element, geo, depth, counts, n=3):
     return w[:n], len(model.elements)
 
 
-def shapes(elements):
-    import shape_cases
-    print("| tank | elements | " + " | ".join(f"{e}, modes 1-6 (%)" for e in elements) + " |")
-    print("|---|---|" + "---|" * len(elements))
+def shapes(elements, markdown=False):
+    from tests import shape_cases
+    table = Table(("tank", "{}"), ("elements", "{:d}"), *((f"{e}, modes 1-6 (%)", "{}") for e in elements))
     for name in shape_cases.CASES:
         geo, depth, mesh, _, ref_w = shape_cases.case(name)
         cells = []
@@ -134,17 +127,17 @@ def shapes(elements):
             other = sum(k != "sloshing" for k in kinds)
             cells.append(", ".join(f"{e:+.2f}" for e in (w / ref_w[:len(w)] - 1) * 100)
                          + (f" ({other} other modes among them)" if other else ""))
-        print(f"| {name} | {ne} | " + " | ".join(cells) + " |", flush=True)
+        table.add(name, ne, *cells)
+    table.print(markdown)
 
 
-def six(elements, names):
+def six(elements, names, markdown=False):
     """Per shape, the worst of the first six sloshing modes' errors (%) and which mode, per element,
     and the element a scene gets when it leaves `element` out, on modes and at full order."""
-    import shape_cases
+    from tests import shape_cases
     from jaxslosh.scene.shape import default_element
-    print("| tank | elements | default on modes / full order | "
-          + " | ".join(f"{e}: worst of modes 1-6 (%)" for e in elements) + " |")
-    print("|---|---|---|" + "---|" * len(elements))
+    table = Table(("tank", "{}"), ("elements", "{:d}"), ("default on modes / full order", "{}"),
+                  *((f"{e}: worst of modes 1-6 (%)", "{}") for e in elements))
     for name in names:
         geo, depth, mesh, _, ref_w = shape_cases.case(name)
         cells = []
@@ -157,13 +150,14 @@ def six(elements, names):
                          + (f", {other} other modes among them" if other else ""))
         counts = mesh or (1, 1, ne)
         default = "/".join(default_element(geo, depth, counts, reduced)[0] for reduced in (True, False))
-        print(f"| {name} | {ne} | {default} | " + " | ".join(cells) + " |", flush=True)
+        table.add(name, ne, default, *cells)
+    table.print(markdown)
 
 
-def cost(meshes):
+def cost(meshes, markdown=False):
     from jaxslosh.fem.liquid_rt import face_basis, face_invariants
-    print("| mesh | face unknowns | build | face_modes (10) | face_basis (20 + correction) | invariants |")
-    print("|---|---|---|---|---|---|")
+    table = Table(("mesh", "{}"), ("face unknowns", "{:,}"), ("build", "{:.1f}"), ("face_modes (10)", "{:.1f}"),
+                  ("face_basis (20 + correction)", "{:.1f}"), ("invariants", "{:.1f}"))
     for mesh in meshes:
         counts = tuple(int(v) for v in mesh.split("x"))
         t = [time.perf_counter()]
@@ -177,36 +171,40 @@ def cost(meshes):
         face_invariants(m, V, (0.0, 0.0, 0.0))
         t.append(time.perf_counter())
         dt = np.diff(t)
-        print(f"| {mesh} | {int(m.free.sum()):,} | " + " | ".join(f"{v:.1f}" for v in dt) + " |", flush=True)
+        table.add(mesh, int(m.free.sum()), *dt)
+    table.print(markdown)
 
 
 def main():
-    p = argparse.ArgumentParser()
+    p = parser(__doc__)
     p.add_argument("--elements", default="rt,stabilized")
     p.add_argument("--cases", default="utube,hanging,standing,hopper,lng30")
     p.add_argument("--meshes", default=None, help="cost: 10x10x6,20x20x12,30x30x16; lng: " + LNG_MESHES)
     a = p.parse_args()
     if a.cases == "cost":
-        return cost((a.meshes or "10x10x6,20x20x12,30x30x16").split(","))
+        return cost((a.meshes or "10x10x6,20x20x12,30x30x16").split(","), a.markdown)
     if a.cases == "shapes":
-        return shapes(a.elements.split(","))
+        return shapes(a.elements.split(","), a.markdown)
     if a.cases == "six":
-        import shape_cases
-        return six(a.elements.split(","), shape_cases.CASES[:3] + shape_cases.LNG_FILLS + shape_cases.CASES[3:])
+        from tests import shape_cases
+        return six(a.elements.split(","), shape_cases.CASES[:3] + shape_cases.LNG_FILLS + shape_cases.CASES[3:],
+                   a.markdown)
+    if a.quick:
+        a.cases = "standing"
     cases = [c for name in a.cases.split(",") for c in (LNG_FILLS if name == "lng" else (name,))]
     for case in cases:
         ref = reference(case)
         print(f"\n{case}: reference omega = {', '.join(f'{w:.5f}' for w in ref)} rad/s")
-        print(f"| mesh | elements | " + " | ".join(f"{e} err % (modes 1, 2, 3)" for e in a.elements.split(",")) + " |")
-        print("|---|---|" + "---|" * len(a.elements.split(",")))
-        for label, geo, depth, counts in meshes(case, a.meshes or LNG_MESHES):
+        table = Table(("mesh", "{}"), ("elements", "{:d}"),
+                      *((f"{e} err % (modes 1, 2, 3)", "{}") for e in a.elements.split(",")))
+        for label, geo, depth, counts in meshes(case, a.meshes or LNG_MESHES)[:1 if a.quick else None]:
             cells = []
             for element in a.elements.split(","):
-                t0 = time.perf_counter()
                 w, ne = omegas(element, geo, depth, counts)
                 err = (w / ref[:len(w)] - 1) * 100
                 cells.append(", ".join(f"{e:+.2f}" for e in err) + ("" if len(w) == 3 else " (missing)"))
-            print(f"| {label} | {ne} | " + " | ".join(cells) + " |")
+            table.add(label, ne, *cells)
+        table.print(a.markdown)
 
 
 if __name__ == "__main__":
