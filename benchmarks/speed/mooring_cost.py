@@ -1,6 +1,6 @@
 """What three catenary mooring lines add to the paper example's step.
 
-    python benchmarks/mooring_cost.py [--steps 200] [--rounds 3]
+    python -m benchmarks.speed.mooring_cost [--steps 200] [--rounds 3]
 
 The paper example (scenes/paper_ship_tank.toml) free and moored on three catenary lines spread at
 120 degrees in 100 m of water (420 m long, 600 N/m, EA 3e8 N, anchors 400 m out: every line

@@ -1,8 +1,8 @@
 """Lumped-mass mooring lines: their cost per line and segment, and their fairlead tension against
 MoorDyn's for a fairlead driven by a motion record (docs/guide/moorings-lumped.md).
 
-    python benchmarks/mooring_lumped.py                                  # the cost table only
-    python benchmarks/mooring_lumped.py --moordyn-python /tmp/mdvenv/bin/python
+    python -m benchmarks.validation.mooring_lumped                                  # the cost table only
+    python -m benchmarks.validation.mooring_lumped --moordyn-python /tmp/mdvenv/bin/python
 
 MoorDyn is never a dependency of jaxslosh or its tests: install it apart, e.g.
 `python -m venv /tmp/mdvenv && /tmp/mdvenv/bin/pip install moordyn`, and name that interpreter;
@@ -129,7 +129,7 @@ def vessel_cost(n_steps=200):
 
 # ---------------------------------------------------------------------------- MoorDyn
 MOORDYN_INPUT = """--------------------- MoorDyn Input File ------------------------------------
-OC3-Hywind line, fairlead driven by a motion record (jaxslosh benchmarks/mooring_lumped.py)
+OC3-Hywind line, fairlead driven by a motion record (jaxslosh benchmarks/validation/mooring_lumped.py)
 ----------------------- LINE TYPES ------------------------------------------
 TypeName   Diam     Mass/m     EA         BA/-zeta    EI     Cd     Ca    CdAx    CaAx
 (name)     (m)      (kg/m)     (N)        (N-s/-)    (N-m^2) (-)    (-)   (-)     (-)
