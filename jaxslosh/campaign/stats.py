@@ -1,6 +1,6 @@
 """Response statistics of one case: per channel (roll, pitch, heave, probe.<name> vertical
-displacement, mooring.<name> fairlead tension) over the saved frames from t = waves.ramp on; the Rayleigh exceedance and the
-operability of a scatter (host NumPy / SciPy)."""
+displacement, mooring.<name> fairlead tension) over the saved frames from t = waves.ramp on; the
+Rayleigh exceedance and the operability of a scatter (host NumPy / SciPy)."""
 from __future__ import annotations
 
 import math
