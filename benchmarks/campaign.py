@@ -194,7 +194,8 @@ def periods(scene):
     A = A0 if A0.ndim == 1 else np.diag(A0)
     liquid = sum(t.fluid.density * t.size[0] * t.size[1] * t.fill_depth for t in scene.tanks)
     m = scene.vessel.mass + liquid
-    izz = np.asarray(scene.vessel.inertia)[2, 2] + liquid * (scene.tanks[0].size[0] ** 2 + scene.tanks[0].size[1] ** 2) / 12
+    a, b = scene.tanks[0].size[:2]
+    izz = np.asarray(scene.vessel.inertia)[2, 2] + liquid * (a ** 2 + b ** 2) / 12
     T = [2 * np.pi * math.sqrt((m + A[0]) / K[0]), 2 * np.pi * math.sqrt((m + A[1]) / K[1]),
          2 * np.pi * math.sqrt((izz + A[5]) / K[5])]
     print(f"moored: the lines' K11 {K[0]:.0f} N/m, K22 {K[1]:.0f} N/m, K66 {K[5]:.4g} N m/rad; natural periods "
