@@ -125,4 +125,4 @@ def test_moored_spar_notebook_runs():
     closed, fem = numbers(r"first mode ([\d.]+) rad/s \(closed form\), ([\d.]+) rad/s", text)
     assert abs(fem / closed - 1) < 0.005
     g, fd = numbers(r"jax.grad ([-\d.e+]+) N/m, finite difference ([-\d.e+]+) N/m", text)
-    assert abs(g - fd) <= 0.01 * abs(fd), (g, fd)
+    assert abs(g - fd) <= 1e-3 * abs(fd), (g, fd)
