@@ -2,7 +2,7 @@
 
     python -m benchmarks.speed.campaign [--cells 20] [--headings 5] [--seeds 2] [--duration 600]
         [--workers 2] [--batch 8[,1,...]] [--serial-cases N | --skip-serial] [-o CAMPAIGN.h5 [--resume]]
-        [--nonlinear] [--hs 1.0,1.5] [--tp 5,6] [--yaw-damping 0] [--components 50] [--quick]
+        [--nonlinear] [--hs 1.0,1.5] [--tp 5,6] [--yaw-damping 0] [--components 50] [--moored] [--quick]
 
 Issue 19 item 5: the paper's ship in irregular seas (scenes/paper_ship_waves.toml, its tank reduced
 to 20 modes without static correction, the wave forces Froude-Krylov on its box so that every
@@ -33,6 +33,13 @@ sea states stays within the model; a case that passes the hull's angle of vanish
 counted as capsized. `--hs`/`--tp` set the scatter's rows and columns, `--yaw-damping 0` frees
 the yaw, `--components` thins the sea (the wave pressure on the hull costs in proportion to the
 components times the panels).
+
+`--moored` holds the ship on three catenary lines instead of the yaw damper (which it sets to 0):
+the water 50 m deep, anchors 240 m out at 180, 300 and 60 degrees, fairleads 5 m from the COG
+towards them and 2 m below it, 258 m of chain of 300 N/m submerged, EA 5e8 N. Their stiffness
+(`jaxslosh mooring`) with the box's added mass at 0.1 rad/s gives natural periods of about 100 s
+in surge, 110 s in sway and 70 s in yaw (printed). The campaign then has the lines' fairlead
+tensions as channels `mooring.line1` to `mooring.line3`.
 
 The scene's [campaign] table holds the operability limits (roll 0.1 rad, pitch 0.1 rad, probe B
 0.5 m), so the campaign runs with them and writes its operability.
@@ -74,17 +81,31 @@ LIMITS = {"roll": 0.1, "pitch": 0.1, "probe.B": 0.5}
 PROJECT_CELLS, PROJECT_HOURS, PROJECT_CORES = 300, 3.0, 100
 
 
+#: the moored variant (`--moored`): three catenary lines 120 degrees apart in 50 m of water
+MOORING_DEPTH = 50.0
+def mooring_tables() -> list:
+    """The three lines: anchors 240 m out, fairleads 5 m from the COG, both towards 180, 300, 60 deg."""
+    out = []
+    for i, a in enumerate((180.0, 300.0, 60.0)):
+        c, s = math.cos(math.radians(a)), math.sin(math.radians(a))
+        out.append({"name": f"line{i + 1}", "fairlead": [5 * c, 5 * s, -2.0], "anchor": [240 * c, 240 * s, -50.0],
+                    "length": 258.0, "weight": 300.0, "ea": 5.0e8})
+    return out
+
+
 #: m, the box's depth for the nonlinear hydrostatics (`--nonlinear`): 2.5 m of freeboard
 DEPTH = 5.0
 
 
-def campaign_scene(nonlinear: bool = False, yaw_damping: float = YAW_DAMPING, components: int = 0) -> js.Scene:
+def campaign_scene(nonlinear: bool = False, yaw_damping: float = YAW_DAMPING, components: int = 0,
+                   moored: bool = False) -> js.Scene:
     """The benchmark's scene; `nonlinear`: the pressure on the box's wetted surface with its deck
-    (restoring and Froude-Krylov forces, hull/), `components`: another number of wave components."""
+    (restoring and Froude-Krylov forces, hull/), `components`: another number of wave components,
+    `moored`: on three catenary lines (pass yaw_damping = 0)."""
     base = load("paper_ship_waves")
     roll = base.vessel.hydrodynamics.viscous_damping[3]           # the scene's roll damping, kept
     keys = {"title": "benchmarks/speed/campaign.py: the paper ship, its tank on 20 modes, Froude-Krylov forces, "
-                     f'{"yaw damping" if yaw_damping else "free yaw"}{", nonlinear hydrostatics" if nonlinear else ""}',
+                     f'{"yaw damping" if yaw_damping else "moored" if moored else "free yaw"}{", nonlinear hydrostatics" if nonlinear else ""}',
             "vessel.hydrodynamics.excitation": "froude-krylov",
             "vessel.hydrodynamics.viscous_damping": [0.0, 0.0, 0.0, float(roll), 0.0, float(yaw_damping)],
             "tanks[0].reduction.modes": 20, "tanks[0].reduction.static_correction": False,
@@ -93,6 +114,9 @@ def campaign_scene(nonlinear: bool = False, yaw_damping: float = YAW_DAMPING, co
         keys.update({"vessel.hull.depth": DEPTH, "vessel.hydrostatics.model": "nonlinear"})
     if components:
         keys["waves.components"] = components
+    if moored:
+        keys["environment.depth"] = MOORING_DEPTH
+        keys["mooring"] = mooring_tables()
     return js.scene_with(base, keys)
 
 
@@ -138,6 +162,23 @@ def _load() -> str:
     return "load average " + " ".join(f"{x:.2f}" for x in os.getloadavg())
 
 
+def periods(scene):
+    """The moored ship's surge, sway and yaw natural periods from the lines' stiffness and the box's
+    mass and added mass at the tables' lowest frequency (the liquid counted as frozen)."""
+    K = np.diag(np.asarray(js.mooring(scene).stiffness))
+    hd = scene.vessel.hydrodynamics
+    A0 = np.asarray(hd.added_mass)[0]
+    A = A0 if A0.ndim == 1 else np.diag(A0)
+    liquid = sum(t.fluid.density * t.size[0] * t.size[1] * t.fill_depth for t in scene.tanks)
+    m = scene.vessel.mass + liquid
+    a, b = scene.tanks[0].size[:2]
+    izz = np.asarray(scene.vessel.inertia)[2, 2] + liquid * (a ** 2 + b ** 2) / 12
+    T = [2 * np.pi * math.sqrt((m + A[0]) / K[0]), 2 * np.pi * math.sqrt((m + A[1]) / K[1]),
+         2 * np.pi * math.sqrt((izz + A[5]) / K[5])]
+    print(f"moored: the lines' K11 {K[0]:.0f} N/m, K22 {K[1]:.0f} N/m, K66 {K[5]:.4g} N m/rad; natural periods "
+          f"surge {T[0]:.0f} s, sway {T[1]:.0f} s, yaw {T[2]:.0f} s; no yaw damper", file=sys.stderr)
+
+
 def check_file(path, n):
     c = load_campaign(path)
     st = np.array(c.status)
@@ -170,6 +211,7 @@ def main(argv=None):
     p.add_argument("--tp", help="comma-separated Tp (s) of the scatter's columns (default 5,6,7,8,9)")
     p.add_argument("--yaw-damping", type=float, default=YAW_DAMPING, help="N m s (0: the ship free in yaw)")
     p.add_argument("--components", type=int, default=0, help="wave components (default the scene's 200)")
+    p.add_argument("--moored", action="store_true", help="three catenary lines instead of the yaw damper")
     p.add_argument("--serial-child", nargs=3, metavar=("SCENE", "CSV", "OUT"), help=argparse.SUPPRESS)
     p.add_argument("--headings-rad", help=argparse.SUPPRESS)
     p.add_argument("--indices", help=argparse.SUPPRESS)
@@ -188,7 +230,7 @@ def main(argv=None):
     with tempfile.TemporaryDirectory() as d:
         scene_path = os.path.join(d, "ship.toml")
         with open(scene_path, "w") as f:
-            f.write(campaign_scene(a.nonlinear, a.yaw_damping, a.components).text)
+            f.write(campaign_scene(a.nonlinear, 0.0 if a.moored else a.yaw_damping, a.components, a.moored).text)
         csv_path = os.path.join(d, "scatter.csv")
         hs = HS if not a.hs else tuple(float(x) for x in a.hs.split(","))
         tp = TP if not a.tp else tuple(float(x) for x in a.tp.split(","))
@@ -196,6 +238,8 @@ def main(argv=None):
         with open(csv_path, "w") as f:
             f.write(scatter_csv(cells, hs, tp))
         scene = js.load_scene(scene_path)
+        if a.moored:
+            periods(scene)
         n = cells * heads.size * a.seeds
         print(f"{n} cases: {cells} sea states x {heads.size} headings x {a.seeds} seeds, {a.duration:g} s each "
               f"(dt {scene.simulation.dt:g} s, {a.duration / scene.simulation.dt:.0f} steps)", file=sys.stderr)

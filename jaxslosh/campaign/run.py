@@ -75,7 +75,7 @@ class CampaignInterrupted(Interrupted):
 
 
 def channel_names(scene: Scene) -> list:
-    return channels(scene.probes)
+    return channels(scene.probes, scene.mooring)
 
 
 class Settings(NamedTuple):

@@ -1,6 +1,6 @@
 """Response statistics of one case: per channel (roll, pitch, heave, probe.<name> vertical
-displacement) over the saved frames from t = waves.ramp on; the Rayleigh exceedance and the
-operability of a scatter (host NumPy / SciPy)."""
+displacement, mooring.<name> fairlead tension) over the saved frames from t = waves.ramp on; the
+Rayleigh exceedance and the operability of a scatter (host NumPy / SciPy)."""
 from __future__ import annotations
 
 import math
@@ -22,6 +22,8 @@ def channels(result, run=None) -> dict:
     out = {"roll": rpy[:, 0], "pitch": rpy[:, 1], "heave": pick(result.vessel.position)[:, 2]}
     for name, p in result.probes.items():
         out[f"probe.{name}"] = pick(p.displacement)[:, 2]
+    for name, line in (result.mooring or {}).items():
+        out[f"mooring.{name}"] = pick(line.fairlead_tension)
     return out
 
 

@@ -7,9 +7,10 @@ they judge. `jaxslosh campaign` and `js.campaign` take them when their own argum
     headings = [0.0, 0.785, 1.571]    # rad
     seeds = 2
     duration = 600.0                  # s
-    [campaign.limits]                 # channel = limit: rad for roll and pitch, m for heave and probes
+    [campaign.limits]                 # channel = limit: rad for roll and pitch, m for heave and probes, N for lines
     roll = 0.1
     "probe.B" = 0.5                   # or probe.B = 0.5 (TOML's dotted key: a table probe = {B = 0.5})
+    "mooring.line1" = 2.0e5           # a line's fairlead tension about its mean, N
 """
 from __future__ import annotations
 
@@ -18,18 +19,26 @@ import math
 from .fields import at_least, flat_list, positive, read, show
 from .types import CampaignTable, Probe, SceneError, Waves
 
-#: the channels of every scene; probes add `probe.<name>` (their vertical displacement)
+#: the channels of every scene; probes add `probe.<name>` (their vertical displacement), mooring
+#: lines `mooring.<name>` (their fairlead tension)
 RIGID_CHANNELS = ("roll", "pitch", "heave")
 UNITS = {"roll": "rad", "pitch": "rad", "heave": "m"}      # probe.<name>: its vertical displacement, m
 
 
-def channels(probes) -> list[str]:
-    """The response channels of a scene with these probes: roll, pitch, heave, probe.<name>."""
-    return list(RIGID_CHANNELS) + [f"probe.{p.name}" for p in probes]
+def unit(channel: str) -> str:
+    """A channel's unit: rad, m, or N for a mooring line's tension."""
+    return "N" if channel.startswith("mooring.") else UNITS.get(channel, "m")
+
+
+def channels(probes, mooring=()) -> list[str]:
+    """The response channels of a scene with these probes and mooring lines: roll, pitch, heave,
+    probe.<name>, mooring.<name>."""
+    return (list(RIGID_CHANNELS) + [f"probe.{p.name}" for p in probes]
+            + [f"mooring.{m.name}" for m in mooring])
 
 
 def read_campaign(table, probes: tuple[Probe, ...], waves: Waves | None, simulation_dt: float,
-                  warnings: list[str]) -> CampaignTable:
+                  warnings: list[str], mooring=()) -> CampaignTable:
     where = "campaign"
     v = read(table, where, {
         "limits": ("table", None), "headings": ("numbers", _headings), "seeds": ("int", at_least(1)),
@@ -51,7 +60,7 @@ def read_campaign(table, probes: tuple[Probe, ...], waves: Waves | None, simulat
         warnings.append('campaign: the [campaign] table is for `jaxslosh campaign`, whose template is an irregular '
                         '[waves] table (type = "jonswap" or "pierson-moskowitz"); this scene has none, and '
                         '`jaxslosh run` ignores the table')
-    limits = _limits(table["limits"], f"{where}.limits", channels(probes)) if "limits" in table else ()
+    limits = _limits(table["limits"], f"{where}.limits", channels(probes, mooring)) if "limits" in table else ()
     return CampaignTable(limits=limits, headings=heads, seeds=v.get("seeds"), duration=duration)
 
 
@@ -72,20 +81,21 @@ def not_radians(headings) -> str | None:
 
 def _limits(table, where: str, chans: list[str]) -> tuple[tuple[str, float], ...]:
     """{channel: limit} as written; `probe.B = 0.5` (a dotted key, which TOML reads as a table
-    probe = {B = 0.5}) and `"probe.B" = 0.5` (a quoted key) name the same channel."""
+    probe = {B = 0.5}) and `"probe.B" = 0.5` (a quoted key) name the same channel (so do
+    `mooring.line1` and `"mooring.line1"`)."""
     if not isinstance(table, dict):
         raise SceneError(where, f"must be a table of channel = limit ({', '.join(chans)}), got {show(table)}")
     flat: dict = {}
     for key, value in table.items():
-        items = ([(f"probe.{k}", x) for k, x in value.items()] if key == "probe" and isinstance(value, dict)
-                 else [(key, value)])
+        items = ([(f"{key}.{k}", x) for k, x in value.items()]
+                 if key in ("probe", "mooring") and isinstance(value, dict) else [(key, value)])
         for ch, x in items:
             if ch in flat:
                 raise SceneError(f"{where}.{ch}", "is given twice (as a quoted key and as a dotted key)")
             if ch not in chans:
                 raise SceneError(f"{where}.{ch}", f"not a channel of this scene (channels: {', '.join(chans)})")
             flat[ch] = x
-    spec = {ch: ("float", _positive_limit(UNITS.get(ch, "m"))) for ch in flat}   # probes: m
+    spec = {ch: ("float", _positive_limit(unit(ch))) for ch in flat}
     out = read(flat, where, spec)
     return tuple((ch, out[ch]) for ch in flat)
 

@@ -4,7 +4,7 @@ keys the loader accepts).
 
 A key is written as the scene file writes it, without indices: `tanks.fluid.density` is the
 `density` of a `[tanks.fluid]` table under any `[[tanks]]`. `<channel>` stands for a channel name
-(`roll`, `pitch`, `heave`, `probe.<name>`). Data only: nothing here is read by the loader.
+(`roll`, `pitch`, `heave`, `probe.<name>`, `mooring.<line>`). Data only: nothing here is read by the loader.
 """
 from __future__ import annotations
 
@@ -309,6 +309,7 @@ KEYS = (
     ("campaign.headings", "waves.heading", "rad", "The campaign's headings."),
     ("campaign.seeds", "1", "", "Seeds per cell and heading."),
     ("campaign.duration", "simulation.duration", "s", "Each case's duration."),
-    ("campaign.limits.<channel>", "none", "rad or m", 'Limit of a channel: roll, pitch (rad), heave, '
-                                                      '"probe.<name>" (m; quoted or as a dotted key).'),
+    ("campaign.limits.<channel>", "none", "rad, m or N", 'Limit of a channel: roll, pitch (rad), heave, '
+                                                         '"probe.<name>" (m), "mooring.<line>" (N, the fairlead '
+                                                         'tension about its mean; quoted or as a dotted key).'),
 )

@@ -115,3 +115,14 @@ def test_nonlinear_sloshing_notebook_runs():
         r"^(multimodal|fem)\s+[\d.]+%\s+[+-][\d.]+%\s+[+-][\d.]+%\s+([\d.]+)$", text, re.M)}
     assert ratio["multimodal"] > 1.4 and ratio["fem"] < 1.2, ratio
     assert text.count("3 runs, 3 ok") == 2, text
+
+
+@pytest.mark.slow
+def test_moored_spar_notebook_runs():
+    """Several minutes on a shared 2-core machine at the small size (three compilations)."""
+    text = printed(run_notebook("moored_spar.ipynb", {"JAXSLOSH_NOTEBOOK_SMALL": "1"}, timeout=1800))
+    assert "with the tank: ok | without: ok" in text
+    closed, fem = numbers(r"first mode ([\d.]+) rad/s \(closed form\), ([\d.]+) rad/s", text)
+    assert abs(fem / closed - 1) < 0.005
+    g, fd = numbers(r"jax.grad ([-\d.e+]+) N/m, finite difference ([-\d.e+]+) N/m", text)
+    assert abs(g - fd) <= 1e-3 * abs(fd), (g, fd)
