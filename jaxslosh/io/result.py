@@ -91,13 +91,29 @@ class Result(eqx.Module):
     energy: Energy
     solver: SolverHistory
     tanks: dict
-    outcome: RunResult = eqx.field(default_factory=lambda: RunResult.ok)
+    outcome: RunResult = None
     steps: jax.Array = 0
     failure: Optional[Failure] = None
     note: str = eqx.field(static=True, default="")       # the host's own text of the ending, where it has one
     scene_text: str = eqx.field(static=True, default="")
     dt: float = eqx.field(static=True, default=0.0)       # to put the failed step's time in the text
     tolerance: float = eqx.field(static=True, default=0.0)
+
+
+    def __init__(self, time, vessel, probes, energy, solver, tanks, outcome=None, steps=0, failure=None, note="",
+                 scene_text="", dt=0.0, tolerance=0.0, mooring=None, bodies=None, connections=None, *,
+                 status=None, steps_done=None, status_code=None):
+        """The fields, or as before `outcome` and `steps` were leaves: `status` (the text, kept as the
+        note; its code read from it), `status_code` and `steps_done`."""
+        if status is not None:
+            note = status
+        if status_code is not None or (status is not None and outcome is None):
+            outcome = outcome_of(code_of(status) if status_code is None else status_code)
+        self.time, self.vessel, self.probes, self.energy, self.solver, self.tanks = time, vessel, probes, energy, solver, tanks
+        self.outcome = RunResult.ok if outcome is None else outcome
+        self.steps = steps if steps_done is None else steps_done
+        self.failure, self.note, self.scene_text, self.dt, self.tolerance = failure, note, scene_text, dt, tolerance
+        self.mooring, self.bodies, self.connections = mooring, bodies, connections
 
     @property
     def status(self) -> str:

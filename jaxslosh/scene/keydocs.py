@@ -264,8 +264,17 @@ KEYS = (
     ("mooring.length", _REQ, "m", "Unstretched length."),
     ("mooring.weight", _REQ, "N/m", "Submerged weight per unstretched metre (negative: buoyant)."),
     ("mooring.ea", _REQ, "N", "Axial stiffness EA."),
-    ("mooring.model", '"catenary"', "", '"catenary": the quasi-static elastic catenary with seabed contact '
-                                        '("lumped" is not available yet).'),
+    ("mooring.model", '"catenary"', "", '"catenary": the quasi-static elastic catenary with seabed contact; '
+                                        '"lumped": dynamic lumped masses (inertia, added mass, drag, seabed).'),
+    ("mooring.segments", "20", "", "Lumped lines: the number of segments (at least 2)."),
+    ("mooring.diameter", "0.09", "m", "Lumped lines: the line's hydrodynamic diameter (drag, added mass)."),
+    ("mooring.mass", "weight / g + the displaced water", "kg/m", "Lumped lines: the mass per metre in air."),
+    ("mooring.cd", "[1.6, 0.1]", "", "Lumped lines: Morison drag coefficients, normal and tangential."),
+    ("mooring.ca", "[1.0, 0.0]", "", "Lumped lines: added-mass coefficients, normal and tangential."),
+    ("mooring.internal_damping", "-0.8", "N s", "Lumped lines: axial internal damping; negative: that fraction "
+                                                  "of each segment's critical damping (MoorDyn's BA)."),
+    ("mooring.seabed_stiffness", "3.0e6", "Pa/m", "Lumped lines: the seabed's contact stiffness."),
+    ("mooring.seabed_damping", "3.0e5", "Pa s/m", "Lumped lines: the seabed's contact damping."),
     ("mooring.seabed_friction", "0", "", "Friction coefficient of the part on the seabed (anchor on the seabed)."),
     # bodies
     ("bodies.name", _REQ, "", 'The body\'s name (result datasets `/bodies/<name>/...`); not "vessel", "fixed" '

@@ -15,13 +15,14 @@ def read_lumped(table: dict, where: str) -> tuple[dict, tuple]:
     lumped-only keys, for the lines' common reader; the lumped values as sorted (key, value) pairs,
     checked: SceneError naming the key). Keys left out take LUMPED_KEYS' defaults when built."""
     rest = {k: v for k, v in table.items() if k not in LUMPED_KEYS}
-    mine = {k: v for k, v in table.items() if k in LUMPED_KEYS and k not in ("cd", "ca")}
+    mine = {k: v for k, v in table.items() if k in LUMPED_KEYS}
     v = read(mine, where, {"segments": ("int", at_least(2)), "diameter": ("float", positive),
                            "mass": ("float", positive), "internal_damping": ("float", None),
-                           "seabed_stiffness": ("float", non_negative), "seabed_damping": ("float", non_negative)})
+                           "seabed_stiffness": ("float", non_negative), "seabed_damping": ("float", non_negative),
+                           "cd": ("any", None), "ca": ("any", None)})
     for key in ("cd", "ca"):
-        if key in table:
-            x = table[key]
+        if key in v:
+            x = v[key]
             ok = (isinstance(x, list) and len(x) == 2
                   and all(isinstance(c, (int, float)) and not isinstance(c, bool) and c >= 0 for c in x))
             if not ok:
