@@ -19,7 +19,7 @@ import numpy as np
 
 from .._version import __version__
 from .output import OutputLock, ensure_room
-from .status import TEXT, RunResult, Status, code_of, failure_text, outcome_of
+from .status import TEXT, Failure, RunResult, Status, code_of, failure_text, is_traced as _is_traced, outcome_of
 
 FORMAT = "jaxslosh.result"
 FORMAT_VERSION = 1
@@ -56,18 +56,6 @@ class TankField(eqx.Module):
     nodes: np.ndarray            # (m, 3) tank-local
     elements: np.ndarray         # (e, 8)
     displacement: jax.Array      # (k, m, 3) tank frame, deformational
-
-
-class Failure(eqx.Module):
-    """Where a run's first numerical failure happened (leaves: traced under `jax.jit`): the step
-    (0 while none, or for the initial accelerations), its scaled residual and Newton iterations."""
-    step: jax.Array
-    residual: jax.Array
-    iterations: jax.Array
-
-
-def _is_traced(x) -> bool:
-    return any(isinstance(v, jax.core.Tracer) for v in jax.tree_util.tree_leaves(x))
 
 
 class LineHistory(eqx.Module):

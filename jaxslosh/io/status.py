@@ -65,6 +65,18 @@ def outcome_of(code) -> RunResult:
     return out
 
 
+class Failure(eqx.Module):
+    """Where a run's first numerical failure happened (leaves: traced under `jax.jit`): the step
+    (0 while none, or for the initial accelerations), its scaled residual and Newton iterations."""
+    step: jax.Array
+    residual: jax.Array
+    iterations: jax.Array
+
+
+def is_traced(x) -> bool:
+    return any(isinstance(v, jax.core.Tracer) for v in jax.tree_util.tree_leaves(x))
+
+
 def failure_text(code: int, step: int, h: float, err: float, iterations: int, tol: float) -> str:
     """The sentence of a numerical failure, naming the step and the time."""
     code = Status(int(code))
