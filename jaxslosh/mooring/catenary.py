@@ -225,11 +225,7 @@ def solve(XF, ZF, L, w, EA, CB=0.0, hA=0.0):
     XF, ZF, L, w, EA, CB, hA = (jnp.asarray(v, dtype=float) for v in (XF, ZF, L, w, EA, CB, hA))
     slack, H0 = jax.lax.stop_gradient(_slack(XF, ZF, L, w, EA, CB, hA))
 
-    def residual(x):
-        xf, zf = profile(x[0], x[1], L, w, EA, CB, hA)[:2]
-        # a slack line has no horizontal tension (H0 stands for zero): XF no longer matters
-        first = jnp.where(slack, (x[0] - H0) / jnp.abs(w), xf - XF)
-        return jnp.stack([first, zf - ZF]) / L
+    residual = _line_residual(L, w, EA, CB, hA, XF, ZF, slack, H0)
 
     def tangent_solve(g, y):
         return jnp.linalg.solve(jax.jacfwd(g)(y), y)
