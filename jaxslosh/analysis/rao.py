@@ -19,6 +19,7 @@ import jax
 import jax.numpy as jnp
 import numpy as np
 
+from ..assemble.bodyhydro import frequency_terms
 from ..assemble.hull import froude_krylov_hull, hull_pressure
 from ..hydro.source import excitation_at, tables_of
 from ..hydro.tables import interpolate_radiation
@@ -38,6 +39,7 @@ class RAO(NamedTuple):
     vessel: np.ndarray         # (f, h, 6) complex: surge, sway, heave (m/m), roll, pitch, yaw (rad/m)
     probes: dict               # name -> (f, h, 3) complex (m/m)
     scene_text: str = ""
+    bodies: Optional[dict] = None   # [[bodies]]: name -> (f, h, 6) complex, as `vessel`
 
 
 class Hydro(NamedTuple):
@@ -170,15 +172,25 @@ def rao(scene: Scene, frequencies=None, headings=None, *, params=None,
     n = lin.n
     F = np.zeros((w.size, n, heads.size), dtype=complex)
     F[:, :6] = X.transpose(0, 2, 1)
+    N = 6 + 6 * len(scene.bodies)
+    if scene.bodies:           # the bodies' excitation and radiation (assemble/bodyhydro.py)
+        if is_traced((lin.M, lin.C, lin.K)):
+            raise SceneError("bodies", "gradients through the RAOs of [[bodies]] are not available yet")
+        dA, dB, Fb = frequency_terms(scene, w, heads)
+        F[:, 6:N] += Fb[:, :, 6:].transpose(0, 2, 1)
     if is_traced((lin.M, lin.C, lin.K)):
         out, xp = _traced_solves(lin, tables, radiation, w, F), jnp
     else:
         out, xp = np.zeros((w.size, heads.size, n), dtype=complex), np
         for i, wi in enumerate(w):
             M, C = frequency_matrices(lin, tables, radiation, wi)
+            if scene.bodies:
+                M[:N, :N] += dA[i]
+                C[:N, :N] += dB[i]
             out[i] = solve_equilibrated(lin.K - wi * wi * M + 1j * wi * C, F[i]).T
     probes = {name: xp.einsum("cn,fhn->fhc", lin.probes[k], out) for k, name in enumerate(lin.probe_names)}
-    return RAO(w, heads, out[:, :, :6], probes, scene.text)
+    bodies = {b.name: out[:, :, 6 + 6 * s:12 + 6 * s] for s, b in enumerate(scene.bodies)}
+    return RAO(w, heads, out[:, :, :6], probes, scene.text, bodies)
 
 
 def _traced_solves(lin: Linearisation, tables, radiation: bool, w, F):

@@ -11,7 +11,9 @@ import numpy as np
 from ..physics.about import About
 from ..physics.bodies import BAND, FIXED, VESSEL, Bodies, Floating, Link
 from ..physics.kinematics import quat_from_rpy
-from ..physics.seakeeping import LinearDamping
+from ..physics.seakeeping import LinearDamping, WaveExcitation
+from .bodyhydro import time_terms
+from .seakeeping import make_excitation
 from ..physics.vessel import Hydrostatics, PaperHydrostatics, RigidBody
 
 
@@ -45,13 +47,18 @@ def build_bodies(scene, params: dict, g) -> Optional[Bodies]:
     P = params.get
     rho = P("environment.water_density", scene.environment.water_density)
     cog = scene.vessel.cog_height
+    Ainf, memory, X = time_terms(scene, params)
+    waves = scene.waves
     floating = []
-    for b in scene.bodies:
+    for s, b in enumerate(scene.bodies):
         rest = np.array([b.position[0], b.position[1], b.cog_height - cog])
         ini = b.initial
         roll, pitch, yaw = ini.roll_pitch_yaw
         floating.append(Floating(
-            terms=rigid_terms(b.mass, b.inertia, b.hydrostatics, rho, g, b.viscous_damping),
+            terms=rigid_terms(b.mass, b.inertia, b.hydrostatics, rho, g, b.viscous_damping) + (
+                () if X is None or not np.abs(X[s]).max() > 0 else
+                (WaveExcitation(make_excitation(waves, X[s], P("waves.amplitude" if waves.type == "regular" else "waves.hs",
+                                                              waves.height))),)),
             rest=jnp.asarray(rest), x0=jnp.asarray(rest + np.asarray(ini.position)),
             q0=quat_from_rpy(jnp.array([roll, pitch, yaw + b.heading])),
             v0=jnp.asarray(np.concatenate([ini.velocity, ini.angular_velocity]), dtype=float)))
@@ -67,7 +74,9 @@ def build_bodies(scene, params: dict, g) -> Optional[Bodies]:
         links.append(Link(ends=tuple(index[e] for e in c.ends), kind=c.kind, pa=jnp.asarray(c.points[0]),
                           pb=jnp.asarray(c.points[1]), length=jnp.asarray(P(f"{key}.length", c.length), dtype=float),
                           xs=xs, fs=fs, damping=jnp.asarray(P(f"{key}.damping", c.damping), dtype=float)))
-    return Bodies(bodies=tuple(floating), links=tuple(links), gravity=g, names=tuple(b.name for b in scene.bodies),
+    radiating = bool(np.abs(Ainf).max() > 0) or memory is not None
+    return Bodies(bodies=tuple(floating), links=tuple(links), gravity=g,
+                  added_mass=jnp.asarray(Ainf) if radiating else None, memory=memory, names=tuple(b.name for b in scene.bodies),
                   link_names=tuple(c.name for c in scene.connections), about=_about(scene))
 
 

@@ -90,13 +90,14 @@ def move_to_cog(tables: Tables, r_point, r_phase, g: float, depth=None) -> Table
 # Capytaine
 
 
-def tables_from_dataset(ds) -> Tables:
+def tables_from_dataset(ds, prefix: str = "") -> Tables:
     """Our tables from a Capytaine dataset (complex values merged), about its rotation centre and
-    phase origin: finite positive frequencies ascending, A_inf from an omega = inf row."""
+    phase origin: finite positive frequencies ascending, A_inf from an omega = inf row. `prefix`:
+    one body's block of a multibody dataset (dofs "<body>__Surge", ...; hydro/multibody.py)."""
     names = [str(x) for x in ds["influenced_dof"].values]
-    if sorted(names) != sorted(DOF_NAMES):
-        raise DatabaseError(f"the dataset's dofs {names} are not the six rigid-body dofs {list(DOF_NAMES)}")
-    order = list(DOF_NAMES)
+    order = [prefix + d for d in DOF_NAMES]
+    if not set(order) <= set(names) or (not prefix and len(names) != 6):
+        raise DatabaseError(f"the dataset's dofs {names} are not the six rigid-body dofs {order}")
     if "omega" not in ds.coords:
         raise DatabaseError("the dataset has no omega coordinate")
     w_all = np.asarray(ds["omega"].values, dtype=float)
@@ -148,10 +149,20 @@ def _merge_complex(ds):
     return ds.drop_vars("complex", errors="ignore")
 
 
-def read_netcdf(path: str, cog=None, g: float = 9.81) -> Database:
+def read_netcdf(path: str, cog=None, g: float = 9.81, body=None) -> Database:
     """A Capytaine NetCDF dataset. `cog`: the COG in the dataset's coordinates (default: its
-    `center_of_mass` where it has one, else its rotation centre, else the origin)."""
+    `center_of_mass` where it has one, else its rotation centre, else the origin). A multibody
+    dataset (dofs "<body>__Surge", ...) gives the block of `body` as it is (each body's dofs about
+    its COG, phases from the file's origin: hydro/multibody.py)."""
     ds = _merge_complex(_open_netcdf(path))
+    labels = [str(x) for x in ds["influenced_dof"].values] if "influenced_dof" in ds.coords else []
+    if labels and all("__" in x for x in labels):
+        have = list(dict.fromkeys(x.split("__")[0] for x in labels))
+        if body not in have:
+            raise DatabaseError(f"a multibody dataset of the bodies {have}, none of them named {body!r}")
+        t = tables_from_dataset(ds, body + "__")
+        rho = float(ds["rho"].values) if "rho" in ds else None
+        return Database(t, None, rho, float(ds["g"].values) if "g" in ds else None, True)
     try:
         t = tables_from_dataset(ds)
     except KeyError as e:
@@ -399,13 +410,15 @@ def write_wamit(stem: str, tables: Tables, rho: float, g: float, length: float =
     return out
 
 
-def read_database(path: str, rho: float, g: float, cog=None, length: float = 1.0, depth=None) -> Database:
-    """A Capytaine NetCDF dataset (.nc) or WAMIT's .1 (with its .3 and .hst), by the file's extension."""
+def read_database(path: str, rho: float, g: float, cog=None, length: float = 1.0, depth=None, body=None) -> Database:
+    """A Capytaine NetCDF dataset (.nc) or WAMIT's .1 (with its .3 and .hst), by the file's extension
+    (`body`: the block of that body in a multibody dataset; WAMIT's NBODY files give the first
+    body's)."""
     if not os.path.exists(path):
         raise DatabaseError(f"{path}: no such file")
     ext = os.path.splitext(path)[1].lower()
     if ext in (".nc", ".cdf", ".netcdf", ".h5"):
-        return read_netcdf(path, cog, g)
+        return read_netcdf(path, cog, g, body)
     if ext == ".1":
         return read_wamit(path, rho, g, length, (0.0, 0.0, 0.0) if cog is None else cog, depth)
     raise DatabaseError(f"{path}: unknown format {ext or '(no extension)'}: a Capytaine NetCDF dataset (.nc) or "

@@ -18,18 +18,20 @@ import numpy as np
 
 class RadiationFit(NamedTuple):
     """The fitted memory on the host: per state k, pole p[k] (complex), input dof inp[k], output
-    coefficients c[:, k] (6, complex); A_inf (6, 6); and the fit's relative error per column."""
+    coefficients c[:, k] (n, complex); A_inf (n, n); and the fit's relative error per column. n is 6
+    for one body, 6 per body for the coupled radiation of several (physics/bodies.py)."""
     p: np.ndarray
     inp: np.ndarray
     c: np.ndarray
     added_mass_infinite: np.ndarray
-    error: np.ndarray      # (6,) max |K_fit - K| / max |K| over the table, per column (0 for a column without memory)
+    error: np.ndarray      # (n,) max |K_fit - K| / max |K| over the table, per column (0 for a column without memory)
 
     def kernel_frequency(self, omega):
         """K(iw) of the fit (n, 6, 6): sum_k c_ik / (i w - p_k) (both conjugates of a complex pole)."""
         s = 1j * np.asarray(omega, dtype=float)[:, None]
-        out = np.zeros((s.shape[0], 6, 6), dtype=complex)
-        for j in range(6):
+        n = self.c.shape[0]
+        out = np.zeros((s.shape[0], n, n), dtype=complex)
+        for j in range(n):
             m = self.inp == j
             if not m.any():
                 continue
@@ -51,7 +53,8 @@ class RadiationFit(NamedTuple):
     def kernel(self, t):
         """K(t) (n, 6, 6)."""
         t = np.asarray(t, dtype=float)
-        out = np.zeros((t.size, 6, 6))
+        n = self.c.shape[0]
+        out = np.zeros((t.size, n, n))
         for k in range(self.p.size):
             out[:, :, self.inp[k]] += np.real(self.c[None, :, k] * np.exp(self.p[k] * t)[:, None])
         return out
@@ -145,8 +148,10 @@ def vector_fit(omega, F, n_pairs, with_e=False, iterations=15, weight=None):
 
 
 def fit_radiation(omega, added_mass, damping, added_mass_infinite=None, order: int = 0, tol: float = 0.005,
-                  max_pairs: int = 12, threshold: float = 1e-2):
-    """Fit the memory to tables A(w), B(w) (n, 6, 6) about the COG; returns a RadiationFit.
+                  max_pairs: int = 12, threshold: float = 1e-2, skip=None):
+    """Fit the memory to tables A(w), B(w) (n, d, d) about the COG (d = 6, or 6 per body of a
+    multibody database); returns a RadiationFit. `skip` (d, d) bool: entries left out (zero in
+    the fit: another term carries them).
 
     Each entry with memory (its |B_ij| or w |A_ij(w) - A_inf,ij| above `threshold` times the
     geometric mean of the two diagonal entries' sizes) is fitted on its own (vector fitting of one
@@ -164,12 +169,15 @@ def fit_radiation(omega, added_mass, damping, added_mass_infinite=None, order: i
         if known else A[-1].copy()
     size = np.maximum(np.abs(B).max(axis=0), w.max() * np.abs(A - Ainf[None]).max(axis=0))   # (6, 6)
     dsize = np.diag(size)
+    d = A.shape[1]
+    skip = np.zeros((d, d), dtype=bool) if skip is None else np.asarray(skip, dtype=bool)
+    Ainf[skip] = 0.0
     poles, inps, cs = [], [], []
-    err = np.zeros(6)
-    for i in range(6):
-        for j in range(i, 6):
+    err = np.zeros(d)
+    for i in range(d):
+        for j in range(i, d):
             ref = np.sqrt(dsize[i] * dsize[j])
-            if ref <= 0 or size[i, j] <= threshold * ref:
+            if skip[i, j] or ref <= 0 or size[i, j] <= threshold * ref:
                 continue
             # A_inf,ij: the given value, or the one fitted with the poles (as the coefficient of i w), whichever
             # leaves the smaller error: a value inconsistent with band-limited tables (an off-diagonal term
@@ -192,12 +200,12 @@ def fit_radiation(omega, added_mass, damping, added_mass_infinite=None, order: i
             Ainf[i, j] = Ainf[j, i] = a_inf
             for (out, inp) in ({(i, j), (j, i)}):
                 for k in range(p.size):
-                    c = np.zeros(6, dtype=complex)
+                    c = np.zeros(d, dtype=complex)
                     c[out] = r[0, k] if p[k].imag == 0 else 2.0 * r[0, k]   # a pair: Re(2 r e^{pt})
                     poles.append(p[k])
                     inps.append(inp)
                     cs.append(c)
-    c = np.array(cs).T if cs else np.zeros((6, 0), dtype=complex)
+    c = np.array(cs).T if cs else np.zeros((d, 0), dtype=complex)
     return RadiationFit(np.array(poles, dtype=complex), np.array(inps, dtype=int), c, Ainf, err)
 
 

@@ -62,13 +62,13 @@ def interpolate_excitation(tables: Tables, omega, heading):
     if heads.size == 1:
         Xh = X[:, 0, :]
     else:
-        Xh = np.zeros((X.shape[0], 6), dtype=complex)
-        for j in range(6):
+        Xh = np.zeros(X.shape[:1] + X.shape[2:], dtype=complex)
+        for j in range(X.shape[2]):
             for i in range(X.shape[0]):
                 Xh[i, j] = np.interp(heading, heads, X[i, :, j].real) + 1j * np.interp(heading, heads, X[i, :, j].imag)
-    out = np.zeros((w.size, 6), dtype=complex)
+    out = np.zeros((w.size, X.shape[2]), dtype=complex)
     inside = (w >= tables.omega[0] - 1e-12) & (w <= tables.omega[-1] + 1e-12)
-    for j in range(6):
+    for j in range(X.shape[2]):
         out[:, j] = (np.interp(w, tables.omega, Xh[:, j].real) + 1j * np.interp(w, tables.omega, Xh[:, j].imag))
     return out * inside[:, None]
 
@@ -77,10 +77,11 @@ def interpolate_radiation(tables: Tables, omega):
     """A(w), B(w) (N, 6, 6) at frequencies omega, linear in w between the tabulated ones (inside
     their range only: the caller checks it)."""
     w = np.asarray(omega, dtype=float)
-    A = np.zeros((w.size, 6, 6))
-    B = np.zeros((w.size, 6, 6))
-    for i in range(6):
-        for j in range(6):
+    d = tables.added_mass.shape[1]
+    A = np.zeros((w.size, d, d))
+    B = np.zeros((w.size, d, d))
+    for i in range(d):
+        for j in range(d):
             A[:, i, j] = np.interp(w, tables.omega, tables.added_mass[:, i, j])
             B[:, i, j] = np.interp(w, tables.omega, tables.damping[:, i, j])
     return A, B

@@ -5,8 +5,15 @@ Bodies as one family: each body is a floating frame of its own (6 rigid unknowns
 group) whose rows are the sum of the *same term classes* as the vessel's rigid part (vessel.py:
 `RigidBody`, the linear `Hydrostatics` about its own rest pose, seakeeping.py's `LinearDamping`),
 evaluated with the body's own kinematics (`Floating.kin`): a body is built by the functions that
-build the vessel's rigid terms. What the vessel has and a body has not yet: tanks, hull meshes and
-nonlinear hydrostatics, hydrodynamic databases and waves.
+build the vessel's rigid terms, its wave excitation among them (seakeeping.py's `WaveExcitation`,
+its forces at the body's place in the incident field). What the vessel has and a body has not
+yet: tanks, hull meshes and nonlinear hydrostatics.
+
+Radiation: one added mass A_inf and one memory (seakeeping.py's `Memory`) over the rigid dofs of
+the vessel and all bodies (6 + 6 S, the step's order): each body's own tables as its diagonal
+block, a multibody file's coupling as the blocks between bodies (the memory kernels between
+bodies are its columns of other bodies' dofs). The memory's states are this term's integrator
+states, advanced with every frame's velocities. The vessel's own block is its own terms'.
 
 Positions are in the frame whose origin is the vessel's COG at rest, axes inertial (the vessel's X0):
 a body's frame origin is its COG, at `rest` when it floats at rest; its hydrostatic restoring reads
@@ -32,6 +39,7 @@ import jax.numpy as jnp
 
 from .about import About
 from .kinematics import quat_exp, quat_multiply, rotation_matrix
+from .seakeeping import Memory
 from .terms import Config, Kin, Rows, Unknowns
 from .unknowns import AbstractOwner
 
@@ -144,6 +152,8 @@ class Bodies(AbstractOwner):
     bodies: tuple
     links: tuple
     gravity: jax.Array
+    added_mass: Optional[jax.Array] = None     # (6 + 6 S, 6 + 6 S) the bodies' radiation A_inf
+    memory: Optional[Memory] = None            # over the 6 + 6 S rigid dofs
     names: tuple = eqx.field(static=True, default=())
     link_names: tuple = eqx.field(static=True, default=())
     about: About = eqx.field(static=True, default=About())
@@ -218,14 +228,30 @@ class Bodies(AbstractOwner):
         return [b.kin(c.Xs[s], c.qs[s], vy[6 + 6 * s:12 + 6 * s], None if ay is None else ay[6 + 6 * s:12 + 6 * s],
                       system.gravity, t) for s, b in enumerate(self.bodies)]
 
-    def add_rows(self, system, c: Config, core_y, core_z, vy, vz, ay, az):
-        own = [b.rows(k) for b, k in zip(self.bodies, self.body_kins(system, c, vy, ay))]
-        return jnp.concatenate([core_y, *own]) - self.link_forces(self.poses(c, vy)), core_z
+    def add_rows(self, system, c: Config, core_y, core_z, vy, vz, ay, az, t=0.0, z=None):
+        own = [b.rows(k) for b, k in zip(self.bodies, self.body_kins(system, c, vy, ay, t))]
+        rows = jnp.concatenate([core_y, *own]) - self.link_forces(self.poses(c, vy))
+        if self.added_mass is not None:
+            rows = rows + self.added_mass @ ay[:rows.shape[0]]
+        if self.memory is not None and z is not None and z.size:
+            rows = rows + self.memory.force(z)
+        return rows, core_z
+
+    # ------------------------------------------------------------ the radiation memory's states
+    def state_init(self):
+        return jnp.zeros((0,)) if self.memory is None else self.memory.init()
+
+    def state_coefficients(self, h):
+        return () if self.memory is None else self.memory.coefficients(h)
+
+    def state_advance(self, z, v_old, v_new, coef):
+        return z if self.memory is None else self.memory.advance(z, v_old, v_new, coef)
 
     def extra_kinetic(self, system, c: Config, v):
         vy = v[:6 + 6 * self.S]
-        return sum((t.kinetic(k) for b, k in zip(self.bodies, self.body_kins(system, c, vy)) for t in b.terms),
-                   jnp.zeros(()))
+        T = sum((t.kinetic(k) for b, k in zip(self.bodies, self.body_kins(system, c, vy)) for t in b.terms),
+                jnp.zeros(()))
+        return T if self.added_mass is None else T + 0.5 * vy @ (self.added_mass @ vy)
 
     def extra_potential(self, system, c: Config):
         vy = jnp.zeros(6 + 6 * self.S)
@@ -234,7 +260,8 @@ class Bodies(AbstractOwner):
         return V + self.link_potential(self.poses(c, vy))
 
     def add_scales(self, y, z):
-        return jnp.concatenate([y, *[sum((t.mass_scale() for t in b.terms), jnp.zeros(6)) for b in self.bodies]]), z
+        y = jnp.concatenate([y, *[sum((t.mass_scale() for t in b.terms), jnp.zeros(6)) for b in self.bodies]])
+        return (y if self.added_mass is None else y.at[6:].add(jnp.diag(self.added_mass)[6:])), z
 
     def constraint(self, system, c: Config, alg):
         return jnp.zeros(0)

@@ -31,11 +31,12 @@ from .terms import AbstractTerm, Kin, Rows
 
 class Memory(eqx.Module):
     """The fitted radiation memory: complex poles (real, imaginary parts), their input dof (a one-hot
-    (M, 6) selection) and output coefficients c (6, M)."""
+    (M, n) selection) and output coefficients c (n, M); n = 6 for the vessel, 6 per body for the
+    coupled radiation of several (physics/bodies.py)."""
     p_re: jax.Array
     p_im: jax.Array
-    select: jax.Array     # (M, 6)
-    c_re: jax.Array       # (6, M)
+    select: jax.Array     # (M, n)
+    c_re: jax.Array       # (n, M)
     c_im: jax.Array
 
     def init(self):
@@ -59,7 +60,8 @@ class Memory(eqx.Module):
     def advance(self, z, v_old, v_new, coef):
         """The states at t_{n+1} from those at t_n and the rigid velocities (6,) at both ends."""
         (Er, Ei), (g0r, g0i), (g1r, g1i) = coef
-        u0, u1 = self.select @ v_old, self.select @ v_new
+        n = self.select.shape[1]          # the vessel's 6, or the rigid dofs of several bodies
+        u0, u1 = self.select @ v_old[:n], self.select @ v_new[:n]
         wr, wi = z[:, 0], z[:, 1]
         nr = Er * wr - Ei * wi + g0r * u0 + g1r * u1
         ni = Er * wi + Ei * wr + g0i * u0 + g1i * u1

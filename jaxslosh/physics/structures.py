@@ -335,7 +335,7 @@ class Structures(AbstractOwner):
             V = V - b.mass * g_vec @ x
         return V
 
-    def add_rows(self, system, c: Config, core_y, core_z, vy, vz, ay, az):
+    def add_rows(self, system, c: Config, core_y, core_z, vy, vz, ay, az, t=0.0, z=None):
         """The rows of the whole dynamic vector from the vessel-and-liquid ones (core_y (6,), core_z
         (nf,)): each structure's rigid and elastic inertia rows appended, and the forces of its
         potential (elastic, gravity) added, the vessel's share too (a prescribed motion replaces the

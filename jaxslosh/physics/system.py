@@ -126,8 +126,10 @@ class System(eqx.Module):
             ry, rz = self.terms_rows(c, vy[:3], vy[3:6], vz[:nf], ay[:6], az[:nf], t, z)
         else:
             ry, rz = jnp.zeros(6), jnp.zeros(nf)
+        states = self.states_init() if z is None else z
         for o in self.owners():
-            ry, rz = o.add_rows(self, c, ry, rz, vy, vz, ay, az)
+            own = next(zi for term, zi in zip(self.all_terms(), states) if term is o)
+            ry, rz = o.add_rows(self, c, ry, rz, vy, vz, ay, az, t, own)
         return self.hold(ry, ay[:6], t), rz
 
     def constraint(self, c: Config, alg):
@@ -204,7 +206,7 @@ class System(eqx.Module):
         return tuple(term.state_coefficients(h) for term in self.all_terms())
 
     def states_advance(self, z: tuple, v_old, v_new, coef: tuple, c_old=None, c_new=None) -> tuple:
-        """The terms' states at t_{n+1} (rigid velocities (6,) at t_n and t_{n+1}; the configurations
+        """The terms' states at t_{n+1} (rigid velocities (6, or 6 per floating frame) at t_n and t_{n+1}; the configurations
         at both ends for the terms that follow them, AbstractTerm.state_advance_config)."""
         return tuple(term.state_advance_config(zi, c_old, v_old, c_new, v_new, ci)
                      for term, zi, ci in zip(self.all_terms(), z, coef, strict=True))

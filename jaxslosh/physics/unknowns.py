@@ -94,8 +94,9 @@ class AbstractOwner(AbstractTerm):
         """`out` with its unknowns advanced from c by its rigid (y) and deformable (z) increments."""
 
     @abc.abstractmethod
-    def add_rows(self, system, c: Config, core_y, core_z, vy, vz, ay, az):
-        """The rows (y, z) from the vessel-and-liquid ones: its own appended, its forces added."""
+    def add_rows(self, system, c: Config, core_y, core_z, vy, vz, ay, az, t=0.0, z=None):
+        """The rows (y, z) from the vessel-and-liquid ones: its own appended, its forces added (at
+        time t, with its own integrator states z: AbstractTerm.state_init)."""
 
     @abc.abstractmethod
     def extra_kinetic(self, system, c: Config, v):

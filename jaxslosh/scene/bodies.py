@@ -7,12 +7,14 @@ What a body cannot have yet is refused by its key, never silently dropped.
 """
 from __future__ import annotations
 
+import dataclasses
 import math
 
 import numpy as np
 
 from .fields import non_negative, one_of, positive, read, show, valid_name
 from .types import Body, Connection, Hydrostatics, Initial, SceneError
+from .waves import FileContext, read_hydrodynamics
 
 KINDS = ("hawser", "fender", "spring")
 #: the vessel's keys a body cannot have yet, refused by name (not as unknown keys)
@@ -22,8 +24,9 @@ NOT_YET = {"hull": "hull meshes (and the waves' and the nonlinear hydrostatics' 
 RESERVED = ("vessel", "fixed")
 
 
-def read_bodies(tables, vessel, environment, warnings: list[str]) -> tuple[Body, ...]:
-    """The `[[bodies]]` of a scene (`vessel`: the scene's types.Vessel)."""
+def read_bodies(tables, vessel, environment, warnings: list[str], files=None) -> tuple[Body, ...]:
+    """The `[[bodies]]` of a scene (`vessel`: the scene's types.Vessel; `files`: waves.FileContext,
+    where a body's hydrodynamic `file` is read from)."""
     out = []
     for i, table in enumerate(tables):
         where = f"bodies[{i}]"
@@ -49,24 +52,21 @@ def read_bodies(tables, vessel, environment, warnings: list[str]) -> tuple[Body,
             raise SceneError(f"{where}.position", f"must be a list of 2 numbers [x, y] (m, horizontally from the "
                                                   f"vessel's COG at rest), got {show(pos)}")
         hs = _hydrostatics(table["hydrostatics"], f"{where}.hydrostatics", warnings)
-        damping = None
-        if "hydrodynamics" in table:
-            other = [k for k in (table["hydrodynamics"] if isinstance(table["hydrodynamics"], dict) else ())
-                     if k != "viscous_damping"]
-            if other:
-                raise SceneError(f"{where}.hydrodynamics.{other[0]}", "hydrodynamic tables and files (added mass, "
-                                 "radiation, wave excitation) are not available yet for [[bodies]]: only "
-                                 "viscous_damping is")
-            hd = read(table["hydrodynamics"], f"{where}.hydrodynamics", {"viscous_damping": ("numbers", None)})
-            if "viscous_damping" in hd:
-                damping = _matrix6(hd["viscous_damping"], f"{where}.hydrodynamics.viscous_damping")
+        damping = hydro = None
+        if "hydrodynamics" in table:      # the vessel's keys and reader (a file's block of this body)
+            ctx = (files or FileContext())._replace(body=name)
+            hydro = read_hydrodynamics(table["hydrodynamics"], None, ctx, warnings, hs, where=f"{where}.hydrodynamics")
+            hydro = dataclasses.replace(hydro, base_dir=ctx.base_dir)
+            if hydro.viscous_damping is not None:
+                damping = _matrix6(hydro.viscous_damping, f"{where}.hydrodynamics.viscous_damping")
         initial = Initial(**read(table.get("initial", {}), f"{where}.initial", {
             "position": ("vec3", None), "velocity": ("vec3", None), "angular_velocity": ("vec3", None),
             "roll_pitch_yaw": ("vec3", None),
         }))
         body = Body(name=name, mass=v["mass"], inertia=v["inertia"], hydrostatics=hs,
                     position=(float(pos[0]), float(pos[1])), heading=v.get("heading", 0.0),
-                    cog_height=v.get("cog_height", 0.0), initial=initial, viscous_damping=damping)
+                    cog_height=v.get("cog_height", 0.0), initial=initial, viscous_damping=damping,
+                    hydrodynamics=hydro)
         buoyant = environment.water_density * hs.displaced_volume
         if environment.gravity > 0 and abs(body.mass - buoyant) > 0.01 * buoyant:
             warnings.append(f"{where}.hydrostatics.displaced_volume: the body's mass {body.mass:.6g} kg differs from "
@@ -203,6 +203,7 @@ def bodies_scene(bodies, vessel_name, structures, mapping, warnings: list[str]) 
     if any(s.frame == "own" for s in structures):
         raise SceneError("bodies", "[[bodies]] together with [[structures]] in their own frames are not available "
                                    "yet (a model holds one of them)")
-    if "waves" in mapping:
-        warnings.append(f"waves: the incident waves act on the vessel only; the [[bodies]] "
-                        f"({', '.join(repr(b.name) for b in bodies)}) feel no wave excitation (not available yet)")
+    dry = [b.name for b in bodies if b.hydrodynamics is None or b.hydrodynamics.excitation_amplitude is None]
+    if "waves" in mapping and dry:
+        warnings.append(f"waves: the [[bodies]] {', '.join(repr(n) for n in dry)} have no excitation tables "
+                        f"([bodies.hydrodynamics] file or excitation_amplitude): the waves exert no force on them")

@@ -122,7 +122,7 @@ def parse_scene(mapping: Mapping[str, Any], text: str = "", path: str = "") -> S
     _unique_names(probes, "probes", "probe")
     for i, probe in enumerate(probes):
         _place_probe(probe, f"probes[{i}]", tanks, structures)
-    bodies = read_bodies(mapping.get("bodies", []), vessel, environment, warnings)
+    bodies = read_bodies(mapping.get("bodies", []), vessel, environment, warnings, files)
     connections = read_connections(mapping.get("connections", []), vessel.name, bodies)
     bodies_scene(bodies, vessel.name, structures, mapping, warnings)
     mooring = read_mooring(mapping.get("mooring", []), environment.depth, vessel.name, vessel.cog_height, warnings,
@@ -252,7 +252,8 @@ def _vessel(table, environment: Environment, warnings: list[str], files=None) ->
     if "hull" in table or "hydrodynamics" in table:   # hull and its hydrodynamics (waves.py)
         if hull is not None and not (hydrostatics is not None and hydrostatics.nonlinear):
             hydrostatics = hull_hydrostatics(hull, hydrostatics, warnings)
-        hydrodynamics = read_hydrodynamics(table["hydrodynamics"], hull, files, warnings, hydrostatics) \
+        named = files._replace(body=v.get("name", "vessel")) if files is not None else None
+        hydrodynamics = read_hydrodynamics(table["hydrodynamics"], hull, named, warnings, hydrostatics) \
             if "hydrodynamics" in table else None
     # a prescribed motion ([vessel.forced]) holds all six dofs, so then nothing falls
     if hydrostatics is None and environment.gravity > 0 and "forced" not in table:

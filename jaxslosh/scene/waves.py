@@ -139,6 +139,7 @@ class FileContext(NamedTuple):
     rho: float = 1025.0
     g: float = 9.81
     depth: Optional[float] = None
+    body: Optional[str] = None       # the body whose block a multibody file gives (the vessel's name, a body's)
 
 
 #: the tables a `file` holds: the scene may not give them too
@@ -154,7 +155,7 @@ def _from_file(v: dict, where: str, files: Optional[FileContext], hydrostatics, 
     files = files or FileContext()
     path = v["file"] if os.path.isabs(v["file"]) else os.path.join(files.base_dir, v["file"])
     try:
-        db = read_database(path, files.rho, files.g, v.get("cog"), v.get("length_scale", 1.0), files.depth)
+        db = read_database(path, files.rho, files.g, v.get("cog"), v.get("length_scale", 1.0), files.depth, files.body)
     except DatabaseError as e:
         raise SceneError(f"{where}.file", " ".join(str(e).split())) from None
     t = db.tables
@@ -239,8 +240,8 @@ def _check_database(where, path, db, files, hydrostatics, hull, length, warnings
 
 
 def read_hydrodynamics(table, hull: Optional[Hull], files: Optional[FileContext] = None,
-                       warnings: Optional[list] = None, hydrostatics=None) -> Hydrodynamics:
-    where = "vessel.hydrodynamics"
+                       warnings: Optional[list] = None, hydrostatics=None,
+                       where: str = "vessel.hydrodynamics") -> Hydrodynamics:
     v = read(table, where, {
         "frequencies": ("numbers", None), "added_mass": ("numbers", None), "damping": ("numbers", None),
         "added_mass_infinite": ("numbers", None), "headings": ("numbers", None),

@@ -129,7 +129,8 @@ def states_next(system: System, solver: Solver, s: State, v_new, c_new=None):
     """The terms' integrator states at t_{n+1} (the radiation memory's: exact for a rigid velocity
     linear over the step, so they are a linear function of the step's unknown new velocity; a
     lumped mooring line's also follow the configuration c_new)."""
-    return system.states_advance(s.z, s.v[:6], v_new[:6], system.states_coefficients(solver.h), s.c, c_new)
+    r = system.layout().n_rigid          # every floating frame's velocities (the bodies' coupled memory)
+    return system.states_advance(s.z, s.v[:r], v_new[:r], system.states_coefficients(solver.h), s.c, c_new)
 
 
 def step_equations(system: System, solver: Solver, s: State):
@@ -160,7 +161,7 @@ def step_equations(system: System, solver: Solver, s: State):
         vy, ay, _ = rates(y, slice(0, r))
         vz, az, _ = rates(z, slice(r, None))
         c_new = system.advance_parts(s.c, y, z)
-        states = system.states_advance(s.z, s.v[:6], vy[:6], coef, s.c, c_new)
+        states = system.states_advance(s.z, s.v[:r], vy, coef, s.c, c_new)
         return system.step_rows_parts(c_new, vy, vz, ay, az, s.t + h, states)
 
     def R(delta):

@@ -1,0 +1,247 @@
+"""The hydrodynamics of `[[bodies]]` (docs/guide/bodies-and-connections.md): each body's tables or
+file (the vessel's keys, read by the vessel's reader), and a multibody file that couples the
+bodies' radiation and diffraction, as host-side sources over the rigid dofs of the vessel and the
+bodies (6 + 6 S: the vessel's six, then six per body, the step's order).
+
+A source is a set of tables over d of those dofs, in the axes they were computed in:
+
+* one body's own tables (`axes = "body"`): its dofs along its own axes about its COG, the wave
+  heading relative to its x axis, phases from its COG. The rows of the step hold translations in
+  inertial axes and rotations in body axes, so with T = diag(R^T, I) (R its heading's rotation)
+  the step's A is T^T A T, its X T^T X(beta - heading) e^{-i k (x cos beta + y sin beta)}, (x, y)
+  its COG at rest from the vessel's;
+* a multibody file (`axes = "global"`): every body's dofs along the file's (the scene's inertial)
+  axes about its own COG, phases from the file's origin (the vessel's COG), so T = diag(I, R) (the
+  rotations' body axes from the inertial ones). The vessel's own 6 x 6 block stays with its own
+  terms (assemble/seakeeping.py reads it from the same file): the source skips it.
+
+The same functions then serve the time domain (A_inf and the memory fitted by hydro/radiation.py
+over all the source's dofs: the memory kernels between bodies are its off-diagonal columns) and
+the frequency domain (A(w) - A_inf and B(w) interpolated, analysis/rao.py).
+"""
+from __future__ import annotations
+
+import os
+from typing import NamedTuple, Optional
+
+import jax.numpy as jnp
+import numpy as np
+
+from ..hydro.multibody import file_bodies, read_multibody
+from ..hydro.radiation import fit_radiation
+from ..hydro.source import tables_of
+from ..hydro.spectra import components, wavenumber
+from ..hydro.tables import Tables, interpolate_excitation, interpolate_radiation
+from ..physics.seakeeping import Memory
+from ..scene.types import SceneError
+
+
+class Source(NamedTuple):
+    index: tuple            # (d,) the rigid dofs (of 6 + 6 S) the tables' rows and columns are
+    tables: Tables
+    T: np.ndarray           # (d, d) the step's dofs -> the tables'
+    origin: tuple           # (x, y) m, the tables' phase origin from the vessel's COG at rest
+    headings: tuple         # per body of the source, rad (its x axis from the inertial X)
+    axes: str               # "body" | "global"
+    skip: np.ndarray        # (d, d) bool: entries the vessel's own terms carry
+    key: tuple              # hashable: what the fit's cache is keyed on
+    warnings: tuple = ()
+
+
+def _rz(psi):
+    c, s = np.cos(psi), np.sin(psi)
+    return np.array([[c, -s, 0.0], [s, c, 0.0], [0.0, 0.0, 1.0]])
+
+
+def transform(headings, axes: str) -> np.ndarray:
+    """T (6 n, 6 n): the step's dofs (translations inertial, rotations body) -> the tables'."""
+    n = len(headings)
+    T = np.eye(6 * n)
+    for k, psi in enumerate(headings):
+        R = _rz(psi)
+        if axes == "body":
+            T[6 * k:6 * k + 3, 6 * k:6 * k + 3] = R.T
+        else:
+            T[6 * k + 3:6 * k + 6, 6 * k + 3:6 * k + 6] = R
+    return T
+
+
+def _path(hd) -> str:
+    return hd.file if os.path.isabs(hd.file) else os.path.join(hd.base_dir, hd.file)
+
+
+def coupled_file(scene) -> Optional[tuple]:
+    """(path, the bodies' names in the file's order, which key named it) of the scene's multibody
+    file, or None. The vessel's file first, else the first body's that is one."""
+    cands = [("vessel.hydrodynamics.file", scene.vessel.hydrodynamics)] + \
+        [(f"bodies[{i}].hydrodynamics.file", b.hydrodynamics) for i, b in enumerate(scene.bodies)]
+    scene_names = [scene.vessel.name] + [b.name for b in scene.bodies]
+    for key, hd in cands:
+        if hd is None or not hd.file:
+            continue
+        path = _path(hd)
+        have = file_bodies(path)
+        if have is None:
+            continue
+        if isinstance(have, int):              # WAMIT NBODY: the scene's first bodies, in order
+            if have > len(scene_names):
+                raise SceneError(key, f"{path} holds {have} bodies, the scene {len(scene_names)}")
+            return path, tuple(scene_names[:have]), key
+        unknown = [n for n in have if n not in scene_names]
+        if unknown:
+            raise SceneError(key, f"{path} holds the bodies {list(have)}: {unknown} are not bodies of the scene "
+                                  f"({scene_names}); the file's bodies are matched by name")
+        return path, tuple(have), key
+    return None
+
+
+def sources(scene) -> list:
+    """The hydrodynamic sources of the scene's bodies (not the vessel's own tables)."""
+    env = scene.environment
+    names = [scene.vessel.name] + [b.name for b in scene.bodies]
+    heading = [0.0] + [b.heading for b in scene.bodies]
+    out = []
+    coupled = coupled_file(scene)
+    members = set()
+    if coupled is not None:
+        path, inside, key = coupled
+        for i, b in enumerate(scene.bodies):
+            hd = b.hydrodynamics
+            if b.name in inside and hd is not None and hd.file and os.path.abspath(_path(hd)) != os.path.abspath(path):
+                raise SceneError(f"bodies[{i}].hydrodynamics.file", f"{b.name!r} is in {path} (coupled); name that "
+                                                                    "file or leave `file` out")
+        mb = read_multibody(path, inside, env.water_density, env.gravity)
+        index = tuple(6 * names.index(n) + k for n in inside for k in range(6))
+        skip = np.zeros((len(index),) * 2, dtype=bool)
+        if scene.vessel.name in inside and scene.vessel.hydrodynamics is not None \
+                and scene.vessel.hydrodynamics.file:
+            v = 6 * inside.index(scene.vessel.name)
+            skip[v:v + 6, v:v + 6] = True
+        heads = tuple(heading[names.index(n)] for n in inside)
+        out.append(Source(index, mb.tables, transform(heads, "global"), (0.0, 0.0), heads, "global", skip,
+                          (path, inside, heads, bool(skip.any())), mb.warnings))
+        members = set(inside)
+    for s, b in enumerate(scene.bodies):
+        hd = b.hydrodynamics
+        if b.name in members or hd is None or not (hd.added_mass is not None or hd.excitation_amplitude is not None):
+            continue
+        t = tables_of(hd, None, env.water_density, env.gravity)
+        out.append(Source(tuple(range(6 + 6 * s, 12 + 6 * s)), t, transform((b.heading,), "body"), b.position,
+                          (b.heading,), "body", np.zeros((6, 6), dtype=bool), (hd, b.heading)))
+    return out
+
+
+def source_warnings(scene) -> list:
+    return [w for src in sources(scene) for w in src.warnings]
+
+
+def _rotate(T, A):
+    return np.einsum("ki,...kl,lj->...ij", T, A, T)
+
+
+#: fits by source key (a file's path, bodies and headings; a body's tables and heading): a fit is
+#: seconds, and every build, linearisation and RAO of a scene asks for it
+_FITS: dict = {}
+
+
+def source_fit(src: Source):
+    """The source's radiation memory fit in the step's dofs (cached per source), or None without
+    radiation tables."""
+    t = src.tables
+    if t.added_mass is None:
+        return None
+    if src.key not in _FITS:
+        if len(_FITS) > 32:
+            _FITS.clear()
+        _FITS[src.key] = fit_radiation(t.omega, _rotate(src.T, t.added_mass), _rotate(src.T, t.damping),
+                                       None if t.added_mass_infinite is None else _rotate(src.T, t.added_mass_infinite),
+                                       skip=src.skip)
+    return _FITS[src.key]
+
+
+def excitation(src: Source, omega, beta, g, depth=None) -> np.ndarray:
+    """X (n, d) in the step's dofs per unit wave amplitude at the vessel's COG, waves heading beta."""
+    t = src.tables
+    d = len(src.index)
+    if t.excitation is None:
+        return np.zeros((np.size(omega), d), dtype=complex)
+    w = np.atleast_1d(np.asarray(omega, dtype=float))
+    if src.axes == "body":
+        X = interpolate_excitation(t, w, beta - src.headings[0])
+    else:
+        X = interpolate_excitation(t, w, beta)
+    k = wavenumber(w, g, depth)
+    shift = np.exp(-1j * k * (src.origin[0] * np.cos(beta) + src.origin[1] * np.sin(beta)))
+    return (X @ src.T) * shift[:, None]
+
+
+def radiation(src: Source, omega):
+    """(A(w) - A_inf of the fit, B(w)) (n, d, d) in the step's dofs, the skipped entries zero."""
+    A, B = interpolate_radiation(src.tables, omega)
+    A, B = _rotate(src.T, A), _rotate(src.T, B)
+    fit = source_fit(src)
+    A = A - fit.added_mass_infinite[None]
+    A[:, src.skip], B[:, src.skip] = 0.0, 0.0
+    return A, B
+
+
+def rigid_size(scene) -> int:
+    return 6 + 6 * len(scene.bodies)
+
+
+def frequency_terms(scene, omega, headings):
+    """(dA (f, N, N), B (f, N, N), F (f, h, N)) of the bodies' sources over the N rigid dofs: what the
+    frequency domain adds to the linearised scene (its M holds each fit's A_inf)."""
+    N, w = rigid_size(scene), np.atleast_1d(np.asarray(omega, dtype=float))
+    dA, B = np.zeros((w.size, N, N)), np.zeros((w.size, N, N))
+    F = np.zeros((w.size, len(headings), N), dtype=complex)
+    depth = scene.waves.depth if scene.waves is not None else None
+    for src in sources(scene):
+        ix = np.asarray(src.index)
+        if src.tables.added_mass is not None and scene.effects.radiation:
+            a, b = radiation(src, w)
+            dA[:, ix[:, None], ix[None, :]] += a
+            B[:, ix[:, None], ix[None, :]] += b
+        for h, beta in enumerate(headings):
+            X = excitation(src, w, float(beta), scene.environment.gravity, depth)
+            X[:, ix < 6] = 0.0             # the vessel's own columns: its own terms' (rao.py)
+            F[:, h, ix] += X
+    return dA, B, F
+
+
+def time_terms(scene, params: dict):
+    """(A_inf (N, N), Memory over the N rigid dofs or None, per-body X at the sea's components
+    (S, n_c, 6) or None) of the bodies' sources, for physics/bodies.py."""
+    N, S = rigid_size(scene), len(scene.bodies)
+    Ainf = np.zeros((N, N))
+    poles, sel, cs = [], [], []
+    waves, eff = scene.waves, scene.effects
+    X = None
+    if waves is not None and eff.waves:
+        c = components(waves)
+        X = np.zeros((S, c.omega.size, 6), dtype=complex)
+    for src in sources(scene):
+        ix = np.asarray(src.index)
+        fit = source_fit(src) if eff.radiation else None
+        if fit is not None:
+            Ainf[ix[:, None], ix[None, :]] += fit.added_mass_infinite
+            poles.append(fit.p)
+            sel.append(ix[fit.inp])
+            cs.append(np.zeros((N, fit.p.size), dtype=complex))
+            cs[-1][ix] = fit.c
+        if X is not None:
+            for beta in np.unique(c.headings):
+                m = c.headings == beta
+                Xs = excitation(src, c.omega[m], float(beta), scene.environment.gravity, waves.depth)
+                for k, i in enumerate(src.index[::6]):
+                    if i >= 6:                   # the vessel's own columns are its own terms'
+                        X[i // 6 - 1, m] += Xs[:, 6 * k:6 * k + 6]
+    memory = None
+    if poles and sum(p.size for p in poles):
+        p = np.concatenate(poles)
+        s = np.zeros((p.size, N))
+        s[np.arange(p.size), np.concatenate(sel)] = 1.0
+        c_all = np.concatenate(cs, axis=1)
+        memory = Memory(jnp.asarray(p.real), jnp.asarray(p.imag), jnp.asarray(s), jnp.asarray(c_all.real),
+                        jnp.asarray(c_all.imag))
+    return Ainf, memory, X

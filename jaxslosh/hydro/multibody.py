@@ -1,0 +1,169 @@
+"""Multibody hydrodynamic databases: the coupled radiation and diffraction of several bodies in one
+file (docs/guide/bodies-and-connections.md, coupled hydrodynamics).
+
+* **Capytaine**: a dataset of several bodies solved together (`Multibody`, or bodies joined) names
+  its dofs `<body>__<Dof>` along `radiating_dof` and `influenced_dof` (e.g. "barge__Surge"). Each
+  body's dofs rotate about that body's rotation centre, which must be its COG (Capytaine's
+  `rigid_body_dofs(rotation_center=cog)`), and the wave phases are relative to the dataset's
+  origin, which the scene takes as the vessel's COG at rest (horizontally): the file's axes are the
+  scene's inertial axes, so each body's dofs are along them whatever its heading.
+* **WAMIT** (NBODY > 1): the `.1` and `.3` hold 6 N dofs, body k's in rows 6 k + 1 ... 6 k + 6, in
+  the order of the run's bodies, which the scene's `[vessel]` and `[[bodies]]` then follow by
+  their file order (`bodies` below); each body about its own origin (its COG: XBODY), phases
+  relative to the global origin.
+
+Read into `Tables` over the 6 N dofs (body by body, ours: surge ... yaw, A[i, j] the force on dof
+i per acceleration of dof j, X for our e^{+i w t}). Checked on reading: A(w) and B(w) symmetric
+(Green's reciprocity: A_ij = A_ji) and B(w) positive semi-definite (radiating waves takes energy
+away), each within `TOLERANCE` of the sizes involved (a coarse panel model's accuracy): where not,
+one warning names the worst entries (the file is used as it is).
+"""
+from __future__ import annotations
+
+import os
+from typing import NamedTuple, Optional
+
+import numpy as np
+
+from .database import DOF_NAMES, DatabaseError, _k_exponent, _merge_complex, _open_netcdf, _rows
+from .tables import Tables
+
+#: relative to sqrt(|X_ii X_jj|) (symmetry) or the largest eigenvalue (semi-definiteness) at the
+#: same frequency: the accuracy a coarse panel model gives its cross terms
+TOLERANCE = 0.02
+SEP = "__"
+
+
+class Multibody(NamedTuple):
+    names: tuple            # the bodies, in the tables' order (6 dofs each)
+    tables: Tables          # over 6 N dofs, about each body's COG, phases from the file's origin
+    warnings: tuple         # the reading's checks that failed (one line each)
+
+
+def dof_label(names, k: int) -> str:
+    return f"{names[k // 6]}__{DOF_NAMES[k % 6]}"
+
+
+def netcdf_bodies(path: str) -> Optional[tuple]:
+    """The bodies a Capytaine dataset names in its dofs (`<body>__<Dof>`), in order; None for a
+    single body's dataset (plain dof names)."""
+    ds = _open_netcdf(path)
+    labels = [str(x) for x in ds["radiating_dof"].values] if "radiating_dof" in ds.coords else []
+    if not labels or not all(SEP in x for x in labels):
+        return None
+    return tuple(dict.fromkeys(x.split(SEP)[0] for x in labels))
+
+
+def read_multibody_netcdf(path: str, names) -> Multibody:
+    """The coupled tables of `names` (every body of the dataset, in the scene's order)."""
+    ds = _merge_complex(_open_netcdf(path))
+    have = netcdf_bodies(path) or ()
+    if sorted(have) != sorted(names):
+        raise DatabaseError(f"{path}: the dataset's bodies {list(have)} are not the scene's {list(names)}")
+    order = [f"{b}{SEP}{d}" for b in names for d in DOF_NAMES]
+    w_all = np.atleast_1d(np.asarray(ds["omega"].values, dtype=float))
+    sel = dict(influenced_dof=order, radiating_dof=order)
+    A_all = ds["added_mass"].sel(**sel).transpose("omega", "influenced_dof", "radiating_dof").values
+    B_all = ds["radiation_damping"].sel(**sel).transpose("omega", "influenced_dof", "radiating_dof").values
+    fin = np.isfinite(w_all) & (w_all > 0)
+    idx = np.flatnonzero(fin)[np.argsort(w_all[fin])]
+    Ainf = A_all[np.flatnonzero(np.isinf(w_all))[0]] if np.isinf(w_all).any() else None
+    X = heads = None
+    if "excitation_force" in ds and "wave_direction" in ds["excitation_force"].dims:
+        F = ds["excitation_force"].sel(influenced_dof=order).transpose("omega", "wave_direction",
+                                                                        "influenced_dof").values[idx]
+        heads = np.asarray(ds["wave_direction"].values, dtype=float)
+        hs = np.argsort(heads)
+        X, heads = np.conj(F[:, hs]), heads[hs]        # Capytaine's e^{-i w t} -> ours
+    t = Tables(w_all[idx], A_all[idx], B_all[idx], Ainf, heads, X)
+    return Multibody(tuple(names), t, tuple(check_coupled(t, names, path)))
+
+
+def wamit_bodies(path: str) -> int:
+    """How many bodies a WAMIT `.1` holds (its largest dof index / 6)."""
+    rows = _rows(path, (4, 5), ".1 (PER I J A B)")
+    top = max((max(int(r[1]), int(r[2])) for _, r in rows), default=0)
+    return max(1, (top + 5) // 6)
+
+
+def read_multibody_wamit(path: str, names, rho: float, g: float, length: float = 1.0) -> Multibody:
+    """WAMIT's NBODY `.1` (with its `.3`) of 6 N dofs, body k the k-th of `names`."""
+    n = 6 * len(names)
+    if wamit_bodies(path) != len(names):
+        raise DatabaseError(f"{path}: holds {wamit_bodies(path)} bodies (6 dofs each), the scene {len(names)}")
+    rows = _rows(path, (4, 5), ".1 (PER I J A B)")
+    per = np.array([r[0] for _, r in rows])
+    periods = np.unique(per[per > 0])
+    w = np.sort(2 * np.pi / periods)
+    A, B = np.zeros((w.size, n, n)), np.zeros((w.size, n, n))
+    Ainf = None
+    for _, r in rows:
+        p, i, j = r[0], int(r[1]) - 1, int(r[2]) - 1
+        if not (0 <= i < n and 0 <= j < n):
+            continue
+        norm = rho * length ** _k_exponent(i % 6, j % 6)
+        if p == 0:
+            Ainf = np.zeros((n, n)) if Ainf is None else Ainf
+            Ainf[i, j] = r[3] * norm
+        elif p > 0:
+            m = int(np.argmin(np.abs(w - 2 * np.pi / p)))
+            A[m, i, j], B[m, i, j] = r[3] * norm, r[4] * norm * w[m]
+    X = heads = None
+    stem = os.path.splitext(path)[0]
+    if os.path.exists(stem + ".3"):
+        r3 = [r for _, r in _rows(stem + ".3", 7, ".3 (PER BETA I |X| phase Re Im)") if r[0] > 0]
+        heads_deg = np.unique(np.round([r[1] for r in r3], 9))
+        heads = np.radians(heads_deg)
+        X = np.zeros((w.size, heads.size, n), dtype=complex)
+        for r in r3:
+            m = int(np.argmin(np.abs(w - 2 * np.pi / r[0])))
+            h = int(np.argmin(np.abs(heads_deg - r[1])))
+            i = int(r[2]) - 1
+            if 0 <= i < n:
+                X[m, h, i] = complex(r[5], r[6]) * rho * g * length ** (2 if i % 6 < 3 else 3)
+    t = Tables(w, A, B, Ainf, heads, X)
+    return Multibody(tuple(names), t, tuple(check_coupled(t, names, path)))
+
+
+def check_coupled(t: Tables, names, path: str) -> list:
+    """One line for A or B not symmetric, one for B not positive semi-definite, beyond TOLERANCE,
+    naming the worst entry and frequency; nothing where the file passes."""
+    out = []
+    for what, M in (("added mass", t.added_mass), ("radiation damping", t.damping)):
+        d = np.sqrt(np.abs(np.einsum("nii->ni", M)))
+        ref = np.maximum(d[:, :, None] * d[:, None, :], 1e-300)
+        asym = np.abs(M - M.transpose(0, 2, 1)) / ref
+        m, i, j = np.unravel_index(np.argmax(asym), asym.shape)
+        if asym[m, i, j] > TOLERANCE:
+            bad = int((asym > TOLERANCE).sum() // 2)
+            out.append(f"{path}: the {what} is not symmetric within {100 * TOLERANCE:g} % ({bad} entries): worst "
+                       f"{dof_label(names, i)} / {dof_label(names, j)} at {t.omega[m]:.4g} rad/s, {M[m, i, j]:.6g} "
+                       f"against {M[m, j, i]:.6g} (reciprocity: a coarse mesh or a file cut); used as it is "
+                       f"(its symmetric part in the radiation memory)")
+    lam, vec = np.linalg.eigh(0.5 * (t.damping + t.damping.transpose(0, 2, 1)))
+    rel = lam[:, 0] / np.maximum(np.abs(lam).max(axis=1), 1e-300)
+    m = int(np.argmin(rel))
+    if rel[m] < -TOLERANCE:
+        k = int(np.argmax(np.abs(vec[m, :, 0])))
+        out.append(f"{path}: the radiation damping is not positive semi-definite at {t.omega[m]:.4g} rad/s: eigenvalue "
+                   f"{lam[m, 0]:.6g} ({100 * rel[m]:.3g} % of the largest), mostly {dof_label(names, k)} (the bodies "
+                   f"would gain energy radiating waves; irregular frequencies or a gap resonance the mesh does not "
+                   f"resolve)")
+    return out
+
+
+def read_multibody(path: str, names, rho: float, g: float, length: float = 1.0) -> Multibody:
+    ext = os.path.splitext(path)[1].lower()
+    if ext == ".1":
+        return read_multibody_wamit(path, names, rho, g, length)
+    return read_multibody_netcdf(path, names)
+
+
+def file_bodies(path: str) -> Optional[tuple]:
+    """The bodies of a NetCDF multibody dataset (names), the count of a WAMIT NBODY `.1`'s (an int),
+    or None for a single body's file."""
+    ext = os.path.splitext(path)[1].lower()
+    if ext == ".1":
+        n = wamit_bodies(path)
+        return n if n > 1 else None
+    return netcdf_bodies(path)
