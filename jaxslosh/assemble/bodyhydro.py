@@ -27,7 +27,8 @@ from typing import NamedTuple, Optional
 import jax.numpy as jnp
 import numpy as np
 
-from ..hydro.multibody import file_bodies, read_multibody
+from ..hydro.multibody import read_multibody
+from ..scene.bodies import coupled_file, resolve
 from ..hydro.radiation import fit_radiation
 from ..hydro.source import tables_of
 from ..hydro.spectra import components, wavenumber
@@ -66,48 +67,19 @@ def transform(headings, axes: str) -> np.ndarray:
     return T
 
 
-def _path(hd) -> str:
-    return hd.file if os.path.isabs(hd.file) else os.path.join(hd.base_dir, hd.file)
-
-
-def coupled_file(scene) -> Optional[tuple]:
-    """(path, the bodies' names in the file's order, which key named it) of the scene's multibody
-    file, or None. The vessel's file first, else the first body's that is one."""
-    cands = [("vessel.hydrodynamics.file", scene.vessel.hydrodynamics)] + \
-        [(f"bodies[{i}].hydrodynamics.file", b.hydrodynamics) for i, b in enumerate(scene.bodies)]
-    scene_names = [scene.vessel.name] + [b.name for b in scene.bodies]
-    for key, hd in cands:
-        if hd is None or not hd.file:
-            continue
-        path = _path(hd)
-        have = file_bodies(path)
-        if have is None:
-            continue
-        if isinstance(have, int):              # WAMIT NBODY: the scene's first bodies, in order
-            if have > len(scene_names):
-                raise SceneError(key, f"{path} holds {have} bodies, the scene {len(scene_names)}")
-            return path, tuple(scene_names[:have]), key
-        unknown = [n for n in have if n not in scene_names]
-        if unknown:
-            raise SceneError(key, f"{path} holds the bodies {list(have)}: {unknown} are not bodies of the scene "
-                                  f"({scene_names}); the file's bodies are matched by name")
-        return path, tuple(have), key
-    return None
-
-
 def sources(scene) -> list:
     """The hydrodynamic sources of the scene's bodies (not the vessel's own tables)."""
     env = scene.environment
     names = [scene.vessel.name] + [b.name for b in scene.bodies]
     heading = [0.0] + [b.heading for b in scene.bodies]
     out = []
-    coupled = coupled_file(scene)
+    coupled = coupled_file(scene.vessel, scene.bodies)
     members = set()
     if coupled is not None:
         path, inside, key = coupled
         for i, b in enumerate(scene.bodies):
             hd = b.hydrodynamics
-            if b.name in inside and hd is not None and hd.file and os.path.abspath(_path(hd)) != os.path.abspath(path):
+            if b.name in inside and hd is not None and hd.file and os.path.abspath(resolve(hd)) != os.path.abspath(path):
                 raise SceneError(f"bodies[{i}].hydrodynamics.file", f"{b.name!r} is in {path} (coupled); name that "
                                                                     "file or leave `file` out")
         mb = read_multibody(path, inside, env.water_density, env.gravity)
@@ -129,10 +101,6 @@ def sources(scene) -> list:
         out.append(Source(tuple(range(6 + 6 * s, 12 + 6 * s)), t, transform((b.heading,), "body"), b.position,
                           (b.heading,), "body", np.zeros((6, 6), dtype=bool), (hd, b.heading)))
     return out
-
-
-def source_warnings(scene) -> list:
-    return [w for src in sources(scene) for w in src.warnings]
 
 
 def _rotate(T, A):
@@ -230,8 +198,9 @@ def time_terms(scene, params: dict):
             cs.append(np.zeros((N, fit.p.size), dtype=complex))
             cs[-1][ix] = fit.c
         if X is not None:
-            for beta in np.unique(c.headings):
-                m = c.headings == beta
+            heads = np.full(c.omega.shape, waves.heading) if c.headings is None else np.asarray(c.headings)
+            for beta in np.unique(heads):
+                m = heads == beta
                 Xs = excitation(src, c.omega[m], float(beta), scene.environment.gravity, waves.depth)
                 for k, i in enumerate(src.index[::6]):
                     if i >= 6:                   # the vessel's own columns are its own terms'

@@ -9,10 +9,14 @@ from __future__ import annotations
 
 import dataclasses
 import math
+import os
+from typing import Optional
 
 import numpy as np
 
 from .fields import non_negative, one_of, positive, read, show, valid_name
+from ..hydro.database import DatabaseError
+from ..hydro.multibody import file_bodies, read_multibody
 from .types import Body, Connection, Hydrostatics, Initial, SceneError
 from .waves import FileContext, read_hydrodynamics
 
@@ -189,11 +193,11 @@ def _curve(x, where: str) -> tuple:
     return tuple((float(d), float(f)) for d, f in a)
 
 
-def bodies_scene(bodies, vessel_name, structures, mapping, warnings: list[str]) -> None:
+def bodies_scene(bodies, vessel, structures, mapping, warnings: list[str], files) -> None:
     """What the scene's other parts cannot do with [[bodies]] yet (docs/guide/bodies-and-connections.md)."""
     for i, t in enumerate(mapping.get("tanks", [])):
         body = t.get("body", "vessel") if isinstance(t, dict) else "vessel"
-        if body not in ("vessel", vessel_name, *[b.name for b in bodies]):
+        if body not in ("vessel", vessel.name, *[b.name for b in bodies]):
             raise SceneError(f"tanks[{i}].body", f"{body!r} is not a body of the scene")
         if body in [b.name for b in bodies]:
             raise SceneError(f"tanks[{i}].body", f"{body!r}: tanks on [[bodies]] are not available yet; "
@@ -203,7 +207,45 @@ def bodies_scene(bodies, vessel_name, structures, mapping, warnings: list[str]) 
     if any(s.frame == "own" for s in structures):
         raise SceneError("bodies", "[[bodies]] together with [[structures]] in their own frames are not available "
                                    "yet (a model holds one of them)")
+    coupled = coupled_file(vessel, bodies, files.base_dir)
+    if coupled is not None:       # read once here: its names matched, its checks' warnings shown
+        path, inside, key = coupled
+        try:
+            warnings.extend(read_multibody(path, inside, files.rho, files.g).warnings)
+        except DatabaseError as e:
+            raise SceneError(key, " ".join(str(e).split())) from None
     dry = [b.name for b in bodies if b.hydrodynamics is None or b.hydrodynamics.excitation_amplitude is None]
     if "waves" in mapping and dry:
         warnings.append(f"waves: the [[bodies]] {', '.join(repr(n) for n in dry)} have no excitation tables "
                         f"([bodies.hydrodynamics] file or excitation_amplitude): the waves exert no force on them")
+
+
+def resolve(hd, base: str = "") -> str:
+    """The path of a `hydrodynamics` table's `file` (relative to the scene's folder: its base_dir,
+    else `base`)."""
+    return hd.file if os.path.isabs(hd.file) else os.path.join(hd.base_dir or base, hd.file)
+
+
+def coupled_file(vessel, bodies, base: str = "") -> Optional[tuple]:
+    """(path, the bodies' names in the file's order, which key named it) of the scene's multibody
+    file, or None. The vessel's file first, else the first body's that is one."""
+    cands = [("vessel.hydrodynamics.file", vessel.hydrodynamics)] + \
+        [(f"bodies[{i}].hydrodynamics.file", b.hydrodynamics) for i, b in enumerate(bodies)]
+    scene_names = [vessel.name] + [b.name for b in bodies]
+    for key, hd in cands:
+        if hd is None or not hd.file:
+            continue
+        path = resolve(hd, base)
+        have = file_bodies(path)
+        if have is None:
+            continue
+        if isinstance(have, int):              # WAMIT NBODY: the scene's first bodies, in order
+            if have > len(scene_names):
+                raise SceneError(key, f"{path} holds {have} bodies, the scene {len(scene_names)}")
+            return path, tuple(scene_names[:have]), key
+        unknown = [n for n in have if n not in scene_names]
+        if unknown:
+            raise SceneError(key, f"{path} holds the bodies {list(have)}: {unknown} are not bodies of the scene "
+                                  f"({scene_names}); the file's bodies are matched by name")
+        return path, tuple(have), key
+    return None

@@ -124,7 +124,7 @@ def parse_scene(mapping: Mapping[str, Any], text: str = "", path: str = "") -> S
         _place_probe(probe, f"probes[{i}]", tanks, structures)
     bodies = read_bodies(mapping.get("bodies", []), vessel, environment, warnings, files)
     connections = read_connections(mapping.get("connections", []), vessel.name, bodies)
-    bodies_scene(bodies, vessel.name, structures, mapping, warnings)
+    bodies_scene(bodies, vessel, structures, mapping, warnings, files)
     mooring = read_mooring(mapping.get("mooring", []), environment.depth, vessel.name, vessel.cog_height, warnings,
                            tuple(b.name for b in bodies))
     _mass_balance(vessel, tanks, environment, warnings, structures, mooring)

@@ -25,7 +25,7 @@ BOXES = {   # name: (L, B, draft, kg, (x, y) of the COG)
 }
 
 
-def box(name, L, B, T, kg, xy, panel=1.0):
+def box(name, L, B, T, kg, xy, panel=0.6):
     zg = kg - T
     res = tuple(max(2, int(np.ceil(s / panel))) for s in (L, B, 2 * T))
     mesh = cpt.mesh_parallelepiped(size=(L, B, 2 * T), center=(xy[0], xy[1], 0.0), resolution=res, name=name)
