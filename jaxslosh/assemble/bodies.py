@@ -85,6 +85,10 @@ def _about(scene) -> About:
     for b in scene.bodies:
         h = b.hydrostatics
         damp = ", viscous damping" if b.viscous_damping is not None else ""
+        hd = b.hydrodynamics
+        if hd is not None and (hd.file or hd.added_mass is not None or hd.excitation_amplitude is not None):
+            damp += (f"; radiation and wave excitation from {hd.file}" if hd.file else
+                     "; radiation and wave excitation from its tables") + " (at its place in the waves)"
         lines.append(("floating body", f"{b.name!r}: 6 unknowns of its own floating frame at "
                                        f"({b.position[0]:g}, {b.position[1]:g}) m from the vessel, heading "
                                        f"{b.heading:g} rad, mass {b.mass:g} kg; rigid-body inertia and linear "

@@ -19,8 +19,8 @@ from .common import COMMANDS, EXIT_OK, InputError, figure_file, load, setup_jax
 def add_parsers(sub):
     r = sub.add_parser("rao", help=COMMANDS["rao"][1])
     r.add_argument("scene")
-    r.add_argument("--frequencies", help="LOW:HIGH:COUNT rad/s (default: the radiation tables' range, else "
-                                         "0.1:4:200)")
+    r.add_argument("--frequencies", help="LOW:HIGH:COUNT or a list W1,W2,... rad/s (default: the radiation "
+                                         "tables' range, else 0.1:4:200)")
     r.add_argument("--headings", help="comma-separated rad, the direction the waves travel to (default: the "
                                       "scene's wave heading, else the excitation tables', else 0,pi/2,pi)")
     r.add_argument("-o", "--output", help="RAO file (default: the scene's name with _rao.h5)")
@@ -28,9 +28,17 @@ def add_parsers(sub):
 
 
 def parse_frequencies(text):
-    """LOW:HIGH:COUNT -> an array (rad/s), or None."""
+    """LOW:HIGH:COUNT, or a list W1,W2,... -> an array (rad/s), or None."""
     if text is None:
         return None
+    if ":" not in text:
+        try:
+            w = np.array([float(x) for x in text.split(",")])
+        except ValueError:
+            raise InputError(f"--frequencies: expected LOW:HIGH:COUNT or W1,W2,... (rad/s), got {text!r}") from None
+        if not (np.all(np.isfinite(w)) and np.all(w > 0)):
+            raise InputError(f"--frequencies: must be positive finite numbers (rad/s), got {text!r}")
+        return w
     try:
         lo, hi, n = text.split(":")
         lo, hi, n = float(lo), float(hi), int(n)
@@ -74,7 +82,7 @@ def cmd_rao(a):
     t0 = time.perf_counter()
     r = rao(scene, w, heads)
     wall = time.perf_counter() - t0
-    write_rao(out, r.frequency, r.heading, r.vessel, r.probes, scene.text)
+    write_rao(out, r.frequency, r.heading, r.vessel, r.probes, scene.text, r.bodies)
     if replaced:
         print(f"note: replaced {out}", file=sys.stderr)
     for line in across_tank_warnings(scene, r.heading):
@@ -84,6 +92,8 @@ def cmd_rao(a):
         rows = [(d, r.vessel[:, h, j] * (180 / np.pi if j >= 3 else 1.0), "deg/m" if j >= 3 else "m/m")
                 for j, d in enumerate(DOFS)]
         rows += [(f"probe {k} z", v[:, h, 2], "m/m") for k, v in r.probes.items()]
+        rows += [(f"{k} {d}", v[:, h, j] * (180 / np.pi if j >= 3 else 1.0), "deg/m" if j >= 3 else "m/m")
+                 for k, v in (r.bodies or {}).items() for j, d in enumerate(DOFS)]
         for name, x, unit in rows:
             i = int(np.argmax(np.abs(x)))
             print(f"{np.degrees(beta):11.1f} {name:>14} {abs(x[i]):11.4g} {unit:<5} {r.frequency[i]:7.4f}")

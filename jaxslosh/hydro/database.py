@@ -90,13 +90,14 @@ def move_to_cog(tables: Tables, r_point, r_phase, g: float, depth=None) -> Table
 # Capytaine
 
 
-def tables_from_dataset(ds, prefix: str = "") -> Tables:
+def tables_from_dataset(ds, prefix: str = "", dofs=None) -> Tables:
     """Our tables from a Capytaine dataset (complex values merged), about its rotation centre and
     phase origin: finite positive frequencies ascending, A_inf from an omega = inf row. `prefix`:
-    one body's block of a multibody dataset (dofs "<body>__Surge", ...; hydro/multibody.py)."""
+    one body's block of a multibody dataset (dofs "<body>__Surge", ...); `dofs`: these dofs in this
+    order (several bodies' coupled tables, hydro/multibody.py)."""
     names = [str(x) for x in ds["influenced_dof"].values]
-    order = [prefix + d for d in DOF_NAMES]
-    if not set(order) <= set(names) or (not prefix and len(names) != 6):
+    order = list(dofs) if dofs is not None else [prefix + d for d in DOF_NAMES]
+    if not set(order) <= set(names) or (not prefix and dofs is None and len(names) != 6):
         raise DatabaseError(f"the dataset's dofs {names} are not the six rigid-body dofs {order}")
     if "omega" not in ds.coords:
         raise DatabaseError("the dataset has no omega coordinate")
@@ -308,11 +309,14 @@ def _show_entry(e):
     return "(" + ", ".join(f"{x:g}" for x in e) + ")"
 
 
-def read_wamit(path: str, rho: float, g: float, length: float = 1.0, cog=(0.0, 0.0, 0.0), depth=None) -> Database:
+def read_wamit(path: str, rho: float, g: float, length: float = 1.0, cog=(0.0, 0.0, 0.0), depth=None,
+               dofs: int = 6) -> Database:
     """WAMIT's `.1` at `path` with the `.3` and `.hst` of the same stem where they exist, made
     dimensional with `rho`, `g` and the length ULEN, moved from WAMIT's origin to the COG at `cog`
     (its position in WAMIT's coordinates). A file cut in the middle of a block, a block missing
-    (I, J) pairs the others have, or periods out of order is refused (DatabaseError, with the line)."""
+    (I, J) pairs the others have, or periods out of order is refused (DatabaseError, with the line).
+    `dofs`: 6 (the first body's), or 6 N for the N bodies of an NBODY run (each about its own
+    origin, not moved: hydro/multibody.py)."""
     stem = os.path.splitext(path)[0]
     rows = _rows(path, (4, 5), ".1 (PER I J A B)")
     if not rows:
@@ -329,15 +333,15 @@ def read_wamit(path: str, rho: float, g: float, length: float = 1.0, cog=(0.0, 0
         raise DatabaseError(f"{path}: no finite period (lines PER I J A B with PER > 0)")
     w = np.sort(2 * np.pi / periods)
     n = w.size
-    A, B = np.zeros((n, 6, 6)), np.zeros((n, 6, 6))
+    A, B = np.zeros((n, dofs, dofs)), np.zeros((n, dofs, dofs))
     Ainf = None
     for _, r in rows:
         p, i, j = r[0], int(r[1]) - 1, int(r[2]) - 1
-        if not (0 <= i < 6 and 0 <= j < 6):
-            continue                                   # generalized modes: not ours
-        k = _k_exponent(i, j)
+        if not (0 <= i < dofs and 0 <= j < dofs):
+            continue                                   # generalized modes (or other bodies): not ours
+        k = _k_exponent(i % 6, j % 6)
         if p == 0:                                     # zero period: infinite frequency
-            Ainf = np.zeros((6, 6)) if Ainf is None else Ainf
+            Ainf = np.zeros((dofs, dofs)) if Ainf is None else Ainf
             Ainf[i, j] = r[3] * rho * length ** k
         elif p > 0:
             m = int(np.argmin(np.abs(w - 2 * np.pi / p)))
@@ -352,13 +356,13 @@ def read_wamit(path: str, rho: float, g: float, length: float = 1.0, cog=(0.0, 0
         p3 = np.unique([r[0] for _, r in r3])
         if p3.size != periods.size or not np.allclose(np.sort(p3), periods, rtol=1e-6):
             raise DatabaseError(f"{stem}.3: its periods ({p3.size}) are not those of {path} ({periods.size})")
-        X = np.zeros((n, heads.size, 6), dtype=complex)
+        X = np.zeros((n, heads.size, dofs), dtype=complex)
         for _, r in r3:
             m = int(np.argmin(np.abs(w - 2 * np.pi / r[0])))
             h = int(np.argmin(np.abs(heads_deg - r[1])))
             i = int(r[2]) - 1
-            if 0 <= i < 6:
-                X[m, h, i] = complex(r[5], r[6]) * rho * g * length ** (2 if i < 3 else 3)
+            if 0 <= i < dofs:
+                X[m, h, i] = complex(r[5], r[6]) * rho * g * length ** (2 if i % 6 < 3 else 3)
     C = None
     if os.path.exists(stem + ".hst"):
         C = np.zeros((6, 6))
@@ -368,7 +372,9 @@ def read_wamit(path: str, rho: float, g: float, length: float = 1.0, cog=(0.0, 0
                 k = 2 if (i, j) == (2, 2) else (3 if 2 in (i, j) else 4)
                 C[i, j] = r[2] * rho * g * length ** k
     cog = np.asarray(cog, dtype=float)
-    t = move_to_cog(Tables(w, A, B, Ainf, heads, X), -cog, -cog, g, depth)
+    t = Tables(w, A, B, Ainf, heads, X)
+    if dofs == 6:
+        t = move_to_cog(t, -cog, -cog, g, depth)
     return Database(t, C, None, None, bool(np.allclose(cog, 0.0)))
 
 

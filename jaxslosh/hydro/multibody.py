@@ -25,7 +25,7 @@ from typing import NamedTuple, Optional
 
 import numpy as np
 
-from .database import DOF_NAMES, DatabaseError, _k_exponent, _merge_complex, _open_netcdf, _rows
+from .database import DOF_NAMES, DatabaseError, _merge_complex, _open_netcdf, _rows, read_wamit, tables_from_dataset
 from .tables import Tables
 
 #: relative to the diagonal's size (symmetry) or the largest eigenvalue (semi-definiteness): the
@@ -60,22 +60,7 @@ def read_multibody_netcdf(path: str, names) -> Multibody:
     have = netcdf_bodies(path) or ()
     if sorted(have) != sorted(names):
         raise DatabaseError(f"{path}: the dataset's bodies {list(have)} are not the scene's {list(names)}")
-    order = [f"{b}{SEP}{d}" for b in names for d in DOF_NAMES]
-    w_all = np.atleast_1d(np.asarray(ds["omega"].values, dtype=float))
-    sel = dict(influenced_dof=order, radiating_dof=order)
-    A_all = ds["added_mass"].sel(**sel).transpose("omega", "influenced_dof", "radiating_dof").values
-    B_all = ds["radiation_damping"].sel(**sel).transpose("omega", "influenced_dof", "radiating_dof").values
-    fin = np.isfinite(w_all) & (w_all > 0)
-    idx = np.flatnonzero(fin)[np.argsort(w_all[fin])]
-    Ainf = A_all[np.flatnonzero(np.isinf(w_all))[0]] if np.isinf(w_all).any() else None
-    X = heads = None
-    if "excitation_force" in ds and "wave_direction" in ds["excitation_force"].dims:
-        F = ds["excitation_force"].sel(influenced_dof=order).transpose("omega", "wave_direction",
-                                                                        "influenced_dof").values[idx]
-        heads = np.asarray(ds["wave_direction"].values, dtype=float)
-        hs = np.argsort(heads)
-        X, heads = np.conj(F[:, hs]), heads[hs]        # Capytaine's e^{-i w t} -> ours
-    t = Tables(w_all[idx], A_all[idx], B_all[idx], Ainf, heads, X)
+    t = tables_from_dataset(ds, dofs=[f"{b}{SEP}{d}" for b in names for d in DOF_NAMES])
     return Multibody(tuple(names), t, tuple(check_coupled(t, names, path)))
 
 
@@ -88,40 +73,9 @@ def wamit_bodies(path: str) -> int:
 
 def read_multibody_wamit(path: str, names, rho: float, g: float, length: float = 1.0) -> Multibody:
     """WAMIT's NBODY `.1` (with its `.3`) of 6 N dofs, body k the k-th of `names`."""
-    n = 6 * len(names)
     if wamit_bodies(path) != len(names):
         raise DatabaseError(f"{path}: holds {wamit_bodies(path)} bodies (6 dofs each), the scene {len(names)}")
-    rows = _rows(path, (4, 5), ".1 (PER I J A B)")
-    per = np.array([r[0] for _, r in rows])
-    periods = np.unique(per[per > 0])
-    w = np.sort(2 * np.pi / periods)
-    A, B = np.zeros((w.size, n, n)), np.zeros((w.size, n, n))
-    Ainf = None
-    for _, r in rows:
-        p, i, j = r[0], int(r[1]) - 1, int(r[2]) - 1
-        if not (0 <= i < n and 0 <= j < n):
-            continue
-        norm = rho * length ** _k_exponent(i % 6, j % 6)
-        if p == 0:
-            Ainf = np.zeros((n, n)) if Ainf is None else Ainf
-            Ainf[i, j] = r[3] * norm
-        elif p > 0:
-            m = int(np.argmin(np.abs(w - 2 * np.pi / p)))
-            A[m, i, j], B[m, i, j] = r[3] * norm, r[4] * norm * w[m]
-    X = heads = None
-    stem = os.path.splitext(path)[0]
-    if os.path.exists(stem + ".3"):
-        r3 = [r for _, r in _rows(stem + ".3", 7, ".3 (PER BETA I |X| phase Re Im)") if r[0] > 0]
-        heads_deg = np.unique(np.round([r[1] for r in r3], 9))
-        heads = np.radians(heads_deg)
-        X = np.zeros((w.size, heads.size, n), dtype=complex)
-        for r in r3:
-            m = int(np.argmin(np.abs(w - 2 * np.pi / r[0])))
-            h = int(np.argmin(np.abs(heads_deg - r[1])))
-            i = int(r[2]) - 1
-            if 0 <= i < n:
-                X[m, h, i] = complex(r[5], r[6]) * rho * g * length ** (2 if i % 6 < 3 else 3)
-    t = Tables(w, A, B, Ainf, heads, X)
+    t = read_wamit(path, rho, g, length, dofs=6 * len(names)).tables
     return Multibody(tuple(names), t, tuple(check_coupled(t, names, path)))
 
 

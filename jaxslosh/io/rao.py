@@ -5,6 +5,9 @@ heading, written by `jaxslosh rao`.
     /frequency (f,) rad/s; /heading (h,) rad
     /rao/vessel        (f, h, 6) complex: surge, sway, heave (m/m), roll, pitch, yaw (rad/m)
     /rao/probes/<name> (f, h, 3) complex (m/m)
+    /rao/bodies/<name> (f, h, 6) complex: each of the [[bodies]], as /rao/vessel (its translations
+                       along the inertial axes, its phase for a wave eta = cos(w t) at the vessel's
+                       COG at rest)
 
 Complex values are HDF5 compound (r, i) pairs, which h5py reads back as numpy complex128. The phase
 is that of x = Re(X e^{i w t}) for a wave eta = cos(w t) at the COG's rest position.
@@ -29,9 +32,10 @@ class RaoData(NamedTuple):
     vessel: np.ndarray
     probes: dict
     scene_text: str = ""
+    bodies: dict = {}
 
 
-def write_rao(path: str, frequency, heading, vessel, probes: dict, scene_text: str = "") -> None:
+def write_rao(path: str, frequency, heading, vessel, probes: dict, scene_text: str = "", bodies=None) -> None:
     lock = OutputLock(path)
     try:
         with h5py.File(path, "w") as f:
@@ -49,6 +53,9 @@ def write_rao(path: str, frequency, heading, vessel, probes: dict, scene_text: s
             g = f.create_group("rao/probes")
             for name, v in probes.items():
                 g.create_dataset(name, data=np.asarray(v, dtype=complex)).attrs["units"] = "m/m"
+            for name, v in (bodies or {}).items():
+                b = f.create_dataset(f"rao/bodies/{name}", data=np.asarray(v, dtype=complex))
+                b.attrs["units"], b.attrs["description"] = ds.attrs["units"], ds.attrs["description"]
     finally:
         lock.release()
 
@@ -63,5 +70,6 @@ def load_rao(path: str) -> RaoData:
             if k not in f:
                 raise ResultFileError(f"{path}: the dataset /{k} is missing")
         probes = {k: f["rao/probes"][k][()] for k in f["rao/probes"]} if "rao/probes" in f else {}
+        bodies = {k: f["rao/bodies"][k][()] for k in f["rao/bodies"]} if "rao/bodies" in f else {}
         return RaoData(f["frequency"][()], f["heading"][()], f["rao/vessel"][()], probes,
-                       attr_str(f.attrs.get("scene", "")))
+                       attr_str(f.attrs.get("scene", "")), bodies)

@@ -40,7 +40,9 @@ TABLES = (
     ("bodies", "Zero or more `[[bodies]]`: rigid floating bodies beside the vessel, each in its own frame "
                "(guide: Bodies and connections)."),
     ("bodies.hydrostatics", "The body's linear restoring about its rest pose, as `[vessel.hydrostatics]`."),
-    ("bodies.hydrodynamics", "The body's linear viscous damping (no tables or files yet)."),
+    ("bodies.hydrodynamics", "The body's hydrodynamics, with `[vessel.hydrodynamics]`'s keys (tables, a file, "
+                             "viscous damping; not `capytaine`: a body has no hull): about its COG, in its axes; "
+                             "a multibody file couples the bodies it names."),
     ("bodies.initial", "The body's initial state, as `[vessel.initial]`; every key optional, zero by default."),
     ("connections", "Zero or more `[[connections]]`: hawsers, fenders and springs between two bodies, or a "
                     "body and a fixed point (guide: Bodies and connections)."),
@@ -293,8 +295,6 @@ KEYS = (
     ("bodies.hydrostatics.moment", '"conservative"', "", 'As `vessel.hydrostatics.moment`.'),
     ("bodies.hydrostatics.model", '"linear"', "", '"linear" only (the nonlinear hydrostatics of a hull are not '
                                                   "available yet for bodies)."),
-    ("bodies.hydrodynamics.viscous_damping", "none", "N s/m, N m s", "Linear damping (6 or 6 x 6) about its COG, "
-                                                                     "its axes."),
     ("bodies.initial.position", "[0, 0, 0]", "m", "Inertial offset of its COG from its rest position."),
     ("bodies.initial.velocity", "[0, 0, 0]", "m/s", "Inertial velocity of its COG."),
     ("bodies.initial.angular_velocity", "[0, 0, 0]", "rad/s", "Its body frame."),
@@ -322,3 +322,8 @@ KEYS = (
                                                          '"probe.<name>" (m), "mooring.<line>" (N, the fairlead '
                                                          'tension about its mean; quoted or as a dotted key).'),
 )
+# a body's hydrodynamics: the vessel's keys, read by the vessel's reader (scene/bodies.py)
+KEYS = KEYS + tuple(
+    (k.replace("vessel.", "bodies.", 1), d, u, f"As `{k}`" + (" (a multibody file: this body's block, about its "
+                                                              "COG)." if k.endswith(".file") else "."))
+    for k, d, u, _ in KEYS if k.startswith("vessel.hydrodynamics."))

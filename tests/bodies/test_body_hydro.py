@@ -123,3 +123,48 @@ def test_a_file_whose_bodies_are_not_the_scenes_names_its_key(tmp_path):
     with pytest.raises(SceneError) as e:
         js.load_scene(text)
     assert e.value.key == "vessel.hydrodynamics.file" and "'tender'" in str(e.value), str(e.value)
+
+
+def test_the_rao_command_writes_each_bodys_rao_at_a_list_of_frequencies(tmp_path, capsys):
+    from jaxslosh.cli import main
+    from jaxslosh.io.rao import load_rao
+    p = tmp_path / "two.toml"
+    p.write_text(two_boxes())
+    out = str(tmp_path / "two_rao.h5")
+    assert main(["rao", str(p), "--frequencies", "0.6091,1.0727", "--headings", "1.5707963267948966", "-o", out]) == 0
+    data = load_rao(out)
+    ref = reference()
+    np.testing.assert_allclose(data.frequency, [0.6091, 1.0727])
+    assert sorted(data.bodies) == ["tender"] and data.bodies["tender"].shape == (2, 1, 6)
+    want = ref["rao"][[2, 5], 1][:, 6:]                  # tabulated 0.60909 and 1.07273 rad/s
+    assert np.abs(data.bodies["tender"][:, 0, 2] - want[:, 2]).max() < 0.01 * np.abs(want[:, 2]).max()
+    assert "tender heave" in capsys.readouterr().out
+
+
+def test_wamit_nbody_files_read_as_the_same_coupled_tables(tmp_path):
+    """The two boxes' coupled tables written as WAMIT's NBODY .1 and .3 (12 dofs, ULEN 1) read back
+    as the NetCDF's."""
+    rho = 1025.0
+    t = read_multibody(os.path.join(DATA, "two_boxes.nc"), ("barge", "tender"), rho, G).tables
+    with open(tmp_path / "two.1", "w") as f:
+        for i in range(12):
+            for j in range(12):
+                f.write(f"0.0 {i + 1} {j + 1} {t.added_mass_infinite[i, j] / rho:.15e}\n")
+        for m in np.argsort(-t.omega):
+            for i in range(12):
+                for j in range(12):
+                    f.write(f"{2 * np.pi / t.omega[m]:.15e} {i + 1} {j + 1} {t.added_mass[m, i, j] / rho:.15e} "
+                            f"{t.damping[m, i, j] / (rho * t.omega[m]):.15e}\n")
+    with open(tmp_path / "two.3", "w") as f:
+        for m in np.argsort(-t.omega):
+            for h, beta in enumerate(t.headings):
+                for i in range(12):
+                    x = t.excitation[m, h, i] / (rho * G)
+                    f.write(f"{2 * np.pi / t.omega[m]:.15e} {np.degrees(beta):.15e} {i + 1} {abs(x):.15e} "
+                            f"{np.degrees(np.angle(x)):.15e} {x.real:.15e} {x.imag:.15e}\n")
+    w = read_multibody(str(tmp_path / "two.1"), ("barge", "tender"), rho, G)
+    np.testing.assert_allclose(w.tables.omega, t.omega, rtol=1e-12)
+    for a, b in ((w.tables.added_mass, t.added_mass), (w.tables.damping, t.damping),
+                 (w.tables.added_mass_infinite, t.added_mass_infinite), (w.tables.excitation, t.excitation)):
+        np.testing.assert_allclose(a, b, rtol=1e-9, atol=1e-9 * np.abs(b).max())
+    assert w.warnings == ()
