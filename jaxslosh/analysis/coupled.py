@@ -5,7 +5,8 @@ rest (linear.py): the quadratic eigenproblem
 
 solved as the generalized eigenproblem of its companion pencil (which takes the algebraic
 unknowns of structures' interfaces: their infinite eigenvalues are dropped). The hull's radiation
-depends on frequency, so each mode is found by iteration: the tables' A(w), B(w) at the mode's own
+depends on frequency, so each mode is found by iteration: the tables' A(w), B(w) (the vessel's and
+those of `[[bodies]]` and their coupling, assemble/bodyhydro.py) at the mode's own
 damped frequency w = Im(lambda), until it stops moving (a fixed point, within 1e-10); modes above
 the tables' frequencies keep the residual's own A_inf and no radiation damping (infinite frequency),
 modes below the lowest tabulated frequency take the lowest's. Without radiation tables the matrices
@@ -39,6 +40,7 @@ import scipy.sparse.linalg as spla
 from ..physics.liquid import RotationPenalty
 from ..scene.types import Scene
 from .linear import Linearisation, linearise
+from ..assemble.bodyhydro import frequency_terms, radiating_bodies
 from .rao import frequency_matrices, hull_tables, solve_equilibrated
 
 #: |lambda| below this (rad/s) is a rigid-body mode without restoring
@@ -117,7 +119,18 @@ def coupled_modes(scene: Scene, n: int = 10, *, params=None, linearisation=None,
     tables = hull_tables(scene, ())
     radiation = bool(scene.effects.radiation and tables is not None and tables.added_mass is not None)
 
+    bodies = radiating_bodies(scene)        # [[bodies]] with radiation tables (assemble/bodyhydro.py)
+
     def matrices(w):
+        if bodies:                          # theirs at the mode's frequency, within their tables' range
+            M, C = frequency_matrices(lin, tables, True, min(max(w, tables.omega[0]), tables.omega[-1])) \
+                if radiation and w <= tables.omega[-1] else (lin.M.copy(), lin.C.copy())
+            dA, dB, _ = frequency_terms(scene, [min(max(w, bodies[0]), bodies[1])], ())
+            if w <= bodies[1]:
+                N = dA.shape[1]
+                M[:N, :N] += dA[0]
+                C[:N, :N] += dB[0]
+            return M, C, "table"
         if not radiation:
             return lin.M, lin.C, "none"
         if w > tables.omega[-1]:
@@ -136,7 +149,7 @@ def coupled_modes(scene: Scene, n: int = 10, *, params=None, linearisation=None,
     order = np.argsort(np.abs(lam))
     out = []
     for k in order[:n + 4]:
-        lk, xk, how = _refine(lin, matrices, lam[k], V[:, k], tol, max_iterations) if radiation else \
+        lk, xk, how = _refine(lin, matrices, lam[k], V[:, k], tol, max_iterations) if radiation or bodies else \
             (lam[k], V[:, k], "none")
         M, _, how = matrices(lk.imag)
         out.append((lk, xk, how, _shares(lin, M, xk)))

@@ -153,6 +153,14 @@ def radiation(src: Source, omega):
     return A, B
 
 
+def radiating_bodies(scene) -> Optional[tuple]:
+    """(lowest, highest) frequency of the bodies' radiation tables, or None without any."""
+    if not scene.effects.radiation or not scene.bodies:
+        return None
+    w = [src.tables.omega for src in sources(scene) if src.tables.added_mass is not None]
+    return (max(x[0] for x in w), min(x[-1] for x in w)) if w else None
+
+
 def rigid_size(scene) -> int:
     return 6 + 6 * len(scene.bodies)
 

@@ -20,6 +20,7 @@ one warning names the worst entries (the file is used as it is).
 """
 from __future__ import annotations
 
+import functools
 import os
 from typing import NamedTuple, Optional
 
@@ -111,8 +112,14 @@ def check_coupled(t: Tables, names, path: str) -> list:
 
 
 def read_multibody(path: str, names, rho: float, g: float, length: float = 1.0) -> Multibody:
-    ext = os.path.splitext(path)[1].lower()
-    if ext == ".1":
+    """A multibody file's coupled tables (cached per file and its modification time: the loader,
+    each build, RAO and mode iteration ask for them)."""
+    return _read_cached(path, os.path.getmtime(path), tuple(names), rho, g, length)
+
+
+@functools.lru_cache(maxsize=8)
+def _read_cached(path, mtime, names, rho, g, length) -> Multibody:
+    if os.path.splitext(path)[1].lower() == ".1":
         return read_multibody_wamit(path, names, rho, g, length)
     return read_multibody_netcdf(path, names)
 

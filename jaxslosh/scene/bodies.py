@@ -247,5 +247,11 @@ def coupled_file(vessel, bodies, base: str = "") -> Optional[tuple]:
         if unknown:
             raise SceneError(key, f"{path} holds the bodies {list(have)}: {unknown} are not bodies of the scene "
                                   f"({scene_names}); the file's bodies are matched by name")
+        vh = vessel.hydrodynamics
+        if vessel.name in have and (vh is None or not vh.file or
+                                    os.path.abspath(resolve(vh, base)) != os.path.abspath(path)):
+            raise SceneError("vessel.hydrodynamics.file", f"the vessel {vessel.name!r} is in {path} ({key}): name "
+                                                          "that file in [vessel.hydrodynamics] too (its own block "
+                                                          "and excitation are read from it)")
         return path, tuple(have), key
     return None

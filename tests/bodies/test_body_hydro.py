@@ -168,3 +168,16 @@ def test_wamit_nbody_files_read_as_the_same_coupled_tables(tmp_path):
                  (w.tables.added_mass_infinite, t.added_mass_infinite), (w.tables.excitation, t.excitation)):
         np.testing.assert_allclose(a, b, rtol=1e-9, atol=1e-9 * np.abs(b).max())
     assert w.warnings == ()
+
+
+def test_coupled_modes_of_bodies_far_apart_are_each_bodys_own():
+    """`modes --coupled` takes each body's radiation at the mode's frequency: 1,000 m apart the
+    tender's roll, heave and pitch are those of the tender alone (the same fixed point)."""
+    from jaxslosh.analysis.coupled import coupled_modes
+    pair = coupled_modes(js.load_scene(two_boxes(1000.0, ("barge.nc", "tender.nc"))), n=6)
+    alone = coupled_modes(js.load_scene("[simulation]\nduration = 1.0\ndt = 0.1\n"
+                                        + box("vessel", "tender", 1, "tender.nc")), n=3)
+    got = {d: w for d, w in zip(pair.dominant, pair.omega) if d.startswith("tender ")}
+    assert len(got) == 3
+    for d, w in zip(alone.dominant, alone.omega):
+        assert got[f"tender {d}"] == pytest.approx(w, rel=1e-6)
