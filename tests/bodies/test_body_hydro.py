@@ -170,6 +170,7 @@ def test_wamit_nbody_files_read_as_the_same_coupled_tables(tmp_path):
     assert w.warnings == ()
 
 
+@pytest.mark.slow       # 40 s on a loaded machine; its fast twin: the far-apart RAOs (the same matrices)
 def test_coupled_modes_of_bodies_far_apart_are_each_bodys_own():
     """`modes --coupled` takes each body's radiation at the mode's frequency: 1,000 m apart the
     tender's roll, heave and pitch are those of the tender alone (the same fixed point)."""
