@@ -134,10 +134,13 @@ def excitation(src: Source, omega, beta, g, depth=None) -> np.ndarray:
     if t.excitation is None:
         return np.zeros((np.size(omega), d), dtype=complex)
     w = np.atleast_1d(np.asarray(omega, dtype=float))
-    if src.axes == "body":
-        X = interpolate_excitation(t, w, beta - src.headings[0])
-    else:
-        X = interpolate_excitation(t, w, beta)
+    rel = beta - src.headings[0] if src.axes == "body" else beta
+    heads = np.asarray(t.headings, dtype=float)
+    near = [r for r in (rel - 2 * np.pi, rel, rel + 2 * np.pi) if heads[0] - 1e-6 <= r <= heads[-1] + 1e-6]
+    if not near:
+        raise SceneError("headings", f"{beta:.6g} rad is {rel:.6g} rad in the axes of a body's excitation tables, "
+                                     f"outside their headings {np.round(heads, 6).tolist()} rad")
+    X = interpolate_excitation(t, w, near[0])
     k = wavenumber(w, g, depth)
     shift = np.exp(-1j * k * (src.origin[0] * np.cos(beta) + src.origin[1] * np.sin(beta)))
     return (X @ src.T) * shift[:, None]

@@ -109,6 +109,25 @@ def _matrix6(x, where: str):
     return tuple(tuple(float(c) for c in row) for row in a)
 
 
+def _wave_headings(bodies, waves, coupled) -> None:
+    """A body's own excitation tables must hold the wave heading relative to its x axis (the vessel's
+    are checked with the waves; a coupled file's with the vessel's)."""
+    if not isinstance(waves, dict) or waves.get("spreading", 0.0) or not isinstance(waves.get("heading", 0.0), (int, float)):
+        return
+    beta = float(waves.get("heading", 0.0))
+    for i, b in enumerate(bodies):
+        hd = b.hydrodynamics
+        if b.name in coupled or hd is None or hd.headings is None:
+            continue
+        heads = np.asarray(hd.headings, dtype=float)
+        rel = [beta - b.heading + k * 2 * math.pi for k in (-1, 0, 1)]
+        inside = [r for r in rel if heads[0] - 1e-6 <= r <= heads[-1] + 1e-6]
+        if not inside:
+            raise SceneError(f"bodies[{i}].heading", f"the waves' heading {beta:.6g} rad is {rel[1]:.6g} rad from "
+                                                     f"{b.name!r}'s x axis, outside its excitation tables' headings "
+                                                     f"{np.round(heads, 6).tolist()} rad")
+
+
 def footprint_radius(area: float) -> float:
     """The radius of the circle of a waterplane's area: the footprint the overlap check compares."""
     return math.sqrt(area / math.pi)
@@ -214,6 +233,7 @@ def bodies_scene(bodies, vessel, structures, mapping, warnings: list[str], files
             warnings.extend(read_multibody(path, inside, files.rho, files.g).warnings)
         except DatabaseError as e:
             raise SceneError(key, " ".join(str(e).split())) from None
+    _wave_headings(bodies, mapping.get("waves"), () if coupled is None else coupled[1])
     dry = [b.name for b in bodies if b.hydrodynamics is None or b.hydrodynamics.excitation_amplitude is None]
     if "waves" in mapping and dry:
         warnings.append(f"waves: the [[bodies]] {', '.join(repr(n) for n in dry)} have no excitation tables "

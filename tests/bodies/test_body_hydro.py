@@ -182,3 +182,14 @@ def test_coupled_modes_of_bodies_far_apart_are_each_bodys_own():
     assert len(got) == 3
     for d, w in zip(alone.dominant, alone.omega):
         assert got[f"tender {d}"] == pytest.approx(w, rel=1e-6)
+
+
+def test_a_wave_heading_outside_a_bodys_tables_names_its_heading():
+    """The tender's file holds headings 0 and pi/2 (relative to its x axis): turned by -90 deg in beam
+    seas it would need pi, which it has not."""
+    waves = '[waves]\ntype = "regular"\namplitude = 0.1\nfrequency = 0.9\nheading = 1.5707963267948966\n'
+    text = two_boxes(1000.0, ("barge.nc", "tender.nc"), waves=waves)
+    js.load_scene(text)
+    with pytest.raises(SceneError) as e:
+        js.load_scene(text.replace("position = [0.0, 1000.0]", "position = [0.0, 1000.0]\nheading = -1.5707963267948966"))
+    assert e.value.key == "bodies[0].heading", str(e.value)
