@@ -12,7 +12,7 @@ from ..liquid.block import LiquidBlock, TankBlock, VesselFrameStructure, rigid_p
 from ..liquid.face.stack import wall_node_count  # noqa: F401
 from ..liquid.forms import block_form, tank_models
 from ..liquid.nodal.sparse import SPARSE_AUTO
-from ..liquid.nodal.term import Liquid
+from ..liquid.nodal.term import NodalLiquid
 from ..scene.types import Scene
 from .effects import liquid_unknowns
 from .structures import held_spin_stiffness, held_structure
@@ -57,5 +57,5 @@ def outline_liquid_block(scene: Scene, include_liquid: bool = True) -> LiquidBlo
     if not tanks and not in_vessel_frame:
         return LiquidBlock(NoLiquid())
     stiffened = any(s.stiffening == "centrifugal" for s in in_vessel_frame)
-    return LiquidBlock(Liquid(r=None, Ms=None, K=None, free=None, n_nodes=0), penalty=(None, None) if tanks else None,
+    return LiquidBlock(NodalLiquid(r=None, Ms=None, K=None, free=None, n_nodes=0), penalty=(None, None) if tanks else None,
                        Kg=np.zeros((6, 0, 0)) if stiffened else None)

@@ -30,7 +30,7 @@ class TankBlock(NamedTuple):
     node_offset: int
     nodes: np.ndarray      # (N_t, 3) tank-local
     elements: np.ndarray   # (E_t, 8) tank-local node indices
-    model: object          # the tank's element model (nodal/model.LiquidModel, face/element.FaceLiquid)
+    model: object          # the tank's element model (nodal/model.NodalModel, face/element.FaceModel)
 
 
 class VesselFrameStructure(NamedTuple):
@@ -63,7 +63,7 @@ def host_block(t, m, offset) -> TankBlock:
 
 
 def slots(free, n_nodes):
-    """nodal/term.Liquid.slot: the position of each of the 3 n_nodes nodal dofs among the free ones,
+    """nodal/term.NodalLiquid.slot: the position of each of the 3 n_nodes nodal dofs among the free ones,
     len(free) where held."""
     slot = np.full(3 * n_nodes, len(free), dtype=np.int32)
     slot[np.asarray(free)] = np.arange(len(free), dtype=np.int32)

@@ -6,7 +6,7 @@ Each form's builder lives in its model's sub-package."""
 from __future__ import annotations
 
 from ..scene.types import FACE_FORMS, SceneError
-from .face.element import FaceLiquid
+from .face.element import FaceModel
 from .face.stack import face_block, face_model
 from .modal.build import reduced_block
 from .nodal.build import nodal_block, nodal_model, walls_block
@@ -23,7 +23,7 @@ def block_form(tanks, models, in_vessel_frame: bool, sparse: bool):
     """The builder of the stacked block, (scene, tanks, models, params, g, sparse, held, Kg) ->
     LiquidBlock, with `held` the structures in the vessel's frame and `Kg` their spin stiffness;
     SceneError, naming the key, where the tanks' forms do not go together."""
-    faces = bool(models) and all(isinstance(m, FaceLiquid) for m in models)
+    faces = bool(models) and all(isinstance(m, FaceModel) for m in models)
     reduced = [t.reduction is not None for t in tanks]
     elastic = [t.wall_spec is not None for t in tanks]
     if (any(elastic) or in_vessel_frame) and faces:     # "rt": face/walls.py, face/build.py, full order
@@ -38,7 +38,7 @@ def block_form(tanks, models, in_vessel_frame: bool, sparse: bool):
         return _walls
     if any(reduced):
         return _reduced
-    if any(isinstance(m, FaceLiquid) for m in models):
+    if any(isinstance(m, FaceModel) for m in models):
         return _face
     return _nodal
 
@@ -47,8 +47,8 @@ def _check_walls(tanks, models, reduced, elastic, sparse):
     """Elastic walls and vessel-frame structures with nodal tanks: every tank's liquid nodal, on a box
     grid, full order, dense and at the scene's own values."""
     for i, t in enumerate(tanks):
-        if isinstance(models[i], FaceLiquid):
-            other = next(m.element for m in models if not isinstance(m, FaceLiquid))
+        if isinstance(models[i], FaceModel):
+            other = next(m.element for m in models if not isinstance(m, FaceModel))
             raise SceneError(f"tanks[{i}].fluid.element",
                              f"{t.fluid.element!r} takes elastic walls and structures in the vessel's frame only "
                              f"when every tank is \"rt\" (another tank's is {other!r}): give every tank the "

@@ -1,6 +1,6 @@
 """Natural modes of the liquid in a rigid tank, their classification, and the closed-form reference.
 
-The modes solve ``K_ff x = omega^2 M_ff x`` on the free dofs of a ``LiquidModel`` (dense
+The modes solve ``K_ff x = omega^2 M_ff x`` on the free dofs of a ``NodalModel`` (dense
 ``scipy.linalg.eigh``). Each mode is classified by where its potential energy ``1/2 x^T K x`` sits:
 
 * ``free_surface_share`` -- the gravity energy of the free surface over the total: for the
@@ -24,7 +24,7 @@ import scipy.linalg as sl
 import scipy.sparse as sp
 from scipy.sparse.linalg import eigsh
 
-from .nodal.model import LiquidModel, build_liquid
+from .nodal.model import NodalModel, build_liquid
 from ..fem.slip import rotate_matrix
 
 
@@ -40,7 +40,7 @@ class Modes:
     circulation: int = 0              # zero-frequency circulation modes left out ("rt": dim ker K)
 
 
-def free_mass(model: LiquidModel) -> np.ndarray:
+def free_mass(model: NodalModel) -> np.ndarray:
     """kron(mass, I3) restricted to the free dofs, without forming the full 3N matrix."""
     f = np.flatnonzero(model.free)
     if model.frames is not None:                       # a shaped tank: on the nodes' frames
@@ -73,7 +73,7 @@ def natural_modes(K, M, n):
     return lam, X
 
 
-def liquid_modes(model: LiquidModel, n: int = 10) -> Modes:
+def liquid_modes(model: NodalModel, n: int = 10) -> Modes:
     """The n lowest modes of the liquid with the tank held fixed (a model built with sparse=True:
     shift-invert Lanczos on its sparse matrices, for meshes whose dense matrices would not fit)."""
     f = model.free
@@ -89,7 +89,7 @@ def liquid_modes(model: LiquidModel, n: int = 10) -> Modes:
     return Modes(omega=omega, kind=kind, free_surface_share=share, shapes=shapes)
 
 
-def energy_shares(model: LiquidModel, shapes: np.ndarray) -> dict:
+def energy_shares(model: NodalModel, shapes: np.ndarray) -> dict:
     """Fractions of each mode's potential energy held by the measures in ``model.parts``."""
     shapes = np.atleast_2d(shapes)
     total = np.einsum("ij,ij->i", shapes, (model.stiffness @ shapes.T).T)
@@ -101,7 +101,7 @@ def energy_shares(model: LiquidModel, shapes: np.ndarray) -> dict:
     return out
 
 
-def classify(model: LiquidModel, shapes: np.ndarray):
+def classify(model: NodalModel, shapes: np.ndarray):
     """(free_surface_share, kinds) of the given mode shapes (rows)."""
     s = energy_shares(model, shapes)
     kinds = []

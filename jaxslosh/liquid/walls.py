@@ -103,7 +103,7 @@ def build_walls(size, fill_depth, liquid_mesh, thickness, young, poisson, densit
 @dataclass(frozen=True, eq=False)
 class TankWithWalls:
     """Host-side coupled model of one elastic tank (tank-local coordinates)."""
-    liquid: object             # liquid.LiquidModel
+    liquid: object             # liquid.NodalModel
     walls: object              # structure.WallModel
     nodes: np.ndarray          # (N_l + N_w, 3): liquid nodes, then wall nodes
     mass: np.ndarray           # (N, N) scalar: block diagonal

@@ -84,9 +84,9 @@ def choice_checks(source: str) -> list:
 
 
 def test_the_finders_see_the_forms():
-    classes = {"FaceLiquid", "NoLiquid"}
-    src = ("a = isinstance(m, FaceLiquid)\nb = isinstance(x, (int, liq.NoLiquid))\nc = type(x) is NoLiquid\n"
-           "d = isinstance(x, int)\ne = issubclass(C, FaceLiquid)\n")
+    classes = {"FaceModel", "NoLiquid"}
+    src = ("a = isinstance(m, FaceModel)\nb = isinstance(x, (int, liq.NoLiquid))\nc = type(x) is NoLiquid\n"
+           "d = isinstance(x, int)\ne = issubclass(C, FaceModel)\n")
     assert [line for line, _ in class_checks(src, classes)] == [1, 2, 3, 5]
     src = ('a = t.model == "multimodal"\nb = t.fluid.element in FACE_FORMS\nc = t.flow != "3d"\n'
            'd = m.model == "catenary"\ne = t.expansion == "third-order"\nf = t.fluid.element in ("rt", "paper")\n'
@@ -99,7 +99,7 @@ def test_no_isinstance_on_a_liquid_class_outside_the_liquid():
     (jaxslosh/liquid/base.py: `empty`, `step_inverse`, `static_start`, `staged_start`, ...) or is
     decided inside jaxslosh/liquid (forms.py, damping.sloshing_basis)."""
     classes = _liquid_classes()
-    assert {"AbstractLiquid", "NoLiquid", "FaceLiquid", "MultimodalLiquid"} <= classes
+    assert {"AbstractLiquid", "NoLiquid", "FaceModel", "MultimodalLiquid"} <= classes
     bad = [f"{rel}:{line}: {text}" for rel, path in sorted(_sources()) if not rel.startswith("liquid/")
            for line, text in class_checks(open(path).read(), classes)]
     assert not bad, "\n".join(bad)

@@ -1,4 +1,4 @@
-"""The full-order liquid of face-normal ("rt") tanks (liquid/face/term.py FluxLiquid) from their
+"""The full-order liquid of face-normal ("rt") tanks (liquid/face/term.py FaceLiquid) from their
 models (liquid/face/element.py): the Gauss points' fields and masses, the blocks, the absolute-rotation
 penalty and the nodal recovery's weights, host-side NumPy. The blocks are either kept without dense
 matrices on the faces (`sparse_tank_blocks`: the mass element by element and the penalty's dense
@@ -16,11 +16,11 @@ from jax.scipy.linalg import block_diag as jax_block_diag
 from scipy.linalg import block_diag
 
 from .schur import face_schur, mass_bounds, project_pools
-from .element import ROTATION_PENALTY_RATIO, FaceLiquid, _gauss, _loads, _Mixed, face_modes
+from .element import ROTATION_PENALTY_RATIO, FaceModel, _gauss, _loads, _Mixed, face_modes
 from ...fem.mesh import box_gauss_points
 from .walls import build_face_tank_with_walls, wall_points
 from .blocks import FaceOps, FaceStiffness
-from .term import FluxLiquid
+from .term import FaceLiquid
 from ...scene.types import RT_FULL_FACES, SceneError
 from .inverse import mass_inverse
 
@@ -33,8 +33,8 @@ RT_SPARSE_AUTO = 0
 ROWS = 1024
 
 
-def recovery_weights(model: FaceLiquid, gauss=None):
-    """(nodes (G, 8), weights (G, 8)): FaceLiquid.nodal_fields as fixed weights, G = E x 8 Gauss
+def recovery_weights(model: FaceModel, gauss=None):
+    """(nodes (G, 8), weights (G, 8)): FaceModel.nodal_fields as fixed weights, G = E x 8 Gauss
     points in element-major order: each node's value is the constant term of the linear field
     fitted by least squares to the Gauss-point values of its elements."""
     x = (_gauss(model) if gauss is None else gauss)[0]                 # (E, P, 3)
@@ -51,7 +51,7 @@ def recovery_weights(model: FaceLiquid, gauss=None):
     return rows.reshape(E * P, 8), w.reshape(E * P, 8)
 
 
-def _kappa(model: FaceLiquid) -> float:
+def _kappa(model: FaceModel) -> float:
     """The penalty's kappa: its modes at ROTATION_PENALTY_RATIO times the highest of the 20 lowest
     modes that is sloshing (an acoustic mode would make it needlessly stiff)."""
     fm = face_modes(model, 20)
@@ -59,7 +59,7 @@ def _kappa(model: FaceLiquid) -> float:
     return (ROTATION_PENALTY_RATIO * float(max(slosh))) ** 2
 
 
-def absolute_rotation_penalty(model: FaceLiquid, origin, gauss=None):
+def absolute_rotation_penalty(model: FaceModel, origin, gauss=None):
     """(K_c (nf, nf), K_dt (nf, 3), K_tt (3, 3)): the penalty 1/2 kappa |P (d + C theta)|_M^2 that holds
     the circulation (K's kernel, the M-orthogonal projection P onto it) at the part of the tank's
     rotation an ideal liquid does not follow, -P C theta (Kelvin: its absolute flow stays
@@ -82,7 +82,7 @@ def absolute_rotation_penalty(model: FaceLiquid, origin, gauss=None):
     return kappa * 0.5 * (MP + MP.T), kappa * MPc, kappa * (Pc.T @ MPc)
 
 
-def sparse_tank_blocks(model: FaceLiquid, origin, gauss=None) -> dict:
+def sparse_tank_blocks(model: FaceModel, origin, gauss=None) -> dict:
     """One tank's full-order blocks without dense matrices on the faces (liquid/face/schur.py): the
     element mass blocks (signed), Y = W - kappa G^+ on its elements and top faces, the
     absolute-rotation penalty's K_dt, K_tt (as `absolute_rotation_penalty`, through G^+), the static
@@ -198,7 +198,7 @@ def _component_masses(model, w, phys):
     return out
 
 
-def traced_depth_blocks(model: FaceLiquid, origin, s, gauss=None):
+def traced_depth_blocks(model: FaceModel, origin, s, gauss=None):
     """A plain box's blocks at the fill depth s h0 (s traced), from its model at h0: the layers scale
     with the depth (z = s z0), so J = diag(1, 1, s) J0, det J = s det J0 and the Piola field is
     diag(1/s, 1/s, 1) u0. Returns (x (E, P, 3), w (E, P), phys (E, P, 6, 3), M, K_acoustic, K_c,
@@ -237,7 +237,7 @@ def traced_depth_blocks(model: FaceLiquid, origin, s, gauss=None):
 
 
 def face_full_liquid(tanks, models, scales=None, depths=None, sparse=False, structures=()):
-    """The FluxLiquid of every tank (all face-normal, full order), stacked, the (K_dt, K_tt) of the
+    """The FaceLiquid of every tank (all face-normal, full order), stacked, the (K_dt, K_tt) of the
     absolute-rotation penalty (liquid/base.py RotationPenalty), and per tank its elastic walls
     (liquid/walls.py WallModel) or None. `scales`: per tank None or its (rho, rho c^2, rho g) over its
     model's (assemble/liquid.py face_scales), traced or not: the masses, the compression and the
@@ -365,7 +365,7 @@ def face_full_liquid(tanks, models, scales=None, depths=None, sparse=False, stru
                      wall_coef=jnp.asarray(coef), wall_N=jnp.asarray(Nw), wall_slots=jnp.asarray(fix(sw)),
                      node_slots=jnp.asarray(fix(np.concatenate(node_slots))), n_wall_faces=n_wf,
                      n_liquid_points=int(sum(len(p) for p in phis)))
-    liquid = FluxLiquid(r=jnp.asarray(xp.concatenate(rs)), m=jnp.asarray(xp.concatenate(ms)),
+    liquid = FaceLiquid(r=jnp.asarray(xp.concatenate(rs)), m=jnp.asarray(xp.concatenate(ms)),
                         phi=jnp.asarray(xp.concatenate(phis)), slots=jnp.asarray(slot),
                         scale=jnp.asarray(np.concatenate(row_scales)), rec_nodes=jnp.asarray(np.concatenate(rec_n)),
                         rec_w=jnp.asarray(np.concatenate(rec_w)), n_nodes=node_off, **blocks, **extra)

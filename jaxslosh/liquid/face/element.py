@@ -45,7 +45,7 @@ _FACE_SIDE = np.array([-1.0, 1.0, -1.0, 1.0, 1.0, -1.0])
 
 
 @dataclass(frozen=True, eq=False)
-class FaceLiquid:
+class FaceModel:
     """The face-normal liquid model of one tank (tank-local coordinates, SI).
 
     ``faces`` (F, 4) node indices of every distinct face; ``element_faces`` (E, 6) and ``signs`` (E, 6):
@@ -159,7 +159,7 @@ def _reference_fields(xi):
     return out
 
 
-def build_face_liquid(nodes, elements, depth, density, sound_speed, gravity, geometry=None) -> FaceLiquid:
+def build_face_liquid(nodes, elements, depth, density, sound_speed, gravity, geometry=None) -> FaceModel:
     """The face-normal model of the liquid meshed by hexahedra ``elements`` (positively oriented;
     a collapsed face allowed) at rest below the free surface z = ``depth``."""
     nodes = np.asarray(nodes, dtype=float)
@@ -194,7 +194,7 @@ def build_face_liquid(nodes, elements, depth, density, sound_speed, gravity, geo
                       shape=(E, nF)).tocsr()
     Kac = (D.T @ sp.diags(rho * c * c / volume) @ D).tocsr()
     Ks = sp.coo_matrix((rho * g / top_area, (top, top)), shape=(nF, nF)).tocsr()
-    return FaceLiquid(nodes=nodes, elements=elements, faces=faces, element_faces=element_faces, signs=signs,
+    return FaceModel(nodes=nodes, elements=elements, faces=faces, element_faces=element_faces, signs=signs,
                       free=free, top=top, top_area=top_area, volume=volume, mass=M, acoustic=Kac, surface=Ks,
                       density=rho, sound_speed=c, gravity=g, depth=float(depth), geometry=geometry)
 
@@ -237,7 +237,7 @@ class FaceModes:
     circulation: int                  # zero-frequency (circulation) modes left out: dim ker K
 
 
-def face_modes(model: FaceLiquid, n: int = 10) -> FaceModes:
+def face_modes(model: FaceModel, n: int = 10) -> FaceModes:
     """The n lowest modes of nonzero frequency of K q = omega^2 M q (free faces).
 
     K = B^T W B with B = [D; T] (each element's outward flux, each top face's flux) and W =
@@ -287,7 +287,7 @@ def face_modes(model: FaceLiquid, n: int = 10) -> FaceModes:
 ROTATION_PENALTY_RATIO = 10.0
 
 
-def _gauss(model: FaceLiquid):
+def _gauss(model: FaceModel):
     """(positions (E, P, 3), weights det J (E, P), signed basis fields (E, P, 6, 3)) at the 2x2x2 Gauss points."""
     X = model.nodes[model.elements]
     dN = shape_gradients(GAUSS8)
@@ -317,7 +317,7 @@ class _Mixed:
     """Solves with G = B M^-1 B^T on the free faces (the saddle-point system, iterated on a
     shifted factor; every right-hand side here is cleared of the pools' uniform pressures)."""
 
-    def __init__(self, model: FaceLiquid):
+    def __init__(self, model: FaceModel):
         f = np.flatnonzero(model.free)
         E, T = len(model.elements), len(model.top)
         D = sp.coo_matrix((model.signs.reshape(-1), (np.repeat(np.arange(E), 6), model.element_faces.reshape(-1))),
@@ -364,7 +364,7 @@ class _Mixed:
         return x, out[:self.nf]
 
 
-def face_basis(model: FaceLiquid, origin, n: int, static_correction: bool = True):
+def face_basis(model: FaceModel, origin, n: int, static_correction: bool = True):
     """A Ritz basis of the face-normal liquid for runs (liquid/modal/reduction.py's counterpart).
 
     Returns (V (F, m) on all faces, omega (m,), n_modes, (K_dt (m, 3), K_tt (3, 3))): the n lowest
@@ -446,7 +446,7 @@ def face_basis(model: FaceLiquid, origin, n: int, static_correction: bool = True
     return Vfull, omega, len(modes.omega), (Kdt, Ktt, kappa, m - nc)
 
 
-def face_invariants(model: FaceLiquid, V, origin):
+def face_invariants(model: FaceModel, V, origin):
     """The inertia invariants of liquid/modal/term.py for the basis V (F, m), as integrals of the
     element fields (2x2x2 Gauss): mass, S0, Q0, U1 (m, 3), Q1 (m, 3, 3), Q2 (m, m, 3, 3), Mr, Kr;
     and the basis as nodal fields (m, N, 3) for outputs and probes, and lumped nodal masses (N,)."""

@@ -98,7 +98,7 @@ class BlockInverse(eqx.Module):
 
 
 def face_solver_blocks(liquid, c_step: float, c_sub=None):
-    """(Cinv_step, Cinv_mass, Cinv_sub or None, sum_j |K_ij| per row) of a sparse FluxLiquid
+    """(Cinv_step, Cinv_mass, Cinv_sub or None, sum_j |K_ij| per row) of a sparse FaceLiquid
     (solve/linear.make_solver): H_c per tank from its Y, W^-1 and kappa (host, float64; in JAX from
     the stop_gradient values where the liquid is at scaled, perhaps traced values: the inverses only
     precondition)."""

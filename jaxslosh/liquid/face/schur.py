@@ -70,7 +70,7 @@ class FaceSchur:
 
 
 def mixed_operators(model):
-    """(free faces, B (ny, nf), M (nf, nf), W^-1 (ny,)) of a FaceLiquid (as liquid/face/element.face_modes)."""
+    """(free faces, B (ny, nf), M (nf, nf), W^-1 (ny,)) of a FaceModel (as liquid/face/element.face_modes)."""
     f = np.flatnonzero(model.free)
     E, T = len(model.elements), len(model.top)
     D = sp.coo_matrix((model.signs.reshape(-1), (np.repeat(np.arange(E), 6), model.element_faces.reshape(-1))),
@@ -96,7 +96,7 @@ def pool_vectors(model) -> np.ndarray:
 
 
 def face_schur(model) -> FaceSchur:
-    """G = B M^-1 B^T of a FaceLiquid, formed from CHUNK sparse solves at a time, and a generalized
+    """G = B M^-1 B^T of a FaceModel, formed from CHUNK sparse solves at a time, and a generalized
     inverse: V Lambda^+ V^T on the generalized eigenvectors of G y = lambda W^-1 y (V^T W^-1 V = I),
     which the closed forms of `schur_inverse` and `FaceSchur.static_solve` need. It is Q G^+ Q^T,
     G^+ = (G + a N N^T)^-1 - N N^T / a the Moore-Penrose inverse (N: the pools' null vectors; a

@@ -11,7 +11,7 @@ from ...scene.types import SceneError
 from ..block import LiquidBlock, VesselFrameStructure, host_block, rigid_part
 from ..walls import shell_mesh
 from .build import RT_SPARSE_AUTO, face_full_liquid
-from .element import FaceLiquid, build_face_liquid
+from .element import FaceModel, build_face_liquid
 
 
 def face_model(scene, t, i, params):
@@ -67,7 +67,7 @@ def face_block(scene, tanks, models, params, g, held=(), Kg=None) -> LiquidBlock
               if isinstance(params.get(f"tanks.{t.name}.fill_depth"), jax.core.Tracer) else None for t in tanks]
     sparse = face_sparse(scene, models, depths)
     for i, m in enumerate(models):
-        if not isinstance(m, FaceLiquid):
+        if not isinstance(m, FaceModel):
             raise SceneError(f"tanks[{i}].fluid.element", "a full-order \"rt\" tank goes with other \"rt\" tanks "
                                                           "only: give this one element = \"rt\" too, or give every "
                                                           "tank a [tanks.reduction] table")

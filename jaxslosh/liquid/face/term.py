@@ -4,7 +4,7 @@ Raviart-Thomas field u = sum_f phi_f d_f.
 
 The kinetic energy of the element is the integral of rho |v|^2 at its 2 x 2 x 2 Gauss points (the
 consistent RT0 mass liquid/face/element.py assembles), so the liquid is written as liquid/base.py's
-`Liquid` with the Gauss points as its particles, each with the diagonal mass rho det J: the same
+`NodalLiquid` with the Gauss points as its particles, each with the diagonal mass rho det J: the same
 particle kinematics (eqs. 1-4)
 
     T = 1/2 sum_g m_g |A^T V0 + u_g' + omega x (r_g + u_g)|^2,   V = 1/2 d^T K d - g_b . sum_g m_g u_g,
@@ -19,7 +19,7 @@ without it, a start with the tank turning (an initial angular velocity) would le
 with the rigid rotation's vorticity, and second-order terms would drift in the kernel. With it, K
 is definite and the hydrostatic start solves K d0 = F_g.
 
-Outputs and probes read the nodal field of the element's patch recovery (FaceLiquid.nodal_field),
+Outputs and probes read the nodal field of the element's patch recovery (FaceModel.nodal_field),
 here as fixed weights of each Gauss point's displacement on the nodes of its element.
 
 Elastic tank walls (liquid/face/walls.py): their free nodal dofs are unknowns after the faces', a wall
@@ -48,7 +48,7 @@ from .inverse import face_solver_blocks
 from ...physics.terms import Kin, Rows
 
 
-class FluxLiquid(AbstractLiquid):
+class FaceLiquid(AbstractLiquid):
     """All tank liquid on face fluxes (tanks stacked: every tank's free faces, then the next's)."""
     r: jax.Array          # (G, 3) Gauss points in the vessel frame
     m: jax.Array          # (G,) their masses rho det J

@@ -31,7 +31,7 @@ import numpy as np
 import scipy.linalg as sl
 import scipy.sparse as sp
 
-from .element import ROTATION_PENALTY_RATIO, FaceLiquid, _gauss, _loads, _Mixed, face_modes
+from .element import ROTATION_PENALTY_RATIO, FaceModel, _gauss, _loads, _Mixed, face_modes
 from ...fem.mesh import box_gauss_points
 from ..modes import Modes
 from ..walls import WallModel, build_walls
@@ -40,7 +40,7 @@ _G2 = np.array([-1.0, 1.0]) / np.sqrt(3.0)
 _QUAD = np.array([[-1.0, -1.0], [1.0, -1.0], [1.0, 1.0], [-1.0, 1.0]])     # a face's corners in cyclic order
 
 
-def face_area_weights(model: FaceLiquid, faces) -> np.ndarray:
+def face_area_weights(model: FaceModel, faces) -> np.ndarray:
     """(k, 4, 3): int_f N_a n dA for the four corners a of each face (bilinear N_a, n the outward
     normal of the face's element): q_f = sum_a w_fa . u_a for a displacement bilinear over the face.
     2 x 2 Gauss is exact (N_a times the bilinear area vector is of degree 2 in each direction)."""
@@ -62,7 +62,7 @@ def face_area_weights(model: FaceLiquid, faces) -> np.ndarray:
     return out
 
 
-def wall_faces(model: FaceLiquid) -> np.ndarray:
+def wall_faces(model: FaceModel) -> np.ndarray:
     """The liquid's wetted wall faces: on the boundary, not free surface, not collapsed."""
     count = np.bincount(model.element_faces.reshape(-1), minlength=len(model.faces))
     collapsed = np.array([len(set(f)) < 3 for f in model.faces])
@@ -73,7 +73,7 @@ def wall_faces(model: FaceLiquid) -> np.ndarray:
 class FaceTankWithWalls:
     """The face-normal liquid and its walls on the unknowns z = [free faces' fluxes q (nq); walls'
     free nodal dofs w (nw)] (tank-local coordinates)."""
-    model: FaceLiquid
+    model: FaceModel
     walls: Optional[WallModel]        # None for a wall given by its matrices alone (`couple_walls`)
     T: sp.csr_matrix                  # (F, nz) every face's flux from z
     wall_dofs: np.ndarray             # (nw,) the free wall dofs' indices in the walls' 3 Nw vector
@@ -99,7 +99,7 @@ class FaceTankWithWalls:
         return (self.T @ np.atleast_2d(Z).T).T
 
 
-def couple_walls(model: FaceLiquid, Tw, Mw, Kw, origin=(0.0, 0.0, 0.0), walls=None, wall_dofs=None,
+def couple_walls(model: FaceModel, Tw, Mw, Kw, origin=(0.0, 0.0, 0.0), walls=None, wall_dofs=None,
                  kappa=None) -> FaceTankWithWalls:
     """Couple the liquid with walls whose unknowns w (nw) have mass Mw and stiffness Kw (nw, nw) and
     set the wall faces' fluxes Tw w (Tw (F, nw), zero on the free faces). `origin`: the tank's in the
@@ -146,7 +146,7 @@ def couple_walls(model: FaceLiquid, Tw, Mw, Kw, origin=(0.0, 0.0, 0.0), walls=No
                              kappa=float(kappa), n_kernel=n_ker)
 
 
-def shell_flux_map(model: FaceLiquid, walls: WallModel):
+def shell_flux_map(model: FaceModel, walls: WallModel):
     """(Tw (F, 3 Nw) sparse, faces): the wall faces' fluxes from the shell's nodal displacements,
     each wall face's corners found among the wall nodes (they coincide: liquid/walls.py wall_planes)."""
     faces = wall_faces(model)
@@ -164,7 +164,7 @@ def shell_flux_map(model: FaceLiquid, walls: WallModel):
     return Tw, faces
 
 
-def build_face_tank_with_walls(tank, model: FaceLiquid, kappa=None) -> FaceTankWithWalls:
+def build_face_tank_with_walls(tank, model: FaceModel, kappa=None) -> FaceTankWithWalls:
     """A scene tank's face-normal liquid (its model) in its elastic walls (liquid/walls.py build_walls:
     the open box of hexahedra held at its attachment face)."""
     ws = tank.wall_spec

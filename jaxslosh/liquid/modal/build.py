@@ -13,25 +13,25 @@ from scipy.linalg import block_diag
 
 from ...scene.types import SceneError
 from ..block import LiquidBlock, host_block
-from ..face.element import FaceLiquid, face_basis, face_invariants
+from ..face.element import FaceModel, face_basis, face_invariants
 from ..face.stack import face_scales
 from ..nodal.model import build_liquid
 from .reduction import tank_basis
-from .term import ReducedLiquid
+from .term import ModalLiquid
 
 
 @functools.lru_cache(maxsize=8)
-def _face_basis(model: FaceLiquid, origin: tuple, n: int, static: bool):
+def _face_basis(model: FaceModel, origin: tuple, n: int, static: bool):
     return face_basis(model, origin, n, static)
 
 
-def face_tank_basis(model: FaceLiquid, origin, n: int, static: bool):
+def face_tank_basis(model: FaceModel, origin, n: int, static: bool):
     """`face_basis` of a face-normal tank, computed once per model (the liquid block and the damping
-    of the same scene take the same basis; FaceLiquid hashes by identity)."""
+    of the same scene take the same basis; FaceModel hashes by identity)."""
     return _face_basis(model, tuple(float(v) for v in origin), int(n), bool(static))
 
 
-def face_sloshing(model: FaceLiquid, V, n_modes: int) -> np.ndarray:
+def face_sloshing(model: FaceModel, V, n_modes: int) -> np.ndarray:
     """The columns of V[:, :n_modes] (face_basis's modes) that are sloshing modes: most of their
     energy in the free surface (liquid/face/element.py face_modes' rule)."""
     Vm = V[:, :n_modes]
@@ -41,11 +41,11 @@ def face_sloshing(model: FaceLiquid, V, n_modes: int) -> np.ndarray:
 
 
 def reduce_liquid(models, concrete_models, origins, offsets, reductions, scales=None):
-    """The reduced liquid of every tank (stacked), from the per-tank `LiquidModel`s.
+    """The reduced liquid of every tank (stacked), from the per-tank `NodalModel`s.
 
     `models` may hold traced values (then JAX arithmetic); `concrete_models` are the same tanks at
     the scene's values, from which the bases are computed (they are the `models` when concrete).
-    `reductions` holds (modes, static_correction) per tank. Returns (ReducedLiquid, (K_dt, K_tt) of
+    `reductions` holds (modes, static_correction) per tank. Returns (ModalLiquid, (K_dt, K_tt) of
     the rotation penalty on the modal coordinates, or None). `scales`: per tank, None or the
     face-normal tank's (rho, rho c^2, rho g) over its model's (liquid/face/stack.py face_scales; traced
     values scale its blocks, the basis stays the scene's)."""
@@ -57,10 +57,10 @@ def reduce_liquid(models, concrete_models, origins, offsets, reductions, scales=
     S0, Q0, mass, Ktt = 0.0, 0.0, 0.0, xp.zeros((3, 3))
     U1s, Q1s, Q2_blocks = [], [], []
     rs, ms = [], []
-    coupled = any(m.rotation_coupling is not None or isinstance(m, FaceLiquid) for m in models)
+    coupled = any(m.rotation_coupling is not None or isinstance(m, FaceModel) for m in models)
     for model, cmodel, origin, off, (n, static), fs in zip(models, concrete_models, origins, offsets, reductions,
                                                            scales):
-        if isinstance(model, FaceLiquid):         # the face-normal element: invariants are its fields' integrals
+        if isinstance(model, FaceModel):         # the face-normal element: invariants are its fields' integrals
             V, _, _, (Kdt_t, Ktt_t, kappa, k0) = face_tank_basis(model, origin, n, static)
             inv = face_invariants(model, V, origin)
             sr, sc, sg = fs if fs is not None else (1.0, 1.0, 1.0)
@@ -130,7 +130,7 @@ def reduce_liquid(models, concrete_models, origins, offsets, reductions, scales=
             Q2[k:k + mt, k:k + mt] = Q2t
         k += mt
     block_diag_ = jax_block_diag if traced else block_diag
-    liquid = ReducedLiquid(
+    liquid = ModalLiquid(
         r=jnp.asarray(xp.concatenate(rs)), m_nodes=jnp.asarray(xp.concatenate(ms)), U=jnp.asarray(U),
         mass=jnp.asarray(mass), S0=jnp.asarray(S0), U1=jnp.asarray(xp.concatenate(U1s)), Q0=jnp.asarray(Q0),
         Q1=jnp.asarray(xp.concatenate(Q1s)), Q2=jnp.asarray(Q2), Mr=jnp.asarray(block_diag_(*Mr_blocks)),
@@ -146,10 +146,10 @@ def reduced_block(scene, tanks, models, params, g) -> LiquidBlock:
         if t.reduction is None:
             raise SceneError(f"tanks[{i}].reduction", "reduce every tank or none: another tank has a "
                                                        "[tanks.reduction] table and this one has not")
-    scales = [face_scales(scene, t, params, g) if isinstance(m, FaceLiquid) else None for t, m in zip(tanks, models)]
+    scales = [face_scales(scene, t, params, g) if isinstance(m, FaceModel) else None for t, m in zip(tanks, models)]
     concrete = []
     for t, m in zip(tanks, models):
-        if getattr(m, "traced", False) or (isinstance(g, jax.core.Tracer) and not isinstance(m, FaceLiquid)):
+        if getattr(m, "traced", False) or (isinstance(g, jax.core.Tracer) and not isinstance(m, FaceModel)):
             m = build_liquid(t.size, t.fill_depth, t.mesh, t.fluid.density, t.fluid.sound_speed,
                              scene.environment.gravity, element=t.fluid.element, geometry=t.geometry)
         concrete.append(m)

@@ -23,10 +23,10 @@ from ..base import AbstractLiquid, inertial_lines, point_mass_scale
 from ...physics.terms import Kin, Rows
 
 
-class ReducedLiquid(AbstractLiquid):
+class ModalLiquid(AbstractLiquid):
     """All tank liquid on a modal basis: d = V eta (eta: m modal coordinates, every tank's stacked).
 
-    The invariants (see the module docstring) replace the dense N x N mass products of `Liquid`."""
+    The invariants (see the module docstring) replace the dense N x N mass products of `NodalLiquid`."""
     r: jax.Array          # (N, 3) node positions in the vessel frame (for scales and outputs)
     m_nodes: jax.Array    # (N,) lumped nodal masses (row sums of the scalar mass)
     U: jax.Array          # (m, N, 3) the basis as nodal fields (zero on the wall-normal dofs)

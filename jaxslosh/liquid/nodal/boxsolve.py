@@ -367,7 +367,7 @@ class Elements(eqx.Module):
 
 def elements(A, layout, check=1e-12):
     """Elements operator of the block-diagonal SciPy matrix A for `layout` = ((mesh, k, rows,
-    blocks), ...) per tank, `blocks` the tank's `LiquidModel.layers` (None: not uniform by layers),
+    blocks), ...) per tank, `blocks` the tank's `NodalModel.layers` (None: not uniform by layers),
     or None where a tank has none or the operator does not reproduce A (checked on random vectors
     to `check` relative: then the caller keeps the stencil)."""
     A = sp.csr_matrix(A)

@@ -1,4 +1,4 @@
-"""The nodal liquid's block (term.py `Liquid`) of a scene's tanks from their element models
+"""The nodal liquid's block (term.py `NodalLiquid`) of a scene's tanks from their element models
 (model.py): stacked dense, sparse on large meshes (sparse.py), or extended by elastic walls and
 structures in the vessel's frame (liquid/walls.py)."""
 from __future__ import annotations
@@ -15,7 +15,7 @@ from ..block import LiquidBlock, TankBlock, VesselFrameStructure, host_block, ri
 from ..walls import build_tank_with_walls
 from .model import build_liquid, surface_bending_scale
 from .sparse import host_sparse
-from .term import Liquid
+from .term import NodalLiquid
 
 
 def nodal_model(t, i, params, g, sparse):
@@ -74,7 +74,7 @@ def nodal_block(tanks, models, sparse: bool, host_lu: bool) -> LiquidBlock:
         nodes_of = [np.arange(m.nodes.shape[0]) for m in models]
         free_of = [np.flatnonzero(np.asarray(m.free)) for m in models]
         layers = tuple(m.layers for m in models) if boxes else None
-        liquid = Liquid(r=jnp.asarray(np.concatenate(rs)),
+        liquid = NodalLiquid(r=jnp.asarray(np.concatenate(rs)),
                         Ms=host_sparse(sp.block_diag(Ms_list), tuple(zip(meshes, [1] * len(models), nodes_of))
                                        if boxes else None, layers),
                         K=host_sparse(sp.block_diag(K_list), tuple(zip(meshes, [3] * len(models), free_of))
@@ -85,7 +85,7 @@ def nodal_block(tanks, models, sparse: bool, host_lu: bool) -> LiquidBlock:
                         sparse=True, frames=frames, host_lu=host_lu)
         return LiquidBlock(liquid, tuple(blocks), (Kdt, jnp.asarray(Ktt)) if coupled else None)
     stack = jax_block_diag if traced else block_diag
-    liquid = Liquid(r=jnp.asarray(xp.concatenate(rs)), Ms=jnp.asarray(stack(*Ms_list)),
+    liquid = NodalLiquid(r=jnp.asarray(xp.concatenate(rs)), Ms=jnp.asarray(stack(*Ms_list)),
                     K=jnp.asarray(stack(*K_list)), free=jnp.asarray(np.concatenate(free_list)), n_nodes=offset,
                     frames=frames, slot=slots(np.concatenate(free_list), offset))
     penalty = (jnp.asarray(xp.concatenate(Kdt_list)), jnp.asarray(Ktt)) if coupled else None
@@ -148,7 +148,7 @@ def walls_block(tanks, models, held=(), Kg=None) -> LiquidBlock:
         free_off += hs.free.size
     dof_map = np.concatenate(maps)
     dof_map = np.where(dof_map >= 0, dof_map, free_off)          # the zero slot after the unknowns
-    liquid = Liquid(r=jnp.asarray(np.concatenate(rs)), Ms=jnp.asarray(block_diag(*Ms_list)),
+    liquid = NodalLiquid(r=jnp.asarray(np.concatenate(rs)), Ms=jnp.asarray(block_diag(*Ms_list)),
                     K=jnp.asarray(block_diag(*K_list)), free=jnp.asarray(np.concatenate(reps)), n_nodes=node_off,
                     dof_map=jnp.asarray(dof_map))
     carried = tuple(rigid_part(Ms_list[k], rs[k][n0:], n0) for k, n0 in carried_idx)

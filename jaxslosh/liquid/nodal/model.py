@@ -18,7 +18,7 @@ Conventions
 * ``free`` is False for the wall-normal dofs (slip walls x=0, x=a, y=0, y=b and the bottom z=0).
 * The equation the transient solver integrates (tank frame, relative displacement d):
   ``kron(mass, I3) d'' + stiffness d = kron(mass, I3) tile(g_body)`` on the free dofs, with
-  ``g_body = A^T (0, 0, -g)``; see ``LiquidModel.body_force``.
+  ``g_body = A^T (0, 0, -g)``; see ``NodalModel.body_force``.
 
 Traceability: ``fill_depth``, ``density``, ``sound_speed`` and ``gravity`` may be JAX tracers (so
 that ``jax.grad`` of a simulation works with respect to them). Everything that depends only on the
@@ -48,7 +48,7 @@ from ...fem.slip import rotate_matrix, rotate_rows, surface_jump_pattern
 
 
 @dataclass(frozen=True, eq=False)
-class LiquidModel:
+class NodalModel:
     """Static finite-element model of the liquid in one rigid rectangular tank (tank frame).
 
     Units SI. ``stiffness`` and ``mass`` act on the relative displacement d (3N, node-major).
@@ -138,7 +138,7 @@ class LiquidModel:
 
 
 def build_liquid(size, fill_depth, mesh, density, sound_speed, gravity, element="stabilized",
-                 sparse=False, geometry=None) -> LiquidModel:
+                 sparse=False, geometry=None) -> NodalModel:
     """Build the liquid model of a rigid tank of inner size (a, b, H) filled to ``fill_depth``.
 
     ``mesh`` = (nx, ny, nz) hexahedra over the liquid region; ``element`` one of ``ELEMENT_FORMS``.
@@ -193,7 +193,7 @@ def build_liquid(size, fill_depth, mesh, density, sound_speed, gravity, element=
     if not traced:
         parts = topo.parts(el, out)
     layers = layer_blocks(el, out, (nx, ny, nz), element, bending) if sparse and not traced else None
-    return LiquidModel(
+    return NodalModel(
         nodes=nodes, elements=topo.elements, mass=mass, stiffness=stiffness, free=topo.free.reshape(-1).copy(),
         surface=topo.surface.copy(), density=rho, sound_speed=c, gravity=g, size=tuple(float(s) for s in size),
         depth=h, element=element, mesh=(nx, ny, nz), rotation_coupling=coupling,
@@ -201,7 +201,7 @@ def build_liquid(size, fill_depth, mesh, density, sound_speed, gravity, element=
     )
 
 
-def _build_shaped(geometry, fill_depth, mesh, rho, c, g, element, sparse) -> LiquidModel:
+def _build_shaped(geometry, fill_depth, mesh, rho, c, g, element, sparse) -> NodalModel:
     """`build_liquid` for another shape (jaxslosh/geometry): its mesh, then the matrices on the nodes' frames."""
     if is_traced(fill_depth):
         raise ValueError("the fill depth of a tank that is not a plain box cannot be traced (its mesh follows it)")
@@ -236,7 +236,7 @@ def _build_shaped(geometry, fill_depth, mesh, rho, c, g, element, sparse) -> Liq
     parts = {} if traced else parts_of(el, out)
     if frames is not None:
         parts = {k: rotate_matrix(np, v, frames) for k, v in parts.items()}
-    return LiquidModel(
+    return NodalModel(
         nodes=nodes, elements=elements, mass=out["mass"], stiffness=K, free=tm.free.reshape(-1).copy(),
         surface=np.unique(faces), density=density, sound_speed=sound_speed, gravity=gravity,
         size=tuple(float(s) for s in geometry.size), depth=h, element=element,
@@ -276,7 +276,7 @@ def layer_blocks(el, out, mesh, form, bending):
     return {"stiffness": 0.5 * (Ks + np.swapaxes(Ks, 1, 2)), "mass": Ms, "surface": Kf, "bending": bend}
 
 
-def surface_bending_scale(model: LiquidModel) -> float:
+def surface_bending_scale(model: NodalModel) -> float:
     """The factor of `surface_bending_pattern` in the stiffness (0 for the paper's form)."""
     if model.element == "paper":
         return 0.0

@@ -129,7 +129,7 @@ class HostSparse(eqx.Module):
 
 def host_sparse(A, layout=None, layers=None) -> HostSparse:
     """`layout`: the rows' places on box grids (see boxsolve.stencil), for the stencil product;
-    `layers`: each tank's element matrices per layer (LiquidModel.layers), for the product element
+    `layers`: each tank's element matrices per layer (NodalModel.layers), for the product element
     by element (boxsolve.elements), which is preferred where every tank has them."""
     A = sp.csr_matrix(A)
     A = (0.5 * (A + A.T)).tocsr()
@@ -165,7 +165,7 @@ def host_inverse(A) -> HostInverse:
 
 
 def free_blocks(liquid):
-    """(M_ff, K_ff) of a sparse `Liquid` as SciPy matrices on its free dofs."""
+    """(M_ff, K_ff) of a sparse `NodalLiquid` as SciPy matrices on its free dofs."""
     f = np.asarray(liquid.free)
     M = sp.kron(liquid.Ms.matrix, sp.eye(3), format="csr")
     if liquid.frames is not None:

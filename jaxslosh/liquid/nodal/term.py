@@ -20,7 +20,7 @@ from ..base import AbstractLiquid, StepInverse, inertial_lines, nodal_product, p
 from .sparse import hydrostatic_start, sparse_solver_blocks
 
 
-class Liquid(AbstractLiquid):
+class NodalLiquid(AbstractLiquid):
     """All tank liquid of the vessel, full order, as one block (tanks stacked block-diagonally);
     with elastic tank walls and structures in the vessel's frame, their nodes too."""
     r: jax.Array          # (N, 3) node positions in the vessel frame (COG origin)
@@ -66,7 +66,7 @@ class Liquid(AbstractLiquid):
             D = jnp.zeros(3 * self.n_nodes, d.dtype).at[self.free].set(d).reshape(self.n_nodes, 3)
         return D if self.frames is None else jnp.einsum("nij,nj->ni", self.frames, D)
 
-    def for_batch(self) -> "Liquid":
+    def for_batch(self) -> "NodalLiquid":
         # Under vmap, XLA's batched gather of the nodal field (`slot`) made the residual 35-45 %
         # slower than the scatter (docs/benchmarks.md, compile time); a single run keeps the gather, whose
         # program compiles faster.
