@@ -138,7 +138,7 @@ def test_a_run_through_the_sparse_blocks_equals_the_dense_run():
 
 
 def test_scaled_sparse_blocks_equal_the_dense_ones():
-    """Density, sound speed and gravity other than the model's (assemble/liquid.py face_scales: the
+    """Density, sound speed and gravity other than the model's (liquid/face/stack.py face_scales: the
     mass, the compression and the free surface scale with rho, rho c^2 and rho g): the sparse blocks
     equal the dense blocks at those values, the stiffness, row sums (a bound within the factors'
     spread), the static start and the Newton blocks' inverses; and traced (jit, grad) as well."""

@@ -119,7 +119,7 @@ def sparse_tank_blocks(model: FaceModel, origin, gauss=None) -> dict:
 def stack_sparse(parts: list, scales=None) -> tuple:
     """(FaceStiffness, MassInverse, start (n, 3)) of the tanks' `sparse_tank_blocks`, stacked (tank
     after tank). `scales`: per tank None or its (rho, rho c^2, rho g) over its model's
-    (assemble/liquid.py face_scales), traced or not: the mass M and the penalty kappa M P scale with
+    (stack.py face_scales), traced or not: the mass M and the penalty kappa M P scale with
     the first (G^+ with it, as G = B M^-1 B^T scales inversely), W's elements (the compression) with
     the second and its top faces (the free surface) with the third, as the dense blocks do."""
     scales = [(1.0, 1.0, 1.0) if sc is None else sc for sc in (scales or [None] * len(parts))]
@@ -240,7 +240,7 @@ def face_full_liquid(tanks, models, scales=None, depths=None, sparse=False, stru
     """The FaceLiquid of every tank (all face-normal, full order), stacked, the (K_dt, K_tt) of the
     absolute-rotation penalty (liquid/base.py RotationPenalty), and per tank its elastic walls
     (liquid/walls.py WallModel) or None. `scales`: per tank None or its (rho, rho c^2, rho g) over its
-    model's (assemble/liquid.py face_scales), traced or not: the masses, the compression and the
+    model's (stack.py face_scales), traced or not: the masses, the compression and the
     free-surface blocks scale with them. `depths`: per tank None or a plain box's fill depth over its
     model's (traced): `traced_depth_blocks`. A tank with elastic walls (liquid/face/walls.py) adds its
     walls' free nodal dofs after its free faces, and its walls' Gauss points after every tank's liquid
