@@ -49,6 +49,29 @@ def point_mass_scale(m, x, total=None):
                    m @ (x[:, 0] ** 2 + x[:, 1] ** 2)])
     return jnp.concatenate([jnp.full(3, m.sum() if total is None else total), I])
 
+def particle_rows(liquid, k: Kin, field, m, inertia) -> Rows:
+    """Eq. (4) for a full-order liquid of particles at `liquid.r` (body frame) with masses m (n,) and
+    displacements field(d) (n, 3) (the nodal liquid's nodes, the face-normal one's Gauss points): the
+    particle accelerations (body components), their inertia forces inertia(a), what they do on the
+    rigid rows and on the liquid's own (`liquid.free_part`); the stiffness `liquid.K` and the gravity
+    load."""
+    c, A, omega = k.c, k.A, k.omega
+    a0, alpha = k.a6[:3], k.a6[3:6]
+    D, Dv, Da = field(c.d), field(k.d_dot), field(k.d_acc)
+    x = liquid.r + D
+    a = tv3(A, a0) + Da + jnp.cross(alpha, x)
+    if liquid.coriolis:
+        a = a + 2.0 * jnp.cross(omega, Dv)
+    if liquid.centrifugal:
+        a = a + jnp.cross(omega, jnp.cross(omega, x))
+    F = inertia(a)
+    mD = m @ D                                                  # first moment of d
+    r_t = mv3(A, F.sum(axis=0))
+    r_r = jnp.cross(x, F).sum(axis=0) - jnp.cross(mD, k.g_b)
+    r_d = liquid.free_part(F - m[:, None] * k.g_b) + liquid.K @ c.d
+    return Rows(jnp.concatenate([r_t, r_r]), r_d)
+
+
 class StepInverse(NamedTuple):
     """The inverses of a liquid's constant Newton blocks (solve/linear.make_solver): each a matrix or
     an operator with `@`."""

@@ -41,9 +41,8 @@ import jax
 import jax.numpy as jnp
 
 from ...fem.linalg import solve
-from ...physics.kinematics import mv3, tv3
 from ...physics.about import About
-from ..base import AbstractLiquid, StepInverse, inertial_lines, point_mass_scale
+from ..base import AbstractLiquid, StepInverse, inertial_lines, particle_rows, point_mass_scale
 from .inverse import face_solver_blocks
 from ...physics.terms import Kin, Rows
 
@@ -119,21 +118,7 @@ class FaceLiquid(AbstractLiquid):
         return self.m @ self.r
 
     def rows(self, k: Kin) -> Rows:
-        c, A, omega = k.c, k.A, k.omega
-        a0, alpha = k.a6[:3], k.a6[3:6]
-        D, Dv, Da = self.field(c.d), self.field(k.d_dot), self.field(k.d_acc)
-        x = self.r + D
-        a = tv3(A, a0) + Da + jnp.cross(alpha, x)
-        if self.coriolis:
-            a = a + 2.0 * jnp.cross(omega, Dv)
-        if self.centrifugal:
-            a = a + jnp.cross(omega, jnp.cross(omega, x))
-        F = self.m[:, None] * a
-        mD = self.m @ D
-        r_t = mv3(A, F.sum(axis=0))
-        r_r = jnp.cross(x, F).sum(axis=0) - jnp.cross(mD, k.g_b)
-        r_d = self.free_part(F - self.m[:, None] * k.g_b) + self.K @ c.d
-        return Rows(jnp.concatenate([r_t, r_r]), r_d)
+        return particle_rows(self, k, self.field, self.m, lambda a: self.m[:, None] * a)
 
     def kinetic(self, k: Kin):
         v = k.A.T @ k.V0 + self.field(k.d_dot) + jnp.cross(k.omega, self.r + self.field(k.c.d))

@@ -14,9 +14,8 @@ import numpy as np
 from ...fem.linalg import solve
 from ...fem.slip import rotate_matrix
 from ...physics.about import About
-from ...physics.kinematics import mv3, tv3
 from ...physics.terms import Kin, Rows
-from ..base import AbstractLiquid, StepInverse, inertial_lines, nodal_product, point_mass_scale
+from ..base import AbstractLiquid, StepInverse, inertial_lines, nodal_product, particle_rows, point_mass_scale
 from .sparse import hydrostatic_start, sparse_solver_blocks
 
 
@@ -94,21 +93,7 @@ class NodalLiquid(AbstractLiquid):
     def rows(self, k: Kin) -> Rows:
         """Eq. (4): the particle accelerations (body components), their inertia forces on the nodes,
         and what they do on the rigid rows and the liquid's own; the stiffness and the gravity load."""
-        c, A, omega = k.c, k.A, k.omega
-        a0, alpha = k.a6[:3], k.a6[3:6]
-        D, Dv, Da = self.full(c.d), self.full(k.d_dot), self.full(k.d_acc)
-        x = self.r + D
-        a = tv3(A, a0) + Da + jnp.cross(alpha, x)
-        if self.coriolis:
-            a = a + 2.0 * jnp.cross(omega, Dv)
-        if self.centrifugal:
-            a = a + jnp.cross(omega, jnp.cross(omega, x))
-        F = nodal_product(self.Ms, a)
-        mD = self.m_nodes @ D                                       # first moment of d
-        r_t = mv3(A, F.sum(axis=0))
-        r_r = jnp.cross(x, F).sum(axis=0) - jnp.cross(mD, k.g_b)
-        r_d = self.free_part(F - self.m_nodes[:, None] * k.g_b) + self.K @ c.d
-        return Rows(jnp.concatenate([r_t, r_r]), r_d)
+        return particle_rows(self, k, self.full, self.m_nodes, lambda a: nodal_product(self.Ms, a))
 
     def kinetic(self, k: Kin):
         v = k.A.T @ k.V0 + self.full(k.d_dot) + jnp.cross(k.omega, self.r + self.full(k.c.d))
