@@ -36,6 +36,7 @@ import numpy as np
 import scipy.linalg as sl
 import scipy.sparse.linalg as spla
 
+from ..liquid.base import rotation_penalty
 from ..scene.types import Scene
 from .linear import Linearisation, linearise
 from .rao import frequency_matrices, hull_tables, solve_equilibrated
@@ -159,8 +160,9 @@ def penalty_shares(lin: Linearisation, shapes) -> np.ndarray:
     a liquid built without its energy parts)."""
     b = lin.built
     k = shapes.shape[1]
+    pen = rotation_penalty(b.system.terms)
     parts = [tb.model.parts.get("rotation") if getattr(tb.model, "parts", None) else None for tb in b.tanks]
-    if b.block.penalty is None or k == 0 or any(p is None for p in parts):     # no RotationPenalty term
+    if pen is None or k == 0 or any(p is None for p in parts):
         return np.zeros(k)
     lay = b.system.layout()
     start = lay.n_small                         # the deformable block (vessel-frame structures too: linear.py)
@@ -177,7 +179,7 @@ def penalty_shares(lin: Linearisation, shapes) -> np.ndarray:
         v = Dt.reshape(k, -1)
         E += np.real(np.einsum("ki,ki->k", v.conj(), (P @ v.T).T))
     th, d = shapes[3:6], shapes[liq]
-    Kdt, Ktt = np.asarray(b.block.penalty[0]), np.asarray(b.block.penalty[1])
+    Kdt, Ktt = np.asarray(pen.Kdt), np.asarray(pen.Ktt)
     E += np.real(2 * np.einsum("ik,ik->k", th.conj(), Kdt.T @ d) + np.einsum("ik,ik->k", th.conj(), Ktt @ th))
     total = np.real(np.einsum("ik,ik->k", shapes.conj(), lin.K @ shapes))
     with np.errstate(divide="ignore", invalid="ignore"):

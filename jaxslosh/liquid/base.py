@@ -252,6 +252,12 @@ class RotationPenalty(AbstractTerm):
         return self.energy(k.c)
 
 
+def rotation_penalty(terms) -> Optional["RotationPenalty"]:
+    """The liquid's rotation penalty among a system's `terms` (None without: no liquid, the "paper"
+    element), for the analyses that split the potential energy by its parts."""
+    return next((t for t in terms if isinstance(t, RotationPenalty)), None)
+
+
 class SpinStiffening(AbstractTerm):
     """Structures in the vessel's frame with centrifugal stiffening: the geometric stiffness of the
     stress the spin causes, K_G(omega) = sum_k (omega omega^T)_k K_k (fem/structure.py). It follows
