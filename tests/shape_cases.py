@@ -46,7 +46,7 @@ def _u_tube_file(nx, ny, nz, length):
 
 def case(name):
     """(geometry, depth, mesh or None, element, reference omega (N,)) of the named case."""
-    from jaxslosh.fem.modes import analytic_sloshing_omegas
+    from jaxslosh.liquid.modes import analytic_sloshing_omegas
     from jaxslosh.geometry import Baffle, Box, Cylinder, MeshFile, Prismatic
 
     lng = ref.prismatic(6.0, 4.0, 1.5, 1.0, 1.5, 1.0)
@@ -99,12 +99,12 @@ def sloshing_omegas(geo, depth, mesh, element, n=N):
     """(omega of the n lowest sloshing modes, elements, kinds of the modes up to the n-th sloshing
     one) of the tank with the given element."""
     if element == "rt":
-        from jaxslosh.fem.liquid_rt import build_face_liquid, face_modes
+        from jaxslosh.liquid.face.element import build_face_liquid, face_modes
         tm = geo.mesh(depth, mesh or (1, 1, 1))
         md = face_modes(build_face_liquid(tm.nodes, tm.elements, tm.depth, 1000.0, 1500.0, G), n)
         return md.omega, len(tm.elements), list(md.kind)
-    from jaxslosh.fem.liquid import build_liquid
-    from jaxslosh.fem.modes import liquid_modes
+    from jaxslosh.liquid.nodal.model import build_liquid
+    from jaxslosh.liquid.modes import liquid_modes
     model = build_liquid(geo.size, depth, mesh or (1, 1, 1), 1000.0, 1500.0, G, element=element, sparse=True,
                          geometry=geo)
     md = liquid_modes(model, n=3 * n + 2)

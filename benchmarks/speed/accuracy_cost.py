@@ -25,9 +25,9 @@ import numpy as np
 from matplotlib.transforms import Bbox
 
 import jaxslosh as js
-from jaxslosh.fem.liquid import build_liquid
-from jaxslosh.fem.modes import analytic_sloshing_omegas
-from jaxslosh.fem.reduction import tank_basis
+from jaxslosh.liquid.nodal.model import build_liquid
+from jaxslosh.liquid.modes import analytic_sloshing_omegas
+from jaxslosh.liquid.modal.reduction import tank_basis
 from benchmarks.harness import ROOT, parser, scene as load, time_scene
 from benchmarks.speed.bench_paper import paper_variant
 

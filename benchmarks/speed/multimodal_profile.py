@@ -29,7 +29,7 @@ import numpy as np
 
 import jaxslosh as js
 from jaxslosh.physics.kinematics import tv3
-from jaxslosh.physics.multimodal_expansion import ExpandedTank
+from jaxslosh.liquid.multimodal.expansion import ExpandedTank
 from jaxslosh.solve.integrator import _split_newton, step_equations
 from jaxslosh.solve.integrator import step as int_step
 from jaxslosh.solve.newton import StructuredNewton

@@ -1,5 +1,5 @@
 """The face-normal liquid ("rt") at full order: its dense blocks against the blocks without dense
-matrices on the faces (fem/face_schur.py, solve/face_inverse.py), and the stabilized element, on the
+matrices on the faces (liquid/face/schur.py, liquid/face/inverse.py), and the stabilized element, on the
 shipped shaped scenes and on larger prismatic tanks.
 
     python -m benchmarks.speed.rt_full_order [--steps 100] [--cases lng_carrier,type_c_tank,...]
@@ -47,7 +47,7 @@ def with_solver(sc: js.Scene, solver: str) -> js.Scene:
 
 def one(name: str, solver: str, steps: int, tol: float) -> dict:
     """In this process: build, compile and time the case."""
-    from jaxslosh.solve import face_inverse
+    from jaxslosh.liquid.face import inverse as face_inverse
     face_inverse.MASS_TOL = tol
     r = time_scene(name, with_solver(case_scene(name), solver), steps, repeat=2)
     return dict(case=name, solver=solver, unknowns=r.unknowns, build=r.build_s, compile=r.compile_s,
@@ -59,7 +59,7 @@ def main():
     ap.add_argument("--steps", type=int, default=100)
     ap.add_argument("--cases", default="lng_carrier,type_c_tank,prismatic_small,prismatic_8k,prismatic_16k")
     ap.add_argument("--solvers", default="rt-dense,rt-sparse,stabilized")
-    ap.add_argument("--chebyshev-tol", type=float, default=1e-15, help="solve/face_inverse.MASS_TOL")
+    ap.add_argument("--chebyshev-tol", type=float, default=1e-15, help="liquid/face/inverse.MASS_TOL")
     ap.add_argument("--one", nargs=2, help=argparse.SUPPRESS)
     a = ap.parse_args()
     if a.quick:             # the small prismatic tank, the sparse faces, a few steps

@@ -1,6 +1,6 @@
 """The liquid damping's validation figures (docs/validation.md): the logarithmic decrement of a
 free decay of the first sloshing mode against 2 pi zeta / sqrt(1 - zeta^2), and the laminar
-boundary-layer ratio against the rectangular tank's closed form (fem/damping.py).
+boundary-layer ratio against the rectangular tank's closed form (liquid/damping.py).
 
     python -m benchmarks.validation.damping [--quick]
 
@@ -21,7 +21,7 @@ import numpy as np  # noqa: E402
 import jaxslosh as js  # noqa: E402
 from jaxslosh.assemble.damping import build_damping  # noqa: E402
 from jaxslosh.assemble.liquid import build_liquid_block  # noqa: E402
-from jaxslosh.fem.damping import rectangular_ratio  # noqa: E402
+from jaxslosh.liquid.damping import rectangular_ratio  # noqa: E402
 from jaxslosh.run.simulate import prepare  # noqa: E402
 from jaxslosh.solve.integrator import initial_state, step  # noqa: E402
 from benchmarks.harness import parser  # noqa: E402

@@ -163,8 +163,8 @@ def relative_penalty():
     """Our liquid with its rotation penalty on the RELATIVE rotation (curl d) only: the coupling to
     the body rotation theta (Liquid.Kdt, Ktt; docs/theory.md item 5) dropped. This is what a floating-
     frame body with a constant stiffness matrix can hold, so it is the model Exudyn is given."""
-    import jaxslosh.fem.liquid as lq
-    import jaxslosh.fem.reduction as rd
+    import jaxslosh.liquid.nodal.model as lq
+    import jaxslosh.liquid.modal.reduction as rd
     orig = lq.build_liquid
 
     def patched(*args, **kw):

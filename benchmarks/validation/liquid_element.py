@@ -37,9 +37,9 @@ import time
 
 import numpy as np
 
-from jaxslosh.fem.liquid import build_liquid
-from jaxslosh.fem.liquid_rt import build_face_liquid, face_modes
-from jaxslosh.fem.modes import liquid_modes
+from jaxslosh.liquid.nodal.model import build_liquid
+from jaxslosh.liquid.face.element import build_face_liquid, face_modes
+from jaxslosh.liquid.modes import liquid_modes
 from jaxslosh.geometry import Baffle, Box, MeshFile, Prismatic
 from benchmarks.harness import Table, parser
 from tests.section_meshes import hopper_baffle_hex, u_tube_hex
@@ -155,7 +155,7 @@ def six(elements, names, markdown=False):
 
 
 def cost(meshes, markdown=False):
-    from jaxslosh.fem.liquid_rt import face_basis, face_invariants
+    from jaxslosh.liquid.face.element import face_basis, face_invariants
     table = Table(("mesh", "{}"), ("face unknowns", "{:,}"), ("build", "{:.1f}"), ("face_modes (10)", "{:.1f}"),
                   ("face_basis (20 + correction)", "{:.1f}"), ("invariants", "{:.1f}"))
     for mesh in meshes:

@@ -13,10 +13,10 @@ blocks and modes are jaxslosh's fem/ internals, what `jaxslosh modes` prints). `
 import numpy as np
 
 import jaxslosh as js
-from jaxslosh.fem.liquid import build_liquid
-from jaxslosh.fem.liquid_rt import build_face_liquid
-from jaxslosh.fem.walls import build_tank_with_walls, tank_modes
-from jaxslosh.fem.walls_rt import build_face_tank_with_walls, face_tank_modes
+from jaxslosh.liquid.nodal.model import build_liquid
+from jaxslosh.liquid.face.element import build_face_liquid
+from jaxslosh.liquid.walls import build_tank_with_walls, tank_modes
+from jaxslosh.liquid.face.walls import build_face_tank_with_walls, face_tank_modes
 from benchmarks.harness import Table, parser, scene
 
 

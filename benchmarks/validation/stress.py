@@ -18,8 +18,8 @@ import time
 import numpy as np
 
 import jaxslosh as js
-from jaxslosh.fem.liquid import build_liquid
-from jaxslosh.fem.modes import analytic_sloshing_table, liquid_modes
+from jaxslosh.liquid.nodal.model import build_liquid
+from jaxslosh.liquid.modes import analytic_sloshing_table, liquid_modes
 from jaxslosh.run.tofile import run_to_file
 from benchmarks.harness import machine, parser, scene
 

@@ -15,11 +15,11 @@ import numpy as np
 from scipy.integrate import solve_ivp
 
 import jaxslosh as js
-from jaxslosh.fem.modes import effective_roll_inertia
+from jaxslosh.liquid.modes import effective_roll_inertia
 from jaxslosh.assemble.system import build
 from jaxslosh.physics.kinematics import rotation_matrix
-from jaxslosh.fem.liquid import build_liquid
-from jaxslosh.fem.modes import analytic_sloshing_omegas, liquid_modes
+from jaxslosh.liquid.nodal.model import build_liquid
+from jaxslosh.liquid.modes import analytic_sloshing_omegas, liquid_modes
 from benchmarks.harness import ROOT, Table, machine, parser, scene
 from tests.helpers import vessel_scene, zero_crossing_period
 

@@ -20,12 +20,12 @@ free-floating hull whose radiation damping vanishes at zero frequency) and overd
 lambda) are not oscillations and are counted apart.
 
 A mode whose potential energy lies mostly (PENALTY_SHARE) in the stabilized liquid element's
-rotation penalty (fem/liquid_element.py, term 3: kappa |P curl d + 2 theta|^2, which holds the
+rotation penalty (liquid/nodal/element.py, term 3: kappa |P curl d + 2 theta|^2, which holds the
 liquid's absolute rotation) is labelled "liquid rotation penalty (numerical)": a slow yaw of the
 hull against the liquid its tank holds still, restored by the penalty alone (no hydrostatics acts on
 yaw). An inviscid liquid has no such stiffness; the mode is an artefact of the element, not of the
 ship. Its share is x^H K_pen x / x^H K x, K_pen the penalty's d-d block (the liquid model's
-"rotation" part) with its d-theta and theta-theta blocks (physics/liquid.RotationPenalty).
+"rotation" part) with its d-theta and theta-theta blocks (liquid/base.RotationPenalty).
 """
 from __future__ import annotations
 
@@ -37,7 +37,7 @@ import numpy as np
 import scipy.linalg as sl
 import scipy.sparse.linalg as spla
 
-from ..physics.liquid import RotationPenalty
+from ..liquid.base import rotation_penalty
 from ..scene.types import Scene
 from .linear import Linearisation, linearise
 from ..assemble.bodyhydro import frequency_terms, radiating_bodies
@@ -173,9 +173,9 @@ def penalty_shares(lin: Linearisation, shapes) -> np.ndarray:
     a liquid built without its energy parts)."""
     b = lin.built
     k = shapes.shape[1]
-    pen = [t for t in b.system.terms if isinstance(t, RotationPenalty)]
+    pen = rotation_penalty(b.system.terms)
     parts = [tb.model.parts.get("rotation") if getattr(tb.model, "parts", None) else None for tb in b.tanks]
-    if not pen or k == 0 or any(p is None for p in parts):
+    if pen is None or k == 0 or any(p is None for p in parts):
         return np.zeros(k)
     lay = b.system.layout()
     start = lay.n_small                         # the deformable block (vessel-frame structures too: linear.py)
@@ -192,7 +192,7 @@ def penalty_shares(lin: Linearisation, shapes) -> np.ndarray:
         v = Dt.reshape(k, -1)
         E += np.real(np.einsum("ki,ki->k", v.conj(), (P @ v.T).T))
     th, d = shapes[3:6], shapes[liq]
-    Kdt, Ktt = np.asarray(pen[0].Kdt), np.asarray(pen[0].Ktt)
+    Kdt, Ktt = np.asarray(pen.Kdt), np.asarray(pen.Ktt)
     E += np.real(2 * np.einsum("ik,ik->k", th.conj(), Kdt.T @ d) + np.einsum("ik,ik->k", th.conj(), Ktt @ th))
     total = np.real(np.einsum("ik,ik->k", shapes.conj(), lin.K @ shapes))
     with np.errstate(divide="ignore", invalid="ignore"):

@@ -4,25 +4,25 @@ from __future__ import annotations
 import numpy as np
 
 from ..assemble.effects import free_liquid_dofs, modal_modes
-from ..assemble.multimodal3d import sample_points
-from ..fem.liquid import build_liquid
-from ..fem.liquid_rt import build_face_liquid, face_modes
+from ..liquid.multimodal.build3d import sample_points
+from ..liquid.nodal.model import build_liquid
+from ..liquid.face.element import build_face_liquid, face_modes
 from ..fem.mesh import face_nodes
-from ..fem.modes import Modes, liquid_modes
+from ..liquid.modes import Modes, liquid_modes
 from ..fem.structure import build_structure, clamped_modes
-from ..fem.walls import build_tank_with_walls, tank_modes
-from ..fem.walls_rt import build_face_tank_with_walls, face_tank_modes
-from ..physics.multimodal_modes import DiskBase, RectangleBase
+from ..liquid.walls import build_tank_with_walls, tank_modes
+from ..liquid.face.walls import build_face_tank_with_walls, face_tank_modes
+from ..liquid.multimodal.modes import DiskBase, RectangleBase
 from ..scene.types import Scene
-from ..solve.sparse import SPARSE_AUTO
+from ..liquid.nodal.sparse import SPARSE_AUTO
 
 
 def sloshing_modes(scene: Scene, tank=None, n: int = 10):
     """The first n modes of a tank's liquid: `Modes(omega, kind, free_surface_share, shapes)`."""
     t = scene.tank(tank) if tank is not None else scene.tanks[0]
-    if t.model == "multimodal":
+    if t.multimodal:
         return _multimodal_modes(scene, t, n)
-    if t.fluid.element == "rt":
+    if t.face_normal:
         return _face_modes(scene, t, n)
     # large meshes as the simulation takes them: sparse matrices and shift-invert Lanczos (a dense
     # generalized eigh needs every matrix dense, and crashed OpenBLAS at 20 x 20 x 12)
@@ -38,13 +38,13 @@ def sloshing_modes(scene: Scene, tank=None, n: int = 10):
 def _multimodal_modes(scene: Scene, t, n: int) -> Modes:
     """A multimodal tank's own linear modes, at most as many as it runs on, omega^2 = g k tanh(k h),
     each a free-surface mode, in frequency order: a two-dimensional box's standing waves along its
-    length, k_i = i pi / L (physics/multimodal.py); a three-dimensional box's k = pi sqrt((i / L)^2 +
+    length, k_i = i pi / L (liquid/multimodal/term.py); a three-dimensional box's k = pi sqrt((i / L)^2 +
     (j / B)^2), an upright cylinder's k = j'_{m,s} / R (the zeros of the Bessel functions' derivatives),
-    the base's lowest modes completed to whole degenerate pairs (physics/multimodal_modes.py). The
+    the base's lowest modes completed to whole degenerate pairs (liquid/multimodal/modes.py). The
     shapes are the surface elevation at sample points: along x in two dimensions; round the walls and
-    at the centre in three (assemble/multimodal3d.py)."""
+    at the centre in three (liquid/multimodal/build3d.py)."""
     modes = modal_modes(t)
-    if t.flow == "3d":
+    if t.three_dimensional:
         base = t.geometry.modal_base(RectangleBase, DiskBase)
         k = base.wavenumbers(modes)
         order = np.argsort(k, kind="stable")[:n]
@@ -59,7 +59,7 @@ def _multimodal_modes(scene: Scene, t, n: int) -> Modes:
 
 
 def _face_modes(scene: Scene, t, n: int) -> Modes:
-    """The face-normal element's modes (fem/liquid_rt.py): the circulation modes, all at zero
+    """The face-normal element's modes (liquid/face/element.py): the circulation modes, all at zero
     frequency, are left out and counted (`Modes.circulation`); shapes are nodal fields, each node the
     mean of its elements' displacements there."""
     tm = t.geometry.mesh(t.fill_depth, t.mesh)

@@ -6,7 +6,6 @@ from __future__ import annotations
 
 import dataclasses
 
-from ..physics.liquid import NoLiquid
 from ..physics.system import System
 from ..physics.terms import AbstractTerm
 from ..scene.types import Scene
@@ -38,7 +37,7 @@ def model_effects(system: System) -> list[tuple[str, str, object]]:
     """(effect, text, its owner) for every line the model's parts give; the owner is the term (or
     the System itself for gravity turning with the body)."""
     out = [(effect, text, part) for part in model_parts(system) for effect, text in part.describe()]
-    if system.gravity_turning and not isinstance(system.liquid, NoLiquid) and float(system.gravity) > 0:
+    if system.gravity_turning and not system.liquid.empty and float(system.gravity) > 0:
         out.append((*GRAVITY_TURNING, system))
     return out
 

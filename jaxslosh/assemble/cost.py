@@ -14,7 +14,7 @@ from typing import NamedTuple
 
 from ..scene.types import Scene, SceneError
 from ..solve.factored import DENSE_MAX
-from ..solve.sparse import SPARSE_AUTO
+from ..liquid.nodal.sparse import SPARSE_AUTO
 from .effects import count_unknowns, free_liquid_dofs
 
 #: a scene is refused when its estimate exceeds this share of the machine's memory (unless forced)
@@ -60,10 +60,10 @@ def _tank_bytes(t, sparse: bool, host_lu: bool = False, rt_dense: bool = False) 
     N = (nx + 1) * (ny + 1) * (nz + 1)
     nf = free_liquid_dofs(t)
     assembly = 8.0 * E * (24 * 24) * 3 + 8.0 * E * 64 * 3            # COO rows, columns and values
-    if t.fluid.element == "rt" and t.reduction is None:
-        # face-normal at full order (assemble/face_liquid.py): dense M, K and inverses on the ~3E
+    if t.face_normal and t.reduction is None:
+        # face-normal at full order (liquid/face/build.py): dense M, K and inverses on the ~3E
         # faces, or (sparse) dense blocks on the elements and top faces only, ~7 of them while the
-        # Schur complement's inverses are formed (fem/face_schur.py)
+        # Schur complement's inverses are formed (liquid/face/schur.py)
         return max(assembly, 8.0 * 6 * (3 * E) ** 2 if rt_dense else 8.0 * 7 * (E + nx * ny) ** 2)
     if not sparse:
         solver = 8.0 * (N * N + 4.0 * nf * nf)                      # mass, stiffness, two or three inverses

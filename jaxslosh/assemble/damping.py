@@ -1,6 +1,6 @@
-"""The liquid's modal damping of a scene (`[tanks.damping]`, physics/damping.py) from its tanks'
-sloshing modes (fem/damping.py): full order on the stacked free dofs, or on the modal basis of a
-reduced liquid (assemble/reduced.py).
+"""The liquid's modal damping of a scene (`[tanks.damping]`, liquid/modal_damping.py) from its tanks'
+sloshing modes (liquid/damping.py): full order on the stacked free dofs, or on the modal basis of a
+reduced liquid (liquid/modal/build.py).
 
 The modes come from the scene's values (as a reduced basis does): a traced fill depth or density
 leaves them as they are, and a traced `tanks.<name>.damping.ratio` scales the damping of each.
@@ -11,18 +11,12 @@ from typing import NamedTuple, Optional
 
 import jax.numpy as jnp
 import numpy as np
-import scipy.sparse as sp
 
-from ..fem.damping import SPARSE_SEARCH, boundary_layer_ratios, sloshing_modes, sloshing_share
-from ..fem.liquid import build_liquid
-from ..fem.liquid_rt import FaceLiquid, face_modes
-from ..fem.modes import free_matrices
-from ..fem.reduction import tank_basis
-from ..physics.damping import ModalDamping
+from ..liquid.damping import boundary_layer_ratios, sloshing_basis
+from ..liquid.modal_damping import ModalDamping
 from ..scene.fields import show
 from ..scene.types import Scene, SceneError
 from .liquid import build_liquid_block
-from .reduced import face_sloshing, face_tank_basis
 
 
 class TankDamping(NamedTuple):
@@ -34,7 +28,7 @@ class TankDamping(NamedTuple):
 
 def build_damping(scene: Scene, params: Optional[dict], block) -> tuple[Optional[ModalDamping], tuple]:
     """(ModalDamping or None, TankDamping per damped tank) for the liquid block `block`
-    (assemble/liquid.py LiquidBlock); None where no tank has a `[tanks.damping]` table."""
+    (liquid/block.py LiquidBlock); None where no tank has a `[tanks.damping]` table."""
     tanks = scene.tanks
     if not any(t.damping is not None for t in tanks) or not block.liquid.nf or not block.tanks:
         return None, ()
@@ -46,45 +40,7 @@ def build_damping(scene: Scene, params: Optional[dict], block) -> tuple[Optional
     reduced = tanks[0].reduction is not None
     parts, cs, table, offset = [], [], [], 0
     for i, (t, tb) in enumerate(zip(tanks, block.tanks)):
-        model = tb.model
-        if isinstance(model, FaceLiquid) and not reduced:      # full order: its lowest modes, on the free faces
-            fm = face_modes(model, SPARSE_SEARCH)
-            slosh = np.array([k == "sloshing" for k in fm.kind], dtype=bool)
-            f = np.flatnonzero(model.free)
-            omega, Phi = fm.omega[slosh], fm.fluxes[slosh].T                # Phi on all faces (wall integrals)
-            n_t = f.size
-            Bt = model.mass[f][:, f] @ Phi[f]
-            where = f"the {SPARSE_SEARCH} lowest modes searched on this mesh hold {omega.size}"
-        elif isinstance(model, FaceLiquid):      # on its modal basis
-            V, omega_b, n_modes, (_, _, _, k0) = face_tank_basis(model, t.origin, t.reduction.modes,
-                                                                 t.reduction.static_correction)
-            n_t = V.shape[1]
-            slosh = face_sloshing(model, V, n_modes)
-            omega, Phi = omega_b[slosh], V[:, slosh]
-            Bt = np.eye(n_t)[:, slosh]
-            where = f"the reduced basis holds {slosh.size} ([tanks.reduction] modes = {t.reduction.modes})"
-        elif model.traced:
-            model = build_liquid(t.size, t.fill_depth, t.mesh, t.fluid.density, t.fluid.sound_speed,
-                                 scene.environment.gravity, element=t.fluid.element, geometry=t.geometry)
-        if isinstance(model, FaceLiquid):
-            pass        # done above
-        elif reduced:
-            basis = tank_basis(model, t.origin, t.reduction.modes, t.reduction.static_correction)
-            n_t = basis.V.shape[1]
-            slosh = np.flatnonzero(sloshing_share(model, basis.V[:, :basis.n_modes]))
-            omega, Phi = basis.omega[slosh], basis.V[:, slosh]
-            Bt = np.eye(n_t)[:, slosh]                  # V^T M Phi: the basis holds these modes as they are
-            where = f"the reduced basis holds {slosh.size} ([tanks.reduction] modes = {t.reduction.modes})"
-        else:
-            omega, Phi = sloshing_modes(model)
-            n_t = Phi.shape[0]
-            Bt = free_matrices(model)[1] @ Phi
-            Bt = np.asarray(Bt.todense() if sp.issparse(Bt) else Bt)
-            if sp.issparse(model.stiffness):     # a large mesh: only its lowest modes are searched
-                searched = min(n_t - 1, SPARSE_SEARCH)
-                where = f"the {searched} lowest modes searched on this mesh hold {omega.size}"
-            else:
-                where = f"the mesh carries {omega.size}"
+        model, n_t, omega, Phi, Bt, where = sloshing_basis(tb.model, t, reduced, scene.environment.gravity)
         if t.damping is None:
             offset += n_t
             continue

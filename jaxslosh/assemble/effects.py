@@ -5,9 +5,9 @@ from __future__ import annotations
 
 import os
 
-from ..fem.face_mesh import free_face_count
-from ..fem.walls import shell_mesh
-from ..physics.multimodal_modes import DiskBase, RectangleBase
+from ..liquid.face.mesh import free_face_count
+from ..liquid.walls import shell_mesh
+from ..liquid.multimodal.modes import modal_modes
 from ..scene.types import EFFECTS, FACE_FORMS, Scene
 
 
@@ -75,15 +75,6 @@ def switched_off(scene: Scene) -> list[str]:
     return [k for k in EFFECTS if not getattr(scene.effects, k)]
 
 
-def modal_modes(t) -> tuple:
-    """The modes a multimodal tank runs on: cos(i pi x / L), i = 1..N, along a two-dimensional box
-    ((i, 0) each); the base's lowest, completed to whole degenerate groups, in three dimensions
-    (physics/multimodal_modes.py, as assemble/multimodal3d.py builds them)."""
-    if t.flow != "3d":
-        return tuple((i, 0) for i in range(1, t.modes + 1))
-    return t.geometry.modal_base(RectangleBase, DiskBase).lowest(t.modes)
-
-
 def modal_words(t) -> str:
     """What a multimodal tank is instead of a mesh: its free-surface modes."""
     n = len(modal_modes(t))
@@ -124,7 +115,7 @@ def tank_notes(t) -> list[str]:
 def free_liquid_dofs(tank) -> int:
     """A tank's free liquid unknowns at full order: the nodal elements' three dofs per node, less the
     wall-normal ones the slip walls hold; the face-normal element's free faces (the interior ones and
-    the free surface's, fem/liquid_rt.py); a multimodal tank's modal coordinates."""
+    the free surface's, liquid/face/element.py); a multimodal tank's modal coordinates."""
     if tank.model == "multimodal":
         return len(modal_modes(tank))
     if tank.fluid.element in FACE_FORMS:

@@ -66,7 +66,7 @@ def build_structures(scene: Scene):
 
 class HeldStructure(NamedTuple):
     """A structure with frame = "vessel" as the vessel-frame block takes it (the nodal liquid's
-    assemble/liquid.py, the face-normal one's assemble/face_liquid.py): its deformation in the
+    liquid/nodal/build.py walls_block, the face-normal one's liquid/face/build.py): its deformation in the
     vessel's frame on its nodal dofs, the attachment face held."""
     name: str
     origin: np.ndarray      # (3,) its min corner in the vessel frame

@@ -16,11 +16,10 @@ import numpy as np
 
 from ..mooring.lumped_term import build_lumped_lines
 from ..mooring.term import build_mooring
-from ..physics.damping import ModalDamping
-from ..physics.face_liquid import FluxLiquid
+from ..liquid.modal_damping import ModalDamping
 from ..physics.kinematics import quat_from_rpy, rotation_matrix
-from ..physics.liquid import NoLiquid, RotationPenalty, SpinStiffening
-from ..physics.multimodal import MultimodalLiquid
+from ..liquid.base import NoLiquid, RotationPenalty, SpinStiffening
+from ..liquid.multimodal.term import MultimodalLiquid
 from ..physics.structures import Structures
 from ..physics.system import System
 from ..physics.terms import Config
@@ -29,13 +28,12 @@ from ..physics.vessel import (HarmonicMotion, RecordedMotion, RigidBody, SpinUpM
 from ..staging import staged
 from ..scene.keys import resolve_params
 from ..scene.types import DOFS, Scene, SceneError
-from ..solve.sparse import hydrostatic_start
 from .about import damping_about, flex_about, liquid_about, record_about, stiffening_about, weight_about
 from .bodies import build_bodies, linear_hydrostatics
 from .damping import build_damping
 from .hull import build_hull_pressure
 from .liquid import LiquidBlock, build_liquid_block, outline_liquid_block, rigid_part
-from .multimodal import build_multimodal, multimodal_damping, multimodal_scene, probe_modal, surface_meshes, surfaces
+from ..liquid.multimodal.build import build_multimodal, multimodal_damping, multimodal_scene, probe_modal, surface_meshes, surfaces
 from .probes import Probes, build_probes
 from .seakeeping import build_seakeeping, outline_seakeeping
 from .structures import build_structures
@@ -139,7 +137,7 @@ def _model(scene: Scene, params: dict, outline: bool = False) -> _Model:
         block = outline_liquid_block(scene, include_liquid=eff.liquid)
     else:
         block = build_liquid_block(scene, params, g, include_liquid=eff.liquid)
-    has_liquid = not isinstance(block.liquid, NoLiquid)
+    has_liquid = not block.liquid.empty
     about = liquid_about(scene, eff.liquid)
     liquid = block.liquid
     if has_liquid and not multimodal:
@@ -240,8 +238,8 @@ def _hull(mass, inertia, parts):
 def _hydrostatic_start(system: System, q0):
     """Discrete hydrostatic equilibrium K d0 = F_g under the initial gravity direction (docs/theory.md
     item 6), so that the stiff acoustic modes are not excited by the start."""
-    if system.liquid.sparse and not isinstance(system.liquid, FluxLiquid):   # face-normal: columns of its own
-        return hydrostatic_start(system.liquid, system.gravity_body(rotation_matrix(q0)))
+    if not system.liquid.staged_start:        # the sparse nodal block's host solves
+        return system.liquid.static_start(system.gravity_body(rotation_matrix(q0)))
     return _dense_static_start(system, q0)
 
 

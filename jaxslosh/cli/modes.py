@@ -6,7 +6,7 @@ import math
 
 from ..analysis.coupled import PENALTY_LABEL, coupled_modes
 from ..analysis.modes import sloshing_modes, structure_modes
-from ..fem.modes import KIND_NOTES, others_in_band
+from ..liquid.modes import KIND_NOTES, others_in_band
 from .common import COMMANDS, EXIT_OK, InputError, setup_jax, load
 
 

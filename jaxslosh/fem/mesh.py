@@ -15,8 +15,8 @@ from __future__ import annotations
 import numpy as np
 
 #: the liquid's element forms on these meshes, here below the scene loader that reads them from
-#: `tanks.fluid.element`: the nodal forms (fem/liquid_element.py) and the face-normal ones
-#: (fem/liquid_rt.py)
+#: `tanks.fluid.element`: the nodal forms (liquid/nodal/element.py) and the face-normal ones
+#: (liquid/face/element.py)
 ELEMENT_FORMS = ("stabilized", "paper")
 FACE_FORMS = ("rt",)
 #: reference coordinates of the eight corners of the hex8 element

@@ -80,7 +80,7 @@ BAND_LAYERS = 2
 
 def surface_layers(h, points, n, width, sloped=False, where="mesh[2]"):
     """n + 1 heights from 0 to the surface h with every kink of `points` (inside) among them, the
-    layers thinner toward the surface: for the face-normal element (fem/liquid_rt.py), whose
+    layers thinner toward the surface: for the face-normal element (liquid/face/element.py), whose
     horizontal displacements are constant through a layer, while a sloshing mode decays from the
     surface down (as exp(-k d)). The layers are spread by the density 1 / (1 + d / l) at the depth
     d, l = SURFACE_GRADING x the surface's `width` (so they thicken linearly with depth); each band

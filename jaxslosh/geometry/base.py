@@ -97,7 +97,7 @@ class AbstractShape(abc.ABC):
 
     def modal_base(self, rectangle, disk):
         """The base the multimodal model's waves run on, built by `rectangle(L, B)` or `disk(R)`
-        (physics/multimodal_modes.py: the geometry sits below it)."""
+        (liquid/multimodal/modes.py: the geometry sits below it)."""
         raise ValueError(f'the multimodal model takes box and upright cylinder tanks, not shape = "{self.name}"')
 
     @classmethod

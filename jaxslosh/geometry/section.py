@@ -170,7 +170,7 @@ def _baffles(size, baffles, mesh, nodes, elements):
 
 
 def _extra_pairs(size, chamfers, baffles, h, mesh, nodes):
-    """The box scheme's count of constraints, kept (fem/liquid.py `_rotation_pairs`): the one-point
+    """The box scheme's count of constraints, kept (liquid/nodal/model.py `_rotation_pairs`): the one-point
     divergence and the axial curl leave exactly as many free fields as the box has sloshing modes,
     so every wall constraint beyond the box's removes a whole mode (a pinned line of nodes inside
     the liquid locks it: measured, a 5 m tank's first mode went from 2.29 to 3.43 rad/s). Each line

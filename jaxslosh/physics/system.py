@@ -17,12 +17,13 @@ such term.
 """
 from __future__ import annotations
 
+from typing import Any
+
 import equinox as eqx
 import jax
 import jax.numpy as jnp
 
 from .kinematics import G_matrix, quat_exp, quat_multiply, rotation_matrix, tv3
-from .liquid import AbstractLiquid
 from .terms import Config, Kin, Unknowns
 from .unknowns import Layout
 from .vessel import RigidBody
@@ -31,7 +32,9 @@ from .vessel import RigidBody
 class System(eqx.Module):
     body: RigidBody                  # the hull's inertia (always a term)
     terms: tuple                     # the other terms the scene has (buoyancy, weight, waves, penalties, ...)
-    liquid: AbstractLiquid           # the owner of the deformable unknowns (liquid.NoLiquid without tanks)
+    # the owner of the deformable unknowns: a jaxslosh/liquid AbstractLiquid (NoLiquid without tanks);
+    # the liquid sits above this module and the solver pieces (it owns its constant block's inverse)
+    liquid: Any
     gravity: jax.Array               # m/s^2, along -Z
     q_ref: jax.Array                 # the initial attitude
     # terms summed after the liquid's rows (its modal damping, [tanks.damping]): the sums' order is

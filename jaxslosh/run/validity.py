@@ -14,10 +14,10 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..assemble.multimodal3d import tank_3d, three_dimensional
+from ..liquid.multimodal.build3d import tank_3d, three_dimensional
 from ..physics.kinematics import rpy_from_quat
-from ..physics.multimodal import NX
-from ..physics.multimodal_steep import STEEP_ON
+from ..liquid.multimodal.term import NX
+from ..liquid.multimodal.steep import STEEP_ON
 from ..scene.types import Scene
 
 #: a frame residual this many times its level, max(tolerance, round-off floor), is reported (the
@@ -35,10 +35,10 @@ def _surface_tables(scene: Scene):
     """Per multimodal tank, (offset of its modal amplitudes, the slope's rows (P, modes) or its x and y
     rows for a three-dimensional tank, the elevation's rows at the liquid's quadrature points (Q,
     modes), their weights (Q,), k_N, omega_N^2): what the slope, the crest index and the round-off
-    floor (physics/multimodal_steep.py) are read from, at the points and weights the liquid uses."""
+    floor (liquid/multimodal/steep.py) are read from, at the points and weights the liquid uses."""
     out, off = [], 0
     for t in scene.tanks:
-        if t.model != "multimodal":
+        if not t.multimodal:
             return []
         if three_dimensional(t):
             mt = tank_3d(t, t.fill_depth, t.fluid.density)
@@ -135,7 +135,7 @@ class Watch:
                 level = np.maximum(level, self.noise * d.max(axis=1))
         if field is not None:
             # a multimodal tank's own floor under high crests, as its Newton iterations take it
-            # (physics/multimodal_steep.roundoff_floor)
+            # (liquid/multimodal/steep.roundoff_floor)
             raw = np.asarray(field, float).reshape(time.size, -1)
             for off, _, Z, _, kN, om2 in self.tables:
                 b = raw[:, off:off + Z.shape[1]]
@@ -158,7 +158,7 @@ class Watch:
                 continue
             roof = t.size[2] - t.fill_depth
             where = f"tanks[{i}] ({t.name!r})"
-            model = "the multimodal liquid" if t.model == "multimodal" else "the linear liquid"
+            model = "the multimodal liquid" if t.multimodal else "the linear liquid"
             if self.high[i] > roof:
                 out.append(f"{where}: the free surface rose {self.high[i]:.3g} m at t = {self.t_high[i]:.4g} s, "
                            f"above the roof ({roof:.3g} m of freeboard): {model} is outside its validity")

@@ -344,7 +344,7 @@ def _tank(table, where: str, base_dir: str = "") -> Tank:
 
 
 def _multimodal_tank(table, where: str) -> None:
-    """A multimodal tank is a plain box (physics/multimodal.py, or multimodal3d.py with flow = "3d") or
+    """A multimodal tank is a plain box (liquid/multimodal/term.py, or multimodal3d.py with flow = "3d") or
     an upright circular cylinder (multimodal3d.py) with rigid walls."""
     read_multimodal_shape(table, where)
     if "shape" in table and not SHAPES[table["shape"]].modal:

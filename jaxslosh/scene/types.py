@@ -181,7 +181,7 @@ class Material:
 class Fluid:
     density: float = 1000.0          # kg/m^3, > 0
     sound_speed: float = 1500.0      # m/s, > 0
-    element: str = "stabilized"      # liquid element form: ELEMENT_FORMS (fem/liquid.py) or FACE_FORMS (fem/liquid_rt.py)
+    element: str = "stabilized"      # liquid element form: ELEMENT_FORMS (liquid/nodal/model.py) or FACE_FORMS (liquid/face/element.py)
     element_default: str = ""        # why the loader chose `element` when the scene left it out ("" when given)
 
 
@@ -195,7 +195,7 @@ class Reduction:
 
 @dataclass(frozen=True)
 class Damping:
-    """`[tanks.damping]`: linear damping of the liquid's sloshing modes (physics/damping.py)."""
+    """`[tanks.damping]`: linear damping of the liquid's sloshing modes (liquid/modal_damping.py)."""
     ratio: Union[float, tuple] = 0.0   # every sloshing mode's damping ratio, or one per lowest mode (others 0)
     viscosity: float = 0.0             # m^2/s, >= 0: adds each mode's laminar boundary-layer damping
 
@@ -224,14 +224,36 @@ class Tank:
     axis: str = "x"                         # cylinder: "x", "y" (horizontal) or "z" (vertical)
     file: str = ""                          # mesh: the mesh file (absolute path)
     baffles: tuple = ()                     # geometry.Baffle per [[tanks.baffles]]
-    model: str = "fem"                      # "fem" | "multimodal" (physics/multimodal.py)
+    model: str = "fem"                      # "fem" | "multimodal" (liquid/multimodal/term.py)
     modes: int = 6                          # multimodal: free-surface modes (the lowest, whole degenerate groups)
     flow: str = "2d"                        # multimodal: "2d" along a box's length | "3d" (a cylinder's always)
-    expansion: str = "exact"                # multimodal: "exact" integrals | "third-order" (physics/multimodal_expansion.py)
+    expansion: str = "exact"                # multimodal: "exact" integrals | "third-order" (liquid/multimodal/expansion.py)
 
     #: the shape (jaxslosh/geometry), built by the loader from the keys above; a Tank made by hand
     #: gets it from them
     geometry: Optional[AbstractShape] = field(default=None, compare=False, repr=False)
+
+    # The liquid model the tank's keys choose, read here once (jaxslosh/liquid decides the rest):
+    # code elsewhere asks these, not the strings of `model`, `fluid.element`, `flow`, `expansion`.
+    @property
+    def multimodal(self) -> bool:
+        """Its liquid is the multimodal one (liquid/multimodal), not a finite-element one."""
+        return self.model == "multimodal"
+
+    @property
+    def face_normal(self) -> bool:
+        """Its finite-element liquid is the face-normal element (liquid/face), not a nodal one."""
+        return self.fluid.element in FACE_FORMS
+
+    @property
+    def three_dimensional(self) -> bool:
+        """A multimodal tank's flow is three-dimensional (a cylinder's always), not along x alone."""
+        return self.flow == "3d"
+
+    @property
+    def third_order(self) -> bool:
+        """A multimodal tank runs its third-order system, not the exact integrals."""
+        return self.expansion == "third-order"
 
     def __post_init__(self):
         if self.geometry is None:

@@ -1,5 +1,5 @@
-"""The constant blocks of the Newton matrix, inverted once per run: the liquid's (dense inverses,
-the sparse path of sparse.py, or the modal liquid's small blocks) and the structures' modal block."""
+"""The constant blocks of the Newton matrix, inverted once per run: the liquid's (formed by the
+liquid itself, AbstractLiquid.step_inverse) and the structures' modal block."""
 from __future__ import annotations
 
 import dataclasses
@@ -10,13 +10,9 @@ import jax
 import jax.numpy as jnp
 import numpy as np
 
-from ..fem.linalg import inv
-from ..physics.face_liquid import FluxLiquid
 from ..physics.system import System
 from ..staging import staged
 from .schemes import Scheme
-from .face_inverse import face_solver_blocks
-from .sparse import sparse_solver_blocks
 
 
 class Solver(eqx.Module):
@@ -88,58 +84,33 @@ def make_solver(system: System, h: float, scheme: Scheme, tol: float, max_iter: 
 
 
 def _liquid_solver(system: System, h, scheme: Scheme, tol, max_iter, substeps, reuse, adaptive) -> Solver:
-    """The solver of the vessel and its liquid: the deformable block's inverses."""
+    """The solver of the vessel and its liquid: the deformable block's inverses, which the liquid forms
+    itself (AbstractLiquid.step_inverse: dense, the sparse factors, the box-grid solve, the face-normal
+    Schur blocks)."""
     nf = system.nf
     if nf == 0 or system.liquid.nonlinear:      # a nonlinear liquid's few unknowns: linearised exactly
         z = jnp.zeros((0, 0))
         return Solver(z, z, jnp.asarray(h, dtype=float), scheme, tol, max_iter, substeps, z if substeps else None,
                       reuse=reuse, adaptive=adaptive, ns=6 + nf)
-    L = system.liquid
-    if L.sparse:         # large mesh (sparse.py): fast diagonalization, factors in JAX, or the host's LU;
-        #                  face-normal tanks: their Schur complement's blocks (face_inverse.py)
-        blocks = face_solver_blocks if isinstance(L, FluxLiquid) else sparse_solver_blocks
-        step_inv, mass_inv, sub_inv, K = blocks(L, scheme.c_a(h), scheme.c_a(h / substeps) if substeps else None)
-        step_inv = damped(step_inv, system, scheme, h)
-        sub_inv = damped(sub_inv, system, scheme, h / substeps) if substeps else None
-        scale = jax.lax.stop_gradient(system.scales()[6:])
-        rowsum = K if isinstance(L, FluxLiquid) else abs(K).sum(axis=1)   # face blocks: K is its row sums (never formed)
-        if isinstance(rowsum, jax.core.Tracer) or isinstance(scale, jax.core.Tracer):   # face blocks at traced values
-            noise = jnp.finfo(jnp.float64).eps * jnp.max(jnp.asarray(rowsum).reshape(-1) / scale)
-        else:
-            scale = np.asarray(scale)
-            noise = np.finfo(np.float64).eps * np.max(np.asarray(rowsum).reshape(-1) / scale)
-        return Solver(step_inv, mass_inv, jnp.asarray(h, dtype=float), scheme, tol, max_iter, substeps, sub_inv,
-                      noise=noise, reuse=reuse, adaptive=adaptive)
-    M_ff, K_ff = jax.lax.stop_gradient(L).constant_blocks()
-    traced = isinstance(M_ff, jax.core.Tracer) or isinstance(K_ff, jax.core.Tracer)
-    if not traced:
-        M_ff, K_ff = np.asarray(M_ff), np.asarray(K_ff)
-
-    def inverse(A):
-        return inv(A) if traced else jnp.asarray(np.linalg.inv(A))
-
-    def step_block_inverse(hh):
-        Cs = scheme.c_a(hh) * M_ff + K_ff
-        return inverse(0.5 * (Cs + Cs.T))
-
-    noise = _noise(system, K_ff)
-    return Solver(damped(step_block_inverse(h), system, scheme, h), inverse(M_ff), jnp.asarray(h, dtype=float),
-                  scheme, tol, max_iter, substeps,
-                  damped(step_block_inverse(h / substeps), system, scheme, h / substeps) if substeps else None,
-                  noise=noise, reuse=reuse, adaptive=adaptive)
+    blocks = system.liquid.step_inverse(scheme.c_a(h), scheme.c_a(h / substeps) if substeps else None)
+    step_inv = damped(blocks.step, system, scheme, h)
+    sub_inv = damped(blocks.sub, system, scheme, h / substeps) if substeps else None
+    return Solver(step_inv, blocks.mass, jnp.asarray(h, dtype=float), scheme, tol, max_iter, substeps, sub_inv,
+                  noise=_noise(system, blocks.stiffness_rows), reuse=reuse, adaptive=adaptive)
 
 
-@staged
-def _noise(system: System, K_ff):
+def _noise(system: System, rowsum):
     """The round-off floor of the scaled residual: eps times the largest row of |K| per unit scale."""
     scale = jax.lax.stop_gradient(system.scales()[6:])
-    return jnp.finfo(jnp.float64).eps * jnp.max(jnp.sum(jnp.abs(jnp.asarray(K_ff)), axis=1) / scale)
+    if isinstance(rowsum, jax.core.Tracer) or isinstance(scale, jax.core.Tracer):
+        return jnp.finfo(jnp.float64).eps * jnp.max(jnp.asarray(rowsum).reshape(-1) / scale)
+    return np.finfo(np.float64).eps * np.max(np.asarray(rowsum).reshape(-1) / np.asarray(scale))
 
 
 def damped(base, system: System, scheme: Scheme, hh):
     """The step block's inverse with every term's constant velocity tangent c_v dR/d(d_dot) added
     (c_v = d v_{n+1} / d Delta = gamma / (beta h)): AbstractTerm.update_inverse, the modal
-    damping's low-rank update (physics/damping.py); `base` itself from a term without one."""
+    damping's low-rank update (liquid/modal_damping.py); `base` itself from a term without one."""
     c_v = scheme.c_v(hh)
     for term in system.all_terms():
         base = term.update_inverse(base, c_v)

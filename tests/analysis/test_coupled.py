@@ -174,7 +174,7 @@ def test_forced_roll_surface_amplitude_matches_the_linear_modal_solution(ratio):
     """Tank rolled harmonically about the vessel's COG (1 m above the tank bottom): the steady
     surface elevation at a wall node from the nonlinear transient against the linear frequency-domain
     (all-modes) solution of the same liquid: Euler force, gravity turning, rotation penalty."""
-    from jaxslosh.fem.liquid import build_liquid
+    from jaxslosh.liquid.nodal.model import build_liquid
     b, h = 2.0, 1.0
     mesh = (2, 8, 4)
     w1 = np.sqrt(G * np.pi / b * np.tanh(np.pi / b * h))

@@ -11,12 +11,12 @@ from jaxslosh.assemble.damping import build_damping
 from jaxslosh.assemble.liquid import build_liquid_block
 from jaxslosh.assemble.system import build
 from jaxslosh.cli.main import main
-from jaxslosh.fem.damping import rectangular_ratio
+from jaxslosh.liquid.damping import rectangular_ratio
 from jaxslosh.fit.identify import identify
 from jaxslosh.fit.problem import add_noise
 from jaxslosh.run.simulate import prepare
 from jaxslosh.solve.integrator import initial_state, step
-from jaxslosh.physics.damping import LowRankUpdate, ModalDamping
+from jaxslosh.liquid.modal_damping import LowRankUpdate, ModalDamping
 
 from helpers import vessel_scene
 
@@ -120,10 +120,10 @@ def test_hht_damps_too():
 
 def test_viscosity_against_the_boundary_layer_formula():
     """The first mode's laminar boundary-layer ratio from the mesh's mode (wall integrals) against the
-    closed form for a rectangular tank (fem/damping.py rectangular_ratio) within 10 % on two meshes,
+    closed form for a rectangular tank (liquid/damping.py rectangular_ratio) within 10 % on two meshes,
     proportional to sqrt(nu); a ratio adds to it."""
     closed = rectangular_ratio(1.0, 0.4, 0.5, 9.81, 1e-6)
-    k, h = math.pi / 1.0, 0.5                 # the formula written out here, apart from fem/damping.py
+    k, h = math.pi / 1.0, 0.5                 # the formula written out here, apart from liquid/damping.py
     w = math.sqrt(9.81 * k * math.tanh(k * h))
     by_hand = math.sqrt(1e-6 / (2 * w)) * (1 / 1.0 + 1 / 0.4 + k * (1 - 2 * h / 1.0) / math.sinh(2 * k * h))
     assert abs(closed / by_hand - 1) < 1e-12, (closed, by_hand)

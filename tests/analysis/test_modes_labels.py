@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 
 from jaxslosh.cli.main import main
-from jaxslosh.fem.modes import others_in_band
+from jaxslosh.liquid.modes import others_in_band
 
 HEAD = """
 title = "labels"

@@ -1,4 +1,4 @@
-"""Runs of the face-normal liquid element "rt" (issue 30, fem/liquid_rt.py) beyond the plain
+"""Runs of the face-normal liquid element "rt" (issue 30, liquid/face/element.py) beyond the plain
 reduced run of tests/fem/test_liquid_element_rt.py: modal damping (`[tanks.damping]`) on its sloshing
 modes, the U-tube's exchange in a forced roll near its frequency against an independent linear
 theory (tests/u_tube_response.py), the default element, and rao / sweep on an rt tank."""
@@ -12,7 +12,7 @@ import pytest
 import jaxslosh as js
 from jaxslosh.assemble.damping import build_damping
 from jaxslosh.assemble.liquid import build_liquid_block
-from jaxslosh.fem.damping import rectangular_ratio
+from jaxslosh.liquid.damping import rectangular_ratio
 
 sys.path.insert(0, os.path.dirname(os.path.dirname(os.path.abspath(__file__))))    # tests/: the references
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
@@ -38,7 +38,7 @@ def test_free_decay_of_an_rt_tank_has_the_decrement_of_its_ratio():
 
 def test_rt_boundary_layer_ratio_against_the_closed_form():
     """The laminar boundary-layer ratio of the first mode from the rt element's own wall field
-    (fem/damping.py) against the rectangular tank's closed form within 3 % (8 x 2 x 4) and 1 %
+    (liquid/damping.py) against the rectangular tank's closed form within 3 % (8 x 2 x 4) and 1 %
     (16 x 4 x 8); a ratio adds to it; every mode of the basis that is sloshing is damped."""
     closed = rectangular_ratio(1.0, 0.4, 0.5, 9.81, 1e-6)
     for mesh, tol in (([8, 2, 4], 0.03), ([16, 4, 8], 0.01)):
@@ -274,7 +274,7 @@ def test_structures_in_the_vessel_frame_with_a_sloped_tank():
 
 
 def test_rt_with_elastic_walls_check_names_the_element(tmp_path, capsys):
-    """"rt" in elastic walls (fem/walls_rt.py; tests/fem/test_walls_rt.py and
+    """"rt" in elastic walls (liquid/face/walls.py; tests/fem/test_walls_rt.py and
     tests/physics/test_rt_elastic_walls.py check it): `check` accepts it and prints the element, how
     it runs, and how the walls hold the liquid."""
     from jaxslosh.cli.main import main

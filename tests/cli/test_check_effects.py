@@ -17,7 +17,7 @@ from jaxslosh.assemble.check import GRAVITY_TURNING, model_effects, model_parts
 from jaxslosh.assemble.system import build, outline
 from jaxslosh.cli import main
 from jaxslosh.physics.about import About
-from jaxslosh.physics.liquid import AbstractLiquid, NoLiquid
+from jaxslosh.liquid.base import AbstractLiquid, NoLiquid
 from jaxslosh.physics.vessel import AbstractPrescribedMotion
 
 DATA = os.path.join(os.path.dirname(os.path.dirname(__file__)), "data")

@@ -22,6 +22,9 @@ LAYERS = [
     # mooring lines: the catenary and the lines' term, below the assembly that adds it
     {"mooring"},
     {"solve"},
+    # the liquid models (jaxslosh/liquid): each its element, blocks, term, inverse and builder; above
+    # the solver pieces its inverses use, below the assembly that builds a scene's system from them
+    {"liquid"},
     {"assemble"},
     {"run.loop"},
     # the compile cache: a wing above the loop it compiles, below the runs that use it

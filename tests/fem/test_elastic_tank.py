@@ -6,11 +6,11 @@ import numpy as np
 import scipy.linalg as sl
 
 import jaxslosh as js
-from jaxslosh.fem.liquid import build_liquid
-from jaxslosh.fem.modes import liquid_modes
+from jaxslosh.liquid.nodal.model import build_liquid
+from jaxslosh.liquid.modes import liquid_modes
 from jaxslosh.scene.types import Fluid, Material, Tank, Walls
-from jaxslosh.fem.walls import build_walls
-from jaxslosh.fem.walls import build_tank_with_walls, tank_modes
+from jaxslosh.liquid.walls import build_walls
+from jaxslosh.liquid.walls import build_tank_with_walls, tank_modes
 
 ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 SIZE, FILL, MESH = (5.0, 5.0, 4.0), 3.0, (5, 5, 5)

@@ -1,5 +1,5 @@
-"""The face-normal liquid at full order without dense matrices on the faces (fem/face_schur.py,
-physics/face_blocks.py, solve/face_inverse.py) against the dense blocks (assemble/face_liquid.py
+"""The face-normal liquid at full order without dense matrices on the faces (liquid/face/schur.py,
+liquid/face/blocks.py, liquid/face/inverse.py) against the dense blocks (liquid/face/build.py
 with sparse=False) on small meshes: the stiffness, the Newton blocks' inverses, the static start and
 the absolute-rotation penalty to round-off, a run to the Newton solver's floor, and the operators
 under vmap and jax.export."""
@@ -11,12 +11,12 @@ import numpy as np
 import pytest
 
 import jaxslosh as js
-from jaxslosh.assemble.face_liquid import face_full_liquid
+from jaxslosh.liquid.face.build import face_full_liquid
 from jaxslosh.assemble.liquid import build_liquid_block
-from jaxslosh.fem.face_schur import face_schur
-from jaxslosh.fem.liquid_rt import build_face_liquid
+from jaxslosh.liquid.face.schur import face_schur
+from jaxslosh.liquid.face.element import build_face_liquid
 from jaxslosh.geometry import Baffle, Box, Prismatic
-from jaxslosh.solve.face_inverse import chebyshev_steps, face_solver_blocks
+from jaxslosh.liquid.face.inverse import chebyshev_steps, face_solver_blocks
 
 
 def _models():
@@ -138,7 +138,7 @@ def test_a_run_through_the_sparse_blocks_equals_the_dense_run():
 
 
 def test_scaled_sparse_blocks_equal_the_dense_ones():
-    """Density, sound speed and gravity other than the model's (assemble/liquid.py face_scales: the
+    """Density, sound speed and gravity other than the model's (liquid/face/stack.py face_scales: the
     mass, the compression and the free surface scale with rho, rho c^2 and rho g): the sparse blocks
     equal the dense blocks at those values, the stiffness, row sums (a bound within the factors'
     spread), the static start and the Newton blocks' inverses; and traced (jit, grad) as well."""

@@ -5,9 +5,9 @@ import pytest
 import scipy.linalg as sl
 
 from jaxslosh.scene.types import ELEMENT_FORMS
-from jaxslosh.fem.liquid_element import ROTATION_PENALTY
-from jaxslosh.fem.liquid import build_liquid
-from jaxslosh.fem.modes import analytic_sloshing_omegas, analytic_sloshing_table, free_mass, liquid_modes
+from jaxslosh.liquid.nodal.element import ROTATION_PENALTY
+from jaxslosh.liquid.nodal.model import build_liquid
+from jaxslosh.liquid.modes import analytic_sloshing_omegas, analytic_sloshing_table, free_mass, liquid_modes
 
 RHO, G = 1000.0, 9.81
 TANK = dict(size=(5.0, 5.0, 4.0), fill_depth=3.0, density=RHO, sound_speed=1500.0, gravity=G)

@@ -1,4 +1,4 @@
-"""The face-normal liquid element "rt" (issue 30, fem/liquid_rt.py): its kinematics (a uniform
+"""The face-normal liquid element "rt" (issue 30, liquid/face/element.py): its kinematics (a uniform
 flow reproduced exactly, fluxes through faces, the mass of a translation), its kernel (the
 circulation modes, exactly at zero and left out), and its sloshing frequencies against closed
 forms and the project's independent 2-D reference (tests/sloshing_reference.py) on the sections
@@ -14,8 +14,8 @@ import pytest
 import scipy.linalg as sl
 
 from jaxslosh.cli.main import main
-from jaxslosh.fem.liquid_rt import build_face_liquid, face_modes
-from jaxslosh.fem.modes import analytic_sloshing_omegas
+from jaxslosh.liquid.face.element import build_face_liquid, face_modes
+from jaxslosh.liquid.modes import analytic_sloshing_omegas
 from jaxslosh.geometry import Baffle, Box, Prismatic
 
 sys.path.insert(0, os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
@@ -249,7 +249,7 @@ def test_static_tilt_keeps_the_surface_level():
     basis, the free surface's face elevations q_f / A_f lie on the plane normal to the apparent
     gravity (to 1e-4 of the tilt: the basis holds compression modes 1e6 times stiffer), in a box and in
     a hopper (sloping walls)."""
-    from jaxslosh.fem.liquid_rt import _gauss, _loads, face_basis
+    from jaxslosh.liquid.face.element import _gauss, _loads, face_basis
     for geo, mesh in [(Box(size=(3.0, 2.0, 2.0)), (6, 4, 3)),
                       (Prismatic(size=(1.0, 2.0, 2.0), chamfers=((0.5, 0.5), (0.0, 0.0))),
                        (2, 8, 4))]:
@@ -273,7 +273,7 @@ def test_rotation_penalty_blocks():
     """The basis's last vectors are circulation (no energy of the liquid's own); the penalty
     1/2 kappa |zeta + C theta|^2 vanishes at its minimum over zeta: K_tt = K_dt^T K_dt / kappa.
     The basis is M-orthonormal and the invariants hold the liquid's mass and centroid."""
-    from jaxslosh.fem.liquid_rt import face_basis, face_invariants
+    from jaxslosh.liquid.face.element import face_basis, face_invariants
     m = box((5.0, 5.0, 4.0), 3.0, (4, 4, 3))
     V, _, n_modes, (Kdt, Ktt, kappa, k0) = face_basis(m, (1.0, 2.0, 0.5), 6)
     assert n_modes == 6 and V.shape[1] - k0 == 3
@@ -391,7 +391,7 @@ def test_rotation_penalty_follows_the_highest_sloshing_mode_not_an_acoustic_one(
     """Asked for more modes than the mesh has sloshing modes, the basis takes acoustic ones too; the
     penalty's stiffness stays ROTATION_PENALTY_RATIO times the highest *sloshing* mode kept (an
     acoustic mode's would make it needlessly stiff and the run's liquid with it)."""
-    from jaxslosh.fem.liquid_rt import ROTATION_PENALTY_RATIO, face_basis, face_modes
+    from jaxslosh.liquid.face.element import ROTATION_PENALTY_RATIO, face_basis, face_modes
     m = box((5.0, 5.0, 4.0), 3.0, (3, 3, 2))
     fm = face_modes(m, 14)
     assert "acoustic" in fm.kind and "sloshing" in fm.kind

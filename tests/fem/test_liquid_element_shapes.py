@@ -11,7 +11,7 @@ import sys
 import numpy as np
 import pytest
 
-from jaxslosh.fem.liquid_rt import build_face_liquid, face_modes
+from jaxslosh.liquid.face.element import build_face_liquid, face_modes
 from jaxslosh.geometry import Cylinder, Prismatic
 
 sys.path.insert(0, os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
@@ -80,8 +80,8 @@ def test_the_pair_at_sloping_walls_is_edge_waves():
 
 
 def stabilized_sloshing(geo, depth, mesh, n):
-    from jaxslosh.fem.liquid import build_liquid
-    from jaxslosh.fem.modes import liquid_modes
+    from jaxslosh.liquid.nodal.model import build_liquid
+    from jaxslosh.liquid.modes import liquid_modes
     model = build_liquid(geo.size, depth, mesh, RHO, C, G, element="stabilized", sparse=True, geometry=geo)
     md = liquid_modes(model, n=2 * n + 4)
     kind = np.array(md.kind)

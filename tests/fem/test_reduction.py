@@ -13,9 +13,9 @@ import scipy.linalg
 import jaxslosh as js
 from jaxslosh.assemble.system import build
 from jaxslosh.physics.kinematics import quat_exp
-from jaxslosh.fem.liquid import build_liquid
+from jaxslosh.liquid.nodal.model import build_liquid
 from jaxslosh.physics.terms import Config
-from jaxslosh.fem.modes import liquid_modes
+from jaxslosh.liquid.modes import liquid_modes
 
 ROOT = Path(__file__).resolve().parents[2]
 PAPER = (ROOT / "scenes" / "paper_ship_tank.toml").read_text()
@@ -57,7 +57,7 @@ def test_reduced_rows_and_energies_are_the_full_models_at_d_equal_V_eta():
 
 
 def test_reduced_frequencies_are_the_full_models():
-    from jaxslosh.fem.reduction import tank_basis
+    from jaxslosh.liquid.modal.reduction import tank_basis
     t = js.load_scene(PAPER).tanks[0]
     model = build_liquid(t.size, t.fill_depth, t.mesh, t.fluid.density, t.fluid.sound_speed, 9.81)
     full = liquid_modes(model, 24)
@@ -78,7 +78,7 @@ def test_sparse_and_dense_liquid_give_the_same_ritz_basis():
     """Large meshes reduce from the sparse matrices (shift-invert Lanczos and a sparse LU for the
     static correction; a dense generalized eigh of the 15,666 unknowns of 20 x 20 x 12 crashed
     OpenBLAS): same frequencies and the same subspace as the dense path, on a mesh both can hold."""
-    from jaxslosh.fem.reduction import tank_basis
+    from jaxslosh.liquid.modal.reduction import tank_basis
     t = js.load_scene(PAPER).tanks[0]
     args = (t.size, t.fill_depth, (4, 4, 3), t.fluid.density, t.fluid.sound_speed, 9.81)
     dense = tank_basis(build_liquid(*args), t.origin, 8)

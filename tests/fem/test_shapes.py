@@ -9,8 +9,8 @@ import pytest
 
 import jaxslosh as js
 from jaxslosh.cli.main import main
-from jaxslosh.fem.liquid import build_liquid
-from jaxslosh.fem.modes import free_matrices, liquid_modes
+from jaxslosh.liquid.nodal.model import build_liquid
+from jaxslosh.liquid.modes import free_matrices, liquid_modes
 from jaxslosh.geometry import Baffle, Box, Cylinder, MeshFile, Prismatic
 
 sys.path.insert(0, os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
@@ -212,9 +212,9 @@ def test_horizontal_cylinder_longitudinal_mode_against_the_box():
 
 
 def test_wall_integrals_on_faces_equal_the_box_planes():
-    """The boundary-layer damping's wall integral over any mesh's wall faces (fem/damping.py) equals
+    """The boundary-layer damping's wall integral over any mesh's wall faces (liquid/damping.py) equals
     the box's plane-by-plane one on the same box grid."""
-    from jaxslosh.fem.damping import wall_integrals
+    from jaxslosh.liquid.damping import wall_integrals
     box = build_liquid((5.0, 4.0, 3.0), 2.0, (6, 4, 4), 1000.0, 1500.0, G)
     same = build_liquid((5.0, 4.0, 3.0), 2.0, (6, 4, 4), 1000.0, 1500.0, G,
                         geometry=Prismatic(size=(5.0, 4.0, 3.0)))

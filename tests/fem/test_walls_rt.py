@@ -1,4 +1,4 @@
-"""The face-normal liquid ("rt") in elastic walls (fem/walls_rt.py): the wall faces' fluxes are the
+"""The face-normal liquid ("rt") in elastic walls (liquid/face/walls.py): the wall faces' fluxes are the
 volumes the walls sweep, imposed by elimination.
 
 The references are potential theory, written here. A 2-D tank a long, filled to h, whose end wall
@@ -31,10 +31,10 @@ import scipy.linalg as sl
 import scipy.optimize as so
 import scipy.sparse as sp
 
-from jaxslosh.fem.liquid_rt import build_face_liquid, face_modes
+from jaxslosh.liquid.face.element import build_face_liquid, face_modes
 from jaxslosh.fem.mesh import box_mesh
-from jaxslosh.fem.walls import build_walls
-from jaxslosh.fem.walls_rt import (build_face_tank_with_walls, couple_walls, face_area_weights, face_tank_modes,
+from jaxslosh.liquid.walls import build_walls
+from jaxslosh.liquid.face.walls import (build_face_tank_with_walls, couple_walls, face_area_weights, face_tank_modes,
                                    wall_faces)
 from jaxslosh.scene.types import Fluid, Material, Tank, Walls
 

@@ -1,7 +1,7 @@
 """Low-frequency effective roll inertia of a closed, full tank against Stokes-Joukowski."""
 import pytest
 
-from jaxslosh.fem.modes import effective_roll_inertia
+from jaxslosh.liquid.modes import effective_roll_inertia
 
 # Stokes-Joukowski: effective / frozen roll inertia of an inviscid liquid filling a rectangle
 SJ = {1.0: 0.1565, 2.0: 0.45}

@@ -1,4 +1,4 @@
-"""The multimodal liquid (physics/multimodal.py): its coefficients against quadrature of the exact
+"""The multimodal liquid (liquid/multimodal/term.py): its coefficients against quadrature of the exact
 modes by SciPy, its small-amplitude limits against linear theory, its nonlinear free oscillations
 against the third-order standing wave of Tadjbakhsh & Keller (1960) and the critical depth
 h / L = 0.3368 (Faltinsen et al. 2000), and its force against the spring-mass model."""
@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 from scipy import integrate
 
-from jaxslosh.physics.multimodal import modal_tank
+from jaxslosh.liquid.multimodal.term import modal_tank
 
 G = 9.81
 Z3 = jnp.zeros(3)

@@ -1,4 +1,4 @@
-"""The three-dimensional multimodal liquid (physics/multimodal3d.py) of box tanks and upright circular
+"""The three-dimensional multimodal liquid (liquid/multimodal/tank3d.py) of box tanks and upright circular
 cylinders: linear frequencies against g k tanh(k h), the two-dimensional tank's coefficients where the
 flow is planar, the integrals against SciPy's adaptive quadrature of the exact modes, the vortical
 flows' curl and wall flux by finite differences, the kinetic energy against a direct quadrature of the
@@ -10,8 +10,8 @@ import numpy as np
 import pytest
 from scipy import integrate, special
 
-from jaxslosh.physics.multimodal import modal_tank
-from jaxslosh.physics.multimodal3d import box_tank3d, cylinder_tank
+from jaxslosh.liquid.multimodal.term import modal_tank
+from jaxslosh.liquid.multimodal.tank3d import box_tank3d, cylinder_tank
 
 G = 9.81
 Z3 = jnp.zeros(3)

@@ -9,7 +9,7 @@ import pytest
 from scipy import special
 
 import jaxslosh as js
-from jaxslosh.physics.multimodal3d import box_tank3d
+from jaxslosh.liquid.multimodal.tank3d import box_tank3d
 
 G = 9.81
 FORCED = """

@@ -1,5 +1,5 @@
 """The multimodal tank's third-order system (tanks.expansion = "third-order",
-physics/multimodal_expansion.py): its backbone against the closed-form third-order standing wave of
+liquid/multimodal/expansion.py): its backbone against the closed-form third-order standing wave of
 Tadjbakhsh & Keller (1960) on both sides of the critical depth h / L = 0.3368, its departure from the
 exact system (fourth order in the amplitude), its linear frequencies, a run against the exact tank's
 and a gradient through a run."""
@@ -10,9 +10,9 @@ import numpy as np
 import pytest
 
 import jaxslosh as js
-from jaxslosh.physics.multimodal import modal_tank
-from jaxslosh.physics.multimodal_expansion import third_order
-from jaxslosh.physics.multimodal3d import cylinder_tank
+from jaxslosh.liquid.multimodal.term import modal_tank
+from jaxslosh.liquid.multimodal.expansion import third_order
+from jaxslosh.liquid.multimodal.tank3d import cylinder_tank
 from test_multimodal3d_tank import BOX, _transfer
 from test_multimodal3d_tank import FORCED as FORCED_3D
 from test_multimodal_tank import FORCED, _amplitude

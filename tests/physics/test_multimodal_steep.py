@@ -1,4 +1,4 @@
-"""Past the multimodal method's range: the steep-wave damping (jaxslosh/physics/multimodal_steep.py,
+"""Past the multimodal method's range: the steep-wave damping (jaxslosh/liquid/multimodal/steep.py,
 docs/guide/nonlinear-sloshing.md, "Past the method's range"). A 1 x 1 m tank with 0.5 m of water surged
 10 mm at 0.95 of its first frequency: the inviscid method's Newton iterations fail at 9.8 s (6 modes,
 dt = 0.02 s) where its crests outgrow its modes; with the damping the run goes on to 12 s and says so
@@ -12,7 +12,7 @@ import pytest
 from scipy.optimize import brentq
 
 import jaxslosh as js
-from jaxslosh.physics.multimodal import modal_tank
+from jaxslosh.liquid.multimodal.term import modal_tank
 from jaxslosh.run.tofile import run_to_file
 
 L, H, G = 1.0, 0.5, 9.81
@@ -66,7 +66,7 @@ def test_damping_is_zero_within_the_range_and_dissipates_past_it():
     """The force on the modal rows is exactly zero while the crest index is below STEEP_ON (a 0.1 m
     crest on 6 modes of a 1 m tank: index 1.4), grows past it, and always takes energy
     (beta_dot . force >= 0); it is the eddy viscosity's, heavier on the higher modes."""
-    from jaxslosh.physics.multimodal_steep import STEEP_FULL, STEEP_ON, crest_index, steep_damping
+    from jaxslosh.liquid.multimodal.steep import STEEP_FULL, STEEP_ON, crest_index, steep_damping
     t = _tank()
     rng = np.random.default_rng(0)
     bd = jnp.asarray(rng.normal(size=6))
@@ -87,7 +87,7 @@ def test_damping_is_zero_within_the_range_and_dissipates_past_it():
 def test_switch_is_smooth():
     """Newton linearises the damping: its derivative in beta is continuous through the switch
     (jax against central differences, inside the ramp and at its start)."""
-    from jaxslosh.physics.multimodal_steep import STEEP_FULL, STEEP_ON, crest_index, steep_damping
+    from jaxslosh.liquid.multimodal.steep import STEEP_FULL, STEEP_ON, crest_index, steep_damping
     t = _tank()
     bd = jnp.linspace(1.0, -0.5, 6)
     base = jnp.array([0.2, 0.05, 0.02, 0.01, 0.005, 0.002])
@@ -105,7 +105,7 @@ def test_switch_is_smooth():
 def test_watch_reads_the_crest_index_as_the_liquid():
     """The validity watch's crest index is the liquid's (the same points and weights); a frame below
     STEEP_ON says nothing, one past it is said once with the frame's time."""
-    from jaxslosh.physics.multimodal_steep import STEEP_ON, crest_index
+    from jaxslosh.liquid.multimodal.steep import STEEP_ON, crest_index
     from jaxslosh.run.validity import Watch, _crest_index, _surface_tables
     scene = js.load_scene(RESONANT.format(duration=1.0, amplitude=0.001))
     (off, _, Z, w, kN, _), = _surface_tables(scene)

@@ -133,7 +133,7 @@ def test_free_vessel_conserves_energy():
 @pytest.mark.slow
 @pytest.mark.parametrize("expansion", ["exact", "third-order"])
 def test_gradient_through_a_run_matches_finite_differences(expansion):
-    """Through the exact integrals and through their third-order polynomial (physics/multimodal_expansion.py)."""
+    """Through the exact integrals and through their third-order polynomial (liquid/multimodal/expansion.py)."""
     scene = js.load_scene(FREE.format(duration=0.3).replace("modes = 4", f'modes = 4\nexpansion = "{expansion}"'))
 
     def f(h):

@@ -1,5 +1,5 @@
-"""Runs of the face-normal liquid ("rt") in elastic walls (physics/face_liquid.py with walls,
-assemble/face_liquid.py): the particles carry the coupled mass, a still tank stays still, the
+"""Runs of the face-normal liquid ("rt") in elastic walls (liquid/face/term.py with walls,
+liquid/face/build.py): the particles carry the coupled mass, a still tank stays still, the
 trapezoidal rule keeps the energy, very stiff walls give the rigid tank, and the vessel moves as
 with the stabilized element in the same walls."""
 import functools
@@ -11,8 +11,8 @@ import numpy as np
 
 import jaxslosh as js
 from jaxslosh.assemble.system import build
-from jaxslosh.fem.liquid_rt import build_face_liquid
-from jaxslosh.fem.walls_rt import build_face_tank_with_walls
+from jaxslosh.liquid.face.element import build_face_liquid
+from jaxslosh.liquid.face.walls import build_face_tank_with_walls
 
 ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 
@@ -34,7 +34,7 @@ def _run(text):
 def test_the_points_carry_the_coupled_mass():
     """The liquid's Gauss points and the walls' (each moving with its element's field) give, as
     sum_g m_g J_g^T J_g, the Newton block's mass, which is T^T M T plus the walls' consistent mass
-    (fem/walls_rt.py), to round-off; `free_part` is the transpose of `field`."""
+    (liquid/face/walls.py), to round-off; `free_part` is the transpose of `field`."""
     scene = js.load_scene(_text())
     liquid = build(scene).system.liquid
     nf = liquid.nf
@@ -101,7 +101,7 @@ def test_modes_of_the_liquid_in_its_walls():
     """`js.sloshing_modes` (`jaxslosh modes`) of an "rt" tank in 5 cm steel walls: the liquid and
     its walls together, circulation modes left out and counted; the sloshing modes within 0.5 % of
     the same liquid's in rigid walls (the walls soften them: never above)."""
-    from jaxslosh.fem.liquid_rt import face_modes
+    from jaxslosh.liquid.face.element import face_modes
     scene = js.load_scene(_text())
     md = js.sloshing_modes(scene, n=8)
     t = scene.tanks[0]

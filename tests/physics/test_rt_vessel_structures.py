@@ -1,5 +1,5 @@
 """The face-normal liquid ("rt") at full order beside structures in the vessel's frame
-(`frame = "vessel"`, assemble/face_liquid.py): the structures' nodal dofs follow the faces' fluxes in
+(`frame = "vessel"`, liquid/face/build.py): the structures' nodal dofs follow the faces' fluxes in
 one block, their Gauss points are particles. Checked against what does not go through that block:
 the structure's clamped modes and the tank's own sloshing modes (a vessel too heavy to move
 uncouples them), and the same structure in its own floating frame, tied by multipliers."""
@@ -15,10 +15,10 @@ from jaxslosh.analysis.coupled import coupled_modes
 from jaxslosh.assemble.liquid import build_liquid_block
 from jaxslosh.assemble.structures import held_structure
 from jaxslosh.assemble.system import build
-from jaxslosh.fem.liquid_rt import build_face_liquid
-from jaxslosh.fem.walls_rt import build_face_tank_with_walls
+from jaxslosh.liquid.face.element import build_face_liquid
+from jaxslosh.liquid.face.walls import build_face_tank_with_walls
 from jaxslosh.physics.kinematics import spin_tensor_components
-from jaxslosh.physics.liquid import SpinStiffening
+from jaxslosh.liquid.base import SpinStiffening
 from jaxslosh.physics.terms import Kin
 
 try:
@@ -115,7 +115,7 @@ def test_runs_as_the_mast_in_its_own_frame():
 
 def test_elastic_walls_and_a_spinning_mast_in_one_block():
     """An "rt" tank in elastic walls and a mast in the vessel's frame with centrifugal stiffening:
-    the block is the tank-and-walls block (fem/walls_rt.py) then the mast's, the points carry it,
+    the block is the tank-and-walls block (liquid/face/walls.py) then the mast's, the points carry it,
     and the spin stiffening acts on the mast's unknowns alone, with its own geometric stiffness."""
     part = mast(origin=(-0.15, -0.15, 3.5), mesh=(1, 1, 2)).replace(
         'attach = "z-"\n', 'attach = "z-"\nframe = "vessel"\nstiffening = "centrifugal"\n')

@@ -11,7 +11,7 @@ from jaxslosh.scene.keys import TRACEABLE
 from jaxslosh.assemble.system import build
 from jaxslosh.solve.schemes import make_scheme
 from jaxslosh.solve.linear import make_solver
-from jaxslosh.fem.liquid import build_liquid
+from jaxslosh.liquid.nodal.model import build_liquid
 from jaxslosh.scene.types import SceneError
 
 SIZE = (5.0, 5.0, 4.0)

@@ -1,5 +1,5 @@
 """A traced fill depth with the face-normal liquid ("rt", full order): a plain box's layers scale
-with the depth, so its blocks are closed functions of h / h0 (assemble/face_liquid.py
+with the depth, so its blocks are closed functions of h / h0 (liquid/face/build.py
 traced_depth_blocks). Checked: those blocks against the model built at the new depth, a run with a
 traced depth against the run of the scene that says that depth, and jax.grad of a trajectory loss
 against central differences; the shapes whose mesh follows the fill, and runs on modes, are refused
@@ -10,8 +10,8 @@ import numpy as np
 import pytest
 
 import jaxslosh as js
-from jaxslosh.assemble.face_liquid import absolute_rotation_penalty, traced_depth_blocks
-from jaxslosh.fem.liquid_rt import _gauss, build_face_liquid, face_modes
+from jaxslosh.liquid.face.build import absolute_rotation_penalty, traced_depth_blocks
+from jaxslosh.liquid.face.element import _gauss, build_face_liquid, face_modes
 from jaxslosh.geometry import Box
 from test_gradients_liquid import SCENE
 

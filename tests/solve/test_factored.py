@@ -16,7 +16,7 @@ import scipy.sparse as sp
 from scipy.sparse.linalg import spsolve
 
 import jaxslosh as js
-from jaxslosh.fem.liquid import build_liquid
+from jaxslosh.liquid.nodal.model import build_liquid
 from jaxslosh.geometry import Prismatic
 from jaxslosh.solve.factored import Banded, Dense, factored_inverse
 

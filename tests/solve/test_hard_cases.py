@@ -17,8 +17,8 @@ import numpy as np
 import pytest
 
 import jaxslosh as js
-from jaxslosh.fem.liquid import build_liquid
-from jaxslosh.fem.modes import analytic_sloshing_table, liquid_modes
+from jaxslosh.liquid.nodal.model import build_liquid
+from jaxslosh.liquid.modes import analytic_sloshing_table, liquid_modes
 
 from helpers import zero_crossing_period
 from test_coupled import ship_with_tank

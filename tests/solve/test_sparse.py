@@ -9,8 +9,8 @@ import scipy.sparse as sp
 from scipy.sparse.linalg import spsolve
 
 import jaxslosh as js
-from jaxslosh.solve.boxsolve import box_inverse, elements, stencil
-from jaxslosh.fem.liquid import build_liquid, surface_bending_scale
+from jaxslosh.liquid.nodal.boxsolve import box_inverse, elements, stencil
+from jaxslosh.liquid.nodal.model import build_liquid, surface_bending_scale
 
 ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 C_A = 1.0 / (0.25 * 1.01 ** 2 * 0.01 ** 2)        # the paper scene's step: HHT alpha 0.01, dt 0.01
@@ -74,7 +74,7 @@ def test_element_products_are_declined_where_layers_differ():
     """The stabilized element with an odd number of elements along x pairs its top wall elements:
     no element matrix per layer holds that, so the model carries none and the general sparse
     product stays (the pairs are too far apart for a stencil too)."""
-    from jaxslosh.solve.sparse import host_sparse
+    from jaxslosh.liquid.nodal.sparse import host_sparse
     m, free, _, K = _blocks((3, 4, 2), "stabilized")
     assert m.layers is None
     assert elements(K, (((3, 4, 2), 3, free, m.layers),)) is None
@@ -110,7 +110,7 @@ def test_sparse_system_has_the_dense_residual_and_inverses():
     agree to round-off, so the Newton iterations of the two are the same (a whole run of each is left
     to the benchmarks: its compilation would cost the suite a minute)."""
     import jax
-    from jaxslosh.solve.boxsolve import BoxInverse, Elements
+    from jaxslosh.liquid.nodal.boxsolve import BoxInverse, Elements
     from jaxslosh.run.loop import core as _core
     from jaxslosh.run.simulate import prepare
     from jaxslosh.scene.keys import with_overrides

@@ -1,0 +1,80 @@
+"""The face-normal liquid's full-order stiffness without a dense matrix on the faces (pure JAX).
+
+K = kappa M + B^T Y B (liquid/face/schur.py): the consistent mass M element by element (each element's
+6 x 6 block on its faces' unknowns), B = [D; T] (each element's outward flux, each top face's flux)
+by gathers, and Y = W - kappa G^+ dense on each tank's elements and top faces (ny = E + T per tank,
+about nf / 2.7): a product streams ny^2 entries where the dense K streams nf^2, about 7 times more.
+The products take d of shape (n,) or (n, k); they are linear, so they differentiate, transpose
+and vmap as jnp code does.
+"""
+from __future__ import annotations
+
+from typing import Optional
+
+import equinox as eqx
+import jax
+import jax.numpy as jnp
+
+
+class FaceOps(eqx.Module):
+    """The sparse structure of the stacked tanks' free faces: each element's six unknowns (`n` where
+    the face is held), the signs that make them outward fluxes, the top faces' unknowns, and each
+    tank's elements and top faces (static ranges; tank t's B rows are its elements' fluxes, then its
+    top faces')."""
+    slots: jax.Array        # (E, 6) int32
+    signs: jax.Array        # (E, 6)
+    top: jax.Array          # (T,) int32
+    n: int = eqx.field(static=True)
+    elements: tuple = eqx.field(static=True)     # per tank (start, stop) of its elements
+    tops: tuple = eqx.field(static=True)         # per tank (start, stop) of its top faces
+
+    def gather(self, d):
+        """(n, ...) -> (E, 6, ...)"""
+        dz = jnp.concatenate([d, jnp.zeros((1,) + d.shape[1:], d.dtype)])
+        return dz[self.slots]
+
+    def scatter(self, v):
+        """(E, 6, ...) -> (n, ...), the transpose of gather."""
+        out = jax.ops.segment_sum(v.reshape((-1,) + v.shape[2:]), self.slots.reshape(-1), self.n + 1)
+        return out[:self.n]
+
+    def elementwise(self, Ae, d):
+        """sum_e P_e^T A_e P_e d for element blocks Ae (E, 6, 6)."""
+        return self.scatter(jnp.einsum("efg,eg...->ef...", Ae, self.gather(d)))
+
+    def B(self, d):
+        """Per tank: its elements' outward fluxes, then its top faces' fluxes ((ny_t, ...) each)."""
+        div = jnp.einsum("ef,ef...->e...", self.signs, self.gather(d))
+        tp = d[self.top]
+        return [jnp.concatenate([div[a:b], tp[c:e]]) for (a, b), (c, e) in zip(self.elements, self.tops)]
+
+    def BT(self, ys):
+        """The transpose of B: per-tank (ny_t, ...) -> (n, ...)."""
+        div = jnp.concatenate([y[:b - a] for y, (a, b) in zip(ys, self.elements)])
+        tp = jnp.concatenate([y[b - a:] for y, (a, b) in zip(ys, self.elements)])
+        out = self.scatter(self.signs.reshape(self.signs.shape + (1,) * (div.ndim - 1)) * div[:, None])
+        return out.at[self.top].add(tp)
+
+
+class FaceStiffness(eqx.Module):
+    """K = kappa M + B^T Y B on the stacked tanks' free faces (`K @ d`, d: (n,) or (n, k))."""
+    ops: FaceOps
+    kappa_M: jax.Array      # (E, 6, 6) each element's mass block times its tank's kappa
+    Y: tuple                # per tank (ny_t, ny_t): W - kappa G^+
+    abs_rowsum: jax.Array   # (n,) sum_j |K_ij| (the Newton iterations' round-off floor)
+    winv: tuple             # per tank (ny_t,) W^-1 (the Newton block's inverse is formed from Y, W, kappa)
+    kappa_n: jax.Array      # (n,) each unknown's tank's kappa
+    kappas: jax.Array       # (tanks,) each tank's kappa (an array: a static float would name the program)
+    # at values other than the model's (traced density, sound speed, gravity): per tank its mass scale
+    # rho_s and its pools' null vectors (ny_t, pools), from which the Newton block's inverse is formed
+    # in JAX (liquid/face/inverse.py); None: the model's values, the inverse formed on the host
+    rho: Optional[tuple] = None
+    pools: Optional[tuple] = None
+
+    @property
+    def shape(self):
+        return (self.ops.n, self.ops.n)
+
+    def __matmul__(self, d):
+        ys = self.ops.B(d)
+        return self.ops.elementwise(self.kappa_M, d) + self.ops.BT([Y @ y for Y, y in zip(self.Y, ys)])
