@@ -60,7 +60,7 @@ def structure_scene(template: Scene, case: Scene) -> Scene:
                             components=case.waves.components)
     if hull_waves(template):
         # the wetted hull's wave pressure is compiled for the depth, and its panels for the top of
-        # the frequency range (assemble/hull.box_divisions)
+        # the frequency range (scene/hulls.py BoxHull.divisions)
         w = dataclasses.replace(w, depth=case.waves.depth, omega_range=case.waves.omega_range)
     return dataclasses.replace(template, waves=w)
 

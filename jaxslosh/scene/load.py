@@ -266,7 +266,7 @@ def _vessel(table, environment: Environment, warnings: list[str], files=None) ->
         if "forced" in table else None
     # the COG's height above the still-water level (it places mooring fairleads): given, or a box
     # hull's kg - draft, else 0
-    cog = v.get("cog_height", hull.kg - hull.draft if hull is not None and hull.type == "box" else 0.0)
+    cog = v.get("cog_height", hull.default_cog_height() if hull is not None else 0.0)
     return Vessel(mass=v["mass"], inertia=inertia, hydrostatics=hydrostatics, initial=initial, forced=forced,
                   hull=hull, hydrodynamics=hydrodynamics, name=v.get("name", "vessel"), cog_height=cog)
 
