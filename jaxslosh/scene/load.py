@@ -39,9 +39,9 @@ from .shape import default_element, fill_and_mesh, read_multimodal_shape, read_s
 from .types import (EFFECTS, ELEMENT_FORMS, FACE_FORMS, FACES, Damping, Effects, Environment, Fluid,
                     Initial, Material, Probe, Reduction, Scene, SceneError, Simulation, Structure, Tank,
                     Vessel, Walls)
+from ..solve.schemes import SCHEMES
 from .waves import FileContext, check_waves, hull_hydrostatics, read_hull, read_hydrodynamics, read_waves
 
-SCHEMES = ("newmark", "hht", "generalized-alpha")
 LINEAR_SOLVERS = ("auto", "dense", "sparse", "sparse-host")      # [simulation] linear_solver (sparse.py)
 WALLS = ("rigid", "elastic")
 TANK_MODELS = ("fem", "multimodal")

@@ -12,6 +12,7 @@ from typing import Optional, Union
 
 from ..fem.mesh import ELEMENT_FORMS, FACE_FORMS  # noqa: F401  (the loader reads them here)
 from ..geometry import SHAPES, AbstractShape
+from ..solve.schemes import SCHEMES, AbstractScheme
 from .hulls import HULLS, BoxHull, Hull, MeshHull  # noqa: F401  (the scene's types, read from here)
 from .seas import WAVES, IrregularSea, JonswapSea, PiersonMoskowitzSea, RegularWaves, Waves  # noqa: F401
 
@@ -60,6 +61,10 @@ class Simulation:
     @property
     def n_steps(self) -> int:
         return int(round(self.duration / self.dt))
+
+    def time_scheme(self) -> AbstractScheme:
+        """The member of the generalized-alpha family that `scheme`, `alpha` and `rho_inf` name."""
+        return SCHEMES[self.scheme].from_settings(self.alpha, self.rho_inf)
 
 
 @dataclass(frozen=True)

@@ -10,7 +10,7 @@ ROOT = os.path.join(os.path.dirname(os.path.dirname(os.path.dirname(os.path.absp
 # lowest first; a module may import its own package and the packages on earlier lines
 LAYERS = [
     {"_version", "staging"},
-    {"fem.mesh", "fem.meshfile", "fem.slip", "physics.kinematics"},
+    {"fem.mesh", "fem.meshfile", "fem.slip", "physics.kinematics", "solve.schemes"},
     {"fem.shapes"},
     {"hull"},
     # the tank shapes: below the scene loader that builds them and the finite elements that mesh them

@@ -18,7 +18,7 @@ from jaxslosh.hydro.box import froude_krylov_box
 from jaxslosh.physics.hull import HullPressure
 from jaxslosh.physics.kinematics import quat_exp, quat_from_rpy, quat_multiply, rotation_matrix
 from jaxslosh.physics.terms import Config, potential_rows
-from jaxslosh.physics.vessel import Hydrostatics
+from jaxslosh.physics.vessel import ConservativeRestoring
 
 from helpers import area_centroid, clip_polygon
 
@@ -120,7 +120,7 @@ def test_small_motion_stiffness_equals_the_linear_model_of_the_same_hull():
     scene = box_scene()
     term = build_hull_pressure(scene, {}, jnp.asarray(G))
     h = scene.vessel.hydrostatics
-    lin = Hydrostatics(rho_w=jnp.asarray(RHO), gravity=jnp.asarray(G), waterplane_area=jnp.asarray(h.waterplane_area),
+    lin = ConservativeRestoring(rho_w=jnp.asarray(RHO), gravity=jnp.asarray(G), waterplane_area=jnp.asarray(h.waterplane_area),
                        displaced_volume=jnp.asarray(h.displaced_volume), gm_t=jnp.asarray(h.gm_t),
                        gm_l=jnp.asarray(h.gm_l))
 
