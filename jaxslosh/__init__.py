@@ -39,17 +39,27 @@ __all__ = [*_PUBLIC, "campaign", "mooring", "__version__"]
 def campaign(*args, **kwargs):
     """`js.campaign`: jaxslosh.campaign.run.campaign (docs/guide/campaigns.md), imported on first call
     (it loads Dask)."""
+    _install_cache()
     return import_module(".campaign.run", __name__).campaign(*args, **kwargs)
 
 
 def mooring(*args, **kwargs):
     """`js.mooring`: jaxslosh.mooring.statics.mooring (docs/guide/moorings.md), imported on first call
     (the name is also the sub-package's, bound above, as for `campaign`)."""
+    _install_cache()
     return import_module(".mooring.statics", __name__).mooring(*args, **kwargs)
+
+
+def _install_cache():
+    """The package's functions are an entry point, as the command line is: their programs go
+    through the compile cache (jaxslosh/cache, installed here on first use, not on import)."""
+    import_module(".cache.programs", __name__).install()
 
 
 def __getattr__(name):
     if name in _PUBLIC:
+        if not _PUBLIC[name].startswith((".scene", ".io")):     # what only reads and writes needs no JAX
+            _install_cache()
         value = getattr(import_module(_PUBLIC[name], __name__), name)
         globals()[name] = value           # looked up once
         return value

@@ -22,7 +22,7 @@ from ..io.result import Failure, Result, result_from, truncated
 from ..scene.keys import check_values, with_overrides
 from ..scene.types import Scene
 from ..solve.linear import Solver, make_solver
-from ..cache.compiled import compile_run
+from .compiled import compile_run
 from .loop import Carry, Frame, advance, concat_frames, core, frame_datasets, start
 
 
