@@ -7,9 +7,10 @@ sloshing" (2013). Entry points switch on float64 (`jax_enable_x64`); a library u
     import jaxslosh as js
     result = js.simulate(js.load_scene("scenes/paper_ship_tank.toml"))
 
-The package's layers, lowest first (docs/design.md): scene/ (TOML to a Scene), fem/ and hydro/
-(host-side models), physics/ (traced terms), solve/ (schemes, Newton, linear solvers), assemble/
-(scene to System), run/ (time loop), io/ (files), analysis/, campaign/, fit/, plot/, cli/.
+The package's layers, lowest first (docs/design.md): _version.py, staging.py; fem/mesh.py,
+fem/meshfile.py, fem/slip.py, physics/kinematics.py, solve/schemes.py; fem/shapes.py; hull/;
+geometry/; hydro/, io/; scene/; fem/; physics/; mooring/; solve/; assemble/; run/; cache/;
+analysis/, campaign/, fit/, mooring/statics.py; plot/; cli/; entry.py; __init__.py, __main__.py.
 
 The public names below are imported on first use (PEP 562): `import jaxslosh` stays light, and a
 command such as `jaxslosh run` loads neither Dask nor SciPy's signal and statistics modules, which
