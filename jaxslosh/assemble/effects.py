@@ -3,8 +3,6 @@ steps) and its unknowns, counted from the scene before anything is built (assemb
 them too). The effects `check` lists are the assembled model's own (assemble/check.py)."""
 from __future__ import annotations
 
-import os
-
 from ..fem.face_mesh import free_face_count
 from ..fem.walls import shell_mesh
 from ..physics.multimodal_modes import DiskBase, RectangleBase

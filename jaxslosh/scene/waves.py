@@ -197,7 +197,7 @@ def _check_database(where, path, db, files, hydrostatics, hull, length, warnings
             est = length / math.sqrt(ratio)
             return (f"WAMIT's files are non-dimensional, and the scene reads them with length_scale = {length:g} m: "
                     f"length_scale = {est:.3g} m would make {what} agree (give the ULEN of the WAMIT run)")
-        return f"the file was computed for another hull, draft or units than the scene's [vessel.hydrostatics]"
+        return "the file was computed for another hull, draft or units than the scene's [vessel.hydrostatics]"
 
     C = db.stiffness
     gross = False

@@ -5,8 +5,6 @@ import json
 import os
 import re
 
-import pytest
-
 ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 # docs/hooks.py writes these at build time: they are cited, and exist only in the built site
 GENERATED = {"docs/reference/scene.md", "docs/reference/commands.md", "docs/reference/api.md"}
