@@ -7,9 +7,10 @@ sloshing" (2013). Entry points switch on float64 (`jax_enable_x64`); a library u
     import jaxslosh as js
     result = js.simulate(js.load_scene("scenes/paper_ship_tank.toml"))
 
-The package's layers, lowest first (docs/design.md): scene/ (TOML to a Scene), fem/ and hydro/
-(host-side models), physics/ (traced terms), solve/ (schemes, Newton, linear solvers), assemble/
-(scene to System), run/ (time loop), io/ (files), analysis/, campaign/, fit/, plot/, cli/.
+The package's layers, lowest first (docs/design.md): _version.py, staging.py; fem/mesh.py,
+fem/meshfile.py, fem/slip.py, physics/kinematics.py, solve/schemes.py; fem/shapes.py; hull/;
+geometry/; hydro/, io/; scene/; fem/; physics/; mooring/; solve/; liquid/; assemble/; run/; cache/;
+analysis/, campaign/, fit/, mooring/statics.py; plot/; cli/; entry.py; __init__.py, __main__.py.
 
 The public names below are imported on first use (PEP 562): `import jaxslosh` stays light, and a
 command such as `jaxslosh run` loads neither Dask nor SciPy's signal and statistics modules, which
@@ -39,17 +40,27 @@ __all__ = [*_PUBLIC, "campaign", "mooring", "__version__"]
 def campaign(*args, **kwargs):
     """`js.campaign`: jaxslosh.campaign.run.campaign (docs/guide/campaigns.md), imported on first call
     (it loads Dask)."""
+    _install_cache()
     return import_module(".campaign.run", __name__).campaign(*args, **kwargs)
 
 
 def mooring(*args, **kwargs):
     """`js.mooring`: jaxslosh.mooring.statics.mooring (docs/guide/moorings.md), imported on first call
     (the name is also the sub-package's, bound above, as for `campaign`)."""
+    _install_cache()
     return import_module(".mooring.statics", __name__).mooring(*args, **kwargs)
+
+
+def _install_cache():
+    """The package's functions are an entry point, as the command line is: their programs go
+    through the compile cache (jaxslosh/cache, installed here on first use, not on import)."""
+    import_module(".cache.programs", __name__).install()
 
 
 def __getattr__(name):
     if name in _PUBLIC:
+        if not _PUBLIC[name].startswith((".scene", ".io")):     # what only reads and writes needs no JAX
+            _install_cache()
         value = getattr(import_module(_PUBLIC[name], __name__), name)
         globals()[name] = value           # looked up once
         return value

@@ -3,10 +3,12 @@ the run's programs, `staged` for the build's jax.numpy steps, and the compiled k
 elements.
 
 The compile cache (jaxslosh/cache: programs exported and kept across processes, their executables,
-the preload) sits in a wing above the modules that compile: they call `lower_program`,
-`compile_program` and `no_eager_folding` here, and the cache installs its own when it is imported
-(`install`; `jaxslosh run`, `js.simulate` and the campaign workers import it). Without it the same
-calls trace and compile in the process, with the same options and results, and keep nothing.
+the preload) sits above the modules that compile: they call `lower_program`, `compile_program`,
+`program_key`, `cached`, `remember`, `folder` and `no_eager_folding` here, and the entry points
+install the cache's own (cache/programs.py `install`, called by the command line's `setup_jax`,
+by the package's public functions on first use, e.g. `js.simulate`, and by the campaign workers).
+Without it the same calls trace and compile in the process, with the same options and results,
+and keep nothing.
 """
 from __future__ import annotations
 
@@ -18,7 +20,7 @@ import jax
 
 _JAXLIB = tuple(int(p) for p in jax.lib.__version__.split(".")[:2] if p.isdigit())
 
-#: XLA options of the run's programs compiled ahead of time (cache/compiled.py: `jaxslosh run`, and
+#: XLA options of the run's programs compiled ahead of time (run/compiled.py: `jaxslosh run`, and
 #: `js.simulate` called outside any transformation; JAX takes options only for a top-level jit, so
 #: js.simulate inside a user's jit keeps XLA's defaults, and agrees to round-off). XLA's classic CPU
 #: loop emitters compile the step's many small fusions in 30-40 % less time than its default fusion
@@ -32,7 +34,8 @@ START_OPTIONS = {**XLA_OPTIONS, "xla_backend_optimization_level": 0}
 
 
 class _Done:
-    """A compilation already finished, in the shape of a background one (`result()`)."""
+    """A compilation already finished, in the shape of a background one (`result()`; no file)."""
+    path = None
 
     def __init__(self, value):
         self.value = value
@@ -57,14 +60,28 @@ class PlainProgram:
         return _Done(self.compile())
 
 
-_IMPL = {"lower": lambda name, fn, args, compiler_options=None: PlainProgram(fn, args, compiler_options),
-         "no_folding": contextlib.nullcontext}
+#: what a process without the compile cache does: trace and compile here, name and keep nothing
+_PLAIN = {"lower": lambda name, fn, args, compiler_options=None: PlainProgram(fn, args, compiler_options),
+          "no_folding": contextlib.nullcontext, "key": lambda name, args, options=None: None,
+          "cached": lambda name, key, compute: compute(), "remember": lambda paths: None, "folder": lambda: None}
+_IMPL = dict(_PLAIN)
 
 
-def install(lower, no_folding):
-    """The compile cache's `lower_program(name, fn, args, compiler_options)` and its context in
-    which a jit trace stages its operations on constants (cache/programs.py)."""
-    _IMPL["lower"], _IMPL["no_folding"] = lower, no_folding
+def install(**hooks):
+    """The compile cache's hooks (cache/programs.py `install`): `lower(name, fn, args,
+    compiler_options)`, `no_folding()` (a context in which a jit trace stages its operations on
+    constants), `key(name, args, options)`, `cached(name, key, compute)`, `remember(paths)`,
+    `folder()`; `install()` with none: back to the plain ones."""
+    unknown = set(hooks) - set(_PLAIN)
+    if unknown:
+        raise TypeError(f"unknown staging hooks {sorted(unknown)}")
+    _IMPL.clear()
+    _IMPL.update(_PLAIN, **hooks)
+
+
+def installed() -> bool:
+    """Whether a compile cache installed its hooks."""
+    return _IMPL["lower"] is not _PLAIN["lower"]
 
 
 def lower_program(name: str, fn, args: tuple, compiler_options=None):
@@ -78,6 +95,27 @@ def compile_program(name: str, fn, args: tuple, compiler_options=None):
     compiled callable (it takes arguments like `args`) and whether it came from the cache's folder."""
     p = lower_program(name, fn, args, compiler_options)
     return p.compile(), p.loaded
+
+
+def program_key(name: str, args: tuple, options=None):
+    """A name for `name`'s program for arguments like `args` (None without the compile cache, or
+    where a static value does not pickle): compiled programs of the same name are reused."""
+    return _IMPL["key"](name, args, options)
+
+
+def cached(name: str, key, compute):
+    """`compute()`, kept by the compile cache where it keeps programs in a folder."""
+    return _IMPL["cached"](name, key, compute)
+
+
+def remember(paths):
+    """Name program files for the next process of the same command line to load ahead."""
+    return _IMPL["remember"](paths)
+
+
+def folder():
+    """The folder where programs are kept (None: not kept)."""
+    return _IMPL["folder"]()
 
 
 def no_eager_folding():

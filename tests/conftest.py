@@ -36,6 +36,12 @@ from threadpoolctl import threadpool_limits  # noqa: E402
 
 jax.config.update("jax_enable_x64", True)
 
+# the tests stand for the entry points (the command line, `js.simulate`), which install the compile
+# cache's hooks (jaxslosh/staging.py): a test that imports a module below them gets the same staging
+from jaxslosh.cache.programs import install as _install_cache  # noqa: E402
+
+_install_cache()
+
 # The suite runs on two xdist workers (pyproject addopts), one per core. OpenBLAS (NumPy's and
 # SciPy's, which jaxlib's LAPACK calls also use) would start a thread per core in each worker as
 # well, and oversubscribed cores slow dense factorizations many times over: one BLAS thread each.

@@ -83,7 +83,6 @@ def hopper_baffle_hex(b, chamfer, fill, baffle_s, baffle_height, ny, nz, thickne
     to ``fill``, and a standing plate at s = ``baffle_s`` (on the flat bottom) ``baffle_height``
     high. Rows at the chamfers' top and the plate's edge; each row's nodes spread between its walls
     and the plate's column, in proportion to the widths at the bottom row."""
-    kc = max(1, round(nz * chamfer / fill))
     levels = sorted({0.0, chamfer, baffle_height, fill})
     counts = np.diff(levels) / fill * nz
     counts = np.maximum(1, np.round(counts).astype(int))

@@ -113,7 +113,7 @@ def waves():
     """The rows of tests/hydro/test_waves.py: the regular-wave RAO and the Cummins memory, Capytaine's box."""
     from tests.hydro import test_waves as tw
     from jaxslosh.hydro.capytaine import capytaine_hydrostatics
-    from jaxslosh.scene.types import Hull
+    from jaxslosh.scene.types import BoxHull
     w, Bv = 0.9, [0.0, 0.0, 0.0, 8.0e5, 0.0, 0.0]
     scene = tw.box_scene(tw.regular(w), duration=180.0, extra_hydro=f'viscous_damping = {Bv}\nexcitation = "froude-krylov"\n')
     r = js.simulate(scene)
@@ -138,7 +138,7 @@ def waves():
         errs.append(f"{100 * (abs(roll) / abs(ref) - 1):+.2f}")
     row("Cummins memory, harmonic roll moment at 0.7, 0.9, 1.1, 1.3, 1.5 rad/s", "frequency domain with A(w), B(w)",
         "amplitude errors " + ", ".join(errs) + " %")
-    hs = capytaine_hydrostatics(Hull(length=20.0, beam=10.0, draft=2.0, kg=2.5))
+    hs = capytaine_hydrostatics(BoxHull(length=20.0, beam=10.0, draft=2.0, kg=2.5))
     closed = {"displaced_volume": 400.0, "waterplane_area": 200.0, "bm_t": 100 / 24, "bm_l": 400 / 24}
     row("Capytaine hydrostatics, box 20 x 10 x 2 m", "V, A_w, BM_T = B^2/12T, BM_L = L^2/12T",
         "errors " + ", ".join(f"{100 * (hs[k] / v - 1):+.3f}" for k, v in closed.items()) + " %")

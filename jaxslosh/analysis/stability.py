@@ -26,7 +26,7 @@ import numpy as np
 
 from ..hull.clip import submerged, submerged_and_cut
 from ..hull.hydrostatics import first_vanishing
-from ..hull.surface import HullMeshError, hull_triangles
+from ..hull.surface import HullMeshError
 from ..hull.tanks import tank_surface
 from ..staging import START_OPTIONS
 from ..scene.load import load_scene
@@ -101,11 +101,11 @@ def hull_surface(scene):
     if hull is None:
         raise SceneError("vessel.hull", "stability needs the hull's geometry: add a [vessel.hull] table "
                                         '(a box: length, beam, draft, kg and depth; or type = "mesh", a closed mesh)')
-    if hull.type == "box" and hull.depth is None:
+    if hull.closed_form and hull.depth is None:
         raise SceneError("vessel.hull.depth", "stability needs the box's depth from keel to deck (m): at large "
                                               "heels the deck edge immerses")
     try:
-        return np.asarray(hull_triangles(hull))
+        return np.asarray(hull.triangles())
     except HullMeshError as e:
         raise SceneError("vessel.hull.file", str(e)) from None
 

@@ -32,8 +32,7 @@ def hull_about(scene: Scene, waves: bool) -> About:
     """HullPressure's lines: the nonlinear buoyancy on the hull's wetted surface, and the incident
     waves' pressure there where it has them."""
     hull = scene.vessel.hull
-    what = (f"box {hull.length:g} x {hull.beam:g} x {hull.depth:g} m (deck included)" if hull.type == "box"
-            else f"mesh {hull.file}")
+    what = hull.describe()
     lines = [("buoyancy", f"nonlinear: the still-water pressure on the instantaneous wetted surface of the {what}, "
                           "clipped exactly at the water")]
     if waves:
@@ -121,12 +120,7 @@ def record_about(f) -> About:
 
 def sea_words(w) -> str:
     """The sea of a `[waves]` table, in a few words."""
-    sea = (f"regular, amplitude {w.amplitude:g} m, {w.omega:.4g} rad/s" if w.type == "regular" else
-           (f"JONSWAP Hs {w.hs:g} m, Tp {w.tp:g} s, gamma {w.gamma:g}" if w.type == "jonswap" else
-            f"Pierson-Moskowitz Hs {w.hs:g} m, Tp {w.tp:g} s")
-           + f", {w.components} components, seed {w.seed}"
-           + (f", cos-2s spreading s = {w.spreading:g} over {w.directions} headings" if w.spreading > 0 else ""))
-    return f"{sea}, heading {w.heading:.4g} rad" + (f", faded in over {w.ramp:g} s" if w.ramp > 0 else "")
+    return f"{w.describe()}, heading {w.heading:.4g} rad" + (f", faded in over {w.ramp:g} s" if w.ramp > 0 else "")
 
 
 def waves_about(scene: Scene, nonlinear: bool) -> About:

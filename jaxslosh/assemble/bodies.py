@@ -12,17 +12,16 @@ from ..physics.about import About
 from ..physics.bodies import BAND, FIXED, VESSEL, Bodies, Floating, Link
 from ..physics.kinematics import quat_from_rpy
 from ..physics.seakeeping import LinearDamping, WaveExcitation
+from ..physics.vessel import RESTORING_FORMS, AbstractRestoring, RigidBody
 from .bodyhydro import time_terms
 from .seakeeping import make_excitation
-from ..physics.vessel import Hydrostatics, PaperHydrostatics, RigidBody
 
 
-def linear_hydrostatics(h, rho_w, g, value=lambda key, v: v) -> Hydrostatics:
+def linear_hydrostatics(h, rho_w, g, value=lambda key, v: v) -> AbstractRestoring:
     """The linear restoring term of a `hydrostatics` table (the vessel's or a body's); `value(name,
     v)` may replace a value (the vessel's traced params)."""
     f = lambda k, v: jnp.asarray(value(k, v), dtype=float)  # noqa: E731
-    form = PaperHydrostatics if h.moment == "paper" else Hydrostatics
-    return form(rho_w=jnp.asarray(rho_w, dtype=float), gravity=g,
+    return RESTORING_FORMS[h.moment](rho_w=jnp.asarray(rho_w, dtype=float), gravity=g,
                 waterplane_area=f("waterplane_area", h.waterplane_area),
                 displaced_volume=f("displaced_volume", h.displaced_volume), gm_t=f("gm_t", h.gm_t),
                 gm_l=f("gm_l", h.gm_l))
@@ -57,7 +56,7 @@ def build_bodies(scene, params: dict, g) -> Optional[Bodies]:
         floating.append(Floating(
             terms=rigid_terms(b.mass, b.inertia, b.hydrostatics, rho, g, b.viscous_damping) + (
                 () if X is None or not np.abs(X[s]).max() > 0 else
-                (WaveExcitation(make_excitation(waves, X[s], P("waves.amplitude" if waves.type == "regular" else "waves.hs",
+                (WaveExcitation(make_excitation(waves, X[s], P(waves.height_key,
                                                               waves.height))),)),
             rest=jnp.asarray(rest), x0=jnp.asarray(rest + np.asarray(ini.position)),
             q0=quat_from_rpy(jnp.array([roll, pitch, yaw + b.heading])),

@@ -3,12 +3,12 @@ steps) and its unknowns, counted from the scene before anything is built (assemb
 them too). The effects `check` lists are the assembled model's own (assemble/check.py)."""
 from __future__ import annotations
 
-import os
 
 from ..liquid.face.mesh import free_face_count
 from ..liquid.walls import shell_mesh
 from ..liquid.multimodal.modes import modal_modes
 from ..scene.types import EFFECTS, FACE_FORMS, Scene
+from ..solve.schemes import SCHEMES
 
 
 def describe(scene: Scene) -> str:
@@ -37,9 +37,8 @@ def describe(scene: Scene) -> str:
         lines.append("probes: " + ", ".join(
             f"{p.name} ({'tank' if p.tank else 'structure'} {p.tank or p.structure!r} at "
             f"[{', '.join(f'{x:g}' for x in p.point)}])" for p in scene.probes))
-    damping = {"newmark": ", energy projection" if sim.energy_projection else "", "hht": f", alpha {sim.alpha:g}", "generalized-alpha": f", rho_inf {sim.rho_inf:g}"}
     lines.append(f"simulation: {sim.n_steps} steps of {sim.dt:g} s to t = {sim.n_steps * sim.dt:g} s, "
-                 f"scheme {sim.scheme}{damping[sim.scheme]}, saving every {sim.save_every} step(s)")
+                 f"scheme {sim.scheme}{SCHEMES[sim.scheme].settings_words(sim)}, saving every {sim.save_every} step(s)")
     return "\n".join(lines)
 
 

@@ -2,39 +2,15 @@
 closed surface, its still water plane and, with `[waves]`, the incident components."""
 from __future__ import annotations
 
-import math
 from typing import Optional
 
 import jax.numpy as jnp
 import numpy as np
 
 from ..hull.clip import MIDPOINT_RULE, area_vectors, clip_below
-from ..hull.surface import hull_triangles, water_height
 from ..hydro.spectra import components, wavenumber
 from ..physics.hull import HullPressure, IncidentWaves
 from .about import hull_about
-
-#: box panels per shortest wave length (the wave pressure's quadrature and tangent planes)
-PANELS_PER_WAVELENGTH = 12
-#: at most this many cells along a box edge
-MAX_DIVISIONS = 48
-
-
-def box_divisions(hull, waves) -> tuple:
-    """Cells along the box's length, beam and depth: one in still water (the clipping is exact on
-    any box), else panels of a twelfth of the shortest wave length of the sea (or finer
-    vertically, where the pressure decays as exp(k z))."""
-    if waves is None:
-        return (1, 1, 1)
-    # the top of an irregular sea's frequency range, not its highest drawn component: the panels
-    # then do not depend on the seed, and a campaign's cases share their model (and its compilation)
-    top = waves.omega if waves.type == "regular" else waves.omega_range[1]
-    lam = 2.0 * math.pi / float(np.max(wavenumber(np.array([top]), 9.81, waves.depth)))
-    size = lam / PANELS_PER_WAVELENGTH
-    n = [min(MAX_DIVISIONS, max(1, math.ceil(s / size))) for s in (hull.length, hull.beam, hull.depth)]
-    n[2] = max(n[2], 4)
-    return tuple(n)
-
 
 def hull_pressure(scene) -> bool:
     """Whether the scene's restoring is the pressure on its wetted hull: the nonlinear
@@ -53,7 +29,7 @@ def incident_waves(scene, params: dict) -> IncidentWaves:
     w, g = scene.waves, scene.environment.gravity
     c = components(w)
     b = c.each_heading()
-    key = "waves.amplitude" if w.type == "regular" else "waves.hs"
+    key = w.height_key
     return IncidentWaves(jnp.asarray(c.omega), jnp.asarray(wavenumber(c.omega, g, w.depth)),
                          jnp.asarray(c.amplitude / w.height), jnp.asarray(c.phase), jnp.asarray(np.cos(b)),
                          jnp.asarray(np.sin(b)), jnp.asarray(params.get(key, w.height), dtype=float),
@@ -72,11 +48,10 @@ def build_hull_pressure(scene, params: dict, g) -> HullPressure:
     against them, not their distribution."""
     hull, env = scene.vessel.hull, scene.environment
     waves = scene.waves if scene.waves is not None and scene.effects.waves else None
-    divisions = box_divisions(hull, waves) if hull.type == "box" else (1, 1, 1)
-    tris = hull_triangles(hull, divisions)
+    tris = hull.triangles(hull.divisions(waves))
     rho = jnp.asarray(params.get("environment.water_density", env.water_density), dtype=float)
     inc: Optional[IncidentWaves] = incident_waves(scene, params) if waves is not None else None
-    z_water, shift = jnp.asarray(water_height(hull), dtype=float), None
+    z_water, shift = jnp.asarray(hull.water_height(), dtype=float), None
     if "vessel.hull.kg" in params:
         kg = jnp.asarray(params["vessel.hull.kg"], dtype=float)
         z_water = jnp.asarray(hull.draft, dtype=float) - kg
@@ -117,7 +92,6 @@ def froude_krylov_hull(scene, omega, headings=None):
     where `headings` is None), with the surface the nonlinear model integrates on (the scene's
     water depth; deep water without [waves])."""
     hull, env, w = scene.vessel.hull, scene.environment, scene.waves
-    divisions = box_divisions(hull, w) if hull.type == "box" else (1, 1, 1)
-    return froude_krylov_surface(hull_triangles(hull, divisions), water_height(hull), omega,
+    return froude_krylov_surface(hull.triangles(hull.divisions(w)), hull.water_height(), omega,
                                  w.heading if headings is None else headings, env.water_density, env.gravity,
                                  None if w is None else w.depth)

@@ -28,7 +28,7 @@ def memory_module(fit: RadiationFit) -> Optional[Memory]:
 def make_excitation(waves, X, height) -> Excitation:
     """From the components of `waves` and X (N, 6): the force of each component per unit `height`."""
     c = components(waves)
-    h0 = waves.amplitude if waves.type == "regular" else waves.hs
+    h0 = waves.height
     a = c.amplitude / h0
     amp = (np.abs(X) * a[:, None]).T
     phase = (np.angle(X) + c.phase[:, None]).T
@@ -58,7 +58,7 @@ def build_seakeeping(scene, params: dict) -> tuple:
     if waves is not None and eff.waves:
         X = linear_excitation_rao(scene, components(waves))
         if X is not None:
-            key = "waves.amplitude" if waves.type == "regular" else "waves.hs"
+            key = waves.height_key
             terms.append(WaveExcitation(make_excitation(waves, X, params.get(key, waves.height)),
                                         about=waves_about(scene, hull_pressure(scene))))
     hd = ves.hydrodynamics

@@ -26,7 +26,7 @@ program, through XLA's cache. An executable XLA's cache gave back is not kept (s
 element matrices, the Newton matrix's constant blocks), a second run of the scene reads it.
 
 XLA's work on a program runs outside Python: `Program.compile_in_background` lets one program
-compile while Python traces the next (`cache/compiled.compile_run`).
+compile while Python traces the next (`run/compiled.compile_run`).
 """
 from __future__ import annotations
 
@@ -361,4 +361,9 @@ def no_eager_folding():
     return state(False) if state is not None else contextlib.nullcontext()
 
 
-staging.install(lower_program, no_eager_folding)
+def install():
+    """Install the cache's hooks in jaxslosh/staging.py: called by the entry points (the command
+    line's `setup_jax`, the package's public functions on first use, the campaign workers), never on
+    import, so that nothing below the cache depends on whether it is imported."""
+    staging.install(lower=lower_program, no_folding=no_eager_folding, key=program_key, cached=cached,
+                    remember=executables.remember, folder=folder)

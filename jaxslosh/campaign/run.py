@@ -148,7 +148,7 @@ def campaign(scene, scatter, headings=None, seeds: int | None = None, duration: 
     the workers' persistent compilation cache (default: this process's, jax_compilation_cache_dir)."""
     t_start = time.perf_counter()
     template = load_scene(scene) if isinstance(scene, (str, os.PathLike)) else scene
-    if template.waves is None or template.waves.type == "regular":
+    if template.waves is None or not template.waves.irregular:
         raise SceneError("waves.type", "a campaign's template is an irregular sea: type = \"jonswap\" or "
                                        "\"pierson-moskowitz\"")
     if not template.text:

@@ -20,6 +20,7 @@ except ModuleNotFoundError:  # Python 3.10
     import tomli as tomllib  # type: ignore[no-redef]
 
 from ..assemble.hull import hull_waves
+from ..cache.programs import install as install_cache
 from ..run.batch import capsize_angles, simulate_seas
 from ..run.capsize import capsize_reason
 from ..scene.load import parse_scene
@@ -34,6 +35,7 @@ def configure_jax(cache_dir: Optional[str]):
     """float64, and the client's persistent compilation cache folder (shared by every worker of
     one machine: the second worker to compile a scene's loop reads the first one's)."""
     jax.config.update("jax_enable_x64", True)
+    install_cache()             # a worker process is an entry point of its own
     if cache_dir:
         jax.config.update("jax_compilation_cache_dir", cache_dir)
         jax.config.update("jax_persistent_cache_min_compile_time_secs", 0.0)
@@ -60,7 +62,7 @@ def structure_scene(template: Scene, case: Scene) -> Scene:
                             components=case.waves.components)
     if hull_waves(template):
         # the wetted hull's wave pressure is compiled for the depth, and its panels for the top of
-        # the frequency range (assemble/hull.box_divisions)
+        # the frequency range (scene/hulls.py BoxHull.divisions)
         w = dataclasses.replace(w, depth=case.waves.depth, omega_range=case.waves.omega_range)
     return dataclasses.replace(template, waves=w)
 

@@ -75,6 +75,7 @@ def setup_jax():
     import jax
 
     programs = import_module("..cache.programs", __package__)
+    programs.install()          # the command line is an entry point: its programs go through the cache
     jax.config.update("jax_enable_x64", True)
     d, kept = cache_folder()
     limit = cache_max_bytes() if d is not None else None     # a bad limit changes nothing

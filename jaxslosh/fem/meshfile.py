@@ -47,13 +47,13 @@ _EDGES = np.array([[[0, 1], [3, 2], [4, 5], [7, 6]], [[0, 3], [1, 2], [4, 7], [5
 _FLIP = [0, 3, 2, 1, 4, 7, 6, 5]
 
 
-class MeshFile(NamedTuple):
+class HexMesh(NamedTuple):
     nodes: np.ndarray        # (N, 3) the used points, in the file's order
     elements: np.ndarray     # (E, 8) hex8, right-handed
     reoriented: int          # elements the file gave left-handed, re-oriented here
 
 
-def read_mesh_file(path) -> MeshFile:
+def read_mesh_file(path) -> HexMesh:
     """The checked hexahedral mesh of a file; ValueError with one line naming what is wrong. Read
     once per file version (the loader, the volume, the build and `check` all ask): shared arrays."""
     try:
@@ -64,7 +64,7 @@ def read_mesh_file(path) -> MeshFile:
 
 
 @functools.lru_cache(maxsize=8)
-def _read(path, mtime_ns, size) -> MeshFile:
+def _read(path, mtime_ns, size) -> HexMesh:
     try:
         import meshio
     except ImportError as e:   # a core dependency (pyproject.toml); an install that skipped it gets one line
@@ -102,7 +102,7 @@ def _read(path, mtime_ns, size) -> MeshFile:
     used = np.unique(elements)
     remap = np.full(len(points), -1)
     remap[used] = np.arange(used.size)
-    return MeshFile(points[used], remap[elements], flipped)
+    return HexMesh(points[used], remap[elements], flipped)
 
 
 def check_hexahedra(points, elements, name="mesh"):

@@ -33,7 +33,7 @@ class Boundary(NamedTuple):
     flat: np.ndarray             # (E,) bool: elements with two faces on one smooth wall (see node_frames)
 
 
-def _boundary_faces(elements):
+def boundary_faces(elements):
     """(faces (B, 4) outward, element of each) of the faces that belong to one element only (faces
     with a repeated node, a collapsed element's, are left out)."""
     F = elements[:, HEX_FACES].reshape(-1, 4)
@@ -46,7 +46,7 @@ def _boundary_faces(elements):
     return F[once], owner[once]
 
 
-def _face_normals(nodes, faces):
+def face_normals(nodes, faces):
     """(unit normals (B, 3), areas (B,)) of quadrilateral faces (from their diagonals)."""
     X = nodes[faces]
     n = 0.5 * np.cross(X[:, 2] - X[:, 0], X[:, 3] - X[:, 1])
@@ -57,8 +57,8 @@ def _face_normals(nodes, faces):
 def boundary(nodes, elements, depth) -> Boundary:
     """The free surface (faces on the plane z = depth facing up) and the walls (every other boundary
     face) of a mesh of the liquid at rest, and the wall nodes' frames."""
-    faces, owner = _boundary_faces(elements)
-    normal, area = _face_normals(nodes, faces)
+    faces, owner = boundary_faces(elements)
+    normal, area = face_normals(nodes, faces)
     centre = nodes[elements[owner]].mean(axis=1)
     outward = np.einsum("ij,ij->i", normal, nodes[faces].mean(axis=1) - centre) >= 0
     normal = np.where(outward[:, None], normal, -normal)

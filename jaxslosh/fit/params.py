@@ -10,7 +10,6 @@ import jax.numpy as jnp
 import numpy as np
 
 from ..hull.hydrostatics import rest_hydrostatics
-from ..hull.surface import hull_triangles
 from ..scene.keys import SPRING_KEYS, canonical_key, scene_values, traceable
 from ..scene.types import Scene, SceneError
 
@@ -129,7 +128,7 @@ def implied_values(scene: Scene, values: dict, errors: dict) -> tuple[dict, dict
     if "vessel.hull.cog" in values:
         hull, env = scene.vessel.hull, scene.environment
         cog = np.asarray(values["vessel.hull.cog"], dtype=float)
-        tris = hull_triangles(hull) + (np.asarray(hull.cog, dtype=float) - cog)
+        tris = hull.triangles() + (np.asarray(hull.cog, dtype=float) - cog)
         own = rest_hydrostatics(tris, -cog[2], env.water_density, env.gravity)
         out = {k: own[k.split(".")[-1]] for k in IMPLIED_BY_KG}
         return out, {k: errors["vessel.hull.cog"][2] for k in out}

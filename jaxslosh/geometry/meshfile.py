@@ -13,7 +13,7 @@ import numpy as np
 from ..fem.mesh import grid_nodes
 from ..fem.meshfile import read_mesh_file
 from ..fem.shapes import TankMesh, as_grid, finish, grid_counts, hex_volumes, read_mesh
-from ..fem.slip import _boundary_faces as boundary_faces, _face_normals as face_normals, boundary
+from ..fem.slip import boundary, boundary_faces, face_normals
 from ..hull.tanks import mesh_surface
 from .base import AbstractShape, Reader
 

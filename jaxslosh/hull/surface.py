@@ -14,7 +14,6 @@ import os
 
 import numpy as np
 
-from .box import box_hull
 
 
 class HullMeshError(ValueError):
@@ -124,26 +123,17 @@ def _mesh_cached(path: str, mtime: float, cog: tuple, label: str):
     return tris
 
 
-def hull_triangles(hull, divisions=(1, 1, 1)):
-    """The closed surface of a scene's `[vessel.hull]` (scene.types.Hull) in the vessel frame:
-    the box with its deck (`divisions` cells along its edges), or the mesh file (read once per
-    file version). HullMeshError names the file and the fault."""
-    if hull.type == "box":
-        return box_hull(hull.length, hull.beam, hull.kg, hull.depth, divisions)
-    path = hull.path()
+def hull_mesh_file(path: str, cog, label: str):
+    """The closed surface of a hull mesh file in the vessel frame (the COG `cog` of the file's
+    coordinates at the origin), read once per file version; HullMeshError names `label`."""
     try:
         mtime = os.path.getmtime(path)
     except OSError:
-        raise HullMeshError(f"{hull.file}: no such file") from None
-    return _mesh_cached(path, mtime, tuple(hull.cog), hull.file)
+        raise HullMeshError(f"{label}: no such file") from None
+    return _mesh_cached(path, mtime, tuple(cog), label)
 
 
-def water_height(hull) -> float:
-    """The still water plane's height in the vessel frame at rest (the COG at the origin)."""
-    return hull.draft - hull.kg if hull.type == "box" else -float(hull.cog[2])
-
-
-def prism_surface(section, length, nx=1, nz=1):
+def prism_hull(section, length, nx=1, nz=1):
     """A closed prism along x (length centred on x = 0) of a convex section polygon `section` (k, 2):
     (y, z) counter-clockwise in the (y, z) plane; `nx` cells along the length, each side of the
     section cut into `nz` cells (`loft_surface` with one section)."""

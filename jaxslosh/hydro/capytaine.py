@@ -8,7 +8,6 @@ from __future__ import annotations
 import importlib.util
 import inspect
 import logging
-import os
 
 import numpy as np
 
@@ -43,14 +42,11 @@ def default_frequencies(n: int = 40, lo: float = 0.1, hi: float = 4.0):
     return tuple(np.linspace(lo, hi, n))
 
 
-def _box_body(cpt, hull, panel_size, resolution=None, lid=True, omega_max=None):
-    """The wetted part of a box hull (the COG at the origin), with a lid inside the waterplane
-    against irregular frequencies (see `_lid_depth`), and the six rigid dofs about the COG."""
-    L, B, T, kg = hull.length, hull.beam, hull.draft, hull.kg
-    size = panel_size or max(min(L, B, T) / 4.0, max(L, B) / 24.0)
-    res = resolution or tuple(max(2, int(np.ceil(x / size))) for x in (L, B, 2 * T))
-    z_wl = T - kg
-    mesh = cpt.mesh_parallelepiped(size=(L, B, 2 * T), center=(0.0, 0.0, z_wl), resolution=res, name="hull")
+def _hull_body(cpt, hull, panel_size, base_dir="", resolution=None, lid=True, omega_max=None):
+    """The wetted part of a hull (scene/hulls.py: the box's mesh or the file's; the COG at the
+    origin), with a lid inside the waterplane against irregular frequencies (see `_lid_depth`),
+    and the six rigid dofs about the COG."""
+    mesh, z_wl = hull.capytaine_mesh(cpt, panel_size, resolution, base_dir)
     return _body_from_mesh(cpt, mesh, z_wl, lid, omega_max)
 
 
@@ -89,25 +85,14 @@ def _body_from_mesh(cpt, mesh, z_wl, lid=True, omega_max=None):
     return body
 
 
-def _mesh_body(cpt, hull, base_dir="", omega_max=None):
-    path = hull.file if os.path.isabs(hull.file) or not base_dir else os.path.join(base_dir, hull.file)
-    mesh = cpt.load_mesh(path)
-    # the mesh's coordinates: waterline at z = 0; our origin is the COG at `cog`
-    mesh = mesh.translated(tuple(-np.asarray(hull.cog)))
-    return _body_from_mesh(cpt, mesh, -float(hull.cog[2]), omega_max=omega_max)
-
-
 def capytaine_hydrostatics(hull, rho=1025.0, g=9.81, panel_size=None, base_dir=""):
     """Hydrostatics of a hull from Capytaine: displaced volume, waterplane area, BM_T, BM_L, KB
     (the centre of buoyancy's height above the keel for a box), GM_T and GM_L about the COG."""
     cpt = _import_capytaine()
-    if hull.type == "box":
-        # Capytaine integrates the waterplane's second moments at panel centres: with n panels across,
-        # BM is low by 1/n^2, so hydrostatics (cheap: no BEM) take 40 along and across (BM -0.06 %)
-        res = None if panel_size else (40, 40, 4)
-        body = _box_body(cpt, hull, panel_size, resolution=res, lid=False)
-    else:
-        body = _mesh_body(cpt, hull, base_dir)
+    # Capytaine integrates the waterplane's second moments at panel centres: with n panels across,
+    # BM is low by 1/n^2, so a box's hydrostatics (cheap: no BEM) take 40 along and across (BM -0.06 %);
+    # no lid: Capytaine's hydrostatics integrate over the hull's mesh alone
+    body = _hull_body(cpt, hull, panel_size, base_dir, resolution=None if panel_size else (40, 40, 4), lid=False)
     V = float(body.disp_volume)
     zb = float(body.center_of_buoyancy[2])
     zg = float(body.center_of_mass[2])
@@ -129,8 +114,7 @@ def _capytaine_solve(hull, rho, g, depth, frequencies, headings, panel_size, bas
     groups them to reuse its matrices), so that `progress` (run/progress.Progress) counts them."""
     cpt = _import_capytaine()
     w = np.asarray(frequencies if frequencies else default_frequencies(), dtype=float)
-    body = _box_body(cpt, hull, panel_size, omega_max=w.max()) if hull.type == "box" else \
-        _mesh_body(cpt, hull, base_dir, omega_max=w.max())
+    body = _hull_body(cpt, hull, panel_size, base_dir, omega_max=w.max())
     kw = {"rho": rho, "g": g}
     if depth is not None:
         kw["water_depth"] = depth

@@ -8,7 +8,6 @@ from typing import Optional
 
 import numpy as np
 
-from .box import froude_krylov_box
 from .capytaine import capytaine_tables
 from .radiation import RadiationFit, fit_radiation
 from .tables import Tables, interpolate_excitation, scene_tables
@@ -72,9 +71,7 @@ def excitation_rao(scene, omega, headings=None):
         return X
     if excitation_source(scene) == "table":
         return interpolate_excitation(scene_hydro_tables(scene), omega, waves.heading)
-    h = ves.hull
-    return froude_krylov_box(omega, waves.heading, h.length, h.beam, h.draft, h.kg, env.water_density,
-                             env.gravity, waves.depth)
+    return ves.hull.froude_krylov(omega, waves.heading, env.water_density, env.gravity, waves.depth)
 
 
 def excitation_at(hd, hull, tables: Optional[Tables], omega, heading, rho, g, depth=None):
@@ -84,9 +81,8 @@ def excitation_at(hd, hull, tables: Optional[Tables], omega, heading, rho, g, de
     "froude-krylov", else Froude-Krylov on the box hull; None when the scene has neither."""
     source = "auto" if hd is None else hd.excitation
     has_table = tables is not None and tables.excitation is not None
-    box = hull is not None and hull.type == "box"
     if has_table and source != "froude-krylov":
         return interpolate_excitation(tables, omega, heading)
-    if box and source != "table":
-        return froude_krylov_box(omega, heading, hull.length, hull.beam, hull.draft, hull.kg, rho, g, depth)
+    if hull is not None and source != "table":
+        return hull.froude_krylov(omega, heading, rho, g, depth)    # None where it has no closed form
     return None

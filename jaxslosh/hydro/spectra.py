@@ -60,10 +60,9 @@ def pierson_moskowitz(omega, hs: float, tp: float):
 
 
 def spectrum(waves, omega):
-    """The spectral density of an irregular `[waves]` table at frequencies omega."""
-    if waves.type == "pierson-moskowitz":
-        return pierson_moskowitz(omega, waves.hs, waves.tp)
-    return jonswap(omega, waves.hs, waves.tp, waves.gamma)
+    """The spectral density of an irregular `[waves]` table at frequencies omega (its kind's:
+    scene/seas.py)."""
+    return waves.spectrum(omega)
 
 
 def spreading_density(theta, s: float):
@@ -120,7 +119,13 @@ class Components(NamedTuple):
 
 
 def components(waves) -> Components:
-    """The components of a scene's `[waves]` table (scene_types.Waves).
+    """The components of a scene's `[waves]` table (scene/seas.py: a regular wave is one, an
+    irregular sea's are `drawn_components`)."""
+    return waves.wave_components()
+
+
+def drawn_components(waves) -> Components:
+    """The components of an irregular sea.
 
     JONSWAP or Pierson-Moskowitz: `components` frequencies, one drawn uniformly in each of equal
     bins over `frequency_range` (so the record does not repeat after 2 pi / dw), amplitudes
@@ -129,16 +134,13 @@ def components(waves) -> Components:
     each frequency at `directions` headings (`spreading`), amplitudes sqrt(2 S dw D_j dtheta) and a
     phase of its own per (frequency, heading), drawn after the long-crested ones (a long-crested
     sea of the same seed keeps its phases)."""
-    if waves.type == "regular":
-        return Components(np.array([waves.omega]), np.array([waves.amplitude]), np.array([waves.phase]),
-                          float(waves.heading))
     lo, hi = waves.omega_range
     n = int(waves.components)
     rng = np.random.default_rng(int(waves.seed))
     dw = (hi - lo) / n
     w = lo + (np.arange(n) + rng.uniform(size=n)) * dw
     eps = rng.uniform(0.0, 2.0 * np.pi, size=n)
-    a = np.sqrt(2.0 * spectrum(waves, w) * dw)
+    a = np.sqrt(2.0 * waves.spectrum(w) * dw)
     s = float(getattr(waves, "spreading", 0.0))
     if s <= 0:
         return Components(w, a, eps, float(waves.heading))

@@ -175,7 +175,7 @@ def _contact_solve(XF, ZF, L, w, EA, CB, hA):
         V = H * _rise_slope(H, ZF + hA, w, EA)
         return _contact(H, V, L, w, EA, CB, hA)[0] - XF, V
 
-    f = lambda h: parts(h)[0]
+    f = lambda h: parts(h)[0]  # noqa: E731
     df = jax.grad(f)
     scale = jnp.log(jnp.abs(w) * L)
 
@@ -189,7 +189,7 @@ def _contact_solve(XF, ZF, L, w, EA, CB, hA):
         new = jnp.where(inside, new, 0.5 * (lo + hi))
         return new, lo, hi, jnp.abs(f(new)) / L, it + 1
 
-    cond = lambda state: (state[3] > TOL) & (state[4] < MAX_ITER)
+    cond = lambda state: (state[3] > TOL) & (state[4] < MAX_ITER)  # noqa: E731
     lo, hi = scale - 40.0, jnp.log(EA) + 10.0
     h0 = jnp.clip(jnp.log(_start(XF, ZF, L, w, EA)[0]), lo + 1.0, hi - 1.0)
     h, *_ = jax.lax.while_loop(cond, step, (h0, lo, hi, jnp.abs(f(h0)) / L, 0))

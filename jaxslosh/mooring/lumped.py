@@ -323,7 +323,6 @@ def static_shape(line: LumpedLine, fair, tol=1e-8, max_iter=200):
     of `potential`, by Levenberg-Marquardt steps on its exact Hessian (a trial that does not lower
     the energy is refused and the damping raised), until the largest out-of-balance force is below
     tol times the weight of a segment. Returns (nodes, converged)."""
-    n = 3 * (line.segments - 1)
     x0 = _start_shape(line, fair).reshape(-1)
     pot = lambda x: potential(line, x.reshape(-1, 3), fair)  # noqa: E731
     grad = jax.grad(pot)

@@ -15,7 +15,7 @@ from ..assemble.system import build
 from ..physics.hull import HullPressure
 from ..physics.kinematics import quat_exp, rotation_matrix, rpy_from_quat
 from ..physics.terms import Config
-from ..physics.vessel import Hydrostatics, Weight
+from ..physics.vessel import AbstractRestoring, Weight
 from ..scene.types import Scene, SceneError
 from .lumped_keys import quasi_static_lines
 from .term import MooringLines, mooring_term
@@ -72,7 +72,7 @@ def static_residual(system, x):
         if isinstance(term, HullPressure):
             F, M = term.still_force_moment(k.c.X0, k.A)
             total = total - jnp.concatenate([F, M])
-        elif isinstance(term, (Hydrostatics, Weight, MooringLines)):
+        elif isinstance(term, (AbstractRestoring, Weight, MooringLines)):
             total = total + term.rows(k).rigid
     return total
 

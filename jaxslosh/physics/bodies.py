@@ -3,7 +3,8 @@ unknowns (`Bodies`, an unknowns.AbstractOwner), docs/guide/bodies-and-connection
 
 Bodies as one family: each body is a floating frame of its own (6 rigid unknowns, rotations on the
 group) whose rows are the sum of the *same term classes* as the vessel's rigid part (vessel.py:
-`RigidBody`, the linear `Hydrostatics` about its own rest pose, seakeeping.py's `LinearDamping`),
+`RigidBody`, the linear restoring `AbstractRestoring` about its own rest pose, seakeeping.py's
+`LinearDamping`),
 evaluated with the body's own kinematics (`Floating.kin`): a body is built by the functions that
 build the vessel's rigid terms, its wave excitation among them (seakeeping.py's `WaveExcitation`,
 its forces at the body's place in the incident field). What the vessel has and a body has not

@@ -4,7 +4,7 @@ prescribes the vessel's rows; a free hull has none)."""
 from __future__ import annotations
 
 import abc
-from typing import Optional
+from typing import ClassVar, Optional, final
 
 import equinox as eqx
 import jax
@@ -75,10 +75,10 @@ class Weight(AbstractTerm):
         return self.about.lines
 
 
-class Hydrostatics(AbstractTerm):
-    """Linear hydrostatic restoring about the initial equilibrium (eqs. 33-36), its moment the
-    gradient of the restoring potential (`vessel.hydrostatics.moment = "conservative"`);
-    `PaperHydrostatics` takes eq. (36) literally."""
+class AbstractRestoring(AbstractTerm):
+    """Linear hydrostatic restoring about the initial equilibrium (eqs. 33-36): the heave force of
+    eq. (35) and a restoring moment of the final kind's form (`vessel.hydrostatics.moment`,
+    RESTORING_FORMS). The scene's table of the values is scene.types.Hydrostatics."""
     rho_w: jax.Array
     gravity: jax.Array
     waterplane_area: jax.Array
@@ -104,9 +104,16 @@ class Hydrostatics(AbstractTerm):
         heave = 0.5 * self.rho_w * self.gravity * self.waterplane_area * X0[2] ** 2
         return heave + k * (self.gm_t * g[1] ** 2 + self.gm_l * g[0] ** 2) / (1.0 + g[2])
 
+    #: the value of `vessel.hydrostatics.moment` that names the form
+    form: ClassVar[str] = ""
+
+    @abc.abstractmethod
     def moment(self, q):
-        """The restoring moment (body frame) of the chosen form. The conservative one is minus the
-        derivative of the potential along body-frame rotations, written out (a JAX gradient inside
+        """The restoring moment (body frame) of the form."""
+
+    def moment_conservative(self, q):
+        """The moment of the conservative form: minus the derivative of the potential along
+        body-frame rotations, written out (a JAX gradient inside
         the residual would be linearised and transposed again in every Newton preconditioner):
         with g = A^T e_z, a body rotation d theta changes g by g x d theta, so M = g x dV/dg.
         tests/physics/test_vessel.py checks it against the gradient of `restoring_potential`."""
@@ -124,17 +131,33 @@ class Hydrostatics(AbstractTerm):
         return self.restoring_potential(k.c.X0, k.c.q)
 
     def describe(self) -> tuple:
-        form = "paper" if isinstance(self, PaperHydrostatics) else "conservative"
-        return (("buoyancy", f"restoring force and moments of eqs. (33)-(36), moment form {form!r}"),)
+        return (("buoyancy", f"restoring force and moments of eqs. (33)-(36), moment form {self.form!r}"),)
 
 
-class PaperHydrostatics(Hydrostatics):
+@final
+class ConservativeRestoring(AbstractRestoring):
+    """The restoring moment the gradient of the restoring potential (`vessel.hydrostatics.moment =
+    "conservative"`): a run without damping conserves its energy."""
+    form: ClassVar[str] = "conservative"
+
+    def moment(self, q):
+        return self.moment_conservative(q)
+
+
+@final
+class PaperRestoring(AbstractRestoring):
     """The restoring of eqs. (33)-(36) with the moment of eq. (36) literally
     (`vessel.hydrostatics.moment = "paper"`): not the gradient of a potential when GM_T != GM_L, so
     a run's energy is not conserved with it."""
+    form: ClassVar[str] = "paper"
 
     def moment(self, q):
         return self.moment_paper(q)
+
+
+#: `vessel.hydrostatics.moment`'s values and their terms (the scene loader checks the key against
+#: scene/hull.py MOMENTS, below this layer; tests/docs/test_variants.py keeps the two the same)
+RESTORING_FORMS = {c.form: c for c in (ConservativeRestoring, PaperRestoring)}
 
 
 def smooth_ramp(s):

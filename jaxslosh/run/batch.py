@@ -87,7 +87,7 @@ def _batch_fn(scene: Scene, keys: tuple, mesh: Optional[Mesh] = None, excited: b
     # XLA's options of the single run's loop (staging.XLA_OPTIONS: its classic CPU emitters compile
     # the step's many small fusions in less time, and the loop runs as fast). One program, the
     # initial state in it: compiled apart with its optimisation off, as a single run's is
-    # (cache/compiled.py), the vmapped loop that takes its carry ran markedly slower (docs/benchmarks.md)
+    # (run/compiled.py), the vmapped loop that takes its carry ran markedly slower (docs/benchmarks.md)
     fn = jax.jit(fn, compiler_options=XLA_OPTIONS or None)
     if cache_key is not None:
         _BATCH_FNS[cache_key] = fn

@@ -143,12 +143,12 @@ def ending_at(carry: Carry, n_steps: int) -> Carry:
 
 def carry_shapes(b: Built, solver: Solver) -> Carry:
     """The shapes and types of init's carry, without tracing its Newton solves (what the loop is
-    lowered for while init is still being traced: cache/compiled.compile_run)."""
+    lowered for while init is still being traced: run/compiled.compile_run)."""
     return eqx.filter_eval_shape(
         lambda b_, s_: _first_carry(*initial_state_like(b_.system, s_, b_.c0, b_.v0, b_.alg0)), b, solver)
 
 
-def step(b: Built, solver: Solver, c: Carry) -> tuple[Carry, tuple]:
+def loop_step(b: Built, solver: Solver, c: Carry) -> tuple[Carry, tuple]:
     """One step of the loop: the integrator's step (retried as sub-steps where the scene asks);
     a step that fails freezes the state and records the first failure's step, residual and code.
     A step past the run's `end` is skipped: the state stays, nothing is counted."""
@@ -193,7 +193,7 @@ def _advance(b: Built, solver: Solver, carry: Carry, n_frames: int, save_every: 
     """n_frames frames of save_every steps each: one scan of scans, no Python loop in traced code."""
 
     def one_step(c: Carry, _):
-        return step(b, solver, c)
+        return loop_step(b, solver, c)
 
     def one_frame(c: Carry, _):
         c, (its, errs) = jax.lax.scan(one_step, c, None, length=save_every)

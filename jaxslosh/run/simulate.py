@@ -22,8 +22,7 @@ from ..io.result import Failure, Result, result_from, truncated
 from ..scene.keys import check_values, with_overrides
 from ..scene.types import Scene
 from ..solve.linear import Solver, make_solver
-from ..solve.schemes import make_scheme
-from ..cache.compiled import compile_run
+from .compiled import compile_run
 from .loop import Carry, Frame, advance, concat_frames, core, frame_datasets, start
 
 
@@ -64,7 +63,7 @@ def prepare(scene: Scene, params=None, batch: bool = False, check: bool = True) 
     # factors), so what does not depend on traced `params` is evaluated now, as outside jit.
     with jax.ensure_compile_time_eval():
         b = build(scene, params)
-        scheme = make_scheme(sim.scheme, sim.alpha, sim.rho_inf)
+        scheme = sim.time_scheme()
         solver = make_solver(b.system, h, scheme, sim.tolerance, sim.max_iterations, sim.substeps,
                              reuse=True, adaptive=not batch)
     if batch:      # carried, formed anew every BATCH_REFRESH steps (a cond inside the iterations would

@@ -23,7 +23,7 @@ from ..physics.kinematics import rpy_from_quat
 from ..scene.keys import with_overrides
 from ..scene.types import Scene
 from ..solve.linear import Solver
-from .loop import Carry, Frame, core, init, observe, step
+from .loop import Carry, Frame, core, init, loop_step, observe
 from .simulate import failure_message, prepare
 
 
@@ -34,12 +34,12 @@ def _init(b, solver):
 
 @eqx.filter_jit
 def _step(b, solver, carry):
-    return step(b, solver, carry)[0]
+    return loop_step(b, solver, carry)[0]
 
 
 @eqx.filter_jit
 def _advance(b, solver, carry, n):
-    return jax.lax.scan(lambda c, _: (step(b, solver, c)[0], None), carry, None, length=n)[0]
+    return jax.lax.scan(lambda c, _: (loop_step(b, solver, c)[0], None), carry, None, length=n)[0]
 
 
 @eqx.filter_jit

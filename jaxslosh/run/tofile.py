@@ -18,11 +18,11 @@ import numpy as np
 from ..io.output import is_disk_full
 from ..io.result import ResultWriter
 from ..io.status import Status
-from ..cache.programs import cached
 from ..scene.types import Scene
 from .guard import Interrupted, interrupts
 from .capsize import vanishing_angles
-from ..cache.compiled import compile_run
+from ..staging import cached
+from .compiled import compile_run
 from ..mooring.lumped_term import lumped_terms
 from ..mooring.term import mooring_term
 from ..physics.bodies import bodies_term

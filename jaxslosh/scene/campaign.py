@@ -51,7 +51,7 @@ def read_campaign(table, probes: tuple[Probe, ...], waves: Waves | None, simulat
     if duration is not None and duration < simulation_dt:
         raise SceneError(f"{where}.duration", f"{show(duration)} s is shorter than one step "
                                               f"(simulation.dt = {show(simulation_dt)} s)")
-    irregular = waves is not None and waves.type != "regular"
+    irregular = waves is not None and waves.irregular
     if duration is not None and irregular and duration <= waves.ramp:
         raise SceneError(f"{where}.duration", f"{show(duration)} s is not longer than waves.ramp = "
                                               f"{show(waves.ramp)} s: a campaign's statistics are over the frames "

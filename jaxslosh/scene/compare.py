@@ -46,7 +46,9 @@ def flatten(scene: Scene) -> dict[str, Any]:
         if dataclasses.is_dataclass(x):
             out[prefix] = _TABLE
             for f in dataclasses.fields(x):
-                name = _TOML_NAME.get((type(x).__name__, f.name), f.name)
+                # a kind (BoxHull, RegularWaves) is named as the class it is a kind of (Hull, Waves)
+                name = next((_TOML_NAME[c.__name__, f.name] for c in type(x).__mro__ if (c.__name__, f.name) in _TOML_NAME),
+                            f.name)
                 if name is not None:
                     walk(f"{prefix}.{name}", getattr(x, f.name))
         elif isinstance(x, tuple) and all(dataclasses.is_dataclass(i) and hasattr(i, "name") for i in x):

@@ -7,8 +7,7 @@ from importlib import import_module
 
 import numpy as np
 
-from ..hull.surface import HullMeshError, hull_triangles, water_height
-from ..hydro.box import box_hydrostatics
+from ..hull.surface import HullMeshError
 from .fields import one_of, positive, read, show
 from .types import Environment, Hydrostatics, SceneError
 
@@ -28,11 +27,11 @@ def nonlinear_hydrostatics(v: dict, hull, environment, warnings: list[str]) -> d
     if hull is None:
         raise SceneError(f"{where}.model", '"nonlinear" needs a [vessel.hull] table: a box with its depth, or a '
                                            'closed mesh (type = "mesh")')
-    if hull.type == "box":
+    if hull.closed_form:
         if hull.depth is None:
             raise SceneError("vessel.hull.depth", 'a required key is missing (model = "nonlinear" needs the box\'s '
                                                   "keel-to-deck depth)")
-        own = box_hydrostatics(hull.length, hull.beam, hull.draft, hull.kg)
+        own = hull.closed_hydrostatics()
     else:
         own = mesh_hydrostatics(hull, environment, warnings)
     out = dict(v)
@@ -50,10 +49,10 @@ def mesh_hydrostatics(hull, environment, warnings: list[str]) -> dict:
     rest_hydrostatics = import_module("..hull.hydrostatics", __package__).rest_hydrostatics
 
     try:
-        tris = hull_triangles(hull)
+        tris = hull.triangles()
     except HullMeshError as e:
         raise SceneError("vessel.hull.file", str(e)) from None
-    h = rest_hydrostatics(tris, water_height(hull), environment.water_density, environment.gravity)
+    h = rest_hydrostatics(tris, hull.water_height(), environment.water_density, environment.gravity)
     if h["displaced_volume"] <= 0 or h["waterplane_area"] <= 0:
         raise SceneError("vessel.hull.file", f"{hull.file}: the hull does not cross the water plane z = 0 of its "
                                              "file's coordinates (the waterline at rest)")
@@ -75,8 +74,8 @@ def read_hydrostatics(table, warnings: list[str], hull=None, environment: Enviro
     })
     if v.get("model", "linear") == "nonlinear":   # the values are the hull's (scene/hull.py)
         v = nonlinear_hydrostatics(v, hull, environment, warnings)
-    elif hull is not None and hull.type == "box":   # what the table leaves out is the box's (as with no table)
-        v = box_hydrostatics(hull.length, hull.beam, hull.draft, hull.kg) | v
+    elif hull is not None and hull.closed_form:   # what the table leaves out is the box's (as with no table)
+        v = hull.closed_hydrostatics() | v
     for k in ("waterplane_area", "displaced_volume", "gm_t", "gm_l"):
         if k not in v:
             raise SceneError(f"{where}.{k}", "a required key is missing")

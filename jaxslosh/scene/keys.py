@@ -101,17 +101,15 @@ def scene_values(scene: Scene) -> dict[str, Any]:
     for key in ("position", "velocity", "angular_velocity", "roll_pitch_yaw"):
         v[f"vessel.initial.{key}"] = getattr(ves.initial, key)
     if ves.hull is not None:      # the COG against the hull: a box's KG, a mesh's COG in its file's coordinates
-        if ves.hull.type == "box":
-            v["vessel.hull.kg"] = ves.hull.kg
-        else:
-            v["vessel.hull.cog"] = ves.hull.cog
+        key, value = ves.hull.cog_key()
+        v[key] = value
     f = ves.forced
     if f is not None and f.profile != "record":   # a record's samples are its file's, not values of the scene
         own = ("amplitude", "frequency", "phase", "ramp") if f.profile == "harmonic" else ("rate", "duration")
         for key in own:
             v[f"vessel.forced.{key}"] = getattr(f, key)
     if scene.waves is not None:   # the wave forces are linear in these (waves.py)
-        v["waves.amplitude" if scene.waves.type == "regular" else "waves.hs"] = scene.waves.height
+        v[scene.waves.height_key] = scene.waves.height
 
     def material(prefix: str, m: Material) -> dict[str, float]:
         return {f"{prefix}.young": m.young, f"{prefix}.poisson": m.poisson, f"{prefix}.density": m.density}

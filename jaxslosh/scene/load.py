@@ -39,9 +39,9 @@ from .shape import default_element, fill_and_mesh, read_multimodal_shape, read_s
 from .types import (EFFECTS, ELEMENT_FORMS, FACE_FORMS, FACES, Damping, Effects, Environment, Fluid,
                     Initial, Material, Probe, Reduction, Scene, SceneError, Simulation, Structure, Tank,
                     Vessel, Walls)
+from ..solve.schemes import SCHEMES
 from .waves import FileContext, check_waves, hull_hydrostatics, read_hull, read_hydrodynamics, read_waves
 
-SCHEMES = ("newmark", "hht", "generalized-alpha")
 LINEAR_SOLVERS = ("auto", "dense", "sparse", "sparse-host")      # [simulation] linear_solver (sparse.py)
 WALLS = ("rigid", "elastic")
 TANK_MODELS = ("fem", "multimodal")
@@ -267,7 +267,7 @@ def _vessel(table, environment: Environment, warnings: list[str], files=None) ->
         if "forced" in table else None
     # the COG's height above the still-water level (it places mooring fairleads): given, or a box
     # hull's kg - draft, else 0
-    cog = v.get("cog_height", hull.kg - hull.draft if hull is not None and hull.type == "box" else 0.0)
+    cog = v.get("cog_height", hull.default_cog_height() if hull is not None else 0.0)
     return Vessel(mass=v["mass"], inertia=inertia, hydrostatics=hydrostatics, initial=initial, forced=forced,
                   hull=hull, hydrodynamics=hydrodynamics, name=v.get("name", "vessel"), cog_height=cog)
 

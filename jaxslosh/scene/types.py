@@ -7,12 +7,14 @@ Values that `simulate(scene, params=...)` may override are looked up by their do
 """
 from __future__ import annotations
 
-import os
 from dataclasses import dataclass, field
 from typing import Optional, Union
 
 from ..fem.mesh import ELEMENT_FORMS, FACE_FORMS  # noqa: F401  (the loader reads them here)
 from ..geometry import SHAPES, AbstractShape
+from ..solve.schemes import SCHEMES, AbstractScheme
+from .hulls import HULLS, BoxHull, Hull, MeshHull  # noqa: F401  (the scene's types, read from here)
+from .seas import WAVES, IrregularSea, JonswapSea, PiersonMoskowitzSea, RegularWaves, Waves  # noqa: F401
 
 #: the six rigid dofs, in the order of every 6-vector and 6 x 6 table
 DOFS = ("surge", "sway", "heave", "roll", "pitch", "yaw")
@@ -59,6 +61,10 @@ class Simulation:
     @property
     def n_steps(self) -> int:
         return int(round(self.duration / self.dt))
+
+    def time_scheme(self) -> AbstractScheme:
+        """The member of the generalized-alpha family that `scheme`, `alpha` and `rho_inf` name."""
+        return SCHEMES[self.scheme].from_settings(self.alpha, self.rho_inf)
 
 
 @dataclass(frozen=True)
@@ -304,47 +310,8 @@ class Probe:
 
 
 # ---- waves and hull hydrodynamics (waves.py, hydrodynamics.py)
-@dataclass(frozen=True)
-class Waves:
-    """The `[waves]` table: a regular wave or a JONSWAP sea (waves.py has the conventions)."""
-    type: str                        # "regular" | "jonswap" | "pierson-moskowitz"
-    heading: float = 0.0             # rad, the direction the waves travel to, from +X towards +Y
-    amplitude: float = 0.0           # m (regular)
-    omega: float = 0.0               # rad/s (regular; the scene gives `period` or `frequency`)
-    phase: float = 0.0               # rad (regular): eta = amplitude cos(omega t + phase) at the origin
-    hs: float = 0.0                  # m, significant wave height (jonswap)
-    tp: float = 0.0                  # s, peak period (jonswap)
-    gamma: float = 3.3               # peak enhancement (jonswap), >= 1
-    seed: int = 0                    # random phases and frequencies (jonswap)
-    components: int = 100            # regular components (jonswap), >= 1
-    omega_range: tuple[float, float] = (0.0, 0.0)   # rad/s (jonswap; default 0.5 to 3 times the peak frequency)
-    ramp: float = 0.0                # s, the forces fade in as (1 - cos(pi t / ramp)) / 2
-    depth: Optional[float] = None    # m, water depth (None: deep water)
-    spreading: float = 0.0           # cos-2s directional spreading exponent s (irregular seas); 0: long-crested
-    directions: int = 1              # headings the spreading is discretised into (odd: one on the mean heading)
-
-    @property
-    def height(self) -> float:
-        """The value the forces are proportional to: the amplitude (regular) or Hs (jonswap)."""
-        return self.amplitude if self.type == "regular" else self.hs
-
-
-@dataclass(frozen=True)
-class Hull:
-    """The `[vessel.hull]` table: a box (length x beam x draft, centred on the COG in plan, the COG
-    `kg` above the keel) or a mesh file (Capytaine only; waterline at z = 0, COG at `cog`)."""
-    type: str = "box"                # "box" | "mesh"
-    length: float = 0.0
-    beam: float = 0.0
-    draft: float = 0.0
-    kg: float = 0.0                  # m, COG above the keel (box)
-    file: str = ""                   # mesh file (type = "mesh"), relative to the scene's folder
-    cog: tuple[float, float, float] = (0.0, 0.0, 0.0)   # the COG in the mesh's coordinates (type = "mesh")
-    depth: Optional[float] = None    # m, keel to deck (docs/guide/large-angles.md): large angles immerse the deck edge
-    base_dir: str = ""               # the scene's folder (a mesh file is relative to it)
-
-    def path(self) -> str:
-        return self.file if os.path.isabs(self.file) else os.path.join(self.base_dir, self.file)
+# Waves (scene/seas.py) and Hull (scene/hulls.py): an abstract class each, with a final kind per
+# value of their `type` key
 
 
 @dataclass(frozen=True)

@@ -14,16 +14,15 @@ from typing import NamedTuple, Optional
 
 import numpy as np
 
-from ..hydro.box import box_hydrostatics
 from ..hydro.capytaine import CAPYTAINE_MISSING, have_capytaine
 from ..hydro.database import DatabaseError, read_database
 from ..hydro.spectra import wavenumber
 from .fields import at_least, non_negative, one_of, positive, read, show
-from .types import Hull, Hydrodynamics, Hydrostatics, Scene, SceneError, Waves
+from .types import HULLS, WAVES, Hull, Hydrodynamics, Hydrostatics, Scene, SceneError, Waves
 
-WAVE_TYPES = ("regular", "jonswap", "pierson-moskowitz")
+WAVE_TYPES = tuple(WAVES)
 DEFAULT_DIRECTIONS = 15          # headings of a spread sea when `directions` is not given
-HULL_TYPES = ("box", "mesh")
+HULL_TYPES = tuple(HULLS)
 EXCITATION_SOURCES = ("auto", "table", "froude-krylov")
 HULL_MISMATCH_TOLERANCE = 0.01   # relative: the box's closed-form hydrostatics against the scene's table
 
@@ -54,7 +53,7 @@ def read_waves(table, warnings: list[str]) -> Waves:
         if ("period" in v) == ("frequency" in v):
             raise SceneError(f"{where}.period", "give exactly one of period (s) or frequency (rad/s)")
         omega = v["frequency"] if "frequency" in v else 2.0 * math.pi / v["period"]
-        return Waves(type=kind, amplitude=v["amplitude"], omega=omega, phase=v.get("phase", 0.0), **common)
+        return WAVES[kind](amplitude=v["amplitude"], omega=omega, phase=v.get("phase", 0.0), **common)
     for k in ("hs", "tp"):
         if k not in v:
             raise SceneError(f"{where}.{k}", f"a required key is missing ({kind} sea)")
@@ -72,7 +71,7 @@ def read_waves(table, warnings: list[str]) -> Waves:
     if "directions" in v and spreading == 0:
         raise SceneError(f"{where}.directions", "only goes with spreading > 0 (a long-crested sea has one heading)")
     directions = v.get("directions", DEFAULT_DIRECTIONS) if spreading > 0 else 1
-    return Waves(type=kind, hs=v["hs"], tp=v["tp"], gamma=v.get("gamma", 3.3) if kind == "jonswap" else 1.0,
+    return WAVES[kind](hs=v["hs"], tp=v["tp"], gamma=v.get("gamma", 3.3) if kind == "jonswap" else 1.0,
                  seed=v.get("seed", 0), components=v.get("components", 100), omega_range=(lo, hi),
                  spreading=spreading, directions=directions, **common)
 
@@ -101,14 +100,14 @@ def read_hull(table, base_dir: str = "") -> Hull:
         if "depth" in v and v["depth"] <= v["draft"]:
             raise SceneError(f"{where}.depth", f"the deck must lie above the waterline: depth {show(v['depth'])} m "
                                                f"is not above the draft {show(v['draft'])} m")
-        return Hull(type="box", length=v["length"], beam=v["beam"], draft=v["draft"], kg=v["kg"],
+        return HULLS["box"](length=v["length"], beam=v["beam"], draft=v["draft"], kg=v["kg"],
                     depth=v.get("depth"), base_dir=base_dir)
     for k in ("length", "beam", "draft", "kg", "depth"):
         if k in v:
             raise SceneError(f"{where}.{k}", 'is a key of box hulls, not of type = "mesh"')
     if "file" not in v:
         raise SceneError(f"{where}.file", "a required key is missing (mesh hull)")
-    return Hull(type="mesh", file=v["file"], cog=v.get("cog", (0.0, 0.0, 0.0)), base_dir=base_dir)
+    return HULLS["mesh"](file=v["file"], cog=v.get("cog", (0.0, 0.0, 0.0)), base_dir=base_dir)
 
 
 def _shape(x):
@@ -199,7 +198,7 @@ def _check_database(where, path, db, files, hydrostatics, hull, length, warnings
             est = length / math.sqrt(ratio)
             return (f"WAMIT's files are non-dimensional, and the scene reads them with length_scale = {length:g} m: "
                     f"length_scale = {est:.3g} m would make {what} agree (give the ULEN of the WAMIT run)")
-        return f"the file was computed for another hull, draft or units than the scene's [vessel.hydrostatics]"
+        return "the file was computed for another hull, draft or units than the scene's [vessel.hydrostatics]"
 
     C = db.stiffness
     gross = False
@@ -223,7 +222,7 @@ def _check_database(where, path, db, files, hydrostatics, hull, length, warnings
     if gross or t.excitation is None or t.added_mass is None or not t.headings.size:
         return
     w0 = float(t.omega[0])
-    span = max(hull.length, hull.beam) if hull is not None and hull.type == "box" else 3.5 * math.sqrt(h.waterplane_area)
+    span = (hull.span() if hull is not None else None) or 3.5 * math.sqrt(h.waterplane_area)
     k0 = float(wavenumber(w0, files.g, files.depth))
     mass = files.rho * h.displaced_volume          # afloat: the whole mass is the displacement's
     inertia = w0 ** 2 * (mass + t.added_mass[0, 2, 2])
@@ -344,9 +343,9 @@ def hull_hydrostatics(hull: Hull, hydrostatics: Optional[Hydrostatics], warnings
     """A box hull without a [vessel.hydrostatics] table gives its closed forms; with one, the two
     are compared (a mismatch is warned about: the excitation's long-wave limit then disagrees with
     the restoring)."""
-    if hull.type != "box":
+    box = hull.closed_hydrostatics()
+    if box is None:
         return hydrostatics
-    box = box_hydrostatics(hull.length, hull.beam, hull.draft, hull.kg)
     if hydrostatics is None:
         return Hydrostatics(**box)
     for key in ("waterplane_area", "displaced_volume", "gm_t", "gm_l"):
@@ -366,14 +365,14 @@ def check_waves(scene: Scene, path: str, warnings: list[str]) -> Scene:
             ves, hydrodynamics=dataclasses.replace(hd, base_dir=os.path.dirname(os.path.abspath(path)))))
         ves, hd = scene.vessel, scene.vessel.hydrodynamics
     nonlinear = ves.hydrostatics is not None and ves.hydrostatics.nonlinear
-    if ves.hull is not None and ves.hull.type == "mesh" and not (hd is not None and hd.capytaine) and not nonlinear:
+    if ves.hull is not None and not ves.hull.closed_form and not (hd is not None and hd.capytaine) and not nonlinear:
         raise SceneError("vessel.hull.type", 'a "mesh" hull is read by Capytaine or by the nonlinear hydrostatics: '
                                              'add [vessel.hydrodynamics] capytaine = true or [vessel.hydrostatics] '
                                              'model = "nonlinear" (or use a box)')
     if waves is None:
         return scene
     tables = hd is not None and (hd.capytaine or hd.excitation_amplitude is not None)
-    box = ves.hull is not None and ves.hull.type == "box"
+    box = ves.hull is not None and ves.hull.closed_form
     source = "auto" if hd is None else hd.excitation
     if source == "table" and not tables:
         raise SceneError("vessel.hydrodynamics.excitation", '"table" needs excitation_amplitude and excitation_phase '
@@ -401,9 +400,9 @@ def check_waves(scene: Scene, path: str, warnings: list[str]) -> Scene:
             raise SceneError("waves.heading", f"{b:.6g} rad lies outside the excitation tables' headings "
                                               f"[{heads[0]:.6g}, {heads[-1]:.6g}] rad")
         lo, hi = hd.frequencies[0], hd.frequencies[-1]
-        wl, wh = (waves.omega, waves.omega) if waves.type == "regular" else waves.omega_range
+        wl, wh = waves.band
         if wl < lo - 1e-9 or wh > hi + 1e-9:
-            if waves.type == "regular":
+            if not waves.irregular:
                 raise SceneError("waves.frequency", f"{waves.omega:.6g} rad/s lies outside the excitation tables' "
                                                     f"frequencies [{lo:.6g}, {hi:.6g}] rad/s")
             warnings.append(f"waves.frequency_range [{wl:.4g}, {wh:.4g}] rad/s reaches beyond the excitation tables' "

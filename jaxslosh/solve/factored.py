@@ -95,7 +95,7 @@ class FactoredInverse(eqx.Module):
     iperm: jax.Array         # (n,) its inverse
     n: int = eqx.field(static=True)
     # a hash of A and the form: the factors' values follow from it, so a run's initial state kept on
-    # disk is named by it (cache/compiled._digest) instead of by hashing the factors' megabytes
+    # disk is named by it (run/compiled._digest) instead of by hashing the factors' megabytes
     content_key: str = eqx.field(static=True, default="")
 
     @property

@@ -96,7 +96,7 @@ def initial_state(system: System, solver: Solver, c0: Config, v0, alg0=None) -> 
 def initial_state_like(system: System, solver: Solver, c0: Config, v0, alg0=None) -> tuple[State, StepInfo]:
     """What initial_state returns, of the same trees, shapes and types, without solving anything:
     the shapes the time loop is lowered for while the initial state's own program is still being
-    traced (cache/compiled.compile_run; a test keeps the two in step)."""
+    traced (run/compiled.compile_run; a test keeps the two in step)."""
     zeros = jnp.zeros_like(v0)
     pre = empty_pre(system) if solver.reuse else None
     info = StepInfo(jnp.zeros((), jnp.int32), jnp.zeros(()), jnp.array(True))

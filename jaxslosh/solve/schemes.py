@@ -4,12 +4,19 @@ a class that owns its constants and the coefficients the step matrix and the pre
 from them, so that no other module writes them out again."""
 from __future__ import annotations
 
-import equinox as eqx
+import abc
+from dataclasses import dataclass
+from typing import ClassVar, final
+
+# plain frozen dataclasses, not JAX modules: the scene loader reads the registry below without
+# importing JAX (the command line checks a scene before it imports JAX), and a solver holds its
+# scheme as a static field (hashable: one compiled loop per scheme)
 
 
-class Scheme(eqx.Module):
-    """A member of the generalized-alpha family, by its four constants (static: one compiled loop
-    per scheme). In the notation of solve/integrator.py,
+@dataclass(frozen=True)
+class AbstractScheme(abc.ABC):
+    """A member of the generalized-alpha family, by its four constants. In the notation of
+    solve/integrator.py,
 
         (1 - alpha_m) a_{n+1} + alpha_m a_n = (1 - alpha_f) acc_{n+1} + alpha_f acc_n
         d_{n+1} = d_n + h v_n + h^2 ((1/2 - beta) a_n + beta a_{n+1})
@@ -19,7 +26,18 @@ class Scheme(eqx.Module):
     beta: float
     gamma: float
 
-    name = "generalized-alpha"
+    #: the value of `simulation.scheme` that names it
+    name: ClassVar[str] = ""
+
+    @classmethod
+    @abc.abstractmethod
+    def from_settings(cls, alpha: float = 0.0, rho_inf: float = 1.0) -> "AbstractScheme":
+        """The member of the scene's `simulation.alpha` and `simulation.rho_inf` (each reads its own)."""
+
+    @classmethod
+    @abc.abstractmethod
+    def settings_words(cls, sim) -> str:
+        """What a scene's `[simulation]` sets of the scheme, in words (", alpha 0.01"; "" for none)."""
 
     def c_a(self, h):
         """d acc_{n+1} / d Delta: the mass matrix's factor in the step matrix c_a M + c_v C + K."""
@@ -34,44 +52,66 @@ class Scheme(eqx.Module):
         return 1.0 / (self.beta * h ** 2)
 
 
-class Newmark(Scheme):
+#: the family's members are AbstractScheme's final classes (solve/linear.py types its solver's field with it)
+Scheme = AbstractScheme
+
+
+@final
+@dataclass(frozen=True)
+class Newmark(AbstractScheme):
     """The trapezoidal rule (average acceleration): second order, no numerical damping, the
     energy-conserving member (`simulation.energy_projection` needs it)."""
-    name = "newmark"
+    name: ClassVar[str] = "newmark"
 
-    def __init__(self):
-        self.alpha_m, self.alpha_f, self.beta, self.gamma = 0.0, 0.0, 0.25, 0.5
+    @classmethod
+    def from_settings(cls, alpha: float = 0.0, rho_inf: float = 1.0) -> "Newmark":
+        return cls(0.0, 0.0, 0.25, 0.5)
+
+    @classmethod
+    def settings_words(cls, sim) -> str:
+        return ", energy projection" if sim.energy_projection else ""
 
 
-class HHT(Scheme):
+@final
+@dataclass(frozen=True)
+class HHT(AbstractScheme):
     """HHT-alpha: gamma = 1/2 + alpha, beta = (1 + alpha)^2 / 4 (docs/theory.md item 7); alpha > 0
     damps the high frequencies."""
-    name = "hht"
+    name: ClassVar[str] = "hht"
 
-    def __init__(self, alpha: float = 0.0):
+    @classmethod
+    def from_settings(cls, alpha: float = 0.0, rho_inf: float = 1.0) -> "HHT":
         alpha = float(alpha)
-        self.alpha_m, self.alpha_f, self.beta, self.gamma = 0.0, alpha, 0.25 * (1.0 + alpha) ** 2, 0.5 + alpha
+        return cls(0.0, alpha, 0.25 * (1.0 + alpha) ** 2, 0.5 + alpha)
+
+    @classmethod
+    def settings_words(cls, sim) -> str:
+        return f", alpha {sim.alpha:g}"
 
 
-class GeneralizedAlpha(Scheme):
+@final
+@dataclass(frozen=True)
+class GeneralizedAlpha(AbstractScheme):
     """Chung & Hulbert (1993) by its high-frequency spectral radius rho_inf (1: no damping)."""
-    name = "generalized-alpha"
+    name: ClassVar[str] = "generalized-alpha"
 
-    def __init__(self, rho_inf: float = 1.0):
+    @classmethod
+    def from_settings(cls, alpha: float = 0.0, rho_inf: float = 1.0) -> "GeneralizedAlpha":
         r = float(rho_inf)
         am, af = (2.0 * r - 1.0) / (r + 1.0), r / (r + 1.0)
-        self.alpha_m, self.alpha_f, self.beta, self.gamma = am, af, 0.25 * (1.0 - am + af) ** 2, 0.5 - am + af
+        return cls(am, af, 0.25 * (1.0 - am + af) ** 2, 0.5 - am + af)
+
+    @classmethod
+    def settings_words(cls, sim) -> str:
+        return f", rho_inf {sim.rho_inf:g}"
 
 
-SCHEMES = {"newmark": Newmark, "hht": HHT, "generalized-alpha": GeneralizedAlpha}
+#: `simulation.scheme`'s values and their members (the scene loader reads this)
+SCHEMES = {c.name: c for c in (Newmark, HHT, GeneralizedAlpha)}
 
 
-def make_scheme(name: str, alpha: float = 0.0, rho_inf: float = 1.0) -> Scheme:
+def make_scheme(name: str, alpha: float = 0.0, rho_inf: float = 1.0) -> AbstractScheme:
     """The scheme of the scene file's `simulation.scheme` (with its `alpha` or `rho_inf`)."""
-    if name == "newmark":
-        return Newmark()
-    if name == "hht":
-        return HHT(alpha)
-    if name == "generalized-alpha":
-        return GeneralizedAlpha(rho_inf)
-    raise ValueError(f"unknown scheme {name!r}")
+    if name not in SCHEMES:
+        raise ValueError(f"unknown scheme {name!r}")
+    return SCHEMES[name].from_settings(alpha, rho_inf)

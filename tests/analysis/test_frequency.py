@@ -82,11 +82,11 @@ def test_hull_alone_rao_against_capytaine_post_processing():
     e^{-i w t} convention: our RAO is its complex conjugate)."""
     cpt = pytest.importorskip("capytaine")
     xr = pytest.importorskip("xarray")
-    from jaxslosh.hydro.capytaine import _box_body
-    from jaxslosh.scene.types import Hull
+    from jaxslosh.hydro.capytaine import _hull_body
+    from jaxslosh.scene.types import BoxHull
     w = np.linspace(0.3, 1.8, 6)
     heads = [0.0, math.pi / 4, math.pi / 2]
-    body = _box_body(cpt, Hull(length=L, beam=B, draft=T, kg=KG), 2.0, omega_max=w.max())
+    body = _hull_body(cpt, BoxHull(length=L, beam=B, draft=T, kg=KG), 2.0, omega_max=w.max())
     probs = [cpt.RadiationProblem(body=body, radiating_dof=d, omega=x, rho=RHO, g=G) for d in body.dofs for x in w]
     probs += [cpt.DiffractionProblem(body=body, wave_direction=b, omega=x, rho=RHO, g=G) for b in heads for x in w]
     ds = cpt.assemble_dataset(cpt.BEMSolver().solve_all(probs, progress_bar=False))

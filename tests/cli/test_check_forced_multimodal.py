@@ -4,8 +4,6 @@ count the assembled liquid has: a cylinder's completed to whole cos/sin pairs), 
 not use, and the unknowns `check` counts are the assembled system's."""
 import os
 
-import pytest
-
 import jaxslosh as js
 from jaxslosh.assemble.effects import count_unknowns
 from jaxslosh.assemble.system import build

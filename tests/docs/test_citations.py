@@ -5,8 +5,6 @@ import json
 import os
 import re
 
-import pytest
-
 ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 # docs/hooks.py writes these at build time: they are cited, and exist only in the built site
 GENERATED = {"docs/reference/scene.md", "docs/reference/commands.md", "docs/reference/api.md"}
@@ -104,3 +102,29 @@ def test_theory_items_cited_exist():
     bad = [f"{rel}: {m.group(0)}" for rel in FILES for m in THEORY_ITEM.finditer(text_of(rel))
            if int(m.group(2) or m.group(1)) > n]
     assert not bad, bad
+
+
+DOCS_SECTION = re.compile(r"(docs/[\w./-]*\w\.md),? \"([^\"]+)\"")
+
+
+def _plain(title: str) -> str:
+    """Code marks, quotes and the comment marks of a title continued on the next comment line dropped."""
+    title = re.sub(r"\n\s*(#|//)*", " ", title)
+    return " ".join(title.replace("`", "").replace('"', "").split())
+
+
+def test_docs_sections_cited_exist():
+    """`docs/guide/liquid-element.md, "Why rt"`: the page has that heading (code marks and quotes aside)."""
+    bad = []
+    for rel in FILES:
+        if rel.startswith("docs/") and rel.endswith(".md"):
+            continue
+        for m in DOCS_SECTION.finditer(text_of(rel)):
+            page, title = m.groups()
+            if page in GENERATED or not os.path.isfile(os.path.join(ROOT, page)):
+                continue                    # a missing page is test_docs_pages_cited_exist's
+            with open(os.path.join(ROOT, page), encoding="utf-8") as f:
+                heads = {_plain(ln.lstrip("#")) for ln in f if ln.startswith("#")}
+            if _plain(title) not in heads:
+                bad.append(f"{rel}: {page}, \"{title}\"")
+    assert not bad, "sections the pages do not have:\n" + "\n".join(bad)

@@ -1,5 +1,7 @@
-"""The package's layout (README "Design"): sub-packages in layers, imports at the top of files and
-only downwards, no import circles, no module over 500 lines. Read from the source with `ast`."""
+"""The package's layout (docs/design.md): sub-packages in layers, imports at the top of files and
+only downwards (the lazy `import_module` calls too), no private name imported from another
+sub-package, no import circles, no module over 500 lines. Read from the source with `ast`.
+`python -m tests.docs.layers --write` writes LAYERS into docs/design.md and jaxslosh/__init__.py."""
 import ast
 import os
 
@@ -10,7 +12,8 @@ ROOT = os.path.join(os.path.dirname(os.path.dirname(os.path.dirname(os.path.absp
 # lowest first; a module may import its own package and the packages on earlier lines
 LAYERS = [
     {"_version", "staging"},
-    {"fem.mesh", "fem.meshfile", "fem.slip", "physics.kinematics"},
+    # the schemes' registry is read by the scene loader: plain classes, no JAX
+    {"fem.mesh", "fem.meshfile", "fem.slip", "physics.kinematics", "solve.schemes"},
     {"fem.shapes"},
     {"hull"},
     # the tank shapes: below the scene loader that builds them and the finite elements that mesh them
@@ -26,10 +29,10 @@ LAYERS = [
     # the solver pieces its inverses use, below the assembly that builds a scene's system from them
     {"liquid"},
     {"assemble"},
-    {"run.loop"},
-    # the compile cache: a wing above the loop it compiles, below the runs that use it
-    {"cache"},
     {"run"},
+    # the compile cache: above the runs, which reach it through staging's hooks that the entry
+    # points install (cache/programs.py `install`)
+    {"cache"},
     {"analysis", "campaign", "fit", "mooring.statics"},
     {"plot"},
     {"cli"},
@@ -62,10 +65,30 @@ def _resolve(module, node):
     return ".".join(base + ([node.module] if node.module else []))
 
 
+def _lazy(module, node):
+    """The package-relative module of `import_module("..x.y", __package__)` (None for others)."""
+    if not (isinstance(node, ast.Call) and getattr(node.func, "id", getattr(node.func, "attr", None)) == "import_module"
+            and node.args and isinstance(node.args[0], ast.Constant) and isinstance(node.args[0].value, str)):
+        return None
+    name = node.args[0].value
+    if not name.startswith("."):
+        return name[len("jaxslosh."):] if name.startswith("jaxslosh.") else None
+    level = len(name) - len(name.lstrip("."))
+    package = module.split(".")[:-1]
+    base = package[:len(package) - (level - 1)] if level > 1 else package
+    return ".".join(base + [name.lstrip(".")])
+
+
 def _imports(module, path):
     tree = ast.parse(open(path).read())
     top, nested = set(), []
     for node in ast.walk(tree):
+        if isinstance(node, ast.Import):
+            names = {a.name[len("jaxslosh."):] for a in node.names if a.name.startswith("jaxslosh.")}
+            if node in tree.body:
+                top |= names
+            else:
+                nested += [(node.lineno, n) for n in names]
         if isinstance(node, ast.ImportFrom):
             target = _resolve(module, node)
             if target is None:
@@ -108,6 +131,59 @@ def test_module_is_short_and_imports_downwards_at_the_top(module):
         t = t[:-len(".__init__")] if t.endswith(".__init__") else t
         theirs, other = _layer(t if t in MODULES or t + ".__init__" in MODULES else t.rsplit(".", 1)[0])
         assert theirs < mine or other == pkg, f"{module} (layer {pkg}) imports {t} (layer {other})"
+
+
+def lazy_imports(module, path):
+    """(line, target) of each `import_module` of a jaxslosh module (the lazy imports that keep
+    `import jaxslosh` and the command line's start light)."""
+    return [(node.lineno, t) for node in ast.walk(ast.parse(open(path).read())) if (t := _lazy(module, node))]
+
+
+def _layer_of_target(t):
+    t = t[:-len(".__init__")] if t.endswith(".__init__") else t
+    return _layer(t if t in MODULES or t + ".__init__" in MODULES else t.rsplit(".", 1)[0])
+
+
+def test_no_import_goes_up_a_layer():
+    """Every import, lazy ones included, goes to a lower layer or within the module's own."""
+    bad = []
+    for module, path in sorted(MODULES.items()):
+        mine, pkg = _layer(module)
+        top, _ = _imports(module, path)
+        for line, t in [(0, t) for t in sorted(top)] + lazy_imports(module, path):
+            theirs, other = _layer_of_target(t)
+            if not (theirs < mine or other == pkg):
+                bad.append(f"{module}:{line} (layer {pkg}) imports {t} (layer {other})")
+    assert not bad, "\n".join(bad)
+
+
+#: private names imported across top-level sub-packages that are left for now: the face-normal
+#: liquid's assembly reads its element's internals (fem/liquid_rt.py), which move together into one
+#: package (jaxslosh/liquid/) in the liquid's own change; nothing may be added here
+PRIVATE_ALLOWED: set = set()
+
+
+def private_imports(module, path) -> list:
+    """(target, name) of each private name (`_x`) `module` imports from another top-level sub-package."""
+    out = []
+    for node in ast.walk(ast.parse(open(path).read())):
+        if isinstance(node, ast.ImportFrom):
+            target = _resolve(module, node)
+            if target is None or target.split(".")[0] == module.split(".")[0]:
+                continue
+            out += [(target, a.name) for a in node.names if a.name.startswith("_") and not a.name.startswith("__")]
+    return out
+
+
+def test_no_private_names_cross_sub_packages():
+    bad = [(m, t, n) for m, path in sorted(MODULES.items()) for t, n in private_imports(m, path)
+           if (m, t, n) not in PRIVATE_ALLOWED]
+    assert not bad, bad
+
+
+def test_the_private_allow_list_is_not_stale():
+    found = {(m, t, n) for m, path in MODULES.items() for t, n in private_imports(m, path)}
+    assert PRIVATE_ALLOWED <= found, PRIVATE_ALLOWED - found
 
 
 def test_no_import_circles():

@@ -13,7 +13,7 @@ import jaxslosh as js
 from jaxslosh.fit.identify import identify
 from jaxslosh.fit.problem import add_noise
 from jaxslosh.hull.hydrostatics import rest_hydrostatics
-from jaxslosh.hull.surface import prism_surface, write_hull_mesh
+from jaxslosh.hull.surface import prism_hull, write_hull_mesh
 
 RHO = 1025.0
 L, DRAFT = 20.0, 3.0
@@ -57,7 +57,7 @@ def scene_text(path, cog):
 def decay(tmp_path_factory):
     d = tmp_path_factory.mktemp("cog")
     mesh = d / "prism.obj"
-    write_hull_mesh(str(mesh), prism_surface(SECTION, L, nx=2, nz=2))
+    write_hull_mesh(str(mesh), prism_hull(SECTION, L, nx=2, nz=2))
     path = d / "prism.toml"
     path.write_text(scene_text(mesh, SCENE_COG))
     clean = js.simulate(js.load_scene(scene_text(mesh, TRUE_COG)))
@@ -70,8 +70,7 @@ def decay(tmp_path_factory):
 
 def test_the_mesh_is_small_and_the_decay_large(decay):
     scene, clean, _, _, _, _ = decay
-    from jaxslosh.hull.surface import hull_triangles
-    assert len(hull_triangles(scene.vessel.hull)) == 48
+    assert len(scene.vessel.hull.triangles()) == 48
     roll = np.asarray(clean.vessel.roll_pitch_yaw)[:, 0]
     # released at 25 degrees, it still rolls past 10 degrees in its last period
     assert np.max(np.abs(roll[-40:])) > math.radians(10.0)
@@ -94,7 +93,7 @@ def test_identify_recovers_the_cog_height_within_half_a_percent_of_kg(decay):
     assert np.all(se > 0) and np.all(np.abs(cog - TRUE_COG) < 5 * se), (cog, se)
     assert se[2] < 0.002 * kg, se
     assert fit.quality == "" and fit.r2["roll"] > 0.99, (fit.quality, fit.r2)
-    tris = prism_surface(SECTION, L, nx=2, nz=2) - cog
+    tris = prism_hull(SECTION, L, nx=2, nz=2) - cog
     own = rest_hydrostatics(tris, -cog[2], RHO, 9.81)
     assert fit.implied["vessel.hydrostatics.gm_t"] == pytest.approx(own["gm_t"], rel=1e-9)
     assert fit.implied_standard_errors["vessel.hydrostatics.gm_t"] == pytest.approx(se[2])

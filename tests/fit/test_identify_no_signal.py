@@ -4,8 +4,6 @@ biased the fitted KG (3.9632 +- 0.0011 for 4.0, "converged", "good"). A channel 
 weight by default (it is named), and a fit whose residual is far above the record's noise floor is
 called poor whatever its R^2."""
 import json
-import math
-import os
 
 import numpy as np
 import pytest

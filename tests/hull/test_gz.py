@@ -156,7 +156,8 @@ def test_prismatic_and_mesh_tanks():
     V = (410000.0 + rho_l * vol) / RHO
     assert s.gm0_frozen - s.gm0 == pytest.approx(rho_l * 6.0 * 8.0 ** 3 / 12 / (RHO * V), rel=1e-6)
 
-    import tempfile, os
+    import os
+    import tempfile
     with tempfile.TemporaryDirectory() as d:
         x, y, z = np.meshgrid(np.linspace(0, 6, 3), np.linspace(0, 8, 3), np.linspace(0, 1.5, 2), indexing="ij")
         nodes = np.column_stack([x.ravel(), y.ravel(), z.ravel()])
@@ -194,7 +195,7 @@ def test_json_fields_and_figure(tmp_path, capsys):
     # the areas against the trapezoidal rule on a fine curve of their own
     fine = js.stability(str(path), np.radians(np.linspace(0, 40, 81)), criteria=False)
     a = np.asarray(fine.angle)
-    area = lambda lo, hi: np.trapezoid(fine.gz[(a >= lo - 1e-12) & (a <= hi + 1e-12)],
+    area = lambda lo, hi: np.trapezoid(fine.gz[(a >= lo - 1e-12) & (a <= hi + 1e-12)],  # noqa: E731
                                        a[(a >= lo - 1e-12) & (a <= hi + 1e-12)])
     assert out["criteria"][0]["value"] == pytest.approx(area(0, np.radians(30)), rel=1e-4)
     assert out["criteria"][2]["value"] == pytest.approx(area(np.radians(30), np.radians(40)), rel=1e-4)

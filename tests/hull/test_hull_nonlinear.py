@@ -18,7 +18,7 @@ from jaxslosh.hydro.box import froude_krylov_box
 from jaxslosh.physics.hull import HullPressure
 from jaxslosh.physics.kinematics import quat_exp, quat_from_rpy, quat_multiply, rotation_matrix
 from jaxslosh.physics.terms import Config, potential_rows
-from jaxslosh.physics.vessel import Hydrostatics
+from jaxslosh.physics.vessel import ConservativeRestoring
 
 from helpers import area_centroid, clip_polygon
 
@@ -120,7 +120,7 @@ def test_small_motion_stiffness_equals_the_linear_model_of_the_same_hull():
     scene = box_scene()
     term = build_hull_pressure(scene, {}, jnp.asarray(G))
     h = scene.vessel.hydrostatics
-    lin = Hydrostatics(rho_w=jnp.asarray(RHO), gravity=jnp.asarray(G), waterplane_area=jnp.asarray(h.waterplane_area),
+    lin = ConservativeRestoring(rho_w=jnp.asarray(RHO), gravity=jnp.asarray(G), waterplane_area=jnp.asarray(h.waterplane_area),
                        displaced_volume=jnp.asarray(h.displaced_volume), gm_t=jnp.asarray(h.gm_t),
                        gm_l=jnp.asarray(h.gm_l))
 
@@ -424,11 +424,11 @@ def test_the_written_out_tangent_of_the_volume_equals_the_clippings():
     surface itself goes through the clipping."""
     from jaxslosh.hull.clip import panels, submerged
     from jaxslosh.hull.hydrostatics import volume_below as coordinate_major
-    from jaxslosh.hull.surface import prism_surface
+    from jaxslosh.hull.surface import prism_hull
 
     def volume_below(tris, n, c):             # it takes the surface coordinate-major (hull/clip.panels)
         return coordinate_major(panels(tris), n, c)
-    tris = jnp.asarray(prism_surface([[-1, 0], [1, 0], [2, 2], [-2, 2]], 10.0, 5, 3))
+    tris = jnp.asarray(prism_hull([[-1, 0], [1, 0], [2, 2], [-2, 2]], 10.0, 5, 3))
     n, c = jnp.array([0.1, 0.3, 1.0]), jnp.asarray(0.4)
     for dn, dc in ((jnp.array([0.3, -0.2, 0.5]), 0.7), (jnp.zeros(3), 1.0)):
         (_, a), (_, b) = (jax.jit(lambda n_, c_, dn_, dc_: jax.jvp(lambda x, y: f(tris, x, y), (n_, c_), (dn_, dc_)))(

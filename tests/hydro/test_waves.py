@@ -143,9 +143,9 @@ def test_froude_krylov_box_against_quadrature_and_long_wave_limit():
 def test_froude_krylov_box_against_capytaine():
     """Capytaine's Froude-Krylov force on the same box (panel centroids, its e^{-iwt} convention)."""
     import capytaine as cpt
-    from jaxslosh.hydro.capytaine import _box_body
-    from jaxslosh.scene.types import Hull
-    body = _box_body(cpt, Hull(length=L, beam=B, draft=T, kg=KG), 0.5)
+    from jaxslosh.hydro.capytaine import _hull_body
+    from jaxslosh.scene.types import BoxHull
+    body = _hull_body(cpt, BoxHull(length=L, beam=B, draft=T, kg=KG), 0.5)
     from capytaine.bem.airy_waves import froude_krylov_force
     for w, beta in [(0.7, math.pi / 2), (1.2, 0.6)]:
         pb = cpt.DiffractionProblem(body=body, wave_direction=beta, omega=w, rho=RHO, g=G)
@@ -265,9 +265,9 @@ def test_cummins_memory_reproduces_the_frequency_domain_roll_response():
 
 def test_capytaine_box_hydrostatics_equal_the_closed_forms_and_feed_a_scene(tmp_path, capsys):
     from jaxslosh.hydro.capytaine import capytaine_hydrostatics
-    from jaxslosh.scene.types import Hull
+    from jaxslosh.scene.types import BoxHull
     for (l_, b_, t_, kg) in [(L, B, T, KG), (60.0, 12.0, 4.0, 5.0)]:
-        hs = capytaine_hydrostatics(Hull(length=l_, beam=b_, draft=t_, kg=kg))
+        hs = capytaine_hydrostatics(BoxHull(length=l_, beam=b_, draft=t_, kg=kg))
         closed = {"displaced_volume": l_ * b_ * t_, "waterplane_area": l_ * b_, "bm_t": b_ ** 2 / (12 * t_),
                   "bm_l": l_ ** 2 / (12 * t_)}
         for k, v in closed.items():

@@ -5,7 +5,7 @@ import jax.numpy as jnp
 import numpy as np
 import pytest
 
-from jaxslosh.mooring.catenary import catenary, solve
+from jaxslosh.mooring.catenary import catenary
 
 # MoorPy's own reference cases: NREL/MoorPy, tests/test_catenary.py (inputs and MoorPy's answers
 # copied as data). Inputs: XF, ZF, L, EA, w, CB (CB >= 0: seabed friction; CB < 0: the anchor -CB
@@ -161,7 +161,8 @@ def test_gradients_in_every_argument(case):
         if k >= 5 and args[k] == 0.0:
             continue      # friction or anchor height at its bound: one-sided only
         h = 1e-6 * max(abs(args[k]), 1.0)
-        e = np.zeros(7); e[k] = h
+        e = np.zeros(7)
+        e[k] = h
         fd = (np.array(outputs(jnp.asarray(args + e))) - np.array(outputs(jnp.asarray(args - e)))) / (2 * h)
         scale = np.abs(np.array(outputs(jnp.asarray(args)))) / max(abs(args[k]), 1.0) + 1e-3
         np.testing.assert_allclose(J[:, k], fd, rtol=1e-4, atol=1e-5 * float(np.max(scale)),

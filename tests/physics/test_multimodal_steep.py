@@ -105,7 +105,7 @@ def test_switch_is_smooth():
 def test_watch_reads_the_crest_index_as_the_liquid():
     """The validity watch's crest index is the liquid's (the same points and weights); a frame below
     STEEP_ON says nothing, one past it is said once with the frame's time."""
-    from jaxslosh.liquid.multimodal.steep import STEEP_ON, crest_index
+    from jaxslosh.liquid.multimodal.steep import crest_index
     from jaxslosh.run.validity import Watch, _crest_index, _surface_tables
     scene = js.load_scene(RESONANT.format(duration=1.0, amplitude=0.001))
     (off, _, Z, w, kN, _), = _surface_tables(scene)

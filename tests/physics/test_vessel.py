@@ -7,7 +7,7 @@ from scipy.integrate import solve_ivp
 
 import jaxslosh as js
 from jaxslosh.physics.kinematics import G_matrix, quat_from_rpy, rotation_matrix, rpy_from_quat, skew
-from jaxslosh.physics.vessel import A_PHI, A_THETA, Hydrostatics as Hydro
+from jaxslosh.physics.vessel import A_PHI, A_THETA, ConservativeRestoring as Hydro
 
 from helpers import vessel_scene, zero_crossing_period
 

@@ -188,11 +188,11 @@ SCENES = os.path.join(os.path.dirname(os.path.dirname(os.path.dirname(os.path.ab
     ("vessel_only.toml", "energy_projection = true"),     # the initial energy in the state
 ])
 def test_the_chunk_is_lowered_for_the_shapes_of_the_initial_state(name, extra):
-    """cache/compiled.compile_run lowers the chunk for loop.carry_shapes before `start` is traced: they
+    """run/compiled.compile_run lowers the chunk for loop.carry_shapes before `start` is traced: they
     must be the shapes and types of start's carry (else the chunk is lowered twice)."""
     from jaxslosh.run.loop import carry_shapes, core, traced_init
     from jaxslosh.run.simulate import prepare
-    from jaxslosh.cache.compiled import same_shapes
+    from jaxslosh.run.compiled import same_shapes
     from jaxslosh.scene import load_scene
     with open(os.path.join(SCENES, name)) as f:
         text = f.read()

@@ -2,7 +2,8 @@
 (run/tofile.py) and `js.simulate` called outside any JAX transformation (run/simulate.py) step with
 them. Compiled ahead of time, a program takes XLA options (staging.XLA_OPTIONS, START_OPTIONS),
 XLA compiles in the background while Python traces the next, and the programs can be read back from
-the exported programs' folder (cache/programs.py)."""
+the exported programs' folder where the entry point installed the compile cache (jaxslosh/cache,
+through the hooks of jaxslosh/staging.py: this module imports no cache)."""
 from __future__ import annotations
 
 import hashlib
@@ -10,11 +11,9 @@ import hashlib
 import jax
 import numpy as np
 
-from ..run.loop import carry_shapes, traced_advance, traced_init
 from ..solve.factored import FactoredInverse
-from ..staging import START_OPTIONS, XLA_OPTIONS
-from .executables import remember
-from .programs import cached, folder, lower_program, program_key
+from ..staging import START_OPTIONS, XLA_OPTIONS, cached, folder, lower_program, program_key, remember
+from .loop import carry_shapes, traced_advance, traced_init
 
 
 def compile_run(bc, solver, chunk_frames: int, save_every: int):
