@@ -355,7 +355,7 @@ def _run(template, duration, cases, scenes, todo, client, workers, batch, output
                                    dashboard_address=None)
         client = Client(cluster)
         client.run(_quiet_cancellations)
-    phases["start"] = time.perf_counter() - t0
+    phases["start"] = time.perf_counter() - t0 if cluster is not None else 0.0
     bar = Progress(enabled=wanted() if progress is None else progress)
     bar.phase("cases", "cases", total=len(todo), unit="case")
     run_now = failed = 0

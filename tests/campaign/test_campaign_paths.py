@@ -11,6 +11,7 @@ import pytest
 import jaxslosh as js
 from jaxslosh.cache import programs
 from jaxslosh.campaign.worker import run_batch
+from jaxslosh.run import batch
 
 from test_campaign import BEAM, CACHE, env, files, scene_text  # noqa: F401 (env: the fixture)
 
@@ -48,14 +49,22 @@ def test_a_batchs_statistics_are_those_recorded_before():
     _check(run_batch(scene_text(60.0, 30), "", None, BOX_CASES, 2), BOX)
 
 
-def test_the_batch_read_back_from_the_programs_folder_gives_the_same_statistics(tmp_path):
+def test_the_batch_read_back_from_the_programs_folder_gives_the_same_statistics(tmp_path, monkeypatch):
     before = programs.folder()
+    text = scene_text(60.0, 30).replace("box alone in irregular seas", "box alone, read back")
     try:
-        run_batch(scene_text(60.0, 30), "", None, BOX_CASES, 2, None, str(tmp_path))
+        run_batch(text, "", None, BOX_CASES, 2, None, str(tmp_path))
         assert any(f.startswith("seas-batch-") for f in os.listdir(tmp_path))
         assert any(f.startswith("model-") for f in os.listdir(tmp_path))
-        # another scene text (its title), the same model: the program and the model are looked up again
-        text = scene_text(60.0, 30).replace("box alone in irregular seas", "the same box")
+        # as a new worker process would: nothing kept in this process, and neither the model built
+        # nor the vmapped loop traced again (both read from the folder)
+        batch._SEAS_PROGRAMS.clear()
+        batch._kept_setup.cache_clear()
+
+        def no(*a, **k):
+            raise AssertionError("built or traced again")
+        monkeypatch.setattr(batch, "_vmapped", no)
+        monkeypatch.setattr(batch, "prepare", no)
         _check(run_batch(text, "", None, BOX_CASES, 2, None, str(tmp_path)), BOX)
     finally:
         programs.use(before)
