@@ -306,13 +306,20 @@ def _in_process(template, duration, cases, batches, batch, caches):
     """One worker and no client: the batches in this process, one after the other. A LocalCluster
     of one worker process cost its start (the processes, their imports, the model and the program
     read back) and a copy of every result, for the same single core's work (docs/benchmarks.md)."""
-    for idx in batches:
-        try:
-            outcomes = run_batch(template.text, template.path, duration, [case_values(cases, i) for i in idx], batch,
-                                 *caches)
-        except Exception as e:          # a batch that raised: its cases fail with the reason, as on Dask
-            outcomes = _raised(e, idx)
-        yield idx, outcomes
+    # the folders a worker is given are set in this process for the campaign alone (js.campaign's
+    # caller keeps its own settings)
+    kept = (programs.folder(), jax.config.jax_compilation_cache_dir)
+    try:
+        for idx in batches:
+            try:
+                outcomes = run_batch(template.text, template.path, duration, [case_values(cases, i) for i in idx],
+                                     batch, *caches)
+            except Exception as e:          # a batch that raised: its cases fail with the reason, as on Dask
+                outcomes = _raised(e, idx)
+            yield idx, outcomes
+    finally:
+        programs.use(kept[0])
+        jax.config.update("jax_compilation_cache_dir", kept[1])
 
 
 def _raised(e, idx):
