@@ -41,6 +41,18 @@ towards them and 2 m below it, 258 m of chain of 300 N/m submerged, EA 5e8 N. Th
 in surge, 110 s in sway and 70 s in yaw (printed). The campaign then has the lines' fairlead
 tensions as channels `mooring.line1` to `mooring.line3`.
 
+`--command`: the campaign as users run it, `python -m jaxslosh campaign SCENE --scatter ... --workers W
+--batch B --duration D` in a subprocess (its own compilation cache folder, filled by a first run of
+the same campaign that is not counted), with 1 worker, then 2 workers, each `--repeat` times (the
+best kept). Printed per row: the whole command's wall time (Python's start, the imports, the scene,
+the cases, writing) and CPU time (the command and the processes it waited for), per case, the
+phases of the command's own summary line, the three-hour sea states per core-hour (3600 s /
+(the time per case x 10800 s / D) per core: one worker has one core, two workers two) and the
+2-worker efficiency (1-worker wall / (2 x 2-worker wall)); then the vmapped loop's CPU time per
+case-step (`campaign.worker.run_batch` of the first B cases in this process, its program read
+back from the same cache) and the command's wall time beyond it. The issue's campaign:
+`--command --cells 16 --headings 2 --seeds 1 --batch 4` (32 cases of 600 s).
+
 The scene's [campaign] table holds the operability limits (roll 0.1 rad, pitch 0.1 rad, probe B
 0.5 m), so the campaign runs with them and writes its operability.
 
@@ -58,6 +70,8 @@ import argparse
 import json
 import math
 import os
+import re
+import resource
 import subprocess
 import sys
 import tempfile
@@ -67,7 +81,8 @@ import numpy as np
 
 import jaxslosh as js
 from jaxslosh.campaign.cases import case_values, make_cases, read_scatter
-from jaxslosh.campaign.worker import run_batch
+from jaxslosh.cache import programs
+from jaxslosh.campaign.worker import configure_jax, run_batch
 from jaxslosh.io.campaign import load_campaign
 from benchmarks.harness import ROOT, Table, parser, scene as load
 
@@ -191,6 +206,83 @@ def check_file(path, n):
     return c
 
 
+#: s, the sea state the rates are counted in
+SEA_STATE = 10800.0
+
+
+def run_command(base, workers, out, env, cwd):
+    """One `jaxslosh campaign` (the argument list `base`) with `workers`: (wall s, CPU s of it and the
+    processes it waited for, {phase: s} from its summary line)."""
+    r0 = resource.getrusage(resource.RUSAGE_CHILDREN)
+    t0 = time.perf_counter()
+    p = subprocess.run(base + ["--workers", str(workers), "-o", out], capture_output=True, text=True, cwd=cwd,
+                       env=env)
+    wall = time.perf_counter() - t0
+    r1 = resource.getrusage(resource.RUSAGE_CHILDREN)
+    if p.returncode != 0:
+        raise SystemExit(f"jaxslosh campaign exited {p.returncode}: {p.stderr[-3000:]}")
+    line = [x for x in p.stdout.splitlines() if x.startswith("done:")][-1]
+    m = re.search(r"([\d.]+) s wall \((.*)\) ->", line)
+    phases = {"campaign": float(m.group(1))} if m else {}
+    for item in (m.group(2).split(", ") if m else []):
+        name, value, _ = item.rsplit(" ", 2)
+        phases[name] = float(value)
+    return wall, r1.ru_utime - r0.ru_utime + r1.ru_stime - r0.ru_stime, phases
+
+
+def loop_cpu(scene_path, csv_path, heads, a, batch, cache):
+    """CPU s per case-step of the vmapped loop (run_batch of the campaign's first `batch` cases in
+    this process, the program and model read from the commands' cache), best of two."""
+    configure_jax(cache)
+    programs.use(os.path.join(cache, "programs"))
+    scene = js.load_scene(scene_path)
+    cases = make_cases(read_scatter(csv_path), heads, a.seeds, scene.waves.seed)
+    values = [case_values(cases, i) for i in range(min(batch, cases.n))]
+    run_batch(scene.text, scene.path, a.duration, values, batch)           # the program loaded
+    best = math.inf
+    for _ in range(2):
+        c0 = time.process_time()
+        run_batch(scene.text, scene.path, a.duration, values, batch)
+        best = min(best, time.process_time() - c0)
+    return best / (batch * round(a.duration / scene.simulation.dt))
+
+
+def command(a, scene_path, csv_path, heads, n, d):
+    """--command: the whole `jaxslosh campaign` with 1 and 2 workers (see the module docstring)."""
+    b = int(a.batch.split(",")[0])
+    cache = os.path.join(d, "cache")
+    env = dict(os.environ, JAXSLOSH_CACHE_DIR=cache, JAXSLOSH_PROGRESS="0")
+    env.pop("JAX_COMPILATION_CACHE_DIR", None)
+    base = [sys.executable, "-m", "jaxslosh", "campaign", scene_path, "--scatter", csv_path, "--headings",
+            ",".join(repr(float(h)) for h in heads), "--seeds", str(a.seeds), "--duration", repr(a.duration),
+            "--batch", str(b), "--no-progress"]
+    wall, cpu, _ = run_command(base, 1, os.path.join(d, "warm.h5"), env, d)
+    print(f"first run (compiles, fills the cache; not counted): {wall:.1f} s wall, {cpu:.1f} s CPU; {_load()}",
+          file=sys.stderr)
+    rows = {}
+    for w in (1, 2):
+        for k in range(a.repeat):
+            r = run_command(base, w, os.path.join(d, f"w{w}_{k}.h5"), env, d)
+            print(f"{w} worker(s), run {k + 1}: {r[0]:.1f} s wall, {r[1]:.1f} s CPU, {r[2]}; {_load()}", file=sys.stderr)
+            if w not in rows or r[0] < rows[w][0]:
+                rows[w] = r
+    per_step = loop_cpu(scene_path, csv_path, heads, a, b, cache)
+    steps = round(a.duration / js.load_scene(scene_path).simulation.dt)
+    scale = SEA_STATE / a.duration
+    table = Table(("jaxslosh campaign", "{}"), ("wall s", "{:.1f}"), ("CPU s", "{:.1f}"), ("wall s/case", "{:.3f}"),
+                  ("sea states/core-hour (wall)", "{:.0f}"), ("(CPU)", "{:.0f}"), ("phases of its summary, s", "{}"))
+    for w, (wall, cpu, ph) in rows.items():
+        shown = ", ".join(f"{k} {v:.1f}" for k, v in ph.items())
+        table.add(f"{w} worker{'s' if w > 1 else ''}, {n} cases of {a.duration:g} s, --batch {b}", wall, cpu, wall / n,
+                  3600.0 / (wall * w / n * scale), 3600.0 / (cpu / n * scale), shown)
+    table.print(a.markdown)
+    w1, w2 = rows[1][0], rows[2][0]
+    print(f"2-worker efficiency (1-worker wall / (2 x 2-worker wall)): {w1 / (2 * w2):.2f}")
+    print(f"the vmapped loop alone (run_batch of {b} cases in one process): {1e6 * per_step:.1f} us CPU per "
+          f"case-step, {3600.0 / (per_step * steps * scale):.0f} sea states per core-hour; the 1-worker command's "
+          f"wall beyond it: {w1 - per_step * steps * n:.1f} s of {w1:.1f} s; {_load()}")
+
+
 def main(argv=None):
     p = parser(__doc__)
     p.add_argument("--cells", type=int, default=20)
@@ -212,6 +304,9 @@ def main(argv=None):
     p.add_argument("--yaw-damping", type=float, default=YAW_DAMPING, help="N m s (0: the ship free in yaw)")
     p.add_argument("--components", type=int, default=0, help="wave components (default the scene's 200)")
     p.add_argument("--moored", action="store_true", help="three catenary lines instead of the yaw damper")
+    p.add_argument("--command", action="store_true",
+                   help="time `python -m jaxslosh campaign` with 1 and 2 workers (see the docstring)")
+    p.add_argument("--repeat", type=int, default=1, help="--command: runs of each row, the best kept")
     p.add_argument("--serial-child", nargs=3, metavar=("SCENE", "CSV", "OUT"), help=argparse.SUPPRESS)
     p.add_argument("--headings-rad", help=argparse.SUPPRESS)
     p.add_argument("--indices", help=argparse.SUPPRESS)
@@ -223,6 +318,7 @@ def main(argv=None):
         return
     if a.quick:
         a.cells, a.headings, a.seeds, a.duration, a.serial_cases, a.workers = 1, 2, 1, 22.0, 1, 1
+        a.batch = "1" if a.command else a.batch
     os.environ["PYTHONPATH"] = os.pathsep.join([ROOT, os.environ.get("PYTHONPATH", "")])
     heads = np.linspace(0.0, np.pi, a.headings) if a.headings > 1 else np.array([np.pi / 2])
     batches = [int(b) for b in a.batch.split(",")]
@@ -243,6 +339,8 @@ def main(argv=None):
         n = cells * heads.size * a.seeds
         print(f"{n} cases: {cells} sea states x {heads.size} headings x {a.seeds} seeds, {a.duration:g} s each "
               f"(dt {scene.simulation.dt:g} s, {a.duration / scene.simulation.dt:.0f} steps)", file=sys.stderr)
+        if a.command:
+            return command(a, scene_path, csv_path, heads, n, d)
         rows, results, compile_s = [], {}, None
         for b in batches:
             out = (os.path.join(d, f"c_b{b}.h5") if not a.output else a.output if len(batches) == 1

@@ -1,5 +1,5 @@
 """The client side of a campaign (`js.campaign`, `jaxslosh campaign`): the cases, their batches on
-Dask (a LocalCluster of worker processes, or a given Client), the campaign file written by this
+Dask (a LocalCluster of worker processes, or a given Client; one worker: in this process), the campaign file written by this
 process alone as batches finish, --resume, and the scatter's exceedance and operability.
 
 A worker that dies takes its running batch with it; Dask's scheduler then runs that batch on
@@ -17,9 +17,9 @@ from typing import NamedTuple, Optional
 
 import jax
 import numpy as np
-from dask.distributed import Client, LocalCluster, as_completed
 
 from ..assemble.hull import hull_waves
+from ..cache import programs
 from ..io.campaign import PENDING, create_campaign, load_campaign, write_cases, write_summary
 from ..io.output import OutputLock
 from ..run.guard import Interrupted, interrupts
@@ -60,6 +60,11 @@ class CampaignResult(NamedTuple):
     exceedance: dict             # {channel: scatter-weighted probability of exceeding its limit}
     operability: float           # % of the scatter's weight whose cases stay within every limit
     failed_weight: float = float("nan")   # % of the judged weight whose cases failed (not operable)
+    # wall seconds of the campaign's phases: "setup" (the cases' scenes checked), "start" (the
+    # workers' cluster started; 0 in this process), "first" (until the first batch came back: a
+    # worker's model, program and first batch), "cases" (the rest of the batches), "write" (the
+    # campaign file, within the last two), "other"
+    phases: dict = {}
 
 
 class CampaignInterrupted(Interrupted):
@@ -142,11 +147,13 @@ def campaign(scene, scatter, headings=None, seeds: int | None = None, duration: 
     `duration` replaces the scene's; `limits` {channel: limit} (rad for roll and pitch, m). Left out
     (None), `headings`, `seeds`, `duration` and `limits` are the scene's `[campaign]` table's where
     it gives them (given limits replace the table's as a whole; {}: none). `client`: a
-    dask.distributed Client, else a LocalCluster of `workers` processes is started and closed here.
+    dask.distributed Client, else a LocalCluster of `workers` processes is started and closed here
+    (`workers=1`: the batches run in this process, one after the other, with no cluster).
     `output`: the campaign file (written as batches finish, locked against a second writer);
     `resume`: keep its "ok" cases. `cache_dir`:
     the workers' persistent compilation cache (default: this process's, jax_compilation_cache_dir)."""
     t_start = time.perf_counter()
+    phases = {}
     template = load_scene(scene) if isinstance(scene, (str, os.PathLike)) else scene
     if template.waves is None or not template.waves.irregular:
         raise SceneError("waves.type", "a campaign's template is an irregular sea: type = \"jonswap\" or "
@@ -179,6 +186,7 @@ def campaign(scene, scatter, headings=None, seeds: int | None = None, duration: 
     stats = {ch: {s: np.full(n, np.nan) for s in STATISTICS} for ch in chans}
     spectra = {ch: np.full((n, freq.size), np.nan) for ch in chans}
     lock = OutputLock(output) if output else None
+    phases["setup"] = time.perf_counter() - t_start
     attrs = {"record_duration": float(scenes[0].simulation.duration - scenes[0].waves.ramp), "seeds": int(seeds),
              "headings": np.asarray(heads, dtype=float)}
     try:
@@ -194,9 +202,10 @@ def campaign(scene, scatter, headings=None, seeds: int | None = None, duration: 
             create_campaign(output, template.text, _case_table(cases), chans, freq, attrs)
         todo = [i for i in range(n) if status[i] != "ok"]
         counts = [0, 0]
+        cache_dir = cache_dir or jax.config.jax_compilation_cache_dir or None
         try:
             _run(template, duration, cases, scenes, todo, client, workers, batch, output, status, stats, spectra,
-                 progress, cache_dir or jax.config.jax_compilation_cache_dir or None, counts)
+                 progress, (cache_dir, _programs_dir(cache_dir)), counts, phases)
         except Interrupted as e:
             raise CampaignInterrupted(str(e), sum(x == "ok" for x in status), n, counts[0], output) from None
         run_now, failed = counts
@@ -209,8 +218,10 @@ def campaign(scene, scatter, headings=None, seeds: int | None = None, duration: 
                       failed=bad)
     if output and lim:
         write_summary(output, lim, ops["exceedance"], ops["operability"], ops["failed"])
+    wall = time.perf_counter() - t_start
+    phases["other"] = wall - sum(v for k, v in phases.items() if k != "write")    # writing is within the batches
     return CampaignResult(cases, status, stats, freq, spectra, run_now, done_before, failed,
-                          time.perf_counter() - t_start, lim, ops["exceedance"], ops["operability"], ops["failed"])
+                          wall, lim, ops["exceedance"], ops["operability"], ops["failed"], phases)
 
 
 def _resume_error(path, why):
@@ -285,21 +296,73 @@ def _quiet_dask():
             logging.getLogger(n).setLevel(lv)
 
 
+def _programs_dir(cache_dir):
+    """The workers' exported programs' folder (cache/programs.py): this process's (the command
+    line's, beside its compilation cache), else one beside the given compilation cache."""
+    return programs.folder() or (os.path.join(cache_dir, "jaxslosh-programs") if cache_dir else None)
+
+
+def _in_process(template, duration, cases, batches, batch, caches):
+    """One worker and no client: the batches in this process, one after the other. A LocalCluster
+    of one worker process cost its start (the processes, their imports, the model and the program
+    read back) and a copy of every result, for the same single core's work (docs/benchmarks.md)."""
+    # the folders a worker is given are set in this process for the campaign alone (js.campaign's
+    # caller keeps its own settings)
+    kept = (programs.folder(), jax.config.jax_compilation_cache_dir)
+    try:
+        for idx in batches:
+            try:
+                outcomes = run_batch(template.text, template.path, duration, [case_values(cases, i) for i in idx],
+                                     batch, *caches)
+            except Exception as e:          # a batch that raised: its cases fail with the reason, as on Dask
+                outcomes = _raised(e, idx)
+            yield idx, outcomes
+    finally:
+        programs.use(kept[0])
+        jax.config.update("jax_compilation_cache_dir", kept[1])
+
+
+def _raised(e, idx):
+    reason = "error: " + " ".join(f"{type(e).__name__}: {e}".split())[:300]
+    return [{"status": reason, "stats": None} for _ in idx]
+
+
+def _on_dask(client, template, duration, cases, batches, batch, caches, futures):
+    from dask.distributed import as_completed      # Dask imported only where a cluster is used (a second of start)
+    for idx in batches:
+        values = [case_values(cases, i) for i in idx]
+        fut = client.submit(run_batch, template.text, template.path, duration, values, batch, *caches,
+                            pure=False, retries=1)
+        futures[fut] = idx
+    for fut in as_completed(list(futures)):
+        idx = futures[fut]
+        try:
+            outcomes = fut.result()
+        except Exception as e:          # a batch that raised: its cases fail with the reason
+            outcomes = _raised(e, idx)
+        yield idx, outcomes
+
+
 def _run(template, duration, cases, scenes, todo, client, workers, batch, output, status, stats, spectra, progress,
-         cache_dir, counts):
+         caches, counts, phases):
     """Run the cases `todo`, storing each batch's outcomes as it finishes; counts[:] = [cases run,
-    cases failed] as they go (read after an interruption too)."""
+    cases failed] as they go (read after an interruption too); `phases` gets the wall seconds of
+    the start, the first batch, the others and the writing (CampaignResult.phases)."""
     if not todo:
         return
+    t0 = time.perf_counter()
     own = client is None
+    local = own and int(workers) == 1
     cluster = None
-    if own:
+    if own and not local:
+        from dask.distributed import Client, LocalCluster
         with warnings.catch_warnings(), _sigint_ignored():   # the dashboard moves off a taken 8787: say nothing
             warnings.filterwarnings("ignore", message=".*already in use.*")
             cluster = LocalCluster(n_workers=int(workers), threads_per_worker=1, processes=True,
                                    dashboard_address=None)
         client = Client(cluster)
         client.run(_quiet_cancellations)
+    phases["start"] = time.perf_counter() - t0 if cluster is not None else 0.0
     bar = Progress(enabled=wanted() if progress is None else progress)
     bar.phase("cases", "cases", total=len(todo), unit="case")
     run_now = failed = 0
@@ -310,19 +373,14 @@ def _run(template, duration, cases, scenes, todo, client, workers, batch, output
     stop = guard.__enter__()
     futures: dict = {}
     stopped = False
+    batches = _batches(scenes, todo, batch)
+    t_cases, writing = time.perf_counter(), 0.0
     try:
-        for idx in _batches(scenes, todo, batch):
-            values = [case_values(cases, i) for i in idx]
-            fut = client.submit(run_batch, template.text, template.path, duration, values, batch, cache_dir,
-                                pure=False, retries=1)
-            futures[fut] = idx
-        for fut in as_completed(list(futures)):
-            idx = futures[fut]
-            try:
-                outcomes = fut.result()
-            except Exception as e:          # a batch that raised: its cases fail with the reason
-                reason = "error: " + " ".join(f"{type(e).__name__}: {e}".split())[:300]
-                outcomes = [{"status": reason, "stats": None} for _ in idx]
+        done = (_in_process(template, duration, cases, batches, batch, caches) if local else
+                _on_dask(client, template, duration, cases, batches, batch, caches, futures))
+        for idx, outcomes in done:
+            if "first" not in phases:
+                phases["first"] = time.perf_counter() - t_cases
             for i, o in zip(idx, outcomes):
                 status[i] = o["status"]
                 if o["stats"] is not None:
@@ -332,7 +390,9 @@ def _run(template, duration, cases, scenes, todo, client, workers, batch, output
                         spectra[ch][i] = st["spectrum"]
                 failed += o["status"] != "ok"
             if output:
+                tw = time.perf_counter()
                 write_cases(output, idx, outcomes)
+                writing += time.perf_counter() - tw
             run_now += len(idx)
             counts[:] = [run_now, failed]
             bar.update(run_now)
@@ -341,15 +401,17 @@ def _run(template, duration, cases, scenes, todo, client, workers, batch, output
         stopped = True
         raise
     finally:
+        phases["cases"] = time.perf_counter() - t_cases - phases.get("first", 0.0)
+        phases["write"] = writing
         guard.__exit__(None, None, None)
         bar.close()
         # our own cluster closes quietly: its nanny kills a worker that XLA's threads keep alive past
         # its grace time ("still alive after 4.0 seconds, killing"), which loses nothing here
-        with _quiet_dask() if stopped or own else contextlib.nullcontext():
-            if stopped:
+        with _quiet_dask() if stopped or cluster is not None else contextlib.nullcontext():
+            if stopped and futures:
                 with contextlib.suppress(Exception):
                     client.cancel(list(futures))
-            if own:
+            if cluster is not None:
                 with contextlib.suppress(Exception):
                     client.run(_quiet_closing)
                     client.run(_quiet_closing, nanny=True)

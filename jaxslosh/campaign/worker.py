@@ -21,6 +21,7 @@ except ModuleNotFoundError:  # Python 3.10
 
 from ..assemble.hull import hull_waves
 from ..cache.programs import install as install_cache
+from ..cache import programs
 from ..run.batch import capsize_angles, simulate_seas
 from ..run.capsize import capsize_reason
 from ..scene.load import parse_scene
@@ -31,15 +32,20 @@ from .stats import case_statistics, channels
 _TEMPLATES: dict = {}
 
 
-def configure_jax(cache_dir: Optional[str]):
+def configure_jax(cache_dir: Optional[str], programs_dir: Optional[str] = None):
     """float64, and the client's persistent compilation cache folder (shared by every worker of
-    one machine: the second worker to compile a scene's loop reads the first one's)."""
+    one machine: the second worker to compile a scene's loop reads the first one's), and its
+    exported programs' folder (cache/programs.py): a worker that finds the batch's program and
+    model there neither traces the vmapped loop nor builds the model (seconds of each worker's
+    start, docs/benchmarks.md)."""
     jax.config.update("jax_enable_x64", True)
     install_cache()             # a worker process is an entry point of its own
     if cache_dir:
         jax.config.update("jax_compilation_cache_dir", cache_dir)
         jax.config.update("jax_persistent_cache_min_compile_time_secs", 0.0)
         jax.config.update("jax_persistent_cache_min_entry_size_bytes", -1)
+    if programs_dir and programs.folder() != programs_dir:
+        programs.use(programs_dir)
 
 
 def template_scene(text: str, path: str, duration: Optional[float]) -> Scene:
@@ -68,11 +74,11 @@ def structure_scene(template: Scene, case: Scene) -> Scene:
 
 
 def run_batch(text: str, path: str, duration: Optional[float], values: list, batch: int,
-              cache_dir: Optional[str] = None) -> list:
+              cache_dir: Optional[str] = None, programs_dir: Optional[str] = None) -> list:
     """Run the cases `values` (their [waves] values, all of one sea structure) padded to `batch`
     runs; returns per case {"status": ..., "stats": {channel: {std, significant, max, mpm, tz,
     spectrum}}, "pid": the worker's process id}."""
-    configure_jax(cache_dir)
+    configure_jax(cache_dir, programs_dir)
     template = template_scene(text, path, duration)
     scenes = [case_scene(template, v, duration) for v in values]
     seas = [sea_arrays(s) for s in scenes]

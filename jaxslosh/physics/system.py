@@ -200,6 +200,15 @@ class System(eqx.Module):
         A = rotation_matrix(c.q)
         return Kin(c, V0, omega, d_dot, a6, d_acc, jnp.asarray(t), jnp.zeros((0,)), A, self.gravity_body(A))
 
+    def at_time(self, t) -> "System":
+        """The System for the evaluations of one step at time t: each term's `at_time` (what
+        depends on the time alone formed once per step, not in every Newton iteration)."""
+        terms = tuple(term.at_time(t) for term in self.terms)
+        tail = tuple(term.at_time(t) for term in self.tail)
+        if all(a is b for a, b in zip(terms + tail, self.terms + self.tail)):
+            return self
+        return eqx.tree_at(lambda s: (s.terms, s.tail), self, (terms, tail))
+
     # ---------------------------------------------------------------- the terms' integrator states
     def states_init(self) -> tuple:
         """Every term's integrator states at t = 0 (AbstractTerm.state_init), in all_terms' order."""

@@ -128,6 +128,12 @@ class AbstractTerm(eqx.Module):
         """What advancing its states over a step h needs, formed once per step (outside the iterations)."""
         return ()
 
+    def at_time(self, t) -> "AbstractTerm":
+        """This term for the evaluations of one step at time t: what depends on the time alone
+        formed once, outside the step's Newton iterations (the residual is evaluated in every
+        iteration and every column of its linearisation). The default has nothing of the kind."""
+        return self
+
     def state_advance(self, z, v_old, v_new, coef):
         """Its states at t_{n+1} from those at t_n and the rigid velocities (6,) at both ends (v_new
         is the step's unknown: the states enter the residual through it)."""

@@ -17,10 +17,11 @@ from ..physics.hull import HullPressure
 from ..physics.seakeeping import Excitation, WaveExcitation
 from ..scene.keys import check_values, resolve_params, with_overrides
 from ..scene.types import Scene, SceneError
-from ..staging import XLA_OPTIONS
+from ..staging import XLA_OPTIONS, cached, compile_program, folder
 from .capsize import vanishing_angles
 from .loop import advance, concat_frames, core, frame_datasets, start
 from .simulate import BATCH_AXIS, failure_message, is_traced, prepare
+from .tofile import model_key
 
 
 _BATCH_FNS: dict = {}
@@ -61,6 +62,21 @@ def _batch_fn(scene: Scene, keys: tuple, mesh: Optional[Mesh] = None, excited: b
         cache_key, hit = None, None
     if hit is not None:
         return hit
+    fn = _vmapped(scene, keys, mesh, excited, incident)
+    # XLA's options of the single run's loop (staging.XLA_OPTIONS: its classic CPU emitters compile
+    # the step's many small fusions in less time, and the loop runs as fast). One program, the
+    # initial state in it: compiled apart with its optimisation off, as a single run's is
+    # (run/compiled.py), the vmapped loop that takes its carry ran markedly slower (docs/benchmarks.md)
+    fn = jax.jit(fn, compiler_options=XLA_OPTIONS or None)
+    if cache_key is not None:
+        _BATCH_FNS[cache_key] = fn
+        while len(_BATCH_FNS) > 8:
+            _BATCH_FNS.pop(next(iter(_BATCH_FNS)))
+    return fn
+
+
+def _vmapped(scene: Scene, keys: tuple, mesh: Optional[Mesh], excited: bool, incident: bool):
+    """The vmapped run of a batch that _batch_fn compiles (not jitted: see _seas_fn)."""
     setup0 = _setup0(scene)
     n_frames = setup0.n_steps // setup0.save_every
 
@@ -84,15 +100,6 @@ def _batch_fn(scene: Scene, keys: tuple, mesh: Optional[Mesh] = None, excited: b
     if mesh is not None:
         fn = jax.shard_map(fn, mesh=mesh, in_specs=PartitionSpec("batch"), out_specs=PartitionSpec("batch"),
                            check_vma=False)
-    # XLA's options of the single run's loop (staging.XLA_OPTIONS: its classic CPU emitters compile
-    # the step's many small fusions in less time, and the loop runs as fast). One program, the
-    # initial state in it: compiled apart with its optimisation off, as a single run's is
-    # (run/compiled.py), the vmapped loop that takes its carry ran markedly slower (docs/benchmarks.md)
-    fn = jax.jit(fn, compiler_options=XLA_OPTIONS or None)
-    if cache_key is not None:
-        _BATCH_FNS[cache_key] = fn
-        while len(_BATCH_FNS) > 8:
-            _BATCH_FNS.pop(next(iter(_BATCH_FNS)))
     return fn
 
 
@@ -106,7 +113,38 @@ def _setup0(scene: Scene):
         return prepare(scene)
 
 
-_kept_setup = functools.lru_cache(maxsize=8)(prepare)
+@functools.lru_cache(maxsize=8)
+def _kept_setup(scene: Scene):
+    # where programs are kept in a folder (the command line, a campaign's workers), so is the model,
+    # under the name `jaxslosh run` gives it: a worker's first batch reads it instead of building it
+    key = model_key(scene) if folder() is not None else None
+    return prepare(scene) if key is None else cached("model", key, lambda: prepare(scene))
+
+
+#: the seas batches' programs read from the exported programs' folder, per scene and shapes
+_SEAS_PROGRAMS: dict = {}
+
+
+def _seas_fn(scene: Scene, vals: list, incident: bool):
+    """The compiled batch of simulate_seas: `_batch_fn`'s, and where programs are kept in a folder
+    (cache/programs.py) its exported program, read back by a later process (a campaign's every
+    worker, every campaign of the scene) instead of traced: tracing the vmapped loop of the paper
+    ship took seconds of each worker's start, more than XLA's cache lookup (docs/benchmarks.md)."""
+    if folder() is None:
+        return _batch_fn(scene, (), None, excited=True, incident=incident)
+    try:
+        key = (scene, incident, tuple((v.shape, str(v.dtype)) for v in vals))
+        hit = _SEAS_PROGRAMS.get(key)
+    except TypeError:                 # an unhashable scene: no reuse in this process
+        key, hit = None, None
+    if hit is None:
+        hit, _ = compile_program("seas-batch", lambda sc, *v: _vmapped(sc, (), None, True, incident)(*v),
+                                 (scene, *vals), XLA_OPTIONS or None)
+        if key is not None:
+            _SEAS_PROGRAMS[key] = hit
+            while len(_SEAS_PROGRAMS) > 8:
+                _SEAS_PROGRAMS.pop(next(iter(_SEAS_PROGRAMS)))
+    return lambda *v: hit(scene, *v)
 
 
 def check_runs(scene: Scene, params: dict) -> list:
@@ -140,7 +178,7 @@ def simulate_seas(scene: Scene, omega, amp, phase, height, incident=None) -> tup
     if incident is not None:
         vals += [jnp.asarray(x, dtype=float) for x in incident]
     setup0 = _setup0(scene)
-    carry, fr = _batch_fn(scene, (), None, excited=True, incident=incident is not None)(*vals)
+    carry, fr = _seas_fn(scene, vals, incident is not None)(*vals)
     return _batch_result(scene, setup0, carry, fr, int(vals[0].shape[0]))
 
 

@@ -156,13 +156,16 @@ def step_equations(system: System, solver: Solver, s: State):
 
     coef = system.states_coefficients(h)
     r = system.layout().n_rigid
+    # the terms' parts that depend on the time alone (the wave excitation's components), formed
+    # once per step: the residual below is evaluated in every Newton iteration
+    at_t = system.at_time(s.t + h)
 
     def parts(y, z):
         vy, ay, _ = rates(y, slice(0, r))
         vz, az, _ = rates(z, slice(r, None))
         c_new = system.advance_parts(s.c, y, z)
         states = system.states_advance(s.z, s.v[:r], vy, coef, s.c, c_new)
-        return system.step_rows_parts(c_new, vy, vz, ay, az, s.t + h, states)
+        return at_t.step_rows_parts(c_new, vy, vz, ay, az, s.t + h, states)
 
     def R(delta):
         return jnp.concatenate(parts(delta[:r], delta[r:]))
