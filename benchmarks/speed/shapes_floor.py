@@ -2,7 +2,7 @@
 default, and the shapes on 20 modes against the box (issue 47 item 1).
 
     python -m benchmarks.speed.shapes_floor [--steps 200] [--repeat 3] [--solvers ...] [--no-modes]
-        [--breakdown] [--quick] [--markdown]
+        [--breakdown] [--quick] [--markdown]        (--solvers "": the 20-mode table alone)
 
 The paper ship carrying one tank of each shape (benchmarks/speed/shapes.py: prismatic 4x12x8,
 vertical cylinder 8x8x5, horizontal cylinder 6x12x6, about the paper tank's 75 m^3 of water) at full
