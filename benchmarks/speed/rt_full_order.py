@@ -8,7 +8,7 @@ shipped shaped scenes and on larger prismatic tanks.
 Each (case, solver) runs in a new process (its peak memory is that process's): the build (the
 model and the Newton blocks), the compile, the step's time after compilation (best of two runs of
 `--steps` steps: benchmarks/harness.py's time_scene), the unknowns and the peak resident memory.
-`--chebyshev-tol` sets jaxslosh/solve/face_inverse.MASS_TOL, an internal (the tolerance of the
+`--chebyshev-tol` sets jaxslosh/liquid/face/inverse.MASS_TOL, an internal (the tolerance of the
 faces' mass inverse has no scene key).
 `rt-dense`: `simulation.linear_solver = "dense"` (the dense M, K and inverses; refused above 4,000
 free faces); `rt-sparse`: "sparse"; `stabilized`: the nodal element with the scene's default solver.

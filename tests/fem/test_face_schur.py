@@ -3,6 +3,7 @@ liquid/face/blocks.py, liquid/face/inverse.py) against the dense blocks (liquid/
 with sparse=False) on small meshes: the stiffness, the Newton blocks' inverses, the static start and
 the absolute-rotation penalty to round-off, a run to the Newton solver's floor, and the operators
 under vmap and jax.export."""
+import dataclasses
 from types import SimpleNamespace
 
 import jax
@@ -16,7 +17,7 @@ from jaxslosh.assemble.liquid import build_liquid_block
 from jaxslosh.liquid.face.schur import face_schur
 from jaxslosh.liquid.face.element import build_face_liquid
 from jaxslosh.geometry import Baffle, Box, Prismatic
-from jaxslosh.liquid.face.inverse import chebyshev_steps, face_solver_blocks
+from jaxslosh.liquid.face.inverse import BlockInverse, chebyshev_steps, face_solver_blocks
 
 
 def _models():
@@ -54,6 +55,34 @@ def test_the_sparse_blocks_equal_the_dense_ones_to_round_off():
     # the dense blocks formed from the products (analysis helpers): the same matrices
     Ms, Ks = sparse.constant_blocks()
     assert rel(Ms, M0) < 1e-14 and rel(Ks, K0) < 1e-13
+
+
+def test_the_dense_step_block_is_the_operator_and_the_element_gathers_the_points_ones():
+    """Below `dense_faces` the step block's inverse is the matrix of the Woodbury-Chebyshev operator
+    (both the inverse of c M + K, as the other test has it); the liquid's fields and forces gathered and
+    scattered over the elements' slots, and FaceOps.scatter as a gather, equal the points' own
+    slots and segment_sum to round-off."""
+    models = _models()
+    tanks = [SimpleNamespace(origin=(0.3, -1.0, -0.5), wall_spec=None), SimpleNamespace(origin=(-1.0, 0.5, -0.2), wall_spec=None)]
+    dense, _, _ = face_full_liquid(tanks, models)
+    sparse, _, _ = face_full_liquid(tanks, models, sparse=True)
+    c = 4.0 / 0.01 ** 2
+    matrix, operator = face_solver_blocks(sparse, c)[0], face_solver_blocks(sparse, c, dense_faces=0)[0]
+    assert isinstance(operator, BlockInverse) and matrix.shape == (sparse.nf, sparse.nf)
+    V = np.random.default_rng(2).standard_normal((sparse.nf, 3))
+    exact = np.linalg.solve(c * np.asarray(dense.Mff) + np.asarray(dense.K), V)
+    for inv in (matrix, operator):
+        assert np.abs(np.asarray(inv @ jnp.asarray(V)) - exact).max() < 1e-10 * np.abs(exact).max()
+    assert sparse._by_element() == 8 and dense._by_element() == 0
+    d = jnp.asarray(V[:, 0])
+    F = jnp.asarray(np.random.default_rng(3).standard_normal((sparse.r.shape[0], 3)))
+    u0, u1 = np.asarray(dense.field(d)), np.asarray(sparse.field(d))
+    f0, f1 = np.asarray(dense.free_part(F)), np.asarray(sparse.free_part(F))
+    assert np.abs(u1 - u0).max() < 1e-14 * np.abs(u0).max() and np.abs(f1 - f0).max() < 1e-14 * np.abs(f0).max()
+    ops = sparse.K.ops
+    v = jnp.asarray(np.random.default_rng(4).standard_normal(ops.slots.shape + (2,)))
+    by_segments = np.asarray(dataclasses.replace(ops, places=None).scatter(v))
+    assert np.abs(np.asarray(ops.scatter(v)) - by_segments).max() < 1e-14 * np.abs(by_segments).max()
 
 
 def test_the_generalized_inverse_is_the_W_weighted_one():

@@ -19,7 +19,7 @@ from .schur import face_schur, mass_bounds, project_pools
 from .element import ROTATION_PENALTY_RATIO, FaceModel, _gauss, _loads, _Mixed, face_modes
 from ...fem.mesh import box_gauss_points
 from .walls import build_face_tank_with_walls, wall_points
-from .blocks import FaceOps, FaceStiffness
+from .blocks import FaceOps, FaceStiffness, owners
 from .term import FaceLiquid
 from ...scene.types import RT_FULL_FACES, SceneError
 from .inverse import mass_inverse
@@ -132,9 +132,10 @@ def stack_sparse(parts: list, scales=None) -> tuple:
         elements.append((e0, e0 + E))
         top_ranges.append((t0, t0 + T))
         off, e0, t0 = off + p["nf"], e0 + E, t0 + T
-    ops = FaceOps(jnp.asarray(np.concatenate(slots).astype(np.int32)),
-                  jnp.asarray(np.concatenate([p["signs"] for p in parts])),
-                  jnp.asarray(np.concatenate(tops).astype(np.int32)), n, tuple(elements), tuple(top_ranges))
+    slots = np.concatenate(slots).astype(np.int32)
+    ops = FaceOps(jnp.asarray(slots), jnp.asarray(np.concatenate([p["signs"] for p in parts])),
+                  jnp.asarray(np.concatenate(tops).astype(np.int32)), n, tuple(elements), tuple(top_ranges),
+                  jnp.asarray(owners(slots, n)))
     kappa_n = np.concatenate([np.full(p["nf"], p["kappa"]) for p in parts])
     lo = min(p["bounds"][0] for p in parts)
     hi = max(p["bounds"][1] for p in parts)

@@ -27,6 +27,13 @@ from .blocks import FaceOps
 MASS_TOL = 1e-15
 #: the spectral bounds of D^-1 M are widened by this factor (they come from a Lanczos run to 1e-6)
 WIDEN = 0.02
+#: free faces up to which the step block's inverse is stored as the dense matrix of the operator below
+#: (formed once per run by applying it to the identity): one product of n^2 entries against two
+#: Chebyshev solves of 25-50 gathers and scatters each. On the prismatic 4x12x8 tank (1,024 faces)
+#: the preconditioner's application fell from 590 to 150 us and the step from 3,240 to about 1,900
+#: us (docs/benchmarks.md, "The shaped tanks against their floor"); the product grows as n^2 and the
+#: solves as n, so they cross near 4,000 faces, where the matrix holds 128 MB
+DENSE_STEP_FACES = 3000
 
 
 def chebyshev_steps(lo: float, hi: float, tol: float = MASS_TOL) -> int:
@@ -97,17 +104,18 @@ class BlockInverse(eqx.Module):
         return self.minv @ (s * r - ops.BT([H @ y for H, y in zip(self.H, ys)]))
 
 
-def face_solver_blocks(liquid, c_step: float, c_sub=None):
+def face_solver_blocks(liquid, c_step: float, c_sub=None, dense_faces: int = DENSE_STEP_FACES):
     """(Cinv_step, Cinv_mass, Cinv_sub or None, sum_j |K_ij| per row) of a sparse FaceLiquid
     (solve/linear.make_solver): H_c per tank from its Y, W^-1 and kappa (host, float64; in JAX from
     the stop_gradient values where the liquid is at scaled, perhaps traced values: the inverses only
-    precondition)."""
+    precondition). Up to `dense_faces` unknowns the step blocks are the dense matrices of the same
+    operators (`dense_matrix`), which the Newton iterations apply several times per step."""
     K, mi = liquid.K, liquid.Minv
     sg = jax.lax.stop_gradient
     if K.rho is not None:
         mi = sg(mi)
 
-    def block(c):
+    def operator(c):
         if K.rho is None:
             H = tuple(jnp.asarray(schur_inverse(np.asarray(Y), np.asarray(wi), float(k), c))
                       for Y, wi, k in zip(K.Y, K.winv, np.asarray(K.kappas)))
@@ -116,5 +124,21 @@ def face_solver_blocks(liquid, c_step: float, c_sub=None):
                   for i, (Y, wi, r, N) in enumerate(zip(K.Y, K.winv, K.rho, K.pools)))
         return BlockInverse(mi, 1.0 / (c + sg(K.kappa_n)), H)
 
+    def block(c):
+        op = operator(c)
+        return dense_matrix(op, host=K.rho is None) if op.shape[0] <= dense_faces else op
+
     rowsum = np.asarray(K.abs_rowsum) if K.rho is None else sg(K.abs_rowsum)
     return block(float(c_step)), mi, block(float(c_sub)) if c_sub is not None else None, rowsum
+
+
+@eqx.filter_jit
+def _columns(op):
+    X = op @ jnp.eye(op.shape[0], dtype=op.s.dtype)
+    return 0.5 * (X + X.T)           # the operator is symmetric: its round-off is not
+
+
+def dense_matrix(op: BlockInverse, host: bool):
+    """The (n, n) matrix of the step block's inverse (its columns: the operator on the identity,
+    symmetrized), a concrete array from the model's values (`host`), else traced like them."""
+    return jnp.asarray(np.asarray(_columns(op))) if host else _columns(op)

@@ -88,9 +88,22 @@ class FaceLiquid(AbstractLiquid):
     def nf(self) -> int:
         return int(self.K.shape[0])
 
+    def _by_element(self) -> int:
+        """Points per element where every point's six unknowns are its element's, as the blocks
+        without dense matrices on the faces have them (no walls or structures; the points element
+        by element, assemble/face_liquid.py): the gathers and scatters then run over the elements'
+        slots (FaceOps), a P-th of the points' (0: the points' own slots)."""
+        if not self.sparse or self.wall_N is not None:
+            return 0
+        return self.r.shape[0] // self.K.ops.slots.shape[0]
+
     def field(self, d):
         """(nf,) unknowns -> (G, 3) displacements at the points (the liquid's Gauss points, then the
         walls')."""
+        P = self._by_element()
+        if P:                   # (a batched product over the elements: XLA's CPU fuses it as a loop)
+            E = self.K.ops.slots.shape[0]
+            return jnp.einsum("epfi,ef->epi", self.phi.reshape(E, P, 6, 3), self.K.ops.gather(d)).reshape(E * P, 3)
         dz = jnp.concatenate([d, jnp.zeros(1, d.dtype)])
         if self.wall_N is None:
             return jnp.einsum("gfi,gf->gi", self.phi, dz[self.slots])
@@ -101,6 +114,10 @@ class FaceLiquid(AbstractLiquid):
     def free_part(self, F):
         """The transpose of `field`: forces (G, 3) at the points -> generalized forces (nf,)."""
         nf = self.nf
+        P = self._by_element()
+        if P:                   # each element's six unknowns summed over its points, then scattered
+            E = self.K.ops.slots.shape[0]
+            return self.K.ops.scatter(jnp.einsum("epfi,epi->ef", self.phi.reshape(E, P, 6, 3), F.reshape(E, P, 3)))
         if self.wall_N is None:
             local = jnp.einsum("gfi,gi->gf", self.phi, F)
             return jax.ops.segment_sum(local.reshape(-1), self.slots.reshape(-1), nf + 1)[:nf]
