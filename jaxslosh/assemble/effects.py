@@ -7,7 +7,7 @@ from __future__ import annotations
 from ..liquid.face.mesh import free_face_count
 from ..liquid.walls import shell_mesh
 from ..liquid.multimodal.modes import modal_modes
-from ..scene.types import EFFECTS, FACE_FORMS, Scene
+from ..scene.types import EFFECTS, Scene
 from ..solve.schemes import SCHEMES
 
 
@@ -77,7 +77,7 @@ def switched_off(scene: Scene) -> list[str]:
 def modal_words(t) -> str:
     """What a multimodal tank is instead of a mesh: its free-surface modes."""
     n = len(modal_modes(t))
-    if t.flow != "3d":
+    if not t.three_dimensional:
         return f"{n} free-surface modes cos(i pi x / L), i = 1..{n} (multimodal, two-dimensional along x), no mesh"
     done = f", {t.modes} asked and completed to whole degenerate pairs" if n != t.modes else ""
     return (f"{n} free-surface modes of its {'disk' if t.geometry.name == 'cylinder' else 'rectangular'} base "
@@ -88,7 +88,7 @@ def mesh_words(t, short: bool = False) -> str:
     """"mesh 5 x 5 x 5 = 125 hexahedra" (a grid, of any shape, or a mesh file that is one), or
     "mesh file of 12 hexahedra on 30 nodes" (a mesh tank's file that is not a grid: its counts
     along x, y, z mean nothing); a multimodal tank's modes (it has no mesh)."""
-    if t.model == "multimodal":
+    if t.multimodal:
         return modal_words(t)
     nx, ny, nz = t.mesh
     words = t.geometry.mesh_words()
@@ -115,9 +115,9 @@ def free_liquid_dofs(tank) -> int:
     """A tank's free liquid unknowns at full order: the nodal elements' three dofs per node, less the
     wall-normal ones the slip walls hold; the face-normal element's free faces (the interior ones and
     the free surface's, liquid/face/element.py); a multimodal tank's modal coordinates."""
-    if tank.model == "multimodal":
+    if tank.multimodal:
         return len(modal_modes(tank))
-    if tank.fluid.element in FACE_FORMS:
+    if tank.face_normal:
         nx, ny, nz = tank.mesh
         if tank.geometry.plain_box:         # interior faces along x, y and z, and the nx ny top faces
             return 3 * nx * ny * nz - ny * nz - nx * nz
@@ -153,8 +153,8 @@ def element_why(t) -> str:
     """`check`'s note on a liquid element the scene left out: which one the loader chose, and why
     (scene/shape.py default_element); a given element needs none. Face-normal tanks say how they run."""
     runs = ""
-    if t.fluid.element == "rt":
+    if t.face_normal:
         runs = f" on {t.reduction.modes} modes" if t.reduction is not None else " at full order"
-    if not t.fluid.element_default or t.model != "fem":
+    if not t.fluid.element_default or t.multimodal:
         return runs
     return f"{runs} (by default: {t.fluid.element_default})"
