@@ -18,7 +18,7 @@ from ..mooring.lumped_term import build_lumped_lines
 from ..mooring.term import build_mooring
 from ..liquid.modal_damping import ModalDamping
 from ..physics.kinematics import quat_from_rpy, rotation_matrix
-from ..liquid.base import NoLiquid, RotationPenalty, SpinStiffening
+from ..liquid.base import RotationPenalty, SpinStiffening
 from ..liquid.multimodal.term import MultimodalLiquid
 from ..physics.structures import Structures
 from ..physics.system import System

@@ -11,7 +11,6 @@ import jax.numpy as jnp
 import numpy as np
 
 from ..physics.system import System
-from ..staging import staged
 from .schemes import Scheme
 
 

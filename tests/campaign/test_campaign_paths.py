@@ -76,7 +76,7 @@ def test_the_paper_ships_batch_gives_the_statistics_recorded_before():
     _check(run_batch(campaign_scene().text, "", 40.0, SHIP_CASES, 2), SHIP)
 
 
-def test_one_worker_runs_in_this_process_with_its_phases(env):
+def test_one_worker_runs_in_this_process_with_its_phases(env):  # noqa: F811 (the env fixture)
     p, s = files(env)
     before = set(multiprocessing.active_children())
     r = js.campaign(js.load_scene(str(p)), str(s), headings=[1.2, BEAM], seeds=1, cache_dir=str(CACHE), batch=4,

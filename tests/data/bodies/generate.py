@@ -13,7 +13,6 @@ import os
 import numpy as np
 import xarray as xr
 import capytaine as cpt
-from capytaine.io.xarray import separate_complex_values
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 RHO, G = 1025.0, 9.81
