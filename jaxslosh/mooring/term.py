@@ -61,24 +61,48 @@ class MooringLines(AbstractTerm):
     names: tuple = eqx.field(static=True, default=())
     about: About = eqx.field(static=True, default=About())
 
-    def state(self, X0, A) -> LineState:
+    def spans(self, X0, A):
+        """(the fairleads (n, 3), their offsets from the anchors (n, 3), XF (n,), ZF (n,))."""
         p = X0[None, :] + self.fairlead @ A.T
         d = p - self.anchor
-        XF = jnp.sqrt(d[:, 0] ** 2 + d[:, 1] ** 2 + _XF_EPS2)
-        ZF = d[:, 2]
-        H, V = solve_lines(XF, ZF, self.length, self.weight, self.ea, self.friction, self.anchor_height).T
+        return p, d, jnp.sqrt(d[:, 0] ** 2 + d[:, 1] ** 2 + _XF_EPS2), d[:, 2]
+
+    def solve(self, X0, A, guess=None):
+        """(n, 2) the lines' (H, V) at the pose (`guess`: a nearby solution, catenary.solve_lines)."""
+        _, _, XF, ZF = self.spans(X0, A)
+        return solve_lines(XF, ZF, self.length, self.weight, self.ea, self.friction, self.anchor_height, guess)
+
+    def state(self, X0, A, guess=None) -> LineState:
+        p, d, XF, ZF = self.spans(X0, A)
+        H, V = solve_lines(XF, ZF, self.length, self.weight, self.ea, self.friction, self.anchor_height, guess).T
         _, _, LB, HA, VA = jax.vmap(profile)(H, V, self.length, self.weight, self.ea, self.friction, self.anchor_height)
         force = jnp.stack([-H * d[:, 0] / XF, -H * d[:, 1] / XF, -V], axis=1)
         return LineState(H, V, HA, VA, LB, force, p)
 
-    def force_moment(self, X0, A):
+    def force_moment(self, X0, A, guess=None):
         """The lines' total force and moment about the COG, both inertial (the carried force left out)."""
-        s = self.state(X0, A)
+        s = self.state(X0, A, guess)
         arm = s.fairlead - X0[None, :]
         return s.force.sum(axis=0), jnp.cross(arm, s.force).sum(axis=0)
 
+    # ------------------------------------------------------------ integrator states: a warm start
+    # Every residual evaluation of a step solves every line. Started cold (the inextensible estimate,
+    # then a bracketed Newton of some ten iterations) three lines added a third to the paper
+    # example's step; the lines' (H, V) at the end of the last step, carried as the term's states
+    # (refreshed once a step, `state_settle`), are a start from which Newton needs two or three
+    # iterations. The states only start the iterations: the rows are the converged solution
+    # whatever they hold (cold where a caller gives none), and no derivative goes through them.
+    def state_init(self):
+        return jax.lax.stop_gradient(self.solve(jnp.zeros(3), jnp.eye(3)).reshape(-1))
+
+    def state_settle(self, z, c):
+        guess = jax.lax.stop_gradient(z.reshape(-1, 2))
+        X0, q = jax.lax.stop_gradient((c.X0, c.q))
+        return jax.lax.stop_gradient(self.solve(X0, rotation_matrix(q), guess).reshape(-1))
+
     def rows(self, k: Kin) -> Rows:
-        F, M = self.force_moment(k.c.X0, k.A)
+        guess = k.z.reshape(-1, 2) if k.z.shape[0] else None
+        F, M = self.force_moment(k.c.X0, k.A, guess)
         return Rows(-jnp.concatenate([F + self.carried, k.A.T @ M]))
 
     def describe(self) -> tuple:
