@@ -290,17 +290,20 @@ def _solve2(J, r):
                      axis=1) / det[:, None]
 
 
-def _lines_warm(XF, ZF, L, w, EA, CB, hA, slack, H0, guess):
-    """`_lines_iterations` from a nearby solution `guess` (n, 2) (the previous step's): plain Newton
-    on every line's profile, each line held once it is below TOL (a guess already converged costs
-    one evaluation); where some line has not converged in WARM_ITER iterations (a guess from far
-    away, a branch change that Newton does not cross), the cold solve of every line."""
+def _lines_warm(XF, ZF, L, w, EA, CB, hA, slack, H0, guess, inverse=None):
+    """`_lines_iterations` from a nearby solution `guess` (n, 2) (the previous step's): Newton on
+    every line's profile, each line held once it is below TOL (a guess already converged costs one
+    evaluation). With `inverse` (n, 2, 2), the inverse of the residual's Jacobian at the guess, the
+    iterations keep it (chord steps: one evaluation each, where Newton's also take the Jacobian's
+    two products; within a step's motion each gains some four digits). Where some line has not
+    converged in WARM_ITER iterations (a guess from far away, a branch change), the cold solve of
+    every line."""
     residual = _lines_residual(XF, ZF, L, w, EA, CB, hA, slack, H0)
     err = lambda r: jnp.where(jnp.isfinite(r).all(axis=1), jnp.max(jnp.abs(r), axis=1), jnp.inf)  # noqa: E731
 
     def step(state):
         x, r, it = state
-        dx = _solve2(_blocks(residual, x), r)
+        dx = _solve2(_blocks(residual, x), r) if inverse is None else jnp.einsum("nij,nj->ni", inverse, r)
         # H stays positive: a step that would cross zero goes nine tenths of the way there
         new = jnp.stack([jnp.maximum(x[:, 0] - dx[:, 0], 0.1 * x[:, 0]), x[:, 1] - dx[:, 1]], axis=1)
         x = jnp.where((err(r) <= TOL)[:, None], x, new)
@@ -314,11 +317,23 @@ def _lines_warm(XF, ZF, L, w, EA, CB, hA, slack, H0, guess):
     return x
 
 
-def solve_lines(XF, ZF, L, w, EA, CB, hA, guess=None):
+def lines_inverse(XF, ZF, L, w, EA, CB, hA, x):
+    """(n, 2, 2) the inverse of the lines' residual Jacobian at their solution x (n, 2): what
+    `solve_lines` keeps for chord steps from there."""
+    XF, ZF, L, w, EA, CB, hA = (jnp.asarray(v, dtype=float) for v in (XF, ZF, L, w, EA, CB, hA))
+    slack, H0 = jax.vmap(_slack)(XF, ZF, L, w, EA, CB, hA)
+    J = _blocks(_lines_residual(XF, ZF, L, w, EA, CB, hA, slack, H0), x)
+    det = J[:, 0, 0] * J[:, 1, 1] - J[:, 0, 1] * J[:, 1, 0]
+    return jnp.stack([jnp.stack([J[:, 1, 1], -J[:, 0, 1]], -1), jnp.stack([-J[:, 1, 0], J[:, 0, 0]], -1)],
+                     1) / det[:, None, None]
+
+
+def solve_lines(XF, ZF, L, w, EA, CB, hA, guess=None, inverse=None):
     """(n, 2) fairlead tensions (H, V) of n lines ((n,) arrays of spans and values): the same
     solutions as `solve` line by line, the whole-profile Newton run only where a line needs it
     (`_lines_iterations`), or Newton from `guess` (n, 2), a nearby solution such as the previous
-    step's (`_lines_warm`); differentiable in every argument through the implicit function
+    step's (`_lines_warm`, with chord steps where the Jacobian's `inverse` there is given, as
+    `lines_inverse` gives it); differentiable in every argument through the implicit function
     theorem, one 2 x 2 solve per line, whatever the guess."""
     XF, ZF, L, w, EA, CB, hA = (jnp.asarray(v, dtype=float) for v in (XF, ZF, L, w, EA, CB, hA))
     slack, H0 = jax.lax.stop_gradient(jax.vmap(_slack)(XF, ZF, L, w, EA, CB, hA))
@@ -332,7 +347,8 @@ def solve_lines(XF, ZF, L, w, EA, CB, hA, guess=None):
     if guess is None:
         iterate = lambda f, _: _lines_iterations(*spans)  # noqa: E731
     else:
-        iterate = lambda f, x0: _lines_warm(*spans, slack, H0, x0)  # noqa: E731
+        inv = None if inverse is None else jax.lax.stop_gradient(inverse)
+        iterate = lambda f, x0: _lines_warm(*spans, slack, H0, x0, inv)  # noqa: E731
     x0 = jnp.zeros((XF.shape[0], 2)) if guess is None else jax.lax.stop_gradient(guess)
     return jax.lax.custom_root(residual, x0, iterate, tangent_solve)
 
