@@ -31,6 +31,8 @@ MAX_ITER = 200
 #: Newton iterations from a warm start before the cold solve takes over (one or two suffice for the
 #: previous step's solution)
 WARM_ITER = 8
+#: chord steps from a warm start with its Jacobian (from a step's motion, two or three reach round-off)
+CHORD_STEPS = 4
 
 
 class Catenary(NamedTuple):
@@ -291,30 +293,41 @@ def _solve2(J, r):
 
 
 def _lines_warm(XF, ZF, L, w, EA, CB, hA, slack, H0, guess, inverse=None):
-    """`_lines_iterations` from a nearby solution `guess` (n, 2) (the previous step's): Newton on
-    every line's profile, each line held once it is below TOL (a guess already converged costs one
-    evaluation). With `inverse` (n, 2, 2), the inverse of the residual's Jacobian at the guess, the
-    iterations keep it (chord steps: one evaluation each, where Newton's also take the Jacobian's
-    two products; within a step's motion each gains some four digits). Where some line has not
-    converged in WARM_ITER iterations (a guess from far away, a branch change), the cold solve of
-    every line."""
+    """`_lines_iterations` from a nearby solution `guess` (n, 2) (the previous step's). With
+    `inverse` (n, 2, 2), the inverse of the residual's Jacobian at the guess: CHORD_STEPS chord
+    steps written out (one evaluation of the profile each; within a step's motion each gains some
+    four digits), no loop: a `lax.while_loop` inside the residual cost the paper example more than
+    the whole solve (its iterations run apart from the step's fused kernels). Then, and without
+    `inverse`, Newton where some line is still above TOL, each line held once below it (a loop that
+    does not run when the chord steps converged); where some line has not converged in WARM_ITER
+    iterations (a guess from far away, a branch change), the cold solve of every line."""
     residual = _lines_residual(XF, ZF, L, w, EA, CB, hA, slack, H0)
     err = lambda r: jnp.where(jnp.isfinite(r).all(axis=1), jnp.max(jnp.abs(r), axis=1), jnp.inf)  # noqa: E731
+    x, r = guess, residual(guess)
+    if inverse is not None:
+        for _ in range(CHORD_STEPS):       # a fixed count, unrolled: not a loop over time steps
+            dx = jnp.einsum("nij,nj->ni", inverse, r)
+            x = jnp.where((err(r) <= TOL)[:, None], x, _descend(x, dx))
+            r = residual(x)
 
-    def step(state):
+    def newton(state):
         x, r, it = state
-        dx = _solve2(_blocks(residual, x), r) if inverse is None else jnp.einsum("nij,nj->ni", inverse, r)
-        # H stays positive: a step that would cross zero goes nine tenths of the way there
-        new = jnp.stack([jnp.maximum(x[:, 0] - dx[:, 0], 0.1 * x[:, 0]), x[:, 1] - dx[:, 1]], axis=1)
-        x = jnp.where((err(r) <= TOL)[:, None], x, new)
+        x = jnp.where((err(r) <= TOL)[:, None], x, _descend(x, _solve2(_blocks(residual, x), r)))
         return x, residual(x), it + 1
 
-    x, r, _ = jax.lax.while_loop(lambda s: jnp.any(err(s[1]) > TOL) & (s[2] < WARM_ITER), step,
-                                 (guess, residual(guess), 0))
-    # the cold solve in a loop that runs at most once: under vmap a lax.cond would run it always
-    x, _ = jax.lax.while_loop(lambda s: s[1], lambda s: (_lines_iterations(XF, ZF, L, w, EA, CB, hA), False),
-                              (x, jnp.any(err(r) > TOL)))
-    return x
+    def polish(state):
+        x, r, _ = jax.lax.while_loop(lambda s: jnp.any(err(s[1]) > TOL) & (s[2] < WARM_ITER), newton, state[:3])
+        # the cold solve in a loop that runs at most once: under vmap a lax.cond would run it always
+        x, _ = jax.lax.while_loop(lambda s: s[1], lambda s: (_lines_iterations(XF, ZF, L, w, EA, CB, hA), False),
+                                  (x, jnp.any(err(r) > TOL)))
+        return x, residual(x), 0, False
+
+    return jax.lax.while_loop(lambda s: s[3], polish, (x, r, 0, jnp.any(err(r) > TOL)))[0]
+
+
+def _descend(x, dx):
+    """x - dx with H kept positive (a step that would cross zero goes nine tenths of the way there)."""
+    return jnp.stack([jnp.maximum(x[:, 0] - dx[:, 0], 0.1 * x[:, 0]), x[:, 1] - dx[:, 1]], axis=1)
 
 
 def lines_inverse(XF, ZF, L, w, EA, CB, hA, x):
