@@ -28,6 +28,11 @@ import jax.numpy as jnp
 #: Newton stops when both profile residuals are below this fraction of the line's length
 TOL = 1e-13
 MAX_ITER = 200
+#: Newton iterations from a warm start before the cold solve takes over (one or two suffice for the
+#: previous step's solution)
+WARM_ITER = 8
+#: chord steps from a warm start with its Jacobian (from a step's motion, two or three reach round-off)
+CHORD_STEPS = 4
 
 
 class Catenary(NamedTuple):
@@ -266,26 +271,99 @@ def _lines_iterations(XF, ZF, L, w, EA, CB, hA):
     return jnp.where(slack[:, None], x_slack, jnp.where(on_seabed[:, None], xc, xs))
 
 
-def solve_lines(XF, ZF, L, w, EA, CB, hA):
+def _lines_residual(XF, ZF, L, w, EA, CB, hA, slack, H0):
+    """x (n, 2) -> the n lines' residuals (n, 2) (_line_residual of each)."""
+    def residual(x):
+        return jax.vmap(lambda *a: _line_residual(*a[:9])(a[9]))(L, w, EA, CB, hA, XF, ZF, slack, H0, x)
+    return residual
+
+
+def _blocks(residual, x):
+    """The lines' 2 x 2 Jacobians (n, 2, 2) of a residual whose lines are independent: two products
+    (every line's H, then every line's V, moved at once), not 2n."""
+    cols = jax.vmap(lambda e: jax.jvp(residual, (x,), (jnp.broadcast_to(e, x.shape),))[1])(jnp.eye(2, dtype=x.dtype))
+    return jnp.moveaxis(cols, 0, -1)
+
+
+def _solve2(J, r):
+    """J^-1 r for (n, 2, 2) blocks, in closed form (a batched LAPACK call costs more than the line)."""
+    det = J[:, 0, 0] * J[:, 1, 1] - J[:, 0, 1] * J[:, 1, 0]
+    return jnp.stack([J[:, 1, 1] * r[:, 0] - J[:, 0, 1] * r[:, 1], J[:, 0, 0] * r[:, 1] - J[:, 1, 0] * r[:, 0]],
+                     axis=1) / det[:, None]
+
+
+def _lines_warm(XF, ZF, L, w, EA, CB, hA, slack, H0, guess, inverse=None):
+    """`_lines_iterations` from a nearby solution `guess` (n, 2) (the previous step's). With
+    `inverse` (n, 2, 2), the inverse of the residual's Jacobian at the guess: CHORD_STEPS chord
+    steps written out (one evaluation of the profile each; within a step's motion each gains some
+    four digits), no loop: a `lax.while_loop` inside the residual cost the paper example more than
+    the whole solve (its iterations run apart from the step's fused kernels). Then, and without
+    `inverse`, Newton where some line is still above TOL, each line held once below it (a loop that
+    does not run when the chord steps converged); where some line has not converged in WARM_ITER
+    iterations (a guess from far away, a branch change), the cold solve of every line."""
+    residual = _lines_residual(XF, ZF, L, w, EA, CB, hA, slack, H0)
+    err = lambda r: jnp.where(jnp.isfinite(r).all(axis=1), jnp.max(jnp.abs(r), axis=1), jnp.inf)  # noqa: E731
+    x, r = guess, residual(guess)
+    if inverse is not None:
+        for _ in range(CHORD_STEPS):       # a fixed count, unrolled: not a loop over time steps
+            dx = jnp.einsum("nij,nj->ni", inverse, r)
+            x = jnp.where((err(r) <= TOL)[:, None], x, _descend(x, dx))
+            r = residual(x)
+
+    def newton(state):
+        x, r, it = state
+        x = jnp.where((err(r) <= TOL)[:, None], x, _descend(x, _solve2(_blocks(residual, x), r)))
+        return x, residual(x), it + 1
+
+    def polish(state):
+        x, r, _ = jax.lax.while_loop(lambda s: jnp.any(err(s[1]) > TOL) & (s[2] < WARM_ITER), newton, state[:3])
+        # the cold solve in a loop that runs at most once: under vmap a lax.cond would run it always
+        x, _ = jax.lax.while_loop(lambda s: s[1], lambda s: (_lines_iterations(XF, ZF, L, w, EA, CB, hA), False),
+                                  (x, jnp.any(err(r) > TOL)))
+        return x, residual(x), 0, False
+
+    return jax.lax.while_loop(lambda s: s[3], polish, (x, r, 0, jnp.any(err(r) > TOL)))[0]
+
+
+def _descend(x, dx):
+    """x - dx with H kept positive (a step that would cross zero goes nine tenths of the way there)."""
+    return jnp.stack([jnp.maximum(x[:, 0] - dx[:, 0], 0.1 * x[:, 0]), x[:, 1] - dx[:, 1]], axis=1)
+
+
+def lines_inverse(XF, ZF, L, w, EA, CB, hA, x):
+    """(n, 2, 2) the inverse of the lines' residual Jacobian at their solution x (n, 2): what
+    `solve_lines` keeps for chord steps from there."""
+    XF, ZF, L, w, EA, CB, hA = (jnp.asarray(v, dtype=float) for v in (XF, ZF, L, w, EA, CB, hA))
+    slack, H0 = jax.vmap(_slack)(XF, ZF, L, w, EA, CB, hA)
+    J = _blocks(_lines_residual(XF, ZF, L, w, EA, CB, hA, slack, H0), x)
+    det = J[:, 0, 0] * J[:, 1, 1] - J[:, 0, 1] * J[:, 1, 0]
+    return jnp.stack([jnp.stack([J[:, 1, 1], -J[:, 0, 1]], -1), jnp.stack([-J[:, 1, 0], J[:, 0, 0]], -1)],
+                     1) / det[:, None, None]
+
+
+def solve_lines(XF, ZF, L, w, EA, CB, hA, guess=None, inverse=None):
     """(n, 2) fairlead tensions (H, V) of n lines ((n,) arrays of spans and values): the same
     solutions as `solve` line by line, the whole-profile Newton run only where a line needs it
-    (`_lines_iterations`); differentiable in every argument through the implicit function theorem."""
+    (`_lines_iterations`), or Newton from `guess` (n, 2), a nearby solution such as the previous
+    step's (`_lines_warm`, with chord steps where the Jacobian's `inverse` there is given, as
+    `lines_inverse` gives it); differentiable in every argument through the implicit function
+    theorem, one 2 x 2 solve per line, whatever the guess."""
     XF, ZF, L, w, EA, CB, hA = (jnp.asarray(v, dtype=float) for v in (XF, ZF, L, w, EA, CB, hA))
     slack, H0 = jax.lax.stop_gradient(jax.vmap(_slack)(XF, ZF, L, w, EA, CB, hA))
-
-    def residual(x):
-        return jax.vmap(lambda *a: _line_residual(*a[:5], *a[5:9])(a[9]))(L, w, EA, CB, hA, XF, ZF, slack, H0, x)
+    residual = _lines_residual(XF, ZF, L, w, EA, CB, hA, slack, H0)
 
     def tangent_solve(g, y):
         # the lines are independent: their 2 x 2 blocks, each solved alone
-        n = y.shape[0]
-        J = jax.jacfwd(g)(y).reshape(n, 2, n, 2)
-        blocks = J[jnp.arange(n), :, jnp.arange(n), :]
-        return jnp.linalg.solve(blocks, y[..., None])[..., 0]
+        return _solve2(_blocks(g, y), y)
 
     spans = jax.lax.stop_gradient((XF, ZF, L, w, EA, CB, hA))
-    return jax.lax.custom_root(residual, jnp.zeros((XF.shape[0], 2)), lambda f, _: _lines_iterations(*spans),
-                               tangent_solve)
+    if guess is None:
+        iterate = lambda f, _: _lines_iterations(*spans)  # noqa: E731
+    else:
+        inv = None if inverse is None else jax.lax.stop_gradient(inverse)
+        iterate = lambda f, x0: _lines_warm(*spans, slack, H0, x0, inv)  # noqa: E731
+    x0 = jnp.zeros((XF.shape[0], 2)) if guess is None else jax.lax.stop_gradient(guess)
+    return jax.lax.custom_root(residual, x0, iterate, tangent_solve)
 
 
 @jax.jit

@@ -20,7 +20,7 @@ import numpy as np
 from ..physics.about import About
 from ..physics.kinematics import rotation_matrix
 from ..physics.terms import AbstractTerm, Kin, Rows
-from .catenary import profile, solve_lines
+from .catenary import lines_inverse, profile, solve_lines
 
 #: m^2: keeps the horizontal direction defined (and differentiable) with the fairlead right above its anchor
 _XF_EPS2 = 1e-12
@@ -61,24 +61,60 @@ class MooringLines(AbstractTerm):
     names: tuple = eqx.field(static=True, default=())
     about: About = eqx.field(static=True, default=About())
 
-    def state(self, X0, A) -> LineState:
+    def spans(self, X0, A):
+        """(the fairleads (n, 3), their offsets from the anchors (n, 3), XF (n,), ZF (n,))."""
         p = X0[None, :] + self.fairlead @ A.T
         d = p - self.anchor
-        XF = jnp.sqrt(d[:, 0] ** 2 + d[:, 1] ** 2 + _XF_EPS2)
-        ZF = d[:, 2]
-        H, V = solve_lines(XF, ZF, self.length, self.weight, self.ea, self.friction, self.anchor_height).T
+        return p, d, jnp.sqrt(d[:, 0] ** 2 + d[:, 1] ** 2 + _XF_EPS2), d[:, 2]
+
+    def solve(self, X0, A, guess=None, inverse=None):
+        """(n, 2) the lines' (H, V) at the pose (`guess`: a nearby solution, `inverse` the inverse
+        of the residual's Jacobian there, catenary.solve_lines)."""
+        _, _, XF, ZF = self.spans(X0, A)
+        return solve_lines(XF, ZF, *self._values(), guess, inverse)
+
+    def _values(self):
+        return self.length, self.weight, self.ea, self.friction, self.anchor_height
+
+    def state(self, X0, A, guess=None, inverse=None) -> LineState:
+        p, d, XF, ZF = self.spans(X0, A)
+        H, V = solve_lines(XF, ZF, *self._values(), guess, inverse).T
         _, _, LB, HA, VA = jax.vmap(profile)(H, V, self.length, self.weight, self.ea, self.friction, self.anchor_height)
         force = jnp.stack([-H * d[:, 0] / XF, -H * d[:, 1] / XF, -V], axis=1)
         return LineState(H, V, HA, VA, LB, force, p)
 
-    def force_moment(self, X0, A):
+    def force_moment(self, X0, A, guess=None, inverse=None):
         """The lines' total force and moment about the COG, both inertial (the carried force left out)."""
-        s = self.state(X0, A)
+        s = self.state(X0, A, guess, inverse)
         arm = s.fairlead - X0[None, :]
         return s.force.sum(axis=0), jnp.cross(arm, s.force).sum(axis=0)
 
+    # ------------------------------------------------------------ integrator states: a warm start
+    # Every residual evaluation of a step solves every line. Started cold (the inextensible estimate,
+    # then a bracketed Newton of some ten iterations) three lines added a third to the paper
+    # example's step. The term's states carry each line's (H, V) at the end of the last step and
+    # the inverse of its residual's Jacobian there (refreshed once a step, `state_settle`): chord
+    # steps from there converge to round-off in two or three evaluations of the profile. The states
+    # only start the iterations: the rows are the converged solution whatever they hold (cold where
+    # a caller gives none), and no derivative goes through them.
+    def _settled(self, X0, A, guess=None, inverse=None):
+        X0, A = jax.lax.stop_gradient((X0, A))
+        x = self.solve(X0, A, guess, inverse)
+        _, _, XF, ZF = self.spans(X0, A)
+        inv = lines_inverse(XF, ZF, *self._values(), x)
+        return jax.lax.stop_gradient(jnp.concatenate([x, inv.reshape(-1, 4)], axis=1).reshape(-1))
+
+    def state_init(self):
+        return self._settled(jnp.zeros(3), jnp.eye(3))
+
+    def state_settle(self, z, c):
+        z = z.reshape(-1, 6)
+        return self._settled(c.X0, rotation_matrix(c.q), z[:, :2], z[:, 2:].reshape(-1, 2, 2))
+
     def rows(self, k: Kin) -> Rows:
-        F, M = self.force_moment(k.c.X0, k.A)
+        z = k.z.reshape(-1, 6)
+        guess, inverse = (z[:, :2], z[:, 2:].reshape(-1, 2, 2)) if k.z.shape[0] else (None, None)
+        F, M = self.force_moment(k.c.X0, k.A, guess, inverse)
         return Rows(-jnp.concatenate([F + self.carried, k.A.T @ M]))
 
     def describe(self) -> tuple:

@@ -18,7 +18,8 @@ for every term and never asks which term has what):
   own that the step advances from t_n to t_{n+1} (the radiation memory); the default is none, a
   zero-size array. A term reads its states at the evaluation's time as `k.z`. The step calls
   `state_advance_config`, which also has the configurations at both ends (a lumped mooring line's
-  nodes follow its fairlead) and by default calls `state_advance`;
+  nodes follow its fairlead) and by default calls `state_advance`; `state_settle` refreshes them once
+  the step has converged (by default it leaves them as advanced);
 * `update_inverse(inv, c_v)`: the inverse of the deformable block of the step matrix with this
   term's constant velocity tangent added (the modal damping's low-rank update); the default
   leaves it as it is;
@@ -145,6 +146,13 @@ class AbstractTerm(eqx.Module):
         t_{n+1}): the configurations (Config) at both ends are given too, c_new the step's unknown.
         The default ignores them."""
         return self.state_advance(z, v_old, v_new, coef)
+
+    def state_settle(self, z, c: Config):
+        """Its states at t_{n+1} once the step has converged at the configuration c, from those the
+        step advanced them to: unchanged (the default). A term whose states only start iterations
+        of its own (the catenary lines' last solution, mooring/term.py) refreshes them here, once a
+        step, not in every evaluation of the residual."""
+        return z
 
     def unknowns(self) -> Unknowns:
         """Its own unknowns: none (see unknowns.AbstractOwner for a term that has some)."""

@@ -128,9 +128,11 @@ def project_energy(system: System, c: Config, v, e0):
 def states_next(system: System, solver: Solver, s: State, v_new, c_new=None):
     """The terms' integrator states at t_{n+1} (the radiation memory's: exact for a rigid velocity
     linear over the step, so they are a linear function of the step's unknown new velocity; a
-    lumped mooring line's also follow the configuration c_new)."""
+    lumped mooring line's also follow the configuration c_new), settled at c_new (the catenary lines'
+    solution there, the start of the next step's)."""
     r = system.layout().n_rigid          # every floating frame's velocities (the bodies' coupled memory)
-    return system.states_advance(s.z, s.v[:r], v_new[:r], system.states_coefficients(solver.h), s.c, c_new)
+    z = system.states_advance(s.z, s.v[:r], v_new[:r], system.states_coefficients(solver.h), s.c, c_new)
+    return z if c_new is None else system.states_settle(z, c_new)
 
 
 def step_equations(system: System, solver: Solver, s: State):
