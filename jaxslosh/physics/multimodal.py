@@ -51,7 +51,7 @@ from .kinematics import mv3, tv3
 from .about import About
 from .liquid import AbstractLiquid
 from .multimodal_modes import odd_powers
-from .multimodal_steep import roundoff_floor, steep_damping
+from .multimodal_steep import roundoff_floor, steep_rows
 from .terms import Kin, Rows
 
 #: quadrature points along the tank (Gauss-Legendre; at least, and 8 per mode: the integrands hold
@@ -429,10 +429,12 @@ class MultimodalLiquid(AbstractLiquid):
         Vb_dot = tv3(A, k.a6[:3]) - jnp.cross(omega, Vb)
         f, m, rd = jnp.zeros(3), jnp.zeros(3), []
         for t, be, bd, bdd in zip(self.tanks, self._split(k.c.d), self._split(k.d_dot), self._split(k.d_acc)):
-            ft, mt, rt = t.rows(Vb, omega, be, bd, Vb_dot, k.a6[3:6], bdd, k.g_b)
+            # past the method's range, what carries the tank on (the steep waves' damping, the modes
+            # above the range's as linear oscillators, the third-order system's exact rows): within
+            # it, the method's rows (multimodal_steep.py)
+            ft, mt, rt = steep_rows(t, Vb, omega, be, bd, Vb_dot, k.a6[3:6], bdd, k.g_b, self.gravity)
             f, m = f + ft, m + mt
-            # past the method's range, the steep waves' damping (zero within it: multimodal_steep.py)
-            rd.append(rt + steep_damping(t, be, bd, self.gravity))
+            rd.append(rt)
         return Rows(jnp.concatenate([mv3(A, f), m]), jnp.concatenate(rd))
 
     def kinetic(self, k: Kin):
