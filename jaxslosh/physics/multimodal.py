@@ -429,9 +429,7 @@ class MultimodalLiquid(AbstractLiquid):
         Vb_dot = tv3(A, k.a6[:3]) - jnp.cross(omega, Vb)
         f, m, rd = jnp.zeros(3), jnp.zeros(3), []
         for t, be, bd, bdd in zip(self.tanks, self._split(k.c.d), self._split(k.d_dot), self._split(k.d_acc)):
-            # past the method's range, what carries the tank on (the steep waves' damping, the modes
-            # above the range's as linear oscillators, the third-order system's exact rows): within
-            # it, the method's rows (multimodal_steep.py)
+            # past the method's range, what carries the tank on (multimodal_steep.py); within it, its rows
             ft, mt, rt = steep_rows(t, Vb, omega, be, bd, Vb_dot, k.a6[3:6], bdd, k.g_b, self.gravity)
             f, m = f + ft, m + mt
             rd.append(rt)
