@@ -53,7 +53,7 @@ class AbstractShape(abc.ABC):
     elastic: ClassVar[bool] = False
     #: the baffle normals the shape takes (none: baffles are refused)
     baffle_normals: ClassVar[tuple] = ()
-    #: whether the multimodal model (physics/multimodal*.py) takes the shape, and its waves there
+    #: whether the multimodal model (liquid/multimodal/) takes the shape, and its waves there
     #: when the tank leaves `flow` out
     modal: ClassVar[bool] = False
     modal_flow: ClassVar[str] = "2d"

@@ -62,6 +62,7 @@ def run_to_file(scene: Scene, out: str, *, progress: bool = True,
             b, solver = setup.built, setup.solver
             watch = Watch(scene, np.asarray(solver.noise))
             watch.watch_capsize(vanishing_angles(b.system))
+            watch.watch_liquid(b.system.liquid)
             se = setup.save_every
             n_frames = setup.n_steps // se
             N = b.system.liquid.n_nodes

@@ -17,7 +17,7 @@ import numpy as np
 from ..liquid.multimodal.build3d import tank_3d, three_dimensional
 from ..physics.kinematics import rpy_from_quat
 from ..liquid.multimodal.term import NX
-from ..liquid.multimodal.steep import STEEP_ON
+from ..liquid.multimodal.steep import DEFINITE_ON, DEFINITE_SOFT, STEEP_FULL, STEEP_MODES, STEEP_ON
 from ..scene.types import Scene
 
 #: a frame residual this many times its level, max(tolerance, round-off floor), is reported (the
@@ -88,6 +88,26 @@ class Watch:
         self.t_slope = np.zeros(len(self.tables))
         self.crest = np.zeros(len(self.tables))     # largest crest index of each, and when it first passed STEEP_ON
         self.t_crest = np.full(len(self.tables), np.nan)
+        # a two-dimensional tank on more than STEEP_MODES modes: (k, omega^2) of its STEEP_MODES-th mode,
+        # whose floor its rows have past STEEP_FULL (liquid/multimodal/steep.steep_rows), by offset
+        self.cut = {}
+        for (off, _, Z, _, _, _), t in zip(self.tables, scene.tanks):
+            if not three_dimensional(t) and t.modes > STEEP_MODES:
+                kc = STEEP_MODES * np.pi / t.size[0]
+                self.cut[off] = (kc, _omega2(scene, t, kc))
+        self.third = {}          # by tank: the third-order system's modal mass polynomial (`watch_liquid`)
+        self.margin = np.ones(len(self.tables))        # its smallest margin, and when it first fell below DEFINITE_ON
+        self.t_margin = np.full(len(self.tables), np.nan)
+
+    def watch_liquid(self, liquid) -> None:
+        """Read the margin of positive definiteness of the liquid's third-order tanks (their modal mass
+        polynomial scaled by the modal masses, liquid/multimodal/steep.definiteness) from the frames."""
+        for i, t in enumerate(getattr(liquid, "tanks", ())[:len(self.tables)]):
+            if hasattr(t, "exact"):
+                d = 1.0 / np.sqrt(np.asarray(t.modal_mass()))
+                D2 = np.outer(d, d)
+                self.third[i] = (np.asarray(t.M0)[6:, 6:] * D2, np.asarray(t.M1)[6:, 6:] * D2[..., None],
+                                 np.asarray(t.M2)[6:, 6:] * D2[..., None, None])
 
     def watch_capsize(self, angles) -> None:
         """Check the frames' roll and pitch against these angles of vanishing stability (rad; None
@@ -127,6 +147,14 @@ class Watch:
                 self.crest[i] = max(self.crest[i], float(a.max()))
                 if np.isnan(self.t_crest[i]) and (a > STEEP_ON).any():
                     self.t_crest[i] = time[int(np.argmax(a > STEEP_ON))]
+                if i in self.third:
+                    M0, M1, M2 = self.third[i]
+                    lam = np.linalg.eigvalsh(M0 + np.einsum("abj,kj->kab", M1, di)
+                                             + np.einsum("abjl,kj,kl->kab", M2, di, di))
+                    mu = lam[:, 0] - DEFINITE_SOFT * np.log(np.exp(-(lam - lam[:, :1]) / DEFINITE_SOFT).sum(axis=1))
+                    self.margin[i] = min(self.margin[i], float(mu.min()))
+                    if np.isnan(self.t_margin[i]) and (mu < DEFINITE_ON).any():
+                        self.t_margin[i] = time[int(np.argmax(mu < DEFINITE_ON))]
         residual = np.asarray(residual, float)
         level = np.full(time.size, self.scene.simulation.tolerance)
         if field is not None and self.noise > 0:
@@ -137,10 +165,15 @@ class Watch:
             # a multimodal tank's own floor under high crests, as its Newton iterations take it
             # (liquid/multimodal/steep.roundoff_floor)
             raw = np.asarray(field, float).reshape(time.size, -1)
-            for off, _, Z, _, kN, om2 in self.tables:
+            for off, _, Z, w, kN, om2 in self.tables:
                 b = raw[:, off:off + Z.shape[1]]
-                level = np.maximum(level, np.finfo(float).eps * om2 * np.abs(b).max(axis=1)
-                                   * np.exp(2.0 * kN * (b @ Z.T).max(axis=1)))
+                k, o2 = np.full(time.size, kN), np.full(time.size, om2)
+                cut = self.cut.get(off)
+                if cut is not None:      # past STEEP_FULL its rows are the first STEEP_MODES modes'
+                    past = _crest_index(Z, w, kN, b) >= STEEP_FULL
+                    k, o2 = np.where(past, cut[0], k), np.where(past, cut[1], o2)
+                level = np.maximum(level, np.finfo(float).eps * o2 * np.abs(b).max(axis=1)
+                                   * np.exp(2.0 * k * (b @ Z.T).max(axis=1)))
         r = int(np.argmax(residual / level))
         if residual[r] / level[r] > self.residual / self.level:
             self.residual, self.t_residual, self.level = float(residual[r]), float(time[r]), float(level[r])
@@ -171,12 +204,19 @@ class Watch:
             if s > STEEP_SLOPE:
                 said.append(f"the free surface's slope reached {s:.3g} at t = {self.t_slope[i]:.4g} s, steeper than "
                             f"{STEEP_SLOPE:.3g} (the 120 degree crest where waves break)")
+            if not np.isnan(self.t_margin[i]):
+                said.append(f"from t = {self.t_margin[i]:.4g} s its third-order system's modal mass neared "
+                            f"singularity (its smallest eigenvalue over the modal masses down to {self.margin[i]:.3g}, "
+                            f"below {DEFINITE_ON:.3g}): its rows were blended into the exact integrals' where it did")
             if not np.isnan(self.t_crest[i]):
+                cut = i < len(self.tables) and self.tables[i][0] in self.cut
                 said.append(f"from t = {self.t_crest[i]:.4g} s its crests were higher than its modes resolve (crest "
                             f"index up to {self.crest[i]:.3g}, past {STEEP_ON:.3g}): the steep-wave damping of its "
-                            f"higher modes acted from then on, and the results are that model's "
+                            f"higher modes acted from then on"
+                            + (f", its modes above the {STEEP_MODES}th as damped linear oscillators" if cut else "")
+                            + ", and the results are that model's "
                             f"(docs/guide/nonlinear-sloshing.md, \"Past the method's range\")")
-            if said and np.isnan(self.t_crest[i]):
+            if said and np.isnan(self.t_crest[i]) and np.isnan(self.t_margin[i]):
                 out.append(f"tanks[{i}] ({t.name!r}): {said[0]}: the multimodal liquid is outside its validity")
             elif said:
                 out.append(f"tanks[{i}] ({t.name!r}): " + "; ".join(said))

@@ -51,7 +51,7 @@ from ...physics.kinematics import mv3, tv3
 from ...physics.about import About
 from ..base import AbstractLiquid
 from .modes import odd_powers
-from .steep import roundoff_floor, steep_damping
+from .steep import roundoff_floor, steep_rows
 from ...physics.terms import Kin, Rows
 
 #: quadrature points along the tank (Gauss-Legendre; at least, and 8 per mode: the integrands hold
@@ -429,10 +429,10 @@ class MultimodalLiquid(AbstractLiquid):
         Vb_dot = tv3(A, k.a6[:3]) - jnp.cross(omega, Vb)
         f, m, rd = jnp.zeros(3), jnp.zeros(3), []
         for t, be, bd, bdd in zip(self.tanks, self._split(k.c.d), self._split(k.d_dot), self._split(k.d_acc)):
-            ft, mt, rt = t.rows(Vb, omega, be, bd, Vb_dot, k.a6[3:6], bdd, k.g_b)
+            # past the method's range, what carries the tank on (multimodal_steep.py); within it, its rows
+            ft, mt, rt = steep_rows(t, Vb, omega, be, bd, Vb_dot, k.a6[3:6], bdd, k.g_b, self.gravity)
             f, m = f + ft, m + mt
-            # past the method's range, the steep waves' damping (zero within it: multimodal_steep.py)
-            rd.append(rt + steep_damping(t, be, bd, self.gravity))
+            rd.append(rt)
         return Rows(jnp.concatenate([mv3(A, f), m]), jnp.concatenate(rd))
 
     def kinetic(self, k: Kin):
