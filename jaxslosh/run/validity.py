@@ -215,7 +215,7 @@ class Watch:
                             f"higher modes acted from then on"
                             + (f", its modes above the {STEEP_MODES}th as damped linear oscillators" if cut else "")
                             + ", and the results are that model's "
-                            f"(docs/guide/nonlinear-sloshing.md, \"Past the method's range\")")
+                            "(docs/guide/nonlinear-sloshing.md, \"Past the method's range\")")
             if said and np.isnan(self.t_crest[i]) and np.isnan(self.t_margin[i]):
                 out.append(f"tanks[{i}] ({t.name!r}): {said[0]}: the multimodal liquid is outside its validity")
             elif said:
