@@ -9,7 +9,7 @@ import jax.numpy as jnp
 import numpy as np
 
 from ..physics.about import About
-from ..physics.bodies import BAND, FIXED, VESSEL, Bodies, Floating, Link
+from ..physics.bodies import BAND, Bodies, Floating, Link, body_rest, end_index
 from ..physics.kinematics import quat_from_rpy
 from ..physics.seakeeping import LinearDamping, WaveExcitation
 from ..physics.vessel import RESTORING_FORMS, AbstractRestoring, RigidBody
@@ -50,7 +50,7 @@ def build_bodies(scene, params: dict, g) -> Optional[Bodies]:
     waves = scene.waves
     floating = []
     for s, b in enumerate(scene.bodies):
-        rest = np.array([b.position[0], b.position[1], b.cog_height - cog])
+        rest = body_rest(b, cog)
         ini = b.initial
         roll, pitch, yaw = ini.roll_pitch_yaw
         floating.append(Floating(
@@ -61,7 +61,7 @@ def build_bodies(scene, params: dict, g) -> Optional[Bodies]:
             rest=jnp.asarray(rest), x0=jnp.asarray(rest + np.asarray(ini.position)),
             q0=quat_from_rpy(jnp.array([roll, pitch, yaw + b.heading])),
             v0=jnp.asarray(np.concatenate([ini.velocity, ini.angular_velocity]), dtype=float)))
-    index = {b.name: s for s, b in enumerate(scene.bodies)} | {"vessel": VESSEL, "fixed": FIXED}
+    index = end_index(b.name for b in scene.bodies)
     links = []
     for c in scene.connections:
         key = f"connections.{c.name}"

@@ -139,6 +139,11 @@ def mooring(scene: Scene, offsets: Optional[Sequence[float]] = None, direction: 
     """
     if not scene.mooring:
         raise SceneError("mooring", "the scene has no [[mooring]] lines")
+    for i, line in enumerate(scene.mooring):
+        if line.body not in ("vessel", scene.vessel.name):
+            raise SceneError(f"mooring[{i}].body", f"{line.body!r}: the static analysis (js.mooring, `jaxslosh "
+                                                   "mooring`) takes the vessel's lines only; this line holds a body of "
+                                                   "[[bodies]] (run the scene to see it moored)")
     scene = quasi_static_lines(scene)        # lumped lines at rest: their catenary
     if offsets is None:
         offsets = np.linspace(0.0, 0.1 * scene.environment.depth, 11)

@@ -7,6 +7,12 @@ the scene. The line's force is a function of the fairlead's position only (quasi
 term's rows are too: Newton's tangent, HHT, `rao` and `modes --coupled` take the lines' stiffness
 from JAX's derivative of these rows, which runs through the catenary's implicit-function
 derivative, not its iterations.
+
+A line may hold a body of `[[bodies]]` instead of the vessel (its `ends` entry: the body's slot, as
+a connection's ends, physics/bodies.py): its fairlead is then in that body's frame, from its COG,
+and its force and moment go to that body's rows (`Rows.frames`). A body's hydrostatics are linear
+springs about its rest pose, so its buoyancy carries its lines' vertical pull at rest
+(`carried_bodies`), as the vessel's does with linear hydrostatics.
 """
 from __future__ import annotations
 
@@ -18,8 +24,9 @@ import jax.numpy as jnp
 import numpy as np
 
 from ..physics.about import About
-from ..physics.kinematics import rotation_matrix
-from ..physics.terms import AbstractTerm, Kin, Rows
+from ..physics.bodies import VESSEL, body_rest, end_index
+from ..physics.kinematics import quat_from_rpy, rotation_matrix
+from ..physics.terms import AbstractTerm, Config, Kin, Rows
 from .catenary import lines_inverse, profile, solve_lines
 
 #: m^2: keeps the horizontal direction defined (and differentiable) with the fairlead right above its anchor
@@ -50,7 +57,7 @@ class MooringLines(AbstractTerm):
     lines': with linear hydrostatics (springs about the rest position) the buoyancy carries the
     lines' vertical pull at rest, as the displacement of a moored platform does, so the rest position
     stays the equilibrium in heave (docs/guide/moorings.md); zero with the hull's own hydrostatics."""
-    fairlead: jax.Array       # (n, 3) body frame, from the COG
+    fairlead: jax.Array       # (n, 3) its body's frame, from its COG
     anchor: jax.Array         # (n, 3) COG-at-rest frame
     length: jax.Array         # (n,)
     weight: jax.Array
@@ -60,10 +67,31 @@ class MooringLines(AbstractTerm):
     carried: jax.Array        # (3,)
     names: tuple = eqx.field(static=True, default=())
     about: About = eqx.field(static=True, default=About())
+    ends: tuple = eqx.field(static=True, default=())   # per line: VESSEL or a body's slot; () all on the vessel
+    n_bodies: int = eqx.field(static=True, default=0)  # the scene's bodies (those without lines included)
+    carried_bodies: Optional[jax.Array] = None   # (S, 3) on the bodies, as `carried` on the vessel
+    rest_X: Optional[jax.Array] = None           # (n, 3) each line's body's COG at rest (lines on bodies only)
+    rest_A: Optional[jax.Array] = None           # (n, 3, 3) its attitude at rest
+
+    @property
+    def on_bodies(self) -> bool:
+        """Whether some line holds a body of [[bodies]] (then the poses are per line)."""
+        return any(e != VESSEL for e in self.ends)
+
+    def frames(self, c: Config, A):
+        """(X (n, 3), A (n, 3, 3)): each line's body's COG and attitude at configuration c (A the
+        vessel's); the bodies at rest where c has none."""
+        if c.Xs is None:
+            vessel = np.array([e == VESSEL for e in self.ends])
+            return jnp.where(vessel[:, None], c.X0, self.rest_X), jnp.where(vessel[:, None, None], A, self.rest_A)
+        idx = np.array([0 if e == VESSEL else 1 + e for e in self.ends])
+        As = jax.vmap(rotation_matrix)(c.qs)
+        return jnp.concatenate([c.X0[None], c.Xs])[idx], jnp.concatenate([A[None], As])[idx]
 
     def spans(self, X0, A):
-        """(the fairleads (n, 3), their offsets from the anchors (n, 3), XF (n,), ZF (n,))."""
-        p = X0[None, :] + self.fairlead @ A.T
+        """(the fairleads (n, 3), their offsets from the anchors (n, 3), XF (n,), ZF (n,)); X0 (3,)
+        and A (3, 3) the vessel's pose, or (n, 3) and (n, 3, 3) each line's body's (`frames`)."""
+        p = X0 + (jnp.einsum("nij,nj->ni", A, self.fairlead) if A.ndim == 3 else self.fairlead @ A.T)
         d = p - self.anchor
         return p, d, jnp.sqrt(d[:, 0] ** 2 + d[:, 1] ** 2 + _XF_EPS2), d[:, 2]
 
@@ -86,8 +114,18 @@ class MooringLines(AbstractTerm):
     def force_moment(self, X0, A, guess=None, inverse=None):
         """The lines' total force and moment about the COG, both inertial (the carried force left out)."""
         s = self.state(X0, A, guess, inverse)
-        arm = s.fairlead - X0[None, :]
+        arm = s.fairlead - X0
         return s.force.sum(axis=0), jnp.cross(arm, s.force).sum(axis=0)
+
+    def frame_rows(self, X, A, guess=None, inverse=None):
+        """(S + 1, 6) the lines' generalized forces (force inertial, moment in the body's frame) on
+        the vessel (first) and on each body, carried forces included; X, A per line (`frames`)."""
+        s = self.state(X, A, guess, inverse)
+        moment = jnp.einsum("nji,nj->ni", A, jnp.cross(s.fairlead - X, s.force))
+        slot = np.array([0 if e == VESSEL else 1 + e for e in self.ends])
+        per = jax.ops.segment_sum(jnp.concatenate([s.force, moment], axis=1), slot, num_segments=self.n_bodies + 1)
+        carried = jnp.concatenate([self.carried[None], self.carried_bodies])
+        return per.at[:, :3].add(carried)
 
     # ------------------------------------------------------------ integrator states: a warm start
     # Every residual evaluation of a step solves every line. Started cold (the inextensible estimate,
@@ -105,15 +143,21 @@ class MooringLines(AbstractTerm):
         return jax.lax.stop_gradient(jnp.concatenate([x, inv.reshape(-1, 4)], axis=1).reshape(-1))
 
     def state_init(self):
+        if self.on_bodies:
+            return self._settled(self.rest_X, self.rest_A)
         return self._settled(jnp.zeros(3), jnp.eye(3))
 
     def state_settle(self, z, c):
         z = z.reshape(-1, 6)
-        return self._settled(c.X0, rotation_matrix(c.q), z[:, :2], z[:, 2:].reshape(-1, 2, 2))
+        X, A = self.frames(c, rotation_matrix(c.q)) if self.on_bodies else (c.X0, rotation_matrix(c.q))
+        return self._settled(X, A, z[:, :2], z[:, 2:].reshape(-1, 2, 2))
 
     def rows(self, k: Kin) -> Rows:
         z = k.z.reshape(-1, 6)
         guess, inverse = (z[:, :2], z[:, 2:].reshape(-1, 2, 2)) if k.z.shape[0] else (None, None)
+        if self.on_bodies:
+            per = self.frame_rows(*self.frames(k.c, k.A), guess, inverse)
+            return Rows(-per[0], frames=-per[1:].reshape(-1))
         F, M = self.force_moment(k.c.X0, k.A, guess, inverse)
         return Rows(-jnp.concatenate([F + self.carried, k.A.T @ M]))
 
@@ -135,11 +179,29 @@ def build_mooring(scene, balanced: bool, outline: bool = False, params: Optional
     about = About(("mooring", f"{len(lines)} quasi-static elastic catenary line(s) "
                               f"{', '.join(repr(m.name) for m in lines)}, depth {scene.environment.depth:g} m"
                               + carried_words))
+    index = end_index(b.name for b in scene.bodies) | {scene.vessel.name: VESSEL}
+    ends = tuple(index[m.body] for m in lines)
+    on_bodies = any(e != VESSEL for e in ends)
+    held = {}
+    if on_bodies:
+        slot = np.array([0 if e == VESSEL else 1 + e for e in ends])
+        rest = np.concatenate([np.zeros((1, 3))] + [body_rest(b, cog)[None] for b in scene.bodies])
+        turn = jnp.stack([jnp.eye(3)] + [rotation_matrix(quat_from_rpy(jnp.array([0.0, 0.0, b.heading])))
+                                          for b in scene.bodies])
+        held = dict(ends=ends, n_bodies=len(scene.bodies), carried_bodies=jnp.zeros((len(scene.bodies), 3)),
+                    rest_X=jnp.asarray(rest[slot]), rest_A=turn[slot])
     term = MooringLines(fairlead=jnp.asarray([m.fairlead for m in lines], dtype=float), anchor=jnp.asarray(anchor),
                         length=col("length"), weight=col("weight"), ea=col("ea"), friction=col("seabed_friction"),
                         anchor_height=col("anchor_height"), carried=jnp.zeros(3), names=tuple(m.name for m in lines),
-                        about=about)
-    if balanced and not outline:
+                        about=about, **held)
+    if outline:
+        return term
+    if on_bodies:       # a body's hydrostatics are always linear springs about its rest pose
+        per = term.frame_rows(term.rest_X, term.rest_A)
+        up = jnp.zeros_like(per[:, :3]).at[:, 2].set(-per[:, 2])
+        term = eqx.tree_at(lambda t: (t.carried, t.carried_bodies), term,
+                           (up[0] if balanced else jnp.zeros(3), up[1:]))
+    elif balanced:
         F, _ = term.force_moment(jnp.zeros(3), jnp.eye(3))
         term = eqx.tree_at(lambda t: t.carried, term, jnp.array([0.0, 0.0, -F[2]]))
     return term
@@ -151,25 +213,30 @@ def mooring_term(system) -> Optional[MooringLines]:
 
 
 @eqx.filter_jit
-def _tensions(term: MooringLines, X0, q):
-    def one(x, qq):
-        s = term.state(x, rotation_matrix(qq))
+def _tensions(term: MooringLines, X0, q, Xs=None, qs=None):
+    def one(x, qq, xs=None, qss=None):
+        A = rotation_matrix(qq)
+        pose = term.frames(Config(x, qq, jnp.zeros(0), xs, qss), A) if term.on_bodies else (x, A)
+        s = term.state(*pose)
         return s.fairlead_tension, s.anchor_tension
-    return jax.vmap(one)(X0, q)
+    return jax.vmap(one)(X0, q) if Xs is None else jax.vmap(one)(X0, q, Xs, qs)
 
 
-def mooring_datasets(system, X0, q) -> dict:
+def mooring_datasets(system, X0, q, Xs=None, qs=None) -> dict:
     """The result file's `/mooring/<line>/fairlead_tension` and `/anchor_tension` (N) of frames
-    whose vessel positions X0 (..., 3) and attitudes q (..., 4) are given (the lines are
-    quasi-static: their tensions are functions of the pose)."""
+    whose vessel positions X0 (..., 3) and attitudes q (..., 4) are given, and the bodies' Xs
+    (..., S, 3) and qs (..., S, 4) where lines hold bodies (the lines are quasi-static: their
+    tensions are functions of the poses)."""
     term = mooring_term(system)
-    return {} if term is None else line_datasets(term, X0, q)
+    return {} if term is None else line_datasets(term, X0, q, Xs, qs)
 
 
-def line_datasets(term: MooringLines, X0, q) -> dict:
+def line_datasets(term: MooringLines, X0, q, Xs=None, qs=None) -> dict:
     """mooring_datasets of one term."""
     lead = X0.shape[:-1]
-    tf, ta = _tensions(term, jnp.reshape(X0, (-1, 3)), jnp.reshape(q, (-1, 4)))
+    bodies = () if Xs is None or not term.on_bodies else (jnp.reshape(Xs, (-1, *Xs.shape[-2:])),
+                                                          jnp.reshape(qs, (-1, *qs.shape[-2:])))
+    tf, ta = _tensions(term, jnp.reshape(X0, (-1, 3)), jnp.reshape(q, (-1, 4)), *bodies)
     d = {}
     for i, name in enumerate(term.names):
         d[f"mooring/{name}/fairlead_tension"] = jnp.reshape(tf[:, i], lead)

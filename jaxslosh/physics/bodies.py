@@ -37,6 +37,7 @@ from typing import Optional
 import equinox as eqx
 import jax
 import jax.numpy as jnp
+import numpy as np
 
 from .about import About
 from .kinematics import quat_exp, quat_multiply, rotation_matrix
@@ -49,6 +50,17 @@ BAND = 1e-3
 #: the end index of the vessel and of a fixed (inertial) point in `Link.ends`
 VESSEL, FIXED = -1, -2
 _D_EPS2 = 1e-24      # m^2: keeps the direction defined (and differentiable) where the points meet
+
+
+def end_index(names) -> dict:
+    """{scene name: end index} of the ends a connection or a mooring line may name: the bodies
+    (`names`, their order in [[bodies]]), "vessel" and "fixed"."""
+    return {n: s for s, n in enumerate(names)} | {"vessel": VESSEL, "fixed": FIXED}
+
+
+def body_rest(b, vessel_cog: float) -> np.ndarray:
+    """(3,) a scene body's COG at rest in the vessel-at-rest frame (`vessel_cog`: the vessel's COG height)."""
+    return np.array([b.position[0], b.position[1], b.cog_height - vessel_cog], dtype=float)
 
 
 def ramp(x, band=BAND):

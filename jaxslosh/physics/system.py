@@ -126,13 +126,15 @@ class System(eqx.Module):
         vessel's)."""
         nf = self.nf
         if core:
-            ry, rz = self.terms_rows(c, vy[:3], vy[3:6], vz[:nf], ay[:6], az[:nf], t, z)
+            ry, rz, frames = self.terms_rows(c, vy[:3], vy[3:6], vz[:nf], ay[:6], az[:nf], t, z)
         else:
-            ry, rz = jnp.zeros(6), jnp.zeros(nf)
+            ry, rz, frames = jnp.zeros(6), jnp.zeros(nf), None
         states = self.states_init() if z is None else z
         for o in self.owners():
             own = next(zi for term, zi in zip(self.all_terms(), states) if term is o)
             ry, rz = o.add_rows(self, c, ry, rz, vy, vz, ay, az, t, own)
+        if frames is not None:       # a term's rows on the bodies' frames (their owner has put them after the vessel's)
+            ry = ry.at[6:6 + frames.shape[0]].add(frames)
         return self.hold(ry, ay[:6], t), rz
 
     def constraint(self, c: Config, alg):
@@ -242,20 +244,23 @@ class System(eqx.Module):
         transpose of the liquid's rigid rows alone, where through one stacked vector every term's
         rows would be linearised and transposed with zero tangents. The vessel's rows are those of
         a prescribed motion where the System has one (`hold`)."""
-        rigid, d = self.terms_rows(c, V0, omega, d_dot, a6, d_acc, t, z)
+        rigid, d, _ = self.terms_rows(c, V0, omega, d_dot, a6, d_acc, t, z)
         return self.hold(rigid, a6, t), d
 
     def terms_rows(self, c: Config, V0, omega, d_dot, a6, d_acc, t=0.0, z=None):
-        """`residual_parts` before `hold`: the sum of the terms' rows."""
+        """`residual_parts` before `hold`: the sum of the terms' rows (vessel, deformable, the bodies'
+        frames: None where no term has rows there)."""
         k = self.kin(c, V0, omega, d_dot, a6, d_acc, t)
-        rigid, d = None, None
+        rigid, d, frames = None, None, None
         for term, zi in zip(self.all_terms(), self.states_init() if z is None else z, strict=True):
             with jax.named_scope(type(term).__name__):
                 r = term.rows(k._replace(z=zi))
             rigid = r.rigid if rigid is None else rigid + r.rigid
             if r.d is not None:
                 d = r.d if d is None else d + r.d
-        return rigid, d
+            if r.frames is not None:
+                frames = r.frames if frames is None else frames + r.frames
+        return rigid, d, frames
 
     # ---------------------------------------------------------------- energies
     def kinetic_energy(self, c: Config, v):

@@ -97,6 +97,7 @@ class Unknowns(NamedTuple):
 class Rows(NamedTuple):
     rigid: jax.Array                 # (6,)
     d: Optional[jax.Array] = None    # (nf,) the deformable block's rows (its owner only)
+    frames: Optional[jax.Array] = None   # (6 S,) rows on the bodies' floating frames (mooring lines on bodies)
 
 
 class AbstractTerm(eqx.Module):

@@ -255,9 +255,11 @@ def frame_datasets(b: Built, fr: Frame, p0=None, fields: bool = True) -> dict:
     for i, name in enumerate(b.probes.names):
         d[f"probes/{name}/position"] = P[..., i, :]
         d[f"probes/{name}/displacement"] = P[..., i, :] - p0[..., i, :]
-    d.update(mooring_datasets(b.system, fr.X0, fr.q))        # quasi-static lines: from the pose
-    d.update(fr.lines)                                       # lumped lines: from their states
     term = bodies_term(b.system)
+    poses = () if term is None or not term.S else (      # the bodies' poses, for lines that hold them
+        fr.bodies[..., :3] + jnp.stack([body.rest for body in term.bodies]), fr.bodies[..., 3:7])
+    d.update(mooring_datasets(b.system, fr.X0, fr.q, *poses))        # quasi-static lines: from the poses
+    d.update(fr.lines)                                       # lumped lines: from their states
     if term is not None:
         for i, name in enumerate(term.names):
             B = fr.bodies[..., i, :]

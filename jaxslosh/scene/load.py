@@ -126,8 +126,9 @@ def parse_scene(mapping: Mapping[str, Any], text: str = "", path: str = "") -> S
     connections = read_connections(mapping.get("connections", []), vessel.name, bodies)
     bodies_scene(bodies, vessel, structures, mapping, warnings, files)
     mooring = read_mooring(mapping.get("mooring", []), environment.depth, vessel.name, vessel.cog_height, warnings,
-                           tuple(b.name for b in bodies))
-    _mass_balance(vessel, tanks, environment, warnings, structures, mooring)
+                           tuple(bodies))
+    _mass_balance(vessel, tanks, environment, warnings, structures,     # the vessel's own lines
+                  tuple(m for m in mooring if m.body in ("vessel", vessel.name)))
     effects = Effects(**read(mapping.get("effects", {}), "effects", {k: ("bool", None) for k in EFFECTS}))
     waves = None
     if "waves" in mapping:   # incident waves (waves.py)

@@ -1,4 +1,5 @@
-"""The `[[mooring]]` tables: lines from the seabed to a body (docs/guide/moorings.md).
+"""The `[[mooring]]` tables: lines from the seabed to the vessel or a body of `[[bodies]]`
+(docs/guide/moorings.md).
 
 Read and checked here, with the `[environment] depth` they need and the vessel's `name` and
 `cog_height` (the COG's height above the still-water level, which places the fairleads). No JAX:
@@ -20,7 +21,8 @@ SEABED_TOLERANCE = 1e-6
 def read_mooring(tables, depth, vessel_name: str, cog_z: float, warnings: list[str],
                  bodies: tuple = ()) -> tuple[MooringLine, ...]:
     """The lines of a scene; `depth` is `[environment] depth` (None when absent), `cog_z` the
-    vessel's COG height above the still-water level."""
+    vessel's COG height above the still-water level, `bodies` the scene's [[bodies]] (scene.types.Body)."""
+    held = {b.name: b for b in bodies}
     lines = []
     for i, table in enumerate(tables):
         where = f"mooring[{i}]"
@@ -39,12 +41,14 @@ def read_mooring(tables, depth, vessel_name: str, cog_z: float, warnings: list[s
             raise SceneError("environment.depth", f"is required by the mooring lines ({where}): the water depth "
                                                   "in m, which places the seabed")
         body = v.get("body", "vessel")
-        if body in bodies:
-            raise SceneError(f"{where}.body", f"{show(body)}: mooring lines on [[bodies]] are not available yet; "
-                                              "moor the vessel, or tie the body with [[connections]]")
-        if body not in ("vessel", vessel_name):
+        if body in held and lumped:
+            raise SceneError(f"{where}.body", f"{show(body)}: lumped-mass lines (line {show(v.get('name', f'line{i + 1}'))}, "
+                                              "model = \"lumped\") hold the vessel only; a body of [[bodies]] "
+                                              "takes catenary lines (the default model)")
+        if body not in ("vessel", vessel_name, *held):
             raise SceneError(f"{where}.body", f"{show(body)} is not a body of the scene (the vessel is "
-                                              f"{show(vessel_name)}; \"vessel\" names it too)")
+                                              f"{show(vessel_name)}; \"vessel\" names it too"
+                                              + (f"; the [[bodies]] are {', '.join(map(show, held))})" if held else ")"))
         ax, ay, az = v["anchor"]
         if az < -depth - SEABED_TOLERANCE:
             raise SceneError(f"{where}.anchor", f"z = {show(az)} m is below the seabed at -{show(depth)} m "
@@ -53,7 +57,13 @@ def read_mooring(tables, depth, vessel_name: str, cog_z: float, warnings: list[s
             raise SceneError(f"{where}.anchor", f"z = {show(az)} m is above the still-water level; anchors lie on "
                                                 f"or above the seabed at -{show(depth)} m, under water")
         fx, fy, fz = v["fairlead"]
-        span = math.dist((fx, fy, fz + cog_z), (ax, ay, az))
+        if body in held:      # the fairlead in the body's frame: its place at rest (the body's position and heading)
+            b = held[body]
+            c, s = math.cos(b.heading), math.sin(b.heading)
+            rest = (b.position[0] + c * fx - s * fy, b.position[1] + s * fx + c * fy, fz + b.cog_height)
+        else:
+            rest = (fx, fy, fz + cog_z)
+        span = math.dist(rest, (ax, ay, az))
         if v["weight"] == 0 and span <= v["length"]:
             raise SceneError(f"{where}.weight", f"0 N/m with a slack line (the anchor is {span:.6g} m from the "
                                                 f"fairlead at rest, the line {show(v['length'])} m long): a "

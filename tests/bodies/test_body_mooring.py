@@ -1,0 +1,98 @@
+"""Mooring lines on a body of [[bodies]] (docs/guide/moorings.md, docs/guide/bodies-and-connections.md):
+the same hull on the same three catenary lines moves the same as the vessel and as a body, its
+lines' tensions the same in the result; bad input exits 2 naming its key."""
+import math
+
+import numpy as np
+import pytest
+
+import jaxslosh as js
+from jaxslosh.scene.types import SceneError
+
+HULL = """
+mass = 4.0e5
+inertia = [5.0e6, 1.5e7, 1.7e7]
+{extra}
+[{table}.hydrostatics]
+waterplane_area = 200.0
+displaced_volume = 390.0
+gm_t = 1.5
+gm_l = 15.0
+[{table}.initial]
+position = {position}
+angular_velocity = {omega}
+"""
+HEAD = """
+title = "moored hull"
+[environment]
+gravity = 9.81
+water_density = 1025.0
+depth = 100.0
+[simulation]
+duration = 1.5
+dt = 0.05
+scheme = "newmark"
+"""
+OFFSET, SPIN = [3.0, -1.0, 0.2], [0.004, -0.003, 0.01]
+BODY_AT = (40.0, 2000.0)       # the body's rest position: the vessel is far away
+
+
+def _lines(body: str, at=(0.0, 0.0), model: str = "") -> str:
+    """Three catenary lines 120 degrees apart, their anchors 400 m from the hull at rest; fairleads 5 m below
+    and 6 m out from the COG, in the hull's frame."""
+    out = ""
+    for i in range(3):
+        a = 2 * math.pi * i / 3 + 0.3
+        c, s = math.cos(a), math.sin(a)
+        out += f"""
+[[mooring]]
+name = "l{i + 1}"
+body = "{body}"
+fairlead = [{6 * c!r}, {6 * s!r}, -5.0]
+anchor = [{at[0] + 400 * c!r}, {at[1] + 400 * s!r}, -100.0]
+length = 420.0
+weight = 1200.0
+ea = 5.0e8
+{model}"""
+    return out
+
+
+def _vessel_moored() -> str:
+    return HEAD + "[vessel]\n" + HULL.format(table="vessel", extra="", position=OFFSET, omega=SPIN) + _lines("vessel")
+
+
+def _body_moored(model: str = "") -> str:
+    return (HEAD + "[vessel]\n" + HULL.format(table="vessel", extra="", position=[0, 0, 0], omega=[0, 0, 0])
+            + "[[bodies]]\nname = \"buoy\"\n"
+            + HULL.format(table="bodies", extra=f"position = {list(BODY_AT)}", position=OFFSET, omega=SPIN)
+            + _lines("buoy", BODY_AT, model))
+
+
+def test_a_moored_body_moves_as_the_same_moored_vessel():
+    """Released from the same offset and rate, the body on its lines follows the vessel on the same
+    lines to 1e-8 (the lines' forces and moments on the body's rows, in its frame), and its lines'
+    tensions in the result equal the vessel's lines'; the free vessel beside it stays at rest."""
+    ref = js.simulate(js.load_scene(_vessel_moored()))
+    r = js.simulate(js.load_scene(_body_moored()))
+    b = r.bodies["buoy"]
+    X, q = np.asarray(ref.vessel.position), np.asarray(ref.vessel.quaternion)
+    assert np.ptp(X[:, 0]) > 1e-3 and np.ptp(np.asarray(ref.vessel.roll_pitch_yaw)[:, 2]) > 1e-3   # it moves
+    np.testing.assert_allclose(np.asarray(b.position), X, rtol=0, atol=1e-8)
+    np.testing.assert_allclose(np.asarray(b.quaternion), q, rtol=0, atol=1e-8)
+    np.testing.assert_allclose(np.asarray(r.vessel.position), 0.0, atol=1e-12)
+    for name in ("l1", "l2", "l3"):
+        for what in ("fairlead_tension", "anchor_tension"):
+            want = np.asarray(getattr(ref.mooring[name], what))
+            assert want.min() > 1e4
+            np.testing.assert_allclose(np.asarray(getattr(r.mooring[name], what)), want, rtol=1e-8)
+
+
+def test_lines_on_bodies_are_refused_where_not_available():
+    """A lumped line on a body, a line on a body that does not exist, and js.mooring on a scene whose
+    lines hold a body: refused naming the key."""
+    with pytest.raises(SceneError, match=r"mooring\[0\]\.body.*lumped"):
+        js.load_scene(_body_moored('model = "lumped"\nsegments = 4\n'))
+    with pytest.raises(SceneError, match=r"mooring\[0\]\.body.*not a body.*buoy"):
+        js.load_scene(_body_moored().replace('body = "buoy"', 'body = "boy"', 1))
+    with pytest.raises(SceneError, match=r"mooring\[0\]\.body.*vessel's lines only"):
+        js.mooring(js.load_scene(_body_moored()))
