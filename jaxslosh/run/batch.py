@@ -13,6 +13,7 @@ from jax.sharding import Mesh, NamedSharding, PartitionSpec
 
 from ..io.result import Result, result_from
 from ..mooring.term import build_mooring, line_datasets
+from ..physics.bodies import body_rest
 from ..physics.hull import HullPressure
 from ..physics.seakeeping import Excitation, WaveExcitation
 from ..scene.keys import check_values, resolve_params, with_overrides
@@ -235,7 +236,11 @@ def _batch_lines(scene: Scene, res: Result, fr, params: dict) -> Result:
     runs = [resolve_params(scene, {k: np.asarray(v)[i] for k, v in params.items()}) for i in range(len(res.time))]
     if not res.mooring or not any(k.startswith("mooring.") for k in runs[0]):
         return res
-    per_run = [line_datasets(build_mooring(scene, False, True, run), fr.X0[i], fr.q[i]) for i, run in enumerate(runs)]
+    rest = jnp.asarray(np.array([body_rest(b, scene.vessel.cog_height) for b in scene.bodies]).reshape(-1, 3))
+    poses = (lambda i: ()) if not scene.bodies else (      # the bodies' poses, for lines that hold them
+        lambda i: (fr.bodies[i][..., :3] + rest, fr.bodies[i][..., 3:7]))
+    per_run = [line_datasets(build_mooring(scene, False, True, run), fr.X0[i], fr.q[i], *poses(i))
+               for i, run in enumerate(runs)]
     d = {k: jnp.stack([p[k] for p in per_run]) for k in per_run[0]}
     lines = {n: type(m)(d[f"mooring/{n}/fairlead_tension"], d[f"mooring/{n}/anchor_tension"])
              for n, m in res.mooring.items()}

@@ -36,7 +36,7 @@ TABLES = (
     ("probes", "Zero or more `[[probes]]`: material points recorded in the result."),
     ("effects", "Switches to leave an effect out (to measure what it contributes); all on by default."),
     ("waves", "Incident linear (Airy) waves."),
-    ("mooring", "Zero or more `[[mooring]]` lines from the seabed to the vessel (guide: Moorings)."),
+    ("mooring", "Zero or more `[[mooring]]` lines from the seabed to the vessel or a body (guide: Moorings)."),
     ("bodies", "Zero or more `[[bodies]]`: rigid floating bodies beside the vessel, each in its own frame "
                "(guide: Bodies and connections)."),
     ("bodies.hydrostatics", "The body's linear restoring about its rest pose, as `[vessel.hydrostatics]`."),
@@ -259,7 +259,8 @@ KEYS = (
     ("waves.directions", "15", "", "Headings of a spread sea (odd: one on the mean heading)."),
     # mooring
     ("mooring.name", '"line<i>"', "", "The line's name (result datasets `/mooring/<name>/...`)."),
-    ("mooring.body", '"vessel"', "", 'The body the fairlead is on: "vessel" or the vessel\'s `name`.'),
+    ("mooring.body", '"vessel"', "", 'The body the fairlead is on: "vessel", the vessel\'s `name`, or a body of '
+                                     '`[[bodies]]` (catenary lines only; guide: Moorings, Lines on a body).'),
     ("mooring.fairlead", _REQ, "m", "The fairlead in the body's frame, from its COG."),
     ("mooring.anchor", _REQ, "m", "The anchor: x, y inertial from the vessel's COG at rest, z from the still-water "
                                   "level (on the seabed at z = -depth, or above it)."),
