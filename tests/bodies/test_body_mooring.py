@@ -3,10 +3,14 @@ the same hull on the same three catenary lines moves the same as the vessel and 
 lines' tensions the same in the result; bad input exits 2 naming its key."""
 import math
 
+import jax.numpy as jnp
 import numpy as np
 import pytest
 
 import jaxslosh as js
+from jaxslosh.assemble.system import build
+from jaxslosh.mooring.term import mooring_term
+from jaxslosh.physics.kinematics import rotation_matrix
 from jaxslosh.scene.types import SceneError
 
 HULL = """
@@ -96,3 +100,30 @@ def test_lines_on_bodies_are_refused_where_not_available():
         js.load_scene(_body_moored().replace('body = "buoy"', 'body = "boy"', 1))
     with pytest.raises(SceneError, match=r"mooring\[0\]\.body.*vessel's lines only"):
         js.mooring(js.load_scene(_body_moored()))
+
+
+def test_a_turned_bodys_lines_act_in_its_own_frame():
+    """A body turned by a heading h, its fairleads given in its own frame (the vessel's turned by -h):
+    at a pose that places the fairleads where the vessel's are, the lines' force is the vessel's and
+    their moment the vessel's turned by -h into the body's axes."""
+    h = 0.7
+    c, s = math.cos(h), math.sin(h)
+    Rz = np.array([[c, -s, 0.0], [s, c, 0.0], [0.0, 0.0, 1.0]])
+    text = _body_moored().replace(f"position = {list(BODY_AT)}", f"position = {list(BODY_AT)}\nheading = {h!r}")
+    for i in range(3):          # each fairlead [6 cos a, 6 sin a, -5] as the body's frame sees it
+        a = 2 * math.pi * i / 3 + 0.3
+        r_b = Rz.T @ np.array([6 * math.cos(a), 6 * math.sin(a), -5.0])
+        text = text.replace(f"fairlead = [{6 * math.cos(a)!r}, {6 * math.sin(a)!r}, -5.0]",
+                            f"fairlead = {[float(x) for x in r_b]}")
+    ves = mooring_term(build(js.load_scene(_vessel_moored())).system)
+    bod = mooring_term(build(js.load_scene(text)).system)
+    A_v = np.asarray(rotation_matrix(jnp.array([0.99, 0.05, -0.03, 0.1]) / np.linalg.norm([0.99, 0.05, -0.03, 0.1])))
+    dx = np.array([2.0, -1.5, 0.3])
+    F, M = ves.force_moment(jnp.asarray(dx), jnp.asarray(A_v))
+    ref = np.concatenate([np.asarray(F + ves.carried), A_v.T @ np.asarray(M)])
+    X_b = np.array([BODY_AT[0], BODY_AT[1], 0.0]) + dx
+    got = np.asarray(bod.frame_rows(jnp.broadcast_to(X_b, (3, 3)), jnp.broadcast_to(A_v @ Rz, (3, 3, 3))))[1]
+    assert np.linalg.norm(ref[:3]) > 5e4 and np.linalg.norm(ref[3:]) > 5e4      # the lines pull and turn
+    np.testing.assert_allclose(got[:3], ref[:3], rtol=1e-10, atol=1e-6)
+    np.testing.assert_allclose(got[3:], Rz.T @ ref[3:], rtol=1e-10, atol=1e-5)
+    assert np.asarray(bod.carried) == pytest.approx(0.0)     # the free vessel has no lines to carry
