@@ -8,6 +8,7 @@ import numpy as np
 import pytest
 
 import jaxslosh as js
+from jaxslosh.analysis.linear import linearise
 from jaxslosh.assemble.system import build
 from jaxslosh.mooring.term import mooring_term
 from jaxslosh.physics.kinematics import rotation_matrix
@@ -127,3 +128,13 @@ def test_a_turned_bodys_lines_act_in_its_own_frame():
     np.testing.assert_allclose(got[:3], ref[:3], rtol=1e-10, atol=1e-6)
     np.testing.assert_allclose(got[3:], Rz.T @ ref[3:], rtol=1e-10, atol=1e-5)
     assert np.asarray(bod.carried) == pytest.approx(0.0)     # the free vessel has no lines to carry
+
+
+@pytest.mark.slow      # two linearisations (rao, modes --coupled): about 40 s on a loaded 2-core machine
+def test_the_linearised_stiffness_of_a_moored_body_is_the_moored_vessels():
+    """The linearisation that `rao` and `modes --coupled` use takes the lines' stiffness on a body's
+    rows as on the vessel's: the body's 6 x 6 block equals the moored vessel's."""
+    a = linearise(js.load_scene(_vessel_moored()))
+    b = linearise(js.load_scene(_body_moored()))
+    assert b.labels[6:12] == ("buoy surge", "buoy sway", "buoy heave", "buoy roll", "buoy pitch", "buoy yaw")
+    np.testing.assert_allclose(b.K[6:12, 6:12], a.K[:6, :6], rtol=0, atol=1e-9 * np.abs(a.K[:6, :6]).max())
