@@ -73,6 +73,7 @@ def _body_moored(model: str = "") -> str:
             + _lines("buoy", BODY_AT, model))
 
 
+@pytest.mark.slow      # two moored runs compiled (about a minute); test_a_turned_bodys_lines_act_in_its_own_frame is the fast check of the same rows
 def test_a_moored_body_moves_as_the_same_moored_vessel():
     """Released from the same offset and rate, the body on its lines follows the vessel on the same
     lines to 1e-8 (the lines' forces and moments on the body's rows, in its frame), and its lines'

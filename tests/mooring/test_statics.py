@@ -177,6 +177,7 @@ def test_vessel_name_and_taut_line_warning():
     assert not any("mooring[1]" in w for w in scene.warnings)
 
 
+@pytest.mark.slow      # the command in process (about a minute on 2 cores); the OC3 tests check js.mooring, which it prints
 def test_mooring_command_json_and_figure(tmp_path, capsys):
     import json
     path = tmp_path / "moored.toml"

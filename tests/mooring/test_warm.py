@@ -3,6 +3,7 @@ the same solution and derivatives as the cold solve, from near and far guesses, 
 import jax
 import jax.numpy as jnp
 import numpy as np
+import pytest
 
 import jaxslosh as js
 from jaxslosh.mooring.catenary import lines_inverse, solve_lines
@@ -29,6 +30,7 @@ def _close(a, b, rel):
     assert np.all(np.abs(a - b) <= rel * np.abs(b).max(axis=0)), np.abs(a - b) / np.abs(b).max(axis=0)
 
 
+@pytest.mark.slow      # six branches from many guesses: minutes of compiling; test_term_states_are_the_solution_at_the_step_end is the fast check
 def test_warm_equals_cold_from_near_and_far_guesses():
     cold = np.asarray(solve_lines(*_cols(LINES)))
     for dx in (1e-4, 1e-2, 0.5, 5.0, -3.0):
@@ -46,6 +48,7 @@ def test_warm_equals_cold_from_near_and_far_guesses():
     _close(warm, cold, 1e-10)
 
 
+@pytest.mark.slow      # four derivatives of six branches: minutes of compiling; the catenary gradients test checks the same tangent
 def test_warm_derivatives_equal_cold():
     cols = _cols(LINES)
     guess = solve_lines(*_cols(LINES + np.array([0.3, 0.1, 0, 0, 0, 0, 0])))
