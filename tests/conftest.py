@@ -35,6 +35,8 @@ import pytest  # noqa: E402
 from threadpoolctl import threadpool_limits  # noqa: E402
 
 jax.config.update("jax_enable_x64", True)
+_CACHE_THRESHOLDS = (jax.config.jax_persistent_cache_min_compile_time_secs,
+                     jax.config.jax_persistent_cache_min_entry_size_bytes)
 
 # the tests stand for the entry points (the command line, `js.simulate`), which install the compile
 # cache's hooks (jaxslosh/staging.py): a test that imports a module below them gets the same staging
@@ -57,6 +59,10 @@ def _cache_folder_off():
     from jax._src import compilation_cache
     from jaxslosh.cache import programs
     programs.use(None)
+    # a campaign's in-process worker sets XLA's cache thresholds to zero (and restores them);
+    # the defaults again after every test, so that no test's compiles depend on an earlier one's
+    jax.config.update("jax_persistent_cache_min_compile_time_secs", _CACHE_THRESHOLDS[0])
+    jax.config.update("jax_persistent_cache_min_entry_size_bytes", _CACHE_THRESHOLDS[1])
     if jax.config.jax_compilation_cache_dir is not None:
         jax.config.update("jax_compilation_cache_dir", None)
         compilation_cache.reset_cache()

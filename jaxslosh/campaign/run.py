@@ -308,7 +308,8 @@ def _in_process(template, duration, cases, batches, batch, caches):
     read back) and a copy of every result, for the same single core's work (docs/benchmarks.md)."""
     # the folders a worker is given are set in this process for the campaign alone (js.campaign's
     # caller keeps its own settings)
-    kept = (programs.folder(), jax.config.jax_compilation_cache_dir)
+    kept = (programs.folder(), jax.config.jax_compilation_cache_dir,
+            jax.config.jax_persistent_cache_min_compile_time_secs, jax.config.jax_persistent_cache_min_entry_size_bytes)
     try:
         for idx in batches:
             try:
@@ -320,6 +321,10 @@ def _in_process(template, duration, cases, batches, batch, caches):
     finally:
         programs.use(kept[0])
         jax.config.update("jax_compilation_cache_dir", kept[1])
+        # the worker's thresholds too (campaign/worker.py configure_jax): with them left at zero, the
+        # caller's later compiles all went to (and came back from) XLA's cache
+        jax.config.update("jax_persistent_cache_min_compile_time_secs", kept[2])
+        jax.config.update("jax_persistent_cache_min_entry_size_bytes", kept[3])
 
 
 def _raised(e, idx):

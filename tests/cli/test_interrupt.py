@@ -24,11 +24,12 @@ def interrupt_after(args, seconds, cwd):
 
 
 def test_stability_stops_on_ctrl_c(tmp_path):
-    """At 1 s the command imports (the scene checked, JAX loading); at 3.5 s and 7 s it computes the
-    GZ curves (about 15 s in all on a 2-core machine)."""
+    """At 1 s the command imports (the scene checked, JAX loading); at 2.5 s and 4 s it computes the
+    GZ curves (about 6 s in all on an idle 2-core machine: a later signal can land in the
+    interpreter's own teardown, after the command's work, which this test does not judge)."""
     scene = os.path.join(ROOT, "scenes", "paper_ship_stability.toml")
     stopped = 0
-    for seconds in (1.0, 3.5, 7.0):
+    for seconds in (1.0, 2.5, 4.0):
         fig = tmp_path / f"gz{seconds}.png"
         ran_on, code, out, err = interrupt_after(["stability", scene, "-o", str(fig)], seconds, tmp_path)
         if not ran_on:              # done before the signal (a fast machine): nothing to see
