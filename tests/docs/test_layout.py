@@ -248,12 +248,18 @@ def _names_a_shape(node) -> bool:
     return False
 
 
-def _shape_strings(node) -> set:
+def string_constants(node) -> set:
+    """The strings a comparison's side names: a constant, or the constants of a tuple, list or set
+    (tests/docs/test_variant_classes.py reads them too)."""
     if isinstance(node, ast.Constant) and isinstance(node.value, str):
-        return {node.value} & TANK_SHAPES
+        return {node.value}
     if isinstance(node, (ast.Tuple, ast.List, ast.Set)):
-        return set().union(*(_shape_strings(e) for e in node.elts)) if node.elts else set()
+        return set().union(*(string_constants(e) for e in node.elts)) if node.elts else set()
     return set()
+
+
+def _shape_strings(node) -> set:
+    return string_constants(node) & TANK_SHAPES
 
 
 def shape_branches(source: str) -> list:

@@ -14,20 +14,14 @@ from jaxslosh.scene.hulls import HULLS, Hull
 from jaxslosh.scene.seas import WAVES, Waves
 from jaxslosh.solve.schemes import SCHEMES, AbstractScheme
 
+from test_layout import string_constants
+
 ROOT = os.path.join(os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__)))), "jaxslosh")
 
 #: attribute -> the strings that would be a branch on a variant: hulls' and waves' `type`, the
 #: scheme's name and the restoring's moment form. Other `.type` comparisons stay legal (meshio's
 #: cell blocks in fem/meshfile.py compare `c.type == "hexahedron"`, which is no scene variant).
 VARIANT_STRINGS = {"type": set(HULLS) | set(WAVES), "scheme": set(SCHEMES), "moment": set(RESTORING_FORMS)}
-
-
-def _strings(node) -> set:
-    if isinstance(node, ast.Constant) and isinstance(node.value, str):
-        return {node.value}
-    if isinstance(node, (ast.Tuple, ast.List, ast.Set)):
-        return set().union(*(_strings(e) for e in node.elts)) if node.elts else set()
-    return set()
 
 
 def variant_branches(source: str) -> list:
@@ -37,7 +31,7 @@ def variant_branches(source: str) -> list:
         if isinstance(node, ast.Compare):
             sides = [node.left] + node.comparators
             attrs = {s.attr for s in sides if isinstance(s, ast.Attribute) and s.attr in VARIANT_STRINGS}
-            if any(_strings(s) & VARIANT_STRINGS[a] for a in attrs for s in sides):
+            if any(string_constants(s) & VARIANT_STRINGS[a] for a in attrs for s in sides):
                 out.append((node.lineno, ast.unparse(node)))
     return out
 
