@@ -17,7 +17,7 @@ from jaxslosh.assemble.liquid import build_liquid_block
 from jaxslosh.liquid.face.schur import face_schur
 from jaxslosh.liquid.face.element import build_face_liquid
 from jaxslosh.geometry import Baffle, Box, Prismatic
-from jaxslosh.liquid.face.inverse import BlockInverse, chebyshev_steps, face_solver_blocks
+from jaxslosh.liquid.face.inverse import FaceStepInverse, chebyshev_steps, face_solver_blocks
 
 
 def _models():
@@ -68,7 +68,7 @@ def test_the_dense_step_block_is_the_operator_and_the_element_gathers_the_points
     sparse, _, _ = face_full_liquid(tanks, models, sparse=True)
     c = 4.0 / 0.01 ** 2
     matrix, operator = face_solver_blocks(sparse, c)[0], face_solver_blocks(sparse, c, dense_faces=0)[0]
-    assert isinstance(operator, BlockInverse) and matrix.shape == (sparse.nf, sparse.nf)
+    assert isinstance(operator, FaceStepInverse) and matrix.shape == (sparse.nf, sparse.nf)
     V = np.random.default_rng(2).standard_normal((sparse.nf, 3))
     exact = np.linalg.solve(c * np.asarray(dense.Mff) + np.asarray(dense.K), V)
     for inv in (matrix, operator):

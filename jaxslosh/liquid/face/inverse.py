@@ -86,7 +86,7 @@ def mass_inverse(ops: FaceOps, Me, diag, lo: float, hi: float, tol: float = MASS
                        jnp.asarray(a), jnp.asarray(b))
 
 
-class BlockInverse(eqx.Module):
+class FaceStepInverse(eqx.Module):
     """C^-1 r = M^-1 (s r - B^T H B M^-1 r) (s: 1 / (c + kappa) per unknown, each tank's kappa)."""
     minv: MassInverse
     s: jax.Array          # (n,)
@@ -119,10 +119,10 @@ def face_solver_blocks(liquid, c_step: float, c_sub=None, dense_faces: int = DEN
         if K.rho is None:
             H = tuple(jnp.asarray(schur_inverse(np.asarray(Y), np.asarray(wi), float(k), c))
                       for Y, wi, k in zip(K.Y, K.winv, np.asarray(K.kappas)))
-            return BlockInverse(mi, jnp.asarray(1.0 / (c + np.asarray(K.kappa_n))), H)
+            return FaceStepInverse(mi, jnp.asarray(1.0 / (c + np.asarray(K.kappa_n))), H)
         H = tuple(schur_inverse(sg(Y), sg(wi), sg(K.kappas[i]), c, sg(r), sg(N), jnp, jax.scipy.linalg)
                   for i, (Y, wi, r, N) in enumerate(zip(K.Y, K.winv, K.rho, K.pools)))
-        return BlockInverse(mi, 1.0 / (c + sg(K.kappa_n)), H)
+        return FaceStepInverse(mi, 1.0 / (c + sg(K.kappa_n)), H)
 
     def block(c):
         op = operator(c)
@@ -138,7 +138,7 @@ def _columns(op):
     return 0.5 * (X + X.T)           # the operator is symmetric: its round-off is not
 
 
-def dense_matrix(op: BlockInverse, host: bool):
+def dense_matrix(op: FaceStepInverse, host: bool):
     """The (n, n) matrix of the step block's inverse (its columns: the operator on the identity,
     symmetrized), a concrete array from the model's values (`host`), else traced like them."""
     return jnp.asarray(np.asarray(_columns(op))) if host else _columns(op)
