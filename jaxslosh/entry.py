@@ -23,6 +23,8 @@ SCENE_COMMANDS = ("run", "check", "modes", "identify", "sweep", "hydro", "rao", 
 
 
 def main() -> int:
+    """The program: the command's exit status ends the process (os._exit, past the interpreter's
+    teardown). Python callers use jaxslosh.cli.main.main(argv), which returns it."""
     # first: Ctrl-C from here on stops the command with one line and exit 130, JAX's import included
     stop_on_signals()
     args = sys.argv[1:]
@@ -32,7 +34,15 @@ def main() -> int:
     if next((w for w in args if not w.startswith("-")), None) == "run":
         executables.preload(executables.cache_folder()[1], command_hint(args))
     # imported now, not above: the point is to import it while the executables load
-    return import_module(".cli.main", __package__).main()
+    code = import_module(".cli.main", __package__).main()
+    # The command's work is done and its files are closed: the process ends here, not in the
+    # interpreter's teardown, where Python has given SIGINT back its default action (a Ctrl-C there
+    # killed the process with no message and status -2) and XLA's thread pools take their time to stop.
+    try:
+        sys.stdout.flush()
+        sys.stderr.flush()
+    finally:
+        os._exit(code if isinstance(code, int) else 0)
 
 
 def scene_argument(args) -> str | None:

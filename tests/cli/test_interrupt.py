@@ -63,3 +63,26 @@ def test_a_file_being_written_is_finished_first(tmp_path):
     assert p.returncode == 130
     assert p.stderr.strip() == "interrupted" and p.stdout == ""
     assert out.read_text() == "whole"
+
+
+ENDS_AT_ITS_END = textwrap.dedent("""
+    import atexit, sys
+    atexit.register(lambda: open(sys.argv[1], "w").write("teardown"))
+    sys.argv = ["jaxslosh", "check", sys.argv[2]]
+    from jaxslosh.entry import main
+    main()
+    print("not reached")
+""")
+
+
+def test_the_program_ends_with_its_command_not_in_the_teardown(tmp_path):
+    """A Ctrl-C in the interpreter's teardown (after the command's work, Python having given SIGINT
+    back its default action) once killed the process silently with status -2: the program now ends
+    with its command's status (jaxslosh/entry.py), the teardown's exit handlers never reached."""
+    mark = tmp_path / "teardown.txt"
+    scene = os.path.join(ROOT, "scenes", "vessel_only.toml")
+    p = subprocess.run([sys.executable, "-c", ENDS_AT_ITS_END, str(mark), scene], cwd=tmp_path, env=ENV,
+                       capture_output=True, text=True, timeout=120)
+    assert p.returncode == 0, p.stderr[-2000:]
+    assert "not reached" not in p.stdout and p.stdout.strip()      # the check's own report, whole
+    assert not mark.exists()
