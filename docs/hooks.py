@@ -41,7 +41,7 @@ def _table_of(key: str, tables) -> str:
 
 def _traceable(key: str) -> bool:
     from jaxslosh.scene.keys import TRACEABLE
-    for group in ("tanks", "mooring", "connections"):    # named tables: any name stands for <name>
+    for group in ("tanks", "mooring", "connections", "bodies"):    # named tables: any name stands for <name>
         if key.startswith(group + "."):
             return (f"{group}.T." + key[len(group) + 1:]) in TRACEABLE
     return key in TRACEABLE

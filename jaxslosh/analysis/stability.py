@@ -29,6 +29,7 @@ from ..hull.hydrostatics import first_vanishing
 from ..hull.surface import HullMeshError
 from ..hull.tanks import tank_surface
 from ..staging import START_OPTIONS
+from .bodystability import bodies_stability, linear_stability
 from ..scene.load import load_scene
 from ..scene.types import SceneError
 
@@ -79,14 +80,23 @@ class Stability:
     axis: str = "roll"
     sinkage: np.ndarray = field(default=None, repr=False)   # m: the water plane's rise in the vessel frame from upright
     trim: np.ndarray = field(default=None, repr=False)      # rad: the free angle (pitch at a roll heel, roll at a pitch heel)
+    #: {name: bodystability.LinearStability} of the scene's [[bodies]]
+    bodies: dict = field(default_factory=dict)
+    #: "hull": the vessel's curves from its hull; "linear": from its linear hydrostatics (a vessel
+    #: without a hull beside bodies, docs/guide/stability.md#bodies)
+    model: str = "hull"
 
     def as_dict(self):
         """The JSON object of `jaxslosh stability --json` (docs/guide/stability.md)."""
-        return {"angle": [float(a) for a in self.angle], "gz": [float(g) for g in self.gz],
-                "gz_frozen": [float(g) for g in self.gz_frozen], "gm0": float(self.gm0),
-                "gm0_frozen": float(self.gm0_frozen),
-                "vanishing_angle": None if self.vanishing_angle is None else float(self.vanishing_angle),
-                "criteria": [c.as_dict() for c in self.criteria]}
+        out = {"angle": [float(a) for a in self.angle], "gz": [float(g) for g in self.gz],
+               "gz_frozen": [float(g) for g in self.gz_frozen], "gm0": float(self.gm0),
+               "gm0_frozen": float(self.gm0_frozen),
+               "vanishing_angle": None if self.vanishing_angle is None else float(self.vanishing_angle),
+               "criteria": [c.as_dict() for c in self.criteria]}
+        if self.bodies or self.model != "hull":         # a scene of the vessel alone: its object as ever
+            out["model"] = self.model
+            out["bodies"] = {n: b.as_dict() for n, b in self.bodies.items()}
+        return out
 
     def __getitem__(self, key):
         return self.as_dict()[key]
@@ -283,7 +293,9 @@ def stability(scene, angles=None, axis: str = "roll", *, criteria: bool = True) 
     the IS Code 2008 Part A 2.2 criteria (roll only) on the level curve. `scene`: a Scene or the
     path of a scene file. Raises SceneError for a scene without what it needs (naming the key),
     StabilityFailure where an equilibrium does not converge. `criteria=False` skips the criteria
-    and the heels they are computed at (`criteria` is then empty)."""
+    and the heels they are computed at (`criteria` is then empty). A scene's [[bodies]] add their
+    linear curves (`bodies`, analysis/bodystability.py); a vessel without a hull beside them gets
+    its own linear curve (model "linear")."""
     if isinstance(scene, str) or hasattr(scene, "__fspath__"):
         scene = load_scene(scene)
     if axis not in AXES:
@@ -293,6 +305,9 @@ def stability(scene, angles=None, axis: str = "roll", *, criteria: bool = True) 
     angles = np.atleast_1d(np.asarray(angles, dtype=float))
     if angles.ndim != 1 or not np.all(np.isfinite(angles)):
         raise ValueError("angles must be a 1-D array of finite numbers (rad)")
+    bodies = bodies_stability(scene, angles, axis)
+    if bodies and scene.vessel.hull is None and not scene.tanks and scene.vessel.hydrostatics is not None:
+        return _linear_vessel(scene, angles, axis, bodies)
     model = build_model(scene)
     grid = np.radians(np.linspace(*DEFAULT_DEGREES))
     x30, w30 = _gauss(0.0, np.radians(30.0), _AREA_POINTS[0])
@@ -325,4 +340,16 @@ def stability(scene, angles=None, axis: str = "roll", *, criteria: bool = True) 
         crit = is_code_criteria(grid, gz2[where[2], 0], gm0, a30, a30 + a3040, a3040)
     return Stability(angle=angles, gz=gz, gz_frozen=gz_f, gm0=gm0, gm0_frozen=gm0_f,
                      vanishing_angle=first_vanishing(angles, gz), criteria=crit, axis=axis,
-                     sinkage=off2[at, 0] - off2[up, 0], trim=psi2[at, 0])
+                     sinkage=off2[at, 0] - off2[up, 0], trim=psi2[at, 0], bodies=bodies)
+
+
+def _linear_vessel(scene, angles, axis: str, bodies: dict) -> Stability:
+    """The Stability of a vessel without a hull (nor tanks) beside bodies: its linear hydrostatics'
+    curve, as the bodies' (it neither sinks nor trims at a heel; no criteria: they judge a hull's
+    curve, which linear springs only approximate near upright)."""
+    env = scene.environment
+    v = linear_stability(scene.vessel.name, scene.vessel.hydrostatics, env.water_density, env.gravity, angles, axis)
+    zero = np.zeros_like(v.gz)
+    return Stability(angle=angles, gz=v.gz, gz_frozen=v.gz, gm0=v.gm0, gm0_frozen=v.gm0,
+                     vanishing_angle=v.vanishing_angle, axis=axis, sinkage=zero, trim=zero, bodies=bodies,
+                     model="linear")

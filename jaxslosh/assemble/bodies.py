@@ -27,13 +27,14 @@ def linear_hydrostatics(h, rho_w, g, value=lambda key, v: v) -> AbstractRestorin
                 gm_l=f("gm_l", h.gm_l))
 
 
-def rigid_terms(mass, inertia, hydrostatics, rho_w, g, viscous=None) -> tuple:
+def rigid_terms(mass, inertia, hydrostatics, rho_w, g, viscous=None, value=lambda key, v: v) -> tuple:
     """A floating body's rigid terms, as the vessel has them: inertia with its gyroscopic terms
     (RigidBody), linear hydrostatics about the rest pose (its weight balanced by the buoyancy at
-    rest), and linear viscous damping (6 x 6) where given."""
+    rest), and linear viscous damping (6 x 6) where given; `value(name, v)` may replace the
+    hydrostatics' values (a body's traced params)."""
     I = jnp.asarray(inertia, dtype=float)
     terms = [RigidBody(mass=jnp.asarray(mass, dtype=float), inertia=jnp.diag(I) if I.ndim == 1 else I),
-             linear_hydrostatics(hydrostatics, rho_w, g)]
+             linear_hydrostatics(hydrostatics, rho_w, g, value)]
     if viscous is not None:
         terms.append(LinearDamping(jnp.asarray(viscous, dtype=float)))
     return tuple(terms)
@@ -53,8 +54,11 @@ def build_bodies(scene, params: dict, g) -> Optional[Bodies]:
         rest = body_rest(b, cog)
         ini = b.initial
         roll, pitch, yaw = ini.roll_pitch_yaw
+        key = f"bodies.{b.name}"
+        traced = lambda k, v, key=key: P(f"{key}.hydrostatics.{k}", v)  # noqa: E731
         floating.append(Floating(
-            terms=rigid_terms(b.mass, b.inertia, b.hydrostatics, rho, g, b.viscous_damping) + (
+            terms=rigid_terms(P(f"{key}.mass", b.mass), b.inertia, b.hydrostatics, rho, g, b.viscous_damping,
+                              traced) + (
                 () if X is None or not np.abs(X[s]).max() > 0 else
                 (WaveExcitation(make_excitation(waves, X[s], P(waves.height_key,
                                                               waves.height))),)),

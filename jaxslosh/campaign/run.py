@@ -80,7 +80,7 @@ class CampaignInterrupted(Interrupted):
 
 
 def channel_names(scene: Scene) -> list:
-    return channels(scene.probes, scene.mooring)
+    return channels(scene.probes, scene.mooring, scene.bodies, scene.connections)
 
 
 class Settings(NamedTuple):

@@ -1,5 +1,5 @@
 """Response statistics of one case: per channel (roll, pitch, heave, probe.<name> vertical
-displacement, mooring.<name> fairlead tension) over the saved frames from t = waves.ramp on; the
+displacement, mooring.<name> fairlead tension, <body>.roll/pitch/heave, connection.<name> force) over the saved frames from t = waves.ramp on; the
 Rayleigh exceedance and the operability of a scatter (host NumPy / SciPy)."""
 from __future__ import annotations
 
@@ -24,6 +24,11 @@ def channels(result, run=None) -> dict:
         out[f"probe.{name}"] = pick(p.displacement)[:, 2]
     for name, line in (result.mooring or {}).items():
         out[f"mooring.{name}"] = pick(line.fairlead_tension)
+    for name, body in (getattr(result, "bodies", None) or {}).items():   # position: its offset from rest
+        b = pick(body.roll_pitch_yaw)
+        out.update({f"{name}.roll": b[:, 0], f"{name}.pitch": b[:, 1], f"{name}.heave": pick(body.position)[:, 2]})
+    for name, c in (getattr(result, "connections", None) or {}).items():
+        out[f"connection.{name}"] = pick(c.force)
     return out
 
 

@@ -114,9 +114,10 @@ def cmd_campaign(a):
             client.close()
     report_failures(r.cases, r.status)
     if r.limits:         # none (--limits "", or none in the scene): no table, no operability
-        print(f"{'channel':>12} {'limit':>10} {'P(exceed)':>10}")
+        wide = max([12] + [len(ch) for ch in r.limits])      # connection.<name> and the like: longer
+        print(f"{'channel':>{wide}} {'limit':>10} {'P(exceed)':>10}")
         for ch, lim in r.limits.items():
-            print(f"{ch:>12} {lim:10.4g} {r.exceedance.get(ch, math.nan):10.4g}")
+            print(f"{ch:>{wide}} {lim:10.4g} {r.exceedance.get(ch, math.nan):10.4g}")
         judged = "" if not r.failed_weight > 0 else \
             f"; {r.failed_weight:.2f} % of it in failed cases, counted as not operable"
         print(f"operability: {r.operability:.2f} % of the scatter's weight within every limit{judged}")

@@ -29,9 +29,9 @@ def add_parsers(subparsers):
     p.add_argument("--max-iter", type=int, default=50, dest="max_iter", help="iterations at most (default 50)")
     p.add_argument("--start", metavar="KEY=VALUE[,...]", help="start values (default: the scene's values)")
     p.add_argument("--noise", metavar="CHANNEL=STD[,...]",
-                   help="the measurement noise of channels (roll, pitch, heave, probes.NAME; standard deviations "
-                        "in the channel's units, rad or m): weight 1 / STD, with which the standard errors are "
-                        "exact for independent Gaussian noise")
+                   help="the measurement noise of channels (roll, pitch, heave, probes.NAME, bodies.NAME.roll, "
+                        "..., connections.NAME; standard deviations in the channel's units, rad, m or N): "
+                        "weight 1 / STD, with which the standard errors are exact for independent Gaussian noise")
     p.add_argument("--weights", metavar="CHANNEL=W[,...]",
                    help="weights of channels (0 leaves one out); channels named by neither --noise nor --weights "
                         "keep the default 1 / std of the measured signal")

@@ -7,6 +7,7 @@ import sys
 
 import numpy as np
 
+from ..analysis.bodystability import LinearStability
 from ..analysis.stability import DEFAULT_DEGREES, StabilityFailure, stability
 from ..plot.stability import plot_stability
 from .common import COMMANDS, EXIT_NUMERICAL, EXIT_OK, InputError, load, output_folder, setup_jax
@@ -54,7 +55,23 @@ def cmd_stability(a):
     if a.json:
         print(json.dumps(s.as_dict()))
         return EXIT_OK
-    print(f"GZ about the {a.axis} axis (m), the vessel free to sink and trim at its displacement:")
+    if s.model == "linear":      # a vessel without a hull beside bodies: its curve as theirs
+        h = scene.vessel.hydrostatics
+        print_body(LinearStability(scene.vessel.name, s.angle, s.gz, s.gm0, h.gm_t, h.gm_l, s.vanishing_angle,
+                                   s.axis), "vessel")
+        print("IS Code 2008 Part A 2.2: not judged on linear hydrostatics (the criteria are for a hull's curve)")
+    else:
+        print_vessel(s, a.axis)
+    for b in s.bodies.values():
+        print_body(b)
+    if a.output:
+        print(f"wrote {a.output}")
+    return EXIT_OK
+
+
+def print_vessel(s, axis: str):
+    """The vessel's curves from its hull and the criteria."""
+    print(f"GZ about the {axis} axis (m), the vessel free to sink and trim at its displacement:")
     print(f"{'heel deg':>9} {'GZ level':>10} {'GZ frozen':>10}")
     for ang, g, gf in zip(s.angle, s.gz, s.gz_frozen):
         print(f"{np.degrees(ang):9.3f} {g:10.5f} {gf:10.5f}")
@@ -70,6 +87,15 @@ def cmd_stability(a):
             print(f"  {'pass' if c.passed else 'FAIL'}  {c.name:<30} {c.value:10.5f}  (>= {c.limit:.5g}){deg}")
     else:
         print("IS Code 2008 Part A 2.2: criteria for heel about the roll axis only")
-    if a.output:
-        print(f"wrote {a.output}")
-    return EXIT_OK
+
+
+def print_body(b, what="body"):
+    """A [[bodies]] body's curve (analysis/bodystability.py LinearStability), as the vessel's table."""
+    print(f"{what} {b.name}: GZ about the {b.axis} axis (m) of its linear hydrostatics, "
+          f"GM_T {b.gm_t:.5f} m, GM_L {b.gm_l:.5f} m:")
+    print(f"{'heel deg':>9} {'GZ':>10}")
+    for ang, g in zip(b.angle, b.gz):
+        print(f"{np.degrees(ang):9.3f} {g:10.5f}")
+    va = b.vanishing_angle
+    print(f"GM0 {b.gm0:.5f} m; angle of vanishing stability: "
+          + ("none in the range" if va is None else f"{np.degrees(va):.3f} deg"))

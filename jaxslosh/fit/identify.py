@@ -6,7 +6,9 @@
 Residuals
     Weighted least squares over the channels the measured result holds and the model has: "roll"
     and "pitch" (`vessel.roll_pitch_yaw[:, :2]`), "heave" (`vessel.position[:, 2]`) and, for every
-    probe present in both, "probes.<name>" (the vertical displacement `probes[name].displacement[:, 2]`).
+    probe present in both, "probes.<name>" (the vertical displacement `probes[name].displacement[:, 2]`);
+    "bodies.<name>.roll", ".pitch", ".heave" of each [[bodies]] body and "connections.<name>" (a
+    connection's force) of each [[connections]] connection.
     r = concat_c w_c (model_c(t_m) - measured_c(t_m)); the loss reported is the mean square
     SSR / n (n = number of residuals). The model runs from t = 0 with the scene's dt and
     save_every up to the last measured time; where the measured times are the model's saved times
@@ -198,7 +200,8 @@ def identify(scene: Scene, measured, fit: Sequence[str], *, weights: Optional[di
              learning_rate: Optional[float] = None, data_scene: str = "warn") -> FitResult:
     """Fit the scene values named by `fit` (dotted keys) to `measured` (a Result or a result file).
 
-    weights: channel -> weight ("roll", "pitch", "heave", "probes.<name>"), default 1 / std of the
+    weights: channel -> weight ("roll", "pitch", "heave", "probes.<name>", "bodies.<name>.roll",
+    ..., "connections.<name>"), default 1 / std of the
     measured channel (0 for a constant channel). method: "gauss-newton" (default), "lbfgs" or
     "adam". x0: key -> start value (default the scene's). bounds: key -> (lo, hi), None for an open
     side (default: (0, None) for positive quantities, fitted in log). callback(iteration, values,

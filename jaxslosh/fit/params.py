@@ -18,6 +18,16 @@ from ..scene.types import Scene, SceneError
 POSITIVE = ("environment.gravity", "environment.water_density", "vessel.mass", "vessel.inertia",
             "vessel.hydrostatics.waterplane_area", "vessel.hydrostatics.displaced_volume",
             "vessel.hydrostatics.gm_t", "vessel.hydrostatics.gm_l", "vessel.hull.kg")
+# ... and of every [[bodies]] body and [[connections]] connection (after the name)
+POSITIVE_OWN = {"bodies": ("mass", "hydrostatics.waterplane_area", "hydrostatics.displaced_volume",
+                           "hydrostatics.gm_t", "hydrostatics.gm_l"),
+                "connections": ("length", "stiffness")}
+
+
+def positive(key: str) -> bool:
+    """Whether a fitted key's value is positive by nature (fitted in log by default)."""
+    group, _, rest = key.partition(".")
+    return key in POSITIVE or rest.partition(".")[2] in POSITIVE_OWN.get(group, ())
 
 
 class Param:
@@ -153,11 +163,11 @@ def make_params(scene: Scene, keys, x0, bounds) -> list:
         if key in bounds:
             lo, hi = _bound_pair(key, bounds[key])
         else:
-            lo, hi = (0.0, None) if key in POSITIVE else (None, None)
+            lo, hi = (0.0, None) if positive(key) else (None, None)
         if not np.all(np.isfinite(start)):
             raise SceneError(f"x0.{key}", "the start must be finite")
         if (lo is not None and np.any(start <= lo)) or (hi is not None and np.any(start >= hi)):
-            why = "; the value must stay positive" if key in POSITIVE and key not in bounds else ""
+            why = "; the value must stay positive" if positive(key) and key not in bounds else ""
             raise SceneError(key, f"the start {start.tolist()} is not strictly inside the bounds ({lo}, {hi}){why}")
         out.append(Param(key, base, start, lo, hi))
     return out

@@ -33,11 +33,18 @@ def as_result(measured) -> Result:
 
 
 def channels_of(r: Result, names=None) -> dict:
-    """name -> (n,) signal of a result: roll, pitch, heave and probes.<name> (vertical displacement)."""
+    """name -> (n,) signal of a result: roll, pitch, heave, probes.<name> (vertical displacement),
+    bodies.<name>.roll, .pitch, .heave (a [[bodies]] body's; its heave: its COG's offset from rest)
+    and connections.<name> (a connection's force, N)."""
     rpy = r.vessel.roll_pitch_yaw
     ch = {"roll": rpy[:, 0], "pitch": rpy[:, 1], "heave": r.vessel.position[:, 2]}
     for name, p in r.probes.items():
         ch[f"probes.{name}"] = p.displacement[:, 2]
+    for name, b in (r.bodies or {}).items():
+        ch |= {f"bodies.{name}.roll": b.roll_pitch_yaw[:, 0], f"bodies.{name}.pitch": b.roll_pitch_yaw[:, 1],
+               f"bodies.{name}.heave": b.position[:, 2]}
+    for name, c in (r.connections or {}).items():
+        ch[f"connections.{name}"] = c.force
     if names is not None:
         ch = {k: ch[k] for k in names}
     return ch
@@ -46,8 +53,9 @@ def channels_of(r: Result, names=None) -> dict:
 def add_noise(r: Result, noise: dict, seed: int = 0, keep_probes: bool = True) -> Result:
     """A synthetic measurement: `r` with independent Gaussian noise of standard deviation
     noise[channel] added to the channels `identify` reads ("roll", "pitch", "heave",
-    "probes.<name>"); other datasets (quaternion, probe positions, ...) are left as they are.
-    keep_probes=False drops the probes (a record of the vessel's motion alone)."""
+    "probes.<name>", "bodies.<name>.roll", ..., "connections.<name>"); other datasets (quaternion,
+    probe positions, ...) are left as they are. keep_probes=False drops the probes (a record of
+    the vessel's motion alone)."""
     rng = np.random.default_rng(seed)
     names = set(channels_of(r))
     for k in noise:
@@ -67,7 +75,17 @@ def add_noise(r: Result, noise: dict, seed: int = 0, keep_probes: bool = True) -
             d[:, 2] += draw(f"probes.{name}")
             probes[name] = dataclasses.replace(p, displacement=d)
     vessel = dataclasses.replace(r.vessel, roll_pitch_yaw=rpy, position=pos)
-    return dataclasses.replace(r, vessel=vessel, probes=probes)
+    bodies = {}
+    for name, b in (r.bodies or {}).items():     # drawn after the vessel's and the probes': their noise as before
+        brpy, bpos = np.array(b.roll_pitch_yaw, dtype=float), np.array(b.position, dtype=float)
+        brpy[:, 0] += draw(f"bodies.{name}.roll")
+        brpy[:, 1] += draw(f"bodies.{name}.pitch")
+        bpos[:, 2] += draw(f"bodies.{name}.heave")
+        bodies[name] = dataclasses.replace(b, roll_pitch_yaw=brpy, position=bpos)
+    links = {name: dataclasses.replace(c, force=np.asarray(c.force, dtype=float) + draw(f"connections.{name}"))
+             for name, c in (r.connections or {}).items()}
+    return dataclasses.replace(r, vessel=vessel, probes=probes, bodies=bodies or r.bodies,
+                               connections=links or r.connections)
 
 
 #: a channel whose spread is at most this share of the largest spread among the channels in its unit
@@ -79,7 +97,11 @@ SIGNAL_FLOOR = 1e-10
 
 
 def channel_unit(name: str) -> str:
-    return "rad" if name in ("roll", "pitch") else "m"
+    """rad (roll, pitch, a body's), N (a connection's force) or m."""
+    if name.startswith("connections."):
+        return "N"
+    return "rad" if name in ("roll", "pitch") or (name.startswith("bodies.") and name.endswith((".roll", ".pitch"))) \
+        else "m"
 
 
 def no_signal(name: str, x, spread: dict) -> bool:
@@ -111,7 +133,9 @@ class Problem:
         self.direct = t.size <= t_model.size and np.allclose(t, t_model[:t.size], rtol=0.0, atol=1e-9 * max(1.0, t[-1]))
 
         meas = {k: np.asarray(v, dtype=float) for k, v in channels_of(measured).items()}
-        model_names = {"roll", "pitch", "heave"} | {f"probes.{p.name}" for p in scene.probes}
+        model_names = ({"roll", "pitch", "heave"} | {f"probes.{p.name}" for p in scene.probes}
+                       | {f"bodies.{b.name}.{c}" for b in scene.bodies for c in ("roll", "pitch", "heave")}
+                       | {f"connections.{c.name}" for c in scene.connections})
         names = [k for k in meas if k in model_names]
         weights = dict(weights or {})
         for k in weights:

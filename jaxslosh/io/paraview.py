@@ -13,10 +13,13 @@ every one; ParaView opens them together), all over one HDF5 file `STEM_paraview.
   the vessel's frame as three lines along its axes from the COG;
 * `STEM_structures.xdmf`: flexible structures as their undeformed blocks carried by the vessel
   (a result file keeps no structure fields: their probes carry their deformation);
+* `STEM_body_<name>.xdmf`: each [[bodies]] body as its frame (three lines along its axes from its
+  COG, half the side of a square of its waterplane area long: a body has no hull), and
+  `STEM_<name>_liquid.xdmf`, `STEM_<name>_surface.xdmf` the tanks it carries;
 * `STEM_probes.xdmf`: the probes' material points, `displacement` (the result's, inertial).
 
 Every step has its own geometry (the meshes move) and attributes, one HDF5 dataset each; the
-topology is written once. The scene's tanks, hull and structures come from the TOML text the
+topology is written once. The scene's tanks, hull, structures and bodies come from the TOML text the
 result keeps (tomllib: io sits below the scene loader).
 """
 from __future__ import annotations
@@ -99,8 +102,43 @@ def series_of(r: Result, every: int = 1) -> list:
     A = rotation_matrices(np.asarray(r.vessel.quaternion)[sl])
     out = []
     origins = _tank_origins(scene)
+    vessel = scene.get("vessel", {})
+    mine = ("vessel", vessel.get("name", "vessel"))
+    on_bodies = {t.get("name") for t in scene.get("tanks", []) if t.get("body", "vessel") not in mine}
+    out += _liquid(r, [n for n in r.tanks if n not in on_bodies], X0, A, origins, sl, "")
+    hull = vessel.get("hull")
+    if hull and hull.get("type", "box") == "box":
+        L, B, T, kg = (float(hull[k]) for k in ("length", "beam", "draft", "kg"))
+        pts, el = box_mesh((L, B, T), (1, 1, 1))
+        out.append(Series("vessel", "hexahedron", el, carried(X0, A, pts + np.array([-L / 2, -B / 2, -kg])), {}))
+    else:
+        size = max([max(t.get("size", (1.0,))) for t in scene.get("tanks", [])] + [1.0])
+        out.append(_axes("vessel", X0, A, size))
+    blocks = []
+    for st in scene.get("structures", []):
+        pts, el = box_mesh(st["size"], st["mesh"])
+        blocks.append((pts + np.asarray(st["origin"], dtype=float), el))
+    if blocks:
+        offs = np.cumsum([0] + [p.shape[0] for p, _ in blocks])
+        out.append(Series("structures", "hexahedron", np.concatenate([e + o for (_, e), o in zip(blocks, offs)]),
+                          carried(X0, A, np.concatenate([p for p, _ in blocks])), {}))
+    out += _bodies(r, scene, origins, sl)
+    if r.probes:
+        names = list(r.probes)
+        pos = np.stack([np.asarray(r.probes[k].position, dtype=float)[sl] for k in names], axis=1)
+        dis = np.stack([np.asarray(r.probes[k].displacement, dtype=float)[sl] for k in names], axis=1)
+        out.append(Series("probes", "vertex", np.arange(len(names))[:, None], pos, {"displacement": dis}))
+    return out
+
+
+def _liquid(r: Result, names, X, A, origins: dict, sl, prefix: str) -> list:
+    """The liquid and free-surface meshes of the tanks `names` (those the result keeps fields of),
+    carried by the frame (X, A) that holds them: the vessel's, or a body's (`prefix` "<body>_")."""
     nodes, cells, disp, surf_cells, offset = [], [], [], [], 0
-    for name, t in r.tanks.items():
+    for name in names:
+        if name not in r.tanks:
+            continue
+        t = r.tanks[name]
         n = np.asarray(t.nodes, dtype=float)
         d = np.asarray(t.displacement, dtype=float)[sl]
         nodes.append(n + origins.get(name, np.zeros(3)))
@@ -111,34 +149,49 @@ def series_of(r: Result, every: int = 1) -> list:
         faces = el[:, 4:8]                                 # hex8: the top face is the last four corners
         surf_cells.append(faces[top[faces].all(axis=1)] + offset)
         offset += n.shape[0]
-    if nodes:
-        D = np.concatenate(disp, axis=1)
-        P = carried(X0, A, np.concatenate(nodes)[None] + D)
-        data = {"displacement": D, "elevation": D[..., 2]}
-        out.append(Series("liquid", "hexahedron", np.concatenate(cells), P, data))
-        out.append(Series("surface", "quad", np.concatenate(surf_cells), P, {"elevation": D[..., 2]}))
-    hull = scene.get("vessel", {}).get("hull")
-    if hull and hull.get("type", "box") == "box":
-        L, B, T, kg = (float(hull[k]) for k in ("length", "beam", "draft", "kg"))
-        pts, el = box_mesh((L, B, T), (1, 1, 1))
-        out.append(Series("vessel", "hexahedron", el, carried(X0, A, pts + np.array([-L / 2, -B / 2, -kg])), {}))
-    else:
-        size = max([max(t.get("size", (1.0,))) for t in scene.get("tanks", [])] + [1.0])
-        pts = np.array([[0.0, 0.0, 0.0], [size, 0, 0], [0, size, 0], [0, 0, size]])
-        out.append(Series("vessel", "line", np.array([[0, 1], [0, 2], [0, 3]]), carried(X0, A, pts), {}))
-    blocks = []
-    for st in scene.get("structures", []):
-        pts, el = box_mesh(st["size"], st["mesh"])
-        blocks.append((pts + np.asarray(st["origin"], dtype=float), el))
-    if blocks:
-        offs = np.cumsum([0] + [p.shape[0] for p, _ in blocks])
-        out.append(Series("structures", "hexahedron", np.concatenate([e + o for (_, e), o in zip(blocks, offs)]),
-                          carried(X0, A, np.concatenate([p for p, _ in blocks])), {}))
-    if r.probes:
-        names = list(r.probes)
-        pos = np.stack([np.asarray(r.probes[k].position, dtype=float)[sl] for k in names], axis=1)
-        dis = np.stack([np.asarray(r.probes[k].displacement, dtype=float)[sl] for k in names], axis=1)
-        out.append(Series("probes", "vertex", np.arange(len(names))[:, None], pos, {"displacement": dis}))
+    if not nodes:
+        return []
+    D = np.concatenate(disp, axis=1)
+    P = carried(X, A, np.concatenate(nodes)[None] + D)
+    data = {"displacement": D, "elevation": D[..., 2]}
+    return [Series(f"{prefix}liquid", "hexahedron", np.concatenate(cells), P, data),
+            Series(f"{prefix}surface", "quad", np.concatenate(surf_cells), P, {"elevation": D[..., 2]})]
+
+
+def _axes(name: str, X, A, size: float) -> Series:
+    """A frame as three lines `size` long along its axes from its origin (a vessel or body without a hull)."""
+    pts = np.array([[0.0, 0.0, 0.0], [size, 0, 0], [0, size, 0], [0, 0, size]])
+    return Series(name, "line", np.array([[0, 1], [0, 2], [0, 3]]), carried(X, A, pts), {})
+
+
+def _cog_height(vessel: dict) -> float:
+    """The vessel's COG height above the still water at rest, as the loader gives it: its
+    `cog_height`, else kg - draft for a box hull, else 0."""
+    if "cog_height" in vessel:
+        return float(vessel["cog_height"])
+    hull = vessel.get("hull") or {}
+    if hull and hull.get("type", "box") == "box" and "kg" in hull and "draft" in hull:
+        return float(hull["kg"]) - float(hull["draft"])
+    return 0.0
+
+
+def _bodies(r: Result, scene: dict, origins: dict, sl) -> list:
+    """Each [[bodies]] body's meshes, carried by its own frame: its axes (a body has no hull), sized
+    by its waterplane (half the side of a square of its area), and the liquid of the tanks it
+    carries; `body_<name>` and `<name>_liquid`, `<name>_surface`."""
+    out = []
+    cog = _cog_height(scene.get("vessel", {}))
+    tables = {b.get("name"): b for b in scene.get("bodies", [])}
+    for name, b in (r.bodies or {}).items():
+        table = tables.get(name, {})
+        px, py = (list(table.get("position", (0.0, 0.0))) + [0.0, 0.0])[:2]
+        rest = np.array([px, py, float(table.get("cog_height", 0.0)) - cog])
+        X = rest + np.asarray(b.position, dtype=float)[sl]      # the result keeps its offset from rest
+        A = rotation_matrices(np.asarray(b.quaternion)[sl])
+        area = float(table.get("hydrostatics", {}).get("waterplane_area", 4.0))
+        out.append(_axes(f"body_{name}", X, A, 0.5 * np.sqrt(max(area, 1e-12))))
+        out += _liquid(r, [t.get("name") for t in scene.get("tanks", []) if t.get("body") == name], X, A, origins,
+                       sl, f"{name}_")
     return out
 
 

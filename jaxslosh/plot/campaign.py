@@ -12,13 +12,22 @@ import numpy as np
 from ..campaign.stats import operability
 from ..io.campaign import PENDING
 from ..run.guard import finishing
+from ..scene.campaign import unit as channel_unit
 from .results import figure, scene_title
 
 #: the spectra are drawn where some channel's density is above this share of its peak (and a
 #: quarter beyond), down to SPECTRUM_FLOOR of the largest: below, Welch's window leakage and
 #: round-off, not response
 SPECTRUM_SHOWN, SPECTRUM_FLOOR = 1e-3, 1e-5
-ANGLES = ("roll", "pitch")
+
+
+def _groups(chans):
+    """The spectra's axes: angles and displacements as always, forces (lines, connections) on a
+    third axis where there are any (on the displacements' they would flatten them by 1e10)."""
+    groups = [("rad^2 s/rad", [ch for ch in chans if channel_unit(ch) == "rad"]),
+              ("m^2 s/rad", [ch for ch in chans if channel_unit(ch) == "m"])]
+    forces = [ch for ch in chans if channel_unit(ch) == "N"]
+    return groups + ([("N^2 s/rad", forces)] if forces else [])
 
 
 def case_states(status):
@@ -80,7 +89,7 @@ def plot_campaign(c, out: str, limits: Optional[dict] = None, case: Optional[int
     cmap = colormaps["viridis"]
     for r, ch in enumerate(chans):
         sig = np.asarray(c.statistics[ch]["significant"], dtype=float)
-        scale, unit = (180.0 / np.pi, "deg") if ch in ANGLES else (1.0, "m")
+        scale, unit = (180.0 / np.pi, "deg") if channel_unit(ch) == "rad" else (1.0, channel_unit(ch))
         finite = sig[ok & np.isfinite(sig)] * scale
         vmax = float(finite.max()) if finite.size and finite.max() > 0 else 1.0
         for k, b in enumerate(uniq):
@@ -117,7 +126,8 @@ def plot_campaign(c, out: str, limits: Optional[dict] = None, case: Optional[int
         fig.supxlabel("failed: every case of the cell failed; *: some of its seeds failed (the mean is of the others)",
                       fontsize=7, color="tab:red")
     lim = dict(limits if limits is not None else {})
-    bottom = gs[rows - 1, :].subgridspec(1, 3, width_ratios=[1, 1.6, 1.6])
+    groups = _groups(chans)
+    bottom = gs[rows - 1, :].subgridspec(1, 1 + len(groups), width_ratios=[1] + [1.6] * len(groups))
     axp = fig.add_subplot(bottom[0, 0], projection="polar")
     if lim and (ok | failed).any():
         th, per, share = heading_operability(c, lim)
@@ -130,20 +140,18 @@ def plot_campaign(c, out: str, limits: Optional[dict] = None, case: Optional[int
     else:
         axp.set_title("operability: no limits given" if not lim else "operability: no case finished yet", fontsize=7)
     axp.tick_params(labelsize=6)
-    _spectra(fig, bottom, c, chans, ok, case, heads, hs_all, tp_all)
+    _spectra(fig, bottom, c, groups, ok, case, heads, hs_all, tp_all)
     fig.suptitle(title or _title(c, heads), fontsize=10)
     with finishing():           # Ctrl-C meanwhile: the figure whole, then exit 130 (run/guard.py)
         fig.savefig(out, dpi=90)
     return fig
 
 
-def _spectra(fig, bottom, c, chans, ok, case, heads, hs_all, tp_all):
-    """The response spectra of one case, angles and displacements on their own axes, over the
-    frequencies where they hold energy; the frequency resolution in the title."""
+def _spectra(fig, bottom, c, groups, ok, case, heads, hs_all, tp_all):
+    """The response spectra of one case, each unit's channels (_groups) on their own axes, over
+    the frequencies where they hold energy; the frequency resolution in the title."""
     w = np.asarray(c.frequency, dtype=float)
-    groups = [("rad^2 s/rad", [ch for ch in chans if ch in ANGLES]),
-              ("m^2 s/rad", [ch for ch in chans if ch not in ANGLES])]
-    axes = [fig.add_subplot(bottom[0, 1 + g]) for g in range(2)]
+    axes = [fig.add_subplot(bottom[0, 1 + g]) for g in range(len(groups))]
     if not ok.any() and case is None:
         for ax in axes:
             ax.text(0.5, 0.5, "no finished case: no spectra", ha="center", va="center", fontsize=8,

@@ -7,7 +7,7 @@ import numpy as np
 
 from ..fit.identify import FitResult
 from ..fit.params import param_value
-from ..fit.problem import as_result, channels_of
+from ..fit.problem import as_result, channel_unit, channels_of
 from ..run.simulate import simulate
 from ..scene.types import Scene
 from ..run.guard import finishing
@@ -39,9 +39,9 @@ def plot_fit(scene: Scene, measured, fit_result: FitResult, out_png: Optional[st
     else:
         fig = figure(9, 2.4 * len(names) + 0.6)
         axes = fig.subplots(len(names), 1, sharex=True, squeeze=False)
-    units = {"roll": ("deg", np.degrees), "pitch": ("deg", np.degrees), "heave": ("m", lambda x: x)}
+    units = {"rad": ("deg", np.degrees), "m": ("m", lambda x: x), "N": ("N", lambda x: x)}
     for ax, k in zip(axes[:, 0], names):
-        unit, conv = units.get(k, ("m", lambda x: x))
+        unit, conv = units[channel_unit(k)]         # a body's roll in degrees too
         ax.plot(t_m, conv(meas[k]), ".", ms=3, color="k", alpha=0.35, label="measured")
         if ch_start is not None and k in ch_start:
             ax.plot(np.asarray(r0.time), conv(ch_start[k]), "--", lw=0.9, color="C1", label="start")

@@ -1,4 +1,5 @@
-"""Time histories of a result: roll, pitch, heave and every probe; of a sweep, every run overlaid."""
+"""Time histories of a result: roll, pitch, heave and every probe, with the [[bodies]]' roll, pitch
+and heave and the [[connections]]' forces; of a sweep, every run overlaid."""
 from __future__ import annotations
 
 import numpy as np
@@ -29,14 +30,17 @@ def scene_title(scene_text: str, default: str = "jaxslosh result") -> str:
     return title.strip() if isinstance(title, str) and title.strip() else default
 
 
-def _axes(r):
-    rows = 2 + (1 if r.probes else 0)
+def _axes(r, links: bool = False):
+    """The panels: angles, heave, the probes' (where any), the connections' forces (`links`)."""
+    rows = 2 + (1 if r.probes else 0) + (1 if links else 0)
     fig = figure(9, 2.6 * rows)
     ax = fig.subplots(rows, 1, sharex=True)
     ax[0].set_ylabel("angle (deg)")
     ax[1].set_ylabel("heave (m)")
     if r.probes:
         ax[2].set_ylabel("vertical displacement (m)")
+    if links:
+        ax[-1].set_ylabel("connection force (kN)")
     ax[-1].set_xlabel("time (s)")
     return fig, ax
 
@@ -51,18 +55,33 @@ def _finish(fig, title: str, out: str) -> Figure:
 
 def plot_result(r, out: str) -> Figure:
     """Time histories: roll, pitch, heave and the vertical displacement of every probe, titled with
-    the scene's title (and the status of a run that failed). Returns the figure written."""
+    the scene's title (and the status of a run that failed); each [[bodies]] body's roll and pitch
+    beside the vessel's (named), its heave (its COG's offset from rest) beside the vessel's, and a
+    panel of the [[connections]]' forces (positive when they pull). Returns the figure written."""
     t = np.asarray(r.time)
     rpy = np.asarray(r.vessel.roll_pitch_yaw)
-    fig, ax = _axes(r)
+    bodies, links = r.bodies or {}, r.connections or {}
+    fig, ax = _axes(r, bool(links))
     ax[0].plot(t, np.degrees(rpy[:, 0]), label="roll")
     ax[0].plot(t, np.degrees(rpy[:, 1]), label="pitch")
-    ax[0].legend(loc="upper right")
-    ax[1].plot(t, np.asarray(r.vessel.position)[:, 2], color="C2")
+    ax[1].plot(t, np.asarray(r.vessel.position)[:, 2], color="C2", label="vessel" if bodies else None)
+    for i, (name, b) in enumerate(bodies.items()):        # the vessel's colours first, then one per body
+        c = f"C{(i + 3) % 10}"
+        brpy = np.degrees(np.asarray(b.roll_pitch_yaw))
+        ax[0].plot(t, brpy[:, 0], color=c, label=f"{name} roll")
+        ax[0].plot(t, brpy[:, 1], color=c, ls="--", label=f"{name} pitch")
+        ax[1].plot(t, np.asarray(b.position)[:, 2], color=c, label=name)
+    ax[0].legend(loc="upper right", fontsize=7 if bodies else None)
+    if bodies:
+        ax[1].legend(loc="upper right", fontsize=7)
     if r.probes:
         for name, p in r.probes.items():
             ax[2].plot(t, np.asarray(p.displacement)[:, 2], label=f"probe {name}")
         ax[2].legend(loc="upper right")
+    for name, c in links.items():
+        ax[-1].plot(t, 1e-3 * np.asarray(c.force), label=name)
+    if links:
+        ax[-1].legend(loc="upper right", fontsize=7)
     status = "" if r.status == "ok" else f"  [{r.status}]"
     return _finish(fig, scene_title(r.scene_text) + status, out)
 

@@ -12,8 +12,13 @@ def plot_stability(s, out: str, title: str = ""):
     fig = figure(9, 5.5)
     ax = fig.add_axes([0.08, 0.11, 0.6, 0.8])
     deg = np.degrees(np.asarray(s.angle))
-    ax.plot(deg, s.gz, color="C0", label="liquids level (b)")
-    ax.plot(deg, s.gz_frozen, color="C1", ls="--", label="liquids frozen (a)")
+    linear = getattr(s, "model", "hull") == "linear"
+    ax.plot(deg, s.gz, color="C0", label="vessel, linear hydrostatics" if linear else "liquids level (b)")
+    if not linear:
+        ax.plot(deg, s.gz_frozen, color="C1", ls="--", label="liquids frozen (a)")
+    for i, b in enumerate(getattr(s, "bodies", {}).values()):      # [[bodies]]: their linear curves
+        ax.plot(np.degrees(np.asarray(b.angle)), b.gz, color=f"C{i + 4}", lw=1.2,
+                label=f"{b.name}, linear (GM0 = {b.gm0:.3f} m)")
     # GM0 as the tangent at the origin, drawn to one radian
     ax.plot([0, np.degrees(1.0)], [0, s.gm0], color="C0", lw=0.7, ls=":", label=f"GM0 = {s.gm0:.3f} m at 1 rad")
     ax.axhline(0.0, color="k", lw=0.6)

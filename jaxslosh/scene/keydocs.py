@@ -321,7 +321,10 @@ KEYS = (
     ("campaign.duration", "simulation.duration", "s", "Each case's duration."),
     ("campaign.limits.<channel>", "none", "rad, m or N", 'Limit of a channel: roll, pitch (rad), heave, '
                                                          '"probe.<name>" (m), "mooring.<line>" (N, the fairlead '
-                                                         'tension about its mean; quoted or as a dotted key).'),
+                                                         'tension about its mean), "<body>.roll", "<body>.pitch" '
+                                                         '(rad), "<body>.heave" (m) of a [[bodies]] body, '
+                                                         '"connection.<name>" (N, its force about its mean); '
+                                                         'quoted or as a dotted key.'),
 )
 # a body's hydrodynamics: the vessel's keys, read by the vessel's reader (scene/bodies.py)
 KEYS = KEYS + tuple(

@@ -56,6 +56,9 @@ TANK_TRACEABLE = ("fill_depth", "fluid.density", "fluid.sound_speed", "damping.r
 MOORING_TRACEABLE = ("length", "weight", "ea", "seabed_friction")
 # a connection's values, leaves of its link (physics/bodies.py)
 CONNECTION_TRACEABLE = ("length", "stiffness", "damping")
+# a [[bodies]] body's values, leaves of its rigid terms (assemble/bodies.py)
+BODY_TRACEABLE = ("mass", "hydrostatics.waterplane_area", "hydrostatics.displaced_volume", "hydrostatics.gm_t",
+                  "hydrostatics.gm_l")
 
 
 TRACEABLE = _Keys((
@@ -67,7 +70,8 @@ TRACEABLE = _Keys((
     "vessel.forced.amplitude", "vessel.forced.frequency", "vessel.forced.phase",
 ) + tuple(f"tanks.<name>.{k}" for k in TANK_TRACEABLE) + ("waves.amplitude", "waves.hs")
   + tuple(f"mooring.<name>.{k}" for k in MOORING_TRACEABLE)
-  + tuple(f"connections.<name>.{k}" for k in CONNECTION_TRACEABLE))
+  + tuple(f"connections.<name>.{k}" for k in CONNECTION_TRACEABLE)
+  + tuple(f"bodies.<name>.{k}" for k in BODY_TRACEABLE))
 
 # keys traced by the nonlinear hydrostatics alone (assemble/hull.py moves the hull's surface against the
 # COG); the linear model's GM springs were derived from them when the scene was loaded
@@ -142,6 +146,13 @@ def scene_values(scene: Scene) -> dict[str, Any]:
             own["stiffness"] = c.stiffness
         for prefix in (f"connections.{c.name}", f"connections[{i}]"):
             v.update({f"{prefix}.{k}": x for k, x in own.items()})
+    for i, b in enumerate(scene.bodies):
+        h = b.hydrostatics
+        own = {"mass": b.mass, "cog_height": b.cog_height, "heading": b.heading,
+               "hydrostatics.waterplane_area": h.waterplane_area, "hydrostatics.displaced_volume": h.displaced_volume,
+               "hydrostatics.gm_t": h.gm_t, "hydrostatics.gm_l": h.gm_l}
+        for prefix in (f"bodies.{b.name}", f"bodies[{i}]"):
+            v.update({f"{prefix}.{k}": x for k, x in own.items()})
     if scene.campaign is not None:   # a campaign's settings (never traced: they change no run)
         if scene.campaign.duration is not None:
             v["campaign.duration"] = scene.campaign.duration
@@ -153,7 +164,8 @@ def scene_values(scene: Scene) -> dict[str, Any]:
 def canonical_key(scene: Scene, key: str) -> str:
     """The name form of a dotted key: `tanks[0].fill_depth` -> `tanks.tank.fill_depth` (others unchanged)."""
     for group, items in (("tanks", scene.tanks), ("structures", scene.structures), ("probes", scene.probes),
-                         ("mooring", scene.mooring), ("connections", scene.connections)):
+                         ("mooring", scene.mooring), ("connections", scene.connections),
+                         ("bodies", scene.bodies)):
         if key.startswith(group + "["):
             index, sep, rest = key[len(group) + 1:].partition("]")
             if sep and index.isdigit() and int(index) < len(items):
@@ -293,7 +305,8 @@ def _plain(value):
 def _toml_path(scene: Scene, key: str) -> list:
     """The path of a canonical key in the TOML mapping: `tanks.tank.fill_depth` -> ["tanks", 0, "fill_depth"]."""
     for group, items in (("tanks", scene.tanks), ("structures", scene.structures), ("probes", scene.probes),
-                         ("mooring", scene.mooring), ("connections", scene.connections)):
+                         ("mooring", scene.mooring), ("connections", scene.connections),
+                         ("bodies", scene.bodies)):
         for i, item in enumerate(items):
             head = f"{group}.{item.name}."
             if key.startswith(head):

@@ -135,7 +135,8 @@ def parse_scene(mapping: Mapping[str, Any], text: str = "", path: str = "") -> S
         waves = read_waves(mapping["waves"], warnings)
     campaign = None
     if "campaign" in mapping:   # a campaign's limits and defaults (campaign.py)
-        campaign = read_campaign(mapping["campaign"], probes, waves, simulation.dt, warnings, mooring)
+        campaign = read_campaign(mapping["campaign"], probes, waves, simulation.dt, warnings, mooring,
+                                 bodies, connections)
     scene = Scene(title=title, environment=environment, simulation=simulation, vessel=vessel, tanks=tanks,
                   structures=structures, probes=probes, effects=effects, text=text, path=path,
                   warnings=tuple(warnings), waves=waves, campaign=campaign, mooring=mooring, bodies=bodies,
