@@ -127,6 +127,11 @@ class AbstractOwner(AbstractTerm):
     def block_diagonal(self, c_m, c_k):
         """The diagonal of its deformable unknowns' block of c_m M + c_k K (constant)."""
 
+    def deformable_block(self, c_m, c_k):
+        """Its deformable unknowns' block of c_m M + c_k K (constant): its diagonal (m,) where the
+        block is diagonal (the structures' modal one), else the block (m, m) (the bodies' tank liquid)."""
+        return self.block_diagonal(c_m, c_k)
+
     @abc.abstractmethod
     def initial_constraint_rows(self, system, c: Config, v, alg0, mscale):
         """x -> its constraint rows of the initial accelerations (x: accelerations and alg)."""
