@@ -16,7 +16,7 @@ water_density = 1025.0
 duration = {duration}
 dt = 0.02
 scheme = "newmark"
-tolerance = 1e-11
+tolerance = 1e-10
 """
 
 VESSEL = """
@@ -48,37 +48,37 @@ angular_velocity = [0.05, 0.0, 0.0]
 TANK = """
 [[tanks]]
 name = "cargo"
-{body}origin = [-4.0, -5.0, 1.0]
-size = [8.0, 10.0, 3.0]
+{body}origin = [-4.0, -2.0, 1.0]
+size = [8.0, 4.0, 3.0]
 fill_depth = 1.5
-mesh = [2, 6, 3]
+mesh = [2, 4, 3]
 [tanks.reduction]
 modes = {modes}
 """
 
-VOLUME = (3.0e5 + 8.0 * 10.0 * 1.5 * 1000.0) / 1025.0     # the carrier and its liquid float at rest
+VOLUME = (3.0e5 + 8.0 * 4.0 * 1.5 * 1000.0) / 1025.0     # the carrier and its liquid float at rest
 
 
-def scene_on_body(duration=2.0, modes=6):
+def scene_on_body(duration=6.0, modes=6):
     """The vessel and the carrier beside it (200 m away, nothing between them), the tank on the carrier."""
     text = (HEAD.format(duration=duration) + VESSEL + '[[bodies]]\nname = "carrier"\nposition = [0.0, 200.0]\n'
             + CARRIER.format(table="bodies", volume=VOLUME) + TANK.format(body='body = "carrier"\n', modes=modes))
     return js.load_scene(text)
 
 
-def scene_alone(duration=2.0, modes=6):
+def scene_alone(duration=6.0, modes=6):
     """The carrier as the only vessel, with the same tank."""
     text = HEAD.format(duration=duration) + "[vessel]\n" + CARRIER.format(table="vessel", volume=VOLUME) + \
         TANK.format(body="", modes=modes)
     return js.load_scene(text)
 
 
-def scene_vessel_only(duration=2.0):
+def scene_vessel_only(duration=6.0):
     return js.load_scene(HEAD.format(duration=duration) + VESSEL)
 
 
 def test_a_body_with_a_tank_moves_as_the_same_vessel_with_the_same_tank():
-    """Over 100 steps of a roll decay: the body's motion and its tank's free surface equal the lone
+    """Over 300 steps of a roll decay: the body's motion and its tank's free surface equal the lone
     vessel's and its tank's within 1e-8 (m, rad), and the vessel beside it equals the vessel alone."""
     a = js.simulate(scene_on_body())
     b = js.simulate(scene_alone())
