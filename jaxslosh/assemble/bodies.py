@@ -129,8 +129,12 @@ def _about(scene) -> About:
                                        f"{h.gm_l:g} m){damp}"))
         for t in b.tanks if scene.effects.liquid else ():      # the vessel's tank lines, on this body's frame
             what, text = tank_line(t)
-            lines.append((what, f"{text}; carried by the body {b.name!r} (in its frame, its liquid's unknowns its "
-                                f"own, its loads on the body's six rows)"))
+            eff = scene.effects
+            loads = ", ".join(["its element's rotation penalty"] + ["Coriolis"] * eff.coriolis
+                              + ["centrifugal"] * eff.centrifugal + ["gravity turning with the body"])
+            lines.append((what, f"{text}, on {t.reduction.modes} modes; carried by the body {b.name!r} (in its frame "
+                                f"from its COG, its liquid's unknowns its own, its loads on the body's six rows: "
+                                f"{loads})"))
     shown = {"vessel": scene.vessel.name}       # the ends as the scene names them
     for c in scene.connections:
         law = f"stiffness {c.stiffness:g} N/m" if c.stiffness is not None else f"a {len(c.curve)}-point force curve"

@@ -17,6 +17,7 @@ import numpy as np
 from ..mooring.lumped_term import build_lumped_lines
 from ..mooring.term import build_mooring
 from ..liquid.modal_damping import ModalDamping
+from ..physics.bodies import bodies_term
 from ..physics.kinematics import quat_from_rpy, rotation_matrix
 from ..liquid.base import RotationPenalty, SpinStiffening
 from ..liquid.multimodal.term import MultimodalLiquid
@@ -95,7 +96,7 @@ def build(scene: Scene, params: Optional[dict] = None) -> Built:
         c0, v0 = motion.start(c0, v0)
     # the terms that own unknowns (the structures) start them; nothing to compile without
     c0, v0, alg0 = _start(system, c0, v0) if system.owners() else (c0, v0, jnp.zeros(0))
-    probes = build_probes(scene, block.tanks, liquid, blocks, block.vstructs)
+    probes = build_probes(scene, block.tanks, liquid, blocks, block.vstructs, body_tanks, bodies_term(system))
     probes = probes._replace(modal=liquid.probe_modal(probes.weights))    # a modal liquid: probes from eta
     tanks = block.tanks
     if multimodal:

@@ -75,6 +75,10 @@ def probe_positions(b: Built, c: Config):
             body = structures.bodies[sp.index]
             x = sp.r + sp.W @ body.u(etas[sp.index])
             probes = probes.at[sp.rows].set(c.Xs[sp.index][None, :] + x @ rotation_matrix(c.qs[sp.index]).T)
+    for bp in pr.on_bodies:               # probes in a body's tanks: its liquid, in its frame
+        tank = bodies_term(sysm).bodies[bp.index].tank
+        x = bp.r + tank.probe_displacements(None, bp.modal, c.eta[bp.offset:bp.offset + bp.n])
+        probes = probes.at[bp.rows].set(c.Xs[bp.index][None, :] + x @ rotation_matrix(c.qs[bp.index]).T)
     return probes
 
 

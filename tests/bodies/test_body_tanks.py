@@ -54,6 +54,10 @@ fill_depth = 1.5
 mesh = [2, 4, 3]
 [tanks.reduction]
 modes = {modes}
+[[probes]]
+name = "crest"
+tank = "cargo"
+point = [4.0, 4.0, 1.5]
 """
 
 VOLUME = (3.0e5 + 8.0 * 4.0 * 1.5 * 1000.0) / 1025.0     # the carrier and its liquid float at rest
@@ -90,5 +94,9 @@ def test_a_body_with_a_tank_moves_as_the_same_vessel_with_the_same_tank():
     Da, Db = a.tanks["cargo"].displacement, b.tanks["cargo"].displacement
     assert np.abs(Db).max() > 1e-3                                  # it sloshes
     np.testing.assert_allclose(Da, Db, rtol=0, atol=1e-8)
+    # a probe on the free surface at a side wall follows the body's liquid
+    pa, pb = a.probes["crest"].displacement, b.probes["crest"].displacement
+    assert np.abs(pb[:, 2]).max() > 0.02
+    np.testing.assert_allclose(pa, pb, rtol=0, atol=1e-8)
     np.testing.assert_allclose(a.vessel.roll_pitch_yaw, v.vessel.roll_pitch_yaw, rtol=0, atol=1e-10)
     np.testing.assert_allclose(a.vessel.position, v.vessel.position, rtol=0, atol=1e-10)
