@@ -28,9 +28,19 @@ NOT_YET = {"hull": "hull meshes (and the waves' and the nonlinear hydrostatics' 
 RESERVED = ("vessel", "fixed")
 
 
-def tank_carriers(tables) -> tuple:
-    """The `body` each `[[tanks]]` table names ("vessel" by default), in order."""
-    return tuple((t.get("body", "vessel") if isinstance(t, dict) else "vessel") for t in tables)
+def tank_carriers(tables, vessel_name: str) -> tuple:
+    """The body each `[[tanks]]` table names in `body`, in order: "vessel" (the default, or the
+    vessel's name) or a body's name."""
+    named = tuple((t.get("body", "vessel") if isinstance(t, dict) else "vessel") for t in tables)
+    return tuple("vessel" if n == vessel_name else n for n in named)
+
+
+def tank_groups(tanks, carriers) -> dict:
+    """{carrier: its tanks} (tank_carriers' names), in the scene's order."""
+    out: dict = {}
+    for t, c in zip(tanks, carriers):
+        out[c] = out.get(c, ()) + (t,)
+    return out
 
 
 def read_bodies(tables, vessel, environment, warnings: list[str], files=None, tanks=(), carriers=()) -> tuple[Body, ...]:
