@@ -11,7 +11,8 @@ x = [vessel, liquid]: one step serves every system (solve/integrator.py), the ow
 entering it as the cheap part Rc of R = Rm + Rc (an empty set of constraints without them).
 The layout holds one owner's unknowns after the vessel's and the liquid's (the flexible
 structures, physics/structures.py, which tie any number of bodies through one term; or the rigid
-floating bodies and their connections, physics/bodies.py).
+floating bodies and their connections, physics/bodies.py, whose deformable unknowns are the liquid
+of the bodies' tanks).
 """
 from __future__ import annotations
 

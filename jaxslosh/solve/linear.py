@@ -69,7 +69,8 @@ def make_solver(system: System, h: float, scheme: Scheme, tol: float, max_iter: 
     """Factor the constant liquid blocks once (float64): NumPy for concrete matrices, JAX when the
     liquid was built from traced values (under jit); the terms that own deformable unknowns append
     their block, diagonal (the structures' modal one, Phi^T M Phi = I, Phi^T K Phi = omega^2:
-    1 / (c_a + omega^2)), and their rigid and algebraic unknowns join the exact block.
+    1 / (c_a + omega^2)) or a small dense one (the bodies' tanks' liquid, inverted here), and their
+    rigid and algebraic unknowns join the exact block.
 
     The inverses only precondition the Newton iterations and the tangent solves, whose solutions do
     not depend on them (`lax.custom_root` drops their tangents), so they are formed from
