@@ -66,11 +66,14 @@ def build_probes(scene: Scene, tanks, liquid, structures=(), vstructs=(), body_t
         w = np.zeros(N)
         if p.tank is not None and p.tank in carried:      # in a body's tank: it follows that body
             s, t = carried[p.tank]
-            bt = next(x for x in body_tanks if x.body == s)
-            floating = bodies.bodies[s]
-            r, modal = _body_probe(p, t, bt, floating.tank)
+            bt = next((x for x in body_tanks if x.body == s), None)
+            if bt is None:                # no liquid built ([effects] liquid = false): it follows the body
+                r, modal, at = np.asarray(t.origin) + np.asarray(p.point), jnp.zeros((0, 3)), (0, 0)
+            else:
+                r, modal = _body_probe(p, t, bt, bodies.bodies[s].tank)
+                at = (bt.offset, bodies.bodies[s].nf)
             pts.append(r)
-            on_body.setdefault(s, (bt.offset, floating.nf, []))[2].append((i, r, modal))
+            on_body.setdefault(s, (*at, []))[2].append((i, r, modal))
         elif p.tank is not None:
             t = scene.tank(p.tank)
             pts.append(np.asarray(t.origin) + np.asarray(p.point))

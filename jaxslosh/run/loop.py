@@ -77,7 +77,7 @@ def probe_positions(b: Built, c: Config):
             probes = probes.at[sp.rows].set(c.Xs[sp.index][None, :] + x @ rotation_matrix(c.qs[sp.index]).T)
     for bp in pr.on_bodies:               # probes in a body's tanks: its liquid, in its frame
         tank = bodies_term(sysm).bodies[bp.index].tank
-        x = bp.r + tank.probe_displacements(None, bp.modal, c.eta[bp.offset:bp.offset + bp.n])
+        x = bp.r if tank is None else bp.r + tank.probe_displacements(None, bp.modal, c.eta[bp.offset:bp.offset + bp.n])
         probes = probes.at[bp.rows].set(c.Xs[bp.index][None, :] + x @ rotation_matrix(c.qs[bp.index]).T)
     return probes
 

@@ -175,3 +175,29 @@ def test_a_body_with_a_tank_on_a_hawser_runs_from_the_command_line(tmp_path, cap
         assert np.abs(f["tanks/cargo/displacement"][-1]).max() > 0
         assert f["probes/crest/position"].shape == (21, 3)
         assert np.all(f["connections/hawser/force"][:] >= 0)
+
+
+@pytest.mark.parametrize("old,new,what", [
+    ("[tanks.reduction]\nmodes = 6\n", "", "full-order tanks"),
+    ("[tanks.reduction]\nmodes = 6\n", '[tanks.reduction]\nmodes = 6\n[tanks.damping]\nratio = 0.01\n',
+     "liquid damping"),
+    ('mesh = [2, 4, 3]\n', 'mesh = [2, 4, 3]\n[tanks.walls]\nthickness = 0.02\n[tanks.walls.material]\n'
+     'young = 2.0e11\npoisson = 0.3\ndensity = 7850.0\n', "elastic tank walls"),
+    ('mesh = [2, 4, 3]\n[tanks.reduction]\nmodes = 6\n', 'model = "multimodal"\n', "multimodal tanks"),
+], ids=["full-order", "damping", "elastic", "multimodal"])
+def test_what_a_body_tank_cannot_be_yet_is_refused_naming_the_key(old, new, what):
+    text = scene_on_body().text
+    assert old in text
+    with pytest.raises(js.SceneError) as e:
+        js.load_scene(text.replace(old, new, 1))
+    assert e.value.key == "tanks[0].body" and what in str(e.value), str(e.value)
+
+
+def test_without_the_liquid_a_probe_in_a_body_tank_follows_the_body():
+    """[effects] liquid = false: no liquid unknowns, the probe moves rigidly with the carrier."""
+    r = js.simulate(js.load_scene(scene_on_body(duration=0.2).text + "[effects]\nliquid = false\n"))
+    p = np.asarray(r.probes["crest"].position)
+    rpy = np.asarray(r.bodies["carrier"].roll_pitch_yaw)
+    assert "cargo" not in r.tanks
+    # the point (0, 2, 2.5) from the carrier's COG, the carrier at (0, 200) rolling about x
+    np.testing.assert_allclose(p[:, 1], 200.0 + 2.0 * np.cos(rpy[:, 0]) - 2.5 * np.sin(rpy[:, 0]), atol=1e-6)
