@@ -15,8 +15,9 @@ from ..physics.bodies import BAND, Bodies, Floating, Link, body_rest, end_index
 from ..physics.kinematics import quat_from_rpy
 from ..physics.seakeeping import LinearDamping, WaveExcitation
 from ..physics.vessel import RESTORING_FORMS, AbstractRestoring, RigidBody
-from .about import tank_line
+from .about import damping_about, tank_line
 from .bodyhydro import time_terms
+from .damping import build_damping
 from .liquid import build_liquid_block
 from .seakeeping import make_excitation
 
@@ -61,10 +62,12 @@ def body_liquid(scene, body, q0, g):
     eff = scene.effects
     if not body.tanks or not eff.liquid:
         return None, (), ()
-    block = build_liquid_block(dataclasses.replace(scene, tanks=body.tanks, structures=()), {}, g)
+    own = dataclasses.replace(scene, tanks=body.tanks, structures=())
+    block = build_liquid_block(own, {}, g)
     liquid = dataclasses.replace(block.liquid, coriolis=eff.coriolis, centrifugal=eff.centrifugal)
     terms = () if block.penalty is None else (RotationPenalty(Kdt=block.penalty[0], Ktt=block.penalty[1], q_ref=q0),)
-    return liquid, terms, block.tanks
+    damping, _ = build_damping(own, {}, block)        # [tanks.damping]: the vessel's modal damping
+    return liquid, terms + (() if damping is None else (damping,)), block.tanks
 
 
 def build_bodies(scene, params: dict, g, outline: bool = False) -> tuple[Optional[Bodies], tuple]:
@@ -127,6 +130,7 @@ def _about(scene) -> About:
                                        f"{b.heading:g} rad, mass {b.mass:g} kg; rigid-body inertia and linear "
                                        f"hydrostatics (A_w {h.waterplane_area:g} m^2, GM_T {h.gm_t:g} m, GM_L "
                                        f"{h.gm_l:g} m){damp}"))
+        damped = dict(damping_about(dataclasses.replace(scene, tanks=b.tanks)).lines)
         for t in b.tanks if scene.effects.liquid else ():      # the vessel's tank lines, on this body's frame
             what, text = tank_line(t)
             eff = scene.effects
@@ -135,6 +139,8 @@ def _about(scene) -> About:
             lines.append((what, f"{text}, on {t.reduction.modes} modes; carried by the body {b.name!r} (in its frame "
                                 f"from its COG, its liquid's unknowns its own, its loads on the body's six rows: "
                                 f"{loads})"))
+            if f"liquid damping in tank {t.name!r}" in damped:
+                lines.append((f"liquid damping in tank {t.name!r}", damped[f"liquid damping in tank {t.name!r}"]))
     shown = {"vessel": scene.vessel.name}       # the ends as the scene names them
     for c in scene.connections:
         law = f"stiffness {c.stiffness:g} N/m" if c.stiffness is not None else f"a {len(c.curve)}-point force curve"

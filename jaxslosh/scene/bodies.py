@@ -171,12 +171,11 @@ def _overlaps(bodies, vessel) -> None:
 
 def _body_tank(table, where: str, body: str) -> None:
     """What a tank on one of [[bodies]] may be yet: a finite-element tank reduced to its modes
-    (`[tanks.reduction]`), rigid walls, no [tanks.damping] (docs/guide/bodies-and-connections.md)."""
+    (`[tanks.reduction]`) with rigid walls (docs/guide/bodies-and-connections.md)."""
     refused = [("model", table.get("model", "fem") == "multimodal", "multimodal tanks"),
                ("reduction", "reduction" not in table, "full-order tanks (give [tanks.reduction] modes = ...: the "
                                                        "reduced liquid)"),
-               ("walls", table.get("walls", "rigid") != "rigid", "elastic tank walls"),
-               ("damping", "damping" in table, "liquid damping ([tanks.damping])")]
+               ("walls", table.get("walls", "rigid") != "rigid", "elastic tank walls")]
     for key, bad, what in refused:
         if bad:
             raise SceneError(f"{where}.body", f"{body!r}: {what} are not available yet on [[bodies]] (only a "

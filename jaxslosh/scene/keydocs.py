@@ -161,7 +161,7 @@ KEYS = (
     ("tanks.body", '"vessel"', "", "The body that carries the tank: \"vessel\" (or the vessel's `name`) or the "
                                    "name of one of `[[bodies]]`. On a body, the tank is in the body's frame (its "
                                    "`origin` from the body's COG) and must be reduced (`[tanks.reduction]`) with rigid "
-                                   "walls and no `[tanks.damping]`; multimodal and full-order tanks are refused there "
+                                   "walls; multimodal and full-order tanks and elastic walls are refused there "
                                    "(docs/guide/bodies-and-connections.md)."),
     ("tanks.origin", _REQ, "m", "The min corner of the tank's bounding box in the frame of the body that carries "
                                 "it (the vessel's by default), from its COG."),
