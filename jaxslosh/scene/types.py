@@ -141,6 +141,7 @@ class Body:
     initial: Initial = field(default_factory=Initial)   # offsets from its rest pose (attitude after the heading)
     viscous_damping: Optional[tuple] = None   # (6, 6) linear damping, N s/m and N m s, its COG and axes
     hydrodynamics: Optional["Hydrodynamics"] = None   # the vessel's keys: tables, a file (its block of a multibody one)
+    tanks: tuple = ()                # the [[tanks]] it carries (`tanks.body`), in its frame from its COG
 
 
 @dataclass(frozen=True)
