@@ -6,9 +6,8 @@ from a scene that fails. Physically doubtful but legal choices (GM <= 0, a displ
 not carry the mass) load, with a sentence in `Scene.warnings` that says what they mean.
 
 The field reader is fields.py; rules that involve several values (dt <= duration, fill_depth <=
-height, probes inside their owner, unique names) follow per table here.
-
-No JAX here: loading a scene is plain Python (and NumPy for the inertia's eigenvalues).
+height, probes inside their owner, unique names) follow per table here. No JAX here: loading a
+scene is plain Python (and NumPy for the inertia's eigenvalues).
 """
 from __future__ import annotations
 

@@ -117,7 +117,7 @@ def test_a_bodys_values_reach_its_terms():
     scene = js.load_scene(SCENE)
     params = {GM_T: 3.0, "bodies.barge.hydrostatics.gm_l": 21.0, "bodies.barge.hydrostatics.waterplane_area": 110.0,
               "bodies.barge.hydrostatics.displaced_volume": 190.0, "bodies.barge.mass": 1.9e5, K: 3.0e5}
-    term = build_bodies(scene, resolve_params(scene, params), 9.81)
+    term = build_bodies(scene, resolve_params(scene, params), 9.81)[0]
     rigid = next(t for t in term.bodies[0].terms if isinstance(t, RigidBody))
     h = next(t for t in term.bodies[0].terms if isinstance(t, AbstractRestoring))
     assert (float(h.gm_t), float(h.gm_l), float(h.waterplane_area), float(h.displaced_volume)) == (3.0, 21.0, 110.0,
@@ -125,7 +125,7 @@ def test_a_bodys_values_reach_its_terms():
     assert float(rigid.mass) == 1.9e5 and float(term.links[0].fs[1]) == 3.0e5
 
     def gm(x):
-        t = build_bodies(scene, {GM_T: x}, 9.81)
+        t = build_bodies(scene, {GM_T: x}, 9.81)[0]
         return next(t for t in t.bodies[0].terms if isinstance(t, AbstractRestoring)).gm_t
 
     assert float(jax.grad(gm)(2.0)) == 1.0
