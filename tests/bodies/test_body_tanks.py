@@ -3,6 +3,7 @@ evaluated with the body's own kinematics. A body with a tank beside the vessel m
 liquid sloshes, as the same body carrying the same tank as the only vessel of a scene (an
 independent path: the vessel's own liquid block); the vessel beside it does not feel it."""
 import h5py
+from meshio.xdmf import TimeSeriesReader
 import numpy as np
 import pytest
 
@@ -190,6 +191,11 @@ def test_a_body_with_a_tank_on_a_hawser_runs_from_the_command_line(tmp_path, cap
         assert np.abs(f["tanks/cargo/displacement"][-1]).max() > 0
         assert f["probes/crest/position"].shape == (21, 3)
         assert np.all(f["connections/hawser/force"][:] >= 0)
+    # ParaView: the body's tank beside the body, carried by it (jaxslosh/io/paraview.py)
+    assert main(["export", "--paraview", str(tmp_path / "view.xdmf"), str(out_file)]) == 0
+    reader = TimeSeriesReader(str(tmp_path / "view_carrier_liquid.xdmf"))
+    points, _ = reader.read_points_cells()
+    assert reader.num_steps == 21 and len(points) == len(h5py.File(out_file)["tanks/cargo/nodes"])
 
 
 @pytest.mark.parametrize("old,new,what", [
