@@ -32,10 +32,11 @@ MAX_ITER = 200
 #: previous step's solution)
 WARM_ITER = 8
 #: chord steps from a warm start with its Jacobian (from a step's motion, two or three reach round-off)
-CHORD_STEPS = 4
-#: the step's residual takes the chord steps' solution where every line's scaled residual is below
-#: this (else NaN: the step fails and says so); the full solve at the step's end reaches TOL
-CHORD_TOL = 1e-10
+CHORD_STEPS = 3
+#: the step's residual takes the chord steps' solution where every line's scaled residual before
+#: the last step is below this (the last gains some four digits more; else NaN: the step fails and
+#: says so); the full solve at the step's end reaches TOL
+CHORD_TOL = 1e-9
 
 
 class Catenary(NamedTuple):
@@ -304,25 +305,28 @@ def _err(r):
 
 
 def _chord(residual, guess, inverse):
-    """(x, residual(x)) after CHORD_STEPS chord steps from `guess` with `inverse` (n, 2, 2), the
-    inverse of the residual's Jacobian at the guess: one evaluation of the profile each (within a
-    step's motion each gains some four digits), a line held once below TOL. Written out, no loop:
-    a `lax.while_loop` inside the residual runs apart from the step's fused kernels."""
+    """(x, the residual before the last step) after CHORD_STEPS chord steps from `guess` with
+    `inverse` (n, 2, 2), the inverse of the residual's Jacobian at the guess: one evaluation of the
+    profile each, none after the last (within a step's motion each step gains some four digits; the
+    profile's evaluations are most of what the lines add to a step), a line held once below TOL.
+    Written out, no loop: a `lax.while_loop` inside the residual runs apart from the step's fused
+    kernels."""
     x, r = guess, residual(guess)
-    for _ in range(CHORD_STEPS):       # a fixed count, unrolled: not a loop over time steps
+    for k in range(CHORD_STEPS):       # a fixed count, unrolled: not a loop over time steps
         dx = jnp.einsum("nij,nj->ni", inverse, r)
         x = jnp.where((_err(r) <= TOL)[:, None], x, _descend(x, dx))
-        r = residual(x)
+        if k < CHORD_STEPS - 1:
+            r = residual(x)
     return x, r
 
 
 def _lines_chord(XF, ZF, L, w, EA, CB, hA, slack, H0, guess, inverse):
     """The chord steps of `_chord` alone, no fallback: what the step's residual solves (it is
     evaluated in every Newton iteration and traced again in every linearisation of the step, where
-    a fallback's loops and cold solve would be compiled again each time). A line still above
-    CHORD_TOL after them (a step that moved it far, a branch change) gives NaN, which fails the
-    step with its number (or redoes it in sub-steps, `[simulation] substeps`); the step's end
-    refreshes the guess with the full solve (`_lines_warm`, once a step)."""
+    a fallback's loops and cold solve would be compiled again each time). A line whose residual
+    before the last step is still above CHORD_TOL (a step that moved it far, a branch change) gives
+    NaN, which fails the step with its number (or redoes it in sub-steps, `[simulation] substeps`);
+    the step's end refreshes the guess with the full solve (`_lines_warm`, once a step)."""
     x, r = _chord(_lines_residual(XF, ZF, L, w, EA, CB, hA, slack, H0), guess, inverse)
     return jnp.where((_err(r) <= CHORD_TOL)[:, None], x, jnp.nan)
 
@@ -334,7 +338,8 @@ def _lines_warm(XF, ZF, L, w, EA, CB, hA, slack, H0, guess, inverse=None):
     run when the chord steps converged); where some line has not converged in WARM_ITER
     iterations (a guess from far away, a branch change), the cold solve of every line."""
     residual = _lines_residual(XF, ZF, L, w, EA, CB, hA, slack, H0)
-    x, r = (guess, residual(guess)) if inverse is None else _chord(residual, guess, inverse)
+    x = guess if inverse is None else _chord(residual, guess, inverse)[0]
+    r = residual(x)
 
     def newton(state):
         x, r, it = state
