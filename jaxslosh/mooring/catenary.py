@@ -361,15 +361,40 @@ def _descend(x, dx):
     return jnp.stack([jnp.maximum(x[:, 0] - dx[:, 0], 0.1 * x[:, 0]), x[:, 1] - dx[:, 1]], axis=1)
 
 
-def lines_inverse(XF, ZF, L, w, EA, CB, hA, x):
-    """(n, 2, 2) the inverse of the lines' residual Jacobian at their solution x (n, 2): what
-    `solve_lines` keeps for chord steps from there."""
-    XF, ZF, L, w, EA, CB, hA = (jnp.asarray(v, dtype=float) for v in (XF, ZF, L, w, EA, CB, hA))
-    slack, H0 = jax.vmap(_slack)(XF, ZF, L, w, EA, CB, hA)
-    J = _blocks(_lines_residual(XF, ZF, L, w, EA, CB, hA, slack, H0), x)
+def _inv2(J):
+    """(n, 2, 2) the inverses of (n, 2, 2) blocks, in closed form."""
     det = J[:, 0, 0] * J[:, 1, 1] - J[:, 0, 1] * J[:, 1, 0]
     return jnp.stack([jnp.stack([J[:, 1, 1], -J[:, 0, 1]], -1), jnp.stack([-J[:, 1, 0], J[:, 0, 0]], -1)],
                      1) / det[:, None, None]
+
+
+def _prepared(XF, ZF, L, w, EA, CB, hA):
+    """The lines' values as float arrays and their residual (`_lines_residual`)."""
+    XF, ZF, L, w, EA, CB, hA = (jnp.asarray(v, dtype=float) for v in (XF, ZF, L, w, EA, CB, hA))
+    slack, H0 = jax.vmap(_slack)(XF, ZF, L, w, EA, CB, hA)
+    return _lines_residual(XF, ZF, L, w, EA, CB, hA, slack, H0)
+
+
+def lines_inverse(XF, ZF, L, w, EA, CB, hA, x):
+    """(n, 2, 2) the inverse of the lines' residual Jacobian at their solution x (n, 2): what
+    `solve_lines` keeps for chord steps from there."""
+    return _inv2(_blocks(_prepared(XF, ZF, L, w, EA, CB, hA), x))
+
+
+def lines_settle(XF, ZF, L, w, EA, CB, hA, guess, inverse):
+    """((n, 2) solutions, (n, 2, 2) the inverses of the Jacobians there) from the chord steps of the
+    step's residual (`_lines_chord`, from the last step's `guess` and `inverse`) and one Newton step
+    after them: what a step's end keeps for the next (once a step, no loop). Where the step's
+    residual took the chord steps' solution (its residual before the last step below CHORD_TOL) the
+    Newton step brings it to round-off; where it did not, the step has failed (NaN) and its states
+    are not kept. The Jacobian is the one at the chord steps' solution (a chord step's, within
+    round-off of the solution's)."""
+    residual = _prepared(XF, ZF, L, w, EA, CB, hA)
+    x, _ = _chord(residual, guess, inverse)
+    r, cols = jax.vmap(lambda e: jax.jvp(residual, (x,), (jnp.broadcast_to(e, x.shape),)),
+                       out_axes=(None, 0))(jnp.eye(2, dtype=x.dtype))
+    J = jnp.moveaxis(cols, 0, -1)
+    return jnp.where((_err(r) <= TOL)[:, None], x, _descend(x, _solve2(J, r))), _inv2(J)
 
 
 def solve_lines(XF, ZF, L, w, EA, CB, hA, guess=None, inverse=None, fallback=True):

@@ -27,7 +27,7 @@ from ..physics.about import About
 from ..physics.bodies import VESSEL, body_rest, end_index
 from ..physics.kinematics import quat_from_rpy, rotation_matrix
 from ..physics.terms import AbstractTerm, Config, Kin, Rows
-from .catenary import lines_inverse, profile, solve_lines
+from .catenary import lines_inverse, lines_settle, profile, solve_lines
 
 #: m^2: keeps the horizontal direction defined (and differentiable) with the fairlead right above its anchor
 _XF_EPS2 = 1e-12
@@ -137,14 +137,18 @@ class MooringLines(AbstractTerm):
     # take those chord steps alone (no loop, no cold fallback: the residual is traced again in every
     # linearisation of the step, and a fallback's code in each copy made compiling a moored run five
     # times longer); a line they leave above catenary.CHORD_TOL gives NaN, which fails the step with
-    # its number. The full solve (its fallbacks included) runs once a step, here, and at the run's
-    # start at the initial pose (solve/integrator.initial_state). No derivative goes through the
-    # states; without states (a caller's own evaluation) the lines are solved cold.
+    # its number. A step's end refreshes the states from the same chord steps and one Newton step
+    # (round-off where the step took them; no loop, `catenary.lines_settle`); the run's start solves
+    # the lines cold at the initial pose (`start`, solve/integrator.initial_state). No derivative goes
+    # through the states; without states (a caller's own evaluation) the lines are solved cold.
     def _settled(self, X0, A, guess=None, inverse=None):
         X0, A = jax.lax.stop_gradient((X0, A))
-        x = self.solve(X0, A, guess, inverse)
         _, _, XF, ZF = self.spans(X0, A)
-        inv = lines_inverse(XF, ZF, *self._values(), x)
+        if guess is None:           # cold (the rest pose, a run's initial pose)
+            x = solve_lines(XF, ZF, *self._values())
+            inv = lines_inverse(XF, ZF, *self._values(), x)
+        else:                       # a step's end: its chord steps and one Newton step, no loop
+            x, inv = lines_settle(XF, ZF, *self._values(), guess, inverse)
         return jax.lax.stop_gradient(jnp.concatenate([x, inv.reshape(-1, 4)], axis=1).reshape(-1))
 
     def state_init(self):
@@ -152,9 +156,11 @@ class MooringLines(AbstractTerm):
             return self._settled(self.rest_X, self.rest_A)
         return self._settled(jnp.zeros(3), jnp.eye(3))
 
-    def state_settle(self, z, c):
-        z = z.reshape(-1, 6)
+    def state_settle(self, z, c, start=False):
         X, A = self.frames(c, rotation_matrix(c.q)) if self.on_bodies else (c.X0, rotation_matrix(c.q))
+        if start:
+            return self._settled(X, A)
+        z = z.reshape(-1, 6)
         return self._settled(X, A, z[:, :2], z[:, 2:].reshape(-1, 2, 2))
 
     def rows(self, k: Kin) -> Rows:
