@@ -304,14 +304,14 @@ def _err(r):
     return jnp.where(jnp.isfinite(r).all(axis=1), jnp.max(jnp.abs(r), axis=1), jnp.inf)
 
 
-def _chord(residual, guess, inverse):
+def _chord(residual, guess, inverse, r0=None):
     """(x, the residual before the last step) after CHORD_STEPS chord steps from `guess` with
     `inverse` (n, 2, 2), the inverse of the residual's Jacobian at the guess: one evaluation of the
     profile each, none after the last (within a step's motion each step gains some four digits; the
     profile's evaluations are most of what the lines add to a step), a line held once below TOL.
     Written out, no loop: a `lax.while_loop` inside the residual runs apart from the step's fused
-    kernels."""
-    x, r = guess, residual(guess)
+    kernels. `r0`: the residual at the guess where the caller has it (`_start_residual`)."""
+    x, r = guess, residual(guess) if r0 is None else r0
     for k in range(CHORD_STEPS):       # a fixed count, unrolled: not a loop over time steps
         dx = jnp.einsum("nij,nj->ni", inverse, r)
         x = jnp.where((_err(r) <= TOL)[:, None], x, _descend(x, dx))
@@ -320,14 +320,24 @@ def _chord(residual, guess, inverse):
     return x, r
 
 
-def _lines_chord(XF, ZF, L, w, EA, CB, hA, slack, H0, guess, inverse):
+def _start_residual(XF, ZF, L, w, slack, H0, guess, at):
+    """The lines' residual at `guess` from `at` (n, 2), the profile's spans (XF, ZF) there, kept
+    from where the guess was solved: no evaluation of the profile (`_line_residual`'s terms)."""
+    first = jnp.where(slack, (guess[:, 0] - H0) / jnp.abs(w), at[:, 0] - XF)
+    return jnp.stack([first, at[:, 1] - ZF], axis=1) / L[:, None]
+
+
+def _lines_chord(XF, ZF, L, w, EA, CB, hA, slack, H0, guess, inverse, at=None):
     """The chord steps of `_chord` alone, no fallback: what the step's residual solves (it is
     evaluated in every Newton iteration and traced again in every linearisation of the step, where
     a fallback's loops and cold solve would be compiled again each time). A line whose residual
     before the last step is still above CHORD_TOL (a step that moved it far, a branch change) gives
     NaN, which fails the step with its number (or redoes it in sub-steps, `[simulation] substeps`);
-    the step's end refreshes the guess with the full solve (`_lines_warm`, once a step)."""
-    x, r = _chord(_lines_residual(XF, ZF, L, w, EA, CB, hA, slack, H0), guess, inverse)
+    the step's end refreshes the guess (`lines_settle`, once a step). `at`: the profile's spans at
+    the guess (then the residual there is not evaluated: one evaluation of the profile fewer in
+    every evaluation of the step's residual)."""
+    r0 = None if at is None else _start_residual(XF, ZF, L, w, slack, H0, guess, at)
+    x, r = _chord(_lines_residual(XF, ZF, L, w, EA, CB, hA, slack, H0), guess, inverse, r0)
     return jnp.where((_err(r) <= CHORD_TOL)[:, None], x, jnp.nan)
 
 
@@ -369,40 +379,50 @@ def _inv2(J):
 
 
 def _prepared(XF, ZF, L, w, EA, CB, hA):
-    """The lines' values as float arrays and their residual (`_lines_residual`)."""
+    """The lines' residual (`_lines_residual`) and (slack, H0) (`_slack`), values as float arrays."""
     XF, ZF, L, w, EA, CB, hA = (jnp.asarray(v, dtype=float) for v in (XF, ZF, L, w, EA, CB, hA))
     slack, H0 = jax.vmap(_slack)(XF, ZF, L, w, EA, CB, hA)
-    return _lines_residual(XF, ZF, L, w, EA, CB, hA, slack, H0)
+    return _lines_residual(XF, ZF, L, w, EA, CB, hA, slack, H0), slack, H0
 
 
 def lines_inverse(XF, ZF, L, w, EA, CB, hA, x):
     """(n, 2, 2) the inverse of the lines' residual Jacobian at their solution x (n, 2): what
     `solve_lines` keeps for chord steps from there."""
-    return _inv2(_blocks(_prepared(XF, ZF, L, w, EA, CB, hA), x))
+    return _inv2(_blocks(_prepared(XF, ZF, L, w, EA, CB, hA)[0], x))
 
 
-def lines_settle(XF, ZF, L, w, EA, CB, hA, guess, inverse):
-    """((n, 2) solutions, (n, 2, 2) the inverses of the Jacobians there) from the chord steps of the
+def lines_settle(XF, ZF, L, w, EA, CB, hA, guess, inverse, at=None):
+    """((n, 2) solutions, (n, 2, 2) the inverses of the Jacobians there, (n, 2) the profile's spans
+    there) from the chord steps of the
     step's residual (`_lines_chord`, from the last step's `guess` and `inverse`) and one Newton step
     after them: what a step's end keeps for the next (once a step, no loop). Where the step's
     residual took the chord steps' solution (its residual before the last step below CHORD_TOL) the
     Newton step brings it to round-off; where it did not, the step has failed (NaN) and its states
     are not kept. The Jacobian is the one at the chord steps' solution (a chord step's, within
-    round-off of the solution's)."""
-    residual = _prepared(XF, ZF, L, w, EA, CB, hA)
-    x, _ = _chord(residual, guess, inverse)
+    round-off of the solution's); `at` as `_lines_chord`'s."""
+    residual, slack, H0 = _prepared(XF, ZF, L, w, EA, CB, hA)
+    r0 = None if at is None else _start_residual(*(jnp.asarray(v, dtype=float) for v in (XF, ZF, L, w)), slack, H0,
+                                                 guess, at)
+    x, _ = _chord(residual, guess, inverse, r0)
     r, cols = jax.vmap(lambda e: jax.jvp(residual, (x,), (jnp.broadcast_to(e, x.shape),)),
                        out_axes=(None, 0))(jnp.eye(2, dtype=x.dtype))
     J = jnp.moveaxis(cols, 0, -1)
-    return jnp.where((_err(r) <= TOL)[:, None], x, _descend(x, _solve2(J, r))), _inv2(J)
+    x = jnp.where((_err(r) <= TOL)[:, None], x, _descend(x, _solve2(J, r)))
+    return x, _inv2(J), lines_spans(L, w, EA, CB, hA, x)
 
 
-def solve_lines(XF, ZF, L, w, EA, CB, hA, guess=None, inverse=None, fallback=True):
+def lines_spans(L, w, EA, CB, hA, x):
+    """(n, 2) the profile's spans (XF, ZF) of the lines at tensions x (n, 2)."""
+    return jnp.stack(jax.vmap(profile)(x[:, 0], x[:, 1], L, w, EA, CB, hA)[:2], axis=1)
+
+
+def solve_lines(XF, ZF, L, w, EA, CB, hA, guess=None, inverse=None, fallback=True, at=None):
     """(n, 2) fairlead tensions (H, V) of n lines ((n,) arrays of spans and values): the same
     solutions as `solve` line by line, the whole-profile Newton run only where a line needs it
     (`_lines_iterations`), or Newton from `guess` (n, 2), a nearby solution such as the previous
     step's (`_lines_warm`, with chord steps where the Jacobian's `inverse` there is given, as
-    `lines_inverse` gives it; with `fallback=False` those chord steps alone, `_lines_chord`);
+    `lines_inverse` gives it; with `fallback=False` those chord steps alone, `_lines_chord`, from
+    the residual at the guess that `at`, the profile's spans there, gives);
     differentiable in every argument through the implicit function
     theorem, one 2 x 2 solve per line, whatever the guess."""
     XF, ZF, L, w, EA, CB, hA = (jnp.asarray(v, dtype=float) for v in (XF, ZF, L, w, EA, CB, hA))
@@ -418,8 +438,11 @@ def solve_lines(XF, ZF, L, w, EA, CB, hA, guess=None, inverse=None, fallback=Tru
         iterate = lambda f, _: _lines_iterations(*spans)  # noqa: E731
     else:
         inv = None if inverse is None else jax.lax.stop_gradient(inverse)
-        warm = _lines_warm if fallback or inv is None else _lines_chord
-        iterate = lambda f, x0: warm(*spans, slack, H0, x0, inv)  # noqa: E731
+        if fallback or inv is None:
+            iterate = lambda f, x0: _lines_warm(*spans, slack, H0, x0, inv)  # noqa: E731
+        else:
+            at = None if at is None else jax.lax.stop_gradient(at)
+            iterate = lambda f, x0: _lines_chord(*spans, slack, H0, x0, inv, at)  # noqa: E731
     x0 = jnp.zeros((XF.shape[0], 2)) if guess is None else jax.lax.stop_gradient(guess)
     return jax.lax.custom_root(residual, x0, iterate, tangent_solve)
 
