@@ -32,7 +32,11 @@ MAX_ITER = 200
 #: previous step's solution)
 WARM_ITER = 8
 #: chord steps from a warm start with its Jacobian (from a step's motion, two or three reach round-off)
-CHORD_STEPS = 4
+CHORD_STEPS = 3
+#: the step's residual takes the chord steps' solution where every line's scaled residual before
+#: the last step is below this (the last gains some four digits more; else NaN: the step fails and
+#: says so); the full solve at the step's end reaches TOL
+CHORD_TOL = 1e-9
 
 
 class Catenary(NamedTuple):
@@ -137,12 +141,14 @@ def _start(XF, ZF, L, w, EA):
 
 
 def _newton(residual, x0, scale):
-    jac = jax.jacfwd(residual)
+    # the residual and its Jacobian from one forward-mode pass, and the error of the step's result
+    # from the line search's own trial residuals: each appears once in the loop's body (every copy
+    # is compiled again wherever the solve is traced)
+    jac = jax.jacfwd(lambda x: (lambda r: (r, r))(residual(x)), has_aux=True)
 
     def step(state):
         x, _, it = state
-        r = residual(x)
-        J = jac(x)
+        J, r = jac(x)
         det = J[0, 0] * J[1, 1] - J[0, 1] * J[1, 0]
         dx = -jnp.array([J[1, 1] * r[0] - J[0, 1] * r[1], J[0, 0] * r[1] - J[1, 0] * r[0]]) / det
         # a backtracking line search, all trial steps at once (no Python or traced loop over
@@ -153,19 +159,18 @@ def _newton(residual, x0, scale):
         alpha = 0.5 ** jnp.arange(12.0)
         H = jnp.maximum(x[0] + alpha * dx[0], 0.1 * x[0])
         trial = jnp.stack([H, x[1] + alpha * dx[1]], axis=1)
-        norms = jax.vmap(lambda y: jnp.sum(residual(y) ** 2))(trial)
+        rs = jax.vmap(residual)(trial)
+        norms = jnp.sum(rs * rs, axis=1)
         norms = jnp.where(jnp.isfinite(norms), norms, jnp.inf)
         ok = norms <= (1 - 1e-4 * alpha) * norm0
         pick = jnp.where(jnp.any(ok), jnp.argmax(ok), jnp.argmin(norms))
-        x = trial[pick]
-        return x, jnp.max(jnp.abs(residual(x))) / scale, it + 1
+        return trial[pick], jnp.max(jnp.abs(rs[pick])) / scale, it + 1
 
     def cond(state):
         _, err, it = state
         return (err > TOL) & (it < MAX_ITER)
 
-    err0 = jnp.max(jnp.abs(residual(x0))) / scale
-    x, err, _ = jax.lax.while_loop(cond, step, (x0, err0, 0))
+    x, err, _ = jax.lax.while_loop(cond, step, (x0, jnp.asarray(jnp.inf, x0.dtype), 0))
     # a line that did not converge gives NaN, which the caller's own Newton reports with its step
     return jnp.where(err <= 1e3 * TOL, x, jnp.nan)
 
@@ -181,23 +186,25 @@ def _contact_solve(XF, ZF, L, w, EA, CB, hA):
         return _contact(H, V, L, w, EA, CB, hA)[0] - XF, V
 
     f = lambda h: parts(h)[0]  # noqa: E731
-    df = jax.grad(f)
     scale = jnp.log(jnp.abs(w) * L)
 
     def step(state):
+        # the value and slope from one jvp, and the error tested at the iterate the step starts
+        # from (one more step past convergence): the profile appears once in the loop's body
         h, lo, hi, _, it = state
-        r = f(h)
+        r, dr = jax.jvp(f, (h,), (jnp.ones_like(h),))
         lo = jnp.where(r < 0, h, lo)
         hi = jnp.where(r > 0, h, hi)
-        new = h - r / df(h)
+        new = h - r / dr
         inside = jnp.isfinite(new) & (new > lo) & (new < hi)
         new = jnp.where(inside, new, 0.5 * (lo + hi))
-        return new, lo, hi, jnp.abs(f(new)) / L, it + 1
+        # a converged iterate stays (a step rounded to nothing would fall outside the bracket)
+        return jnp.where(jnp.abs(r) / L <= TOL, h, new), lo, hi, jnp.abs(r) / L, it + 1
 
     cond = lambda state: (state[3] > TOL) & (state[4] < MAX_ITER)  # noqa: E731
     lo, hi = scale - 40.0, jnp.log(EA) + 10.0
     h0 = jnp.clip(jnp.log(_start(XF, ZF, L, w, EA)[0]), lo + 1.0, hi - 1.0)
-    h, *_ = jax.lax.while_loop(cond, step, (h0, lo, hi, jnp.abs(f(h0)) / L, 0))
+    h, *_ = jax.lax.while_loop(cond, step, (h0, lo, hi, jnp.asarray(jnp.inf, h0.dtype), 0))
     H = jnp.exp(h)
     return jnp.stack([H, parts(h)[1]])
 
@@ -292,37 +299,71 @@ def _solve2(J, r):
                      axis=1) / det[:, None]
 
 
+def _err(r):
+    """Each line's largest scaled residual (inf where it is not finite)."""
+    return jnp.where(jnp.isfinite(r).all(axis=1), jnp.max(jnp.abs(r), axis=1), jnp.inf)
+
+
+def _chord(residual, guess, inverse, r0=None):
+    """(x, the residual before the last step) after CHORD_STEPS chord steps from `guess` with
+    `inverse` (n, 2, 2), the inverse of the residual's Jacobian at the guess: one evaluation of the
+    profile each, none after the last (within a step's motion each step gains some four digits; the
+    profile's evaluations are most of what the lines add to a step), a line held once below TOL.
+    Written out, no loop: a `lax.while_loop` inside the residual runs apart from the step's fused
+    kernels. `r0`: the residual at the guess where the caller has it (`_start_residual`)."""
+    x, r = guess, residual(guess) if r0 is None else r0
+    for k in range(CHORD_STEPS):       # a fixed count, unrolled: not a loop over time steps
+        dx = jnp.einsum("nij,nj->ni", inverse, r)
+        x = jnp.where((_err(r) <= TOL)[:, None], x, _descend(x, dx))
+        if k < CHORD_STEPS - 1:
+            r = residual(x)
+    return x, r
+
+
+def _start_residual(XF, ZF, L, w, slack, H0, guess, at):
+    """The lines' residual at `guess` from `at` (n, 2), the profile's spans (XF, ZF) there, kept
+    from where the guess was solved: no evaluation of the profile (`_line_residual`'s terms)."""
+    first = jnp.where(slack, (guess[:, 0] - H0) / jnp.abs(w), at[:, 0] - XF)
+    return jnp.stack([first, at[:, 1] - ZF], axis=1) / L[:, None]
+
+
+def _lines_chord(XF, ZF, L, w, EA, CB, hA, slack, H0, guess, inverse, at=None):
+    """The chord steps of `_chord` alone, no fallback: what the step's residual solves (it is
+    evaluated in every Newton iteration and traced again in every linearisation of the step, where
+    a fallback's loops and cold solve would be compiled again each time). A line whose residual
+    before the last step is still above CHORD_TOL (a step that moved it far, a branch change) gives
+    NaN, which fails the step with its number (or redoes it in sub-steps, `[simulation] substeps`);
+    the step's end refreshes the guess (`lines_settle`, once a step). `at`: the profile's spans at
+    the guess (then the residual there is not evaluated: one evaluation of the profile fewer in
+    every evaluation of the step's residual)."""
+    r0 = None if at is None else _start_residual(XF, ZF, L, w, slack, H0, guess, at)
+    x, r = _chord(_lines_residual(XF, ZF, L, w, EA, CB, hA, slack, H0), guess, inverse, r0)
+    return jnp.where((_err(r) <= CHORD_TOL)[:, None], x, jnp.nan)
+
+
 def _lines_warm(XF, ZF, L, w, EA, CB, hA, slack, H0, guess, inverse=None):
-    """`_lines_iterations` from a nearby solution `guess` (n, 2) (the previous step's). With
-    `inverse` (n, 2, 2), the inverse of the residual's Jacobian at the guess: CHORD_STEPS chord
-    steps written out (one evaluation of the profile each; within a step's motion each gains some
-    four digits), no loop: a `lax.while_loop` inside the residual cost the paper example more than
-    the whole solve (its iterations run apart from the step's fused kernels). Then, and without
-    `inverse`, Newton where some line is still above TOL, each line held once below it (a loop that
-    does not run when the chord steps converged); where some line has not converged in WARM_ITER
+    """`_lines_iterations` from a nearby solution `guess` (n, 2) (the previous step's): the chord
+    steps of `_chord` where the Jacobian's `inverse` there is given; then, and without `inverse`,
+    Newton where some line is still above TOL, each line held once below it (a loop that does not
+    run when the chord steps converged); where some line has not converged in WARM_ITER
     iterations (a guess from far away, a branch change), the cold solve of every line."""
     residual = _lines_residual(XF, ZF, L, w, EA, CB, hA, slack, H0)
-    err = lambda r: jnp.where(jnp.isfinite(r).all(axis=1), jnp.max(jnp.abs(r), axis=1), jnp.inf)  # noqa: E731
-    x, r = guess, residual(guess)
-    if inverse is not None:
-        for _ in range(CHORD_STEPS):       # a fixed count, unrolled: not a loop over time steps
-            dx = jnp.einsum("nij,nj->ni", inverse, r)
-            x = jnp.where((err(r) <= TOL)[:, None], x, _descend(x, dx))
-            r = residual(x)
+    x = guess if inverse is None else _chord(residual, guess, inverse)[0]
+    r = residual(x)
 
     def newton(state):
         x, r, it = state
-        x = jnp.where((err(r) <= TOL)[:, None], x, _descend(x, _solve2(_blocks(residual, x), r)))
+        x = jnp.where((_err(r) <= TOL)[:, None], x, _descend(x, _solve2(_blocks(residual, x), r)))
         return x, residual(x), it + 1
 
     def polish(state):
-        x, r, _ = jax.lax.while_loop(lambda s: jnp.any(err(s[1]) > TOL) & (s[2] < WARM_ITER), newton, state[:3])
+        x, r, _ = jax.lax.while_loop(lambda s: jnp.any(_err(s[1]) > TOL) & (s[2] < WARM_ITER), newton, state[:3])
         # the cold solve in a loop that runs at most once: under vmap a lax.cond would run it always
         x, _ = jax.lax.while_loop(lambda s: s[1], lambda s: (_lines_iterations(XF, ZF, L, w, EA, CB, hA), False),
-                                  (x, jnp.any(err(r) > TOL)))
+                                  (x, jnp.any(_err(r) > TOL)))
         return x, residual(x), 0, False
 
-    return jax.lax.while_loop(lambda s: s[3], polish, (x, r, 0, jnp.any(err(r) > TOL)))[0]
+    return jax.lax.while_loop(lambda s: s[3], polish, (x, r, 0, jnp.any(_err(r) > TOL)))[0]
 
 
 def _descend(x, dx):
@@ -330,23 +371,59 @@ def _descend(x, dx):
     return jnp.stack([jnp.maximum(x[:, 0] - dx[:, 0], 0.1 * x[:, 0]), x[:, 1] - dx[:, 1]], axis=1)
 
 
-def lines_inverse(XF, ZF, L, w, EA, CB, hA, x):
-    """(n, 2, 2) the inverse of the lines' residual Jacobian at their solution x (n, 2): what
-    `solve_lines` keeps for chord steps from there."""
-    XF, ZF, L, w, EA, CB, hA = (jnp.asarray(v, dtype=float) for v in (XF, ZF, L, w, EA, CB, hA))
-    slack, H0 = jax.vmap(_slack)(XF, ZF, L, w, EA, CB, hA)
-    J = _blocks(_lines_residual(XF, ZF, L, w, EA, CB, hA, slack, H0), x)
+def _inv2(J):
+    """(n, 2, 2) the inverses of (n, 2, 2) blocks, in closed form."""
     det = J[:, 0, 0] * J[:, 1, 1] - J[:, 0, 1] * J[:, 1, 0]
     return jnp.stack([jnp.stack([J[:, 1, 1], -J[:, 0, 1]], -1), jnp.stack([-J[:, 1, 0], J[:, 0, 0]], -1)],
                      1) / det[:, None, None]
 
 
-def solve_lines(XF, ZF, L, w, EA, CB, hA, guess=None, inverse=None):
+def _prepared(XF, ZF, L, w, EA, CB, hA):
+    """The lines' residual (`_lines_residual`) and (slack, H0) (`_slack`), values as float arrays."""
+    XF, ZF, L, w, EA, CB, hA = (jnp.asarray(v, dtype=float) for v in (XF, ZF, L, w, EA, CB, hA))
+    slack, H0 = jax.vmap(_slack)(XF, ZF, L, w, EA, CB, hA)
+    return _lines_residual(XF, ZF, L, w, EA, CB, hA, slack, H0), slack, H0
+
+
+def lines_inverse(XF, ZF, L, w, EA, CB, hA, x):
+    """(n, 2, 2) the inverse of the lines' residual Jacobian at their solution x (n, 2): what
+    `solve_lines` keeps for chord steps from there."""
+    return _inv2(_blocks(_prepared(XF, ZF, L, w, EA, CB, hA)[0], x))
+
+
+def lines_settle(XF, ZF, L, w, EA, CB, hA, guess, inverse, at=None):
+    """((n, 2) solutions, (n, 2, 2) the inverses of the Jacobians there, (n, 2) the profile's spans
+    there) from the chord steps of the
+    step's residual (`_lines_chord`, from the last step's `guess` and `inverse`) and one Newton step
+    after them: what a step's end keeps for the next (once a step, no loop). Where the step's
+    residual took the chord steps' solution (its residual before the last step below CHORD_TOL) the
+    Newton step brings it to round-off; where it did not, the step has failed (NaN) and its states
+    are not kept. The Jacobian is the one at the chord steps' solution (a chord step's, within
+    round-off of the solution's); `at` as `_lines_chord`'s."""
+    residual, slack, H0 = _prepared(XF, ZF, L, w, EA, CB, hA)
+    r0 = None if at is None else _start_residual(*(jnp.asarray(v, dtype=float) for v in (XF, ZF, L, w)), slack, H0,
+                                                 guess, at)
+    x, _ = _chord(residual, guess, inverse, r0)
+    r, cols = jax.vmap(lambda e: jax.jvp(residual, (x,), (jnp.broadcast_to(e, x.shape),)),
+                       out_axes=(None, 0))(jnp.eye(2, dtype=x.dtype))
+    J = jnp.moveaxis(cols, 0, -1)
+    x = jnp.where((_err(r) <= TOL)[:, None], x, _descend(x, _solve2(J, r)))
+    return x, _inv2(J), lines_spans(L, w, EA, CB, hA, x)
+
+
+def lines_spans(L, w, EA, CB, hA, x):
+    """(n, 2) the profile's spans (XF, ZF) of the lines at tensions x (n, 2)."""
+    return jnp.stack(jax.vmap(profile)(x[:, 0], x[:, 1], L, w, EA, CB, hA)[:2], axis=1)
+
+
+def solve_lines(XF, ZF, L, w, EA, CB, hA, guess=None, inverse=None, fallback=True, at=None):
     """(n, 2) fairlead tensions (H, V) of n lines ((n,) arrays of spans and values): the same
     solutions as `solve` line by line, the whole-profile Newton run only where a line needs it
     (`_lines_iterations`), or Newton from `guess` (n, 2), a nearby solution such as the previous
     step's (`_lines_warm`, with chord steps where the Jacobian's `inverse` there is given, as
-    `lines_inverse` gives it); differentiable in every argument through the implicit function
+    `lines_inverse` gives it; with `fallback=False` those chord steps alone, `_lines_chord`, from
+    the residual at the guess that `at`, the profile's spans there, gives);
+    differentiable in every argument through the implicit function
     theorem, one 2 x 2 solve per line, whatever the guess."""
     XF, ZF, L, w, EA, CB, hA = (jnp.asarray(v, dtype=float) for v in (XF, ZF, L, w, EA, CB, hA))
     slack, H0 = jax.lax.stop_gradient(jax.vmap(_slack)(XF, ZF, L, w, EA, CB, hA))
@@ -361,7 +438,11 @@ def solve_lines(XF, ZF, L, w, EA, CB, hA, guess=None, inverse=None):
         iterate = lambda f, _: _lines_iterations(*spans)  # noqa: E731
     else:
         inv = None if inverse is None else jax.lax.stop_gradient(inverse)
-        iterate = lambda f, x0: _lines_warm(*spans, slack, H0, x0, inv)  # noqa: E731
+        if fallback or inv is None:
+            iterate = lambda f, x0: _lines_warm(*spans, slack, H0, x0, inv)  # noqa: E731
+        else:
+            at = None if at is None else jax.lax.stop_gradient(at)
+            iterate = lambda f, x0: _lines_chord(*spans, slack, H0, x0, inv, at)  # noqa: E731
     x0 = jnp.zeros((XF.shape[0], 2)) if guess is None else jax.lax.stop_gradient(guess)
     return jax.lax.custom_root(residual, x0, iterate, tangent_solve)
 
@@ -384,7 +465,10 @@ def catenary(span: tuple, length: float, weight: float, ea: float, seabed_fricti
     """
     XF, ZF = span
     args = tuple(jnp.asarray(v, dtype=float) for v in (XF, ZF, length, weight, ea, seabed_friction, anchor_height))
-    H, V = solve(*args)
+    def solved(s):
+        x = solve(s[0], s[1], *args[2:])
+        return x, x
+    # the solution as the derivative's own primal: the solve traced (and compiled) once
+    K, (H, V) = jax.jacfwd(solved, has_aux=True)(jnp.stack(args[:2]))
     _, _, LB, HA, VA = profile(H, V, *args[2:])
-    K = jax.jacfwd(lambda s: solve(s[0], s[1], *args[2:]))(jnp.stack(args[:2]))
     return Catenary(H, V, HA, VA, LB, K)

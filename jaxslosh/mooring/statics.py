@@ -78,33 +78,59 @@ def static_residual(system, x):
 
 
 def equilibrium(system, scale):
-    """The pose [X0, theta] where the still-water rows vanish, by Newton from rest."""
+    """(the pose [X0, theta] where the still-water rows vanish, Newton's scaled residual at the
+    iterate before the last), by Newton from rest. The residual and its Jacobian come from one
+    forward-mode pass and the test is made on that residual: the rows (the lines' cold solve
+    among them) appear once in the loop's body, which is what its compilation costs."""
     f = lambda x: static_residual(system, x) / scale  # noqa: E731
+    jac = jax.jacfwd(lambda x: (lambda r: (r, r))(f(x)), has_aux=True)
 
     def step(state):
         x, _, it = state
-        r = f(x)
-        dx = -jnp.linalg.solve(jax.jacfwd(f)(x), r)
-        x = x + dx
-        return x, jnp.max(jnp.abs(f(x))), it + 1
+        J, r = jac(x)
+        return x - jnp.linalg.solve(J, r), jnp.max(jnp.abs(r)), it + 1
 
     cond = lambda s: (s[1] > TOL) & (s[2] < MAX_ITER)  # noqa: E731
-    x0 = jnp.zeros(6)
-    x, err, it = jax.lax.while_loop(cond, step, (x0, jnp.max(jnp.abs(f(x0))), 0))
+    x, err, _ = jax.lax.while_loop(cond, step, (jnp.zeros(6), jnp.asarray(jnp.inf), 0))
     return x, err
+
+
+def _loads(term: MooringLines, X0, A, P):
+    """x = (translation, small inertial rotation about P) -> ((the lines' force, their moment about
+    P + translation), the lines' state): the pose's loads with the lines' state beside them."""
+    def loads(x):
+        R = rotation_matrix(quat_exp(x[3:]))
+        X = P + x[:3] + R @ (X0 - P)
+        s = term.state(X, R @ A)
+        F = s.force.sum(axis=0)
+        M = jnp.cross(s.fairlead - X, s.force).sum(axis=0)
+        return jnp.concatenate([F, M + jnp.cross(X - P - x[:3], F)]), s
+    return loads
 
 
 def stiffness(term: MooringLines, X0, A, point=None):
     """The lines' 6 x 6 stiffness K = -d(F, M)/d(x, theta) at pose (X0, A): translations and small
     inertial rotations about `point` (inertial; the COG by default), moments about it too."""
     P = X0 if point is None else jnp.asarray(point, dtype=float)
+    return -jax.jacfwd(_loads(term, X0, A, P), has_aux=True)(jnp.zeros(6))[0]
 
-    def loads(x):
-        R = rotation_matrix(quat_exp(x[3:]))
-        X = P + x[:3] + R @ (X0 - P)
-        F, M = term.force_moment(X, R @ A)
-        return jnp.concatenate([F, M + jnp.cross(X - P - x[:3], F)])
-    return -jax.jacfwd(loads)(jnp.zeros(6))
+
+@eqx.filter_jit
+def _analysis(system, scale, offsets, e):
+    """The equilibrium, and at it and at each offset from it along e the lines' state and
+    stiffness: one program (cached by the system's structure, so that a second call with the
+    same scene compiles nothing), the lines' cold solve traced twice in it (Newton's body, and the
+    poses' state with its derivative, vmapped over the poses)."""
+    term = mooring_term(system)
+    x, err = equilibrium(system, scale)
+    X0, A = x[:3], rotation_matrix(quat_exp(x[3:]))
+
+    def at(o):
+        X = X0 + o * e
+        K, s = jax.jacfwd(_loads(term, X, A, X), has_aux=True)(jnp.zeros(6))
+        return -K, s
+    K, s = jax.vmap(at)(jnp.concatenate([jnp.zeros(1), offsets]))
+    return x, err, rpy_from_quat(quat_exp(x[3:])), K[0], s
 
 
 def line_shape(H, V, L, w, EA, LB, hA, n=200):
@@ -155,30 +181,24 @@ def mooring(scene: Scene, offsets: Optional[Sequence[float]] = None, direction: 
     m = float(system.total_mass())
     size = max(float(np.max(np.abs(np.asarray(term.fairlead)))), 1.0)
     scale = jnp.array([m * g] * 3 + [m * g * size] * 3)
-    x, err = eqx.filter_jit(equilibrium)(system, scale)
+    e = jnp.array([np.cos(direction), np.sin(direction), 0.0])
+    x, err, rpy, K, states = _analysis(system, scale, jnp.asarray(offsets), e)
     if not (np.isfinite(float(err)) and float(err) <= 1e3 * TOL):
         raise StaticFailure(f"no static equilibrium found (Newton's scaled residual {float(err):.3g} after "
                             f"{MAX_ITER} iterations): do the lines and the hydrostatics hold every dof?")
-    q = quat_exp(x[3:])
-    X0, A = x[:3], rotation_matrix(q)
-    eq = np.concatenate([np.asarray(X0), np.asarray(rpy_from_quat(q))])
-    s = eqx.filter_jit(lambda t, X, R: t.state(X, R))(term, X0, A)
+    eq = np.concatenate([np.asarray(x[:3]), np.asarray(rpy)])
+    states = jax.tree_util.tree_map(np.asarray, states)      # NumPy from here: no more programs to compile
+    s = jax.tree_util.tree_map(lambda v: v[0], states)       # at the equilibrium
+    tension = np.hypot(states.horizontal, states.vertical)
+    anchor = np.hypot(states.anchor_horizontal, states.anchor_vertical)
     lines, shapes = [], []
     for i, line in enumerate(scene.mooring):
-        lines.append({"name": line.name, "fairlead_tension": float(s.fairlead_tension[i]),
-                      "anchor_tension": float(s.anchor_tension[i]), "horizontal": float(s.horizontal[i]),
+        lines.append({"name": line.name, "fairlead_tension": float(tension[0, i]),
+                      "anchor_tension": float(anchor[0, i]), "horizontal": float(s.horizontal[i]),
                       "vertical": float(s.vertical[i]), "seabed_length": float(s.seabed_length[i])})
         shapes.append(line_shape(float(s.horizontal[i]), float(s.vertical[i]), line.length, line.weight, line.ea,
                                  float(s.seabed_length[i]), line.anchor_height))
-    K = np.asarray(eqx.filter_jit(stiffness)(term, X0, A))
-    e = jnp.array([np.cos(direction), np.sin(direction), 0.0])
-
-    @eqx.filter_jit
-    def curve(t, offsets):
-        def one(o):
-            st = t.state(X0 + o * e, A)
-            return -(st.force.sum(axis=0) @ e), jnp.max(st.fairlead_tension)
-        return jax.vmap(one)(offsets)
-    restoring, tmax = curve(term, jnp.asarray(offsets))
-    return MooringAnalysis(eq, lines, K, offsets, np.asarray(restoring), np.asarray(tmax), float(direction),
+    restoring = -(states.force[1:].sum(axis=1) @ np.array([np.cos(direction), np.sin(direction), 0.0]))
+    tmax = np.max(tension[1:], axis=1)
+    return MooringAnalysis(eq, lines, np.asarray(K), offsets, restoring, tmax, float(direction),
                            tuple(shapes))

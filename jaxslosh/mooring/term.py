@@ -27,7 +27,7 @@ from ..physics.about import About
 from ..physics.bodies import VESSEL, body_rest, end_index
 from ..physics.kinematics import quat_from_rpy, rotation_matrix
 from ..physics.terms import AbstractTerm, Config, Kin, Rows
-from .catenary import lines_inverse, profile, solve_lines
+from .catenary import lines_inverse, lines_settle, lines_spans, profile, solve_lines
 
 #: m^2: keeps the horizontal direction defined (and differentiable) with the fairlead right above its anchor
 _XF_EPS2 = 1e-12
@@ -104,23 +104,24 @@ class MooringLines(AbstractTerm):
     def _values(self):
         return self.length, self.weight, self.ea, self.friction, self.anchor_height
 
-    def state(self, X0, A, guess=None, inverse=None) -> LineState:
+    def state(self, X0, A, guess=None, inverse=None, fallback=True, at=None) -> LineState:
+        """The lines at the pose (`guess`, `inverse`, `fallback`, `at`: catenary.solve_lines)."""
         p, d, XF, ZF = self.spans(X0, A)
-        H, V = solve_lines(XF, ZF, *self._values(), guess, inverse).T
+        H, V = solve_lines(XF, ZF, *self._values(), guess, inverse, fallback, at).T
         _, _, LB, HA, VA = jax.vmap(profile)(H, V, self.length, self.weight, self.ea, self.friction, self.anchor_height)
         force = jnp.stack([-H * d[:, 0] / XF, -H * d[:, 1] / XF, -V], axis=1)
         return LineState(H, V, HA, VA, LB, force, p)
 
-    def force_moment(self, X0, A, guess=None, inverse=None):
+    def force_moment(self, X0, A, guess=None, inverse=None, fallback=True, at=None):
         """The lines' total force and moment about the COG, both inertial (the carried force left out)."""
-        s = self.state(X0, A, guess, inverse)
+        s = self.state(X0, A, guess, inverse, fallback, at)
         arm = s.fairlead - X0
         return s.force.sum(axis=0), jnp.cross(arm, s.force).sum(axis=0)
 
-    def frame_rows(self, X, A, guess=None, inverse=None):
+    def frame_rows(self, X, A, guess=None, inverse=None, fallback=True, at=None):
         """(S + 1, 6) the lines' generalized forces (force inertial, moment in the body's frame) on
         the vessel (first) and on each body, carried forces included; X, A per line (`frames`)."""
-        s = self.state(X, A, guess, inverse)
+        s = self.state(X, A, guess, inverse, fallback, at)
         moment = jnp.einsum("nji,nj->ni", A, jnp.cross(s.fairlead - X, s.force))
         slot = np.array([0 if e == VESSEL else 1 + e for e in self.ends])
         per = jax.ops.segment_sum(jnp.concatenate([s.force, moment], axis=1), slot, num_segments=self.n_bodies + 1)
@@ -130,35 +131,52 @@ class MooringLines(AbstractTerm):
     # ------------------------------------------------------------ integrator states: a warm start
     # Every residual evaluation of a step solves every line. Started cold (the inextensible estimate,
     # then a bracketed Newton of some ten iterations) three lines added a third to the paper
-    # example's step. The term's states carry each line's (H, V) at the end of the last step and
-    # the inverse of its residual's Jacobian there (refreshed once a step, `state_settle`): chord
-    # steps from there converge to round-off in two or three evaluations of the profile. The states
-    # only start the iterations: the rows are the converged solution whatever they hold (cold where
-    # a caller gives none), and no derivative goes through them.
-    def _settled(self, X0, A, guess=None, inverse=None):
+    # example's step. The term's states carry each line's (H, V) at the end of the last step, the
+    # inverse of its residual's Jacobian there and the profile's spans there (the residual at the
+    # start without evaluating the profile), refreshed once a step (`state_settle`): chord
+    # steps from there converge to round-off in two or three evaluations of the profile. The rows
+    # take those chord steps alone (no loop, no cold fallback: the residual is traced again in every
+    # linearisation of the step, and a fallback's code in each copy made compiling a moored run five
+    # times longer); a line they leave above catenary.CHORD_TOL gives NaN, which fails the step with
+    # its number. A step's end refreshes the states from the same chord steps and one Newton step
+    # (round-off where the step took them; no loop, `catenary.lines_settle`); the run's start solves
+    # the lines cold at the initial pose (`start`, solve/integrator.initial_state). No derivative goes
+    # through the states; without states (a caller's own evaluation) the lines are solved cold.
+    def _settled(self, X0, A, guess=None, inverse=None, at=None):
         X0, A = jax.lax.stop_gradient((X0, A))
-        x = self.solve(X0, A, guess, inverse)
         _, _, XF, ZF = self.spans(X0, A)
-        inv = lines_inverse(XF, ZF, *self._values(), x)
-        return jax.lax.stop_gradient(jnp.concatenate([x, inv.reshape(-1, 4)], axis=1).reshape(-1))
+        if guess is None:           # cold (the rest pose, a run's initial pose)
+            x = solve_lines(XF, ZF, *self._values())
+            inv, at = lines_inverse(XF, ZF, *self._values(), x), lines_spans(*self._values(), x)
+        else:                       # a step's end: its chord steps and one Newton step, no loop
+            x, inv, at = lines_settle(XF, ZF, *self._values(), guess, inverse, at)
+        # per line: (H, V), the inverse Jacobian (4), the profile's spans at (H, V) (`_warm`)
+        return jax.lax.stop_gradient(jnp.concatenate([x, inv.reshape(-1, 4), at], axis=1).reshape(-1))
+
+    @staticmethod
+    def _warm(z):
+        """(guess, inverse, at) from the states z (`_settled`)."""
+        z = z.reshape(-1, 8)
+        return z[:, :2], z[:, 2:6].reshape(-1, 2, 2), z[:, 6:]
 
     def state_init(self):
         if self.on_bodies:
             return self._settled(self.rest_X, self.rest_A)
         return self._settled(jnp.zeros(3), jnp.eye(3))
 
-    def state_settle(self, z, c):
-        z = z.reshape(-1, 6)
+    def state_settle(self, z, c, start=False):
         X, A = self.frames(c, rotation_matrix(c.q)) if self.on_bodies else (c.X0, rotation_matrix(c.q))
-        return self._settled(X, A, z[:, :2], z[:, 2:].reshape(-1, 2, 2))
+        if start:
+            return self._settled(X, A)
+        return self._settled(X, A, *self._warm(z))
 
     def rows(self, k: Kin) -> Rows:
-        z = k.z.reshape(-1, 6)
-        guess, inverse = (z[:, :2], z[:, 2:].reshape(-1, 2, 2)) if k.z.shape[0] else (None, None)
+        guess, inverse, at = self._warm(k.z) if k.z.shape[0] else (None, None, None)
+        # with states (the step's evaluations): the chord steps alone, the full solve at the step's end
         if self.on_bodies:
-            per = self.frame_rows(*self.frames(k.c, k.A), guess, inverse)
+            per = self.frame_rows(*self.frames(k.c, k.A), guess, inverse, False, at)
             return Rows(-per[0], frames=-per[1:].reshape(-1))
-        F, M = self.force_moment(k.c.X0, k.A, guess, inverse)
+        F, M = self.force_moment(k.c.X0, k.A, guess, inverse, False, at)
         return Rows(-jnp.concatenate([F + self.carried, k.A.T @ M]))
 
     def describe(self) -> tuple:
@@ -196,15 +214,23 @@ def build_mooring(scene, balanced: bool, outline: bool = False, params: Optional
                         about=about, **held)
     if outline:
         return term
-    if on_bodies:       # a body's hydrostatics are always linear springs about its rest pose
+    if on_bodies or balanced:
+        return _carry_rest(term, balanced)
+    return term
+
+
+@eqx.filter_jit
+def _carry_rest(term: MooringLines, balanced: bool) -> MooringLines:
+    """The term with the lines' vertical pull at rest carried by the buoyancy (`build_mooring`): one
+    program, cached by the term's structure (run eagerly, the cold solve's loops were compiled anew
+    for every build)."""
+    if term.on_bodies:       # a body's hydrostatics are always linear springs about its rest pose
         per = term.frame_rows(term.rest_X, term.rest_A)
         up = jnp.zeros_like(per[:, :3]).at[:, 2].set(-per[:, 2])
-        term = eqx.tree_at(lambda t: (t.carried, t.carried_bodies), term,
+        return eqx.tree_at(lambda t: (t.carried, t.carried_bodies), term,
                            (up[0] if balanced else jnp.zeros(3), up[1:]))
-    elif balanced:
-        F, _ = term.force_moment(jnp.zeros(3), jnp.eye(3))
-        term = eqx.tree_at(lambda t: t.carried, term, jnp.array([0.0, 0.0, -F[2]]))
-    return term
+    F, _ = term.force_moment(jnp.zeros(3), jnp.eye(3))
+    return eqx.tree_at(lambda t: t.carried, term, jnp.array([0.0, 0.0, -F[2]]))
 
 
 def mooring_term(system) -> Optional[MooringLines]:

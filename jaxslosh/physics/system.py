@@ -231,9 +231,10 @@ class System(eqx.Module):
         return tuple(term.state_advance_config(zi, c_old, v_old, c_new, v_new, ci)
                      for term, zi, ci in zip(self.all_terms(), z, coef, strict=True))
 
-    def states_settle(self, z: tuple, c: Config) -> tuple:
-        """The terms' states at the end of a converged step at configuration c (AbstractTerm.state_settle)."""
-        return tuple(term.state_settle(zi, c) for term, zi in zip(self.all_terms(), z, strict=True))
+    def states_settle(self, z: tuple, c: Config, start: bool = False) -> tuple:
+        """The terms' states at the end of a converged step at configuration c, or at the run's
+        initial configuration where `start` (AbstractTerm.state_settle)."""
+        return tuple(term.state_settle(zi, c, start) for term, zi in zip(self.all_terms(), z, strict=True))
 
     # ---------------------------------------------------------------- equations of motion
     def residual(self, c: Config, V0, omega, d_dot, acc, t=0.0, z=None):

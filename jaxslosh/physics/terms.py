@@ -148,9 +148,10 @@ class AbstractTerm(eqx.Module):
         The default ignores them."""
         return self.state_advance(z, v_old, v_new, coef)
 
-    def state_settle(self, z, c: Config):
+    def state_settle(self, z, c: Config, start: bool = False):
         """Its states at t_{n+1} once the step has converged at the configuration c, from those the
-        step advanced them to: unchanged (the default). A term whose states only start iterations
+        step advanced them to, or (`start`) at the run's initial configuration c, from state_init's:
+        unchanged (the default). A term whose states only start iterations
         of its own (the catenary lines' last solution, mooring/term.py) refreshes them here, once a
         step, not in every evaluation of the residual."""
         return z

@@ -76,7 +76,9 @@ def initial_state(system: System, solver: Solver, c0: Config, v0, alg0=None) -> 
     L = system.layout()
     gsc, alg_sc = system.alg_scales(1.0, lambda itf: 1.0)       # rows m_ref d2g/dt2: forces
     scale = L.to_x(system.unknown_scales(), alg_sc)
-    z0 = system.states_init()
+    # the states settled at the initial configuration (the catenary lines' solution at the initial
+    # pose, which the step's own chord steps start from: mooring/term.py)
+    z0 = system.states_settle(system.states_init(), c0, start=True)
     r, t0 = L.n_rigid, jnp.zeros(())
 
     def Rm_parts(ay, az):

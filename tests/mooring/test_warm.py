@@ -68,6 +68,6 @@ def test_term_states_are_the_solution_at_the_step_end():
     c = st.advance(st.init(), 4)
     term = mooring_term(st.built.system)
     i = st.built.system.all_terms().index(term)
-    z = np.asarray(c.s.z[i]).reshape(-1, 6)[:, :2]
+    z = np.asarray(c.s.z[i]).reshape(-1, 8)[:, :2]
     cold = np.asarray(term.solve(c.s.c.X0, rotation_matrix(c.s.c.q)))
     np.testing.assert_allclose(z, cold, rtol=1e-10)
