@@ -30,7 +30,7 @@ from ..geometry import AXES, SHAPES
 from .campaign import read_campaign
 from .fields import (at_least, counts, flat_list, non_negative, one_of, poisson_ratio, positive, read, show, sizes,
                      valid_name)
-from .bodies import bodies_scene, read_bodies, read_connections
+from .bodies import bodies_scene, read_bodies, read_connections, read_footprint
 from .mooring import read_mooring
 from .record import forced_span, read_forced
 from .rules import conservative as _conservative, locking_elements as _locking_elements
@@ -244,6 +244,7 @@ def _vessel(table, environment: Environment, warnings: list[str], files=None) ->
         "mass": ("float", positive), "inertia": ("inertia", None), "hydrostatics": ("table", None),
         "initial": ("table", None), "forced": ("table", None), "hull": ("table", None),
         "hydrodynamics": ("table", None), "name": ("str", valid_name), "cog_height": ("float", None),
+        "footprint": ("any", None),
     }, required=("mass", "inertia"))
     inertia = v["inertia"]
     _inertia_warnings(inertia, warnings)
@@ -270,7 +271,8 @@ def _vessel(table, environment: Environment, warnings: list[str], files=None) ->
     # hull's kg - draft, else 0
     cog = v.get("cog_height", hull.default_cog_height() if hull is not None else 0.0)
     return Vessel(mass=v["mass"], inertia=inertia, hydrostatics=hydrostatics, initial=initial, forced=forced,
-                  hull=hull, hydrodynamics=hydrodynamics, name=v.get("name", "vessel"), cog_height=cog)
+                  hull=hull, hydrodynamics=hydrodynamics, name=v.get("name", "vessel"), cog_height=cog,
+                  footprint=read_footprint(table, "vessel"))
 
 
 def _inertia_warnings(inertia, warnings: list[str]) -> None:
