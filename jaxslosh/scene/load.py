@@ -242,9 +242,8 @@ def _overlapping_tanks(tanks, warnings: list[str]) -> None:
 def _vessel(table, environment: Environment, warnings: list[str], files=None) -> Vessel:
     v = read(table, "vessel", {
         "mass": ("float", positive), "inertia": ("inertia", None), "hydrostatics": ("table", None),
-        "initial": ("table", None), "forced": ("table", None), "hull": ("table", None),
+        "initial": ("table", None), "forced": ("table", None), "hull": ("table", None), "footprint": ("any", None),
         "hydrodynamics": ("table", None), "name": ("str", valid_name), "cog_height": ("float", None),
-        "footprint": ("any", None),
     }, required=("mass", "inertia"))
     inertia = v["inertia"]
     _inertia_warnings(inertia, warnings)
@@ -270,9 +269,8 @@ def _vessel(table, environment: Environment, warnings: list[str], files=None) ->
     # the COG's height above the still-water level (it places mooring fairleads): given, or a box
     # hull's kg - draft, else 0
     cog = v.get("cog_height", hull.default_cog_height() if hull is not None else 0.0)
-    return Vessel(mass=v["mass"], inertia=inertia, hydrostatics=hydrostatics, initial=initial, forced=forced,
-                  hull=hull, hydrodynamics=hydrodynamics, name=v.get("name", "vessel"), cog_height=cog,
-                  footprint=read_footprint(table, "vessel"))
+    return Vessel(mass=v["mass"], inertia=inertia, hydrostatics=hydrostatics, initial=initial, forced=forced, hull=hull,
+                  hydrodynamics=hydrodynamics, name=v.get("name", "vessel"), cog_height=cog, footprint=read_footprint(table, "vessel"))
 
 
 def _inertia_warnings(inertia, warnings: list[str]) -> None:
