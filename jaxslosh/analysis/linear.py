@@ -30,6 +30,7 @@ import numpy as np
 from ..assemble.effects import structure_unknowns
 from ..assemble.system import Built
 from ..mooring.lumped_keys import quasi_static_lines
+from ..physics.bodies import bodies_term
 from ..physics.seakeeping import AddedMass
 from ..run.loop import probe_positions
 from ..run.simulate import is_traced, prepare
@@ -90,6 +91,9 @@ def _labels(b: Built, L: Layout, scene: Scene) -> tuple:
     names += ["interface"] * L.n_alg + ["liquid"] * (L.nf - len(held)) + held
     for s in b.structures:
         names += [f"structure {s.name}"] * s.model.Phi.shape[1]
+    term = bodies_term(b.system)         # the bodies' tanks' liquid: the owner's deformable unknowns
+    for name, body in zip(term.names, term.bodies) if term is not None else ():
+        names += [f"{name} liquid"] * body.nf
     return tuple(names)
 
 

@@ -3,17 +3,22 @@
 vessel's (`rigid_terms`): its inertia, its linear hydrostatics and its viscous damping."""
 from __future__ import annotations
 
-from typing import Optional
+import dataclasses
+from typing import NamedTuple, Optional
 
 import jax.numpy as jnp
 import numpy as np
 
+from ..liquid.base import RotationPenalty
 from ..physics.about import About
 from ..physics.bodies import BAND, Bodies, Floating, Link, body_rest, end_index
 from ..physics.kinematics import quat_from_rpy
 from ..physics.seakeeping import LinearDamping, WaveExcitation
 from ..physics.vessel import RESTORING_FORMS, AbstractRestoring, RigidBody
+from .about import damping_about, tank_line
 from .bodyhydro import time_terms
+from .damping import build_damping
+from .liquid import build_liquid_block
 from .seakeeping import make_excitation
 
 
@@ -39,28 +44,60 @@ def rigid_terms(mass, inertia, hydrostatics, rho_w, g, viscous=None) -> tuple:
     return tuple(terms)
 
 
-def build_bodies(scene, params: dict, g) -> Optional[Bodies]:
-    """The term of the scene's bodies and connections, or None without either."""
+class BodyTanks(NamedTuple):
+    """The host-side blocks of the tanks one body carries (liquid/block.TankBlock: meshes for the
+    result's fields and the probes), its index among the bodies and the offset of its liquid
+    unknowns among the bodies' tanks' (physics/bodies.py Bodies.tank_slices)."""
+    body: int
+    name: str
+    offset: int
+    tanks: tuple
+
+
+def body_liquid(scene, body, q0, g):
+    """(liquid, its terms, host blocks) of the tanks a body carries: the vessel's builder
+    (assemble/liquid.py) on the scene with the body's tanks as its tanks, so that a tank is the
+    same model on any body; the rotation penalty at the body's initial attitude, as the vessel's
+    at its own. (None, (), ()) without tanks or with the liquid switched off."""
+    eff = scene.effects
+    if not body.tanks or not eff.liquid:
+        return None, (), ()
+    own = dataclasses.replace(scene, tanks=body.tanks, structures=())
+    block = build_liquid_block(own, {}, g)
+    liquid = dataclasses.replace(block.liquid, coriolis=eff.coriolis, centrifugal=eff.centrifugal)
+    terms = () if block.penalty is None else (RotationPenalty(Kdt=block.penalty[0], Ktt=block.penalty[1], q_ref=q0),)
+    damping, _ = build_damping(own, {}, block)        # [tanks.damping]: the vessel's modal damping
+    return liquid, terms + (() if damping is None else (damping,)), block.tanks
+
+
+def build_bodies(scene, params: dict, g, outline: bool = False) -> tuple[Optional[Bodies], tuple]:
+    """The term of the scene's bodies and connections, or None without either; and BodyTanks per
+    body that carries tanks (none in `outline`: no liquid is built, its lines are the term's)."""
     if not scene.bodies and not scene.connections:
-        return None
+        return None, ()
     P = params.get
     rho = P("environment.water_density", scene.environment.water_density)
     cog = scene.vessel.cog_height
     Ainf, memory, X = time_terms(scene, params)
     waves = scene.waves
-    floating = []
+    floating, hosts, offset = [], [], 0
     for s, b in enumerate(scene.bodies):
         rest = body_rest(b, cog)
         ini = b.initial
         roll, pitch, yaw = ini.roll_pitch_yaw
+        q0 = quat_from_rpy(jnp.array([roll, pitch, yaw + b.heading]))
+        tank, tank_terms, blocks = (None, (), ()) if outline else body_liquid(scene, b, q0, g)
+        if blocks:
+            hosts.append(BodyTanks(s, b.name, offset, blocks))
+            offset += tank.nf
         floating.append(Floating(
             terms=rigid_terms(b.mass, b.inertia, b.hydrostatics, rho, g, b.viscous_damping) + (
                 () if X is None or not np.abs(X[s]).max() > 0 else
                 (WaveExcitation(make_excitation(waves, X[s], P(waves.height_key,
                                                               waves.height))),)),
             rest=jnp.asarray(rest), x0=jnp.asarray(rest + np.asarray(ini.position)),
-            q0=quat_from_rpy(jnp.array([roll, pitch, yaw + b.heading])),
-            v0=jnp.asarray(np.concatenate([ini.velocity, ini.angular_velocity]), dtype=float)))
+            q0=q0, v0=jnp.asarray(np.concatenate([ini.velocity, ini.angular_velocity]), dtype=float),
+            tank=tank, tank_terms=tank_terms))
     index = end_index(b.name for b in scene.bodies)
     links = []
     for c in scene.connections:
@@ -76,7 +113,7 @@ def build_bodies(scene, params: dict, g) -> Optional[Bodies]:
     radiating = bool(np.abs(Ainf).max() > 0) or memory is not None
     return Bodies(bodies=tuple(floating), links=tuple(links), gravity=g,
                   added_mass=jnp.asarray(Ainf) if radiating else None, memory=memory, names=tuple(b.name for b in scene.bodies),
-                  link_names=tuple(c.name for c in scene.connections), about=_about(scene))
+                  link_names=tuple(c.name for c in scene.connections), about=_about(scene)), tuple(hosts)
 
 
 def _about(scene) -> About:
@@ -93,6 +130,17 @@ def _about(scene) -> About:
                                        f"{b.heading:g} rad, mass {b.mass:g} kg; rigid-body inertia and linear "
                                        f"hydrostatics (A_w {h.waterplane_area:g} m^2, GM_T {h.gm_t:g} m, GM_L "
                                        f"{h.gm_l:g} m){damp}"))
+        damped = dict(damping_about(dataclasses.replace(scene, tanks=b.tanks)).lines)
+        for t in b.tanks if scene.effects.liquid else ():      # the vessel's tank lines, on this body's frame
+            what, text = tank_line(t)
+            eff = scene.effects
+            loads = ", ".join(["its element's rotation penalty"] + ["Coriolis"] * eff.coriolis
+                              + ["centrifugal"] * eff.centrifugal + ["gravity turning with the body"])
+            lines.append((what, f"{text}, on {t.reduction.modes} modes; carried by the body {b.name!r} (in its frame "
+                                f"from its COG, its liquid's unknowns its own, its loads on the body's six rows: "
+                                f"{loads})"))
+            if f"liquid damping in tank {t.name!r}" in damped:
+                lines.append((f"liquid damping in tank {t.name!r}", damped[f"liquid damping in tank {t.name!r}"]))
     shown = {"vessel": scene.vessel.name}       # the ends as the scene names them
     for c in scene.connections:
         law = f"stiffness {c.stiffness:g} N/m" if c.stiffness is not None else f"a {len(c.curve)}-point force curve"

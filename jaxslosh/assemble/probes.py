@@ -17,6 +17,7 @@ class Probes(NamedTuple):
     weights: jnp.ndarray   # (P, N) interpolation of the liquid displacement (zero rows: the probe follows the tank)
     on_structures: tuple = ()   # StructureProbes per structure that has probes
     modal: Optional[jnp.ndarray] = None   # (P, m, 3) weights @ basis, with a reduced liquid: probes from eta
+    on_bodies: tuple = ()       # BodyProbes per body whose tanks have probes
 
 
 class StructureProbes(NamedTuple):
@@ -28,14 +29,52 @@ class StructureProbes(NamedTuple):
     W: jnp.ndarray
 
 
-def build_probes(scene: Scene, tanks, liquid, structures=(), vstructs=()) -> Probes:
+class BodyProbes(NamedTuple):
+    """Probes in the tanks of body `index` (of [[bodies]]): rows `rows` of the probe table, points `r`
+    in its frame (from its COG) and their weights on its tanks' modal coordinates `modal` (k, m, 3),
+    which are the bodies' tanks' unknowns offset ... offset + n."""
+    index: int
+    rows: np.ndarray
+    r: jnp.ndarray
+    modal: jnp.ndarray
+    offset: int
+    n: int
+
+
+def _body_probe(p, t, bt, tank):
+    """(point in the body's frame, its weights (m, 3) on the body's tank liquid's coordinates) of a
+    probe in tank t (TankBlock `bt.tanks`' one) carried by a body whose liquid is `tank`: the
+    vessel's rule (probe_weights) on the body's mesh."""
+    b = next(x for x in bt.tanks if x.name == t.name)
+    local = (mapped_weights(np.asarray(p.point), t.fill_depth, b.nodes, b.elements)
+             if getattr(b.model, "geometry", None) is not None else
+             probe_weights(np.asarray(p.point), t.size, t.fill_depth, b.nodes, b.elements))
+    w = np.zeros((1, tank.n_nodes))
+    w[0, b.node_offset:b.node_offset + b.nodes.shape[0]] = local
+    return np.asarray(t.origin) + np.asarray(p.point), tank.probe_modal(jnp.asarray(w))[0]
+
+
+def build_probes(scene: Scene, tanks, liquid, structures=(), vstructs=(), body_tanks=(), bodies=None) -> Probes:
+    """The probes' weights; `body_tanks` (assemble/bodies.BodyTanks) and `bodies` (the Bodies term):
+    the tanks the bodies carry, whose probes follow their body."""
     names, pts, W = [], [], []
     N = liquid.n_nodes
     by_name = {b.name: b for b in tanks}
-    on_struct = {}
+    on_struct, on_body = {}, {}
+    carried = {t.name: (s, t) for s, body in enumerate(scene.bodies) for t in body.tanks}
     for i, p in enumerate(scene.probes):
         w = np.zeros(N)
-        if p.tank is not None:
+        if p.tank is not None and p.tank in carried:      # in a body's tank: it follows that body
+            s, t = carried[p.tank]
+            bt = next((x for x in body_tanks if x.body == s), None)
+            if bt is None:                # no liquid built ([effects] liquid = false): it follows the body
+                r, modal, at = np.asarray(t.origin) + np.asarray(p.point), jnp.zeros((0, 3)), (0, 0)
+            else:
+                r, modal = _body_probe(p, t, bt, bodies.bodies[s].tank)
+                at = (bt.offset, bodies.bodies[s].nf)
+            pts.append(r)
+            on_body.setdefault(s, (*at, []))[2].append((i, r, modal))
+        elif p.tank is not None:
             t = scene.tank(p.tank)
             pts.append(np.asarray(t.origin) + np.asarray(p.point))
             b = by_name.get(t.name)
@@ -62,8 +101,10 @@ def build_probes(scene: Scene, tanks, liquid, structures=(), vstructs=()) -> Pro
         W.append(w)
     sp = tuple(StructureProbes(k, np.array([e[0] for e in v]), jnp.asarray(np.array([e[1] for e in v])),
                                jnp.asarray(np.array([e[2] for e in v]))) for k, v in sorted(on_struct.items()))
+    bp = tuple(BodyProbes(s, np.array([e[0] for e in v]), jnp.asarray(np.array([e[1] for e in v])),
+                          jnp.stack([e[2] for e in v]), off, n) for s, (off, n, v) in sorted(on_body.items()))
     return Probes(tuple(names), jnp.asarray(np.array(pts).reshape(-1, 3)),
-                  jnp.asarray(np.array(W, dtype=float).reshape(len(W), N)), sp)
+                  jnp.asarray(np.array(W, dtype=float).reshape(len(W), N)), sp, on_bodies=bp)
 
 
 def block_weights(point, nodes, elements, tol=1e-9):

@@ -17,6 +17,7 @@ import numpy as np
 from ..mooring.lumped_term import build_lumped_lines
 from ..mooring.term import build_mooring
 from ..liquid.modal_damping import ModalDamping
+from ..physics.bodies import bodies_term
 from ..physics.kinematics import quat_from_rpy, rotation_matrix
 from ..liquid.base import RotationPenalty, SpinStiffening
 from ..liquid.multimodal.term import MultimodalLiquid
@@ -48,6 +49,7 @@ class Built(NamedTuple):
     alg0: jnp.ndarray                    # algebraic unknowns at t = 0: interface frame positions, zero multipliers
     structures: tuple = ()               # host-side StructureBlock per structure (result fields)
     surfaces: tuple = ()                 # per tank, the stacked indices of its free-surface nodes (validity)
+    body_tanks: tuple = ()               # assemble/bodies.BodyTanks per body that carries tanks (host-side)
 
 
 #: the build's jax.numpy steps, each one compiled program (staging.staged), wrapped once per process
@@ -72,13 +74,14 @@ class _Model(NamedTuple):
     block: LiquidBlock
     blocks: tuple             # StructureBlock per structure in its own frame
     multimodal: bool
+    body_tanks: tuple = ()    # assemble/bodies.BodyTanks
 
 
 def build(scene: Scene, params: Optional[dict] = None) -> Built:
     params = resolve_params(scene, params)
     P = params.get
     ves = scene.vessel
-    system, block, blocks, multimodal = _model(scene, params)
+    system, block, blocks, multimodal, body_tanks = _model(scene, params)
     liquid, q0 = system.liquid, system.q_ref
     ini = ves.initial
     nf = system.nf
@@ -93,7 +96,7 @@ def build(scene: Scene, params: Optional[dict] = None) -> Built:
         c0, v0 = motion.start(c0, v0)
     # the terms that own unknowns (the structures) start them; nothing to compile without
     c0, v0, alg0 = _start(system, c0, v0) if system.owners() else (c0, v0, jnp.zeros(0))
-    probes = build_probes(scene, block.tanks, liquid, blocks, block.vstructs)
+    probes = build_probes(scene, block.tanks, liquid, blocks, block.vstructs, body_tanks, bodies_term(system))
     probes = probes._replace(modal=liquid.probe_modal(probes.weights))    # a modal liquid: probes from eta
     tanks = block.tanks
     if multimodal:
@@ -103,7 +106,7 @@ def build(scene: Scene, params: Optional[dict] = None) -> Built:
     else:
         tops = tuple(jnp.asarray(t.node_offset + np.flatnonzero(np.isclose(t.nodes[:, 2], t.nodes[:, 2].max())))
                      for t in block.tanks)
-    return Built(system, c0, v0, probes, tanks, alg0, blocks, tops)
+    return Built(system, c0, v0, probes, tanks, alg0, blocks, tops, body_tanks)
 
 
 def outline(scene: Scene) -> System:
@@ -177,7 +180,7 @@ def _model(scene: Scene, params: dict, outline: bool = False) -> _Model:
     if any(m.model == "catenary" for m in scene.mooring):   # quasi-static catenary lines (jaxslosh/mooring/term.py)
         terms.append(build_mooring(scene, balanced, outline, params))
     terms.extend(build_lumped_lines(scene, balanced, q0))    # dynamic lumped-mass lines (mooring/lumped_term.py)
-    bodies = build_bodies(scene, params, g)   # [[bodies]] and [[connections]] (physics/bodies.py)
+    bodies, body_tanks = build_bodies(scene, params, g, outline)   # [[bodies]] and [[connections]] (physics/bodies.py)
     if bodies is not None:
         terms.append(bodies)
     if block.penalty is not None:
@@ -202,7 +205,7 @@ def _model(scene: Scene, params: dict, outline: bool = False) -> _Model:
     system = System(body=body, terms=tuple(terms), liquid=liquid, gravity=g, q_ref=q0,
                     gravity_turning=eff.gravity_turning or not has_liquid, balanced=balanced,
                     tail=() if damping is None else (damping,))
-    return _Model(system, block, blocks, multimodal)
+    return _Model(system, block, blocks, multimodal, body_tanks)
 
 
 def _prescribed(f, P):

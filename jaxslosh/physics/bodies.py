@@ -8,7 +8,15 @@ group) whose rows are the sum of the *same term classes* as the vessel's rigid p
 evaluated with the body's own kinematics (`Floating.kin`): a body is built by the functions that
 build the vessel's rigid terms, its wave excitation among them (seakeeping.py's `WaveExcitation`,
 its forces at the body's place in the incident field). What the vessel has and a body has not
-yet: tanks, hull meshes and nonlinear hydrostatics.
+yet: hull meshes, nonlinear hydrostatics, and tanks other than reduced ones.
+
+Tanks on a body (`[[tanks]] body = ...`): each body's tanks are a liquid of the vessel's kind
+(jaxslosh/liquid, built by the vessel's builder; the reduced one, whose block is constant and
+small), held by its `Floating` and evaluated with the body's kinematics: its rigid rows add to the
+body's six, its own rows are this term's deformable unknowns (the layout's z after the vessel's
+liquid; the configuration's `eta`, every body's tanks' stacked in the bodies' order), with the
+liquid's constant blocks as their block of the Newton preconditioner (`deformable_block`). They
+start at the liquid's hydrostatic equilibrium under the body's initial gravity, as the vessel's do.
 
 Radiation: one added mass A_inf and one memory (seakeeping.py's `Memory`) over the rigid dofs of
 the vessel and all bodies (6 + 6 S, the step's order): each body's own tables as its diagonal
@@ -32,11 +40,12 @@ hawser does not push, a fender does not pull).
 """
 from __future__ import annotations
 
-from typing import Optional
+from typing import Any, Optional
 
 import equinox as eqx
 import jax
 import jax.numpy as jnp
+from jax.scipy.linalg import block_diag
 import numpy as np
 
 from .about import About
@@ -140,22 +149,52 @@ class Link(eqx.Module):
 
 class Floating(eqx.Module):
     """One body's floating frame: its rigid terms (the vessel's classes, evaluated with its own
-    kinematics), its rest pose and its initial state."""
+    kinematics), its rest pose and its initial state; and the liquid of the tanks it carries
+    (`tank`: a liquid of the vessel's kind, jaxslosh/liquid, built by the vessel's builder; None
+    without tanks) with the terms that act on that liquid (`tank_terms`: its rotation penalty)."""
     terms: tuple
     rest: jax.Array        # (3,) its COG at rest, in the vessel-at-rest frame
     x0: jax.Array          # (3,) its COG at t = 0, same frame
     q0: jax.Array          # (4,) its attitude at t = 0 (its heading included)
     v0: jax.Array          # (6,) V (inertial), omega (body) at t = 0
+    tank: Any = None
+    tank_terms: tuple = ()
 
-    def kin(self, X, q, v, a, gravity, t) -> Kin:
-        """The body's Kin: its offset from rest as the configuration's X0 (what the hydrostatics read)."""
+    @property
+    def nf(self) -> int:
+        """Its tanks' liquid unknowns."""
+        return 0 if self.tank is None else self.tank.nf
+
+    def kin(self, X, q, v, a, gravity, t, d=None, d_dot=None, d_acc=None) -> Kin:
+        """The body's Kin: its offset from rest as the configuration's X0 (what the hydrostatics read)
+        and its tanks' liquid unknowns as the deformable ones (d, their rates d_dot and d_acc)."""
         A = rotation_matrix(q)
         g_b = A.T @ jnp.array([0.0, 0.0, -gravity])
-        return Kin(Config(X - self.rest, q, jnp.zeros(0)), v[:3], v[3:], jnp.zeros(0), a,
-                   None if a is None else jnp.zeros(0), jnp.asarray(t), jnp.zeros((0,)), A, g_b)
+        e = jnp.zeros(0)
+        return Kin(Config(X - self.rest, q, e if d is None else d), v[:3], v[3:], e if d_dot is None else d_dot, a,
+                   None if a is None else (e if d_acc is None else d_acc), jnp.asarray(t), jnp.zeros((0,)), A, g_b)
+
+    def carried(self):
+        """Its terms on its tanks' liquid: the liquid's own, then the others'."""
+        return () if self.tank is None else (self.tank, *self.tank_terms)
 
     def rows(self, k: Kin):
-        return sum((t.rows(k).rigid for t in self.terms), jnp.zeros(6))
+        """(its six rows, its liquid's rows)."""
+        rigid = sum((t.rows(k).rigid for t in self.terms), jnp.zeros(6))
+        d = jnp.zeros(0)
+        for t in self.carried():
+            r = t.rows(k)
+            rigid, d = rigid + r.rigid, r.d if not d.size else d + r.d
+        return rigid, d
+
+    def kinetic(self, k: Kin):
+        return sum((t.kinetic(k) for t in self.terms + self.carried()), jnp.zeros(()))
+
+    def potential(self, k: Kin):
+        return sum((t.potential(k) for t in self.terms + self.carried()), jnp.zeros(()))
+
+    def mass_scale(self):
+        return sum((t.mass_scale() for t in self.terms + self.carried()), jnp.zeros(6))
 
 
 class Bodies(AbstractOwner):
@@ -178,8 +217,21 @@ class Bodies(AbstractOwner):
     def describe(self) -> tuple:
         return self.about.lines
 
+    @property
+    def M(self) -> int:
+        """Its bodies' tanks' liquid unknowns (the owner's deformable ones), stacked in the bodies' order."""
+        return sum(b.nf for b in self.bodies)
+
+    def tank_slices(self) -> tuple:
+        """(S,) each body's slice of the stacked liquid unknowns of the bodies' tanks."""
+        out, k = [], 0
+        for b in self.bodies:
+            out.append(slice(k, k + b.nf))
+            k += b.nf
+        return tuple(out)
+
     def unknowns(self) -> Unknowns:
-        return Unknowns(frames=self.S)
+        return Unknowns(frames=self.S, deformable=self.M)
 
     def settles(self) -> bool:
         """Its unknowns start where the scene puts them, not at a static equilibrium (a body held by a
@@ -224,9 +276,13 @@ class Bodies(AbstractOwner):
 
     # ------------------------------------------------------------ the owner's hooks
     def start(self, system, c0: Config, v0):
+        # each body's tank liquid at its discrete hydrostatic equilibrium under the body's initial gravity,
+        # as the vessel's liquid starts (assemble/system.py)
+        etas = [b.tank.static_start(b.kin(b.x0, b.q0, jnp.zeros(6), None, self.gravity, 0.0).g_b)
+                for b in self.bodies if b.tank is not None]
         c = c0._replace(Xs=jnp.stack([b.x0 for b in self.bodies]), qs=jnp.stack([b.q0 for b in self.bodies]),
-                        eta=jnp.zeros(0))
-        v = jnp.concatenate([v0[:6], *[b.v0 for b in self.bodies], v0[6:]])
+                        eta=jnp.concatenate([jnp.zeros(0), *etas]))
+        v = jnp.concatenate([v0[:6], *[b.v0 for b in self.bodies], v0[6:], jnp.zeros(self.M)])
         return c, v, jnp.zeros(0)
 
     def carried_velocities(self, system, c: Config, v):
@@ -235,15 +291,23 @@ class Bodies(AbstractOwner):
     def advance(self, c: Config, out: Config, y, z) -> Config:
         st = y.reshape(self.S, 6)
         qs = jax.vmap(lambda q, th: quat_multiply(q, quat_exp(th)))(c.qs, st[:, 3:])
-        return out._replace(Xs=c.Xs + st[:, :3], qs=qs, eta=c.eta)
+        return out._replace(Xs=c.Xs + st[:, :3], qs=qs, eta=c.eta + z)
 
-    def body_kins(self, system, c: Config, vy, ay=None, t=0.0):
+    def body_kins(self, system, c: Config, vy, ay=None, t=0.0, vz=None, az=None):
+        """Each body's Kin; `vz`, `az`: the rates of the deformable unknowns (the vessel's liquid's,
+        then the bodies' tanks'), for the bodies' tanks."""
+        nf = system.nf
+
+        def tank(x, sl):
+            return None if x is None else x[nf:][sl]
         return [b.kin(c.Xs[s], c.qs[s], vy[6 + 6 * s:12 + 6 * s], None if ay is None else ay[6 + 6 * s:12 + 6 * s],
-                      system.gravity, t) for s, b in enumerate(self.bodies)]
+                      system.gravity, t, c.eta[sl], tank(vz, sl), tank(az, sl))
+                for s, (b, sl) in enumerate(zip(self.bodies, self.tank_slices()))]
 
     def add_rows(self, system, c: Config, core_y, core_z, vy, vz, ay, az, t=0.0, z=None):
-        own = [b.rows(k) for b, k in zip(self.bodies, self.body_kins(system, c, vy, ay, t))]
-        rows = jnp.concatenate([core_y, *own]) - self.link_forces(self.poses(c, vy))
+        own = [b.rows(k) for b, k in zip(self.bodies, self.body_kins(system, c, vy, ay, t, vz, az))]
+        rows = jnp.concatenate([core_y, *[r[0] for r in own]]) - self.link_forces(self.poses(c, vy))
+        core_z = jnp.concatenate([core_z, *[r[1] for r in own]])
         if self.added_mass is not None:
             rows = rows + self.added_mass @ ay[:rows.shape[0]]
         if self.memory is not None and z is not None and z.size:
@@ -262,18 +326,18 @@ class Bodies(AbstractOwner):
 
     def extra_kinetic(self, system, c: Config, v):
         vy = v[:6 + 6 * self.S]
-        T = sum((t.kinetic(k) for b, k in zip(self.bodies, self.body_kins(system, c, vy)) for t in b.terms),
+        T = sum((b.kinetic(k) for b, k in zip(self.bodies, self.body_kins(system, c, vy, vz=v[6 + 6 * self.S:]))),
                 jnp.zeros(()))
         return T if self.added_mass is None else T + 0.5 * vy @ (self.added_mass @ vy)
 
     def extra_potential(self, system, c: Config):
         vy = jnp.zeros(6 + 6 * self.S)
-        V = sum((t.potential(k) for b, k in zip(self.bodies, self.body_kins(system, c, vy)) for t in b.terms),
-                jnp.zeros(()))
+        V = sum((b.potential(k) for b, k in zip(self.bodies, self.body_kins(system, c, vy))), jnp.zeros(()))
         return V + self.link_potential(self.poses(c, vy))
 
     def add_scales(self, y, z):
-        y = jnp.concatenate([y, *[sum((t.mass_scale() for t in b.terms), jnp.zeros(6)) for b in self.bodies]])
+        y = jnp.concatenate([y, *[b.mass_scale() for b in self.bodies]])
+        z = jnp.concatenate([z, *[b.tank.d_scale() for b in self.bodies if b.tank is not None]])
         return (y if self.added_mass is None else y.at[6:].add(jnp.diag(self.added_mass)[6:])), z
 
     def constraint(self, system, c: Config, alg):
@@ -285,8 +349,14 @@ class Bodies(AbstractOwner):
     def alg_scales(self, row_factor, err_factor):
         return [], jnp.zeros(0)
 
+    def deformable_block(self, c_m, c_k):
+        """c_m M + c_k K of its bodies' tanks' liquid (block diagonal over the bodies; each tank's
+        constant blocks, as the vessel's liquid gives them to the solver)."""
+        blocks = [c_m * M + c_k * K for M, K in (b.tank.constant_blocks() for b in self.bodies if b.tank is not None)]
+        return block_diag(*blocks) if blocks else jnp.zeros((0, 0))
+
     def block_diagonal(self, c_m, c_k):
-        return jnp.zeros(0)
+        return jnp.diag(self.deformable_block(c_m, c_k))
 
     def initial_constraint_rows(self, system, c: Config, v, alg0, mscale):
         return lambda x: jnp.zeros_like(x)

@@ -190,6 +190,12 @@ class System(eqx.Module):
         """The diagonal of the owners' deformable block of c_m M + c_k K (empty without)."""
         return jnp.concatenate([jnp.zeros(0)] + [o.block_diagonal(c_m, c_k) for o in self.owners()])
 
+    def deformable_block(self, c_m, c_k):
+        """The owner's deformable block of c_m M + c_k K (unknowns.AbstractOwner.deformable_block: a
+        diagonal (m,) or a block (m, m)); empty without."""
+        owner = self.owners()
+        return owner[0].deformable_block(c_m, c_k) if owner else jnp.zeros(0)
+
     def total_mass(self):
         return self.body.mass + self.liquid.total_mass()
 

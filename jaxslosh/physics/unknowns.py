@@ -11,7 +11,8 @@ x = [vessel, liquid]: one step serves every system (solve/integrator.py), the ow
 entering it as the cheap part Rc of R = Rm + Rc (an empty set of constraints without them).
 The layout holds one owner's unknowns after the vessel's and the liquid's (the flexible
 structures, physics/structures.py, which tie any number of bodies through one term; or the rigid
-floating bodies and their connections, physics/bodies.py).
+floating bodies and their connections, physics/bodies.py, whose deformable unknowns are the liquid
+of the bodies' tanks).
 """
 from __future__ import annotations
 
@@ -126,6 +127,11 @@ class AbstractOwner(AbstractTerm):
     @abc.abstractmethod
     def block_diagonal(self, c_m, c_k):
         """The diagonal of its deformable unknowns' block of c_m M + c_k K (constant)."""
+
+    def deformable_block(self, c_m, c_k):
+        """Its deformable unknowns' block of c_m M + c_k K (constant): its diagonal (m,) where the
+        block is diagonal (the structures' modal one), else the block (m, m) (the bodies' tank liquid)."""
+        return self.block_diagonal(c_m, c_k)
 
     @abc.abstractmethod
     def initial_constraint_rows(self, system, c: Config, v, alg0, mscale):

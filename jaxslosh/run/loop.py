@@ -58,6 +58,7 @@ class Frame(NamedTuple):
     bodies: jax.Array = None   # (S, 10): each [[bodies]] body's COG offset from its rest position (3, inertial),
     #                            quaternion (4), angular velocity (3, body frame); (0, 10) without
     links: jax.Array = None    # (n, 2): each connection's force (positive when it pulls) and extension
+    body_d: jax.Array = None   # the bodies' tanks' liquid unknowns (modal coordinates), stacked; (0,) without
 
 
 def probe_positions(b: Built, c: Config):
@@ -74,6 +75,10 @@ def probe_positions(b: Built, c: Config):
             body = structures.bodies[sp.index]
             x = sp.r + sp.W @ body.u(etas[sp.index])
             probes = probes.at[sp.rows].set(c.Xs[sp.index][None, :] + x @ rotation_matrix(c.qs[sp.index]).T)
+    for bp in pr.on_bodies:               # probes in a body's tanks: its liquid, in its frame
+        tank = bodies_term(sysm).bodies[bp.index].tank
+        x = bp.r if tank is None else bp.r + tank.probe_displacements(None, bp.modal, c.eta[bp.offset:bp.offset + bp.n])
+        probes = probes.at[bp.rows].set(c.Xs[bp.index][None, :] + x @ rotation_matrix(c.qs[bp.index]).T)
     return probes
 
 
@@ -88,8 +93,10 @@ def _frame(b: Built, s: State, it, err, failed) -> Frame:
     surface = jnp.array([[h.min(), h.max()] for h in heave]).reshape(len(heave), 2)
     bodies, links = body_frames(sysm, s.c, s.v)
     lines = lumped_observe(sysm, s.z, s.c, s.v[:3], s.v[3:6])
+    term = bodies_term(sysm)
+    body_d = s.c.eta if term is not None and term.M else jnp.zeros(0)
     return Frame(s.t, s.c.X0, s.c.q, s.v[3:6], probes, ke, pe, it, err, sysm.liquid.frame_field(s.c.d), failed, gmax,
-                 surface, lines, bodies, links)
+                 surface, lines, bodies, links, body_d)
 
 
 def body_frames(sysm, c: Config, v):
@@ -108,9 +115,14 @@ def body_frames(sysm, c: Config, v):
     return bodies, jnp.stack([T, e], axis=1).reshape(-1, 2)
 
 
+def tank_blocks(b: Built) -> tuple:
+    """The host-side blocks of every tank: the vessel's, then each body's (assemble/bodies.BodyTanks)."""
+    return tuple(b.tanks) + tuple(t for bt in b.body_tanks for t in bt.tanks)
+
+
 def core(b: Built) -> Built:
     """What the compiled loop needs: the host-side tank blocks (NumPy meshes) stay out of it."""
-    return b._replace(tanks=(), structures=())
+    return b._replace(tanks=(), structures=(), body_tanks=())
 
 
 def _select(pred, a, b):
@@ -273,6 +285,11 @@ def frame_datasets(b: Built, fr: Frame, p0=None, fields: bool = True) -> dict:
     if fields and b.tanks:
         D = nodal(b, fr.D)
         for t in b.tanks:
+            d[f"tanks/{t.name}/displacement"] = D[..., t.node_offset:t.node_offset + t.nodes.shape[0], :]
+    for bt in b.body_tanks if fields else ():     # a body's tanks: their fields from its liquid's coordinates
+        floating = term.bodies[bt.body]
+        D = floating.tank.nodal_fields(fr.body_d[..., bt.offset:bt.offset + floating.nf])
+        for t in bt.tanks:
             d[f"tanks/{t.name}/displacement"] = D[..., t.node_offset:t.node_offset + t.nodes.shape[0], :]
     return d
 

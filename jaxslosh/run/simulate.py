@@ -23,7 +23,7 @@ from ..scene.keys import check_values, with_overrides
 from ..scene.types import Scene
 from ..solve.linear import Solver, make_solver
 from .compiled import compile_run
-from .loop import Carry, Frame, advance, concat_frames, core, frame_datasets, start
+from .loop import Carry, Frame, advance, concat_frames, core, frame_datasets, start, tank_blocks
 
 
 class NumericalFailure(RuntimeError):
@@ -95,7 +95,7 @@ def to_result(b: Built, fr: Frame, scene_text: str, status: str, carry: Carry, s
     """The result of a run's frames and its final carry: the outcome, steps done and first failure
     are the carry's (leaves, traced inside a transformation); `status` the host's text ("" where the
     carry is traced: the result reads its outcome once computed)."""
-    tanks = {t.name: (t.nodes, t.elements) for t in b.tanks}
+    tanks = {t.name: (t.nodes, t.elements) for t in tank_blocks(b)}
     failure = Failure(carry.fail_step, carry.fail_err, carry.fail_it)
     return result_from(frame_datasets(b, fr), b.probes.names, tanks, status=status, steps_done=carry.k,
                        scene_text=scene_text, status_code=carry.code, failure=failure, dt=float(solver.h),

@@ -26,7 +26,7 @@ from .compiled import compile_run
 from ..mooring.lumped_term import lumped_terms
 from ..mooring.term import mooring_term
 from ..physics.bodies import bodies_term
-from .loop import core, ending_at, frame_datasets
+from .loop import core, ending_at, frame_datasets, tank_blocks
 from .progress import Progress
 from .simulate import failure_message, prepare
 from .validity import Watch
@@ -70,7 +70,7 @@ def run_to_file(scene: Scene, out: str, *, progress: bool = True,
                 save_fields = N * 3 * 8 * (n_frames + 1) < 200e6
             chunk_frames = scene.simulation.chunk or max(1, min(n_frames, max(1, 500 // se)))
             lumped = lumped_terms(b.system)
-            writer = ResultWriter(out, scene.text, b.probes.names, b.tanks if save_fields else (),
+            writer = ResultWriter(out, scene.text, b.probes.names, tank_blocks(b) if save_fields else (),
                                   (*getattr(mooring_term(b.system), "names", ()), *(t.name for t in lumped)),
                                   {t.name: t.line.segments + 1 for t in lumped},
                                   bodies=getattr(bodies_term(b.system), "names", ()),

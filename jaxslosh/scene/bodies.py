@@ -28,9 +28,24 @@ NOT_YET = {"hull": "hull meshes (and the waves' and the nonlinear hydrostatics' 
 RESERVED = ("vessel", "fixed")
 
 
-def read_bodies(tables, vessel, environment, warnings: list[str], files=None) -> tuple[Body, ...]:
+def tank_carriers(tables, vessel_name: str) -> tuple:
+    """The body each `[[tanks]]` table names in `body`, in order: "vessel" (the default, or the
+    vessel's name) or a body's name."""
+    named = tuple((t.get("body", "vessel") if isinstance(t, dict) else "vessel") for t in tables)
+    return tuple("vessel" if n == vessel_name else n for n in named)
+
+
+def tank_groups(tanks, carriers) -> dict:
+    """{carrier: its tanks} (tank_carriers' names), in the scene's order."""
+    out: dict = {}
+    for t, c in zip(tanks, carriers):
+        out[c] = out.get(c, ()) + (t,)
+    return out
+
+
+def read_bodies(tables, vessel, environment, warnings: list[str], files=None, tanks=(), carriers=()) -> tuple[Body, ...]:
     """The `[[bodies]]` of a scene (`vessel`: the scene's types.Vessel; `files`: waves.FileContext,
-    where a body's hydrodynamic `file` is read from)."""
+    where a body's hydrodynamic `file` is read from), each with the `tanks` whose `carriers` name it."""
     out = []
     for i, table in enumerate(tables):
         where = f"bodies[{i}]"
@@ -71,12 +86,16 @@ def read_bodies(tables, vessel, environment, warnings: list[str], files=None) ->
         body = Body(name=name, mass=v["mass"], inertia=v["inertia"], hydrostatics=hs,
                     position=(float(pos[0]), float(pos[1])), heading=v.get("heading", 0.0),
                     cog_height=v.get("cog_height", 0.0), initial=initial, viscous_damping=damping,
-                    hydrodynamics=hydro, footprint=read_footprint(table, where))
+                    hydrodynamics=hydro, footprint=read_footprint(table, where),
+                    tanks=tuple(t for t, c in zip(tanks, carriers) if c == name))
         buoyant = environment.water_density * hs.displaced_volume
-        if environment.gravity > 0 and abs(body.mass - buoyant) > 0.01 * buoyant:
-            warnings.append(f"{where}.hydrostatics.displaced_volume: the body's mass {body.mass:.6g} kg differs from "
+        # as the vessel's: its mass is the body's without the liquid of its tanks
+        total = body.mass + sum(t.liquid_mass for t in body.tanks)
+        liquid = f" (body {body.mass:.6g} kg + tank liquid {total - body.mass:.6g} kg)" if body.tanks else ""
+        if environment.gravity > 0 and abs(total - buoyant) > 0.01 * buoyant:
+            warnings.append(f"{where}.hydrostatics.displaced_volume: the body's mass {total:.6g} kg{liquid} differs from "
                             f"water_density * displaced_volume = {buoyant:.6g} kg by "
-                            f"{100 * (body.mass - buoyant) / buoyant:+.2f} %; its hydrostatic restoring is taken "
+                            f"{100 * (total - buoyant) / buoyant:+.2f} %; its hydrostatic restoring is taken "
                             "about its rest pose as if it were the equilibrium (the imbalance is ignored)")
         out.append(body)
     _overlaps(out, vessel)
@@ -201,6 +220,19 @@ def _overlaps(bodies, vessel) -> None:
                 f"`footprint`, circles of their areas without one) overlap at rest by {-gap:.4g} m"))
 
 
+def _body_tank(table, where: str, body: str) -> None:
+    """What a tank on one of [[bodies]] may be yet: a finite-element tank reduced to its modes
+    (`[tanks.reduction]`) with rigid walls (docs/guide/bodies-and-connections.md)."""
+    refused = [("model", table.get("model", "fem") == "multimodal", "multimodal tanks"),
+               ("reduction", "reduction" not in table, "full-order tanks (give [tanks.reduction] modes = ...: the "
+                                                       "reduced liquid)"),
+               ("walls", table.get("walls", "rigid") != "rigid", "elastic tank walls")]
+    for key, bad, what in refused:
+        if bad:
+            raise SceneError(f"{where}.body", f"{body!r}: {what} are not available yet on [[bodies]] (only a "
+                                              f"reduced tank rides on a body; {where}.{key})")
+
+
 def read_connections(tables, vessel_name: str, bodies) -> tuple[Connection, ...]:
     """The `[[connections]]` of a scene, their ends among "vessel" (or the vessel's name), the
     bodies' names and "fixed"."""
@@ -269,8 +301,7 @@ def bodies_scene(bodies, vessel, structures, mapping, warnings: list[str], files
         if body not in ("vessel", vessel.name, *[b.name for b in bodies]):
             raise SceneError(f"tanks[{i}].body", f"{body!r} is not a body of the scene")
         if body in [b.name for b in bodies]:
-            raise SceneError(f"tanks[{i}].body", f"{body!r}: tanks on [[bodies]] are not available yet; "
-                                                 "tanks ride on the vessel")
+            _body_tank(t, f"tanks[{i}]", body)
     if not bodies:
         return
     if any(s.frame == "own" for s in structures):

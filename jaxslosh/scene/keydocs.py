@@ -160,9 +160,13 @@ KEYS = (
     ("vessel.hydrodynamics.length_scale", "1", "m", "WAMIT's ULEN."),
     # tanks
     ("tanks.name", _REQ, "", "The tank's name (no '.', '[', ']' or '/')."),
-    ("tanks.body", '"vessel"', "", "The body that carries the tank: the vessel (tanks on `[[bodies]]` are not "
-                                   "available yet)."),
-    ("tanks.origin", _REQ, "m", "The min corner of the tank's bounding box in the vessel frame."),
+    ("tanks.body", '"vessel"', "", "The body that carries the tank: \"vessel\" (or the vessel's `name`) or the "
+                                   "name of one of `[[bodies]]`. On a body, the tank is in the body's frame (its "
+                                   "`origin` from the body's COG) and must be reduced (`[tanks.reduction]`) with rigid "
+                                   "walls; multimodal and full-order tanks and elastic walls are refused there "
+                                   "(docs/guide/bodies-and-connections.md)."),
+    ("tanks.origin", _REQ, "m", "The min corner of the tank's bounding box in the frame of the body that carries "
+                                "it (the vessel's by default), from its COG."),
     ("tanks.size", _REQ, "m", "The bounding box: inner length (x), breadth (y), height (z)."),
     ("tanks.fill_depth", "required (not for mesh)", "m", "Liquid depth at rest from the tank's lowest point."),
     ("tanks.mesh", "required (not for mesh)", "", "Liquid hexahedra along x, y, z."),

@@ -30,7 +30,7 @@ from ..geometry import AXES, SHAPES
 from .campaign import read_campaign
 from .fields import (at_least, counts, flat_list, non_negative, one_of, poisson_ratio, positive, read, show, sizes,
                      valid_name)
-from .bodies import bodies_scene, read_bodies, read_connections, read_footprint
+from .bodies import bodies_scene, read_bodies, read_connections, read_footprint, tank_carriers, tank_groups
 from .mooring import read_mooring
 from .record import forced_span, read_forced
 from .rules import conservative as _conservative, locking_elements as _locking_elements
@@ -115,16 +115,19 @@ def parse_scene(mapping: Mapping[str, Any], text: str = "", path: str = "") -> S
     probes = tuple(_probe(p, f"probes[{i}]") for i, p in enumerate(mapping.get("probes", [])))
     _unique_names(tanks, "tanks", "tank")
     _multimodal_scene(tanks, warnings)
-    _overlapping_tanks(tanks, warnings)
+    carriers = tank_carriers(mapping.get("tanks", []), vessel.name)      # "vessel" or a body's name, per tank
+    for group in tank_groups(tanks, carriers).values():                    # tanks overlap within one body
+        _overlapping_tanks(group, warnings)
     _locking_elements(tanks, warnings)
     _unique_names(structures, "structures", "structure")
     _attachments(structures)
     _unique_names(probes, "probes", "probe")
     for i, probe in enumerate(probes):
         _place_probe(probe, f"probes[{i}]", tanks, structures)
-    bodies = read_bodies(mapping.get("bodies", []), vessel, environment, warnings, files)
+    bodies = read_bodies(mapping.get("bodies", []), vessel, environment, warnings, files, tanks, carriers)
     connections = read_connections(mapping.get("connections", []), vessel.name, bodies)
     bodies_scene(bodies, vessel, structures, mapping, warnings, files)
+    tanks = tank_groups(tanks, carriers).get("vessel", ())      # the vessel's; a body's are in its Body
     mooring = read_mooring(mapping.get("mooring", []), environment.depth, vessel.name, vessel.cog_height, warnings,
                            tuple(bodies))
     _mass_balance(vessel, tanks, environment, warnings, structures,     # the vessel's own lines

@@ -29,7 +29,7 @@ def conservative(scene: Scene) -> None:
         why.append("[vessel.forced] prescribes motion (it does work)")
     if scene.waves is not None or v.hydrodynamics is not None or v.hull is not None:
         why.append("waves and hull hydrodynamics add and radiate energy")
-    if any(t.damping is not None for t in scene.tanks):
+    if any(t.damping is not None for t in scene.tanks + tuple(t for b in scene.bodies for t in b.tanks)):
         why.append("[tanks.damping] removes energy")
     if scene.structures:
         why.append("flexible structures are not covered by the projection")

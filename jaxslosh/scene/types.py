@@ -143,6 +143,7 @@ class Body:
     viscous_damping: Optional[tuple] = None   # (6, 6) linear damping, N s/m and N m s, its COG and axes
     hydrodynamics: Optional["Hydrodynamics"] = None   # the vessel's keys: tables, a file (its block of a multibody one)
     footprint: Optional[tuple] = None   # (length, beam) m of the waterplane along its heading: the overlap check
+    tanks: tuple = ()                # the [[tanks]] it carries (`tanks.body`), in its frame from its COG
 
 
 @dataclass(frozen=True)

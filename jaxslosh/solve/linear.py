@@ -69,16 +69,17 @@ def make_solver(system: System, h: float, scheme: Scheme, tol: float, max_iter: 
     """Factor the constant liquid blocks once (float64): NumPy for concrete matrices, JAX when the
     liquid was built from traced values (under jit); the terms that own deformable unknowns append
     their block, diagonal (the structures' modal one, Phi^T M Phi = I, Phi^T K Phi = omega^2:
-    1 / (c_a + omega^2)), and their rigid and algebraic unknowns join the exact block.
+    1 / (c_a + omega^2)) or a small dense one (the bodies' tanks' liquid, inverted here), and their
+    rigid and algebraic unknowns join the exact block.
 
     The inverses only precondition the Newton iterations and the tangent solves, whose solutions do
     not depend on them (`lax.custom_root` drops their tangents), so they are formed from
     `stop_gradient` values: under `jax.grad` outside jit the matrices are then concrete again."""
     substeps = int(substeps) if substeps and substeps > 1 else 0
     base = _liquid_solver(system, h, scheme, tol, max_iter, substeps, reuse, adaptive)
-    sub = _extended(base.Cinv_sub, system.block_diagonal(scheme.c_a(h / substeps), 1.0)) if substeps else None
-    return dataclasses.replace(base, Cinv_step=_extended(base.Cinv_step, system.block_diagonal(scheme.c_a(h), 1.0)),
-                               Cinv_mass=_extended(base.Cinv_mass, system.block_diagonal(1.0, 0.0)), Cinv_sub=sub,
+    sub = _extended(base.Cinv_sub, system.deformable_block(scheme.c_a(h / substeps), 1.0)) if substeps else None
+    return dataclasses.replace(base, Cinv_step=_extended(base.Cinv_step, system.deformable_block(scheme.c_a(h), 1.0)),
+                               Cinv_mass=_extended(base.Cinv_mass, system.deformable_block(1.0, 0.0)), Cinv_sub=sub,
                                ns=base.ns + system.layout().n_small - 6)
 
 
@@ -118,9 +119,10 @@ def damped(base, system: System, scheme: Scheme, hh):
 
 class BlockInverse(eqx.Module):
     """The constant-block inverse with the owners' deformable unknowns: the liquid's (a dense
-    matrix, or the sparse factors of sparse.py) and theirs, which is diagonal (the structures' modal block)."""
+    matrix, or the sparse factors of sparse.py) and theirs, diagonal (the structures' modal block)
+    or a small dense block (the bodies' tank liquid)."""
     liquid: Any           # (nf, nf)
-    modal: jax.Array      # (m,)
+    modal: jax.Array      # (m,) a diagonal's inverse, or (m, m)
 
     @property
     def shape(self):
@@ -129,14 +131,22 @@ class BlockInverse(eqx.Module):
 
     def __matmul__(self, x):
         nf = self.liquid.shape[0]
-        bottom = self.modal[:, None] * x[nf:] if x.ndim == 2 else self.modal * x[nf:]
+        if self.modal.ndim == 2:
+            bottom = self.modal @ x[nf:]
+        else:
+            bottom = self.modal[:, None] * x[nf:] if x.ndim == 2 else self.modal * x[nf:]
         return jnp.concatenate([self.liquid @ x[:nf], bottom])
 
 
-def _extended(inv, diag):
-    """The inverse with the owners' diagonal block `diag` appended (itself where they have none: a
-    size, static)."""
-    return inv if diag.shape[0] == 0 else BlockInverse(inv, 1.0 / diag)
+def _extended(inv, block):
+    """The inverse with the owners' block appended, a diagonal (m,) or a block (m, m) (itself where
+    they have none: a size, static). Like the liquid's, it only preconditions: formed from
+    `stop_gradient` values."""
+    if block.shape[0] == 0:
+        return inv
+    if block.ndim == 2:
+        return BlockInverse(inv, jnp.linalg.inv(jax.lax.stop_gradient(block)))
+    return BlockInverse(inv, 1.0 / block)
 
 
 def empty_pre(system: System):

@@ -287,7 +287,7 @@ def test_the_gradient_of_the_connections_rows_in_the_stiffness():
 
     @jax.jit
     def forces(k):
-        term = build_bodies(scene, {"connections.hawser.stiffness": k}, jnp.asarray(G))
+        term, _ = build_bodies(scene, {"connections.hawser.stiffness": k}, jnp.asarray(G))
         return term.link_forces(term.poses(c, vy))
 
     k = 1.0e5
@@ -304,7 +304,7 @@ def test_the_connections_forces_are_the_gradient_of_their_energy_along_the_incre
     from jaxslosh.assemble.bodies import build_bodies
     from jaxslosh.physics.kinematics import quat_exp, quat_from_rpy, quat_multiply
     from jaxslosh.physics.terms import Config
-    term = build_bodies(_pair(), {}, jnp.asarray(G))
+    term, _ = build_bodies(_pair(), {}, jnp.asarray(G))
     c = Config(jnp.array([0.1, 0.3, -0.05]), quat_from_rpy(jnp.array([0.02, -0.01, 0.05])), jnp.zeros(0),
                Xs=jnp.array([[0.0, 29.6, 0.02]]), qs=quat_from_rpy(jnp.array([-0.03, 0.01, 0.02]))[None, :])
     zero = jnp.zeros(12)

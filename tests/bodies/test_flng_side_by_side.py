@@ -27,8 +27,11 @@ def test_the_scene_loads_without_warnings_and_floats_at_rest(scene):
     # the four tanks' LNG from their sections (hopper 5 x 5 m, top chamfer 8 x 6 m) by hand
     assert liquid == pytest.approx(35.127e6, rel=1e-4)
     assert scene.vessel.mass + liquid == pytest.approx(rho * scene.vessel.hydrostatics.displaced_volume, rel=1e-6)
+    # the carrier's four half-full tanks (36 x 22 m section, 4 x 4 m hoppers): (36 x 11 - 16) x 40 m^3 each
     carrier = scene.bodies[0]
-    assert carrier.mass == pytest.approx(rho * carrier.hydrostatics.displaced_volume, rel=1e-6)
+    assert [t.liquid_mass for t in carrier.tanks] == pytest.approx([450.0 * 380.0 * 40.0] * 4, rel=1e-9)
+    assert carrier.mass + sum(t.liquid_mass for t in carrier.tanks) == pytest.approx(
+        rho * carrier.hydrostatics.displaced_volume, rel=1e-6)
     # the fenders touch at rest: the FLNG's side (32.5 m) and the carrier's (60 - 23 m) 4.5 m apart
     for c in scene.connections:
         if c.kind == "fender":
