@@ -339,7 +339,12 @@ def static_shape(line: LumpedLine, fair, tol=1e-8, max_iter=200):
         H = hess(x)
         dH = jnp.abs(jnp.diag(H)) + 1e-12 * line.ea / line.seg
         dx = jnp.linalg.solve(H + mu * jnp.diag(dH), -g)
-        better = pot(x + dx) < pot(x)
+        p_old, p_new = pot(x), pot(x + dx)
+        # near the minimum a step's energy change falls to the energy's round-off (a stiff chain: EA
+        # 1e9 N, forces of mN against 1e9 J): a step that keeps the energy within that and lowers the
+        # largest force is taken too, or the damping would only grow there
+        flat = p_new <= p_old + 64 * jnp.finfo(p_old.dtype).eps * jnp.abs(p_old)
+        better = (p_new < p_old) | (flat & (jnp.max(jnp.abs(grad(x + dx))) < jnp.max(jnp.abs(g))))
         x = jnp.where(better, x + dx, x)
         mu = jnp.where(better, mu * 0.3, mu * 4.0)
         return x, jnp.maximum(mu, 1e-12), it + 1, jnp.max(jnp.abs(grad(x)))

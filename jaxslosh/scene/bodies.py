@@ -58,6 +58,7 @@ def read_bodies(tables, vessel, environment, warnings: list[str], files=None, ta
             "name": ("str", valid_name), "position": ("any", None), "heading": ("float", None),
             "cog_height": ("float", None), "mass": ("float", positive), "inertia": ("inertia", None),
             "hydrostatics": ("table", None), "hydrodynamics": ("table", None), "initial": ("table", None),
+            "footprint": ("any", None),
         }, required=("name", "mass", "inertia", "hydrostatics"))
         name = v["name"]
         if name in RESERVED or name == vessel.name:
@@ -85,7 +86,8 @@ def read_bodies(tables, vessel, environment, warnings: list[str], files=None, ta
         body = Body(name=name, mass=v["mass"], inertia=v["inertia"], hydrostatics=hs,
                     position=(float(pos[0]), float(pos[1])), heading=v.get("heading", 0.0),
                     cog_height=v.get("cog_height", 0.0), initial=initial, viscous_damping=damping,
-                    hydrodynamics=hydro, tanks=tuple(t for t, c in zip(tanks, carriers) if c == name))
+                    hydrodynamics=hydro, footprint=read_footprint(table, where),
+                    tanks=tuple(t for t, c in zip(tanks, carriers) if c == name))
         buoyant = environment.water_density * hs.displaced_volume
         # as the vessel's: its mass is the body's without the liquid of its tanks
         total = body.mass + sum(t.liquid_mass for t in body.tanks)
@@ -146,27 +148,76 @@ def _wave_headings(bodies, waves, coupled) -> None:
                                                      f"{np.round(heads, 6).tolist()} rad")
 
 
+def read_footprint(table, where: str) -> Optional[tuple]:
+    """`footprint = [length, beam]`: the waterplane's extent at rest (m), along the body's x axis and
+    across it, for the overlap check; None when absent."""
+    f = table.get("footprint") if isinstance(table, dict) else None
+    if f is None:
+        return None
+    if not (isinstance(f, list) and len(f) == 2 and all(isinstance(c, (int, float)) and not isinstance(c, bool)
+                                                          and math.isfinite(c) and c > 0 for c in f)):
+        raise SceneError(f"{where}.footprint", f"must be [length, beam], two positive numbers (m), got {show(f)}")
+    return (float(f[0]), float(f[1]))
+
+
 def footprint_radius(area: float) -> float:
     """The radius of the circle of a waterplane's area: the footprint the overlap check compares."""
     return math.sqrt(area / math.pi)
 
 
+def _outline(centre, heading, footprint, area):
+    """A waterplane at rest as the overlap check sees it: ("rect", centre, its axes (2, 2), half sizes)
+    for a footprint, else ("circle", centre, radius) of its area."""
+    if footprint is None:
+        return ("circle", np.asarray(centre, dtype=float), footprint_radius(area))
+    c, s = math.cos(heading), math.sin(heading)
+    return ("rect", np.asarray(centre, dtype=float), np.array([[c, s], [-s, c]]), 0.5 * np.asarray(footprint))
+
+
+def _apart(a, b) -> float:
+    """A separation of two outlines: positive when they do not intersect, negative when they do (for two
+    circles their gap; otherwise the largest gap along a separating axis, the rectangles' axes and, for a
+    circle, the line from its centre to the rectangle's nearest point)."""
+    if a[0] == "circle" and b[0] == "circle":
+        return float(np.linalg.norm(a[1] - b[1]) - a[2] - b[2])
+    if a[0] == "circle":
+        a, b = b, a
+    if b[0] == "circle":      # a rectangle and a circle: the circle's centre from the rectangle
+        local = a[2] @ (b[1] - a[1])
+        outside = np.maximum(np.abs(local) - a[3], 0.0)
+        inside = float(np.min(a[3] - np.abs(local)))
+        return float(np.linalg.norm(outside)) - b[2] if outside.any() else -inside - b[2]
+
+    def half(r, axis):        # a rectangle's half extent along a unit axis
+        return float(np.sum(r[3] * np.abs(r[2] @ axis)))
+    d = b[1] - a[1]
+    return max(abs(float(d @ axis)) - half(a, axis) - half(b, axis) for axis in (*a[2], *b[2]))
+
+
 def _overlaps(bodies, vessel) -> None:
-    """Two bodies whose waterplanes, as circles of their areas about their COGs at rest, intersect
-    are refused: they would float through each other (no contact is modelled but by fenders)."""
-    disks = []
+    """Two bodies whose waterplanes intersect at rest are refused: they would float through each other
+    (no contact is modelled but by fenders). A waterplane is the rectangle of its `footprint` along its
+    heading where given, else the circle of its area about its COG."""
+    outlines = []
     if vessel.hydrostatics is not None:
-        disks.append(("vessel", (0.0, 0.0), footprint_radius(vessel.hydrostatics.waterplane_area)))
-    disks += [(b.name, b.position, footprint_radius(b.hydrostatics.waterplane_area)) for b in bodies]
-    for j, (nb, pb, rb) in enumerate(disks):
-        for na, pa, ra in disks[:j]:
-            gap = math.dist(pa, pb)
-            if gap < ra + rb:
-                i = [b.name for b in bodies].index(nb)
+        outlines.append(("vessel", _outline((0.0, 0.0), 0.0, vessel.footprint,
+                                            vessel.hydrostatics.waterplane_area)))
+    outlines += [(b.name, _outline(b.position, b.heading, b.footprint, b.hydrostatics.waterplane_area)) for b in bodies]
+    for j, (nb, ob) in enumerate(outlines):
+        for na, oa in outlines[:j]:
+            gap = _apart(oa, ob)
+            if gap >= 0:
+                continue
+            i = [b.name for b in bodies].index(nb)
+            dist = float(np.linalg.norm(oa[1] - ob[1]))
+            if oa[0] == ob[0] == "circle":
                 raise SceneError(f"bodies[{i}].position", (
-                    f"{show(list(pb))} puts {nb!r} {gap:.6g} m from {na!r}: their waterplanes (as circles of their "
-                    f"areas, radii {rb:.4g} and {ra:.4g} m) overlap at rest; place the bodies at least "
-                    f"{ra + rb:.6g} m apart"))
+                    f"{show(list(ob[1]))} puts {nb!r} {dist:.6g} m from {na!r}: their waterplanes (as circles of their "
+                    f"areas, radii {ob[2]:.4g} and {oa[2]:.4g} m) overlap at rest; place the bodies at least "
+                    f"{oa[2] + ob[2]:.6g} m apart, or give their `footprint` (length, beam)"))
+            raise SceneError(f"bodies[{i}].position", (
+                f"{show(list(ob[1]))} puts {nb!r} {dist:.6g} m from {na!r}: their waterplanes (rectangles of their "
+                f"`footprint`, circles of their areas without one) overlap at rest by {-gap:.4g} m"))
 
 
 def _body_tank(table, where: str, body: str) -> None:

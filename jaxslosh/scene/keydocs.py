@@ -86,6 +86,8 @@ KEYS = (
                                     "tanks (`tanks.body`) name the vessel (\"vessel\" names it too)."),
     ("vessel.cog_height", "box hull: kg - draft; else 0", "m", "The COG's height above the still-water level at "
                                                                 "rest (it places the mooring fairleads)."),
+    ("vessel.footprint", "the circle of the waterplane area", "m", "[length, beam] of the waterplane at rest: "
+     "the overlap check of `[[bodies]]` compares this rectangle (ships side by side) instead of the circle."),
     ("vessel.mass", _REQ, "kg", "The whole ship without its tank liquid (structures and elastic walls "
                                 "included)."),
     ("vessel.inertia", _REQ, "kg m^2", "About the COG in body axes: 3 diagonal values or a 3 x 3 list "
@@ -287,9 +289,11 @@ KEYS = (
     ("bodies.name", _REQ, "", 'The body\'s name (result datasets `/bodies/<name>/...`); not "vessel", "fixed" '
                               "or the vessel's `name`."),
     ("bodies.position", "[0, 0]", "m", "Its COG at rest, horizontally from the vessel's COG at rest, inertial "
-                                       "[x, y]; their waterplanes (as circles of their areas) must not overlap."),
+                                       "[x, y]; their waterplanes (circles of their areas, or rectangles of their `footprint`) must not overlap."),
     ("bodies.heading", "0", "rad", "Its x axis from the inertial X axis at rest."),
     ("bodies.cog_height", "0", "m", "Its COG's height above the still-water level at rest."),
+    ("bodies.footprint", "the circle of the waterplane area", "m", "[length, beam] of its waterplane at rest, "
+     "along its heading and across: the overlap check compares this rectangle instead of the circle."),
     ("bodies.mass", _REQ, "kg", "The body's mass."),
     ("bodies.inertia", _REQ, "kg m^2", "About its COG, its body axes: 3 diagonal values or 3 x 3."),
     ("bodies.hydrostatics.waterplane_area", _REQ, "m^2", "A_w: heave restoring rho g A_w."),

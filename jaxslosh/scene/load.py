@@ -29,7 +29,7 @@ from ..geometry import AXES, SHAPES
 from .campaign import read_campaign
 from .fields import (at_least, counts, flat_list, non_negative, one_of, poisson_ratio, positive, read, show, sizes,
                      valid_name)
-from .bodies import bodies_scene, read_bodies, read_connections, tank_carriers, tank_groups
+from .bodies import bodies_scene, read_bodies, read_connections, read_footprint, tank_carriers, tank_groups
 from .mooring import read_mooring
 from .record import forced_span, read_forced
 from .rules import conservative as _conservative, locking_elements as _locking_elements
@@ -245,7 +245,7 @@ def _overlapping_tanks(tanks, warnings: list[str]) -> None:
 def _vessel(table, environment: Environment, warnings: list[str], files=None) -> Vessel:
     v = read(table, "vessel", {
         "mass": ("float", positive), "inertia": ("inertia", None), "hydrostatics": ("table", None),
-        "initial": ("table", None), "forced": ("table", None), "hull": ("table", None),
+        "initial": ("table", None), "forced": ("table", None), "hull": ("table", None), "footprint": ("any", None),
         "hydrodynamics": ("table", None), "name": ("str", valid_name), "cog_height": ("float", None),
     }, required=("mass", "inertia"))
     inertia = v["inertia"]
@@ -272,8 +272,8 @@ def _vessel(table, environment: Environment, warnings: list[str], files=None) ->
     # the COG's height above the still-water level (it places mooring fairleads): given, or a box
     # hull's kg - draft, else 0
     cog = v.get("cog_height", hull.default_cog_height() if hull is not None else 0.0)
-    return Vessel(mass=v["mass"], inertia=inertia, hydrostatics=hydrostatics, initial=initial, forced=forced,
-                  hull=hull, hydrodynamics=hydrodynamics, name=v.get("name", "vessel"), cog_height=cog)
+    return Vessel(mass=v["mass"], inertia=inertia, hydrostatics=hydrostatics, initial=initial, forced=forced, hull=hull,
+                  hydrodynamics=hydrodynamics, name=v.get("name", "vessel"), cog_height=cog, footprint=read_footprint(table, "vessel"))
 
 
 def _inertia_warnings(inertia, warnings: list[str]) -> None:

@@ -124,6 +124,7 @@ class Vessel:
     hydrodynamics: Optional["Hydrodynamics"] = None   # added mass, radiation damping, excitation tables
     name: str = "vessel"             # how mooring lines (`body`) name it
     cog_height: float = 0.0          # m, the COG's height above the still-water level at rest
+    footprint: Optional[tuple] = None   # (length, beam) m of the waterplane: the bodies' overlap check
 
 
 @dataclass(frozen=True)
@@ -141,6 +142,7 @@ class Body:
     initial: Initial = field(default_factory=Initial)   # offsets from its rest pose (attitude after the heading)
     viscous_damping: Optional[tuple] = None   # (6, 6) linear damping, N s/m and N m s, its COG and axes
     hydrodynamics: Optional["Hydrodynamics"] = None   # the vessel's keys: tables, a file (its block of a multibody one)
+    footprint: Optional[tuple] = None   # (length, beam) m of the waterplane along its heading: the overlap check
     tanks: tuple = ()                # the [[tanks]] it carries (`tanks.body`), in its frame from its COG
 
 

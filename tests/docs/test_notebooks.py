@@ -126,3 +126,14 @@ def test_moored_spar_notebook_runs():
     assert abs(fem / closed - 1) < 0.005
     g, fd = numbers(r"jax.grad ([-\d.e+]+) N/m, finite difference ([-\d.e+]+) N/m", text)
     assert abs(g - fd) <= 1e-3 * abs(fd), (g, fd)
+
+
+@pytest.mark.slow
+def test_flng_side_by_side_notebook_runs():
+    """Minutes at the small size (two builds of the FLNG with its lines and tanks, two compiles)."""
+    text = printed(run_notebook("flng_side_by_side.ipynb", {"JAXSLOSH_NOTEBOOK_SMALL": "1"}, timeout=1800))
+    assert "sloshing: ok" in text and "frozen: ok" in text
+    # the frozen LNG: the four tanks' 35,127 t (their sections by hand, tests/bodies/test_flng_side_by_side.py)
+    (tonnes,) = numbers(r"LNG ([\d,]+) t;", text.replace(",", ""))
+    assert abs(tonnes / 35127 - 1) < 0.002, tonnes
+    assert "largest fender kN" in text and "manifold y m" in text
