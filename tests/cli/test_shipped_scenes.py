@@ -60,22 +60,23 @@ def core_closure():
     (no extras) and, transitively, theirs (as this environment's metadata lists them)."""
     with open(os.path.join(ROOT, "pyproject.toml"), "rb") as f:
         project = tomllib.load(f)["project"]
-    env = dict(default_environment(), extra="")
-    todo = [Requirement(r) for r in project["dependencies"]]
+    # each requirement with the extras its requirer asks for (the core's "dask[distributed]")
+    todo = [(Requirement(r), "") for r in project["dependencies"]]
     seen = set()
     while todo:
-        r = todo.pop()
-        if r.marker is not None and not r.marker.evaluate(env):
+        r, extra = todo.pop()
+        if r.marker is not None and not r.marker.evaluate(dict(default_environment(), extra=extra)):
             continue
-        n = _name(r.name)
+        n = (_name(r.name), tuple(sorted(r.extras)))
         if n in seen:
             continue
         seen.add(n)
         try:
-            todo += [Requirement(x) for x in (metadata.requires(r.name) or [])]
+            reqs = [Requirement(x) for x in (metadata.requires(r.name) or [])]
         except metadata.PackageNotFoundError:
-            pass                        # a dependency for another platform or Python
-    return seen
+            continue                    # a dependency for another platform or Python
+        todo += [(x, e) for x in reqs for e in ("", *r.extras)]
+    return {name for name, _ in seen}
 
 
 #: modules imported when present and passed over when not (an ImportError caught by their importer)
