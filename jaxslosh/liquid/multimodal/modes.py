@@ -264,12 +264,12 @@ def cylinder_columns(R, D, x, y):
 
 def cylinder_flow(columns, D, z):
     """`cylinder_vortical` at heights z of the columns (`cylinder_columns`, broadcast against z): the
-    series' terms in eta, sin and cos of odd multiples of pi eta / D, as odd powers of the first
-    (`odd_powers`: products in place of sines)."""
+    series' terms in eta, sin and cos of mu_m eta. (Odd powers of exp(i pi eta / D), as the box's
+    flows take them, cost 1.4 times the sines here: XLA's complex products on the CPU.)"""
     xc, yc, c, s, Br, Bq, Be = columns
     eta = jnp.asarray(z) - 0.5 * D
-    e = odd_powers(jnp.exp(1j * (jnp.pi / D) * eta), SJ_TERMS)     # cos(mu eta) + i sin(mu eta)
-    sn, cs = e.imag, e.real
+    mu = (2 * jnp.arange(SJ_TERMS) + 1) * jnp.pi / D
+    sn, cs = jnp.sin(mu * eta[..., None]), jnp.cos(mu * eta[..., None])
     Gr = jnp.sum(Br * sn, -1)                                  # dG / dr
     G_r = jnp.sum(Bq * sn, -1)                                 # G / r
     Ge = jnp.sum(Be * cs, -1)                                  # dG / deta
