@@ -98,6 +98,14 @@ class RectangleBase:
     def vortical(self, D, x, y, z):
         return box_vortical(self.L, self.B, D, x, y, z)
 
+    def vortical_columns(self, D, x, y):
+        """What `vortical_at` needs of the points (x, y) (formed once at a tank's quadrature points)."""
+        return (jnp.asarray(x, dtype=float), jnp.asarray(y, dtype=float))
+
+    def vortical_at(self, columns, D, z):
+        """The vortical flows at heights z over the points of `vortical_columns`."""
+        return box_vortical(self.L, self.B, D, *columns, z)
+
     def rim(self, n: int):
         """(x, y): n points round the walls, the corners among them."""
         L, B = self.L, self.B
@@ -163,6 +171,15 @@ class DiskBase:
     def vortical(self, D, x, y, z):
         return cylinder_vortical(self.R, D, x, y, z)
 
+    def vortical_columns(self, D, x, y):
+        """The flows' radial factors at the points (x, y) (`cylinder_columns`: Bessel functions, formed
+        once at a tank's quadrature points, never in a step)."""
+        return cylinder_columns(self.R, D, x, y)
+
+    def vortical_at(self, columns, D, z):
+        """The vortical flows at heights z over the points of `vortical_columns`."""
+        return cylinder_flow(columns, D, z)
+
     def rim(self, n: int):
         """(x, y): n points round the wall."""
         th = 2.0 * np.pi * np.arange(n) / n
@@ -219,7 +236,16 @@ def cylinder_vortical(R, D, x, y, z):
     sin(mu_m eta), mu_m = (2m + 1) pi / D, c_m mu_m I_1'(mu_m R) the sine series of -2 eta (no flux
     through the wall; eta from mid-height)."""
     x, y, z = jnp.broadcast_arrays(jnp.asarray(x), jnp.asarray(y), jnp.asarray(z))
-    xc, yc, eta = x - R, y - R, z - 0.5 * D
+    return cylinder_flow(cylinder_columns(R, D, x, y), D, z)
+
+
+def cylinder_columns(R, D, x, y):
+    """What the cylinder's vortical flows (`cylinder_vortical`) hold at points (x, y) of its base that
+    does not depend on the height: the series' radial factors (Bessel functions of mu_m r, (..., SJ_TERMS)
+    each) and the point's place. A tank forms them once at its quadrature points' columns (build time):
+    the flows at the liquid's depth points are then a sine series in eta alone."""
+    x, y = jnp.broadcast_arrays(jnp.asarray(x, dtype=float), jnp.asarray(y, dtype=float))
+    xc, yc = x - R, y - R
     r = jnp.hypot(xc, yc)
     rs = jnp.where(r > 0, r, 1.0)
     c, s = jnp.where(r > 0, xc / rs, 1.0), jnp.where(r > 0, yc / rs, 0.0)
@@ -233,11 +259,35 @@ def cylinder_vortical(R, D, x, y, z):
     mr = mu * r[..., None]
     mrs = jnp.where(mr > 0, mr, 1.0)
     I1r = jnp.where(mr > 0, i1e(mrs) / mrs, 0.5) * scale      # I_1(mu r) / (mu r), scaled
-    sn, cs = jnp.sin(mu * eta[..., None]), jnp.cos(mu * eta[..., None])
-    Gr = jnp.sum(b * jnp.where(mr > 0, i1pe(mrs), 0.5) * scale * sn, -1)
-    G_r = jnp.sum(b * I1r * sn, -1)                            # G / r
-    Ge = jnp.sum(b * I1r * mr * cs, -1)
-    zero = jnp.zeros_like(x)
+    return (xc, yc, c, s, b * jnp.where(mr > 0, i1pe(mrs), 0.5) * scale, b * I1r, b * I1r * mr)
+
+
+def _odd_series(B, alpha, sign):
+    """Clenshaw's recurrence for sum_m B_m t_m, t_m = sin or cos of (2m + 1) theta (t_(m+1) = alpha
+    t_m - t_(m-1), alpha = 2 cos 2 theta): b_m = B_m + alpha b_(m+1) - b_(m+2), the sum sin(theta)
+    (b_0 + b_1) for the sines (sign +1), cos(theta) (b_0 - b_1) for the cosines (sign -1); returned
+    without that factor. B (..., M) broadcast against alpha's shape; elementwise steps, one fused
+    loop for XLA."""
+    b1 = b2 = jnp.zeros_like(alpha)
+    for m in range(B.shape[-1] - 1, 0, -1):        # the series' terms (SJ_TERMS), not elements
+        b1, b2 = B[..., m] + alpha * b1 - b2, b1
+    return B[..., 0] + alpha * b1 - b2 + sign * b1
+
+
+def cylinder_flow(columns, D, z):
+    """`cylinder_vortical` at heights z of the columns (`cylinder_columns`, broadcast against z): the
+    series in eta, sums of B_m sin(mu_m eta) or B_m cos(mu_m eta) with mu_m = (2m + 1) pi / D, by
+    Clenshaw's recurrence (`_odd_series`: two sines per point, no sine per term)."""
+    xc, yc, c, s, Br, Bq, Be = columns
+    eta = jnp.asarray(z) - 0.5 * D
+    th = (jnp.pi / D) * eta
+    sin1, cos1 = jnp.sin(th), jnp.cos(th)
+    alpha = 2.0 * (cos1 * cos1 - sin1 * sin1)                  # 2 cos(2 theta)
+    Gr = sin1 * _odd_series(Br, alpha, +1.0)                   # dG / dr
+    G_r = sin1 * _odd_series(Bq, alpha, +1.0)                  # G / r
+    Ge = cos1 * _odd_series(Be, alpha, -1.0)                   # dG / deta
+    xc, yc, c, s = jnp.broadcast_arrays(xc, yc, c, s, eta)[:4]
+    zero = jnp.zeros_like(Gr)
     wx = jnp.stack([(Gr - G_r) * s * c, 2.0 * eta + Gr * s * s + G_r * c * c, s * Ge], -1)
     wy = jnp.stack([-2.0 * eta - Gr * c * c - G_r * s * s, -(Gr - G_r) * c * s, -c * Ge], -1)
     wz = jnp.stack([yc, -xc, zero], -1)

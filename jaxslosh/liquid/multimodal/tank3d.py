@@ -30,6 +30,7 @@ two-dimensional tank. The equations are Kirchhoff's, as there (`rows`).
 """
 from __future__ import annotations
 
+import functools
 from typing import NamedTuple
 
 import equinox as eqx
@@ -37,6 +38,7 @@ import jax
 import jax.numpy as jnp
 import numpy as np
 
+from .columns import column_values
 from .modes import DiskBase, RectangleBase
 
 #: Gauss points through the depth
@@ -77,6 +79,7 @@ class ModalTank3D(eqx.Module):
     norms: jax.Array      # (N,) integral of f_n^2 over the base
     sq: jax.Array         # (NZ,) points on [0, 1] through the depth
     ws: jax.Array         # (NZ,) their weights
+    vq: tuple             # the vortical flows' factors at the points' columns (base.vortical_columns)
     base: object = eqx.field(static=True)    # RectangleBase | DiskBase (liquid/multimodal/modes.py)
     modes: tuple = eqx.field(static=True)    # box (i, j); cylinder (m, s, cos 0 | sin 1)
 
@@ -105,25 +108,16 @@ class ModalTank3D(eqx.Module):
 
     # ------------------------------------------------------------------ integrals
     def integrals(self, beta) -> Integrals3:
+        """The integrals at beta: the columns' sums (`_columns`, their derivatives in beta column by
+        column: liquid/multimodal/columns.py), scaled by the modes' cosh(k h); the moments of the
+        liquid's volume, simple sums over the base."""
         k, w, F = self.k, self.wq, self.F
         H = self.h + F @ beta                                              # (Q,)
+        geo = (k, w, F, self.Fx, self.Fy, self.xq, self.yq, self.sq, self.ws, self.vq, self.D)
+        a, *sums = column_values(_column_fn(self.base), 0, H, geo)
+        An, Ank, grad, rxg, Bw, W, wint, rxw = (jnp.sum(c, axis=0) for c in sums)
         ch = jnp.cosh(k * self.h)
-        An = jnp.einsum("q,qn->n", w, F * jnp.sinh(H[:, None] * k) / (k * ch))
-        Jn = jnp.einsum("q,qn,qj->nj", w, F * jnp.cosh(H[:, None] * k) / ch, F)
-        u = H[:, None] * self.sq[None, :]                                  # (Q, S)
-        wu = w[:, None] * H[:, None] * self.ws[None, :]
-        C = jnp.cosh(u[..., None] * k) / ch                               # (Q, S, N)
-        S = jnp.sinh(u[..., None] * k) / ch
-        g = jnp.stack([self.Fx[:, None, :] * C, self.Fy[:, None, :] * C, k * F[:, None, :] * S], axis=-1)
-        r = jnp.stack([jnp.broadcast_to(self.xq[:, None], u.shape), jnp.broadcast_to(self.yq[:, None], u.shape), u], -1)
-        Ank = jnp.einsum("qs,qsnc,qsmc->nm", wu, g, g)
-        grad = jnp.einsum("qs,qsnc->nc", wu, g)
-        rxg = jnp.einsum("qs,qsnc->nc", wu, jnp.cross(r[:, :, None, :], g))
-        wl = self.vortical(self.xq[:, None], self.yq[:, None], u)          # (3, Q, S, 3)
-        Bw = jnp.einsum("qs,qsnc,lqsc->nl", wu, g, wl)
-        W = jnp.einsum("qs,lqsc,mqsc->lm", wu, wl, wl)
-        wint = jnp.einsum("qs,lqsc->lc", wu, wl)
-        rxw = jnp.einsum("qs,lqsc->lc", wu, jnp.cross(r[None], wl))
+        Jn = jnp.einsum("qn,qj->nj", a, F) / ch[:, None]
         x, y = self.xq, self.yq
         m1 = jnp.array([w @ (x * H), w @ (y * H), w @ (0.5 * H ** 2)])
         hh = 0.5 * H ** 2
@@ -131,7 +125,8 @@ class ModalTank3D(eqx.Module):
                         [w @ (x * y * H), w @ (y * y * H), w @ (y * hh)],
                         [w @ (x * hh), w @ (y * hh), w @ (H ** 3 / 3.0)]])
         dm1 = jnp.stack([(w * x) @ F, (w * y) @ F, (w * H) @ F])
-        return Integrals3(An, Jn, Ank, grad, rxg, Bw, W, wint, rxw, w @ H, m1, m2, dm1)
+        return Integrals3(An / ch, Jn, Ank / jnp.outer(ch, ch), grad / ch[:, None], rxg / ch[:, None],
+                          Bw / ch[:, None], W, wint, rxw, w @ H, m1, m2, dm1)
 
     def moments(self, I: Integrals3):
         """(first moment S (3,), second moment J = sum m x x^T (3, 3)) of the liquid in the vessel frame."""
@@ -195,6 +190,33 @@ class ModalTank3D(eqx.Module):
         return f, m, dp[6:] - dT - g_b @ (self.rho * I.dm1)           # dV/dbeta = -g_b . dS/dbeta
 
 
+def _columns(base, H, geo):
+    """What each column of the liquid holds (the column axis first; ModalTank3D.integrals sums them): the
+    integrals of the potential's modes phi_n = f_n cosh(k_n z) (cosh(k_n h) left out: the caller
+    scales), their gradients and the vortical flows w_l over the column of height H_q, by Gauss
+    through the depth. `a` gives J_nj = sum_q a_qn F_qj (kept by column)."""
+    k, w, F, Fx, Fy, x, y, sq, ws, vq, D = geo
+    a = w[:, None] * F * jnp.cosh(H[:, None] * k)
+    An = w[:, None] * F * jnp.sinh(H[:, None] * k) / k
+    u = H[:, None] * sq[None, :]                                       # (Q, S)
+    wu = w[:, None] * H[:, None] * ws[None, :]
+    C = jnp.cosh(u[..., None] * k)                                     # (Q, S, N)
+    S = jnp.sinh(u[..., None] * k)
+    g = jnp.stack([Fx[:, None, :] * C, Fy[:, None, :] * C, k * F[:, None, :] * S], axis=-1)
+    r = jnp.stack([jnp.broadcast_to(x[:, None], u.shape), jnp.broadcast_to(y[:, None], u.shape), u], -1)
+    wl = base.vortical_at(vq, D, u)                                    # (3, Q, S, 3)
+    return (a, An, jnp.einsum("qs,qsnc,qsmc->qnm", wu, g, g), jnp.einsum("qs,qsnc->qnc", wu, g),
+            jnp.einsum("qs,qsnc->qnc", wu, jnp.cross(r[:, :, None, :], g)),
+            jnp.einsum("qs,qsnc,lqsc->qnl", wu, g, wl), jnp.einsum("qs,lqsc,mqsc->qlm", wu, wl, wl),
+            jnp.einsum("qs,lqsc->qlc", wu, wl), jnp.einsum("qs,lqsc->qlc", wu, jnp.cross(r[None], wl)))
+
+
+@functools.lru_cache(maxsize=None)
+def _column_fn(base):
+    """`_columns` of one base (one function per base: the derivative rule's static argument)."""
+    return functools.partial(_columns, base)
+
+
 def _tank(base, h, D, rho, origin, modes) -> ModalTank3D:
     x, y, w = base.quadrature(modes)
     F, Fx, Fy = base.values(modes, x, y)
@@ -202,7 +224,8 @@ def _tank(base, h, D, rho, origin, modes) -> ModalTank3D:
     f = lambda a: jnp.asarray(a, dtype=float)  # noqa: E731
     return ModalTank3D(size=f(base.size), h=f(h), D=f(D), rho=f(rho), origin=f(origin),
                        k=f(base.wavenumbers(modes)), xq=f(x), yq=f(y), wq=f(w), F=f(F), Fx=f(Fx), Fy=f(Fy),
-                       norms=f(w @ F ** 2), sq=f(0.5 * (sg + 1.0)), ws=f(0.5 * sw), base=base, modes=tuple(modes))
+                       norms=f(w @ F ** 2), sq=f(0.5 * (sg + 1.0)), ws=f(0.5 * sw),
+                       vq=base.vortical_columns(f(D), f(x)[:, None], f(y)[:, None]), base=base, modes=tuple(modes))
 
 
 def box_tank3d(L, B, h, rho, origin, n_modes: int = 0, D=None, modes=None) -> ModalTank3D:
