@@ -21,9 +21,12 @@ def test_batch_equals_single_runs():
     for i, g in enumerate(gm):
         single = js.simulate(scene, params={"vessel.hydrostatics.gm_t": g})
         # the batch forms its Newton preconditioner anew every 4 steps, a single run when its
-        # convergence slows: both converge to the Newton tolerance (1e-10 m/s^2), not bitwise alike
+        # convergence slows: both converge to the Newton tolerance (1e-10 m/s^2), not bitwise alike.
+        # An acceleration error below it bounds the attitudes' difference by 1e-10 t^2 / 2 = 4.5e-10
+        # at 3 s; measured 6.4e-12 with the predictor a_n, 1.6e-11 with the extrapolated one (the
+        # batch then stops after one iteration just below the tolerance, the single run after two)
         np.testing.assert_allclose(np.asarray(batch.vessel.quaternion[i]), np.asarray(single.vessel.quaternion),
-                                   atol=1e-11)
+                                   atol=5e-11)
     # a larger GM_T rolls less
     roll = np.abs(np.asarray(batch.vessel.roll_pitch_yaw)[:, :, 0]).max(axis=1)
     assert roll[0] > roll[1] > roll[2]
