@@ -21,8 +21,6 @@ for a velocity linear over the step, so the memory force is linear in the step's
 """
 from __future__ import annotations
 
-import math
-
 import equinox as eqx
 import jax
 import jax.numpy as jnp
@@ -74,38 +72,6 @@ class Memory(eqx.Module):
         return self.c_re @ z[:, 0] - self.c_im @ z[:, 1]
 
 
-#: pi/2 in three parts (fdlibm's pio2_1, pio2_2, pio2_2t): the first two have 33 significant bits,
-#: so n times them is exact for |n| < 2^20 and x - n pi/2 keeps every digit of x (Cody & Waite)
-_PIO2 = (1.57079632673412561417e+00, 6.07710050630396597660e-11, 2.02226624879595063154e-21)
-#: Taylor coefficients of sin and cos on |r| <= pi/4: the first terms left out are below 1e-17
-_SIN = tuple((-1.0) ** k / math.factorial(2 * k + 1) for k in range(9))
-_COS = tuple((-1.0) ** k / math.factorial(2 * k) for k in range(10))
-
-
-def _horner(c, r2):
-    out = c[-1]
-    for ck in c[-2::-1]:
-        out = ck + r2 * out
-    return out
-
-
-def cos_sin(x):
-    """(cos x, sin x) elementwise, float64, from one reduction by pi/2 and two polynomials: XLA's
-    CPU cosine and sine of float64 are scalar library calls, and the wave excitation's N of each
-    per step were a sixth of the campaign ship's step (docs/benchmarks.md). Within an ulp or two of
-    jnp.cos and jnp.sin for |x| < 1.6e6 (n pi/2 exact below it); beyond, the reduction loses what
-    x itself has already lost to rounding."""
-    n = jnp.round(x * (2.0 / math.pi))
-    r = ((x - n * _PIO2[0]) - n * _PIO2[1]) - n * _PIO2[2]
-    r2 = r * r
-    s, c = r * _horner(_SIN, r2), _horner(_COS, r2)
-    q = jnp.mod(n, 4.0)               # the quadrant: x = r + q pi/2 (mod 2 pi)
-    swap = (q == 1.0) | (q == 3.0)
-    cos_x = jnp.where(swap, s, c) * jnp.where((q == 1.0) | (q == 2.0), -1.0, 1.0)
-    sin_x = jnp.where(swap, c, s) * jnp.where(q >= 2.0, -1.0, 1.0)
-    return cos_x, sin_x
-
-
 class Excitation(eqx.Module):
     """First-order wave forces as a known function of time: F_j(t) = r(t) height sum_i
     amp_ji cos(w_i t + phase_ji), rows in the residual's frame (translations inertial, rotations
@@ -113,9 +79,9 @@ class Excitation(eqx.Module):
     (regular) or Hs (JONSWAP): the forces are linear in it, so it may be a traced parameter.
 
     The sum is evaluated as amp cos(phase) . cos(w t) - amp sin(phase) . sin(w t), the two
-    (6, N) products formed once where the excitation is made: the force is evaluated once per step
-    (System.at_time), and N cosines and N sines there cost a third of a cosine per row and
-    component (6 N); they are `cos_sin`'s, a fifth of XLA's library calls."""
+    (6, N) products formed once where the excitation is made: the force is evaluated in every
+    Newton iteration, and N cosines and N sines there cost a third of a cosine per row and
+    component (6 N)."""
     omega: jax.Array      # (N,)
     amp: jax.Array        # (6, N) per unit `height`
     phase: jax.Array      # (6, N)
@@ -130,8 +96,8 @@ class Excitation(eqx.Module):
         self.quadrature = amp * jnp.sin(phase)
 
     def force(self, t):
-        cos_wt, sin_wt = cos_sin(self.omega * t)
-        F = self.height * (self.in_phase @ cos_wt - self.quadrature @ sin_wt)
+        wt = self.omega * t
+        F = self.height * (self.in_phase @ jnp.cos(wt) - self.quadrature @ jnp.sin(wt))
         if self.ramp > 0:
             F = F * jnp.where(t < self.ramp, 0.5 * (1.0 - jnp.cos(jnp.pi * jnp.clip(t, 0.0, self.ramp) / self.ramp)), 1.0)
         return F
