@@ -100,7 +100,7 @@ def across_tank_warnings(scene: Scene, headings) -> list:
             f"heading {shown} deg the sway, roll and yaw leave its liquid frozen across the tank (no transverse "
             f"sloshing, no free-surface effect in roll): set flow = \"3d\" in [[tanks]] for waves across it too"
             for i, t in enumerate(scene.tanks)
-            if t.multimodal and not t.three_dimensional]
+            if t.form.along_length_only]
 
 
 def default_frequencies(scene: Scene, tables=None, radiation=None, count: int = DEFAULT_COUNT):

@@ -4,7 +4,7 @@ them too). The effects `check` lists are the assembled model's own (assemble/che
 from __future__ import annotations
 
 
-from ..liquid.face.mesh import free_face_count
+from ..liquid.forms import tank_liquid
 from ..liquid.walls import shell_mesh
 from ..liquid.multimodal.modes import modal_modes
 from ..scene.types import EFFECTS, Scene
@@ -112,22 +112,11 @@ def tank_notes(t) -> list[str]:
 
 
 def free_liquid_dofs(tank) -> int:
-    """A tank's free liquid unknowns at full order: the nodal elements' three dofs per node, less the
-    wall-normal ones the slip walls hold; the face-normal element's free faces (the interior ones and
-    the free surface's, liquid/face/element.py); a multimodal tank's modal coordinates."""
-    if tank.multimodal:
-        return len(modal_modes(tank))
-    if tank.face_normal:
-        nx, ny, nz = tank.mesh
-        if tank.geometry.plain_box:         # interior faces along x, y and z, and the nx ny top faces
-            return 3 * nx * ny * nz - ny * nz - nx * nz
-        tm = tank.geometry.mesh(tank.fill_depth, tuple(tank.mesh))
-        return free_face_count(tm.nodes, tm.elements, tm.depth)
-    if not tank.geometry.plain_box:
-        return tank.geometry.free_count(tank.fill_depth, tuple(tank.mesh))
-    nx, ny, nz = tank.mesh
-    nodes = (nx + 1) * (ny + 1) * (nz + 1)
-    return 3 * nodes - (2 * (ny + 1) * (nz + 1) + 2 * (nx + 1) * (nz + 1) + (nx + 1) * (ny + 1))
+    """A tank's free liquid unknowns at full order, as the model that runs its form counts them
+    (liquid/base.py `AbstractLiquid.tank_unknowns`): the nodal elements' three dofs per node, less the
+    wall-normal ones the slip walls hold; the face-normal element's free faces; a multimodal tank's
+    modal coordinates."""
+    return tank_liquid(tank).tank_unknowns(tank)
 
 
 def liquid_unknowns(scene: Scene) -> int:

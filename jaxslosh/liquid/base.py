@@ -86,6 +86,28 @@ def _abs_rowsum(K):
     return jnp.sum(jnp.abs(jnp.asarray(K)), axis=1)
 
 
+def dense_step_inverse(liquid, c_a, c_a_sub=None) -> StepInverse:
+    """The inverses of a liquid's constant blocks for the Newton step at c_a (and a sub-step's
+    c_a_sub), dense, from its `constant_blocks` (NumPy for concrete matrices, JAX when the liquid
+    was built from traced values): every model's `step_inverse` but on large meshes, where the nodal
+    and face-normal ones use their own solves. They only precondition the Newton iterations and the
+    tangent solves, so they are formed from `stop_gradient` values."""
+    M_ff, K_ff = jax.lax.stop_gradient(liquid).constant_blocks()
+    traced = isinstance(M_ff, jax.core.Tracer) or isinstance(K_ff, jax.core.Tracer)
+    if not traced:
+        M_ff, K_ff = np.asarray(M_ff), np.asarray(K_ff)
+
+    def inverse(A):
+        return inv(A) if traced else jnp.asarray(np.linalg.inv(A))
+
+    def step(c):
+        Cs = c * M_ff + K_ff
+        return inverse(0.5 * (Cs + Cs.T))
+
+    return StepInverse(step(c_a), inverse(M_ff), step(c_a_sub) if c_a_sub is not None else None,
+                       _abs_rowsum(K_ff))
+
+
 class AbstractLiquid(AbstractTerm):
     """The owner of the deformable unknowns d: what the solver, the build, the frames and `check`
     need of it besides its rows and energies. Every model is a final subclass (equinox's
@@ -111,25 +133,29 @@ class AbstractLiquid(AbstractTerm):
     def constant_blocks(self):
         """(M_ff, K_ff): its constant mass and stiffness on the unknowns, dense."""
 
+    @abc.abstractmethod
     def step_inverse(self, c_a, c_a_sub=None) -> StepInverse:
         """The inverses of its constant blocks for the Newton step at c_a (and a sub-step's c_a_sub):
-        dense here, from `constant_blocks` (NumPy for concrete matrices, JAX when the liquid was built
-        from traced values); large meshes override it with their own solves. They only precondition
-        the Newton iterations and the tangent solves, so they are formed from `stop_gradient` values."""
-        M_ff, K_ff = jax.lax.stop_gradient(self).constant_blocks()
-        traced = isinstance(M_ff, jax.core.Tracer) or isinstance(K_ff, jax.core.Tracer)
-        if not traced:
-            M_ff, K_ff = np.asarray(M_ff), np.asarray(K_ff)
+        `dense_step_inverse` above, or a model's own solves on large meshes. They only precondition
+        the Newton iterations and the tangent solves (solve/linear.make_solver asks this alone)."""
 
-        def inverse(A):
-            return inv(A) if traced else jnp.asarray(np.linalg.inv(A))
+    @abc.abstractmethod
+    def describe(self) -> tuple:
+        """(effect, text) lines: what this liquid adds to the model, as `jaxslosh check` lists it."""
 
-        def step(c):
-            Cs = c * M_ff + K_ff
-            return inverse(0.5 * (Cs + Cs.T))
+    # What a model answers of one tank before any block is built, asked of the class that runs the
+    # tank's form (liquid/forms.py `tank_liquid`): `jaxslosh modes`, `check` and the cost estimate.
+    @classmethod
+    @abc.abstractmethod
+    def tank_unknowns(cls, tank) -> int:
+        """The tank's free unknowns at full order in this model, counted from its keys (a reduced
+        tank's are its element's: the modes are cut from them)."""
 
-        return StepInverse(step(c_a), inverse(M_ff), step(c_a_sub) if c_a_sub is not None else None,
-                           _abs_rowsum(K_ff))
+    @classmethod
+    @abc.abstractmethod
+    def sloshing_modes(cls, tank, g: float, n: int = 10):
+        """The n lowest natural modes of the tank's liquid (with its elastic walls, where it has them)
+        at gravity g, the vessel held fixed: `liquid/modes.Modes` (or `liquid/walls.TankModes`)."""
 
     @property
     @abc.abstractmethod
@@ -215,6 +241,20 @@ class NoLiquid(AbstractLiquid):
 
     def constant_blocks(self):
         return jnp.zeros((0, 0)), jnp.zeros((0, 0))
+
+    def step_inverse(self, c_a, c_a_sub=None) -> StepInverse:
+        return dense_step_inverse(self, c_a, c_a_sub)
+
+    def describe(self) -> tuple:
+        return ()
+
+    @classmethod
+    def tank_unknowns(cls, tank) -> int:
+        return 0
+
+    @classmethod
+    def sloshing_modes(cls, tank, g: float, n: int = 10):
+        raise ValueError("a vessel without tank liquid has no sloshing modes")
 
 
 class RotationPenalty(AbstractTerm):

@@ -1,21 +1,37 @@
-"""Which liquid model a scene's tanks take, decided once: each tank's element model (the nodal one
-of nodal/model.py, or the face-normal one of face/element.py, by `tanks.fluid.element`), then the
-one form of the stacked block they go into together (nodal, face-normal, on modal bases, or with
-elastic walls and structures in the vessel's frame), after the checks that their keys go together.
-Each form's builder lives in its model's sub-package."""
+"""Which liquid model a scene's tanks take, decided once from each tank's form (scene/liquids.py
+`Tank.form`, made by the loader from its keys): the final liquid class that runs a tank
+(`tank_liquid`, which answers its unknowns and modes), each tank's element model (the nodal one of
+nodal/model.py, or the face-normal one of face/element.py), then the one form of the stacked block
+they go into together (nodal, face-normal, on modal bases, or with elastic walls and structures in
+the vessel's frame), after the checks that their keys go together. Each form's builder lives in its
+model's sub-package."""
 from __future__ import annotations
 
-from ..scene.types import FACE_FORMS, SceneError
-from .face.element import FaceModel
+from ..scene.liquids import FaceForm, MultimodalForm, NodalForm
+from ..scene.types import SceneError
+from .base import AbstractLiquid
 from .face.stack import face_block, face_model
+from .face.term import FaceLiquid
 from .modal.build import reduced_block
+from .modal.term import ModalLiquid
+from .multimodal.term import MultimodalLiquid
 from .nodal.build import nodal_block, nodal_model, walls_block
+from .nodal.term import NodalLiquid
+
+#: the final liquid that runs each form at full order (with rigid or elastic walls)
+FULL_ORDER = {NodalForm: NodalLiquid, FaceForm: FaceLiquid, MultimodalForm: MultimodalLiquid}
+
+
+def tank_liquid(tank) -> type[AbstractLiquid]:
+    """The final liquid class that runs the tank's form: its `tank_unknowns` and `sloshing_modes`
+    answer for the tank before any block is built (a reduced tank's: ModalLiquid)."""
+    return ModalLiquid if tank.form.reduced else FULL_ORDER[type(tank.form)]
 
 
 def tank_models(scene, tanks, params: dict, g, sparse: bool) -> list:
     """Each tank's element model at the values `params` (canonical keys) and `g` give: a face-normal
     tank's at the scene's own values (its blocks scale to traced ones), a nodal one's at them."""
-    return [face_model(scene, t, i, params) if t.fluid.element in FACE_FORMS else nodal_model(t, i, params, g, sparse)
+    return [face_model(scene, t, i, params) if t.form.face_normal else nodal_model(t, i, params, g, sparse)
             for i, t in enumerate(tanks)]
 
 
@@ -23,9 +39,9 @@ def block_form(tanks, models, in_vessel_frame: bool, sparse: bool):
     """The builder of the stacked block, (scene, tanks, models, params, g, sparse, held, Kg) ->
     LiquidBlock, with `held` the structures in the vessel's frame and `Kg` their spin stiffness;
     SceneError, naming the key, where the tanks' forms do not go together."""
-    faces = bool(models) and all(isinstance(m, FaceModel) for m in models)
-    reduced = [t.reduction is not None for t in tanks]
-    elastic = [t.wall_spec is not None for t in tanks]
+    faces = bool(tanks) and all(t.form.face_normal for t in tanks)
+    reduced = [t.form.reduced for t in tanks]
+    elastic = [t.form.elastic for t in tanks]
     if (any(elastic) or in_vessel_frame) and faces:     # "rt": face/walls.py, face/build.py, full order
         for i in range(len(tanks)):
             if reduced[i]:
@@ -38,7 +54,7 @@ def block_form(tanks, models, in_vessel_frame: bool, sparse: bool):
         return _walls
     if any(reduced):
         return _reduced
-    if any(isinstance(m, FaceModel) for m in models):
+    if any(t.form.face_normal for t in tanks):
         return _face
     return _nodal
 
@@ -47,8 +63,8 @@ def _check_walls(tanks, models, reduced, elastic, sparse):
     """Elastic walls and vessel-frame structures with nodal tanks: every tank's liquid nodal, on a box
     grid, full order, dense and at the scene's own values."""
     for i, t in enumerate(tanks):
-        if isinstance(models[i], FaceModel):
-            other = next(m.element for m in models if not isinstance(m, FaceModel))
+        if t.form.face_normal:
+            other = next(u.form.element for u in tanks if not u.form.face_normal)
             raise SceneError(f"tanks[{i}].fluid.element",
                              f"{t.fluid.element!r} takes elastic walls and structures in the vessel's frame only "
                              f"when every tank is \"rt\" (another tank's is {other!r}): give every tank the "

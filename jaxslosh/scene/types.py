@@ -13,6 +13,7 @@ from typing import Optional, Union
 from ..fem.mesh import ELEMENT_FORMS, FACE_FORMS  # noqa: F401  (the loader reads them here)
 from ..geometry import SHAPES, AbstractShape
 from ..solve.schemes import SCHEMES, AbstractScheme
+from .liquids import LiquidForm, liquid_form
 from .hulls import HULLS, BoxHull, Hull, MeshHull  # noqa: F401  (the scene's types, read from here)
 from .seas import WAVES, IrregularSea, JonswapSea, PiersonMoskowitzSea, RegularWaves, Waves  # noqa: F401
 
@@ -242,27 +243,31 @@ class Tank:
     #: gets it from them
     geometry: Optional[AbstractShape] = field(default=None, compare=False, repr=False)
 
-    # The liquid model the tank's keys choose, read here once (jaxslosh/liquid decides the rest):
-    # code elsewhere asks these, not the strings of `model`, `fluid.element`, `flow`, `expansion`.
+    #: the liquid form its keys choose (scene/liquids.py), made from them at construction: code
+    #: elsewhere asks it (or the properties below), not the strings of `model`, `fluid.element`,
+    #: `flow`, `expansion`; jaxslosh/liquid maps it to the model that runs it
+    form: Optional[LiquidForm] = field(default=None, init=False, compare=False, repr=False)
+
+    # The form's answers, kept here for the code and scripts that ask the tank.
     @property
     def multimodal(self) -> bool:
         """Its liquid is the multimodal one (liquid/multimodal), not a finite-element one."""
-        return self.model == "multimodal"
+        return self.form.multimodal
 
     @property
     def face_normal(self) -> bool:
         """Its finite-element liquid is the face-normal element (liquid/face), not a nodal one."""
-        return self.fluid.element in FACE_FORMS
+        return self.form.face_normal
 
     @property
     def three_dimensional(self) -> bool:
         """A multimodal tank's flow is three-dimensional (a cylinder's always), not along x alone."""
-        return self.flow == "3d"
+        return self.form.three_dimensional
 
     @property
     def third_order(self) -> bool:
         """A multimodal tank runs its third-order system, not the exact integrals."""
-        return self.expansion == "third-order"
+        return self.form.third_order
 
     def __post_init__(self):
         if self.geometry is None:
@@ -270,6 +275,7 @@ class Tank:
             own = {k: getattr(self, k) for k in ("chamfers", "axis", "file", "baffles")
                    if k in cls.__dataclass_fields__}
             object.__setattr__(self, "geometry", cls(size=tuple(self.size), **own))
+        object.__setattr__(self, "form", liquid_form(self))
 
     @property
     def liquid_volume(self) -> float:

@@ -42,8 +42,9 @@ import jax.numpy as jnp
 
 from ...fem.linalg import solve
 from ...physics.about import About
-from ..base import AbstractLiquid, StepInverse, inertial_lines, particle_rows, point_mass_scale
+from ..base import AbstractLiquid, StepInverse, dense_step_inverse, inertial_lines, particle_rows, point_mass_scale
 from .inverse import face_solver_blocks
+from .tank_modes import face_sloshing_modes, face_unknowns
 from ...physics.terms import Kin, Rows
 
 
@@ -178,10 +179,18 @@ class FaceLiquid(AbstractLiquid):
         return self.Mff, self.K
 
     def step_inverse(self, c_a, c_a_sub=None) -> StepInverse:
-        """Dense (AbstractLiquid's), or sparse: the Schur complement's blocks (inverse.py)."""
+        """Dense (liquid/base.py), or sparse: the Schur complement's blocks (inverse.py)."""
         if not self.sparse:
-            return super().step_inverse(c_a, c_a_sub)
+            return dense_step_inverse(self, c_a, c_a_sub)
         return StepInverse(*face_solver_blocks(self, c_a, c_a_sub))
+
+    @classmethod
+    def tank_unknowns(cls, tank) -> int:
+        return face_unknowns(tank)
+
+    @classmethod
+    def sloshing_modes(cls, tank, g: float, n: int = 10):
+        return face_sloshing_modes(tank, g, n)
 
     def static_start(self, g_b):
         """The discrete hydrostatic equilibrium K d0 = F_g: K holds the absolute-rotation penalty on

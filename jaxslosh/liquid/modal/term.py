@@ -19,7 +19,9 @@ import jax.numpy as jnp
 from ...fem.linalg import solve
 from ...physics.kinematics import mv3, tv3
 from ...physics.about import About
-from ..base import AbstractLiquid, inertial_lines, point_mass_scale
+from ..base import AbstractLiquid, dense_step_inverse, inertial_lines, point_mass_scale
+from ..face.tank_modes import face_sloshing_modes, face_unknowns
+from ..nodal.tank_modes import nodal_sloshing_modes, nodal_unknowns
 from ...physics.terms import Kin, Rows
 
 
@@ -144,6 +146,18 @@ class ModalLiquid(AbstractLiquid):
 
     def probe_displacements(self, weights, modal, d):
         return jnp.einsum("pkc,k->pc", modal, d)
+
+    def step_inverse(self, c_a, c_a_sub=None):
+        return dense_step_inverse(self, c_a, c_a_sub)
+
+    # A reduced tank's basis is cut from its element's modes: it counts and lists those.
+    @classmethod
+    def tank_unknowns(cls, tank) -> int:
+        return (face_unknowns if tank.form.face_normal else nodal_unknowns)(tank)
+
+    @classmethod
+    def sloshing_modes(cls, tank, g: float, n: int = 10):
+        return (face_sloshing_modes if tank.form.face_normal else nodal_sloshing_modes)(tank, g, n)
 
     def static_start(self, g_b):
         """The discrete hydrostatic equilibrium Kr eta = V^T F_g (exact with the static correction)."""

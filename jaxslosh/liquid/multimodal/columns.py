@@ -57,3 +57,17 @@ def _column_jvp(fn, order, primals, tangents):
 
 
 column_values.defjvp(_column_jvp, symbolic_zeros=True)
+
+
+# The two-dimensional tank's (term.py) other derivative formed in products.
+@jax.custom_jvp
+def spd_inverse(A):
+    """A^-1, its derivatives -X dA X in matrix products only: differentiated twice (the rows take
+    the mass matrix's derivative, Newton the rows'), a solve's would factorise batches of matrices."""
+    return jnp.linalg.inv(A)
+
+
+@spd_inverse.defjvp
+def _spd_inverse_jvp(primals, tangents):
+    X = spd_inverse(primals[0])
+    return X, -X @ tangents[0] @ X

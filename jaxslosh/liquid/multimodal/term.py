@@ -49,9 +49,11 @@ import numpy as np
 
 from ...physics.kinematics import mv3, tv3
 from ...physics.about import About
-from ..base import AbstractLiquid
+from ..base import AbstractLiquid, dense_step_inverse
+from .columns import spd_inverse
 from .modes import odd_powers
 from .steep import roundoff_floor, steep_rows
+from .tank_modes import multimodal_sloshing_modes, multimodal_unknowns
 from ...physics.terms import Kin, Rows
 
 #: quadrature points along the tank (Gauss-Legendre; at least, and 8 per mode: the integrands hold
@@ -75,19 +77,6 @@ def _vortical_tables(L, D, xq):
     chh = jnp.stack([jnp.zeros_like(Cm), jnp.zeros_like(Cm), Sm * c, Cm * c / kap, jnp.zeros_like(Cm)], -1)
     # sinh = (e - f) / den, cosh = (e + f) / den, with e = exp(-kappa (d - eta)), f = exp(-kappa (d + eta))
     return sh + chh, chh - sh
-
-
-@jax.custom_jvp
-def spd_inverse(A):
-    """A^-1, its derivatives -X dA X in matrix products only: differentiated twice (the rows take
-    the mass matrix's derivative, Newton the rows'), a solve's would factorise batches of matrices."""
-    return jnp.linalg.inv(A)
-
-
-@spd_inverse.defjvp
-def _spd_inverse_jvp(primals, tangents):
-    X = spd_inverse(primals[0])
-    return X, -X @ tangents[0] @ X
 
 
 class Integrals(NamedTuple):
@@ -407,6 +396,17 @@ class MultimodalLiquid(AbstractLiquid):
     def describe(self) -> tuple:
         return self.about.lines
     nonlinear = True
+
+    def step_inverse(self, c_a, c_a_sub=None):
+        return dense_step_inverse(self, c_a, c_a_sub)
+
+    @classmethod
+    def tank_unknowns(cls, tank) -> int:
+        return multimodal_unknowns(tank)
+
+    @classmethod
+    def sloshing_modes(cls, tank, g: float, n: int = 10):
+        return multimodal_sloshing_modes(tank, g, n)
 
     @property
     def n_nodes(self) -> int:

@@ -15,8 +15,10 @@ from ...fem.linalg import solve
 from ...fem.slip import rotate_matrix
 from ...physics.about import About
 from ...physics.terms import Kin, Rows
-from ..base import AbstractLiquid, StepInverse, inertial_lines, nodal_product, particle_rows, point_mass_scale
+from ..base import (AbstractLiquid, StepInverse, dense_step_inverse, inertial_lines, nodal_product, particle_rows,
+                    point_mass_scale)
 from .sparse import hydrostatic_start, sparse_solver_blocks
+from .tank_modes import nodal_sloshing_modes, nodal_unknowns
 
 
 class NodalLiquid(AbstractLiquid):
@@ -143,12 +145,20 @@ class NodalLiquid(AbstractLiquid):
         return not self.sparse
 
     def step_inverse(self, c_a, c_a_sub=None) -> StepInverse:
-        """Dense (AbstractLiquid's), or on large meshes the sparse path of sparse.py: the box-grid
+        """Dense (liquid/base.py), or on large meshes the sparse path of sparse.py: the box-grid
         fast diagonalization, factors in JAX, or the host's LU."""
         if not self.sparse:
-            return super().step_inverse(c_a, c_a_sub)
+            return dense_step_inverse(self, c_a, c_a_sub)
         step, mass, sub, K = sparse_solver_blocks(self, c_a, c_a_sub)
         return StepInverse(step, mass, sub, abs(K).sum(axis=1))
+
+    @classmethod
+    def tank_unknowns(cls, tank) -> int:
+        return nodal_unknowns(tank)
+
+    @classmethod
+    def sloshing_modes(cls, tank, g: float, n: int = 10):
+        return nodal_sloshing_modes(tank, g, n)
 
     def static_start(self, g_b):
         """The discrete hydrostatic equilibrium K d0 = F_g under the body gravity g_b (docs/theory.md

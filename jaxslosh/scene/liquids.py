@@ -1,0 +1,92 @@
+"""The liquid form of a `[[tanks]]` table: an abstract `LiquidForm` and one final class per liquid
+model, made once from the tank's keys (`model`, `fluid.element`, `flow`, `expansion`, the
+`[tanks.reduction]` and `[tanks.walls]` tables) by `liquid_form`. The tank keeps it as `Tank.form`;
+code outside the loader asks it (its `multimodal`, `face_normal`, `reduced`, `elastic`, ...) instead
+of comparing the keys' strings, and jaxslosh/liquid maps it to the model that runs it
+(liquid/forms.py `tank_liquid`). docs/design.md, "The liquid", lists the forms.
+"""
+from __future__ import annotations
+
+import abc
+from dataclasses import dataclass
+from typing import ClassVar, final
+
+from ..fem.mesh import FACE_FORMS
+
+
+@dataclass(frozen=True)
+class LiquidForm(abc.ABC):
+    """Which liquid model a tank's liquid takes, and how it runs: on its lowest modes (`reduced`,
+    [tanks.reduction]) or at full order, in rigid or elastic walls (`elastic`, [tanks.walls])."""
+    reduced: bool = False
+    elastic: bool = False
+
+    #: the model's name in words (`jaxslosh check`, error messages)
+    name: ClassVar[str] = ""
+    #: the multimodal liquid (liquid/multimodal), not a finite-element one
+    multimodal: ClassVar[bool] = False
+    #: the face-normal finite element (liquid/face), not a nodal one
+    face_normal: ClassVar[bool] = False
+    #: a multimodal tank's flow is three-dimensional (a cylinder's always), not along x alone
+    three_dimensional: ClassVar[bool] = False
+    #: a multimodal tank runs its third-order system, not the exact integrals
+    third_order: ClassVar[bool] = False
+
+    @property
+    def along_length_only(self) -> bool:
+        """Its liquid sloshes along the tank's length (x) alone: a two-dimensional multimodal tank."""
+        return self.multimodal and not self.three_dimensional
+
+    @property
+    @abc.abstractmethod
+    def element(self) -> str:
+        """The finite-element form (`fluid.element`: "stabilized", "paper", "rt"), "" for none."""
+
+
+@final
+@dataclass(frozen=True)
+class NodalForm(LiquidForm):
+    """The nodal finite element (liquid/nodal): the "stabilized" or "paper" form."""
+    form: str = "stabilized"
+    name: ClassVar[str] = "nodal"
+
+    @property
+    def element(self) -> str:
+        return self.form
+
+
+@final
+@dataclass(frozen=True)
+class FaceForm(LiquidForm):
+    """The face-normal finite element "rt" (liquid/face)."""
+    name: ClassVar[str] = "face-normal"
+    face_normal: ClassVar[bool] = True
+
+    @property
+    def element(self) -> str:
+        return "rt"
+
+
+@final
+@dataclass(frozen=True)
+class MultimodalForm(LiquidForm):
+    """The multimodal liquid (liquid/multimodal): free-surface modes in a rigid tank, two-dimensional
+    along a box's length or three-dimensional, on exact integrals or its third-order system."""
+    three_dimensional: bool = False
+    third_order: bool = False
+    name: ClassVar[str] = "multimodal"
+    multimodal: ClassVar[bool] = True
+
+    @property
+    def element(self) -> str:
+        return ""
+
+
+def liquid_form(tank) -> LiquidForm:
+    """The form a tank's keys choose (the loader has checked that they go together)."""
+    if tank.model == "multimodal":
+        return MultimodalForm(three_dimensional=tank.flow == "3d", third_order=tank.expansion == "third-order")
+    how = dict(reduced=tank.reduction is not None, elastic=tank.wall_spec is not None)
+    if tank.fluid.element in FACE_FORMS:
+        return FaceForm(**how)
+    return NodalForm(form=tank.fluid.element, **how)
