@@ -43,9 +43,9 @@ def hull_about(scene: Scene, waves: bool) -> About:
 
 def tank_line(t) -> tuple[str, str]:
     """One tank's liquid, as the liquid term holds it."""
-    if t.multimodal:
-        flow = "three-dimensional" if t.three_dimensional else "two-dimensional along x"
-        system = "its third-order system" if t.third_order else "exact integrals"
+    if t.form.multimodal:
+        flow = "three-dimensional" if t.form.three_dimensional else "two-dimensional along x"
+        system = "its third-order system" if t.form.third_order else "exact integrals"
         return (f"liquid in tank {t.name!r}", f"{shape_words(t)}multimodal ({flow}), {len(modal_modes(t))} free-surface "
                                               f"modes, {system}, {t.liquid_mass:.6g} kg; its inertial loads (Coriolis and "
                                               "centrifugal among them) are the modal Lagrangian's, not switched by "
@@ -60,11 +60,11 @@ def liquid_about(scene: Scene, include_liquid: bool) -> About:
     lines = []
     for t in scene.tanks if include_liquid else ():
         lines.append(tank_line(t))
-        if t.wall_spec is not None:
+        if t.form.elastic:
             lines.append((f"elastic walls of tank {t.name!r}",
                           f"{t.wall_spec.thickness:g} m thick, {t.wall_mass:.6g} kg of elastic hexahedra built into "
                           "the hull (the vessel's frame), the liquid tied to them in the normal direction only"
-                          + (": each wall face's flux is the volume the wall sweeps there" if t.face_normal
+                          + (": each wall face's flux is the volume the wall sweeps there" if t.form.face_normal
                              else "")))
     for s in scene.structures:
         if s.frame == "vessel":
@@ -105,7 +105,7 @@ def damping_about(scene: Scene) -> About:
         d = t.damping
         ratio = list(d.ratio) if isinstance(d.ratio, tuple) else d.ratio
         layers = f" plus laminar boundary layers (viscosity {d.viscosity:g} m^2/s)" if d.viscosity else ""
-        what = "the multimodal tank's linear modes" if t.multimodal else "the sloshing modes"
+        what = "the multimodal tank's linear modes" if t.form.multimodal else "the sloshing modes"
         lines.append((f"liquid damping in tank {t.name!r}", f"modal damping of {what}, ratio {ratio}{layers}"))
     return About(*lines)
 

@@ -60,7 +60,7 @@ def _tank_bytes(t, sparse: bool, host_lu: bool = False, rt_dense: bool = False) 
     N = (nx + 1) * (ny + 1) * (nz + 1)
     nf = free_liquid_dofs(t)
     assembly = 8.0 * E * (24 * 24) * 3 + 8.0 * E * 64 * 3            # COO rows, columns and values
-    if t.face_normal and t.reduction is None:
+    if t.form.face_normal and not t.form.reduced:
         # face-normal at full order (liquid/face/build.py): dense M, K and inverses on the ~3E
         # faces, or (sparse) dense blocks on the elements and top faces only, ~7 of them while the
         # Schur complement's inverses are formed (liquid/face/schur.py)
@@ -69,9 +69,9 @@ def _tank_bytes(t, sparse: bool, host_lu: bool = False, rt_dense: bool = False) 
         solver = 8.0 * (N * N + 4.0 * nf * nf)                      # mass, stiffness, two or three inverses
     else:
         solver = 8.0 * 81 * 3 * nf * 2 + 8.0 * nx * ny * (3 * (nz + 1)) ** 2   # sparse products, box blocks
-        if not t.geometry.plain_box and not host_lu and t.reduction is None:
+        if not t.geometry.plain_box and not host_lu and not t.form.reduced:
             solver += _factor_bytes(t, nf)
-        if t.reduction is not None:                                  # the basis: a sparse factor of the mesh
+        if t.form.reduced:                                           # the basis: a sparse factor of the mesh
             solver = max(solver, 8.0 * nf * 30 * max(nx * ny, ny * nz, nx * nz) ** 0.5)
     return max(assembly, solver)
 
@@ -83,7 +83,7 @@ def estimate(scene: Scene) -> Cost:
     liquid = sum(free_liquid_dofs(t) for t in scene.tanks) if scene.effects.liquid else 0
     choice = sim.linear_solver
     sparse = choice in ("sparse", "sparse-host") or (choice == "auto" and liquid > SPARSE_AUTO
-                                    and not any(t.wall_spec is not None for t in scene.tanks))
+                                    and not any(t.form.elastic for t in scene.tanks))
     worst, total = ("", 0.0), 0.0
     for i, t in enumerate(scene.tanks if scene.effects.liquid else ()):
         b = _tank_bytes(t, sparse, choice == "sparse-host", choice == "dense")

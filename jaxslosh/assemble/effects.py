@@ -23,7 +23,7 @@ def describe(scene: Scene) -> str:
              if ves.forced is not None else "no hydrostatics (free body)")
     lines.append(f"vessel: mass {ves.mass:.4g} kg, inertia diagonal [{diag}] kg m^2; {hydro}")
     for t in scene.tanks:
-        walls = t.walls if t.wall_spec is None else f"elastic, {t.wall_spec.thickness:g} m thick"
+        walls = t.walls if not t.form.elastic else f"elastic, {t.wall_spec.thickness:g} m thick"
         lines.append(f"tank {t.name!r}: {shape_words(t)}{t.size[0]:g} x {t.size[1]:g} x {t.size[2]:g} m filled to "
                      f"{t.fill_depth:g} m, liquid {t.liquid_mass:.4g} kg ({t.liquid_volume:.4g} m^3), "
                      f"{mesh_words(t)}, walls {walls}")
@@ -77,7 +77,7 @@ def switched_off(scene: Scene) -> list[str]:
 def modal_words(t) -> str:
     """What a multimodal tank is instead of a mesh: its free-surface modes."""
     n = len(modal_modes(t))
-    if not t.three_dimensional:
+    if not t.form.three_dimensional:
         return f"{n} free-surface modes cos(i pi x / L), i = 1..{n} (multimodal, two-dimensional along x), no mesh"
     done = f", {t.modes} asked and completed to whole degenerate pairs" if n != t.modes else ""
     return (f"{n} free-surface modes of its {'disk' if t.geometry.name == 'cylinder' else 'rectangular'} base "
@@ -88,7 +88,7 @@ def mesh_words(t, short: bool = False) -> str:
     """"mesh 5 x 5 x 5 = 125 hexahedra" (a grid, of any shape, or a mesh file that is one), or
     "mesh file of 12 hexahedra on 30 nodes" (a mesh tank's file that is not a grid: its counts
     along x, y, z mean nothing); a multimodal tank's modes (it has no mesh)."""
-    if t.multimodal:
+    if t.form.multimodal:
         return modal_words(t)
     nx, ny, nz = t.mesh
     words = t.geometry.mesh_words()
@@ -124,7 +124,7 @@ def liquid_unknowns(scene: Scene) -> int:
     n = 0
     for t in scene.tanks:
         n += free_liquid_dofs(t)
-        if t.wall_spec is not None:       # the walls' free nodes (the liquid's wall-normal dofs, or its
+        if t.form.elastic:       # the walls' free nodes (the liquid's wall-normal dofs, or its
             #                               wall faces' fluxes, follow theirs)
             _, _, _, held = shell_mesh(t.size, t.fill_depth, t.mesh, t.wall_spec.thickness, t.wall_spec.mesh)
             n += 3 * int((~held).sum())
@@ -143,8 +143,8 @@ def element_why(t) -> str:
     """`check`'s note on a liquid element the scene left out: which one the loader chose, and why
     (scene/shape.py default_element); a given element needs none. Face-normal tanks say how they run."""
     runs = ""
-    if t.face_normal:
-        runs = f" on {t.reduction.modes} modes" if t.reduction is not None else " at full order"
-    if not t.fluid.element_default or t.multimodal:
+    if t.form.face_normal:
+        runs = f" on {t.reduction.modes} modes" if t.form.reduced else " at full order"
+    if not t.fluid.element_default or t.form.multimodal:
         return runs
     return f"{runs} (by default: {t.fluid.element_default})"

@@ -42,7 +42,7 @@ def wants_sparse(scene) -> bool:
     choice = scene.simulation.linear_solver
     if choice != "auto":
         return choice in ("sparse", "sparse-host")
-    if any(t.wall_spec is not None for t in scene.tanks):
+    if any(t.form.elastic for t in scene.tanks):
         return False             # elastic walls have dense blocks of their own
     return liquid_unknowns(scene) > SPARSE_AUTO
 

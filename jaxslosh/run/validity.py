@@ -38,7 +38,7 @@ def _surface_tables(scene: Scene):
     floor (liquid/multimodal/steep.py) are read from, at the points and weights the liquid uses."""
     out, off = [], 0
     for t in scene.tanks:
-        if not t.multimodal:
+        if not t.form.multimodal:
             return []
         if three_dimensional(t):
             mt = tank_3d(t, t.fill_depth, t.fluid.density)
@@ -191,7 +191,7 @@ class Watch:
                 continue
             roof = t.size[2] - t.fill_depth
             where = f"tanks[{i}] ({t.name!r})"
-            model = "the multimodal liquid" if t.multimodal else "the linear liquid"
+            model = "the multimodal liquid" if t.form.multimodal else "the linear liquid"
             if self.high[i] > roof:
                 out.append(f"{where}: the free surface rose {self.high[i]:.3g} m at t = {self.t_high[i]:.4g} s, "
                            f"above the roof ({roof:.3g} m of freeboard): {model} is outside its validity")

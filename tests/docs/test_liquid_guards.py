@@ -1,13 +1,16 @@
 """The liquid behind one interface (docs/design.md, "The liquid"): the models are the sub-packages of
-jaxslosh/liquid, code elsewhere asks the AbstractLiquid contract and the scene's tank (its
-`multimodal`, `face_normal`, `three_dimensional`, `third_order`) instead of which class or string it
-holds, and the assembly's dispatch stays short. Read from the source with `ast`."""
+jaxslosh/liquid, code elsewhere asks the AbstractLiquid contract and the tank's liquid form
+(`Tank.form`: its `multimodal`, `face_normal`, `reduced`, `elastic`, ...) instead of which class or
+string it holds, and the assembly's dispatch stays short. Read from the source with `ast`."""
 import ast
 import inspect
 import os
 
 from jaxslosh.assemble.liquid import build_liquid_block
 from jaxslosh.fem.mesh import ELEMENT_FORMS, FACE_FORMS
+from jaxslosh.liquid.base import AbstractLiquid
+from jaxslosh.liquid.forms import FULL_ORDER
+from jaxslosh.scene.liquids import LiquidForm
 
 ROOT = os.path.join(os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__)))), "jaxslosh")
 LIQUID = os.path.join(ROOT, "liquid")
@@ -114,6 +117,36 @@ def test_no_string_checks_on_the_liquid_model_outside_the_loader_and_the_liquid(
     assert not bad, "\n".join(bad)
     done = sorted(rel for rel in PENDING if not found.get(rel))
     assert not done, f"no string checks left in {done}: take them off PENDING"
+
+
+#: the liquid form's answers that name which model a tank takes (scene/liquids.py)
+KIND_FLAGS = {"multimodal", "face_normal"}
+
+
+def kind_branches(source: str) -> list:
+    """(line, text) of each read of a tank's (or its form's) `multimodal` or `face_normal`."""
+    return [(node.lineno, ast.unparse(node)) for node in ast.walk(ast.parse(source))
+            if isinstance(node, ast.Attribute) and node.attr in KIND_FLAGS]
+
+
+def test_the_kind_finder_sees_the_flags():
+    src = "a = t.multimodal\nb = t.form.face_normal\nc = t.form.reduced\nfrom ..liquid.multimodal import x\n"
+    assert [line for line, _ in kind_branches(src)] == [1, 2]
+
+
+def test_analysis_and_the_solver_ask_the_liquid_not_its_kind():
+    """analysis/ and solve/ call one thing per question, the model behind the tank's form
+    (liquid/forms.py `tank_liquid(t).sloshing_modes`, the AbstractLiquid contract), and never branch
+    on which model a tank takes."""
+    bad = [f"{rel}:{line}: {text}" for rel, path in sorted(_sources()) if rel.startswith(("analysis/", "solve/"))
+           for line, text in kind_branches(open(path).read())]
+    assert not bad, "\n".join(bad)
+
+
+def test_every_form_has_its_liquid():
+    """Each final liquid form of the loader (scene/liquids.py) maps to the final liquid that runs it."""
+    assert set(FULL_ORDER) == set(LiquidForm.__subclasses__())
+    assert all(issubclass(c, AbstractLiquid) and not getattr(c, "__abstractmethods__", None) for c in FULL_ORDER.values())
 
 
 def test_the_liquid_block_dispatch_is_short():

@@ -143,7 +143,7 @@ def reduced_block(scene, tanks, models, params, g) -> LiquidBlock:
     """Every tank's liquid on its modal basis (reduction.py); the bases come from the scene's values,
     and a face-normal tank's blocks scale to traced density, sound speed and gravity (face_scales)."""
     for i, t in enumerate(tanks):
-        if t.reduction is None:
+        if not t.form.reduced:
             raise SceneError(f"tanks[{i}].reduction", "reduce every tank or none: another tank has a "
                                                        "[tanks.reduction] table and this one has not")
     scales = [face_scales(scene, t, params, g) if isinstance(m, FaceModel) else None for t, m in zip(tanks, models)]

@@ -36,7 +36,7 @@ def build_multimodal(scene: Scene, params: Optional[dict], gravity) -> Multimoda
                                 t.origin, t.modes, D=t.size[2]))
         rows.append(np.cos(np.outer(np.linspace(0.0, t.size[0], SAMPLES), np.arange(1, t.modes + 1) * np.pi / t.size[0])))
     # the third-order system's coefficients are the exact tank's derivatives at rest
-    tanks = [third_order(mt) if t.expansion == "third-order" else mt for t, mt in zip(scene.tanks, tanks)]
+    tanks = [third_order(mt) if t.form.third_order else mt for t, mt in zip(scene.tanks, tanks)]
     sizes = tuple(r.shape[1] for r in rows)
     samples = np.zeros((SAMPLES * len(tanks), sum(sizes)))
     off = 0

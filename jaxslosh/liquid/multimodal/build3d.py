@@ -10,7 +10,7 @@ from ...scene.types import Tank
 
 
 def three_dimensional(t: Tank) -> bool:
-    return t.three_dimensional           # a cylinder's always (the loader's default, and it refuses "2d")
+    return t.form.three_dimensional           # a cylinder's always (the loader's default, and it refuses "2d")
 
 
 def _base(t: Tank):
