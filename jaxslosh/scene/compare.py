@@ -31,6 +31,7 @@ _TOML_NAME = {("Tank", "wall_spec"): "walls", ("Tank", "walls"): None,      # th
               ("Hydrodynamics", "base_dir"): None, ("Hull", "base_dir"): None,   # where the scene file lay
               ("Fluid", "element_default"): None,                                 # the loader's note
               ("Tank", "geometry"): None,                                         # the shape keys, as a shape
+              ("Tank", "form"): None,                                             # the liquid keys, as a form
               ("MooringLine", "anchor_height"): None,                             # the anchor's z and the depth
               ("Vessel", "cog_height"): None}     # derived from the hull (kg - draft), which is compared
 
