@@ -27,7 +27,7 @@ import scipy.linalg as sl
 import scipy.sparse as sp
 
 from ..fem.mesh import grid_index
-from .face.element import FaceModel, face_modes, shape_gradients
+from .face.element import face_modes, shape_gradients
 from .modal.build import face_sloshing, face_tank_basis
 from .modal.reduction import tank_basis
 from .modes import classify, free_matrices, natural_modes
@@ -213,14 +213,14 @@ def sloshing_basis(model, t, reduced: bool, gravity: float) -> SloshingBasis:
     """The sloshing modes of tank `t` (its element model `model`): at full order on its free dofs
     (or faces), or on its modal basis (`reduced`, [tanks.reduction]); from the scene's values
     (`gravity` the scene's) where the model was built at traced ones."""
-    if isinstance(model, FaceModel) and not reduced:      # full order: its lowest modes, on the free faces
+    if t.form.face_normal and not reduced:      # full order: its lowest modes, on the free faces
         fm = face_modes(model, SPARSE_SEARCH)
         slosh = np.array([k == "sloshing" for k in fm.kind], dtype=bool)
         f = np.flatnonzero(model.free)
         omega, Phi = fm.omega[slosh], fm.fluxes[slosh].T                # Phi on all faces (wall integrals)
         return SloshingBasis(model, f.size, omega, Phi, model.mass[f][:, f] @ Phi[f],
                              f"the {SPARSE_SEARCH} lowest modes searched on this mesh hold {omega.size}")
-    if isinstance(model, FaceModel):      # on its modal basis
+    if t.form.face_normal:                # on its modal basis
         V, omega_b, n_modes, (_, _, _, k0) = face_tank_basis(model, t.origin, t.reduction.modes,
                                                              t.reduction.static_correction)
         slosh = face_sloshing(model, V, n_modes)

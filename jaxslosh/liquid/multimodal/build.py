@@ -20,7 +20,7 @@ SAMPLES = 33
 
 
 def multimodal_scene(scene: Scene) -> bool:
-    return bool(scene.tanks) and scene.tanks[0].model == "multimodal"
+    return bool(scene.tanks) and scene.tanks[0].form.multimodal
 
 
 def build_multimodal(scene: Scene, params: Optional[dict], gravity) -> MultimodalLiquid:

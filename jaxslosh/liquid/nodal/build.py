@@ -105,7 +105,7 @@ def walls_block(tanks, models, held=(), Kg=None) -> LiquidBlock:
     node_off, free_off = 0, 0
     for t, m in zip(tanks, models):
         blocks.append(TankBlock(t.name, node_off, np.asarray(m.nodes), np.asarray(m.elements), m))
-        if t.wall_spec is not None:
+        if t.form.elastic:
             tw = build_tank_with_walls(t, m)
             nodes, Ms, K, dmap, rep, C = tw.nodes, tw.mass, tw.stiffness, tw.dof_map, tw.rep, tw.rotation_coupling
             carried_idx.append((len(rs), m.n_nodes))
