@@ -18,6 +18,7 @@ import jax
 import numpy as np
 
 from .._version import __version__
+from .line_energy import LINE_ENERGY, line_energy_of
 from .output import OutputLock, ensure_room
 from .status import TEXT, Failure, RunResult, Status, code_of, failure_text, is_traced as _is_traced, outcome_of
 
@@ -62,6 +63,7 @@ class LineHistory(eqx.Module):
     fairlead_tension: jax.Array  # (n,) N
     anchor_tension: jax.Array    # (n,) N
     nodes: Optional[jax.Array] = None   # (n, s + 1, 3) m: a lumped line's nodes, anchor to fairlead
+    energy: Optional[dict] = None       # {part: (n,)} J: a lumped line's energies (LINE_ENERGY)
 
 
 class ConnectionHistory(eqx.Module):
@@ -142,8 +144,8 @@ class Result(eqx.Module):
 
 
 def schema(probe_names=(), tank_nodes: Optional[dict] = None, lines=(), line_nodes: Optional[dict] = None,
-           bodies=(), connections=()) -> dict:
-    """{dataset: shape of one frame} of a result file, in the file's order."""
+           bodies=(), connections=(), line_energy=()) -> dict:
+    """{dataset: shape of one frame} of a result file, in the file's order (`line_energy`: lumped lines)."""
     spec = {"time": (), "vessel/position": (3,), "vessel/quaternion": (4,), "vessel/angular_velocity": (3,),
             "vessel/roll_pitch_yaw": (3,), "energy/kinetic": (), "energy/potential": (),
             "solver/iterations": (), "solver/residual": (), "solver/constraint": ()}
@@ -157,6 +159,7 @@ def schema(probe_names=(), tank_nodes: Optional[dict] = None, lines=(), line_nod
         spec[f"mooring/{name}/anchor_tension"] = ()
     for name, n in (line_nodes or {}).items():       # lumped lines: their nodes (s + 1 of them)
         spec[f"mooring/{name}/nodes"] = (n, 3)
+    spec.update({f"energy/mooring/{name}/{k}": () for name in line_energy for k in LINE_ENERGY})
     for name in bodies:
         spec[f"bodies/{name}/position"] = (3,)
         spec[f"bodies/{name}/quaternion"] = (4,)
@@ -195,6 +198,7 @@ DESCRIPTIONS = {
     "bodies/angular_velocity": "angular velocity in the body's frame",
     "connections/force": "the connection's force, positive when it pulls its points together",
     "connections/extension": "the distance of the connection's points less its length",
+    **{f"energy/mooring/{k}": v for k, v in LINE_ENERGY.items()},
 }
 
 
@@ -203,7 +207,7 @@ def units_of(key: str) -> str:
     parts = key.split("/")
     if parts[0] in ("probes", "tanks", "mooring", "bodies", "connections") and len(parts) == 3:
         key = f"{parts[0]}/{parts[2]}"
-    return UNITS.get(key, "1")
+    return "J" if parts[0] == "energy" else UNITS.get(key, "1")
 
 
 def label(ds, key: str) -> None:
@@ -211,7 +215,7 @@ def label(ds, key: str) -> None:
     ds.attrs["units"] = units_of(key)
     parts = key.split("/")
     short = f"{parts[0]}/{parts[2]}" if parts[0] in ("probes", "tanks", "bodies", "connections") and len(parts) == 3 \
-        else key
+        else "/".join(parts[:2] + parts[3:]) if parts[:2] == ["energy", "mooring"] else key
     if short in DESCRIPTIONS:
         ds.attrs["description"] = DESCRIPTIONS[short]
 
@@ -233,6 +237,7 @@ def result_frames(r: Result) -> dict:
         d[f"mooring/{name}/anchor_tension"] = m.anchor_tension
         if m.nodes is not None:
             d[f"mooring/{name}/nodes"] = m.nodes
+        d.update({f"energy/mooring/{name}/{k}": v for k, v in (m.energy or {}).items()})
     for name, b in (r.bodies or {}).items():
         d[f"bodies/{name}/position"] = b.position
         d[f"bodies/{name}/quaternion"] = b.quaternion
@@ -257,7 +262,7 @@ def result_from(d: dict, probe_names=(), tanks: Optional[dict] = None, *, status
     code = code_of(status) if status_code is None else status_code
     lines = [k.split("/")[1] for k in d if k.startswith("mooring/") and k.endswith("/fairlead_tension")]
     mooring = {n: LineHistory(d[f"mooring/{n}/fairlead_tension"], d[f"mooring/{n}/anchor_tension"],
-                              d.get(f"mooring/{n}/nodes")) for n in lines}
+                              d.get(f"mooring/{n}/nodes"), line_energy_of(d, n)) for n in lines}
     bodies = {n: VesselHistory(*(d[f"bodies/{n}/{k}"] for k in ("position", "quaternion", "angular_velocity",
                                                                  "roll_pitch_yaw")))
               for n in dict.fromkeys(k.split("/")[1] for k in d if k.startswith("bodies/"))}
@@ -278,7 +283,7 @@ class ResultWriter:
     before the file is truncated until it is closed (a second writer gets io.output.OutputError)."""
 
     def __init__(self, path: str, scene_text: str, probe_names, tanks=(), lines=(), line_nodes=None, bodies=(),
-                 connections=()):
+                 connections=(), line_energy=()):
         self.path = path
         self.lock = OutputLock(path)
         try:
@@ -299,7 +304,7 @@ class ResultWriter:
             label(self.f.create_dataset(f"tanks/{t.name}/nodes", data=t.nodes), f"tanks/{t.name}/nodes")
             label(self.f.create_dataset(f"tanks/{t.name}/elements", data=t.elements), f"tanks/{t.name}/elements")
         for k, shape in schema(probe_names, {t.name: t.nodes.shape[0] for t in tanks}, lines, line_nodes, bodies,
-                               connections).items():
+                               connections, line_energy).items():
             dtype = "i8" if k == "solver/iterations" else "f8"
             label(self.f.create_dataset(k, shape=(0, *shape), maxshape=(None, *shape), dtype=dtype,
                                         chunks=(max(1, min(1024, 2 ** 20 // (8 * max(1, int(np.prod(shape)))))),
@@ -346,7 +351,8 @@ def save_result(r: Result, path: str) -> None:
     w = ResultWriter(path, r.scene_text, list(r.probes), [_Mesh(n, t.nodes, t.elements) for n, t in r.tanks.items()],
                      list(r.mooring or {}),
                      {n: m.nodes.shape[-2] for n, m in (r.mooring or {}).items() if m.nodes is not None},
-                     list(r.bodies or {}), list(r.connections or {}))
+                     list(r.bodies or {}), list(r.connections or {}),
+                     [n for n, m in (r.mooring or {}).items() if m.energy is not None])
     w.append(result_frames(r), r.steps_done)
     w.close(r.status, r.steps_done, r.status_code)
 
@@ -471,7 +477,8 @@ def load_result(path: str) -> Result:
         line_nodes = {n: f[f"mooring/{n}/nodes"].shape[1] for n in lines if f"mooring/{n}/nodes" in f}
         bodies = list(f["bodies"]) if "bodies" in f else []
         connections = list(f["connections"]) if "connections" in f else []
-        d = read_frames(f, schema(probes, {name: 0 for name in tanks}, lines, line_nodes, bodies, connections))
+        d = read_frames(f, schema(probes, {name: 0 for name in tanks}, lines, line_nodes, bodies, connections,
+                                  list(f["energy/mooring"]) if "energy/mooring" in f else []))
         check_required(d, probes, path)
         status = attr_str(a.get("status", "ok"))
         code = int(a["status_code"]) if "status_code" in a else None

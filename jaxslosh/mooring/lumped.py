@@ -143,26 +143,35 @@ def lumped_line(anchor, length, weight, ea, *, segments=20, diameter=0.09, mass=
 class LineState(NamedTuple):
     r: jax.Array    # (N - 1, 3) the moving nodes' positions
     v: jax.Array    # (N - 1, 3) their velocities
+    dissipated: jax.Array = 0.0   # J: the work the internal damping, drag and seabed damping took out
+    work: jax.Array = 0.0         # J: the work the fairlead did on the line
 
 
 def _nodes(line: LumpedLine, r, fair):
     return jnp.concatenate([line.anchor[None], r, fair[None]], axis=0)
 
 
-def segment_tensions(line: LumpedLine, r_all, v_all):
-    """(T (N,), unit vectors (N, 3) from node j to j + 1) of the segments (nodes (N + 1, 3))."""
+def _segments(line: LumpedLine, r_all, v_all):
+    """(T (N,), unit vectors (N, 3) from node j to j + 1, strain rates (N,)) of the segments."""
     d = r_all[1:] - r_all[:-1]
     ln = _norm(d)
     q = d / ln[:, None]
     l0 = line.seg
     e = ln / l0 - 1.0
     e_dot = jnp.sum(q * (v_all[1:] - v_all[:-1]), axis=-1) / l0
-    return line.ea * _ramp(e, STRAIN_BAND) + line.ba * e_dot, q
+    return line.ea * _ramp(e, STRAIN_BAND) + line.ba * e_dot, q, e_dot
 
 
-def _node_loads(line: LumpedLine, r_all, v_all):
+def segment_tensions(line: LumpedLine, r_all, v_all):
+    """(T (N,), unit vectors (N, 3) from node j to j + 1) of the segments (nodes (N + 1, 3))."""
+    return _segments(line, r_all, v_all)[:2]
+
+
+def _node_loads(line: LumpedLine, r_all, v_all, power=False):
     """(external loads on every node but the segments' (N + 1, 3): weight, drag, seabed; tangents
-    (N + 1, 3)). The end nodes carry half a segment."""
+    (N + 1, 3), each node's share of the line's length (N + 1,)). The end nodes carry half a
+    segment. `power`: the power (W) the drag and the seabed's damping take out of the moving nodes
+    too, appended."""
     n = line.segments
     l0 = line.seg
     share = jnp.full((n + 1,), l0).at[0].set(0.5 * l0).at[-1].set(0.5 * l0)
@@ -176,28 +185,44 @@ def _node_loads(line: LumpedLine, r_all, v_all):
     half_rho_d = 0.5 * line.rho * line.diameter * share[:, None]
     drag = half_rho_d * (line.cd[0] * _norm(un)[:, None] * un + line.cd[1] * jnp.pi * _norm(ut)[:, None] * ut)
     p = line.seabed_z - r_all[:, 2]
-    bed = line.diameter * share * (line.seabed_stiffness * _ramp(p, SEABED_BAND)
-                                   - line.seabed_damping * _step01(p, SEABED_BAND) * v_all[:, 2])
+    c_bed = line.diameter * share * line.seabed_damping * _step01(p, SEABED_BAND)
+    bed = line.diameter * share * line.seabed_stiffness * _ramp(p, SEABED_BAND) - c_bed * v_all[:, 2]
     bed = jnp.where(jnp.isfinite(line.seabed_z), bed, 0.0)
     fz = bed - line.weight * share
-    return drag.at[:, 2].add(fz), tan, share
+    out = drag.at[:, 2].add(fz), tan, share
+    if not power:
+        return out
+    # the drag's work against the nodes' velocity (negative where a current drives them) and the
+    # seabed's damping, c v_z^2: what the moving nodes' equations lose besides the conservative forces
+    c_bed = jnp.where(jnp.isfinite(line.seabed_z), c_bed, 0.0)
+    lost = -jnp.sum(drag[1:-1] * v_all[1:-1]) + jnp.sum(c_bed[1:-1] * v_all[1:-1, 2] ** 2)
+    return out + (lost,)
 
 
-def accelerations(line: LumpedLine, r, v, fair_r, fair_v):
-    """The moving nodes' accelerations (N - 1, 3) for positions r and velocities v, the fairlead at
-    fair_r moving at fair_v."""
+def _rates(line: LumpedLine, r, v, fair_r, fair_v):
+    """(the moving nodes' accelerations (N - 1, 3), the power (W) the internal damping, the drag
+    and the seabed's damping take out of the line, the power the fairlead puts into it)."""
     r_all = _nodes(line, r, fair_r)
     v_all = _nodes(line, v, fair_v).at[0].set(0.0)
-    T, q = segment_tensions(line, r_all, v_all)
+    T, q, e_dot = _segments(line, r_all, v_all)
     f_seg = T[:, None] * q                    # pulls node j towards j + 1 and j + 1 towards j
-    loads, tan, share = _node_loads(line, r_all, v_all)
+    loads, tan, share, lost = _node_loads(line, r_all, v_all, power=True)
     f = (f_seg[1:] - f_seg[:-1] + loads[1:-1])
     t = tan[1:-1]
     vol = jnp.pi * line.diameter ** 2 / 4.0 * line.seg
     alpha = line.mass * line.seg + line.rho * vol * line.ca[0]
     beta = line.rho * vol * (line.ca[1] - line.ca[0])
     tf = jnp.sum(t * f, axis=-1, keepdims=True)
-    return (f - beta / (alpha + beta) * tf * t) / alpha
+    # each segment's damping force BA e' along it, against its stretching rate l e': BA l e'^2;
+    # the fairlead pulls the last segment's end with its whole tension
+    lost = lost + line.ba * line.seg * jnp.sum(e_dot * e_dot)
+    return (f - beta / (alpha + beta) * tf * t) / alpha, lost, T[-1] * jnp.dot(q[-1], fair_v)
+
+
+def accelerations(line: LumpedLine, r, v, fair_r, fair_v):
+    """The moving nodes' accelerations (N - 1, 3) for positions r and velocities v, the fairlead at
+    fair_r moving at fair_v."""
+    return _rates(line, r, v, fair_r, fair_v)[0]
 
 
 def fairlead_force(line: LumpedLine, r, v, fair_r, fair_v):
@@ -233,18 +258,23 @@ def hermite(p0, v0, p1, v1, h, tau):
 def advance(line: LumpedLine, s: LineState, fair0, fair_v0, fair1, fair_v1, h, substeps=None) -> LineState:
     """The moving nodes at t_n + h from those at t_n, the fairlead at (fair0, fair_v0) at t_n and
     (fair1, fair_v1) at t_n + h: `substeps` (static; default: from the stability limit) symplectic
-    Euler sub-steps in a `lax.scan`."""
+    Euler sub-steps in a `lax.scan`. The dissipated work and the fairlead's work add each
+    sub-step's power at its start (the point its acceleration is taken at): the line's energy
+    balance (`energies`) then holds to the scheme's first order in the sub-step."""
     k = line.substeps(h) if substeps is None else int(substeps)
     dt = h / k
 
     def one(c, i):
-        r, v = c
+        r, v, lost, work = c
         fr, fv = hermite(fair0, fair_v0, fair1, fair_v1, h, i / k)
-        v = v + dt * accelerations(line, r, v, fr, fv)
-        return (r + dt * v, v), None
+        a, p_lost, p_fair = _rates(line, r, v, fr, fv)
+        v = v + dt * a
+        return (r + dt * v, v, lost + dt * p_lost, work + dt * p_fair), None
 
-    (r, v), _ = jax.lax.scan(one, (s.r, s.v), jnp.arange(k, dtype=s.r.dtype))
-    return LineState(r, v)
+    zero = jnp.zeros((), s.r.dtype)
+    (r, v, lost, work), _ = jax.lax.scan(one, (s.r, s.v, zero + s.dissipated, zero + s.work),
+                                         jnp.arange(k, dtype=s.r.dtype))
+    return LineState(r, v, lost, work)
 
 
 def potential(line: LumpedLine, r, fair):
@@ -262,16 +292,34 @@ def potential(line: LumpedLine, r, fair):
 
 def kinetic(line: LumpedLine, r, v, fair):
     """The moving nodes' kinetic energy with their added mass (J)."""
+    e = energies(line, r, v, fair)
+    return e["kinetic"] + e["added_kinetic"]
+
+
+def energies(line: LumpedLine, r, v, fair) -> dict:
+    """The line's energies (J) for the moving nodes at r with velocities v, the fairlead at `fair`:
+    `kinetic` (the nodes' own mass), `added_kinetic` (the water's, through the added mass),
+    `elastic` (the segments' strain energy), `weight` (the moving nodes' submerged weight w l z, z
+    in the line's frame) and `seabed` (its springs' energy). The end nodes' half segments are left
+    out: their weight and contact load the anchor and the fairlead's body, not the line. With the
+    fairlead held and no drag or damping their sum is constant; with them, it falls by the dissipated
+    work and rises by the fairlead's (`LineState`), exactly where the added mass is isotropic (ca
+    normal = tangential) or zero; otherwise the tangent's turning exchanges some energy with the
+    water that no term holds (the node's added mass is taken along its current tangent, as MoorDyn)."""
     r_all = _nodes(line, r, fair)
+    e = _norm(r_all[1:] - r_all[:-1]) / line.seg - 1.0
     d = r_all[1:] - r_all[:-1]
     qs = d / _norm(d)[:, None]
     t = qs[:-1] + qs[1:]
     t = t / _norm(t)[:, None]
     vol = jnp.pi * line.diameter ** 2 / 4.0 * line.seg
-    vt = jnp.sum(v * t, axis=-1)
-    vv = jnp.sum(v * v, axis=-1)
-    return 0.5 * jnp.sum((line.mass * line.seg + line.rho * vol * line.ca[0]) * vv
-                         + line.rho * vol * (line.ca[1] - line.ca[0]) * vt * vt)
+    vt, vv = jnp.sum(v * t, axis=-1), jnp.sum(v * v, axis=-1)
+    bed = line.diameter * line.seabed_stiffness * line.seg * jnp.sum(_ramp_int(line.seabed_z - r[:, 2], SEABED_BAND))
+    return {"kinetic": 0.5 * line.mass * line.seg * jnp.sum(vv),
+            "added_kinetic": 0.5 * line.rho * vol * jnp.sum(line.ca[0] * vv + (line.ca[1] - line.ca[0]) * vt * vt),
+            "elastic": line.ea * line.seg * jnp.sum(_ramp_int(e, STRAIN_BAND)),
+            "weight": line.weight * line.seg * jnp.sum(r[:, 2]),
+            "seabed": jnp.where(jnp.isfinite(line.seabed_z), bed, 0.0)}
 
 
 def _start_shape(line: LumpedLine, fair):

@@ -25,6 +25,7 @@ import jax
 import jax.numpy as jnp
 import numpy as np
 
+from ..io.line_energy import LINE_ENERGY
 from ..physics.kinematics import rotation_matrix
 from ..physics.terms import AbstractTerm, Config, Kin, Rows
 from . import lumped as lm
@@ -54,11 +55,12 @@ class LumpedLineTerm(AbstractTerm):
 
     # ------------------------------------------------------------ states
     def state_init(self):
-        return jnp.concatenate([self.nodes0.reshape(-1), jnp.zeros(self.nodes0.size)])
+        # the nodes, their velocities, the dissipated work and the fairlead's work (lm.LineState)
+        return jnp.concatenate([self.nodes0.reshape(-1), jnp.zeros(self.nodes0.size + 2)])
 
     def split(self, z) -> lm.LineState:
         n = self.nodes0.size
-        return lm.LineState(z[:n].reshape(-1, 3), z[n:].reshape(-1, 3))
+        return lm.LineState(z[:n].reshape(-1, 3), z[n:2 * n].reshape(-1, 3), z[2 * n], z[2 * n + 1])
 
     def state_coefficients(self, h):
         return jnp.asarray(h)
@@ -70,7 +72,7 @@ class LumpedLineTerm(AbstractTerm):
         p0, u0 = _fairlead(self.fairlead, c_old, v_old[:3], v_old[3:6])
         p1, u1 = _fairlead(self.fairlead, c_new, v_new[:3], v_new[3:6])
         s = lm.advance(self.line, self.split(z), p0, u0, p1, u1, coef, self.substeps)
-        return jnp.concatenate([s.r.reshape(-1), s.v.reshape(-1)])
+        return jnp.concatenate([s.r.reshape(-1), s.v.reshape(-1), jnp.stack([s.dissipated, s.work])])
 
     # ------------------------------------------------------------ forces
     def force(self, c: Config, V0, omega, z):
@@ -193,7 +195,8 @@ def build_lumped_lines(scene, balanced: bool, q0=None) -> tuple:
 def lumped_observe(system, z: tuple, c: Config, V0, omega) -> dict:
     """For the result file, at one frame (the integrator state's configuration c, velocities and the
     terms' states z, as State.z): `mooring/<line>/fairlead_tension`, `anchor_tension` (N) and
-    `nodes` ((N + 1, 3), in the frame of the vessel's position X0) of each lumped line."""
+    `nodes` ((N + 1, 3), in the frame of the vessel's position X0) of each lumped line, and its
+    energies `energy/mooring/<line>/<part>` (J: lm.energies, the dissipated work and the fairlead's)."""
     out = {}
     for term, zi in zip(system.all_terms(), z, strict=True):
         if isinstance(term, LumpedLineTerm):
@@ -202,6 +205,8 @@ def lumped_observe(system, z: tuple, c: Config, V0, omega) -> dict:
             out[f"mooring/{term.name}/fairlead_tension"] = jnp.linalg.norm(lm.fairlead_force(term.line, s.r, s.v, p, u))
             out[f"mooring/{term.name}/anchor_tension"] = jnp.linalg.norm(lm.anchor_force(term.line, s.r, s.v, p, u))
             out[f"mooring/{term.name}/nodes"] = term.nodes(c, zi)
+            parts = dict(lm.energies(term.line, s.r, s.v, p), dissipated=s.dissipated, fairlead_work=s.work)
+            out.update({f"energy/mooring/{term.name}/{k}": parts[k] for k in LINE_ENERGY})
     return out
 
 

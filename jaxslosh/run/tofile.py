@@ -74,7 +74,8 @@ def run_to_file(scene: Scene, out: str, *, progress: bool = True,
                                   (*getattr(mooring_term(b.system), "names", ()), *(t.name for t in lumped)),
                                   {t.name: t.line.segments + 1 for t in lumped},
                                   bodies=getattr(bodies_term(b.system), "names", ()),
-                                  connections=getattr(bodies_term(b.system), "link_names", ()))
+                                  connections=getattr(bodies_term(b.system), "link_names", ()),
+                                  line_energy=[t.name for t in lumped])
             stop.check()
             bar.phase("compile", "compiling the step")
             bc = core(b)
