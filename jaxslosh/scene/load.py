@@ -124,7 +124,7 @@ def parse_scene(mapping: Mapping[str, Any], text: str = "", path: str = "") -> S
     for i, probe in enumerate(probes):
         _place_probe(probe, f"probes[{i}]", tanks, structures)
     bodies = read_bodies(mapping.get("bodies", []), vessel, environment, warnings, files, tanks, carriers)
-    connections = read_connections(mapping.get("connections", []), vessel.name, bodies)
+    connections = read_connections(mapping.get("connections", []), vessel, bodies)
     bodies_scene(bodies, vessel, structures, mapping, warnings, files)
     tanks = tank_groups(tanks, carriers).get("vessel", ())      # the vessel's; a body's are in its Body
     mooring = read_mooring(mapping.get("mooring", []), environment.depth, vessel.name, vessel.cog_height, warnings,
