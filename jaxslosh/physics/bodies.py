@@ -222,6 +222,11 @@ class Bodies(AbstractOwner):
         """Its bodies' tanks' liquid unknowns (the owner's deformable ones), stacked in the bodies' order."""
         return sum(b.nf for b in self.bodies)
 
+    def exact(self) -> bool:
+        """A body's nonlinear (multimodal) liquid: every deformable unknown linearised exactly, as the
+        vessel's multimodal liquid is (its rows' mass and stiffness move with the free surface)."""
+        return any(b.tank is not None and b.tank.nonlinear for b in self.bodies)
+
     def tank_slices(self) -> tuple:
         """(S,) each body's slice of the stacked liquid unknowns of the bodies' tanks."""
         out, k = [], 0

@@ -30,6 +30,8 @@ RESERVED = ("vessel", "fixed")
 #: how far a connection point may lie outside its body's hull, relative to the hull's size (round-off:
 #: a point on the side, as a fender's face, is inside)
 EDGE = 1e-6
+#: below this fill depth over length the multimodal method's ordering fails (shallow water, bores)
+MULTIMODAL_SHALLOW = 0.1
 #: how far (m) a body of a multibody file may be from its place in the scene (a file's own rounding)
 PLACE = 1e-3
 
@@ -47,6 +49,23 @@ def tank_groups(tanks, carriers) -> dict:
     for t, c in zip(tanks, carriers):
         out[c] = out.get(c, ()) + (t,)
     return out
+
+
+def multimodal_scene(tanks, carriers, warnings: list[str]) -> None:
+    """The tanks one body carries (the vessel, or one of [[bodies]]: `carriers`, tank_carriers') all
+    multimodal or none (its stacked liquid is of one kind); the multimodal method's validity."""
+    first: dict = {}
+    for i, (t, c) in enumerate(zip(tanks, carriers)):
+        j = first.setdefault(c, i)
+        if t.model != tanks[j].model:
+            on = "" if c == "vessel" else f" on the body {c!r}"
+            raise SceneError(f"tanks[{i}].model", f'is "{t.model}" but tanks[{j}]{on} is "{tanks[j].model}": all '
+                                                  f"tanks of one body take the same model")
+        ratio = t.fill_depth / t.size[0]
+        if t.model == "multimodal" and ratio < MULTIMODAL_SHALLOW:
+            warnings.append(f"tanks[{i}] ({t.name!r}): fill depth / length = {ratio:.3g} is below "
+                            f"{MULTIMODAL_SHALLOW}: shallow-water sloshing (bores, hydraulic jumps), outside the "
+                            "multimodal method's validity")
 
 
 def read_bodies(tables, vessel, environment, warnings: list[str], files=None, tanks=(), carriers=()) -> tuple[Body, ...]:
@@ -227,16 +246,16 @@ def _overlaps(bodies, vessel) -> None:
 
 
 def _body_tank(table, where: str, body: str) -> None:
-    """What a tank on one of [[bodies]] may be yet: a finite-element tank reduced to its modes
-    (`[tanks.reduction]`) with rigid walls (docs/guide/bodies-and-connections.md)."""
-    refused = [("model", table.get("model", "fem") == "multimodal", "multimodal tanks"),
-               ("reduction", "reduction" not in table, "full-order tanks (give [tanks.reduction] modes = ...: the "
-                                                       "reduced liquid)"),
+    """What a tank on one of [[bodies]] may be yet: a multimodal tank, or a finite-element tank
+    reduced to its modes (`[tanks.reduction]`) with rigid walls (docs/guide/bodies-and-connections.md)."""
+    fem = table.get("model", "fem") != "multimodal"
+    refused = [("reduction", fem and "reduction" not in table, "full-order tanks (give [tanks.reduction] modes = "
+                                                               '...: the reduced liquid; or model = "multimodal")'),
                ("walls", table.get("walls", "rigid") != "rigid", "elastic tank walls")]
     for key, bad, what in refused:
         if bad:
-            raise SceneError(f"{where}.body", f"{body!r}: {what} are not available yet on [[bodies]] (only a "
-                                              f"reduced tank rides on a body; {where}.{key})")
+            raise SceneError(f"{where}.body", f"{body!r}: {what} are not available yet on [[bodies]] (a reduced "
+                                              f"or a multimodal tank rides on a body; {where}.{key})")
 
 
 def hull_extent(owner) -> Optional[tuple]:
@@ -353,6 +372,7 @@ def bodies_scene(bodies, vessel, structures, mapping, warnings: list[str], files
             _body_tank(t, f"tanks[{i}]", body)
     if not bodies:
         return
+    _beside_multimodal(bodies, vessel, structures, mapping.get("tanks", []))
     if any(s.frame == "own" for s in structures):
         raise SceneError("bodies", "[[bodies]] together with [[structures]] in their own frames are not available "
                                    "yet (a model holds one of them)")
@@ -402,6 +422,22 @@ def file_centres(path: str) -> dict:
         return netcdf_centres(path) if os.path.splitext(path)[1].lower() != ".1" else {}
     except (KeyError, ValueError) as e:
         raise DatabaseError(f"{path}: its bodies' centres do not read ({e})") from None
+
+
+def _beside_multimodal(bodies, vessel, structures, tables) -> None:
+    """A body's multimodal tank joins the Newton matrix's exact block with its few coordinates, and the
+    vessel's liquid lies before them there (physics/system.py exact_block): the vessel's tanks must
+    then be multimodal too, or none, and no structure share their block."""
+    where = next((f"tanks[{i}].model" for i, t in enumerate(tables) if isinstance(t, dict)
+                  and t.get("body", "vessel") in [b.name for b in bodies] and t.get("model") == "multimodal"), None)
+    if where is None:
+        return
+    carried = [tank_carriers(tables, vessel.name)[i] == "vessel" and t.get("model", "fem") != "multimodal"
+               for i, t in enumerate(tables) if isinstance(t, dict)]
+    if any(carried) or any(s.frame == "vessel" for s in structures):
+        raise SceneError(where, "a multimodal tank on one of [[bodies]] beside finite-element tanks (or structures) "
+                                "on the vessel is not available yet: make the vessel's tanks multimodal too, or the "
+                                "body's reduced ([tanks.reduction])")
 
 
 def resolve(hd, base: str = "") -> str:

@@ -163,8 +163,8 @@ KEYS = (
     ("tanks.name", _REQ, "", "The tank's name (no '.', '[', ']' or '/')."),
     ("tanks.body", '"vessel"', "", "The body that carries the tank: \"vessel\" (or the vessel's `name`) or the "
                                    "name of one of `[[bodies]]`. On a body, the tank is in the body's frame (its "
-                                   "`origin` from the body's COG) and must be reduced (`[tanks.reduction]`) with rigid "
-                                   "walls; multimodal and full-order tanks and elastic walls are refused there "
+                                   "`origin` from the body's COG) and must be reduced (`[tanks.reduction]`) or multimodal, "
+                                   "with rigid walls; full-order tanks and elastic walls are refused there "
                                    "(docs/guide/bodies-and-connections.md)."),
     ("tanks.origin", _REQ, "m", "The min corner of the tank's bounding box in the frame of the body that carries "
                                 "it (the vessel's by default), from its COG."),
@@ -181,8 +181,8 @@ KEYS = (
     ("tanks.file", "required (mesh)", "", "Mesh tank: the liquid at rest as hexahedra (any format meshio "
                                           "reads), relative to the scene."),
     ("tanks.model", '"fem"', "", '"fem" (the linear finite elements) or "multimodal": nonlinear sloshing '
-                                 "in a box tank or an upright (axis = \"z\") circular cylinder (every tank of the "
-                                 "scene the same)."),
+                                 "in a box tank or an upright (axis = \"z\") circular cylinder (every tank of one "
+                                 "body the same; on a body, the vessel's tanks multimodal or none)."),
     ("tanks.modes", "6", "", "Multimodal: the free-surface modes, the lowest; with flow = \"3d\" and in a "
                              "cylinder completed to whole degenerate groups (a square's (1, 0), (0, 1) pair, a "
                              "cylinder's cos/sin pairs)."),
