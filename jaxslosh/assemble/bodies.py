@@ -64,7 +64,9 @@ def body_liquid(scene, body, q0, g):
     eff = scene.effects
     if not body.tanks or not eff.liquid:
         return None, (), ()
-    own = dataclasses.replace(scene, tanks=body.tanks, structures=())
+    # dense: the body's liquid block is inverted whole as the Bodies term's deformable block
+    own = dataclasses.replace(scene, tanks=body.tanks, structures=(),
+                              simulation=dataclasses.replace(scene.simulation, linear_solver="dense"))
     if multimodal_scene(own):     # the vessel's multimodal liquid and damping; its fields on surface meshes
         liquid = build_multimodal(own, {}, g)
         damping = multimodal_damping(own, {}, liquid)
@@ -147,7 +149,7 @@ def _about(scene) -> About:
                               + ["centrifugal"] * eff.centrifugal + ["gravity turning with the body"])
             if t.multimodal:        # its loads are its modal Lagrangian's (tank_line says so)
                 text, loads = text.split("; its inertial loads")[0], "the modal Lagrangian's, gravity turning with it"
-            else:
+            elif t.reduction is not None:
                 text += f", on {t.reduction.modes} modes"
             lines.append((what, f"{text}; carried by the body {b.name!r} (in its frame from its COG, its liquid's "
                                 f"unknowns its own, its loads on the body's six rows: {loads})"))

@@ -5,6 +5,7 @@ from __future__ import annotations
 import dataclasses
 from typing import NamedTuple, Optional
 
+import jax
 import jax.numpy as jnp
 import numpy as np
 
@@ -57,7 +58,10 @@ def _body_probe(scene, p, t, bt, tank):
              probe_weights(np.asarray(p.point), t.size, t.fill_depth, b.nodes, b.elements))
     w = np.zeros((1, tank.n_nodes))
     w[0, b.node_offset:b.node_offset + b.nodes.shape[0]] = local
-    return np.asarray(t.origin) + np.asarray(p.point), tank.probe_modal(jnp.asarray(w))[0]
+    modal = tank.probe_modal(jnp.asarray(w))
+    if modal is None:             # a full-order liquid: its probe displacement is linear in d, (3, nf) -> (nf, 3)
+        modal = jax.jacfwd(lambda d: tank.probe_displacements(jnp.asarray(w), None, d)[0])(jnp.zeros(tank.nf)).T[None]
+    return np.asarray(t.origin) + np.asarray(p.point), modal[0]
 
 
 def build_probes(scene: Scene, tanks, liquid, structures=(), vstructs=(), body_tanks=(), bodies=None) -> Probes:

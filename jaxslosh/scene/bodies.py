@@ -246,16 +246,14 @@ def _overlaps(bodies, vessel) -> None:
 
 
 def _body_tank(table, where: str, body: str) -> None:
-    """What a tank on one of [[bodies]] may be yet: a multimodal tank, or a finite-element tank
-    reduced to its modes (`[tanks.reduction]`) with rigid walls (docs/guide/bodies-and-connections.md)."""
-    fem = table.get("model", "fem") != "multimodal"
-    refused = [("reduction", fem and "reduction" not in table, "full-order tanks (give [tanks.reduction] modes = "
-                                                               '...: the reduced liquid; or model = "multimodal")'),
-               ("walls", table.get("walls", "rigid") != "rigid", "elastic tank walls")]
+    """What a tank on one of [[bodies]] may be yet: a multimodal tank, or a finite-element tank (full
+    or reduced to its modes) with rigid walls (docs/guide/bodies-and-connections.md)."""
+    refused = [("walls", table.get("walls", "rigid") != "rigid", "elastic tank walls")]
     for key, bad, what in refused:
         if bad:
-            raise SceneError(f"{where}.body", f"{body!r}: {what} are not available yet on [[bodies]] (a reduced "
-                                              f"or a multimodal tank rides on a body; {where}.{key})")
+            raise SceneError(f"{where}.body", f"{body!r}: {what} are not available yet on [[bodies]] (a "
+                                              f"finite-element tank with rigid walls or a multimodal tank rides on a "
+                                              f"body; {where}.{key})")
 
 
 def hull_extent(owner) -> Optional[tuple]:

@@ -163,8 +163,8 @@ KEYS = (
     ("tanks.name", _REQ, "", "The tank's name (no '.', '[', ']' or '/')."),
     ("tanks.body", '"vessel"', "", "The body that carries the tank: \"vessel\" (or the vessel's `name`) or the "
                                    "name of one of `[[bodies]]`. On a body, the tank is in the body's frame (its "
-                                   "`origin` from the body's COG) and must be reduced (`[tanks.reduction]`) or multimodal, "
-                                   "with rigid walls; full-order tanks and elastic walls are refused there "
+                                   "`origin` from the body's COG), a finite-element (full or reduced) or multimodal tank with "
+                                   "rigid walls; elastic walls are refused there "
                                    "(docs/guide/bodies-and-connections.md)."),
     ("tanks.origin", _REQ, "m", "The min corner of the tank's bounding box in the frame of the body that carries "
                                 "it (the vessel's by default), from its COG."),
