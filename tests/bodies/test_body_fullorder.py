@@ -3,16 +3,13 @@
 the body's kinematics, its block inverted whole as the bodies' deformable block. The body carrying
 it beside the vessel moves, and its liquid sloshes, as the same body carrying the same tank as the
 only vessel of a scene (the vessel's own liquid: an independent path through the model)."""
-import jax.numpy as jnp
 import numpy as np
 import pytest
 
 import jaxslosh as js
-from jaxslosh.assemble.system import build
 from jaxslosh.cli import main
-from jaxslosh.physics.bodies import bodies_term
-from jaxslosh.physics.kinematics import quat_from_rpy
-from jaxslosh.physics.terms import Config
+
+from body_rows import rows_and_residual
 
 from test_body_tanks import CARRIER, HEAD, TANK, VESSEL, VOLUME
 
@@ -49,19 +46,9 @@ def test_a_bodys_full_order_rows_are_the_lone_vessels_at_any_state():
     """The fast twin: at a tilted, moving state with the liquid displaced and accelerating, the body's
     six rows and its liquid's rows (the rotation penalty's included) equal the lone vessel's residual
     at the same state, 1e-12 of their size."""
-    floating = bodies_term(build(js.load_scene(on_body())).system).bodies[0]
-    vessel = build(js.load_scene(alone())).system
-    nf = floating.nf
-    assert nf == vessel.nf > 0
-    rng = np.random.default_rng(5)
-    x, q = jnp.asarray(rng.normal(size=3) * 0.1), quat_from_rpy(jnp.asarray([0.05, -0.08, 0.3]))
-    v, a = jnp.asarray(rng.normal(size=6) * 0.1), jnp.asarray(rng.normal(size=6) * 0.1)
-    d, d_dot, d_acc = (jnp.asarray(rng.normal(size=nf) * s) for s in (0.01, 0.02, 0.05))
-    rigid, rows_d = floating.rows(floating.kin(floating.rest + x, q, v, a, vessel.gravity, 0.0, d, d_dot, d_acc))
-    ref = vessel.residual(Config(x, q, d), v[:3], v[3:], d_dot, jnp.concatenate([a, d_acc]))
-    ours = np.concatenate([np.asarray(rigid), np.asarray(rows_d)])
+    ours, ref = rows_and_residual(on_body(), alone(), seed=5, sizes=(0.01, 0.02, 0.05))
     assert np.abs(ours).max() > 1e3
-    np.testing.assert_allclose(ours, np.asarray(ref), rtol=0, atol=1e-12 * np.abs(ours).max())
+    np.testing.assert_allclose(ours, ref, rtol=0, atol=1e-12 * np.abs(ours).max())
 
 
 def test_check_describes_the_full_order_tank_on_its_body(tmp_path, capsys):

@@ -3,16 +3,13 @@ the vessel's multimodal liquid evaluated with the body's kinematics, its coordin
 block of the Newton matrix as the vessel's are. The body carrying it beside the vessel moves, and
 its free surface sloshes, as the same body carrying the same tank as the only vessel of a scene (the
 vessel's own liquid: an independent path through the model)."""
-import jax.numpy as jnp
 import numpy as np
 import pytest
 
 import jaxslosh as js
-from jaxslosh.assemble.system import build
-from jaxslosh.cli import main
-from jaxslosh.physics.bodies import bodies_term
-from jaxslosh.physics.kinematics import quat_from_rpy
-from jaxslosh.physics.terms import Config
+
+from body_rows import rows_and_residual
+from test_body_checks import _check
 
 from test_body_tanks import CARRIER, HEAD, VESSEL
 
@@ -70,13 +67,6 @@ def test_a_body_with_a_multimodal_tank_moves_as_the_same_vessel_with_that_tank(r
     np.testing.assert_allclose(a.vessel.roll_pitch_yaw, v.vessel.roll_pitch_yaw, rtol=0, atol=1e-10)
 
 
-def _check(tmp_path, capsys, text):
-    p = tmp_path / "scene.toml"
-    p.write_text(text)
-    status = main(["check", str(p)])
-    return status, capsys.readouterr()
-
-
 def test_check_describes_the_multimodal_tank_on_its_body(tmp_path, capsys):
     status, out = _check(tmp_path, capsys, on_body())
     assert status == 0, out.err
@@ -109,15 +99,6 @@ def test_a_bodys_multimodal_rows_are_the_lone_vessels_at_any_state():
     """The fast twin of the run's equivalence: at a state away from rest (tilted, moving, the surface
     displaced and accelerating), the body's six rows and its tank's modal rows equal the lone
     vessel's residual at the same state to round-off, 1e-12 of their size."""
-    floating = bodies_term(build(js.load_scene(on_body())).system).bodies[0]
-    vessel = build(js.load_scene(alone())).system
-    rng = np.random.default_rng(3)
-    x, q = jnp.asarray(rng.normal(size=3) * 0.1), quat_from_rpy(jnp.asarray([0.05, -0.08, 0.3]))
-    v, a = jnp.asarray(rng.normal(size=6) * 0.1), jnp.asarray(rng.normal(size=6) * 0.1)
-    d, d_dot, d_acc = (jnp.asarray(rng.normal(size=4) * s) for s in (0.05, 0.1, 0.2))
-    g = vessel.gravity
-    rigid, rows_d = floating.rows(floating.kin(floating.rest + x, q, v, a, g, 0.0, d, d_dot, d_acc))
-    ref = vessel.residual(Config(x, q, d), v[:3], v[3:], d_dot, jnp.concatenate([a, d_acc]))
-    ours = np.concatenate([np.asarray(rigid), np.asarray(rows_d)])
+    ours, ref = rows_and_residual(on_body(), alone(), seed=3)
     assert np.abs(ours).max() > 1e3
-    np.testing.assert_allclose(ours, np.asarray(ref), rtol=0, atol=1e-12 * np.abs(ours).max())
+    np.testing.assert_allclose(ours, ref, rtol=0, atol=1e-12 * np.abs(ours).max())
