@@ -10,6 +10,7 @@ import jax.numpy as jnp
 import numpy as np
 
 from ..liquid.base import RotationPenalty
+from ..liquid.multimodal.build import build_multimodal, multimodal_damping, multimodal_scene, surface_meshes
 from ..physics.about import About
 from ..physics.bodies import BAND, Bodies, Floating, Link, body_rest, end_index
 from ..physics.kinematics import quat_from_rpy
@@ -63,7 +64,13 @@ def body_liquid(scene, body, q0, g):
     eff = scene.effects
     if not body.tanks or not eff.liquid:
         return None, (), ()
-    own = dataclasses.replace(scene, tanks=body.tanks, structures=())
+    # dense: the body's liquid block is inverted whole as the Bodies term's deformable block
+    own = dataclasses.replace(scene, tanks=body.tanks, structures=(),
+                              simulation=dataclasses.replace(scene.simulation, linear_solver="dense"))
+    if multimodal_scene(own):     # the vessel's multimodal liquid and damping; its fields on surface meshes
+        liquid = build_multimodal(own, {}, g)
+        damping = multimodal_damping(own, {}, liquid)
+        return liquid, () if damping is None else (damping,), surface_meshes(own)
     block = build_liquid_block(own, {}, g)
     liquid = dataclasses.replace(block.liquid, coriolis=eff.coriolis, centrifugal=eff.centrifugal)
     terms = () if block.penalty is None else (RotationPenalty(Kdt=block.penalty[0], Ktt=block.penalty[1], q_ref=q0),)
@@ -140,9 +147,12 @@ def _about(scene) -> About:
             eff = scene.effects
             loads = ", ".join(["its element's rotation penalty"] + ["Coriolis"] * eff.coriolis
                               + ["centrifugal"] * eff.centrifugal + ["gravity turning with the body"])
-            lines.append((what, f"{text}, on {t.reduction.modes} modes; carried by the body {b.name!r} (in its frame "
-                                f"from its COG, its liquid's unknowns its own, its loads on the body's six rows: "
-                                f"{loads})"))
+            if t.multimodal:        # its loads are its modal Lagrangian's (tank_line says so)
+                text, loads = text.split("; its inertial loads")[0], "the modal Lagrangian's, gravity turning with it"
+            elif t.reduction is not None:
+                text += f", on {t.reduction.modes} modes"
+            lines.append((what, f"{text}; carried by the body {b.name!r} (in its frame from its COG, its liquid's "
+                                f"unknowns its own, its loads on the body's six rows: {loads})"))
             if f"liquid damping in tank {t.name!r}" in damped:
                 lines.append((f"liquid damping in tank {t.name!r}", damped[f"liquid damping in tank {t.name!r}"]))
     shown = {"vessel": scene.vessel.name}       # the ends as the scene names them

@@ -2,12 +2,15 @@
 the liquid's nodes (or a structure's), computed once."""
 from __future__ import annotations
 
+import dataclasses
 from typing import NamedTuple, Optional
 
+import jax
 import jax.numpy as jnp
 import numpy as np
 
 from ..fem.mesh import HEX_CORNERS
+from ..liquid.multimodal.build import probe_modal
 from ..scene.types import Scene
 
 
@@ -41,17 +44,24 @@ class BodyProbes(NamedTuple):
     n: int
 
 
-def _body_probe(p, t, bt, tank):
+def _body_probe(scene, p, t, bt, tank):
     """(point in the body's frame, its weights (m, 3) on the body's tank liquid's coordinates) of a
     probe in tank t (TankBlock `bt.tanks`' one) carried by a body whose liquid is `tank`: the
     vessel's rule (probe_weights) on the body's mesh."""
     b = next(x for x in bt.tanks if x.name == t.name)
+    if t.multimodal:              # the free surface's elevation at the probe: the vessel's rule (probe_modal)
+        body = next(x for x in scene.bodies if t in x.tanks)
+        own = dataclasses.replace(scene, tanks=body.tanks, probes=(p,))
+        return np.asarray(t.origin) + np.asarray(p.point), probe_modal(own, tank)[0]
     local = (mapped_weights(np.asarray(p.point), t.fill_depth, b.nodes, b.elements)
              if getattr(b.model, "geometry", None) is not None else
              probe_weights(np.asarray(p.point), t.size, t.fill_depth, b.nodes, b.elements))
     w = np.zeros((1, tank.n_nodes))
     w[0, b.node_offset:b.node_offset + b.nodes.shape[0]] = local
-    return np.asarray(t.origin) + np.asarray(p.point), tank.probe_modal(jnp.asarray(w))[0]
+    modal = tank.probe_modal(jnp.asarray(w))
+    if modal is None:             # a full-order liquid: its probe displacement is linear in d, (3, nf) -> (nf, 3)
+        modal = jax.jacfwd(lambda d: tank.probe_displacements(jnp.asarray(w), None, d)[0])(jnp.zeros(tank.nf)).T[None]
+    return np.asarray(t.origin) + np.asarray(p.point), modal[0]
 
 
 def build_probes(scene: Scene, tanks, liquid, structures=(), vstructs=(), body_tanks=(), bodies=None) -> Probes:
@@ -70,7 +80,7 @@ def build_probes(scene: Scene, tanks, liquid, structures=(), vstructs=(), body_t
             if bt is None:                # no liquid built ([effects] liquid = false): it follows the body
                 r, modal, at = np.asarray(t.origin) + np.asarray(p.point), jnp.zeros((0, 3)), (0, 0)
             else:
-                r, modal = _body_probe(p, t, bt, bodies.bodies[s].tank)
+                r, modal = _body_probe(scene, p, t, bt, bodies.bodies[s].tank)
                 at = (bt.offset, bodies.bodies[s].nf)
             pts.append(r)
             on_body.setdefault(s, (*at, []))[2].append((i, r, modal))

@@ -55,6 +55,23 @@ def netcdf_bodies(path: str) -> Optional[tuple]:
     return tuple(dict.fromkeys(x.split(SEP)[0] for x in labels))
 
 
+def netcdf_centres(path: str) -> dict:
+    """{body: (x, y, z)} of a multibody Capytaine dataset: each body's `rotation_center` (where its
+    dofs rotate: its COG), else its `center_of_mass`, in the dataset's coordinates (Capytaine stores
+    them along the dimensions (body, space_coordinate)); {} where the file holds neither."""
+    ds = _open_netcdf(path)
+    names = netcdf_bodies(path) or ()
+    for key in ("rotation_center", "center_of_mass"):
+        if key not in ds.variables or ds[key].ndim != 2 or "body" not in ds[key].dims:
+            continue
+        da = ds[key].transpose("body", ...)
+        labels = [str(x) for x in ds["body"].values] if "body" in ds.coords else list(names)
+        if len(labels) != da.shape[0] or da.shape[1] != 3:
+            continue
+        return {n: tuple(float(c) for c in row) for n, row in zip(labels, np.asarray(da.values, dtype=float))}
+    return {}
+
+
 def read_multibody_netcdf(path: str, names) -> Multibody:
     """The coupled tables of `names` (every body of the dataset, in the scene's order)."""
     ds = _merge_complex(_open_netcdf(path))

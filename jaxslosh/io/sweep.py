@@ -44,8 +44,9 @@ def load_sweep(path) -> Sweep:
     """The sweep file at `path`; a file that is not one or cannot be read raises ResultFileError."""
     with open_format(path, SWEEP_FORMAT, "sweep") as f:
         probes = list(f["probes"]) if "probes" in f else []
+        bodies, links = (list(f[g]) if g in f else [] for g in ("bodies", "connections"))
         params = read_frames(f, [f"sweep/{k}" for k in (f["sweep"] if "sweep" in f else [])])
-        d = read_frames(f, schema(probes), axis=1)
+        d = read_frames(f, schema(probes, bodies=bodies, connections=links), axis=1)
         check_required(d, probes, path)
         runs = d["time"].shape[0]
         if not params or any(len(v) != runs for v in params.values()):

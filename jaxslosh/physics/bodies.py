@@ -8,11 +8,12 @@ group) whose rows are the sum of the *same term classes* as the vessel's rigid p
 evaluated with the body's own kinematics (`Floating.kin`): a body is built by the functions that
 build the vessel's rigid terms, its wave excitation among them (seakeeping.py's `WaveExcitation`,
 its forces at the body's place in the incident field). What the vessel has and a body has not
-yet: hull meshes, nonlinear hydrostatics, and tanks other than reduced ones.
+yet: hull meshes, nonlinear hydrostatics, and elastic tank walls.
 
 Tanks on a body (`[[tanks]] body = ...`): each body's tanks are a liquid of the vessel's kind
-(jaxslosh/liquid, built by the vessel's builder; the reduced one, whose block is constant and
-small), held by its `Floating` and evaluated with the body's kinematics: its rigid rows add to the
+(jaxslosh/liquid, built by the vessel's builder: finite elements, reduced or full, whose block
+is constant, or the multimodal one, whose coordinates join the exact block: `exact`), held by its
+`Floating` and evaluated with the body's kinematics: its rigid rows add to the
 body's six, its own rows are this term's deformable unknowns (the layout's z after the vessel's
 liquid; the configuration's `eta`, every body's tanks' stacked in the bodies' order), with the
 liquid's constant blocks as their block of the Newton preconditioner (`deformable_block`). They
@@ -221,6 +222,11 @@ class Bodies(AbstractOwner):
     def M(self) -> int:
         """Its bodies' tanks' liquid unknowns (the owner's deformable ones), stacked in the bodies' order."""
         return sum(b.nf for b in self.bodies)
+
+    def exact(self) -> bool:
+        """A body's nonlinear (multimodal) liquid: every deformable unknown linearised exactly, as the
+        vessel's multimodal liquid is (its rows' mass and stiffness move with the free surface)."""
+        return any(b.tank is not None and b.tank.nonlinear for b in self.bodies)
 
     def tank_slices(self) -> tuple:
         """(S,) each body's slice of the stacked liquid unknowns of the bodies' tanks."""

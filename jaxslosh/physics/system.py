@@ -83,6 +83,20 @@ class System(eqx.Module):
         the vessel's rows where its motion is prescribed: its rows are the constraint alone."""
         return rows.at[:6].set(0.0) if self.prescribing() else rows
 
+    def exact_block(self) -> int:
+        """How many of the Newton unknowns (x = [y, alg, z]: physics/unknowns.py) form its exact block,
+        linearised at every preconditioner: the rigid and algebraic ones; a nonlinear liquid's too (the
+        vessel's multimodal); and the owners' deformable ones where an owner asks (a body's multimodal
+        tank), which then needs the vessel's liquid in the exact block too (it lies between)."""
+        L = self.layout()
+        ns = L.n_small + (L.nf if self.liquid.nonlinear else 0)
+        if any(o.exact() for o in self.owners()):
+            if ns != L.n_small + L.nf:
+                raise ValueError("a body's nonlinear liquid beside a linear liquid on the vessel: the exact block "
+                                 "is the Newton unknowns' first ones")
+            ns = L.n
+        return ns
+
     def layout(self) -> Layout:
         u = [t.unknowns() for t in self.owners()]
         return Layout(sum(x.frames for x in u), self.nf, sum(x.deformable for x in u), sum(x.alg for x in u))

@@ -128,6 +128,12 @@ class AbstractOwner(AbstractTerm):
     def block_diagonal(self, c_m, c_k):
         """The diagonal of its deformable unknowns' block of c_m M + c_k K (constant)."""
 
+    def exact(self) -> bool:
+        """Whether its deformable unknowns join the exact block of the Newton matrix, linearised at
+        every preconditioner as the rigid ones are (a nonlinear liquid's few coordinates: a body's
+        multimodal tank, physics/bodies.py), instead of the constant block (static)."""
+        return False
+
     def deformable_block(self, c_m, c_k):
         """Its deformable unknowns' block of c_m M + c_k K (constant): its diagonal (m,) where the
         block is diagonal (the structures' modal one), else the block (m, m) (the bodies' tank liquid)."""

@@ -30,15 +30,18 @@ def scene_title(scene_text: str, default: str = "jaxslosh result") -> str:
     return title.strip() if isinstance(title, str) and title.strip() else default
 
 
-def _axes(r, links: bool = False):
-    """The panels: angles, heave, the probes' (where any), the connections' forces (`links`)."""
-    rows = 2 + (1 if r.probes else 0) + (1 if links else 0)
+def _axes(r, links: bool = False, bodies=()):
+    """The panels: angles, heave, the probes' (where any), one of angles per body in `bodies` (a
+    sweep's), the connections' forces (`links`)."""
+    rows = 2 + (1 if r.probes else 0) + len(bodies) + (1 if links else 0)
     fig = figure(9, 2.6 * rows)
     ax = fig.subplots(rows, 1, sharex=True)
     ax[0].set_ylabel("angle (deg)")
     ax[1].set_ylabel("heave (m)")
     if r.probes:
         ax[2].set_ylabel("vertical displacement (m)")
+    for k, name in enumerate(bodies):
+        ax[2 + bool(r.probes) + k].set_ylabel(f"{name}: roll (solid),\npitch (dashed) (deg)")
     if links:
         ax[-1].set_ylabel("connection force (kN)")
     ax[-1].set_xlabel("time (s)")
@@ -95,16 +98,20 @@ def _short_keys(keys):
 
 def plot_sweep(params: dict, r, statuses, out: str, scene_text: str = "") -> Figure:
     """A sweep file's runs overlaid (one colour per run, the same in every panel): roll (solid) and
-    pitch (dashed), heave, and each probe's vertical displacement (one line style per probe); the
-    legend names each run's swept values (up to MAX_LEGEND runs), a failed run is marked. Returns
-    the figure written."""
+    pitch (dashed), heave, and each probe's vertical displacement (one line style per probe); each
+    [[bodies]] body's roll and pitch in a panel of its own and its heave beside the vessel's (one line
+    style per body), and the [[connections]]' forces (one line style per connection); the legend
+    names each run's swept values (up to MAX_LEGEND runs), a failed run is marked. Returns the figure
+    written."""
     keys = list(params)
     names = _short_keys(keys)
     t = np.asarray(r.time)
     rpy = np.degrees(np.asarray(r.vessel.roll_pitch_yaw))
     z = np.asarray(r.vessel.position)[..., 2]
     runs = t.shape[0]
-    fig, ax = _axes(r)
+    bodies, links = r.bodies or {}, r.connections or {}
+    fig, ax = _axes(r, bool(links), tuple(bodies))
+    first = 2 + bool(r.probes)         # the bodies' panels
     # up to ten runs the default colour cycle (easiest told apart); more: a colour map in run order
     cmap = colormaps["viridis"] if runs > 10 else None
     styles = ["-", "--", ":", "-."]
@@ -119,11 +126,25 @@ def plot_sweep(params: dict, r, statuses, out: str, scene_text: str = "") -> Fig
         for j, (pname, p) in enumerate(r.probes.items()):
             ax[2].plot(t[i], np.asarray(p.displacement)[i, :, 2], color=c, ls=styles[j % len(styles)],
                        label=f"probe {pname}" if i == 0 else None)
+        for k, (bname, b) in enumerate(bodies.items()):
+            brpy = np.degrees(np.asarray(b.roll_pitch_yaw)[i])
+            ax[first + k].plot(t[i], brpy[:, 0], color=c)
+            ax[first + k].plot(t[i], brpy[:, 1], color=c, ls="--", lw=0.9)
+            ax[1].plot(t[i], np.asarray(b.position)[i, :, 2], color=c, ls=styles[(k + 1) % len(styles)],
+                       label=bname if i == 0 else None)
+        for k, (lname, link) in enumerate(links.items()):
+            ax[-1].plot(t[i], 1e-3 * np.asarray(link.force)[i], color=c, ls=styles[k % len(styles)],
+                        label=lname if i == 0 else None)
     ax[0].set_ylabel("roll (solid), pitch (dashed) (deg)")
     if runs <= MAX_LEGEND:             # beside the panel: a legend of many runs would cover their curves
         ax[0].legend(loc="upper left", bbox_to_anchor=(1.01, 1.0), fontsize=7, borderaxespad=0.0)
     if r.probes:
         ax[2].legend(loc="upper right", fontsize=7)
+    if bodies:                         # the vessel's heave solid, each body's in its style
+        ax[1].lines[0].set_label("vessel")
+        ax[1].legend(loc="upper right", fontsize=7)
+    if links:
+        ax[-1].legend(loc="upper right", fontsize=7)
     ranges = ", ".join(f"{n} {np.min(params[k]):.4g} to {np.max(params[k]):.4g}" for n, k in zip(names, keys))
     failed = sum(s != "ok" for s in statuses)
     return _finish(fig, f"{scene_title(scene_text, 'jaxslosh sweep')}: {runs} runs ({ranges})"

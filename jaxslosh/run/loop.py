@@ -77,7 +77,8 @@ def probe_positions(b: Built, c: Config):
             probes = probes.at[sp.rows].set(c.Xs[sp.index][None, :] + x @ rotation_matrix(c.qs[sp.index]).T)
     for bp in pr.on_bodies:               # probes in a body's tanks: its liquid, in its frame
         tank = bodies_term(sysm).bodies[bp.index].tank
-        x = bp.r if tank is None else bp.r + tank.probe_displacements(None, bp.modal, c.eta[bp.offset:bp.offset + bp.n])
+        # its weights on the body's liquid unknowns (assemble/probes.py), whatever the liquid's form
+        x = bp.r if tank is None else bp.r + jnp.einsum("pkc,k->pc", bp.modal, c.eta[bp.offset:bp.offset + bp.n])
         probes = probes.at[bp.rows].set(c.Xs[bp.index][None, :] + x @ rotation_matrix(c.qs[bp.index]).T)
     return probes
 
@@ -288,7 +289,10 @@ def frame_datasets(b: Built, fr: Frame, p0=None, fields: bool = True) -> dict:
             d[f"tanks/{t.name}/displacement"] = D[..., t.node_offset:t.node_offset + t.nodes.shape[0], :]
     for bt in b.body_tanks if fields else ():     # a body's tanks: their fields from its liquid's coordinates
         floating = term.bodies[bt.body]
-        D = floating.tank.nodal_fields(fr.body_d[..., bt.offset:bt.offset + floating.nf])
+        eta = fr.body_d[..., bt.offset:bt.offset + floating.nf]
+        flat = eta.reshape(-1, floating.nf)       # the frames' kept field of each (a full-order liquid's: nodal)
+        D = floating.tank.nodal_fields(jax.vmap(floating.tank.frame_field)(flat))
+        D = D.reshape(eta.shape[:-1] + D.shape[1:])
         for t in bt.tanks:
             d[f"tanks/{t.name}/displacement"] = D[..., t.node_offset:t.node_offset + t.nodes.shape[0], :]
     return d

@@ -63,6 +63,7 @@ def run_to_file(scene: Scene, out: str, *, progress: bool = True,
             watch = Watch(scene, np.asarray(solver.noise))
             watch.watch_capsize(vanishing_angles(b.system))
             watch.watch_liquid(b.system.liquid)
+            watch.watch_bodies(b)
             se = setup.save_every
             n_frames = setup.n_steps // se
             N = b.system.liquid.n_nodes
@@ -90,7 +91,7 @@ def run_to_file(scene: Scene, out: str, *, progress: bool = True,
                 ok = ~np.asarray(pending.failed)
                 n_ok = int(ok.sum()) if ok.all() else int(np.argmin(ok))
                 rows = jax.tree_util.tree_map(lambda x: x[:n_ok], pending)
-                watch.update(rows.t, rows.surface, rows.residual, rows.D, rows.q)
+                watch.update(rows.t, rows.surface, rows.residual, rows.D, rows.q, rows.body_d)
                 steps = min(int(carry.k), setup.n_steps)
                 writer.append({k: np.asarray(v) for k, v in frame_datasets(b, rows, p0, save_fields).items()}, steps)
                 steps_written = steps

@@ -12,9 +12,14 @@ times its floor). A residual at the floor is round-off, not a fault; one well ab
 whose iterations stalled. Displacements beyond the model's range are said by the free-surface check."""
 from __future__ import annotations
 
+import dataclasses
+
+import jax
 import numpy as np
 
+from ..liquid.multimodal.build import multimodal_scene, surfaces
 from ..liquid.multimodal.build3d import tank_3d, three_dimensional
+from ..physics.bodies import bodies_term
 from ..physics.kinematics import rpy_from_quat
 from ..liquid.multimodal.term import NX
 from ..liquid.multimodal.steep import DEFINITE_ON, DEFINITE_SOFT, STEEP_FULL, STEEP_MODES, STEEP_ON
@@ -67,11 +72,18 @@ def _crest_index(Z, w, kN, d):
     return m[:, 0] + np.log(np.exp(e - m) @ (w / w.sum()))
 
 
-class Watch:
-    """Extremes seen over the frames of a run, chunk by chunk."""
+def _tank_label(i, t) -> str:
+    return f"tanks[{i}] ({t.name!r})"
 
-    def __init__(self, scene: Scene, noise: float = 0.0):
+
+class Watch:
+    """Extremes seen over the frames of a run, chunk by chunk. The tanks of [[bodies]] are watched
+    by a Watch of their own per body (`watch_bodies`), fed from the frames' bodies' liquid unknowns."""
+
+    def __init__(self, scene: Scene, noise: float = 0.0, label=_tank_label):
         self.scene = scene
+        self.label = label                # (index among scene.tanks, tank) -> how the warnings name it
+        self.on_bodies = []               # (Watch, liquid, its unknowns' slice, top rows per tank) per body
         self.noise = float(noise)       # the solver's round-off floor per unit of the liquid's unknowns
         n = len(scene.tanks) if scene.effects.liquid else 0
         self.low = np.full(n, np.inf)
@@ -109,18 +121,37 @@ class Watch:
                 self.third[i] = (np.asarray(t.M0)[6:, 6:] * D2, np.asarray(t.M1)[6:, 6:] * D2[..., None],
                                  np.asarray(t.M2)[6:, 6:] * D2[..., None, None])
 
+    def watch_bodies(self, built) -> None:
+        """Watch the tanks each body carries (built: the run's assemble.system.Built) as the vessel's
+        are: their free surface against roof and floor, a multimodal tank's slope and crests."""
+        term = bodies_term(built.system)
+        for bt in getattr(built, "body_tanks", ()):
+            floating, body = term.bodies[bt.body], self.scene.bodies[bt.body]
+            own = dataclasses.replace(self.scene, tanks=body.tanks)
+            tops = (surfaces(own) if multimodal_scene(own) else
+                    tuple(t.node_offset + np.flatnonzero(np.isclose(t.nodes[:, 2], t.nodes[:, 2].max()))
+                          for t in bt.tanks))
+            sub = Watch(own, label=lambda i, t, b=body.name: f"tank {t.name!r} on the body {b!r}")
+            sub.watch_liquid(floating.tank)
+            self.on_bodies.append((sub, floating.tank, slice(bt.offset, bt.offset + floating.nf), tops))
+
     def watch_capsize(self, angles) -> None:
         """Check the frames' roll and pitch against these angles of vanishing stability (rad; None
         where the hull has none)."""
         self.vanishing = angles
 
-    def update(self, time, surface, residual, field=None, q=None):
+    def update(self, time, surface, residual, field=None, q=None, body_d=None):
         """time (k,), surface (k, tanks, 2), residual (k,) of the frames just computed; `field`
         (k, ...): their liquid unknowns (Frame.D), whose size sets each frame's round-off floor;
-        `q` (k, 4): their attitudes."""
+        `q` (k, 4): their attitudes; `body_d` (k, m): the bodies' tanks' liquid unknowns (Frame.body_d)."""
         time = np.asarray(time)
         if time.size == 0:
             return
+        for sub, liquid, sl, tops in self.on_bodies if body_d is not None else ():
+            d = np.asarray(body_d, float).reshape(time.size, -1)[:, sl]
+            heave = [np.asarray(jax.vmap(lambda x, i=i: liquid.surface_heave(x, i))(d)) for i in tops]
+            sub.update(time, np.stack([np.stack([h.min(axis=1), h.max(axis=1)], -1) for h in heave], 1),
+                       np.zeros(time.size), d)
         if self.vanishing is not None and q is not None:
             rp = np.abs(np.asarray(rpy_from_quat(np.asarray(q)))[:, :2])
             for axis, limit in enumerate(self.vanishing):
@@ -190,7 +221,7 @@ class Watch:
             if not np.isfinite(self.low[i]):
                 continue
             roof = t.size[2] - t.fill_depth
-            where = f"tanks[{i}] ({t.name!r})"
+            where = self.label(i, t)
             model = "the multimodal liquid" if t.form.multimodal else "the linear liquid"
             if self.high[i] > roof:
                 out.append(f"{where}: the free surface rose {self.high[i]:.3g} m at t = {self.t_high[i]:.4g} s, "
@@ -217,9 +248,9 @@ class Watch:
                             + ", and the results are that model's "
                             "(docs/guide/nonlinear-sloshing.md, \"Past the method's range\")")
             if said and np.isnan(self.t_crest[i]) and np.isnan(self.t_margin[i]):
-                out.append(f"tanks[{i}] ({t.name!r}): {said[0]}: the multimodal liquid is outside its validity")
+                out.append(f"{self.label(i, t)}: {said[0]}: the multimodal liquid is outside its validity")
             elif said:
-                out.append(f"tanks[{i}] ({t.name!r}): " + "; ".join(said))
+                out.append(f"{self.label(i, t)}: " + "; ".join(said))
         tol = self.scene.simulation.tolerance
         if self.residual > RESIDUAL_FACTOR * self.level:
             floor = "" if self.level <= tol else \
@@ -228,4 +259,4 @@ class Watch:
                        f"{self.residual / self.level:.3g} times what the iterations aim at (the tolerance {tol:.3g}"
                        f"{floor}): they stalled there, and the steps near that time are less accurate than asked "
                        f"(a smaller dt helps)")
-        return out
+        return out + [w for sub, *_ in self.on_bodies for w in sub.warnings()]

@@ -15,8 +15,9 @@ from typing import Optional
 import numpy as np
 
 from .fields import non_negative, one_of, positive, read, show, valid_name
+from ..hull.surface import HullMeshError
 from ..hydro.database import DatabaseError
-from ..hydro.multibody import file_bodies, read_multibody
+from ..hydro.multibody import file_bodies, netcdf_centres, read_multibody
 from .types import Body, Connection, Hydrostatics, Initial, SceneError
 from .waves import FileContext, read_hydrodynamics
 
@@ -26,6 +27,13 @@ NOT_YET = {"hull": "hull meshes (and the waves' and the nonlinear hydrostatics' 
            "forced": "prescribed motions"}
 #: names a body cannot take: the words that name the vessel and an inertial point in `bodies = [...]`
 RESERVED = ("vessel", "fixed")
+#: how far a connection point may lie outside its body's hull, relative to the hull's size (round-off:
+#: a point on the side, as a fender's face, is inside)
+EDGE = 1e-6
+#: below this fill depth over length the multimodal method's ordering fails (shallow water, bores)
+MULTIMODAL_SHALLOW = 0.1
+#: how far (m) a body of a multibody file may be from its place in the scene (a file's own rounding)
+PLACE = 1e-3
 
 
 def tank_carriers(tables, vessel_name: str) -> tuple:
@@ -41,6 +49,23 @@ def tank_groups(tanks, carriers) -> dict:
     for t, c in zip(tanks, carriers):
         out[c] = out.get(c, ()) + (t,)
     return out
+
+
+def multimodal_scene(tanks, carriers, warnings: list[str]) -> None:
+    """The tanks one body carries (the vessel, or one of [[bodies]]: `carriers`, tank_carriers') all
+    multimodal or none (its stacked liquid is of one kind); the multimodal method's validity."""
+    first: dict = {}
+    for i, (t, c) in enumerate(zip(tanks, carriers)):
+        j = first.setdefault(c, i)
+        if t.model != tanks[j].model:
+            on = "" if c == "vessel" else f" on the body {c!r}"
+            raise SceneError(f"tanks[{i}].model", f'is "{t.model}" but tanks[{j}]{on} is "{tanks[j].model}": all '
+                                                  f"tanks of one body take the same model")
+        ratio = t.fill_depth / t.size[0]
+        if t.model == "multimodal" and ratio < MULTIMODAL_SHALLOW:
+            warnings.append(f"tanks[{i}] ({t.name!r}): fill depth / length = {ratio:.3g} is below "
+                            f"{MULTIMODAL_SHALLOW}: shallow-water sloshing (bores, hydraulic jumps), outside the "
+                            "multimodal method's validity")
 
 
 def read_bodies(tables, vessel, environment, warnings: list[str], files=None, tanks=(), carriers=()) -> tuple[Body, ...]:
@@ -221,21 +246,61 @@ def _overlaps(bodies, vessel) -> None:
 
 
 def _body_tank(table, where: str, body: str) -> None:
-    """What a tank on one of [[bodies]] may be yet: a finite-element tank reduced to its modes
-    (`[tanks.reduction]`) with rigid walls (docs/guide/bodies-and-connections.md)."""
-    refused = [("model", table.get("model", "fem") == "multimodal", "multimodal tanks"),
-               ("reduction", "reduction" not in table, "full-order tanks (give [tanks.reduction] modes = ...: the "
-                                                       "reduced liquid)"),
-               ("walls", table.get("walls", "rigid") != "rigid", "elastic tank walls")]
+    """What a tank on one of [[bodies]] may be yet: a multimodal tank, or a finite-element tank (full
+    or reduced to its modes) with rigid walls (docs/guide/bodies-and-connections.md)."""
+    refused = [("walls", table.get("walls", "rigid") != "rigid", "elastic tank walls")]
     for key, bad, what in refused:
         if bad:
-            raise SceneError(f"{where}.body", f"{body!r}: {what} are not available yet on [[bodies]] (only a "
-                                              f"reduced tank rides on a body; {where}.{key})")
+            raise SceneError(f"{where}.body", f"{body!r}: {what} are not available yet on [[bodies]] (a "
+                                              f"finite-element tank with rigid walls or a multimodal tank rides on a "
+                                              f"body; {where}.{key})")
 
 
-def read_connections(tables, vessel_name: str, bodies) -> tuple[Connection, ...]:
+def hull_extent(owner) -> Optional[tuple]:
+    """((x_min, y_min, z_min or -inf), (x_max, y_max)) of a body's (or the vessel's) hull in its frame
+    from its COG, what the connection points are checked against: the vessel's hull where it has one
+    (its plan and its keel), else the rectangle of a `footprint` about the COG (its plan only: a
+    body has no keel), else None (nothing to check against)."""
+    hull = getattr(owner, "hull", None)
+    if hull is not None:
+        try:
+            return hull.extent()
+        except HullMeshError as e:
+            raise SceneError("vessel.hull.file", str(e)) from None
+    if owner.footprint is not None:
+        half = 0.5 * np.asarray(owner.footprint)
+        return (-half[0], -half[1], -math.inf), (half[0], half[1])
+    return None
+
+
+def _points_inside(connections, vessel, bodies) -> None:
+    """A connection's point in a body's frame lies within that body's hull (hull_extent; its side and
+    its keel themselves included, within EDGE of the hull's size): a hawser's fairlead or a
+    fender's face outside it is a typing error (a sign or the other body's frame)."""
+    owners = {"vessel": vessel} | {b.name: b for b in bodies}
+    for i, c in enumerate(connections):
+        for k, (end, p) in enumerate(zip(c.ends, c.points)):
+            box = hull_extent(owners[end]) if end in owners else None
+            if box is None:
+                continue
+            lo, hi = np.asarray(box[0]), np.asarray(box[1])
+            tol = EDGE * max(float(np.max(hi - lo[:2])), 1.0)
+            out = [f"{'xy'[j]} = {p[j]:.6g} m outside [{lo[j]:.6g}, {hi[j]:.6g}]" for j in (0, 1)
+                   if not lo[j] - tol <= p[j] <= hi[j] + tol]
+            if p[2] < lo[2] - tol:
+                out.append(f"z = {p[2]:.6g} m below the keel at {lo[2]:.6g} m")
+            if out:
+                whose = "the vessel's hull" if end == "vessel" and getattr(vessel, "hull", None) is not None \
+                    else f"{end!r}'s footprint"
+                raise SceneError(f"connections[{i}].points", (
+                    f"point {k + 1} {list(p)} (in {end!r}'s frame, from its COG) lies outside {whose}: "
+                    f"{'; '.join(out)}"))
+
+
+def read_connections(tables, vessel, bodies) -> tuple[Connection, ...]:
     """The `[[connections]]` of a scene, their ends among "vessel" (or the vessel's name), the
-    bodies' names and "fixed"."""
+    bodies' names and "fixed", their points within their bodies' hulls where those are known."""
+    vessel_name = vessel.name
     names = [b.name for b in bodies]
     out = []
     for i, table in enumerate(tables):
@@ -276,6 +341,7 @@ def read_connections(tables, vessel_name: str, bodies) -> tuple[Connection, ...]
         out.append(Connection(name=name, kind=v["kind"], ends=canon,
                               points=tuple(tuple(float(c) for c in p) for p in pts), length=v["length"],
                               stiffness=v.get("stiffness"), curve=curve, damping=v.get("damping", 0.0)))
+    _points_inside(out, vessel, bodies)
     return tuple(out)
 
 
@@ -304,6 +370,7 @@ def bodies_scene(bodies, vessel, structures, mapping, warnings: list[str], files
             _body_tank(t, f"tanks[{i}]", body)
     if not bodies:
         return
+    _beside_multimodal(bodies, vessel, structures, mapping.get("tanks", []))
     if any(s.frame == "own" for s in structures):
         raise SceneError("bodies", "[[bodies]] together with [[structures]] in their own frames are not available "
                                    "yet (a model holds one of them)")
@@ -312,6 +379,7 @@ def bodies_scene(bodies, vessel, structures, mapping, warnings: list[str], files
         path, inside, key = coupled
         try:
             warnings.extend(read_multibody(path, inside, files.rho, files.g).warnings)
+            _file_places(path, vessel, bodies)
         except DatabaseError as e:
             raise SceneError(key, " ".join(str(e).split())) from None
     _wave_headings(bodies, mapping.get("waves"), () if coupled is None else coupled[1])
@@ -319,6 +387,55 @@ def bodies_scene(bodies, vessel, structures, mapping, warnings: list[str], files
     if "waves" in mapping and dry:
         warnings.append(f"waves: the [[bodies]] {', '.join(repr(n) for n in dry)} have no excitation tables "
                         f"([bodies.hydrodynamics] file or excitation_amplitude): the waves exert no force on them")
+
+
+def _file_places(path: str, vessel, bodies) -> None:
+    """Each body of a multibody NetCDF file that stores its bodies' centres (Capytaine's
+    `rotation_center`, else `center_of_mass`) is where the scene puts it: horizontally at its
+    `position` from the file's origin, the vessel's COG at rest (the vessel at the origin), and at its
+    `cog_height` (the point its dofs rotate about), within PLACE m. Files without centres (WAMIT's,
+    older Capytaine's) are taken as the scene says."""
+    centres = file_centres(path)
+    places = {vessel.name: ((0.0, 0.0, vessel.cog_height), "vessel.hydrodynamics.file", "vessel.cog_height")}
+    places |= {b.name: ((*b.position, b.cog_height), f"bodies[{i}].position", f"bodies[{i}].cog_height")
+               for i, b in enumerate(bodies)}
+    for name, centre in centres.items():
+        if name not in places:
+            continue
+        (x, y, z), plan_key, height_key = places[name]
+        cx, cy, cz = centre
+        if math.hypot(cx - x, cy - y) > PLACE:
+            where = "at the origin (the vessel)" if plan_key.startswith("vessel") else f"at {show([x, y])}"
+            raise SceneError(plan_key, f"{path} places {name!r} at x, y = {cx:.6g}, {cy:.6g} m (its rotation centre "
+                                       f"from the file's origin, the vessel's COG at rest), the scene {where}: its "
+                                       f"waves' phases and the coupling would be another layout's")
+        if abs(cz - z) > PLACE:
+            raise SceneError(height_key, f"{path} has {name!r} rotate about z = {cz:.6g} m, the scene's COG height "
+                                         f"{z:.6g} m: give cog_height = {cz:.6g} (the file's tables are about that "
+                                         f"point)")
+
+
+def file_centres(path: str) -> dict:
+    try:
+        return netcdf_centres(path) if os.path.splitext(path)[1].lower() != ".1" else {}
+    except (KeyError, ValueError) as e:
+        raise DatabaseError(f"{path}: its bodies' centres do not read ({e})") from None
+
+
+def _beside_multimodal(bodies, vessel, structures, tables) -> None:
+    """A body's multimodal tank joins the Newton matrix's exact block with its few coordinates, and the
+    vessel's liquid lies before them there (physics/system.py exact_block): the vessel's tanks must
+    then be multimodal too, or none, and no structure share their block."""
+    where = next((f"tanks[{i}].model" for i, t in enumerate(tables) if isinstance(t, dict)
+                  and t.get("body", "vessel") in [b.name for b in bodies] and t.get("model") == "multimodal"), None)
+    if where is None:
+        return
+    carried = [tank_carriers(tables, vessel.name)[i] == "vessel" and t.get("model", "fem") != "multimodal"
+               for i, t in enumerate(tables) if isinstance(t, dict)]
+    if any(carried) or any(s.frame == "vessel" for s in structures):
+        raise SceneError(where, "a multimodal tank on one of [[bodies]] beside finite-element tanks (or structures) "
+                                "on the vessel is not available yet: make the vessel's tanks multimodal too, or the "
+                                "body's reduced ([tanks.reduction])")
 
 
 def resolve(hd, base: str = "") -> str:

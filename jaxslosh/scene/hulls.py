@@ -85,6 +85,12 @@ class Hull(abc.ABC):
     def default_cog_height(self) -> float:
         """The COG's height above the still water when `vessel.cog_height` is not given."""
 
+    def extent(self) -> tuple:
+        """((x_min, y_min, z_min), (x_max, y_max)) of the hull in the vessel frame: its plan's bounds
+        and its keel (the connection points' check, scene/bodies.py); HullMeshError names a bad file."""
+        pts = np.asarray(self.triangles(), dtype=float).reshape(-1, 3)
+        return tuple(float(c) for c in pts.min(axis=0)), tuple(float(c) for c in pts.max(axis=0)[:2])
+
     @abc.abstractmethod
     def describe(self) -> str:
         """The hull in a few words."""
@@ -138,6 +144,10 @@ class BoxHull(Hull):
 
     def default_cog_height(self) -> float:
         return self.kg - self.draft
+
+    def extent(self) -> tuple:
+        # without the mesh: the box's deck may be absent (no `depth`)
+        return (-self.length / 2, -self.beam / 2, -self.kg), (self.length / 2, self.beam / 2)
 
     def describe(self) -> str:
         return f"box {self.length:g} x {self.beam:g} x {self.depth:g} m (deck included)"

@@ -87,7 +87,8 @@ KEYS = (
     ("vessel.cog_height", "box hull: kg - draft; else 0", "m", "The COG's height above the still-water level at "
                                                                 "rest (it places the mooring fairleads)."),
     ("vessel.footprint", "the circle of the waterplane area", "m", "[length, beam] of the waterplane at rest: "
-     "the overlap check of `[[bodies]]` compares this rectangle (ships side by side) instead of the circle."),
+     "the overlap check of `[[bodies]]` compares this rectangle (ships side by side) instead of the circle; "
+     "the connection points must lie within it."),
     ("vessel.mass", _REQ, "kg", "The whole ship without its tank liquid (structures and elastic walls "
                                 "included)."),
     ("vessel.inertia", _REQ, "kg m^2", "About the COG in body axes: 3 diagonal values or a 3 x 3 list "
@@ -162,8 +163,8 @@ KEYS = (
     ("tanks.name", _REQ, "", "The tank's name (no '.', '[', ']' or '/')."),
     ("tanks.body", '"vessel"', "", "The body that carries the tank: \"vessel\" (or the vessel's `name`) or the "
                                    "name of one of `[[bodies]]`. On a body, the tank is in the body's frame (its "
-                                   "`origin` from the body's COG) and must be reduced (`[tanks.reduction]`) with rigid "
-                                   "walls; multimodal and full-order tanks and elastic walls are refused there "
+                                   "`origin` from the body's COG), a finite-element (full or reduced) or multimodal tank with "
+                                   "rigid walls; elastic walls are refused there "
                                    "(docs/guide/bodies-and-connections.md)."),
     ("tanks.origin", _REQ, "m", "The min corner of the tank's bounding box in the frame of the body that carries "
                                 "it (the vessel's by default), from its COG."),
@@ -180,8 +181,8 @@ KEYS = (
     ("tanks.file", "required (mesh)", "", "Mesh tank: the liquid at rest as hexahedra (any format meshio "
                                           "reads), relative to the scene."),
     ("tanks.model", '"fem"', "", '"fem" (the linear finite elements) or "multimodal": nonlinear sloshing '
-                                 "in a box tank or an upright (axis = \"z\") circular cylinder (every tank of the "
-                                 "scene the same)."),
+                                 "in a box tank or an upright (axis = \"z\") circular cylinder (every tank of one "
+                                 "body the same; on a body, the vessel's tanks multimodal or none)."),
     ("tanks.modes", "6", "", "Multimodal: the free-surface modes, the lowest; with flow = \"3d\" and in a "
                              "cylinder completed to whole degenerate groups (a square's (1, 0), (0, 1) pair, a "
                              "cylinder's cos/sin pairs)."),
@@ -291,9 +292,11 @@ KEYS = (
     ("bodies.position", "[0, 0]", "m", "Its COG at rest, horizontally from the vessel's COG at rest, inertial "
                                        "[x, y]; their waterplanes (circles of their areas, or rectangles of their `footprint`) must not overlap."),
     ("bodies.heading", "0", "rad", "Its x axis from the inertial X axis at rest."),
-    ("bodies.cog_height", "0", "m", "Its COG's height above the still-water level at rest."),
+    ("bodies.cog_height", "0", "m", "Its COG's height above the still-water level at rest (a multibody file's "
+                                    "rotation centre's, where it stores one)."),
     ("bodies.footprint", "the circle of the waterplane area", "m", "[length, beam] of its waterplane at rest, "
-     "along its heading and across: the overlap check compares this rectangle instead of the circle."),
+     "along its heading and across: the overlap check compares this rectangle instead of the circle; the "
+     "connection points must lie within it."),
     ("bodies.mass", _REQ, "kg", "The body's mass."),
     ("bodies.inertia", _REQ, "kg m^2", "About its COG, its body axes: 3 diagonal values or 3 x 3."),
     ("bodies.hydrostatics.waterplane_area", _REQ, "m^2", "A_w: heave restoring rho g A_w."),
@@ -315,7 +318,8 @@ KEYS = (
     ("connections.bodies", _REQ, "", 'The two bodies it ties: "vessel" (or the vessel\'s `name`), a body\'s '
                                      'name, or "fixed" as the second (an inertial point).'),
     ("connections.points", _REQ, "m", "One point per body in that body's frame, from its COG; a fixed point "
-                                      "inertial, from the vessel's COG at rest."),
+                                      "inertial, from the vessel's COG at rest. A body's point lies within its hull (the vessel's "
+                                      "`hull`, else the `footprint` in plan; none: unchecked)."),
     ("connections.length", _REQ, "m", "Unstretched length (hawser, spring), or the points' distance at first "
                                       "contact (fender)."),
     ("connections.stiffness", "required unless curve", "N/m", "Linear stiffness."),

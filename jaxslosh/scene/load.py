@@ -29,7 +29,8 @@ from ..geometry import AXES, SHAPES
 from .campaign import read_campaign
 from .fields import (at_least, counts, flat_list, non_negative, one_of, poisson_ratio, positive, read, show, sizes,
                      valid_name)
-from .bodies import bodies_scene, read_bodies, read_connections, read_footprint, tank_carriers, tank_groups
+from .bodies import (bodies_scene, multimodal_scene, read_bodies, read_connections, read_footprint, tank_carriers,
+                     tank_groups)
 from .mooring import read_mooring
 from .record import forced_span, read_forced
 from .rules import conservative as _conservative, locking_elements as _locking_elements
@@ -46,8 +47,6 @@ WALLS = ("rigid", "elastic")
 TANK_MODELS = ("fem", "multimodal")
 MULTIMODAL_FLOWS = ("2d", "3d")         # a multimodal box's waves along its length, or across its whole base
 MULTIMODAL_EXPANSIONS = ("exact", "third-order")    # the integrals exact, or their third-order polynomial
-#: below this fill depth over length the multimodal method's ordering fails (shallow water, bores)
-MULTIMODAL_SHALLOW = 0.1
 PROBE_TOLERANCE = 1e-9                           # m: how far outside its owner a probe may lie
 MASS_BALANCE_TOLERANCE = 0.01                    # relative mismatch of weight and buoyancy that warns
 HHT_ALPHA_MAX = 1.0 / 3.0
@@ -113,8 +112,8 @@ def parse_scene(mapping: Mapping[str, Any], text: str = "", path: str = "") -> S
     structures = tuple(_structure(s, f"structures[{i}]") for i, s in enumerate(mapping.get("structures", [])))
     probes = tuple(_probe(p, f"probes[{i}]") for i, p in enumerate(mapping.get("probes", [])))
     _unique_names(tanks, "tanks", "tank")
-    _multimodal_scene(tanks, warnings)
     carriers = tank_carriers(mapping.get("tanks", []), vessel.name)      # "vessel" or a body's name, per tank
+    multimodal_scene(tanks, carriers, warnings)
     for group in tank_groups(tanks, carriers).values():                    # tanks overlap within one body
         _overlapping_tanks(group, warnings)
     _locking_elements(tanks, warnings)
@@ -124,7 +123,7 @@ def parse_scene(mapping: Mapping[str, Any], text: str = "", path: str = "") -> S
     for i, probe in enumerate(probes):
         _place_probe(probe, f"probes[{i}]", tanks, structures)
     bodies = read_bodies(mapping.get("bodies", []), vessel, environment, warnings, files, tanks, carriers)
-    connections = read_connections(mapping.get("connections", []), vessel.name, bodies)
+    connections = read_connections(mapping.get("connections", []), vessel, bodies)
     bodies_scene(bodies, vessel, structures, mapping, warnings, files)
     tanks = tank_groups(tanks, carriers).get("vessel", ())      # the vessel's; a body's are in its Body
     mooring = read_mooring(mapping.get("mooring", []), environment.depth, vessel.name, vessel.cog_height, warnings,
@@ -149,23 +148,6 @@ def parse_scene(mapping: Mapping[str, Any], text: str = "", path: str = "") -> S
     if simulation.energy_projection:
         _conservative(scene)
     return scene
-
-
-def _multimodal_scene(tanks, warnings: list[str]) -> None:
-    """Every tank multimodal or none (the stacked liquid is of one kind); the method's validity."""
-    kinds = {t.model for t in tanks}
-    if len(kinds) > 1:
-        i = next(i for i, t in enumerate(tanks) if t.model != tanks[0].model)
-        raise SceneError(f"tanks[{i}].model", f'is "{tanks[i].model}" but tanks[0] is "{tanks[0].model}": all '
-                                              "tanks of a scene take the same model")
-    for i, t in enumerate(tanks):
-        if t.model != "multimodal":
-            continue
-        ratio = t.fill_depth / t.size[0]
-        if ratio < MULTIMODAL_SHALLOW:
-            warnings.append(f"tanks[{i}] ({t.name!r}): fill depth / length = {ratio:.3g} is below "
-                            f"{MULTIMODAL_SHALLOW}: shallow-water sloshing (bores, hydraulic jumps), outside the "
-                            "multimodal method's validity")
 
 
 # --------------------------------------------------------------------------------------------

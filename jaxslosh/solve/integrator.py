@@ -56,7 +56,8 @@ class StepInfo(NamedTuple):
 
 def _split_newton(system: System, Rm_parts, Rc, r):
     """(R, the split of R = Rm + Rc the Newton preconditioner takes, or None): every unknown in
-    the exact block for a nonlinear liquid (its few unknowns linearised exactly)."""
+    the exact block for a nonlinear liquid, the vessel's or a body's (its few unknowns linearised
+    exactly: System.exact_block)."""
     L = system.layout()
 
     def Rm(x):
@@ -65,7 +66,7 @@ def _split_newton(system: System, Rm_parts, Rc, r):
     def R(x):
         return Rm(x) + Rc(x)
 
-    return R, None if system.liquid.nonlinear else (Rm, Rc, r, Rm_parts)
+    return R, None if system.exact_block() > L.n_small else (Rm, Rc, r, Rm_parts)
 
 
 def initial_state(system: System, solver: Solver, c0: Config, v0, alg0=None) -> tuple[State, StepInfo]:

@@ -80,7 +80,7 @@ def make_solver(system: System, h: float, scheme: Scheme, tol: float, max_iter: 
     sub = _extended(base.Cinv_sub, system.deformable_block(scheme.c_a(h / substeps), 1.0)) if substeps else None
     return dataclasses.replace(base, Cinv_step=_extended(base.Cinv_step, system.deformable_block(scheme.c_a(h), 1.0)),
                                Cinv_mass=_extended(base.Cinv_mass, system.deformable_block(1.0, 0.0)), Cinv_sub=sub,
-                               ns=base.ns + system.layout().n_small - 6)
+                               ns=system.exact_block())
 
 
 def _liquid_solver(system: System, h, scheme: Scheme, tol, max_iter, substeps, reuse, adaptive) -> Solver:
@@ -152,6 +152,7 @@ def _extended(inv, block):
 def empty_pre(system: System):
     """A carried preconditioner of the right shapes, marked not valid (formed at the first step)."""
     L = system.layout()
-    ns, nz = (L.n_small + L.nf, L.m) if system.liquid.nonlinear else (L.n_small, L.nf + L.m)
+    ns = system.exact_block()
+    nz = L.n - ns
     data = (jnp.zeros((ns, ns)),) if nz == 0 else (jnp.zeros((ns, ns)), jnp.zeros((ns, nz)), jnp.zeros((nz, ns)))
     return data, jnp.zeros(())

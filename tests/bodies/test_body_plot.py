@@ -1,12 +1,17 @@
 """`jaxslosh plot` of a result with bodies and connections: each body's roll, pitch and heave beside
 the vessel's, a panel of the connections' forces (docs/guide/running.md); the vessel alone's
-figure keeps its panels."""
+figure keeps its panels; a sweep file's runs with their bodies and connections."""
+import dataclasses
+import types
+
+import jax
 import numpy as np
 
 import jaxslosh as js
 from jaxslosh.cli import main
 from jaxslosh.io.result import ConnectionHistory, Energy, Result, SolverHistory, VesselHistory
-from jaxslosh.plot.results import plot_result
+from jaxslosh.io.sweep import load_sweep, write_sweep
+from jaxslosh.plot.results import plot_result, plot_sweep
 
 SCENE = 'title = "two"\n[simulation]\nduration = 1.0\ndt = 0.1\n'
 
@@ -61,3 +66,29 @@ def test_jaxslosh_plot_of_a_result_file_with_bodies(tmp_path, capsys):
     js.save_result(result(), str(path))
     assert main(["plot", str(path), "-o", str(tmp_path / "two.png")]) == 0
     assert (tmp_path / "two.png").stat().st_size > 10000 and "wrote" in capsys.readouterr().out
+
+
+def test_a_sweep_file_with_bodies_draws_each_runs_bodies_and_connections(tmp_path, capsys):
+    """`jaxslosh plot` of a sweep file whose scene has bodies and connections: the file reads them back,
+    each body has a panel of its roll and pitch (every run), its heave beside the vessel's, and each
+    connection's force its panel's line per run (kN)."""
+    runs = [result(), result()]
+    runs[1] = dataclasses.replace(runs[1], bodies={"barge": _history(runs[1].time, 0.3 * np.sin(runs[1].time),
+                                                                     0 * runs[1].time, 0 * runs[1].time)})
+    batch = jax.tree_util.tree_map(lambda *x: np.stack([np.asarray(v) for v in x]), *runs)
+    params = {"connections.bow.stiffness": np.array([1e5, 2e5])}
+    path = tmp_path / "sweep.h5"
+    write_sweep(str(path), types.SimpleNamespace(text=SCENE), params, batch, ["ok", "ok"])
+    sw = load_sweep(str(path))
+    assert list(sw.result.bodies) == ["barge"] and list(sw.result.connections) == ["bow", "fender"]
+    fig = plot_sweep(sw.params, sw.result, sw.statuses, str(tmp_path / "s.png"), sw.scene_text)
+    axes = fig.get_axes()
+    assert [a.get_ylabel() for a in axes[2:]] == ["barge: roll (solid),\npitch (dashed) (deg)", "connection force (kN)"]
+    rolls = [ln.get_ydata() for ln in axes[2].get_lines()][::2]
+    for i, r in enumerate(runs):
+        np.testing.assert_allclose(rolls[i], np.degrees(r.bodies["barge"].roll_pitch_yaw[:, 0]), rtol=1e-15)
+    heave = {ln.get_label(): ln.get_ydata() for ln in axes[1].get_lines() if not ln.get_label().startswith("_")}
+    np.testing.assert_allclose(heave["barge"], runs[0].bodies["barge"].position[:, 2], rtol=1e-15)
+    force = {ln.get_label(): ln.get_ydata() for ln in axes[3].get_lines() if not ln.get_label().startswith("_")}
+    np.testing.assert_allclose(force["fender"], 1e-3 * runs[0].connections["fender"].force, rtol=1e-15)
+    assert main(["plot", str(path), "-o", str(tmp_path / "s2.png")]) == 0 and "2 runs" in capsys.readouterr().out

@@ -199,11 +199,9 @@ def test_a_body_with_a_tank_on_a_hawser_runs_from_the_command_line(tmp_path, cap
 
 
 @pytest.mark.parametrize("old,new,what", [
-    ("[tanks.reduction]\nmodes = 6\n", "", "full-order tanks"),
     ('mesh = [2, 4, 3]\n', 'mesh = [2, 4, 3]\n[tanks.walls]\nthickness = 0.02\n[tanks.walls.material]\n'
      'young = 2.0e11\npoisson = 0.3\ndensity = 7850.0\n', "elastic tank walls"),
-    ('mesh = [2, 4, 3]\n[tanks.reduction]\nmodes = 6\n', 'model = "multimodal"\n', "multimodal tanks"),
-], ids=["full-order", "elastic", "multimodal"])
+], ids=["elastic"])
 def test_what_a_body_tank_cannot_be_yet_is_refused_naming_the_key(old, new, what):
     text = scene_on_body().text
     assert old in text
