@@ -183,7 +183,21 @@ def loop_step(b: Built, solver: Solver, c: Carry) -> tuple[Carry, tuple]:
     def idle(c: Carry):
         return c, (jnp.zeros((), jnp.int32), jnp.zeros((), c.fail_err.dtype))
 
-    return jax.lax.cond(c.n < c.end, go, idle, c)
+    if solver.implicit:           # reverse mode may reach the run: a cond (a while loop has no transpose)
+        return jax.lax.cond(c.n < c.end, go, idle, c)
+    # No gradient reaches the run (Solver.implicit is False): the step as a loop of zero or one pass.
+    # XLA's CPU layouts the constants inside a conditional's branch as they come, so a cond around the
+    # step re-lays the face-normal liquid's fields (transposes and copies) at every residual of every
+    # Newton iteration, 15-25 % of its step (docs/benchmarks.md, the shaped tanks against their floor);
+    # a while loop's body gets them laid out once, before the loops.
+    def once(x):
+        _, c1, _ = x
+        c2, out = go(c1)
+        return jnp.ones((), jnp.int32), c2, out
+
+    passes = (c.n < c.end).astype(jnp.int32)
+    _, c2, out = jax.lax.while_loop(lambda x: x[0] < passes, once, (jnp.zeros((), jnp.int32),) + idle(c))
+    return c2, out
 
 
 def observe(b: Built, c: Carry, iterations=None, residual=None) -> Frame:
