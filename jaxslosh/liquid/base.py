@@ -166,10 +166,12 @@ class AbstractLiquid(AbstractTerm):
     def d_scale(self):
         """(nf,) a mass per row, so that a row over it is an acceleration."""
 
+    # The hooks below have a neutral answer for most models; each final class still states its own
+    # (equinox's abstract-or-final: no default to inherit by accident).
+    @abc.abstractmethod
     def roundoff(self, d):
         """The round-off floor of its scaled rows at d beyond the solver's own (solve/linear.Solver.noise),
-        which the Newton iterations aim at when it is above the tolerance: none for a linear liquid."""
-        return jnp.zeros(())
+        which the Newton iterations aim at when it is above the tolerance: zero for a linear liquid."""
 
     @abc.abstractmethod
     def frame_field(self, d):
@@ -183,21 +185,24 @@ class AbstractLiquid(AbstractTerm):
     def probe_displacements(self, weights, modal, d):
         """(P, 3) displacement of the probes (interpolation `weights` (P, N), or `modal` (P, m, 3))."""
 
+    @abc.abstractmethod
     def surface_heave(self, d, nodes):
-        """The vertical displacement (k,) of the nodes `nodes` (the free surface of a tank)."""
-        return self.nodal_fields(self.frame_field(d))[nodes, 2]
+        """The vertical displacement (k,) of the points `nodes` of its free surface (a tank's, as the
+        block's `surfaces` lists them): the run's validity watch."""
 
+    @abc.abstractmethod
     def probe_modal(self, weights):
-        """The probes' weights on the modal coordinates (P, m, 3), for a liquid whose d is modal."""
-        return None
+        """The probes' weights on the modal coordinates (P, m, 3) from their nodal interpolation
+        `weights` (P, N), for a liquid whose d is modal; None where the probes read the nodal field
+        (or where the model's builder makes them from the scene: liquid/block.py `probe_rows`)."""
 
+    @abc.abstractmethod
     def rigid_first_moment(self):
         """sum_i m_i r_i (3,) of the undeformed block about the frame origin, kg m."""
-        return jnp.zeros(3)
 
+    @abc.abstractmethod
     def for_batch(self) -> "AbstractLiquid":
-        """The same liquid in the form a vmapped batch of runs computes fastest."""
-        return self
+        """The same liquid in the form a vmapped batch of runs computes fastest (most: itself)."""
 
 
 def inertial_lines(liquid) -> tuple:
@@ -247,6 +252,21 @@ class NoLiquid(AbstractLiquid):
 
     def describe(self) -> tuple:
         return ()
+
+    def roundoff(self, d):
+        return jnp.zeros(())
+
+    def surface_heave(self, d, nodes):
+        return jnp.zeros(jnp.shape(nodes))
+
+    def probe_modal(self, weights):
+        return None
+
+    def rigid_first_moment(self):
+        return jnp.zeros(3)
+
+    def for_batch(self) -> "NoLiquid":
+        return self
 
     @classmethod
     def tank_unknowns(cls, tank) -> int:

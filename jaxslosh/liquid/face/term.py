@@ -135,6 +135,18 @@ class FaceLiquid(AbstractLiquid):
     def rigid_first_moment(self):
         return self.m @ self.r
 
+    def roundoff(self, d):
+        return jnp.zeros(())          # linear rows: the solver's own floor
+
+    def surface_heave(self, d, nodes):
+        return self.nodal_fields(self.frame_field(d))[nodes, 2]
+
+    def probe_modal(self, weights):
+        return None                   # the probes read the recovered nodal field
+
+    def for_batch(self) -> "FaceLiquid":
+        return self
+
     def rows(self, k: Kin) -> Rows:
         return particle_rows(self, k, self.field, self.m, lambda a: self.m[:, None] * a)
 

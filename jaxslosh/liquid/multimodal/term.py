@@ -490,6 +490,12 @@ class MultimodalLiquid(AbstractLiquid):
     def surface_heave(self, d, nodes):
         return (self.samples @ d)[nodes]
 
+    def probe_modal(self, weights):
+        return None       # its probes' rows come from the scene (build.py probe_modal: the block's probe_rows)
+
+    def for_batch(self) -> "MultimodalLiquid":
+        return self
+
     def static_start(self, g_b):
         """The level surface under the initial gravity direction: the minimum of the potential (Newton)."""
         beta = jnp.zeros(self.nf)

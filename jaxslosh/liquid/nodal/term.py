@@ -92,6 +92,15 @@ class NodalLiquid(AbstractLiquid):
     def rigid_first_moment(self):
         return self.m_nodes @ self.r
 
+    def roundoff(self, d):
+        return jnp.zeros(())          # linear rows: the solver's own floor
+
+    def surface_heave(self, d, nodes):
+        return self.nodal_fields(self.frame_field(d))[nodes, 2]
+
+    def probe_modal(self, weights):
+        return None                   # the probes read the nodal field
+
     def rows(self, k: Kin) -> Rows:
         """Eq. (4): the particle accelerations (body components), their inertia forces on the nodes,
         and what they do on the rigid rows and the liquid's own; the stiffness and the gravity load."""
