@@ -30,6 +30,8 @@ def build_damping(scene: Scene, params: Optional[dict], block) -> tuple[Optional
     """(ModalDamping or None, TankDamping per damped tank) for the liquid block `block`
     (liquid/block.py LiquidBlock); None where no tank has a `[tanks.damping]` table."""
     tanks = scene.tanks
+    if block.damping is not None:      # made with the block by its model's builder (the multimodal one)
+        return block.damping, ()
     if not any(t.damping is not None for t in tanks) or not block.liquid.nf or not block.tanks:
         return None, ()
     if block.vstructs or any(t.form.elastic for t in tanks):

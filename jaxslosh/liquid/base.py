@@ -19,6 +19,7 @@ gravity moment here.
 from __future__ import annotations
 
 import abc
+import dataclasses
 from typing import Any, NamedTuple, Optional
 import equinox as eqx
 import jax
@@ -143,6 +144,11 @@ class AbstractLiquid(AbstractTerm):
     def describe(self) -> tuple:
         """(effect, text) lines: what this liquid adds to the model, as `jaxslosh check` lists it."""
 
+    @abc.abstractmethod
+    def with_effects(self, coriolis: bool, centrifugal: bool, about: About) -> "AbstractLiquid":
+        """The liquid with the scene's `[effects]` switches of its inertial loads (where the model
+        has such switches) and its tanks' lines `about` (assemble/about.py liquid_about)."""
+
     # What a model answers of one tank before any block is built, asked of the class that runs the
     # tank's form (liquid/forms.py `tank_liquid`): `jaxslosh modes`, `check` and the cost estimate.
     @classmethod
@@ -205,6 +211,12 @@ class AbstractLiquid(AbstractTerm):
         """The same liquid in the form a vmapped batch of runs computes fastest (most: itself)."""
 
 
+def switch_inertial(liquid, coriolis: bool, centrifugal: bool, about: About):
+    """A nodal, face-normal or reduced liquid's `with_effects`: its Coriolis and centrifugal loads
+    switched as `[effects]` says, and its lines."""
+    return dataclasses.replace(liquid, coriolis=coriolis, centrifugal=centrifugal, about=about)
+
+
 def inertial_lines(liquid) -> tuple:
     """A nodal, face-normal or reduced liquid's lines: its tanks' (its `about`, set at assembly),
     then the inertial loads its `coriolis` and `centrifugal` switches keep."""
@@ -252,6 +264,9 @@ class NoLiquid(AbstractLiquid):
 
     def describe(self) -> tuple:
         return ()
+
+    def with_effects(self, coriolis: bool, centrifugal: bool, about: About) -> "NoLiquid":
+        return self           # nothing to switch, nothing to list
 
     def roundoff(self, d):
         return jnp.zeros(())

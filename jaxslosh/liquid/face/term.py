@@ -42,7 +42,7 @@ import jax.numpy as jnp
 
 from ...fem.linalg import solve
 from ...physics.about import About
-from ..base import AbstractLiquid, StepInverse, dense_step_inverse, inertial_lines, particle_rows, point_mass_scale
+from ..base import AbstractLiquid, StepInverse, dense_step_inverse, inertial_lines, switch_inertial, particle_rows, point_mass_scale
 from .inverse import face_solver_blocks
 from .tank_modes import face_sloshing_modes, face_unknowns
 from ...physics.terms import Kin, Rows
@@ -84,6 +84,9 @@ class FaceLiquid(AbstractLiquid):
 
     def describe(self) -> tuple:
         return inertial_lines(self)
+
+    def with_effects(self, coriolis: bool, centrifugal: bool, about: About) -> "FaceLiquid":
+        return switch_inertial(self, coriolis, centrifugal, about)
 
     @property
     def nf(self) -> int:

@@ -19,7 +19,7 @@ import jax.numpy as jnp
 from ...fem.linalg import solve
 from ...physics.kinematics import mv3, tv3
 from ...physics.about import About
-from ..base import AbstractLiquid, dense_step_inverse, inertial_lines, point_mass_scale
+from ..base import AbstractLiquid, dense_step_inverse, inertial_lines, switch_inertial, point_mass_scale
 from ..face.tank_modes import face_sloshing_modes, face_unknowns
 from ..nodal.tank_modes import nodal_sloshing_modes, nodal_unknowns
 from ...physics.terms import Kin, Rows
@@ -49,6 +49,9 @@ class ModalLiquid(AbstractLiquid):
 
     def describe(self) -> tuple:
         return inertial_lines(self)
+
+    def with_effects(self, coriolis: bool, centrifugal: bool, about: About) -> "ModalLiquid":
+        return switch_inertial(self, coriolis, centrifugal, about)
 
     @property
     def nf(self) -> int:

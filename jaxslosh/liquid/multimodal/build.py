@@ -8,8 +8,10 @@ from typing import NamedTuple, Optional
 import jax.numpy as jnp
 import numpy as np
 
+from ..block import LiquidBlock
 from ..modal_damping import ModalDamping
-from .term import MultimodalLiquid, modal_tank
+from .liquid import MultimodalLiquid
+from .term import modal_tank
 from .expansion import third_order
 from ...scene.types import Scene, SceneError
 from .modes import modal_modes
@@ -21,6 +23,19 @@ SAMPLES = 33
 
 def multimodal_scene(scene: Scene) -> bool:
     return bool(scene.tanks) and scene.tanks[0].form.multimodal
+
+
+def multimodal_block(scene: Scene, params: Optional[dict], gravity) -> LiquidBlock:
+    """The multimodal liquid's block (liquid/forms.py block_form): the liquid, the surface meshes a
+    result keeps, the surface samples the validity watch reads, the probes' rows and the damping."""
+    liquid = build_multimodal(scene, params, gravity)
+    return LiquidBlock(liquid, kept=surface_meshes(scene), tops=surfaces(scene), probe_rows=probe_modal(scene, liquid),
+                       damping=multimodal_damping(scene, params, liquid))
+
+
+def outline_multimodal(gravity) -> LiquidBlock:
+    """`multimodal_block`'s liquid without its arrays, for `jaxslosh check` (only its lines are read)."""
+    return LiquidBlock(MultimodalLiquid(tanks=(), sizes=(), samples=None, gravity=gravity))
 
 
 def build_multimodal(scene: Scene, params: Optional[dict], gravity) -> MultimodalLiquid:

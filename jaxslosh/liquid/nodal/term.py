@@ -15,7 +15,7 @@ from ...fem.linalg import solve
 from ...fem.slip import rotate_matrix
 from ...physics.about import About
 from ...physics.terms import Kin, Rows
-from ..base import (AbstractLiquid, StepInverse, dense_step_inverse, inertial_lines, nodal_product, particle_rows,
+from ..base import (AbstractLiquid, StepInverse, dense_step_inverse, inertial_lines, switch_inertial, nodal_product, particle_rows,
                     point_mass_scale)
 from .sparse import hydrostatic_start, sparse_solver_blocks
 from .tank_modes import nodal_sloshing_modes, nodal_unknowns
@@ -51,6 +51,9 @@ class NodalLiquid(AbstractLiquid):
 
     def describe(self) -> tuple:
         return inertial_lines(self)
+
+    def with_effects(self, coriolis: bool, centrifugal: bool, about: About) -> "NodalLiquid":
+        return switch_inertial(self, coriolis, centrifugal, about)
 
     @property
     def nf(self) -> int:
