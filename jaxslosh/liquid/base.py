@@ -163,6 +163,39 @@ class AbstractLiquid(AbstractTerm):
         """The n lowest natural modes of the tank's liquid (with its elastic walls, where it has them)
         at gravity g, the vessel held fixed: `liquid/modes.Modes` (or `liquid/walls.TankModes`)."""
 
+    # The tank's liquid in `jaxslosh check`'s words and the run's validity watch (assemble/about.py,
+    # effects.py, run/validity.py ask these of `tank_liquid(tank)`; liquid/words.py the shared pieces).
+    @classmethod
+    @abc.abstractmethod
+    def tank_line(cls, tank) -> tuple[str, str]:
+        """(effect, text): the tank's liquid as the liquid term holds it."""
+
+    @classmethod
+    @abc.abstractmethod
+    def walls_lines(cls, tank) -> tuple:
+        """(effect, text) lines of the tank's elastic walls in the deformable block (none: rigid walls)."""
+
+    @classmethod
+    @abc.abstractmethod
+    def tank_words(cls, tank, short: bool = False) -> str:
+        """What the tank's liquid is discretized into: its mesh, or its free-surface modes."""
+
+    @classmethod
+    @abc.abstractmethod
+    def modes_words(cls) -> str:
+        """The modes that `[tanks.damping]` damps in this model, in words."""
+
+    @classmethod
+    @abc.abstractmethod
+    def model_words(cls) -> str:
+        """The model in words, as the validity warnings name it ("the linear liquid")."""
+
+    @classmethod
+    @abc.abstractmethod
+    def surface_table(cls, tank, g: float):
+        """What the run's validity watch reads of a tank's modal free surface (its slope, crest index and
+        round-off floor: liquid/multimodal/watch.py SurfaceTable), or None for a model without one."""
+
     @property
     @abc.abstractmethod
     def nf(self) -> int:
@@ -290,6 +323,31 @@ class NoLiquid(AbstractLiquid):
     @classmethod
     def sloshing_modes(cls, tank, g: float, n: int = 10):
         raise ValueError("a vessel without tank liquid has no sloshing modes")
+
+    # no tank runs NoLiquid (liquid/forms.py tank_liquid): these are never asked of a tank
+    @classmethod
+    def tank_line(cls, tank) -> tuple[str, str]:
+        raise ValueError("a vessel without tank liquid has no tank lines")
+
+    @classmethod
+    def walls_lines(cls, tank) -> tuple:
+        return ()
+
+    @classmethod
+    def tank_words(cls, tank, short: bool = False) -> str:
+        return "no liquid"
+
+    @classmethod
+    def modes_words(cls) -> str:
+        return "no modes"
+
+    @classmethod
+    def model_words(cls) -> str:
+        return "no liquid"
+
+    @classmethod
+    def surface_table(cls, tank, g: float):
+        return None
 
 
 class RotationPenalty(AbstractTerm):

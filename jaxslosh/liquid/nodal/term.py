@@ -15,6 +15,7 @@ from ...fem.linalg import solve
 from ...fem.slip import rotate_matrix
 from ...physics.about import About
 from ...physics.terms import Kin, Rows
+from ..words import elastic_walls_lines, element_line, grid_words
 from ..base import (AbstractLiquid, StepInverse, dense_step_inverse, inertial_lines, switch_inertial, nodal_product, particle_rows,
                     point_mass_scale)
 from .sparse import hydrostatic_start, sparse_solver_blocks
@@ -171,6 +172,30 @@ class NodalLiquid(AbstractLiquid):
     @classmethod
     def sloshing_modes(cls, tank, g: float, n: int = 10):
         return nodal_sloshing_modes(tank, g, n)
+
+    @classmethod
+    def tank_line(cls, tank) -> tuple[str, str]:
+        return element_line(tank)
+
+    @classmethod
+    def walls_lines(cls, tank) -> tuple:
+        return elastic_walls_lines(tank)
+
+    @classmethod
+    def tank_words(cls, tank, short: bool = False) -> str:
+        return grid_words(tank, short)
+
+    @classmethod
+    def modes_words(cls) -> str:
+        return "the sloshing modes"
+
+    @classmethod
+    def model_words(cls) -> str:
+        return "the linear liquid"
+
+    @classmethod
+    def surface_table(cls, tank, g: float):
+        return None             # its validity: the free surface inside the tank (run/validity.py Watch)
 
     def static_start(self, g_b):
         """The discrete hydrostatic equilibrium K d0 = F_g under the body gravity g_b (docs/theory.md
