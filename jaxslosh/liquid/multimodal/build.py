@@ -1,4 +1,4 @@
-"""The multimodal liquid of a scene (liquid/multimodal/term.py): one ModalTank per tank, its probes (the
+"""The multimodal liquid of a scene (liquid/multimodal/liquid.py): one ModalTank per tank, its probes (the
 free-surface elevation at their point), its damping and the sample points of the surface that the
 run's validity watch reads."""
 from __future__ import annotations
