@@ -42,8 +42,8 @@ def hull_about(scene: Scene, waves: bool) -> About:
 
 
 def tank_line(t) -> tuple[str, str]:
-    """One tank's liquid, as the liquid term holds it (the model's words: AbstractLiquid.tank_line)."""
-    return tank_liquid(t).tank_line(t)
+    """One tank's liquid, as the liquid term holds it (the model's words: AbstractLiquid.describe_tank)."""
+    return tank_liquid(t).describe_tank(t).line
 
 
 def liquid_about(scene: Scene, include_liquid: bool) -> About:
@@ -51,7 +51,8 @@ def liquid_about(scene: Scene, include_liquid: bool) -> About:
     vessel's frame that share the block."""
     lines = []
     for t in scene.tanks if include_liquid else ():
-        lines += [tank_line(t), *tank_liquid(t).walls_lines(t)]
+        words = tank_liquid(t).describe_tank(t)
+        lines += [words.line, *words.walls]
     for s in scene.structures:
         if s.frame == "vessel":
             nx, ny, nz = s.mesh
@@ -92,7 +93,7 @@ def damping_about(scene: Scene) -> About:
         ratio = list(d.ratio) if isinstance(d.ratio, tuple) else d.ratio
         layers = f" plus laminar boundary layers (viscosity {d.viscosity:g} m^2/s)" if d.viscosity else ""
         lines.append((f"liquid damping in tank {t.name!r}",
-                      f"modal damping of {tank_liquid(t).modes_words()}, ratio {ratio}{layers}"))
+                      f"modal damping of {tank_liquid(t).describe_tank(t).damped}, ratio {ratio}{layers}"))
     return About(*lines)
 
 

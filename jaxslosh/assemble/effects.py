@@ -72,11 +72,11 @@ def switched_off(scene: Scene) -> list[str]:
     return [k for k in EFFECTS if not getattr(scene.effects, k)]
 
 
-def mesh_words(t, short: bool = False) -> str:
+def mesh_words(t) -> str:
     """What the tank's liquid is discretized into, as the model that runs its form says it
-    (AbstractLiquid.tank_words): "mesh 5 x 5 x 5 = 125 hexahedra", a mesh file's counts, or a
+    (AbstractLiquid.describe_tank): "mesh 5 x 5 x 5 = 125 hexahedra", a mesh file's counts, or a
     multimodal tank's modes (it has no mesh)."""
-    return tank_liquid(t).tank_words(t, short)
+    return tank_liquid(t).describe_tank(t).mesh
 
 
 def tank_notes(t) -> list[str]:

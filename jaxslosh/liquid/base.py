@@ -31,6 +31,7 @@ from ..physics.about import About
 from ..physics.kinematics import mv3, quat_multiply, skew, spin_tensor_components, tv3
 from ..physics.terms import AbstractTerm, Config, Kin, Rows
 from ..staging import staged
+from .words import TankWords
 
 
 def nodal_product(Ms, a):
@@ -167,28 +168,9 @@ class AbstractLiquid(AbstractTerm):
     # effects.py, run/validity.py ask these of `tank_liquid(tank)`; liquid/words.py the shared pieces).
     @classmethod
     @abc.abstractmethod
-    def tank_line(cls, tank) -> tuple[str, str]:
-        """(effect, text): the tank's liquid as the liquid term holds it."""
-
-    @classmethod
-    @abc.abstractmethod
-    def walls_lines(cls, tank) -> tuple:
-        """(effect, text) lines of the tank's elastic walls in the deformable block (none: rigid walls)."""
-
-    @classmethod
-    @abc.abstractmethod
-    def tank_words(cls, tank, short: bool = False) -> str:
-        """What the tank's liquid is discretized into: its mesh, or its free-surface modes."""
-
-    @classmethod
-    @abc.abstractmethod
-    def modes_words(cls) -> str:
-        """The modes that `[tanks.damping]` damps in this model, in words."""
-
-    @classmethod
-    @abc.abstractmethod
-    def model_words(cls) -> str:
-        """The model in words, as the validity warnings name it ("the linear liquid")."""
+    def describe_tank(cls, tank) -> TankWords:
+        """The tank's liquid in words (liquid/words.py TankWords): its line in the liquid term, its
+        elastic walls' lines, its mesh (or modes), what its damping damps and the model's name."""
 
     @classmethod
     @abc.abstractmethod
@@ -324,26 +306,10 @@ class NoLiquid(AbstractLiquid):
     def sloshing_modes(cls, tank, g: float, n: int = 10):
         raise ValueError("a vessel without tank liquid has no sloshing modes")
 
-    # no tank runs NoLiquid (liquid/forms.py tank_liquid): these are never asked of a tank
+    # no tank runs NoLiquid (liquid/forms.py tank_liquid): never asked of a tank
     @classmethod
-    def tank_line(cls, tank) -> tuple[str, str]:
-        raise ValueError("a vessel without tank liquid has no tank lines")
-
-    @classmethod
-    def walls_lines(cls, tank) -> tuple:
-        return ()
-
-    @classmethod
-    def tank_words(cls, tank, short: bool = False) -> str:
-        return "no liquid"
-
-    @classmethod
-    def modes_words(cls) -> str:
-        return "no modes"
-
-    @classmethod
-    def model_words(cls) -> str:
-        return "no liquid"
+    def describe_tank(cls, tank) -> TankWords:
+        raise ValueError("a vessel without tank liquid has no tank to describe")
 
     @classmethod
     def surface_table(cls, tank, g: float):

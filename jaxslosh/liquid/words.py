@@ -1,11 +1,21 @@
-"""A tank's liquid in `jaxslosh check`'s words, the pieces every model's lines share: its shape, a
-finite-element tank's mesh and element, its walls. Each model's own lines are its class's
-(liquid/base.py `AbstractLiquid.tank_line`, `tank_words`, `walls_lines`), asked of the class that
-runs the tank's form (liquid/forms.py `tank_liquid`): assemble/about.py and effects.py list them
-without asking which model a tank takes."""
+"""A tank's liquid in words (`TankWords`), as the model that runs its form says it (liquid/base.py
+`AbstractLiquid.describe_tank`, asked of liquid/forms.py `tank_liquid(tank)`): assemble/about.py,
+effects.py and run/validity.py list them without asking which model a tank takes. Here the
+pieces the models share: the tank's shape, a finite-element tank's mesh, element and walls."""
 from __future__ import annotations
 
+from typing import NamedTuple
+
 from .walls import shell_mesh
+
+
+class TankWords(NamedTuple):
+    """A tank's liquid in `jaxslosh check`'s words and the run's validity warnings."""
+    line: tuple          # (effect, text): the tank's liquid as the liquid term holds it
+    walls: tuple         # (effect, text) lines of its elastic walls in the deformable block (none: rigid)
+    mesh: str            # what the liquid is discretized into: its mesh, or a multimodal tank's modes
+    damped: str          # the modes `[tanks.damping]` damps
+    model: str           # the model's name in the validity warnings ("the linear liquid")
 
 
 def shape_words(t) -> str:
@@ -33,6 +43,13 @@ def element_line(t, runs: str = "") -> tuple[str, str]:
     why = runs + (f" (by default: {t.fluid.element_default})" if t.fluid.element_default else "")
     return (f"liquid in tank {t.name!r}", f"{shape_words(t)}{grid_words(t, short=True)}, {t.liquid_mass:.6g} kg, "
                                           f"element {t.fluid.element!r}{why}, {t.walls} walls (slip)")
+
+
+def element_words(t, runs: str = "", flux: bool = False) -> TankWords:
+    """A finite-element tank's words: `runs`, how its model runs the element (" at full order", " on
+    8 modes"); `flux`, its wall faces follow elastic walls by their flux (the face-normal element)."""
+    return TankWords(element_line(t, runs), elastic_walls_lines(t, flux), grid_words(t), "the sloshing modes",
+                     "the linear liquid")
 
 
 def elastic_walls_lines(t, flux: bool = False) -> tuple:

@@ -178,7 +178,7 @@ class Watch:
                 continue
             roof = t.size[2] - t.fill_depth
             where = f"tanks[{i}] ({t.name!r})"
-            model = tank_liquid(t).model_words()
+            model = tank_liquid(t).describe_tank(t).model
             if self.high[i] > roof:
                 out.append(f"{where}: the free surface rose {self.high[i]:.3g} m at t = {self.t_high[i]:.4g} s, "
                            f"above the roof ({roof:.3g} m of freeboard): {model} is outside its validity")

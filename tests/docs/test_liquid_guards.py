@@ -177,7 +177,7 @@ def test_no_private_imports_across_the_liquid_models():
 
 
 #: the modules that describe a tank's liquid (`jaxslosh check`, the run's validity warnings) or
-#: assemble the system: they ask the model behind the tank's form (`tank_liquid(t).tank_line`, ...)
+#: assemble the system: they ask the model behind the tank's form (`tank_liquid(t).describe_tank`)
 #: or the block (`block.surfaces()`), never the form's flags
 ASK_THE_LIQUID = ("assemble/about.py", "assemble/effects.py", "run/validity.py", "assemble/system.py")
 
@@ -211,7 +211,7 @@ def test_the_check_words_and_the_assembly_ask_the_liquid_not_its_form():
 
 #: the contract's hooks that most models answer neutrally: each final liquid states its own
 HOOKS = ("roundoff", "probe_modal", "surface_heave", "rigid_first_moment", "for_batch", "with_effects",
-         "tank_line", "walls_lines", "tank_words", "modes_words", "model_words", "surface_table")
+         "describe_tank", "surface_table")
 
 
 def test_every_final_liquid_states_every_hook():

@@ -42,7 +42,7 @@ import jax.numpy as jnp
 
 from ...fem.linalg import solve
 from ...physics.about import About
-from ..words import elastic_walls_lines, element_line, grid_words
+from ..words import TankWords, element_words
 from ..base import AbstractLiquid, StepInverse, dense_step_inverse, inertial_lines, switch_inertial, particle_rows, point_mass_scale
 from .inverse import face_solver_blocks
 from .tank_modes import face_sloshing_modes, face_unknowns
@@ -209,24 +209,8 @@ class FaceLiquid(AbstractLiquid):
         return face_sloshing_modes(tank, g, n)
 
     @classmethod
-    def tank_line(cls, tank) -> tuple[str, str]:
-        return element_line(tank, " at full order")
-
-    @classmethod
-    def walls_lines(cls, tank) -> tuple:
-        return elastic_walls_lines(tank, flux=True)
-
-    @classmethod
-    def tank_words(cls, tank, short: bool = False) -> str:
-        return grid_words(tank, short)
-
-    @classmethod
-    def modes_words(cls) -> str:
-        return "the sloshing modes"
-
-    @classmethod
-    def model_words(cls) -> str:
-        return "the linear liquid"
+    def describe_tank(cls, tank) -> TankWords:
+        return element_words(tank, " at full order", flux=True)
 
     @classmethod
     def surface_table(cls, tank, g: float):

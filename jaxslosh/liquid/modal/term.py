@@ -19,7 +19,7 @@ import jax.numpy as jnp
 from ...fem.linalg import solve
 from ...physics.kinematics import mv3, tv3
 from ...physics.about import About
-from ..words import elastic_walls_lines, element_line, grid_words
+from ..words import TankWords, element_words
 from ..base import AbstractLiquid, dense_step_inverse, inertial_lines, switch_inertial, point_mass_scale
 from ..face.tank_modes import face_sloshing_modes, face_unknowns
 from ..nodal.tank_modes import nodal_sloshing_modes, nodal_unknowns
@@ -170,24 +170,9 @@ class ModalLiquid(AbstractLiquid):
         return (face_sloshing_modes if tank.form.face_normal else nodal_sloshing_modes)(tank, g, n)
 
     @classmethod
-    def tank_line(cls, tank) -> tuple[str, str]:
-        return element_line(tank, f" on {tank.reduction.modes} modes" if tank.form.face_normal else "")
-
-    @classmethod
-    def walls_lines(cls, tank) -> tuple:
-        return elastic_walls_lines(tank, flux=tank.form.face_normal)
-
-    @classmethod
-    def tank_words(cls, tank, short: bool = False) -> str:
-        return grid_words(tank, short)
-
-    @classmethod
-    def modes_words(cls) -> str:
-        return "the sloshing modes"
-
-    @classmethod
-    def model_words(cls) -> str:
-        return "the linear liquid"
+    def describe_tank(cls, tank) -> TankWords:
+        return element_words(tank, f" on {tank.reduction.modes} modes" if tank.form.face_normal else "",
+                             flux=tank.form.face_normal)
 
     @classmethod
     def surface_table(cls, tank, g: float):

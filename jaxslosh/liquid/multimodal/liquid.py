@@ -16,7 +16,8 @@ from ...physics.terms import Kin, Rows
 from ..base import AbstractLiquid, dense_step_inverse
 from .steep import roundoff_floor, steep_rows
 from .tank_modes import multimodal_sloshing_modes, multimodal_unknowns
-from .watch import SurfaceTable, modal_words, multimodal_line, surface_table
+from ..words import TankWords
+from .watch import SurfaceTable, multimodal_words, surface_table
 
 
 class MultimodalLiquid(AbstractLiquid):
@@ -52,24 +53,8 @@ class MultimodalLiquid(AbstractLiquid):
         return multimodal_sloshing_modes(tank, g, n)
 
     @classmethod
-    def tank_line(cls, tank) -> tuple[str, str]:
-        return multimodal_line(tank)
-
-    @classmethod
-    def walls_lines(cls, tank) -> tuple:
-        return ()                # a multimodal tank's walls are rigid
-
-    @classmethod
-    def tank_words(cls, tank, short: bool = False) -> str:
-        return modal_words(tank)
-
-    @classmethod
-    def modes_words(cls) -> str:
-        return "the multimodal tank's linear modes"
-
-    @classmethod
-    def model_words(cls) -> str:
-        return "the multimodal liquid"
+    def describe_tank(cls, tank) -> TankWords:
+        return multimodal_words(tank)
 
     @classmethod
     def surface_table(cls, tank, g: float) -> SurfaceTable:

@@ -7,7 +7,7 @@ from typing import NamedTuple
 
 import numpy as np
 
-from ..words import shape_words
+from ..words import TankWords, shape_words
 from .build3d import tank_3d, three_dimensional
 from .modes import modal_modes
 from .term import NX
@@ -54,11 +54,12 @@ def modal_words(t) -> str:
             f"(multimodal, three-dimensional{done}), no mesh")
 
 
-def multimodal_line(t) -> tuple[str, str]:
-    """The tank's liquid as the multimodal term holds it."""
+def multimodal_words(t) -> TankWords:
+    """The tank's liquid in words (liquid/words.py TankWords): its modes; its walls are rigid."""
     flow = "three-dimensional" if t.form.three_dimensional else "two-dimensional along x"
     system = "its third-order system" if t.form.third_order else "exact integrals"
-    return (f"liquid in tank {t.name!r}", f"{shape_words(t)}multimodal ({flow}), {len(modal_modes(t))} free-surface "
+    line = (f"liquid in tank {t.name!r}", f"{shape_words(t)}multimodal ({flow}), {len(modal_modes(t))} free-surface "
                                           f"modes, {system}, {t.liquid_mass:.6g} kg; its inertial loads (Coriolis and "
                                           "centrifugal among them) are the modal Lagrangian's, not switched by "
                                           "[effects]")
+    return TankWords(line, (), modal_words(t), "the multimodal tank's linear modes", "the multimodal liquid")

@@ -15,7 +15,7 @@ from ...fem.linalg import solve
 from ...fem.slip import rotate_matrix
 from ...physics.about import About
 from ...physics.terms import Kin, Rows
-from ..words import elastic_walls_lines, element_line, grid_words
+from ..words import TankWords, element_words
 from ..base import (AbstractLiquid, StepInverse, dense_step_inverse, inertial_lines, switch_inertial, nodal_product, particle_rows,
                     point_mass_scale)
 from .sparse import hydrostatic_start, sparse_solver_blocks
@@ -174,24 +174,8 @@ class NodalLiquid(AbstractLiquid):
         return nodal_sloshing_modes(tank, g, n)
 
     @classmethod
-    def tank_line(cls, tank) -> tuple[str, str]:
-        return element_line(tank)
-
-    @classmethod
-    def walls_lines(cls, tank) -> tuple:
-        return elastic_walls_lines(tank)
-
-    @classmethod
-    def tank_words(cls, tank, short: bool = False) -> str:
-        return grid_words(tank, short)
-
-    @classmethod
-    def modes_words(cls) -> str:
-        return "the sloshing modes"
-
-    @classmethod
-    def model_words(cls) -> str:
-        return "the linear liquid"
+    def describe_tank(cls, tank) -> TankWords:
+        return element_words(tank)
 
     @classmethod
     def surface_table(cls, tank, g: float):
