@@ -29,7 +29,7 @@ class LiquidBlock(NamedTuple):
     kept: Optional[tuple] = None
     tops: Optional[tuple] = None
     probe_rows: Optional[jax.Array] = None
-    damping: Optional[object] = None    # liquid/modal_damping.ModalDamping
+    damping: Optional[tuple] = None     # (ModalDamping or None, TankDamping per damped tank)
 
     def result_tanks(self) -> tuple:
         """The tanks a result keeps the fields of (TankBlock, or the multimodal ModalSurface)."""

@@ -9,7 +9,7 @@ import jax.numpy as jnp
 import numpy as np
 
 from ..block import LiquidBlock
-from ..modal_damping import ModalDamping
+from ..modal_damping import ModalDamping, TankDamping
 from .liquid import MultimodalLiquid
 from .term import modal_tank
 from .expansion import third_order
@@ -141,13 +141,15 @@ def probe_modal(scene: Scene, liquid: MultimodalLiquid) -> jnp.ndarray:
     return jnp.asarray(out)
 
 
-def multimodal_damping(scene: Scene, params: Optional[dict], liquid: MultimodalLiquid) -> Optional[ModalDamping]:
+def multimodal_damping(scene: Scene, params: Optional[dict], liquid: MultimodalLiquid) -> tuple:
     """`[tanks.damping] ratio` on each modal coordinate: 2 zeta_n omega_n times its modal mass (the
-    damping ratio of each linear mode), ModalDamping's C = B diag(c) B^T with B = diag(sqrt(mass))."""
+    damping ratio of each linear mode), ModalDamping's C = B diag(c) B^T with B = diag(sqrt(mass));
+    (None, ()) without a damped tank. With it, TankDamping per damped tank (`check`'s lines: its
+    linear modes' frequencies and ratios), as assemble/damping.py build_damping gives them."""
     if not any(t.damping is not None for t in scene.tanks):
-        return None
+        return None, ()
     params = params or {}
-    Bs, cs = [], []
+    Bs, cs, table = [], [], []
     for i, (t, mt) in enumerate(zip(scene.tanks, liquid.tanks)):
         Bs.append(jnp.sqrt(mt.modal_mass()))
         n = mt.n
@@ -162,5 +164,7 @@ def multimodal_damping(scene: Scene, params: Optional[dict], liquid: MultimodalL
             zeta = jnp.concatenate([jnp.asarray(ratio, dtype=float), jnp.zeros(n - len(ratio))])
         else:
             zeta = jnp.full(n, 1.0) * jnp.asarray(ratio, dtype=float)
-        cs.append(2.0 * zeta * mt.omega_linear(liquid.gravity))
-    return ModalDamping(B=jnp.diag(jnp.concatenate(Bs)), c=jnp.concatenate(cs))
+        omega = mt.omega_linear(liquid.gravity)
+        cs.append(2.0 * zeta * omega)
+        table.append(TankDamping(t.name, omega, zeta))
+    return ModalDamping(B=jnp.diag(jnp.concatenate(Bs)), c=jnp.concatenate(cs)), tuple(table)
