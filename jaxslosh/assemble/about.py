@@ -10,8 +10,8 @@ import os
 from ..hydro.source import excitation_source
 from ..physics.about import About
 from ..scene.types import Scene
-from .effects import (element_why, interface_unknowns, mesh_words, modal_modes, shape_words, structure_modes,
-                      structure_unknowns)
+from ..liquid.forms import tank_liquid
+from .effects import interface_unknowns, structure_modes, structure_unknowns
 
 
 def weight_about(scene: Scene, nonlinear: bool) -> About:
@@ -42,16 +42,8 @@ def hull_about(scene: Scene, waves: bool) -> About:
 
 
 def tank_line(t) -> tuple[str, str]:
-    """One tank's liquid, as the liquid term holds it."""
-    if t.form.multimodal:
-        flow = "three-dimensional" if t.form.three_dimensional else "two-dimensional along x"
-        system = "its third-order system" if t.form.third_order else "exact integrals"
-        return (f"liquid in tank {t.name!r}", f"{shape_words(t)}multimodal ({flow}), {len(modal_modes(t))} free-surface "
-                                              f"modes, {system}, {t.liquid_mass:.6g} kg; its inertial loads (Coriolis and "
-                                              "centrifugal among them) are the modal Lagrangian's, not switched by "
-                                              "[effects]")
-    return (f"liquid in tank {t.name!r}", f"{shape_words(t)}{mesh_words(t, short=True)}, {t.liquid_mass:.6g} kg, "
-                                          f"element {t.fluid.element!r}{element_why(t)}, {t.walls} walls (slip)")
+    """One tank's liquid, as the liquid term holds it (the model's words: AbstractLiquid.describe_tank)."""
+    return tank_liquid(t).describe_tank(t).line
 
 
 def liquid_about(scene: Scene, include_liquid: bool) -> About:
@@ -59,13 +51,8 @@ def liquid_about(scene: Scene, include_liquid: bool) -> About:
     vessel's frame that share the block."""
     lines = []
     for t in scene.tanks if include_liquid else ():
-        lines.append(tank_line(t))
-        if t.form.elastic:
-            lines.append((f"elastic walls of tank {t.name!r}",
-                          f"{t.wall_spec.thickness:g} m thick, {t.wall_mass:.6g} kg of elastic hexahedra built into "
-                          "the hull (the vessel's frame), the liquid tied to them in the normal direction only"
-                          + (": each wall face's flux is the volume the wall sweeps there" if t.form.face_normal
-                             else "")))
+        words = tank_liquid(t).describe_tank(t)
+        lines += [words.line, *words.walls]
     for s in scene.structures:
         if s.frame == "vessel":
             nx, ny, nz = s.mesh
@@ -105,8 +92,8 @@ def damping_about(scene: Scene) -> About:
         d = t.damping
         ratio = list(d.ratio) if isinstance(d.ratio, tuple) else d.ratio
         layers = f" plus laminar boundary layers (viscosity {d.viscosity:g} m^2/s)" if d.viscosity else ""
-        what = "the multimodal tank's linear modes" if t.form.multimodal else "the sloshing modes"
-        lines.append((f"liquid damping in tank {t.name!r}", f"modal damping of {what}, ratio {ratio}{layers}"))
+        lines.append((f"liquid damping in tank {t.name!r}",
+                      f"modal damping of {tank_liquid(t).describe_tank(t).damped}, ratio {ratio}{layers}"))
     return About(*lines)
 
 

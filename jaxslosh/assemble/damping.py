@@ -7,29 +7,24 @@ leaves them as they are, and a traced `tanks.<name>.damping.ratio` scales the da
 """
 from __future__ import annotations
 
-from typing import NamedTuple, Optional
+from typing import Optional
 
 import jax.numpy as jnp
 import numpy as np
 
 from ..liquid.damping import boundary_layer_ratios, sloshing_basis
-from ..liquid.modal_damping import ModalDamping
+from ..liquid.modal_damping import ModalDamping, TankDamping
 from ..scene.fields import show
 from ..scene.types import Scene, SceneError
 from .liquid import build_liquid_block
-
-
-class TankDamping(NamedTuple):
-    """One tank's damped modes: their frequencies (rad/s) and ratios (the ratio part may be traced)."""
-    name: str
-    omega: np.ndarray
-    zeta: object
 
 
 def build_damping(scene: Scene, params: Optional[dict], block) -> tuple[Optional[ModalDamping], tuple]:
     """(ModalDamping or None, TankDamping per damped tank) for the liquid block `block`
     (liquid/block.py LiquidBlock); None where no tank has a `[tanks.damping]` table."""
     tanks = scene.tanks
+    if block.damping is not None:      # made with the block by its model's builder (the multimodal one)
+        return block.damping
     if not any(t.damping is not None for t in tanks) or not block.liquid.nf or not block.tanks:
         return None, ()
     if block.vstructs or any(t.form.elastic for t in tanks):
@@ -77,8 +72,8 @@ def describe_damping(scene: Scene) -> list[str]:
     lines = []
     for d in build_damping(scene, None, block)[1]:
         t = next(x for x in scene.tanks if x.name == d.name)
-        zeta = np.asarray(d.zeta)
-        shown = ", ".join(f"{w:.4g} rad/s {z:.4g}" for w, z in zip(d.omega[:12], zeta[:12]))
+        omega, zeta = np.asarray(d.omega), np.asarray(d.zeta)
+        shown = ", ".join(f"{w:.4g} rad/s {z:.4g}" for w, z in zip(omega[:12], zeta[:12]))
         more = f", ... ({len(zeta)} modes)" if len(zeta) > 12 else ""
         given = f"ratio {show(list(t.damping.ratio) if isinstance(t.damping.ratio, tuple) else t.damping.ratio)}"
         if t.damping.viscosity:

@@ -5,8 +5,7 @@ from __future__ import annotations
 
 
 from ..liquid.forms import tank_liquid
-from ..liquid.walls import shell_mesh
-from ..liquid.multimodal.modes import modal_modes
+from ..liquid.words import shape_words, wall_unknowns, walls_words
 from ..scene.types import EFFECTS, Scene
 from ..solve.schemes import SCHEMES
 
@@ -23,10 +22,9 @@ def describe(scene: Scene) -> str:
              if ves.forced is not None else "no hydrostatics (free body)")
     lines.append(f"vessel: mass {ves.mass:.4g} kg, inertia diagonal [{diag}] kg m^2; {hydro}")
     for t in scene.tanks:
-        walls = t.walls if not t.form.elastic else f"elastic, {t.wall_spec.thickness:g} m thick"
         lines.append(f"tank {t.name!r}: {shape_words(t)}{t.size[0]:g} x {t.size[1]:g} x {t.size[2]:g} m filled to "
                      f"{t.fill_depth:g} m, liquid {t.liquid_mass:.4g} kg ({t.liquid_volume:.4g} m^3), "
-                     f"{mesh_words(t)}, walls {walls}")
+                     f"{mesh_words(t)}, walls {walls_words(t)}")
         lines += tank_notes(t)
     for s in scene.structures:
         nx, ny, nz = s.mesh
@@ -74,34 +72,11 @@ def switched_off(scene: Scene) -> list[str]:
     return [k for k in EFFECTS if not getattr(scene.effects, k)]
 
 
-def modal_words(t) -> str:
-    """What a multimodal tank is instead of a mesh: its free-surface modes."""
-    n = len(modal_modes(t))
-    if not t.form.three_dimensional:
-        return f"{n} free-surface modes cos(i pi x / L), i = 1..{n} (multimodal, two-dimensional along x), no mesh"
-    done = f", {t.modes} asked and completed to whole degenerate pairs" if n != t.modes else ""
-    return (f"{n} free-surface modes of its {'disk' if t.geometry.name == 'cylinder' else 'rectangular'} base "
-            f"(multimodal, three-dimensional{done}), no mesh")
-
-
-def mesh_words(t, short: bool = False) -> str:
-    """"mesh 5 x 5 x 5 = 125 hexahedra" (a grid, of any shape, or a mesh file that is one), or
-    "mesh file of 12 hexahedra on 30 nodes" (a mesh tank's file that is not a grid: its counts
-    along x, y, z mean nothing); a multimodal tank's modes (it has no mesh)."""
-    if t.form.multimodal:
-        return modal_words(t)
-    nx, ny, nz = t.mesh
-    words = t.geometry.mesh_words()
-    if words is not None:
-        return words
-    return f"{nx}x{ny}x{nz} hexahedra" if short else f"mesh {nx} x {ny} x {nz} = {nx * ny * nz} hexahedra"
-
-
-def shape_words(t) -> str:
-    """"prismatic (chamfers ...) " and the like for a tank that is not a plain box, else ""."""
-    if t.geometry.plain_box:
-        return ""
-    return t.geometry.describe() + ", "
+def mesh_words(t) -> str:
+    """What the tank's liquid is discretized into, as the model that runs its form says it
+    (AbstractLiquid.describe_tank): "mesh 5 x 5 x 5 = 125 hexahedra", a mesh file's counts, or a
+    multimodal tank's modes (it has no mesh)."""
+    return tank_liquid(t).describe_tank(t).mesh
 
 
 def tank_notes(t) -> list[str]:
@@ -123,11 +98,7 @@ def liquid_unknowns(scene: Scene) -> int:
     """Unknowns of the full-order liquid block: every tank's free liquid dofs, and its elastic walls'."""
     n = 0
     for t in scene.tanks:
-        n += free_liquid_dofs(t)
-        if t.form.elastic:       # the walls' free nodes (the liquid's wall-normal dofs, or its
-            #                               wall faces' fluxes, follow theirs)
-            _, _, _, held = shell_mesh(t.size, t.fill_depth, t.mesh, t.wall_spec.thickness, t.wall_spec.mesh)
-            n += 3 * int((~held).sum())
+        n += free_liquid_dofs(t) + wall_unknowns(t)
     return n
 
 
@@ -137,14 +108,3 @@ def count_unknowns(scene: Scene) -> int:
         return n
     # the bodies' tanks (reduced, rigid walls) counted as the vessel's are
     return n + liquid_unknowns(scene) + sum(free_liquid_dofs(t) for b in scene.bodies for t in b.tanks)
-
-
-def element_why(t) -> str:
-    """`check`'s note on a liquid element the scene left out: which one the loader chose, and why
-    (scene/shape.py default_element); a given element needs none. Face-normal tanks say how they run."""
-    runs = ""
-    if t.form.face_normal:
-        runs = f" on {t.reduction.modes} modes" if t.form.reduced else " at full order"
-    if not t.fluid.element_default or t.form.multimodal:
-        return runs
-    return f"{runs} (by default: {t.fluid.element_default})"

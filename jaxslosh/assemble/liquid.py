@@ -5,14 +5,11 @@ from __future__ import annotations
 
 from typing import Optional
 
-import numpy as np
-
 from ..liquid.base import NoLiquid
 from ..liquid.block import LiquidBlock, TankBlock, VesselFrameStructure, rigid_part  # noqa: F401 (the assembly's names)
 from ..liquid.face.stack import wall_node_count  # noqa: F401
-from ..liquid.forms import block_form, tank_models
+from ..liquid.forms import block_form, outline_block, tank_models
 from ..liquid.nodal.sparse import SPARSE_AUTO
-from ..liquid.nodal.term import NodalLiquid
 from ..scene.types import Scene
 from .effects import liquid_unknowns
 from .structures import held_spin_stiffness, held_structure
@@ -47,15 +44,8 @@ def wants_sparse(scene) -> bool:
     return liquid_unknowns(scene) > SPARSE_AUTO
 
 
-def outline_liquid_block(scene: Scene, include_liquid: bool = True) -> LiquidBlock:
-    """`build_liquid_block`'s terms without their arrays (None), for `jaxslosh check` (assemble/
-    check.py), whatever the mesh's size: no mesh is assembled. The liquid (its class the nodal one
-    whatever the element: only its description is read), the rotation penalty that tank liquid of
-    every element form brings, and the vessel-frame structures' spin stiffening."""
+def outline_liquid_block(scene: Scene, gravity, include_liquid: bool = True) -> LiquidBlock:
+    """`build_liquid_block`'s terms without their arrays (liquid/forms.py outline_block), for
+    `jaxslosh check`."""
     tanks = list(scene.tanks) if include_liquid else []
-    in_vessel_frame = [s for s in scene.structures if s.frame == "vessel"]
-    if not tanks and not in_vessel_frame:
-        return LiquidBlock(NoLiquid())
-    stiffened = any(s.stiffening == "centrifugal" for s in in_vessel_frame)
-    return LiquidBlock(NodalLiquid(r=None, Ms=None, K=None, free=None, n_nodes=0), penalty=(None, None) if tanks else None,
-                       Kg=np.zeros((6, 0, 0)) if stiffened else None)
+    return outline_block(tanks, [s for s in scene.structures if s.frame == "vessel"], gravity)

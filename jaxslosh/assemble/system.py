@@ -20,7 +20,6 @@ from ..liquid.modal_damping import ModalDamping
 from ..physics.bodies import bodies_term
 from ..physics.kinematics import quat_from_rpy, rotation_matrix
 from ..liquid.base import RotationPenalty, SpinStiffening
-from ..liquid.multimodal.term import MultimodalLiquid
 from ..physics.structures import Structures
 from ..physics.system import System
 from ..physics.terms import Config
@@ -34,7 +33,6 @@ from .bodies import build_bodies, linear_hydrostatics
 from .damping import build_damping
 from .hull import build_hull_pressure
 from .liquid import LiquidBlock, build_liquid_block, outline_liquid_block, rigid_part
-from ..liquid.multimodal.build import build_multimodal, multimodal_damping, multimodal_scene, probe_modal, surface_meshes, surfaces
 from .probes import Probes, build_probes
 from .seakeeping import build_seakeeping, outline_seakeeping
 from .structures import build_structures
@@ -73,7 +71,6 @@ class _Model(NamedTuple):
     system: System
     block: LiquidBlock
     blocks: tuple             # StructureBlock per structure in its own frame
-    multimodal: bool
     body_tanks: tuple = ()    # assemble/bodies.BodyTanks
 
 
@@ -81,7 +78,7 @@ def build(scene: Scene, params: Optional[dict] = None) -> Built:
     params = resolve_params(scene, params)
     P = params.get
     ves = scene.vessel
-    system, block, blocks, multimodal, body_tanks = _model(scene, params)
+    system, block, blocks, body_tanks = _model(scene, params)
     liquid, q0 = system.liquid, system.q_ref
     ini = ves.initial
     nf = system.nf
@@ -97,16 +94,8 @@ def build(scene: Scene, params: Optional[dict] = None) -> Built:
     # the terms that own unknowns (the structures) start them; nothing to compile without
     c0, v0, alg0 = _start(system, c0, v0) if system.owners() else (c0, v0, jnp.zeros(0))
     probes = build_probes(scene, block.tanks, liquid, blocks, block.vstructs, body_tanks, bodies_term(system))
-    probes = probes._replace(modal=liquid.probe_modal(probes.weights))    # a modal liquid: probes from eta
-    tanks = block.tanks
-    if multimodal:
-        probes = probes._replace(modal=probe_modal(scene, liquid))
-        tops = surfaces(scene)
-        tanks = surface_meshes(scene)      # the fields a result keeps: the free surface on its mesh
-    else:
-        tops = tuple(jnp.asarray(t.node_offset + np.flatnonzero(np.isclose(t.nodes[:, 2], t.nodes[:, 2].max())))
-                     for t in block.tanks)
-    return Built(system, c0, v0, probes, tanks, alg0, blocks, tops, body_tanks)
+    probes = probes._replace(modal=block.probe_modal(probes.weights))    # a modal liquid: probes from its coordinates
+    return Built(system, c0, v0, probes, block.result_tanks(), alg0, blocks, block.surfaces(), body_tanks)
 
 
 def outline(scene: Scene) -> System:
@@ -131,22 +120,11 @@ def _model(scene: Scene, params: dict, outline: bool = False) -> _Model:
         # the one function that makes every floating body's restoring (assemble/bodies.py)
         terms.append(linear_hydrostatics(ves.hydrostatics, P("environment.water_density", env.water_density), g,
                                          lambda k, v: P(f"vessel.hydrostatics.{k}", v)))
-    multimodal = eff.liquid and multimodal_scene(scene)
-    if multimodal and outline:
-        block = LiquidBlock(MultimodalLiquid(tanks=(), sizes=(), samples=None, gravity=g))
-    elif multimodal:
-        block = LiquidBlock(build_multimodal(scene, params, g))
-    elif outline:
-        block = outline_liquid_block(scene, include_liquid=eff.liquid)
-    else:
-        block = build_liquid_block(scene, params, g, include_liquid=eff.liquid)
+    # every liquid model's block from the one dispatch (liquid/forms.py block_form)
+    block = outline_liquid_block(scene, g, include_liquid=eff.liquid) if outline else \
+        build_liquid_block(scene, params, g, include_liquid=eff.liquid)
     has_liquid = not block.liquid.empty
-    about = liquid_about(scene, eff.liquid)
-    liquid = block.liquid
-    if has_liquid and not multimodal:
-        liquid = dataclasses.replace(liquid, coriolis=eff.coriolis, centrifugal=eff.centrifugal, about=about)
-    elif has_liquid:
-        liquid = dataclasses.replace(liquid, about=about)
+    liquid = block.liquid.with_effects(eff.coriolis, eff.centrifugal, liquid_about(scene, eff.liquid))
     # a prescribed motion is a term that holds the vessel's rows (System.hold); a free vessel has none
     motion = None if ves.forced is None else _prescribed(ves.forced, P)
     q0 = None
@@ -194,8 +172,6 @@ def _model(scene: Scene, params: dict, outline: bool = False) -> _Model:
     if outline:
         damping = ModalDamping(B=None, c=None) if any(t.damping is not None for t in scene.tanks) and has_liquid \
             and eff.liquid else None
-    elif multimodal:
-        damping = multimodal_damping(scene, params, liquid)
     elif eff.liquid:
         damping, _ = build_damping(scene, params, block)
     if damping is not None:
@@ -205,7 +181,7 @@ def _model(scene: Scene, params: dict, outline: bool = False) -> _Model:
     system = System(body=body, terms=tuple(terms), liquid=liquid, gravity=g, q_ref=q0,
                     gravity_turning=eff.gravity_turning or not has_liquid, balanced=balanced,
                     tail=() if damping is None else (damping,))
-    return _Model(system, block, blocks, multimodal, body_tanks)
+    return _Model(system, block, blocks, body_tanks)
 
 
 def _prescribed(f, P):

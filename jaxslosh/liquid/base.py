@@ -19,6 +19,7 @@ gravity moment here.
 from __future__ import annotations
 
 import abc
+import dataclasses
 from typing import Any, NamedTuple, Optional
 import equinox as eqx
 import jax
@@ -30,6 +31,7 @@ from ..physics.about import About
 from ..physics.kinematics import mv3, quat_multiply, skew, spin_tensor_components, tv3
 from ..physics.terms import AbstractTerm, Config, Kin, Rows
 from ..staging import staged
+from .words import TankWords
 
 
 def nodal_product(Ms, a):
@@ -143,6 +145,11 @@ class AbstractLiquid(AbstractTerm):
     def describe(self) -> tuple:
         """(effect, text) lines: what this liquid adds to the model, as `jaxslosh check` lists it."""
 
+    @abc.abstractmethod
+    def with_effects(self, coriolis: bool, centrifugal: bool, about: About) -> "AbstractLiquid":
+        """The liquid with the scene's `[effects]` switches of its inertial loads (where the model
+        has such switches) and its tanks' lines `about` (assemble/about.py liquid_about)."""
+
     # What a model answers of one tank before any block is built, asked of the class that runs the
     # tank's form (liquid/forms.py `tank_liquid`): `jaxslosh modes`, `check` and the cost estimate.
     @classmethod
@@ -157,6 +164,20 @@ class AbstractLiquid(AbstractTerm):
         """The n lowest natural modes of the tank's liquid (with its elastic walls, where it has them)
         at gravity g, the vessel held fixed: `liquid/modes.Modes` (or `liquid/walls.TankModes`)."""
 
+    # The tank's liquid in `jaxslosh check`'s words and the run's validity watch (assemble/about.py,
+    # effects.py, run/validity.py ask these of `tank_liquid(tank)`; liquid/words.py the shared pieces).
+    @classmethod
+    @abc.abstractmethod
+    def describe_tank(cls, tank) -> TankWords:
+        """The tank's liquid in words (liquid/words.py TankWords): its line in the liquid term, its
+        elastic walls' lines, its mesh (or modes), what its damping damps and the model's name."""
+
+    @classmethod
+    @abc.abstractmethod
+    def surface_table(cls, tank, g: float):
+        """What the run's validity watch reads of a tank's modal free surface (its slope, crest index and
+        round-off floor: liquid/multimodal/watch.py SurfaceTable), or None for a model without one."""
+
     @property
     @abc.abstractmethod
     def nf(self) -> int:
@@ -166,10 +187,12 @@ class AbstractLiquid(AbstractTerm):
     def d_scale(self):
         """(nf,) a mass per row, so that a row over it is an acceleration."""
 
+    # The hooks below have a neutral answer for most models; each final class still states its own
+    # (equinox's abstract-or-final: no default to inherit by accident).
+    @abc.abstractmethod
     def roundoff(self, d):
         """The round-off floor of its scaled rows at d beyond the solver's own (solve/linear.Solver.noise),
-        which the Newton iterations aim at when it is above the tolerance: none for a linear liquid."""
-        return jnp.zeros(())
+        which the Newton iterations aim at when it is above the tolerance: zero for a linear liquid."""
 
     @abc.abstractmethod
     def frame_field(self, d):
@@ -183,21 +206,30 @@ class AbstractLiquid(AbstractTerm):
     def probe_displacements(self, weights, modal, d):
         """(P, 3) displacement of the probes (interpolation `weights` (P, N), or `modal` (P, m, 3))."""
 
+    @abc.abstractmethod
     def surface_heave(self, d, nodes):
-        """The vertical displacement (k,) of the nodes `nodes` (the free surface of a tank)."""
-        return self.nodal_fields(self.frame_field(d))[nodes, 2]
+        """The vertical displacement (k,) of the points `nodes` of its free surface (a tank's, as the
+        block's `surfaces` lists them): the run's validity watch."""
 
+    @abc.abstractmethod
     def probe_modal(self, weights):
-        """The probes' weights on the modal coordinates (P, m, 3), for a liquid whose d is modal."""
-        return None
+        """The probes' weights on the modal coordinates (P, m, 3) from their nodal interpolation
+        `weights` (P, N), for a liquid whose d is modal; None where the probes read the nodal field
+        (or where the model's builder makes them from the scene: liquid/block.py `probe_rows`)."""
 
+    @abc.abstractmethod
     def rigid_first_moment(self):
         """sum_i m_i r_i (3,) of the undeformed block about the frame origin, kg m."""
-        return jnp.zeros(3)
 
+    @abc.abstractmethod
     def for_batch(self) -> "AbstractLiquid":
-        """The same liquid in the form a vmapped batch of runs computes fastest."""
-        return self
+        """The same liquid in the form a vmapped batch of runs computes fastest (most: itself)."""
+
+
+def switch_inertial(liquid, coriolis: bool, centrifugal: bool, about: About):
+    """A nodal, face-normal or reduced liquid's `with_effects`: its Coriolis and centrifugal loads
+    switched as `[effects]` says, and its lines."""
+    return dataclasses.replace(liquid, coriolis=coriolis, centrifugal=centrifugal, about=about)
 
 
 def inertial_lines(liquid) -> tuple:
@@ -248,6 +280,24 @@ class NoLiquid(AbstractLiquid):
     def describe(self) -> tuple:
         return ()
 
+    def with_effects(self, coriolis: bool, centrifugal: bool, about: About) -> "NoLiquid":
+        return self           # nothing to switch, nothing to list
+
+    def roundoff(self, d):
+        return jnp.zeros(())
+
+    def surface_heave(self, d, nodes):
+        return jnp.zeros(jnp.shape(nodes))
+
+    def probe_modal(self, weights):
+        return None
+
+    def rigid_first_moment(self):
+        return jnp.zeros(3)
+
+    def for_batch(self) -> "NoLiquid":
+        return self
+
     @classmethod
     def tank_unknowns(cls, tank) -> int:
         return 0
@@ -255,6 +305,15 @@ class NoLiquid(AbstractLiquid):
     @classmethod
     def sloshing_modes(cls, tank, g: float, n: int = 10):
         raise ValueError("a vessel without tank liquid has no sloshing modes")
+
+    # no tank runs NoLiquid (liquid/forms.py tank_liquid): never asked of a tank
+    @classmethod
+    def describe_tank(cls, tank) -> TankWords:
+        raise ValueError("a vessel without tank liquid has no tank to describe")
+
+    @classmethod
+    def surface_table(cls, tank, g: float):
+        return None
 
 
 class RotationPenalty(AbstractTerm):

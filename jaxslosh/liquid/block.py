@@ -22,6 +22,31 @@ class LiquidBlock(NamedTuple):
     Kg_offset: int = 0                  # on the unknowns Kg_offset ... (the structures', after the liquid's)
     vstructs: tuple = ()                # VesselFrameStructure per structure in the vessel's frame
     carried: tuple = ()                 # rigid_part of the elastic walls and vessel-frame structures
+    # What a model whose unknowns are not a mesh's nodal field makes from the scene (the multimodal
+    # one, multimodal/build.py): the tanks a result keeps (its surface meshes), each tank's rows of
+    # `surface_heave`, the probes' weights on its coordinates (P, nf, 3) and its modal damping.
+    # None: the finite-element block's, read from `tanks` and the probes' nodal weights
+    kept: Optional[tuple] = None
+    tops: Optional[tuple] = None
+    probe_rows: Optional[jax.Array] = None
+    damping: Optional[tuple] = None     # (ModalDamping or None, TankDamping per damped tank)
+
+    def result_tanks(self) -> tuple:
+        """The tanks a result keeps the fields of (TankBlock, or the multimodal ModalSurface)."""
+        return self.tanks if self.kept is None else self.kept
+
+    def surfaces(self) -> tuple:
+        """Per tank, the indices of its free surface that the liquid's `surface_heave` reads (the
+        run's validity watch): a tank block's top nodes, in the stacked nodal field."""
+        if self.tops is not None:
+            return self.tops
+        return tuple(jnp.asarray(t.node_offset + np.flatnonzero(np.isclose(t.nodes[:, 2], t.nodes[:, 2].max())))
+                     for t in self.tanks)
+
+    def probe_modal(self, weights):
+        """The probes' weights on the liquid's coordinates (P, m, 3) from their nodal `weights`, or
+        None where the probes read the nodal field (AbstractLiquid.probe_modal)."""
+        return self.liquid.probe_modal(weights) if self.probe_rows is None else self.probe_rows
 
 
 class TankBlock(NamedTuple):

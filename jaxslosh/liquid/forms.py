@@ -7,14 +7,18 @@ the vessel's frame), after the checks that their keys go together. Each form's b
 model's sub-package."""
 from __future__ import annotations
 
+import numpy as np
+
 from ..scene.liquids import FaceForm, MultimodalForm, NodalForm
 from ..scene.types import SceneError
-from .base import AbstractLiquid
+from .base import AbstractLiquid, NoLiquid
+from .block import LiquidBlock
 from .face.stack import face_block, face_model
 from .face.term import FaceLiquid
 from .modal.build import reduced_block
 from .modal.term import ModalLiquid
-from .multimodal.term import MultimodalLiquid
+from .multimodal.build import multimodal_block, outline_multimodal
+from .multimodal.liquid import MultimodalLiquid
 from .nodal.build import nodal_block, nodal_model, walls_block
 from .nodal.term import NodalLiquid
 
@@ -30,15 +34,18 @@ def tank_liquid(tank) -> type[AbstractLiquid]:
 
 def tank_models(scene, tanks, params: dict, g, sparse: bool) -> list:
     """Each tank's element model at the values `params` (canonical keys) and `g` give: a face-normal
-    tank's at the scene's own values (its blocks scale to traced ones), a nodal one's at them."""
-    return [face_model(scene, t, i, params) if t.form.face_normal else nodal_model(t, i, params, g, sparse)
-            for i, t in enumerate(tanks)]
+    tank's at the scene's own values (its blocks scale to traced ones), a nodal one's at them; a
+    multimodal tank has none (None)."""
+    return [None if t.form.multimodal else face_model(scene, t, i, params) if t.form.face_normal
+            else nodal_model(t, i, params, g, sparse) for i, t in enumerate(tanks)]
 
 
 def block_form(tanks, models, in_vessel_frame: bool, sparse: bool):
     """The builder of the stacked block, (scene, tanks, models, params, g, sparse, held, Kg) ->
     LiquidBlock, with `held` the structures in the vessel's frame and `Kg` their spin stiffness;
     SceneError, naming the key, where the tanks' forms do not go together."""
+    if tanks and tanks[0].form.multimodal:       # the loader has made every tank multimodal, or none
+        return _multimodal
     faces = bool(tanks) and all(t.form.face_normal for t in tanks)
     reduced = [t.form.reduced for t in tanks]
     elastic = [t.form.elastic for t in tanks]
@@ -90,6 +97,24 @@ def _walls(scene, tanks, models, params, g, sparse, held, Kg):
 
 def _reduced(scene, tanks, models, params, g, sparse, held, Kg):
     return reduced_block(scene, tanks, models, params, g)
+
+
+def _multimodal(scene, tanks, models, params, g, sparse, held, Kg):
+    return multimodal_block(scene, params, g)
+
+
+def outline_block(tanks, in_vessel_frame, g) -> LiquidBlock:
+    """`block_form`'s block without its arrays (None), for `jaxslosh check` (assemble/check.py),
+    whatever the mesh's size: no mesh is assembled. The liquid (a finite-element tank's the nodal
+    one whatever the element: only its description is read), the rotation penalty that their tank
+    liquid of every element form brings, and the vessel-frame structures' spin stiffening."""
+    if not tanks and not in_vessel_frame:
+        return LiquidBlock(NoLiquid())
+    if tanks and tanks[0].form.multimodal:
+        return outline_multimodal(g)
+    stiffened = any(s.stiffening == "centrifugal" for s in in_vessel_frame)
+    return LiquidBlock(NodalLiquid(r=None, Ms=None, K=None, free=None, n_nodes=0), penalty=(None, None) if tanks else None,
+                       Kg=np.zeros((6, 0, 0)) if stiffened else None)
 
 
 def _nodal(scene, tanks, models, params, g, sparse, held, Kg):

@@ -15,7 +15,7 @@ coordinates of its sloshing modes and C = B diag(c) B^T is diagonal on them.
 """
 from __future__ import annotations
 
-from typing import Any
+from typing import Any, NamedTuple
 
 import equinox as eqx
 import jax
@@ -24,6 +24,13 @@ import jax.numpy as jnp
 from ..physics.about import About
 from ..fem.linalg import solve
 from ..physics.terms import AbstractTerm, Kin, Rows
+
+
+class TankDamping(NamedTuple):
+    """One tank's damped modes: their frequencies (rad/s) and ratios (the ratio part may be traced)."""
+    name: str
+    omega: Any
+    zeta: Any
 
 
 class ModalDamping(AbstractTerm):

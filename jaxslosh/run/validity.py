@@ -17,11 +17,12 @@ import dataclasses
 import jax
 import numpy as np
 
+from ..liquid.forms import tank_liquid
 from ..liquid.multimodal.build import multimodal_scene, surfaces
-from ..liquid.multimodal.build3d import tank_3d, three_dimensional
+from ..liquid.multimodal.build3d import three_dimensional
+from ..liquid.multimodal.watch import omega2
 from ..physics.bodies import bodies_term
 from ..physics.kinematics import rpy_from_quat
-from ..liquid.multimodal.term import NX
 from ..liquid.multimodal.steep import DEFINITE_ON, DEFINITE_SOFT, STEEP_FULL, STEEP_MODES, STEEP_ON
 from ..scene.types import Scene
 
@@ -32,37 +33,23 @@ RESIDUAL_FACTOR = 10.0
 #: the free-surface slope past which a multimodal tank's waves are taken as breaking: tan 30 deg, the
 #: limiting crest of Stokes's wave (120 degrees), where a modal surface z = zeta(x) stops holding
 STEEP_SLOPE = float(np.tan(np.radians(30.0)))
-#: points per multimodal tank where the slope is read (walls included)
-SLOPE_SAMPLES = 65
 
 
 def _surface_tables(scene: Scene):
-    """Per multimodal tank, (offset of its modal amplitudes, the slope's rows (P, modes) or its x and y
-    rows for a three-dimensional tank, the elevation's rows at the liquid's quadrature points (Q,
-    modes), their weights (Q,), k_N, omega_N^2): what the slope, the crest index and the round-off
-    floor (liquid/multimodal/steep.py) are read from, at the points and weights the liquid uses."""
+    """Per tank with a modal free surface (a multimodal one), (offset of its modal amplitudes, the
+    slope's rows (P, modes) or its x and y rows for a three-dimensional tank, the elevation's rows at
+    the liquid's quadrature points (Q, modes), their weights (Q,), k_N, omega_N^2): what the slope,
+    the crest index and the round-off floor (liquid/multimodal/steep.py) are read from, as the model
+    that runs the tank's form gives them (AbstractLiquid.surface_table); none where a tank has none."""
+    g = scene.environment.gravity
+    tables = [tank_liquid(t).surface_table(t, g) for t in scene.tanks]
+    if any(s is None for s in tables):
+        return []
     out, off = [], 0
-    for t in scene.tanks:
-        if not t.form.multimodal:
-            return []
-        if three_dimensional(t):
-            mt = tank_3d(t, t.fill_depth, t.fluid.density)
-            F, Fx, Fy = (np.asarray(a) for a in (mt.F, mt.Fx, mt.Fy))
-            kN = float(np.max(np.asarray(mt.k)))
-            out.append((off, (Fx, Fy), F, np.asarray(mt.wq), kN, _omega2(scene, t, kN)))
-            off += F.shape[1]
-            continue
-        k = np.arange(1, t.modes + 1) * np.pi / t.size[0]
-        xg, wg = np.polynomial.legendre.leggauss(max(NX, 8 * t.modes))
-        xq = 0.5 * t.size[0] * (xg + 1.0)
-        out.append((off, (-k * np.sin(np.outer(np.linspace(0.0, t.size[0], SLOPE_SAMPLES), k)),),
-                    np.cos(np.outer(xq, k)), 0.5 * t.size[0] * wg, float(k[-1]), _omega2(scene, t, k[-1])))
-        off += t.modes
+    for s in tables:
+        out.append((off, *s))
+        off += s.Z.shape[1]
     return out
-
-
-def _omega2(scene: Scene, t, kN):
-    return float(scene.environment.gravity * kN * np.tanh(kN * t.fill_depth))
 
 
 def _crest_index(Z, w, kN, d):
@@ -106,7 +93,7 @@ class Watch:
         for (off, _, Z, _, _, _), t in zip(self.tables, scene.tanks):
             if not three_dimensional(t) and t.modes > STEEP_MODES:
                 kc = STEEP_MODES * np.pi / t.size[0]
-                self.cut[off] = (kc, _omega2(scene, t, kc))
+                self.cut[off] = (kc, omega2(scene.environment.gravity, t, kc))
         self.third = {}          # by tank: the third-order system's modal mass polynomial (`watch_liquid`)
         self.margin = np.ones(len(self.tables))        # its smallest margin, and when it first fell below DEFINITE_ON
         self.t_margin = np.full(len(self.tables), np.nan)
@@ -222,7 +209,7 @@ class Watch:
                 continue
             roof = t.size[2] - t.fill_depth
             where = self.label(i, t)
-            model = "the multimodal liquid" if t.form.multimodal else "the linear liquid"
+            model = tank_liquid(t).describe_tank(t).model
             if self.high[i] > roof:
                 out.append(f"{where}: the free surface rose {self.high[i]:.3g} m at t = {self.t_high[i]:.4g} s, "
                            f"above the roof ({roof:.3g} m of freeboard): {model} is outside its validity")

@@ -4,6 +4,8 @@ count the assembled liquid has: a cylinder's completed to whole cos/sin pairs), 
 not use, and the unknowns `check` counts are the assembled system's."""
 import os
 
+import numpy as np
+
 import jaxslosh as js
 from jaxslosh.assemble.effects import count_unknowns
 from jaxslosh.assemble.system import build
@@ -52,3 +54,18 @@ def test_a_free_vessel_without_hydrostatics_still_falls(tmp_path, capsys):
     path.write_text(t)
     out = _check(capsys, str(path))
     assert "gravity: no hydrostatics table: the vessel falls freely" in out and "(free body)" in out, out
+
+
+def test_a_damped_multimodal_tank_lists_its_own_linear_modes(tmp_path, capsys):
+    """`check`'s damping line of a multimodal tank is the damping its model runs: its N linear modes,
+    omega_i^2 = g k_i tanh(k_i h), k_i = i pi / L (not the sloshing modes of a mesh it has no use for)."""
+    t = open(EXPERIMENT).read().replace("modes = 8", "modes = 3\n[tanks.damping]\nratio = 0.02\n")
+    path = tmp_path / "damped.toml"
+    path.write_text(t)
+    out = _check(capsys, str(path))
+    line = next(x for x in out.splitlines() if x.startswith("damping of tank 'tank'"))
+    k = np.arange(1, 4) * np.pi / 1.73
+    omega = np.sqrt(9.81 * k * np.tanh(k * 0.6))
+    shown = [float(w.split(" rad/s")[0]) for w in line.split("per sloshing mode: ")[1].split(", ")]
+    np.testing.assert_allclose(shown, omega, rtol=1e-3)
+    assert "modal damping of the multimodal tank's linear modes, ratio 0.02" in out

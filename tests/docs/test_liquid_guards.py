@@ -8,8 +8,9 @@ import os
 
 from jaxslosh.assemble.liquid import build_liquid_block
 from jaxslosh.fem.mesh import ELEMENT_FORMS, FACE_FORMS
-from jaxslosh.liquid.base import AbstractLiquid
+from jaxslosh.liquid.base import AbstractLiquid, NoLiquid
 from jaxslosh.liquid.forms import FULL_ORDER
+from jaxslosh.liquid.modal.term import ModalLiquid
 from jaxslosh.scene.liquids import LiquidForm
 
 ROOT = os.path.join(os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__)))), "jaxslosh")
@@ -173,3 +174,51 @@ def test_no_private_imports_across_the_liquid_models():
                 if private and there != here:
                     bad.append(f"{rel}:{node.lineno}: {private} from {'.'.join(target)}")
     assert not bad, "\n".join(bad)
+
+
+#: the modules that describe a tank's liquid (`jaxslosh check`, the run's validity warnings) or
+#: assemble the system: they ask the model behind the tank's form (`tank_liquid(t).describe_tank`)
+#: or the block (`block.surfaces()`), never the form's flags
+ASK_THE_LIQUID = ("assemble/about.py", "assemble/effects.py", "run/validity.py", "assemble/system.py")
+
+
+def form_reads(source: str) -> list:
+    """(line, text) of each read of a tank's liquid form (`t.form.x`), and of the tank's own
+    answers that name the model (`t.multimodal`, `t.face_normal`)."""
+    return sorted({(node.lineno, ast.unparse(node)) for node in ast.walk(ast.parse(source))
+                   if isinstance(node, ast.Attribute) and (node.attr in KIND_FLAGS or (
+                       isinstance(node.value, ast.Attribute) and node.value.attr == "form"))})
+
+
+def test_the_form_finder_sees_the_reads():
+    src = ("a = t.form.elastic\nb = t.multimodal\nc = tank.form\nd = x.formats.y\n"
+           "e = scene.tanks[0].form.three_dimensional\n")
+    assert [line for line, _ in form_reads(src)] == [1, 2, 5]
+
+
+def test_the_check_words_and_the_assembly_ask_the_liquid_not_its_form():
+    """A tank's words, its validity warnings and the system's assembly are one call for every
+    model: no `t.form.<flag>` branch in these modules, and no multimodal path of their own."""
+    bad = []
+    for rel in ASK_THE_LIQUID:
+        source = open(os.path.join(ROOT, rel)).read()
+        bad += [f"{rel}:{line}: {text}" for line, text in form_reads(source)]
+        bad += [f"{rel}:{node.lineno}: imports {node.module}" for node in ast.walk(ast.parse(source))
+                if isinstance(node, ast.ImportFrom) and rel == "assemble/system.py"
+                and (node.module or "").startswith("liquid.multimodal")]
+    assert not bad, "\n".join(bad)
+
+
+#: the contract's hooks that most models answer neutrally: each final liquid states its own
+HOOKS = ("roundoff", "probe_modal", "surface_heave", "rigid_first_moment", "for_batch", "with_effects",
+         "describe_tank", "surface_table")
+
+
+def test_every_final_liquid_states_every_hook():
+    """equinox's abstract-or-final: the hooks are abstract on AbstractLiquid, and each final liquid
+    (NoLiquid and the reduced ModalLiquid too) defines each in its own body, none inherited."""
+    assert set(HOOKS) <= AbstractLiquid.__abstractmethods__
+    finals = {NoLiquid, ModalLiquid, *FULL_ORDER.values()}
+    missing = [f"{c.__name__}.{h}" for c in sorted(finals, key=lambda c: c.__name__) for h in HOOKS
+               if h not in vars(c)]
+    assert not missing, missing

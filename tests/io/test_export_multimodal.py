@@ -132,7 +132,8 @@ modes = 5
 def test_the_multimodal_liquid_gives_the_surface_meshes_fields():
     """The fields the run saves (MultimodalLiquid.nodal_fields of the frames' modal coordinates) on
     the mesh the build hands the writer (Built.tanks): cos(i pi x / L) on top, zero at the bottom."""
-    from jaxslosh.liquid.multimodal.term import MultimodalLiquid, modal_tank
+    from jaxslosh.liquid.multimodal.liquid import MultimodalLiquid
+    from jaxslosh.liquid.multimodal.term import modal_tank
     scene = js.load_scene((ROOT / "scenes" / "sloshing_experiment.toml").read_text().replace("modes = 8 ", "modes = 3 "))
     t = scene.tanks[0]
     (mesh,) = surface_meshes(scene)

@@ -8,7 +8,7 @@ import pytest
 from jaxslosh.liquid.face.term import FaceLiquid
 from jaxslosh.liquid.forms import tank_liquid
 from jaxslosh.liquid.modal.term import ModalLiquid
-from jaxslosh.liquid.multimodal.term import MultimodalLiquid
+from jaxslosh.liquid.multimodal.liquid import MultimodalLiquid
 from jaxslosh.liquid.nodal.term import NodalLiquid
 from jaxslosh.scene.liquids import FaceForm, MultimodalForm, NodalForm
 from jaxslosh.scene.load import load_scene

@@ -266,7 +266,7 @@ def face_full_liquid(tanks, models, scales=None, depths=None, sparse=False, stru
                                                            f"the dense blocks, and this mesh holds {f.size} free "
                                                            f"faces, more than {MAX_FULL_FACES} for them: trace the "
                                                            "fill depth on a coarser mesh")
-            dense_only = structures or any(u.wall_spec is not None for u in tanks)
+            dense_only = structures or any(u.form.elastic for u in tanks)
             hint = ("elastic walls and structures in the vessel's frame take the dense blocks only: use a coarser "
                     "mesh, or set element = \"stabilized\"") if dense_only else \
                 ("leave simulation.linear_solver at \"auto\" (or \"sparse\"), add a [tanks.reduction] table (modes = "
@@ -279,7 +279,7 @@ def face_full_liquid(tanks, models, scales=None, depths=None, sparse=False, stru
         slot = np.full(len(model.faces), HELD)
         slot[f] = np.arange(f.size) + off
         tw = None
-        if t.wall_spec is not None:
+        if t.form.elastic:
             if ds is not None or any(isinstance(v, jax.core.Tracer) for v in (fs or ())):
                 raise SceneError(f"tanks[{i}].walls", "elastic walls need the liquid with the scene's own values "
                                                       "(no traced fill depth, density, sound speed or gravity)")

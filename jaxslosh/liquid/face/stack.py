@@ -23,7 +23,7 @@ def face_model(scene, t, i, params):
             raise SceneError(f"tanks[{i}].fill_depth", f"the fill depth of a {t.shape} tank (or one with baffles) "
                                                       f"with element {t.fluid.element!r} cannot be traced: its mesh "
                                                       "follows the fill (a plain box's can, at full order)")
-        if t.reduction is not None:
+        if t.form.reduced:
             raise SceneError(f"tanks[{i}].fill_depth", f"a traced fill depth with element {t.fluid.element!r} runs "
                                                       "at full order only (its modes are the scene's fill's): "
                                                       "leave out [tanks.reduction]")
@@ -49,7 +49,7 @@ def face_sparse(scene, models, depths) -> bool:
     them: `stack_sparse`): no elastic walls or structures in the vessel's frame (their dense blocks),
     no traced fill depth (a plain box's depth reshapes its blocks: the dense `traced_depth_blocks`),
     and `simulation.linear_solver` "sparse" or "sparse-host", or "auto" above RT_SPARSE_AUTO free faces."""
-    if any(t.wall_spec is not None for t in scene.tanks) or any(s.frame == "vessel" for s in scene.structures):
+    if any(t.form.elastic for t in scene.tanks) or any(s.frame == "vessel" for s in scene.structures):
         return False                    # elastic walls, structures in the vessel's frame: their dense blocks
     if any(d is not None for d in depths):
         return False
@@ -79,7 +79,7 @@ def face_block(scene, tanks, models, params, g, held=(), Kg=None) -> LiquidBlock
     blocks, offset = [], 0
     for t, m in zip(tanks, models):
         blocks.append(host_block(t, m, offset))
-        offset += m.n_nodes + (0 if t.wall_spec is None else wall_node_count(t))    # a tank's walls follow its liquid
+        offset += m.n_nodes + (wall_node_count(t) if t.form.elastic else 0)    # a tank's walls follow its liquid
     liquid, penalty, walls = face_full_liquid(tanks, models, scales, depths, sparse, held)
     carried = tuple(rigid_part(w.mass, w.nodes + np.asarray(t.origin)[None, :]) for t, w in zip(tanks, walls)
                     if w is not None)           # the walls are part of the ship's mass (docs/reference/scene.md)

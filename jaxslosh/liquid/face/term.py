@@ -42,7 +42,8 @@ import jax.numpy as jnp
 
 from ...fem.linalg import solve
 from ...physics.about import About
-from ..base import AbstractLiquid, StepInverse, dense_step_inverse, inertial_lines, particle_rows, point_mass_scale
+from ..words import TankWords, element_words
+from ..base import AbstractLiquid, StepInverse, dense_step_inverse, inertial_lines, switch_inertial, particle_rows, point_mass_scale
 from .inverse import face_solver_blocks
 from .tank_modes import face_sloshing_modes, face_unknowns
 from ...physics.terms import Kin, Rows
@@ -84,6 +85,9 @@ class FaceLiquid(AbstractLiquid):
 
     def describe(self) -> tuple:
         return inertial_lines(self)
+
+    def with_effects(self, coriolis: bool, centrifugal: bool, about: About) -> "FaceLiquid":
+        return switch_inertial(self, coriolis, centrifugal, about)
 
     @property
     def nf(self) -> int:
@@ -134,6 +138,18 @@ class FaceLiquid(AbstractLiquid):
 
     def rigid_first_moment(self):
         return self.m @ self.r
+
+    def roundoff(self, d):
+        return jnp.zeros(())          # linear rows: the solver's own floor
+
+    def surface_heave(self, d, nodes):
+        return self.nodal_fields(self.frame_field(d))[nodes, 2]
+
+    def probe_modal(self, weights):
+        return None                   # the probes read the recovered nodal field
+
+    def for_batch(self) -> "FaceLiquid":
+        return self
 
     def rows(self, k: Kin) -> Rows:
         return particle_rows(self, k, self.field, self.m, lambda a: self.m[:, None] * a)
@@ -191,6 +207,14 @@ class FaceLiquid(AbstractLiquid):
     @classmethod
     def sloshing_modes(cls, tank, g: float, n: int = 10):
         return face_sloshing_modes(tank, g, n)
+
+    @classmethod
+    def describe_tank(cls, tank) -> TankWords:
+        return element_words(tank, " at full order", flux=True)
+
+    @classmethod
+    def surface_table(cls, tank, g: float):
+        return None             # its validity: the free surface inside the tank (run/validity.py Watch)
 
     def static_start(self, g_b):
         """The discrete hydrostatic equilibrium K d0 = F_g: K holds the absolute-rotation penalty on

@@ -19,7 +19,8 @@ import jax.numpy as jnp
 from ...fem.linalg import solve
 from ...physics.kinematics import mv3, tv3
 from ...physics.about import About
-from ..base import AbstractLiquid, dense_step_inverse, inertial_lines, point_mass_scale
+from ..words import TankWords, element_words
+from ..base import AbstractLiquid, dense_step_inverse, inertial_lines, switch_inertial, point_mass_scale
 from ..face.tank_modes import face_sloshing_modes, face_unknowns
 from ..nodal.tank_modes import nodal_sloshing_modes, nodal_unknowns
 from ...physics.terms import Kin, Rows
@@ -49,6 +50,9 @@ class ModalLiquid(AbstractLiquid):
 
     def describe(self) -> tuple:
         return inertial_lines(self)
+
+    def with_effects(self, coriolis: bool, centrifugal: bool, about: About) -> "ModalLiquid":
+        return switch_inertial(self, coriolis, centrifugal, about)
 
     @property
     def nf(self) -> int:
@@ -138,6 +142,12 @@ class ModalLiquid(AbstractLiquid):
     def probe_modal(self, weights):
         return jnp.einsum("pn,knc->pkc", weights, self.U)
 
+    def roundoff(self, d):
+        return jnp.zeros(())          # linear rows: the solver's own floor
+
+    def for_batch(self) -> "ModalLiquid":
+        return self
+
     def frame_field(self, d):
         return d          # the frames keep eta; the nodal field is formed after the run
 
@@ -158,6 +168,15 @@ class ModalLiquid(AbstractLiquid):
     @classmethod
     def sloshing_modes(cls, tank, g: float, n: int = 10):
         return (face_sloshing_modes if tank.form.face_normal else nodal_sloshing_modes)(tank, g, n)
+
+    @classmethod
+    def describe_tank(cls, tank) -> TankWords:
+        return element_words(tank, f" on {tank.reduction.modes} modes" if tank.form.face_normal else "",
+                             flux=tank.form.face_normal)
+
+    @classmethod
+    def surface_table(cls, tank, g: float):
+        return None             # its validity: the free surface inside the tank (run/validity.py Watch)
 
     def static_start(self, g_b):
         """The discrete hydrostatic equilibrium Kr eta = V^T F_g (exact with the static correction)."""

@@ -1,4 +1,4 @@
-"""The multimodal liquid of a scene (liquid/multimodal/term.py): one ModalTank per tank, its probes (the
+"""The multimodal liquid of a scene (liquid/multimodal/liquid.py): one ModalTank per tank, its probes (the
 free-surface elevation at their point), its damping and the sample points of the surface that the
 run's validity watch reads."""
 from __future__ import annotations
@@ -8,8 +8,10 @@ from typing import NamedTuple, Optional
 import jax.numpy as jnp
 import numpy as np
 
-from ..modal_damping import ModalDamping
-from .term import MultimodalLiquid, modal_tank
+from ..block import LiquidBlock
+from ..modal_damping import ModalDamping, TankDamping
+from .liquid import MultimodalLiquid
+from .term import modal_tank
 from .expansion import third_order
 from ...scene.types import Scene, SceneError
 from .modes import modal_modes
@@ -21,6 +23,19 @@ SAMPLES = 33
 
 def multimodal_scene(scene: Scene) -> bool:
     return bool(scene.tanks) and scene.tanks[0].form.multimodal
+
+
+def multimodal_block(scene: Scene, params: Optional[dict], gravity) -> LiquidBlock:
+    """The multimodal liquid's block (liquid/forms.py block_form): the liquid, the surface meshes a
+    result keeps, the surface samples the validity watch reads, the probes' rows and the damping."""
+    liquid = build_multimodal(scene, params, gravity)
+    return LiquidBlock(liquid, kept=surface_meshes(scene), tops=surfaces(scene), probe_rows=probe_modal(scene, liquid),
+                       damping=multimodal_damping(scene, params, liquid))
+
+
+def outline_multimodal(gravity) -> LiquidBlock:
+    """`multimodal_block`'s liquid without its arrays, for `jaxslosh check` (only its lines are read)."""
+    return LiquidBlock(MultimodalLiquid(tanks=(), sizes=(), samples=None, gravity=gravity))
 
 
 def build_multimodal(scene: Scene, params: Optional[dict], gravity) -> MultimodalLiquid:
@@ -126,13 +141,15 @@ def probe_modal(scene: Scene, liquid: MultimodalLiquid) -> jnp.ndarray:
     return jnp.asarray(out)
 
 
-def multimodal_damping(scene: Scene, params: Optional[dict], liquid: MultimodalLiquid) -> Optional[ModalDamping]:
+def multimodal_damping(scene: Scene, params: Optional[dict], liquid: MultimodalLiquid) -> tuple:
     """`[tanks.damping] ratio` on each modal coordinate: 2 zeta_n omega_n times its modal mass (the
-    damping ratio of each linear mode), ModalDamping's C = B diag(c) B^T with B = diag(sqrt(mass))."""
+    damping ratio of each linear mode), ModalDamping's C = B diag(c) B^T with B = diag(sqrt(mass));
+    (None, ()) without a damped tank. With it, TankDamping per damped tank (`check`'s lines: its
+    linear modes' frequencies and ratios), as assemble/damping.py build_damping gives them."""
     if not any(t.damping is not None for t in scene.tanks):
-        return None
+        return None, ()
     params = params or {}
-    Bs, cs = [], []
+    Bs, cs, table = [], [], []
     for i, (t, mt) in enumerate(zip(scene.tanks, liquid.tanks)):
         Bs.append(jnp.sqrt(mt.modal_mass()))
         n = mt.n
@@ -147,5 +164,7 @@ def multimodal_damping(scene: Scene, params: Optional[dict], liquid: MultimodalL
             zeta = jnp.concatenate([jnp.asarray(ratio, dtype=float), jnp.zeros(n - len(ratio))])
         else:
             zeta = jnp.full(n, 1.0) * jnp.asarray(ratio, dtype=float)
-        cs.append(2.0 * zeta * mt.omega_linear(liquid.gravity))
-    return ModalDamping(B=jnp.diag(jnp.concatenate(Bs)), c=jnp.concatenate(cs))
+        omega = mt.omega_linear(liquid.gravity)
+        cs.append(2.0 * zeta * omega)
+        table.append(TankDamping(t.name, omega, zeta))
+    return ModalDamping(B=jnp.diag(jnp.concatenate(Bs)), c=jnp.concatenate(cs)), tuple(table)

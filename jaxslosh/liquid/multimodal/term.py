@@ -40,21 +40,15 @@ liquid's momentum: they are the rigid rows.
 """
 from __future__ import annotations
 
-from typing import NamedTuple, Optional
+from typing import NamedTuple
 
 import equinox as eqx
 import jax
 import jax.numpy as jnp
 import numpy as np
 
-from ...physics.kinematics import mv3, tv3
-from ...physics.about import About
-from ..base import AbstractLiquid, dense_step_inverse
 from .columns import spd_inverse
 from .modes import odd_powers
-from .steep import roundoff_floor, steep_rows
-from .tank_modes import multimodal_sloshing_modes, multimodal_unknowns
-from ...physics.terms import Kin, Rows
 
 #: quadrature points along the tank (Gauss-Legendre; at least, and 8 per mode: the integrands hold
 #: cos(k_2N x) exp(k_2N zeta)) and through the depth (the reference quadrature over the liquid)
@@ -379,121 +373,3 @@ def modal_tank(L, b, h, rho, origin, n_modes: int, D=None) -> ModalTank:
     vort0 = (I.Bw - (w * flux) @ phis, I.W - w @ (chi * flux + (x - 0.5 * L) * 2.0 * Gz),
              I.wint - jnp.stack([w @ Gx, w @ Gz]), I.Zwx - w @ Gux, I.Xwz - (w * x) @ Gz)
     return eqx.tree_at(lambda m: (m.vort0, m.S0), t, (vort0, t.moments(I)[0]))
-
-
-class MultimodalLiquid(AbstractLiquid):
-    """Every tank's liquid as a multimodal tank (ModalTank), the modal coordinates stacked."""
-    tanks: tuple                      # ModalTank per tank
-    sizes: tuple = eqx.field(static=True)     # modes per tank
-    samples: jax.Array                # (Ns, nf) surface elevation at sample points of every tank (validity)
-    gravity: jax.Array                # m/s^2, for the rest stiffness
-    about: About = eqx.field(static=True, default=About())     # its tanks
-    # (N, nf): the vertical displacement of the nodes of the tanks' surface meshes per modal coordinate
-    # (liquid/multimodal/build.py surface_meshes: what a result keeps to draw and export); None: no fields
-    fields: Optional[jax.Array] = None
-    sparse = False
-
-    def describe(self) -> tuple:
-        return self.about.lines
-    nonlinear = True
-
-    def step_inverse(self, c_a, c_a_sub=None):
-        return dense_step_inverse(self, c_a, c_a_sub)
-
-    @classmethod
-    def tank_unknowns(cls, tank) -> int:
-        return multimodal_unknowns(tank)
-
-    @classmethod
-    def sloshing_modes(cls, tank, g: float, n: int = 10):
-        return multimodal_sloshing_modes(tank, g, n)
-
-    @property
-    def n_nodes(self) -> int:
-        return 0 if self.fields is None else int(self.fields.shape[0])
-
-    @property
-    def nf(self) -> int:
-        return int(sum(self.sizes))
-
-    def _split(self, v):
-        out, i = [], 0
-        for n in self.sizes:
-            out.append(v[i:i + n])
-            i += n
-        return out
-
-    def rows(self, k: Kin) -> Rows:
-        A, omega = k.A, k.omega
-        Vb = tv3(A, k.V0)
-        Vb_dot = tv3(A, k.a6[:3]) - jnp.cross(omega, Vb)
-        f, m, rd = jnp.zeros(3), jnp.zeros(3), []
-        for t, be, bd, bdd in zip(self.tanks, self._split(k.c.d), self._split(k.d_dot), self._split(k.d_acc)):
-            # past the method's range, what carries the tank on (multimodal_steep.py); within it, its rows
-            ft, mt, rt = steep_rows(t, Vb, omega, be, bd, Vb_dot, k.a6[3:6], bdd, k.g_b, self.gravity)
-            f, m = f + ft, m + mt
-            rd.append(rt)
-        return Rows(jnp.concatenate([mv3(A, f), m]), jnp.concatenate(rd))
-
-    def kinetic(self, k: Kin):
-        Vb = tv3(k.A, k.V0)
-        return sum((t.kinetic(Vb, k.omega, be, bd) for t, be, bd in
-                    zip(self.tanks, self._split(k.c.d), self._split(k.d_dot))), jnp.zeros(()))
-
-    def potential(self, k: Kin):
-        return self._potential(k.c.d, k.g_b)
-
-    def _potential(self, d, g_b):
-        return sum((t.potential(be, g_b) for t, be in zip(self.tanks, self._split(d))), jnp.zeros(()))
-
-    def mass_scale(self):
-        m = sum(t.mass for t in self.tanks)
-        I = jnp.zeros(3)
-        for t in self.tanks:
-            J = t.moments(t.integrals(jnp.zeros(t.n)))[1]
-            I = I + jnp.trace(J) - jnp.diag(J)
-        return jnp.concatenate([jnp.full(3, m), I])
-
-    def d_scale(self):
-        return jnp.concatenate([t.modal_mass() for t in self.tanks])
-
-    def total_mass(self):
-        return sum((t.mass for t in self.tanks), jnp.zeros(()))
-
-    def rigid_first_moment(self):
-        return sum((t.rest_moment() for t in self.tanks), jnp.zeros(3))
-
-    def constant_blocks(self):
-        """The modal rows' mass and stiffness at rest (they precondition Newton; the rows are exact)."""
-        M = jnp.diag(self.d_scale())
-        Kd = jnp.concatenate([t.modal_mass() * t.omega_linear(self.gravity) ** 2 for t in self.tanks])
-        return M, jnp.diag(Kd)
-
-    def frame_field(self, d):
-        return d
-
-    def roundoff(self, d):
-        """The rows' round-off floor, m/s^2 (`roundoff_floor`, multimodal_steep.py: their terms grow as
-        exp(2 k_N zeta_max) under the highest crest and cancel)."""
-        return sum((roundoff_floor(t, be, self.gravity) for t, be in zip(self.tanks, self._split(d))), jnp.zeros(()))
-
-    def nodal_fields(self, D):
-        """Modal coordinates (..., nf) -> the surface meshes' nodal displacements (..., N, 3), vertical."""
-        if self.fields is None:
-            return D
-        z = D @ self.fields.T
-        return jnp.stack([jnp.zeros_like(z), jnp.zeros_like(z), z], axis=-1)
-
-    def probe_displacements(self, weights, modal, d):
-        return jnp.einsum("pkc,k->pc", modal, d)
-
-    def surface_heave(self, d, nodes):
-        return (self.samples @ d)[nodes]
-
-    def static_start(self, g_b):
-        """The level surface under the initial gravity direction: the minimum of the potential (Newton)."""
-        beta = jnp.zeros(self.nf)
-        grad = jax.grad(self._potential)
-        for _ in range(4):
-            beta = beta - jnp.linalg.solve(jax.jacfwd(grad)(beta, g_b), grad(beta, g_b))
-        return beta

@@ -15,7 +15,8 @@ from ...fem.linalg import solve
 from ...fem.slip import rotate_matrix
 from ...physics.about import About
 from ...physics.terms import Kin, Rows
-from ..base import (AbstractLiquid, StepInverse, dense_step_inverse, inertial_lines, nodal_product, particle_rows,
+from ..words import TankWords, element_words
+from ..base import (AbstractLiquid, StepInverse, dense_step_inverse, inertial_lines, switch_inertial, nodal_product, particle_rows,
                     point_mass_scale)
 from .sparse import hydrostatic_start, sparse_solver_blocks
 from .tank_modes import nodal_sloshing_modes, nodal_unknowns
@@ -51,6 +52,9 @@ class NodalLiquid(AbstractLiquid):
 
     def describe(self) -> tuple:
         return inertial_lines(self)
+
+    def with_effects(self, coriolis: bool, centrifugal: bool, about: About) -> "NodalLiquid":
+        return switch_inertial(self, coriolis, centrifugal, about)
 
     @property
     def nf(self) -> int:
@@ -91,6 +95,15 @@ class NodalLiquid(AbstractLiquid):
 
     def rigid_first_moment(self):
         return self.m_nodes @ self.r
+
+    def roundoff(self, d):
+        return jnp.zeros(())          # linear rows: the solver's own floor
+
+    def surface_heave(self, d, nodes):
+        return self.nodal_fields(self.frame_field(d))[nodes, 2]
+
+    def probe_modal(self, weights):
+        return None                   # the probes read the nodal field
 
     def rows(self, k: Kin) -> Rows:
         """Eq. (4): the particle accelerations (body components), their inertia forces on the nodes,
@@ -159,6 +172,14 @@ class NodalLiquid(AbstractLiquid):
     @classmethod
     def sloshing_modes(cls, tank, g: float, n: int = 10):
         return nodal_sloshing_modes(tank, g, n)
+
+    @classmethod
+    def describe_tank(cls, tank) -> TankWords:
+        return element_words(tank)
+
+    @classmethod
+    def surface_table(cls, tank, g: float):
+        return None             # its validity: the free surface inside the tank (run/validity.py Watch)
 
     def static_start(self, g_b):
         """The discrete hydrostatic equilibrium K d0 = F_g under the body gravity g_b (docs/theory.md
