@@ -73,14 +73,17 @@ def _free_compiled_code():
     """Dropping the compiled executables after a module keeps the suite's memory flat (a whole run
     otherwise grows past several GB), but costs every later module its compiles again, the many
     small programs of eager operations during model building included (seconds per module). So
-    they are dropped only once the worker holds more than _KEEP_BYTES."""
+    they are dropped only once the worker holds more than _KEEP_BYTES: at 3 GB both workers passed it
+    a quarter into the suite and cleared after nearly every later module (a module that clears after
+    itself recompiles about 20 programs more, 1 s of CPU); at 5 GB two workers still fit a 24 GB
+    machine with room for a module's peak."""
     yield
     if _resident_bytes() > _KEEP_BYTES:
         jax.clear_caches()
 
 
 #: a worker's resident memory above which the compiled executables are dropped after a module
-_KEEP_BYTES = 3 << 30
+_KEEP_BYTES = 5 << 30
 
 
 def _resident_bytes():
