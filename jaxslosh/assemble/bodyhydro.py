@@ -34,6 +34,7 @@ from ..hydro.source import tables_of
 from ..hydro.spectra import components, wavenumber
 from ..hydro.tables import Tables, interpolate_excitation, interpolate_radiation
 from ..physics.seakeeping import Memory
+from .hull import froude_krylov_surface
 from ..scene.types import SceneError
 
 
@@ -127,6 +128,21 @@ def source_fit(src: Source):
     return _FITS[src.key]
 
 
+def hull_share(scene, body, c) -> np.ndarray:
+    """X (N, 6) in the step's axes, phases from the vessel's COG at rest: the linear Froude-Krylov
+    force of the waves `c` on a body's wetted hull at rest, which its nonlinear hydrostatics
+    integrate themselves (physics/hull.py), so its tables keep only the rest (diffraction), as the
+    vessel's do (assemble/seakeeping.py linear_excitation_rao)."""
+    waves, env, hull = scene.waves, scene.environment, body.hull
+    heads = np.broadcast_to(waves.heading if c.headings is None else np.asarray(c.headings), c.omega.shape)
+    Xb = froude_krylov_surface(hull.triangles(hull.divisions(waves)), hull.water_height(), c.omega,
+                               heads - body.heading, env.water_density, env.gravity, waves.depth)
+    Xs = np.concatenate([Xb[:, :3] @ _rz(body.heading).T, Xb[:, 3:]], axis=1)    # forces in inertial axes
+    k = wavenumber(c.omega, env.gravity, waves.depth)
+    x, y = body.position
+    return Xs * np.exp(-1j * k * (x * np.cos(heads) + y * np.sin(heads)))[:, None]
+
+
 def excitation(src: Source, omega, beta, g, depth=None) -> np.ndarray:
     """X (n, d) in the step's dofs per unit wave amplitude at the vessel's COG, waves heading beta."""
     t = src.tables
@@ -216,6 +232,10 @@ def time_terms(scene, params: dict):
                 for k, i in enumerate(src.index[::6]):
                     if i >= 6:                   # the vessel's own columns are its own terms'
                         X[i // 6 - 1, m] += Xs[:, 6 * k:6 * k + 6]
+    if X is not None:
+        for s, b in enumerate(scene.bodies):
+            if np.abs(X[s]).max() > 0 and b.hydrostatics.nonlinear and eff.buoyancy:
+                X[s] -= hull_share(scene, b, c)
     memory = None
     if poles and sum(p.size for p in poles):
         p = np.concatenate(poles)

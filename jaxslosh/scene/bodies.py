@@ -144,7 +144,7 @@ def _hydrostatics(table, owner: str, warnings: list[str], hull=None, environment
     if hull is not None:
         if not hull.closed_form and not (isinstance(table, dict) and table.get("model") == "nonlinear"):
             raise SceneError(f"{owner}.hull.type", 'a "mesh" hull on a body is read by the nonlinear hydrostatics: '
-                                                   f'add [bodies.hydrostatics] model = "nonlinear" (or use a box)')
+                                                   'add [bodies.hydrostatics] model = "nonlinear" (or use a box)')
         return read_hydrostatics(table, warnings, hull, environment, owner)
     if isinstance(table, dict) and table.get("model") == "nonlinear":
         raise SceneError(f"{where}.model", '"nonlinear" hydrostatics need the body\'s [bodies.hull] table: a box '
@@ -402,10 +402,20 @@ def bodies_scene(bodies, vessel, structures, mapping, warnings: list[str], files
         except DatabaseError as e:
             raise SceneError(key, " ".join(str(e).split())) from None
     _wave_headings(bodies, mapping.get("waves"), () if coupled is None else coupled[1])
-    dry = [b.name for b in bodies if b.hydrodynamics is None or b.hydrodynamics.excitation_amplitude is None]
+    # a body's nonlinear hydrostatics take the waves' pressure on its hull (the waves' effect and
+    # buoyancy on: without them no hull force acts, and the warning below stays true)
+    on_hull = effects_on(mapping, "buoyancy") and effects_on(mapping, "waves")
+    dry = [b.name for b in bodies if (b.hydrodynamics is None or b.hydrodynamics.excitation_amplitude is None)
+           and not (b.hydrostatics.nonlinear and on_hull)]
     if "waves" in mapping and dry:
         warnings.append(f"waves: the [[bodies]] {', '.join(repr(n) for n in dry)} have no excitation tables "
                         f"([bodies.hydrodynamics] file or excitation_amplitude): the waves exert no force on them")
+
+
+def effects_on(mapping, name: str) -> bool:
+    """Whether the scene's `[effects] name` is on (the default), from its raw tables."""
+    eff = mapping.get("effects", {})
+    return not isinstance(eff, dict) or eff.get(name, True) is not False
 
 
 def _file_places(path: str, vessel, bodies) -> None:

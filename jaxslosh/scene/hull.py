@@ -60,8 +60,9 @@ def mesh_hydrostatics(hull, environment, warnings: list[str], owner: str = "vess
     size = float(np.ptp(tris.reshape(-1, 3), axis=0).max())
     xb, yb, _ = h.pop("centre_of_buoyancy")
     if max(abs(xb), abs(yb)) > TRIM_TOLERANCE * size:
+        what = "vessel" if owner == "vessel" else "body"
         warnings.append(f"{owner}.hull.cog: the centre of buoyancy at rest lies {xb:.4g} m forward and {yb:.4g} m to "
-                        f"port of the COG: the {'vessel' if owner == 'vessel' else 'body'} is not in equilibrium at its mesh's waterline and trims or "
+                        f"port of the COG: the {what} is not in equilibrium at its mesh's waterline and trims or "
                         "heels from the start")
     return h
 
