@@ -404,18 +404,13 @@ def bodies_scene(bodies, vessel, structures, mapping, warnings: list[str], files
     _wave_headings(bodies, mapping.get("waves"), () if coupled is None else coupled[1])
     # a body's nonlinear hydrostatics take the waves' pressure on its hull (the waves' effect and
     # buoyancy on: without them no hull force acts, and the warning below stays true)
-    on_hull = effects_on(mapping, "buoyancy") and effects_on(mapping, "waves")
+    eff = mapping.get("effects", {}) if isinstance(mapping.get("effects", {}), dict) else {}
+    on_hull = eff.get("buoyancy", True) is not False and eff.get("waves", True) is not False
     dry = [b.name for b in bodies if (b.hydrodynamics is None or b.hydrodynamics.excitation_amplitude is None)
            and not (b.hydrostatics.nonlinear and on_hull)]
     if "waves" in mapping and dry:
         warnings.append(f"waves: the [[bodies]] {', '.join(repr(n) for n in dry)} have no excitation tables "
                         f"([bodies.hydrodynamics] file or excitation_amplitude): the waves exert no force on them")
-
-
-def effects_on(mapping, name: str) -> bool:
-    """Whether the scene's `[effects] name` is on (the default), from its raw tables."""
-    eff = mapping.get("effects", {})
-    return not isinstance(eff, dict) or eff.get(name, True) is not False
 
 
 def _file_places(path: str, vessel, bodies) -> None:
