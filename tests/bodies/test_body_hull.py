@@ -173,3 +173,24 @@ def test_connection_points_outside_a_bodys_hull_exit_2(tmp_path, capsys):
     status, out = _check(tmp_path, capsys, on_body() + link.format(z=-3.5))
     assert status == 2 and "connections[0].points" in out.err and "'barge''s hull" in out.err \
         and "below the keel at -3 m" in out.err, out.err
+
+
+def test_a_bodys_box_hull_gives_its_large_angle_gz_curve(tmp_path, capsys):
+    """`stability` on a body with a box hull: its curve from its hull (free to sink and trim), the
+    wall-sided box's GZ = sin(phi) (GM + BM tan^2(phi) / 2) while the bilge stays wet (26.6 deg)
+    within 1e-8 m, GM0 = KB + BM - KG within 1e-6 m; the command line prints its table and criteria."""
+    text = (HEAD.format(duration=1.0) + VESSEL.replace("kg = 3.0", "kg = 3.0\ndepth = 5.0")
+            + f'[[bodies]]\nname = "barge"\nposition = [{X0}, 200.0]\n' + BOX.format(t="bodies"))
+    phi = np.radians([0.0, 5.0, 10.0, 20.0, 25.0])
+    b = js.stability(js.load_scene(text), phi, criteria=False).bodies["barge"]
+    bm = B ** 2 / (12 * T)
+    gm = T / 2 + bm - KG
+    assert b["model"] == "hull"
+    np.testing.assert_allclose(b.gz, np.sin(phi) * (gm + bm * np.tan(phi) ** 2 / 2), rtol=0, atol=1e-8)
+    assert b.gm0 == pytest.approx(gm, abs=1e-6)
+    p = tmp_path / "scene.toml"
+    p.write_text(text)
+    from jaxslosh.cli import main
+    assert main(["stability", str(p), "--angles", "0:40:5"]) == 0
+    out = capsys.readouterr().out
+    assert "body barge:" in out and "IS Code 2008 Part A 2.2 (liquids level):" in out.split("body barge:")[1]
