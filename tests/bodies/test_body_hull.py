@@ -194,3 +194,16 @@ def test_a_bodys_box_hull_gives_its_large_angle_gz_curve(tmp_path, capsys):
     assert main(["stability", str(p), "--angles", "0:40:5"]) == 0
     out = capsys.readouterr().out
     assert "body barge:" in out and "IS Code 2008 Part A 2.2 (liquids level):" in out.split("body barge:")[1]
+
+
+def test_a_bodys_hull_takes_the_waves_in_its_rao():
+    """Without tables, a body's RAO has the Froude-Krylov force on its wetted hull at its place (the
+    small-wave limit of the pressure its runs integrate): the lone box's RAO shifted by the phase
+    k X0, within 1e-4 of its size (the lone vessel's box force is in closed form, the body's the
+    quadrature of its hull's panels)."""
+    w = np.array([0.6, 1.0, 2.0 * np.pi / 5.0])
+    a = js.rao(js.load_scene(on_body()), w, [0.0]).bodies["barge"][:, 0]
+    b = js.rao(js.load_scene(alone()), w, [0.0]).vessel[:, 0]
+    assert np.abs(b[:, 2]).min() > 0.5                           # it heaves
+    shifted = b * np.exp(-1j * w ** 2 / G * X0)[:, None]
+    np.testing.assert_allclose(a, shifted, rtol=0, atol=1e-4 * np.abs(b).max())
