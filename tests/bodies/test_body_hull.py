@@ -207,3 +207,21 @@ def test_a_bodys_hull_takes_the_waves_in_its_rao():
     assert np.abs(b[:, 2]).min() > 0.5                           # it heaves
     shifted = b * np.exp(-1j * w ** 2 / G * X0)[:, None]
     np.testing.assert_allclose(a, shifted, rtol=0, atol=1e-4 * np.abs(b).max())
+
+
+def test_a_bodys_tables_lose_the_froude_krylov_share_its_hull_takes():
+    """A nonlinear body whose excitation tables hold exactly its hull's Froude-Krylov force (the
+    quadrature the run integrates): the linear excitation term the run adds is zero (the hull's
+    pressure carries it all), where it would count that force twice."""
+    from jaxslosh.assemble.bodyhydro import time_terms
+    from jaxslosh.assemble.hull import froude_krylov_surface
+    scene = js.load_scene(on_body())
+    hull = scene.bodies[0].hull
+    w = np.array([0.5, OMEGA, 2.0, 3.0])
+    X = froude_krylov_surface(hull.triangles(hull.divisions(scene.waves)), hull.water_height(), w, 0.0, RHO, G)
+    tables = (f"[bodies.hydrodynamics]\nfrequencies = {w.tolist()}\nheadings = [0.0]\n"
+              f"excitation_amplitude = {np.abs(X).tolist()}\nexcitation_phase = {np.angle(X).tolist()}\n")
+    text = on_body().replace("[bodies.initial]", tables + "[bodies.initial]")
+    _, _, Xs = time_terms(js.load_scene(text), {})
+    assert np.abs(X).max() > 1e5
+    np.testing.assert_allclose(Xs[0], 0.0, atol=1e-9 * np.abs(X).max())
