@@ -1,6 +1,7 @@
 """The `[[bodies]]` and `[[connections]]` of a scene as the term physics/bodies.py defines
 (docs/guide/bodies-and-connections.md). A body's rigid terms come from the functions that make the
-vessel's (`rigid_terms`): its inertia, its linear hydrostatics and its viscous damping."""
+vessel's (`rigid_terms`): its inertia, its linear hydrostatics (or, on its hull, the vessel's
+nonlinear ones and its weight: assemble/hull.py) and its viscous damping."""
 from __future__ import annotations
 
 import dataclasses
