@@ -225,3 +225,19 @@ def test_a_bodys_tables_lose_the_froude_krylov_share_its_hull_takes():
     _, _, Xs = time_terms(js.load_scene(text), {})
     assert np.abs(X).max() > 1e5
     np.testing.assert_allclose(Xs[0], 0.0, atol=1e-9 * np.abs(X).max())
+
+
+def test_a_bodys_mesh_hull_rows_are_the_lone_vessels(tmp_path):
+    """`type = "mesh"` on a body: the box written as a closed mesh (waterline at z = 0, COG at
+    kg - draft); the body's six rows in the waves equal the lone vessel's with the same mesh."""
+    from jaxslosh.hull.box import box_hull
+    from jaxslosh.hull.surface import write_hull_mesh
+    path = tmp_path / "barge.obj"
+    write_hull_mesh(str(path), np.asarray(box_hull(L, B, KG, 5.0, (4, 2, 2))) + np.array([0.0, 0.0, KG - T]))
+    mesh = f'type = "mesh"\nfile = "{path}"\ncog = [0.0, 0.0, {KG - T}]\n'
+    box = f"length = {L}\nbeam = {B}\ndraft = {T}\nkg = {KG}\ndepth = 5.0\n"
+    text = on_body(ramp=0.0).replace(box, mesh)
+    assert js.load_scene(text).bodies[0].hull.type == "mesh"
+    ours, ref = rows_and_residual(text, alone(ramp=0.0).replace(box, mesh), seed=7)
+    assert np.abs(ours).max() > 1e4
+    np.testing.assert_allclose(ours, ref, rtol=0, atol=1e-12 * np.abs(ours).max())
