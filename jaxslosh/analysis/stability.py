@@ -16,6 +16,7 @@ rights the vessel. Everything is traced once and vmapped over the angles; the it
 """
 from __future__ import annotations
 
+import dataclasses
 import functools
 from dataclasses import dataclass, field
 from typing import Optional
@@ -31,7 +32,7 @@ from ..hull.tanks import tank_surface
 from ..staging import START_OPTIONS
 from .bodystability import bodies_stability, linear_stability
 from ..scene.load import load_scene
-from ..scene.types import SceneError
+from ..scene.types import SceneError, Vessel
 
 #: most iterations of the bracketed Newton solves of a plane's offset and of the free angle (each
 #: stops when converged)
@@ -85,6 +86,8 @@ class Stability:
     #: "hull": the vessel's curves from its hull; "linear": from its linear hydrostatics (a vessel
     #: without a hull beside bodies, docs/guide/stability.md#bodies)
     model: str = "hull"
+    #: a body's name where this is a [[bodies]] body's curves from its own hull (an entry of `bodies`)
+    name: str = ""
 
     def as_dict(self):
         """The JSON object of `jaxslosh stability --json` (docs/guide/stability.md)."""
@@ -93,7 +96,9 @@ class Stability:
                "gm0_frozen": float(self.gm0_frozen),
                "vanishing_angle": None if self.vanishing_angle is None else float(self.vanishing_angle),
                "criteria": [c.as_dict() for c in self.criteria]}
-        if self.bodies or self.model != "hull":         # a scene of the vessel alone: its object as ever
+        if self.name:                                   # a body's entry in "bodies": its curves from its hull
+            out["model"] = self.model
+        elif self.bodies or self.model != "hull":       # a scene of the vessel alone: its object as ever
             out["model"] = self.model
             out["bodies"] = {n: b.as_dict() for n, b in self.bodies.items()}
         return out
@@ -306,6 +311,9 @@ def stability(scene, angles=None, axis: str = "roll", *, criteria: bool = True) 
     if angles.ndim != 1 or not np.all(np.isfinite(angles)):
         raise ValueError("angles must be a 1-D array of finite numbers (rad)")
     bodies = bodies_stability(scene, angles, axis)
+    for i, b in enumerate(scene.bodies):      # a body's own hull gives its large-angle curves
+        if b.hull is not None and (not b.hull.closed_form or b.hull.depth is not None):
+            bodies[b.name] = _body_hull(scene, i, angles, axis, criteria)
     if bodies and scene.vessel.hull is None and not scene.tanks and scene.vessel.hydrostatics is not None:
         return _linear_vessel(scene, angles, axis, bodies)
     model = build_model(scene)
@@ -341,6 +349,21 @@ def stability(scene, angles=None, axis: str = "roll", *, criteria: bool = True) 
     return Stability(angle=angles, gz=gz, gz_frozen=gz_f, gm0=gm0, gm0_frozen=gm0_f,
                      vanishing_angle=first_vanishing(angles, gz), criteria=crit, axis=axis,
                      sinkage=off2[at, 0] - off2[up, 0], trim=psi2[at, 0], bodies=bodies)
+
+
+def _body_hull(scene, i: int, angles, axis: str, criteria: bool) -> Stability:
+    """The Stability of the body `scene.bodies[i]` from its hull, the vessel's analysis on the body as
+    the only vessel of the scene with its own tanks (docs/guide/stability.md#bodies)."""
+    b = scene.bodies[i]
+    own = dataclasses.replace(scene, vessel=Vessel(mass=b.mass, inertia=b.inertia, hydrostatics=b.hydrostatics,
+                                                   hull=b.hull, name=b.name, cog_height=b.cog_height),
+                              tanks=b.tanks, bodies=(), connections=(), mooring=())
+    try:
+        s = stability(own, angles, axis, criteria=criteria)
+    except SceneError as e:      # its keys are the body's
+        key = e.key.replace("vessel", f"bodies[{i}]", 1)
+        raise SceneError(key, str(e)[len(e.key) + 2:].replace("vessel", "body")) from None
+    return dataclasses.replace(s, name=b.name)
 
 
 def _linear_vessel(scene, angles, axis: str, bodies: dict) -> Stability:

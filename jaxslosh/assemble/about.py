@@ -28,10 +28,10 @@ def weight_about(scene: Scene, nonlinear: bool) -> About:
                              "environment.gravity = 0: no weight"))
 
 
-def hull_about(scene: Scene, waves: bool) -> About:
-    """HullPressure's lines: the nonlinear buoyancy on the hull's wetted surface, and the incident
-    waves' pressure there where it has them."""
-    hull = scene.vessel.hull
+def hull_about(scene: Scene, waves: bool, hull=None) -> About:
+    """HullPressure's lines: the nonlinear buoyancy on the hull's wetted surface (the vessel's, or
+    `hull`, a body's), and the incident waves' pressure there where it has them."""
+    hull = scene.vessel.hull if hull is None else hull
     what = hull.describe()
     lines = [("buoyancy", f"nonlinear: the still-water pressure on the instantaneous wetted surface of the {what}, "
                           "clipped exactly at the water")]

@@ -1,6 +1,7 @@
 """The `[[bodies]]` and `[[connections]]` of a scene as the term physics/bodies.py defines
 (docs/guide/bodies-and-connections.md). A body's rigid terms come from the functions that make the
-vessel's (`rigid_terms`): its inertia, its linear hydrostatics and its viscous damping."""
+vessel's (`rigid_terms`): its inertia, its linear hydrostatics (or, on its hull, the vessel's
+nonlinear ones and its weight: assemble/hull.py) and its viscous damping."""
 from __future__ import annotations
 
 import dataclasses
@@ -19,6 +20,7 @@ from ..physics.vessel import RESTORING_FORMS, AbstractRestoring, RigidBody
 from .about import damping_about, tank_line
 from .bodyhydro import time_terms
 from .damping import build_damping
+from .hull import body_restoring, restoring_words
 from .liquid import build_liquid_block
 from .seakeeping import make_excitation
 
@@ -33,14 +35,16 @@ def linear_hydrostatics(h, rho_w, g, value=lambda key, v: v) -> AbstractRestorin
                 gm_l=f("gm_l", h.gm_l))
 
 
-def rigid_terms(mass, inertia, hydrostatics, rho_w, g, viscous=None, value=lambda key, v: v) -> tuple:
+def rigid_terms(mass, inertia, hydrostatics, rho_w, g, viscous=None, value=lambda key, v: v,
+                restoring=None) -> tuple:
     """A floating body's rigid terms, as the vessel has them: inertia with its gyroscopic terms
     (RigidBody), linear hydrostatics about the rest pose (its weight balanced by the buoyancy at
-    rest), and linear viscous damping (6 x 6) where given; `value(name, v)` may replace the
-    hydrostatics' values (a body's traced params)."""
+    rest) or the `restoring` terms given instead (a hull's pressure and the weight:
+    assemble/hull.py body_restoring), and linear viscous damping (6 x 6) where given; `value(name,
+    v)` may replace the hydrostatics' values (a body's traced params)."""
     I = jnp.asarray(inertia, dtype=float)
     terms = [RigidBody(mass=jnp.asarray(mass, dtype=float), inertia=jnp.diag(I) if I.ndim == 1 else I),
-             linear_hydrostatics(hydrostatics, rho_w, g, value)]
+             *((linear_hydrostatics(hydrostatics, rho_w, g, value),) if restoring is None else restoring)]
     if viscous is not None:
         terms.append(LinearDamping(jnp.asarray(viscous, dtype=float)))
     return tuple(terms)
@@ -102,7 +106,7 @@ def build_bodies(scene, params: dict, g, outline: bool = False) -> tuple[Optiona
             offset += tank.nf
         floating.append(Floating(
             terms=rigid_terms(P(f"{key}.mass", b.mass), b.inertia, b.hydrostatics, rho, g, b.viscous_damping,
-                              traced) + (
+                              traced, body_restoring(scene, b, params, g, tank)) + (
                 () if X is None or not np.abs(X[s]).max() > 0 else
                 (WaveExcitation(make_excitation(waves, X[s], P(waves.height_key,
                                                               waves.height))),)),
@@ -136,11 +140,12 @@ def _about(scene) -> About:
         if hd is not None and (hd.file or hd.added_mass is not None or hd.excitation_amplitude is not None):
             damp += (f"; radiation and wave excitation from {hd.file}" if hd.file else
                      "; radiation and wave excitation from its tables") + " (at its place in the waves)"
+        statics = (f"linear hydrostatics (A_w {h.waterplane_area:g} m^2, GM_T {h.gm_t:g} m, GM_L {h.gm_l:g} m)"
+                   if not h.nonlinear else restoring_words(scene, b))
         lines.append(("floating body", f"{b.name!r}: 6 unknowns of its own floating frame at "
                                        f"({b.position[0]:g}, {b.position[1]:g}) m from the vessel, heading "
-                                       f"{b.heading:g} rad, mass {b.mass:g} kg; rigid-body inertia and linear "
-                                       f"hydrostatics (A_w {h.waterplane_area:g} m^2, GM_T {h.gm_t:g} m, GM_L "
-                                       f"{h.gm_l:g} m){damp}"))
+                                       f"{b.heading:g} rad, mass {b.mass:g} kg; rigid-body inertia and "
+                                       f"{statics}{damp}"))
         damped = dict(damping_about(dataclasses.replace(scene, tanks=b.tanks)).lines)
         for t in b.tanks if scene.effects.liquid else ():      # the vessel's tank lines, on this body's frame
             what, text = tank_line(t)

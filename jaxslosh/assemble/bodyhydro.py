@@ -34,6 +34,7 @@ from ..hydro.source import tables_of
 from ..hydro.spectra import components, wavenumber
 from ..hydro.tables import Tables, interpolate_excitation, interpolate_radiation
 from ..physics.seakeeping import Memory
+from .hull import froude_krylov_surface
 from ..scene.types import SceneError
 
 
@@ -127,6 +128,28 @@ def source_fit(src: Source):
     return _FITS[src.key]
 
 
+def hull_share(scene, body, omega, heads) -> np.ndarray:
+    """X (n, 6) in the step's axes, phases from the vessel's COG at rest: the linear Froude-Krylov
+    force of the waves (frequencies `omega`, headings `heads`, (n,) each) on a body's wetted hull at
+    rest, which its nonlinear hydrostatics integrate themselves (physics/hull.py): a run's tables
+    keep only the rest (diffraction), as the vessel's do (assemble/seakeeping.py
+    linear_excitation_rao), and a body without tables gets it in the frequency domain."""
+    waves, env, hull = scene.waves, scene.environment, body.hull
+    depth = None if waves is None else waves.depth
+    heads = np.broadcast_to(np.asarray(heads, dtype=float), np.shape(omega))
+    Xb = froude_krylov_surface(hull.triangles(hull.divisions(waves)), hull.water_height(), omega,
+                               heads - body.heading, env.water_density, env.gravity, depth)
+    Xs = np.concatenate([Xb[:, :3] @ _rz(body.heading).T, Xb[:, 3:]], axis=1)    # forces in inertial axes
+    k = wavenumber(np.asarray(omega, dtype=float), env.gravity, depth)
+    x, y = body.position
+    return Xs * np.exp(-1j * k * (x * np.cos(heads) + y * np.sin(heads)))[:, None]
+
+
+def on_hull(scene, body) -> bool:
+    """Whether the waves act on a body's wetted hull (its nonlinear hydrostatics, buoyancy and waves on)."""
+    return body.hydrostatics.nonlinear and scene.effects.buoyancy and scene.effects.waves
+
+
 def excitation(src: Source, omega, beta, g, depth=None) -> np.ndarray:
     """X (n, d) in the step's dofs per unit wave amplitude at the vessel's COG, waves heading beta."""
     t = src.tables
@@ -185,6 +208,11 @@ def frequency_terms(scene, omega, headings):
             X = excitation(src, w, float(beta), scene.environment.gravity, depth)
             X[:, ix < 6] = 0.0             # the vessel's own columns: its own terms' (rao.py)
             F[:, h, ix] += X
+    for s, b in enumerate(scene.bodies):
+        # a body without tables whose hull takes the waves: the small-wave limit of that pressure, as a run has it
+        if on_hull(scene, b) and not np.abs(F[:, :, 6 + 6 * s:12 + 6 * s]).max(initial=0.0) > 0:
+            for h, beta in enumerate(headings):
+                F[:, h, 6 + 6 * s:12 + 6 * s] = hull_share(scene, b, w, np.full(w.shape, float(beta)))
     return dA, B, F
 
 
@@ -216,6 +244,10 @@ def time_terms(scene, params: dict):
                 for k, i in enumerate(src.index[::6]):
                     if i >= 6:                   # the vessel's own columns are its own terms'
                         X[i // 6 - 1, m] += Xs[:, 6 * k:6 * k + 6]
+    if X is not None:
+        for s, b in enumerate(scene.bodies):
+            if np.abs(X[s]).max() > 0 and on_hull(scene, b):
+                X[s] -= hull_share(scene, b, c.omega, waves.heading if c.headings is None else c.headings)
     memory = None
     if poles and sum(p.size for p in poles):
         p = np.concatenate(poles)

@@ -9,7 +9,9 @@ import numpy as np
 
 from ..hull.clip import MIDPOINT_RULE, area_vectors, clip_below
 from ..hydro.spectra import components, wavenumber
+from ..physics.about import About
 from ..physics.hull import HullPressure, IncidentWaves
+from ..physics.vessel import Weight
 from .about import hull_about
 
 def hull_pressure(scene) -> bool:
@@ -37,30 +39,69 @@ def incident_waves(scene, params: dict) -> IncidentWaves:
 
 
 def build_hull_pressure(scene, params: dict, g) -> HullPressure:
-    """The term: still water, and the incident waves where the scene has them and `[effects] waves` is on.
+    """The vessel's term: still water, and the incident waves where the scene has them and
+    `[effects] waves` is on (`hull_term` of `[vessel.hull]`)."""
+    return hull_term(scene, scene.vessel.hull, params, g)
 
-    A traced `vessel.hull.kg` moves the COG against the hull: in the vessel frame (origin at the
+
+def hull_term(scene, hull, params: dict, g, key: str = "vessel.hull", place=None) -> HullPressure:
+    """The pressure term of `hull` (the vessel's, or a body's: `key` its params' prefix, `place` its
+    rest COG's (x, y) from the vessel's, where the waves reach it): one builder for every floating
+    body's wetted hull.
+
+    A traced `<key>.kg` moves the COG against the hull: in the body's frame (origin at the
     COG) the surface shifts by kg0 - kg along z and the still water plane, `draft` above the keel,
-    lies at draft - kg; a mesh's traced `vessel.hull.cog` shifts it by cog0 - cog, the water at
+    lies at draft - kg; a mesh's traced `<key>.cog` shifts it by cog0 - cog, the water at
     -cog_z (the file's z = 0). The triangles stay the scene's (constants) and carry the shift as a vector
-    (HullPressure.shift), so the clipping's tangent stays the water plane's. The vessel's mass and
+    (HullPressure.shift), so the clipping's tangent stays the water plane's. The mass and
     inertia about the COG are the scene's (`vessel.mass`, `vessel.inertia`): KG moves the hull
     against them, not their distribution."""
-    hull, env = scene.vessel.hull, scene.environment
+    env = scene.environment
     waves = scene.waves if scene.waves is not None and scene.effects.waves else None
     tris = hull.triangles(hull.divisions(waves))
     rho = jnp.asarray(params.get("environment.water_density", env.water_density), dtype=float)
     inc: Optional[IncidentWaves] = incident_waves(scene, params) if waves is not None else None
     z_water, shift = jnp.asarray(hull.water_height(), dtype=float), None
-    if "vessel.hull.kg" in params:
-        kg = jnp.asarray(params["vessel.hull.kg"], dtype=float)
+    if f"{key}.kg" in params:
+        kg = jnp.asarray(params[f"{key}.kg"], dtype=float)
         z_water = jnp.asarray(hull.draft, dtype=float) - kg
         shift = jnp.stack([jnp.zeros_like(kg), jnp.zeros_like(kg), hull.kg - kg])
-    elif "vessel.hull.cog" in params:       # a mesh: its waterline is z = 0 of the file's coordinates
-        cog = jnp.asarray(params["vessel.hull.cog"], dtype=float)
+    elif f"{key}.cog" in params:       # a mesh: its waterline is z = 0 of the file's coordinates
+        cog = jnp.asarray(params[f"{key}.cog"], dtype=float)
         z_water = -cog[2]
         shift = jnp.asarray(hull.cog, dtype=float) - cog
-    return HullPressure(jnp.asarray(tris), rho, g, z_water, inc, shift, about=hull_about(scene, waves is not None))
+    at = None if place is None else jnp.asarray([place[0], place[1], 0.0], dtype=float)
+    return HullPressure(jnp.asarray(tris), rho, g, z_water, inc, shift,
+                        about=hull_about(scene, waves is not None, hull), place=at)
+
+
+def body_restoring(scene, body, params: dict, g, liquid=None) -> Optional[tuple]:
+    """The restoring terms of a `[[bodies]]` body with nonlinear hydrostatics, as the vessel's
+    (assemble/system.py): its hull's pressure (`hull_term`, the waves at its place) and its weight,
+    the liquid of its tanks (`liquid`) included; () with `[effects] buoyancy` off (nothing holds it
+    up nor pulls it down, as the vessel); None for linear hydrostatics (assemble/bodies.py's term)."""
+    if not body.hydrostatics.nonlinear:
+        return None
+    if not scene.effects.buoyancy:
+        return ()
+    key = f"bodies.{body.name}"
+    mass = jnp.asarray(params.get(f"{key}.mass", body.mass), dtype=float)
+    S = jnp.zeros(3)
+    if liquid is not None:
+        mass, S = mass + liquid.total_mass(), liquid.rigid_first_moment()
+    weight = About(("gravity", f"the weight of the body {body.name!r} and its liquid, borne by its hull's pressure"))
+    return (hull_term(scene, body.hull, params, g, f"{key}.hull", body.position),
+            Weight(mass=mass, S=S, gravity=g, about=weight))
+
+
+def restoring_words(scene, body) -> str:
+    """A body's nonlinear restoring in words (its line in `jaxslosh check`)."""
+    if not scene.effects.buoyancy:
+        return "no hydrostatics ([effects] buoyancy off)"
+    waves = scene.waves is not None and scene.effects.waves
+    return (f"nonlinear hydrostatics: the still-water pressure on the instantaneous wetted surface of its "
+            f"{body.hull.describe()}" + (" and the waves' Froude-Krylov pressure there, at its place" if waves else "")
+            + ", and its weight")
 
 
 def froude_krylov_surface(tris, z_water, omega, headings, rho=1025.0, g=9.81, depth=None):

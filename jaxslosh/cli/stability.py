@@ -63,7 +63,11 @@ def cmd_stability(a):
     else:
         print_vessel(s, a.axis)
     for b in s.bodies.values():
-        print_body(b)
+        if b["model"] == "hull":        # a body with its own hull: the vessel's table of its curves
+            print(f"body {b.name}:")
+            print_vessel(b, a.axis)
+        else:
+            print_body(b)
     if a.output:
         print(f"wrote {a.output}")
     return EXIT_OK

@@ -108,11 +108,16 @@ class HullPressure(AbstractTerm):
     waves: Optional[IncidentWaves] = None
     # (3,) body frame: the surface is tris + shift (a traced KG: assemble/hull.py); None: tris itself
     shift: Optional[jax.Array] = None
+    # (3,) the rest COG's horizontal place (x, y, 0) in the waves' frame (from the vessel's rest COG):
+    # a body's (X0 is its offset from its own rest), so that the waves reach it with its own phase;
+    # None: the origin (the vessel)
+    place: Optional[jax.Array] = None
     about: About = eqx.field(static=True, default=About())     # the hull (box or mesh file) and its waves
 
-    def __init__(self, tris, rho_w, gravity, z_water, waves=None, shift=None, about=About()):
+    def __init__(self, tris, rho_w, gravity, z_water, waves=None, shift=None, about=About(), place=None):
         self.panels = coordinate_major(tris)
         self.rho_w, self.gravity, self.z_water, self.waves, self.shift = rho_w, gravity, z_water, waves, shift
+        self.place = place
         self.about = about
 
     def describe(self) -> tuple:
@@ -144,6 +149,8 @@ class HullPressure(AbstractTerm):
         each triangle below the plane tangent to the incident surface at its centroid, by the
         edge-midpoint rule on each wetted piece (hull/clip.cut_pieces)."""
         w, P = self.waves, self.surface_panels()
+        if self.place is not None:       # the waves' frame; the water's height is the same (place[2] = 0)
+            X0 = X0 + self.place
         C = _to_inertial(X0, A, (P[0] + P[1] + P[2]) / 3.0)          # (3, n) centroids, inertial
         eta, slope = w.elevation_and_slope(C, t)
         N_in = jnp.stack([-slope[0], -slope[1], jnp.ones_like(eta)])  # (3, n)

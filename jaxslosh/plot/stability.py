@@ -16,9 +16,9 @@ def plot_stability(s, out: str, title: str = ""):
     ax.plot(deg, s.gz, color="C0", label="vessel, linear hydrostatics" if linear else "liquids level (b)")
     if not linear:
         ax.plot(deg, s.gz_frozen, color="C1", ls="--", label="liquids frozen (a)")
-    for i, b in enumerate(getattr(s, "bodies", {}).values()):      # [[bodies]]: their linear curves
+    for i, b in enumerate(getattr(s, "bodies", {}).values()):      # [[bodies]]: their linear or hull curves
         ax.plot(np.degrees(np.asarray(b.angle)), b.gz, color=f"C{i + 4}", lw=1.2,
-                label=f"{b.name}, linear (GM0 = {b.gm0:.3f} m)")
+                label=f"{b.name}, {b['model']} (GM0 = {b.gm0:.3f} m)")
     # GM0 as the tangent at the origin, drawn to one radian
     ax.plot([0, np.degrees(1.0)], [0, s.gm0], color="C0", lw=0.7, ls=":", label=f"GM0 = {s.gm0:.3f} m at 1 rad")
     ax.axhline(0.0, color="k", lw=0.6)

@@ -15,16 +15,16 @@ from typing import Optional
 import numpy as np
 
 from .fields import non_negative, one_of, positive, read, show, valid_name
+from .hull import read_hydrostatics
 from ..hull.surface import HullMeshError
 from ..hydro.database import DatabaseError
 from ..hydro.multibody import file_bodies, netcdf_centres, read_multibody
 from .types import Body, Connection, Hydrostatics, Initial, SceneError
-from .waves import FileContext, read_hydrodynamics
+from .waves import FileContext, read_hull, read_hydrodynamics
 
 KINDS = ("hawser", "fender", "spring")
 #: the vessel's keys a body cannot have yet, refused by name (not as unknown keys)
-NOT_YET = {"hull": "hull meshes (and the waves' and the nonlinear hydrostatics' forces on them)",
-           "forced": "prescribed motions"}
+NOT_YET = {"forced": "prescribed motions"}
 #: names a body cannot take: the words that name the vessel and an inertial point in `bodies = [...]`
 RESERVED = ("vessel", "fixed")
 #: how far a connection point may lie outside its body's hull, relative to the hull's size (round-off:
@@ -83,7 +83,7 @@ def read_bodies(tables, vessel, environment, warnings: list[str], files=None, ta
             "name": ("str", valid_name), "position": ("any", None), "heading": ("float", None),
             "cog_height": ("float", None), "mass": ("float", positive), "inertia": ("inertia", None),
             "hydrostatics": ("table", None), "hydrodynamics": ("table", None), "initial": ("table", None),
-            "footprint": ("any", None),
+            "footprint": ("any", None), "hull": ("table", None),
         }, required=("name", "mass", "inertia", "hydrostatics"))
         name = v["name"]
         if name in RESERVED or name == vessel.name:
@@ -96,7 +96,9 @@ def read_bodies(tables, vessel, environment, warnings: list[str], files=None, ta
                                                                   and math.isfinite(c) for c in pos)):
             raise SceneError(f"{where}.position", f"must be a list of 2 numbers [x, y] (m, horizontally from the "
                                                   f"vessel's COG at rest), got {show(pos)}")
-        hs = _hydrostatics(table["hydrostatics"], f"{where}.hydrostatics", warnings)
+        base = (files or FileContext()).base_dir
+        hull = read_hull(table["hull"], base, f"{where}.hull") if "hull" in table else None
+        hs = _hydrostatics(table["hydrostatics"], where, warnings, hull, environment)
         damping = hydro = None
         if "hydrodynamics" in table:      # the vessel's keys and reader (a file's block of this body)
             ctx = (files or FileContext())._replace(body=name)
@@ -110,14 +112,21 @@ def read_bodies(tables, vessel, environment, warnings: list[str], files=None, ta
         }))
         body = Body(name=name, mass=v["mass"], inertia=v["inertia"], hydrostatics=hs,
                     position=(float(pos[0]), float(pos[1])), heading=v.get("heading", 0.0),
-                    cog_height=v.get("cog_height", 0.0), initial=initial, viscous_damping=damping,
-                    hydrodynamics=hydro, footprint=read_footprint(table, where),
+                    cog_height=v.get("cog_height", hull.default_cog_height() if hull is not None else 0.0),
+                    initial=initial, viscous_damping=damping, hydrodynamics=hydro,
+                    footprint=read_footprint(table, where), hull=hull,
                     tanks=tuple(t for t, c in zip(tanks, carriers) if c == name))
         buoyant = environment.water_density * hs.displaced_volume
         # as the vessel's: its mass is the body's without the liquid of its tanks
         total = body.mass + sum(t.liquid_mass for t in body.tanks)
         liquid = f" (body {body.mass:.6g} kg + tank liquid {total - body.mass:.6g} kg)" if body.tanks else ""
-        if environment.gravity > 0 and abs(total - buoyant) > 0.01 * buoyant:
+        if environment.gravity > 0 and abs(total - buoyant) > 0.01 * buoyant and hs.nonlinear:
+            # the restoring is the hull's own: the body is released out of equilibrium, as the vessel is
+            warnings.append(f"bodies[{i}].mass: the body's mass {total:.6g} kg{liquid} differs from the water its hull "
+                            f"displaces at rest, {buoyant:.6g} kg, by {100 * (total - buoyant) / buoyant:+.2f} %: it "
+                            f"starts out of equilibrium and {'sinks' if total > buoyant else 'rises'} to its own "
+                            "draft (heaving about it) from t = 0")
+        elif environment.gravity > 0 and abs(total - buoyant) > 0.01 * buoyant:
             warnings.append(f"{where}.hydrostatics.displaced_volume: the body's mass {total:.6g} kg{liquid} differs from "
                             f"water_density * displaced_volume = {buoyant:.6g} kg by "
                             f"{100 * (total - buoyant) / buoyant:+.2f} %; its hydrostatic restoring is taken "
@@ -127,10 +136,19 @@ def read_bodies(tables, vessel, environment, warnings: list[str], files=None, ta
     return tuple(out)
 
 
-def _hydrostatics(table, where: str, warnings: list[str]) -> Hydrostatics:
+def _hydrostatics(table, owner: str, warnings: list[str], hull=None, environment=None) -> Hydrostatics:
+    """`[bodies.hydrostatics]` of the body `owner` ("bodies[i]"): with a `[bodies.hull]`, the
+    vessel's reader (its nonlinear model, the box's closed forms for what the table leaves out);
+    without one, the four linear values."""
+    where = f"{owner}.hydrostatics"
+    if hull is not None:
+        if not hull.closed_form and not (isinstance(table, dict) and table.get("model") == "nonlinear"):
+            raise SceneError(f"{owner}.hull.type", 'a "mesh" hull on a body is read by the nonlinear hydrostatics: '
+                                                   'add [bodies.hydrostatics] model = "nonlinear" (or use a box)')
+        return read_hydrostatics(table, warnings, hull, environment, owner)
     if isinstance(table, dict) and table.get("model") == "nonlinear":
-        raise SceneError(f"{where}.model", '"nonlinear" hydrostatics (a hull\'s wetted surface) are not available '
-                                           'yet for [[bodies]]: give the linear values')
+        raise SceneError(f"{where}.model", '"nonlinear" hydrostatics need the body\'s [bodies.hull] table: a box '
+                                           'with its depth, or a closed mesh (type = "mesh")')
     v = read(table, where, {
         "waterplane_area": ("float", positive), "displaced_volume": ("float", positive), "gm_t": ("float", None),
         "gm_l": ("float", None), "moment": ("str", one_of(("conservative", "paper"))),
@@ -256,17 +274,17 @@ def _body_tank(table, where: str, body: str) -> None:
                                               f"body; {where}.{key})")
 
 
-def hull_extent(owner) -> Optional[tuple]:
+def hull_extent(owner, key: str = "vessel.hull.file") -> Optional[tuple]:
     """((x_min, y_min, z_min or -inf), (x_max, y_max)) of a body's (or the vessel's) hull in its frame
-    from its COG, what the connection points are checked against: the vessel's hull where it has one
-    (its plan and its keel), else the rectangle of a `footprint` about the COG (its plan only: a
-    body has no keel), else None (nothing to check against)."""
+    from its COG, what the connection points are checked against: its hull where it has one (its
+    plan and its keel), else the rectangle of a `footprint` about the COG (its plan only: a
+    footprint has no keel), else None (nothing to check against). `key`: the hull's file key."""
     hull = getattr(owner, "hull", None)
     if hull is not None:
         try:
             return hull.extent()
         except HullMeshError as e:
-            raise SceneError("vessel.hull.file", str(e)) from None
+            raise SceneError(key, str(e)) from None
     if owner.footprint is not None:
         half = 0.5 * np.asarray(owner.footprint)
         return (-half[0], -half[1], -math.inf), (half[0], half[1])
@@ -278,9 +296,10 @@ def _points_inside(connections, vessel, bodies) -> None:
     its keel themselves included, within EDGE of the hull's size): a hawser's fairlead or a
     fender's face outside it is a typing error (a sign or the other body's frame)."""
     owners = {"vessel": vessel} | {b.name: b for b in bodies}
+    keys = {"vessel": "vessel.hull.file"} | {b.name: f"bodies[{i}].hull.file" for i, b in enumerate(bodies)}
     for i, c in enumerate(connections):
         for k, (end, p) in enumerate(zip(c.ends, c.points)):
-            box = hull_extent(owners[end]) if end in owners else None
+            box = hull_extent(owners[end], keys[end]) if end in owners else None
             if box is None:
                 continue
             lo, hi = np.asarray(box[0]), np.asarray(box[1])
@@ -290,8 +309,8 @@ def _points_inside(connections, vessel, bodies) -> None:
             if p[2] < lo[2] - tol:
                 out.append(f"z = {p[2]:.6g} m below the keel at {lo[2]:.6g} m")
             if out:
-                whose = "the vessel's hull" if end == "vessel" and getattr(vessel, "hull", None) is not None \
-                    else f"{end!r}'s footprint"
+                whose = (("the vessel's" if end == "vessel" else f"{end!r}'s")
+                         + (" hull" if getattr(owners[end], "hull", None) is not None else " footprint"))
                 raise SceneError(f"connections[{i}].points", (
                     f"point {k + 1} {list(p)} (in {end!r}'s frame, from its COG) lies outside {whose}: "
                     f"{'; '.join(out)}"))
@@ -383,7 +402,12 @@ def bodies_scene(bodies, vessel, structures, mapping, warnings: list[str], files
         except DatabaseError as e:
             raise SceneError(key, " ".join(str(e).split())) from None
     _wave_headings(bodies, mapping.get("waves"), () if coupled is None else coupled[1])
-    dry = [b.name for b in bodies if b.hydrodynamics is None or b.hydrodynamics.excitation_amplitude is None]
+    # a body's nonlinear hydrostatics take the waves' pressure on its hull (the waves' effect and
+    # buoyancy on: without them no hull force acts, and the warning below stays true)
+    eff = mapping.get("effects", {}) if isinstance(mapping.get("effects", {}), dict) else {}
+    on_hull = eff.get("buoyancy", True) is not False and eff.get("waves", True) is not False
+    dry = [b.name for b in bodies if (b.hydrodynamics is None or b.hydrodynamics.excitation_amplitude is None)
+           and not (b.hydrostatics.nonlinear and on_hull)]
     if "waves" in mapping and dry:
         warnings.append(f"waves: the [[bodies]] {', '.join(repr(n) for n in dry)} have no excitation tables "
                         f"([bodies.hydrodynamics] file or excitation_amplitude): the waves exert no force on them")

@@ -39,9 +39,12 @@ TABLES = (
     ("mooring", "Zero or more `[[mooring]]` lines from the seabed to the vessel or a body (guide: Moorings)."),
     ("bodies", "Zero or more `[[bodies]]`: rigid floating bodies beside the vessel, each in its own frame "
                "(guide: Bodies and connections)."),
-    ("bodies.hydrostatics", "The body's linear restoring about its rest pose, as `[vessel.hydrostatics]`."),
+    ("bodies.hydrostatics", "The body's restoring, as `[vessel.hydrostatics]`: linear about its rest pose, or "
+                            "nonlinear on its hull."),
+    ("bodies.hull", "The body's hull, with `[vessel.hull]`'s keys, in its frame from its COG: its nonlinear "
+                    "hydrostatics, a box's closed forms, its connection points' bounds."),
     ("bodies.hydrodynamics", "The body's hydrodynamics, with `[vessel.hydrodynamics]`'s keys (tables, a file, "
-                             "viscous damping; not `capytaine`: a body has no hull): about its COG, in its axes; "
+                             "viscous damping; not `capytaine`): about its COG, in its axes; "
                              "a multibody file couples the bodies it names."),
     ("bodies.initial", "The body's initial state, as `[vessel.initial]`; every key optional, zero by default."),
     ("connections", "Zero or more `[[connections]]`: hawsers, fenders and springs between two bodies, or a "
@@ -292,21 +295,23 @@ KEYS = (
     ("bodies.position", "[0, 0]", "m", "Its COG at rest, horizontally from the vessel's COG at rest, inertial "
                                        "[x, y]; their waterplanes (circles of their areas, or rectangles of their `footprint`) must not overlap."),
     ("bodies.heading", "0", "rad", "Its x axis from the inertial X axis at rest."),
-    ("bodies.cog_height", "0", "m", "Its COG's height above the still-water level at rest (a multibody file's "
+    ("bodies.cog_height", "0 (a box hull: kg - draft)", "m", "Its COG's height above the still-water level at rest (a multibody file's "
                                     "rotation centre's, where it stores one)."),
     ("bodies.footprint", "the circle of the waterplane area", "m", "[length, beam] of its waterplane at rest, "
      "along its heading and across: the overlap check compares this rectangle instead of the circle; the "
      "connection points must lie within it."),
     ("bodies.mass", _REQ, "kg", "The body's mass."),
     ("bodies.inertia", _REQ, "kg m^2", "About its COG, its body axes: 3 diagonal values or 3 x 3."),
-    ("bodies.hydrostatics.waterplane_area", _REQ, "m^2", "A_w: heave restoring rho g A_w."),
-    ("bodies.hydrostatics.displaced_volume", _REQ, "m^3", "Displaced volume at rest (its buoyancy balances its "
-                                                          "weight there)."),
-    ("bodies.hydrostatics.gm_t", _REQ, "m", "Transverse metacentric height."),
-    ("bodies.hydrostatics.gm_l", _REQ, "m", "Longitudinal metacentric height."),
+    ("bodies.hydrostatics.waterplane_area", "required (the box's with a box hull)", "m^2",
+     "A_w: heave restoring rho g A_w."),
+    ("bodies.hydrostatics.displaced_volume", "required (the box's with a box hull)", "m^3",
+     "Displaced volume at rest (its buoyancy balances its weight there)."),
+    ("bodies.hydrostatics.gm_t", "required (the box's with a box hull)", "m", "Transverse metacentric height."),
+    ("bodies.hydrostatics.gm_l", "required (the box's with a box hull)", "m", "Longitudinal metacentric height."),
     ("bodies.hydrostatics.moment", '"conservative"', "", 'As `vessel.hydrostatics.moment`.'),
-    ("bodies.hydrostatics.model", '"linear"', "", '"linear" only (the nonlinear hydrostatics of a hull are not '
-                                                  "available yet for bodies)."),
+    ("bodies.hydrostatics.model", '"linear"', "", 'As `vessel.hydrostatics.model`: "nonlinear" needs '
+                                                  "`[bodies.hull]` (a box with its depth, or a closed mesh); the "
+                                                  "waves' pressure on it at the body's place."),
     ("bodies.initial.position", "[0, 0, 0]", "m", "Inertial offset of its COG from its rest position."),
     ("bodies.initial.velocity", "[0, 0, 0]", "m/s", "Inertial velocity of its COG."),
     ("bodies.initial.angular_velocity", "[0, 0, 0]", "rad/s", "Its body frame."),
@@ -338,6 +343,10 @@ KEYS = (
                                                          '"connection.<name>" (N, its force about its mean); '
                                                          'quoted or as a dotted key.'),
 )
+# a body's hull: the vessel's keys, read by the vessel's reader (scene/bodies.py)
+KEYS = KEYS + tuple(
+    (k.replace("vessel.", "bodies.", 1), d, u, f"As `{k}` (in the body's frame from its COG).")
+    for k, d, u, _ in KEYS if k.startswith("vessel.hull."))
 # a body's hydrodynamics: the vessel's keys, read by the vessel's reader (scene/bodies.py)
 KEYS = KEYS + tuple(
     (k.replace("vessel.", "bodies.", 1), d, u, f"As `{k}`" + (" (a multibody file: this body's block, about its "

@@ -145,6 +145,7 @@ class Body:
     hydrodynamics: Optional["Hydrodynamics"] = None   # the vessel's keys: tables, a file (its block of a multibody one)
     footprint: Optional[tuple] = None   # (length, beam) m of the waterplane along its heading: the overlap check
     tanks: tuple = ()                # the [[tanks]] it carries (`tanks.body`), in its frame from its COG
+    hull: Optional["Hull"] = None    # [bodies.hull]: the vessel's kinds (scene/hulls.py), in its frame from its COG
 
 
 @dataclass(frozen=True)

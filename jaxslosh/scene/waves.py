@@ -80,8 +80,8 @@ def _at_least_one(v):
     return None if v >= 1.0 else f"must be >= 1, got {v}"
 
 
-def read_hull(table, base_dir: str = "") -> Hull:
-    where = "vessel.hull"
+def read_hull(table, base_dir: str = "", where: str = "vessel.hull") -> Hull:
+    """`[vessel.hull]` (or a body's `[bodies.hull]`: `where` names its keys)."""
     v = read(table, where, {
         "type": ("str", one_of(HULL_TYPES)), "length": ("float", positive), "beam": ("float", positive),
         "draft": ("float", positive), "kg": ("float", None), "file": ("str", None), "cog": ("vec3", None),

@@ -16,7 +16,7 @@ def rows_and_residual(on_body: str, alone: str, seed: int, sizes=(0.05, 0.1, 0.2
     the liquid's unknowns displaced, moving and accelerating by `sizes`."""
     floating = bodies_term(build(js.load_scene(on_body)).system).bodies[0]
     vessel = build(js.load_scene(alone)).system
-    assert floating.nf == vessel.nf > 0
+    assert floating.nf == vessel.nf
     rng = np.random.default_rng(seed)
     x, q = jnp.asarray(rng.normal(size=3) * 0.1), quat_from_rpy(jnp.asarray([0.05, -0.08, 0.3]))
     v, a = jnp.asarray(rng.normal(size=6) * 0.1), jnp.asarray(rng.normal(size=6) * 0.1)

@@ -47,6 +47,8 @@ _EXTRA = [
             '[[probes]]\nname = "B"\ntank = "t"\npoint = [4.0, 2.5, 2.0]\n'
             '[waves]\ntype = "jonswap"\nhs = 1.0\ntp = 8.0\n'
             '[campaign]\nseeds = 2\n[campaign.limits]\nroll = 0.1\n"probe.B" = 0.5\n',
+    _BASE + '[[bodies]]\nname = "b"\nposition = [0.0, 100.0]\nmass = 1.0e5\ninertia = [1.0e6, 1.0e6, 1.0e6]\n'
+            '[bodies.hull]\nlength = 10.0\nbeam = 5.0\ndraft = 2.0\nkg = 1.0\n[bodies.hydrostatics]\nmodel = "linear"\n',
 ]
 
 
