@@ -73,7 +73,7 @@ def body_liquid(scene, body, q0, g):
                               simulation=dataclasses.replace(scene.simulation, linear_solver="dense"))
     if multimodal_scene(own):     # the vessel's multimodal liquid and damping; its fields on surface meshes
         liquid = build_multimodal(own, {}, g)
-        damping = multimodal_damping(own, {}, liquid)
+        damping, _ = multimodal_damping(own, {}, liquid)
         return liquid, () if damping is None else (damping,), surface_meshes(own)
     block = build_liquid_block(own, {}, g)
     liquid = dataclasses.replace(block.liquid, coriolis=eff.coriolis, centrifugal=eff.centrifugal)
