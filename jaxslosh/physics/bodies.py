@@ -98,7 +98,9 @@ class Link(eqx.Module):
     def curve(self, x):
         """(W(x), F(x)): the curve's energy and force at deflection x >= 0."""
         xs, fs = self.xs, self.fs
-        i = jnp.clip(jnp.searchsorted(xs, x, side="right") - 1, 0, xs.shape[0] - 2)
+        # a curve has a handful of points: compared with all of them at once (the default search's
+        # loop of bisections made a tenth of the FLNG scene's step program)
+        i = jnp.clip(jnp.searchsorted(xs, x, side="right", method="compare_all") - 1, 0, xs.shape[0] - 2)
         slope = (fs[1:] - fs[:-1]) / (xs[1:] - xs[:-1])
         W_nodes = jnp.concatenate([jnp.zeros(1), jnp.cumsum(0.5 * (fs[1:] + fs[:-1]) * (xs[1:] - xs[:-1]))])
         s = x - xs[i]
