@@ -14,7 +14,7 @@ import jax
 import jax.numpy as jnp
 import numpy as np
 
-from ..mooring.lumped_term import build_lumped_lines
+from ..mooring.lumped_term import build_lumped_lines, group_lines
 from ..mooring.term import build_mooring
 from ..liquid.modal_damping import ModalDamping
 from ..physics.bodies import bodies_term
@@ -157,7 +157,7 @@ def _model(scene: Scene, params: dict, outline: bool = False) -> _Model:
             terms.append(Weight(mass=mass + liquid.total_mass(), S=S, gravity=g, about=weight))
     if any(m.model == "catenary" for m in scene.mooring):   # quasi-static catenary lines (jaxslosh/mooring/term.py)
         terms.append(build_mooring(scene, balanced, outline, params))
-    terms.extend(build_lumped_lines(scene, balanced, q0))    # dynamic lumped-mass lines (mooring/lumped_term.py)
+    terms.extend(group_lines(build_lumped_lines(scene, balanced, q0)))    # dynamic lumped-mass lines (mooring/lumped_term.py)
     bodies, body_tanks = build_bodies(scene, params, g, outline)   # [[bodies]] and [[connections]] (physics/bodies.py)
     if bodies is not None:
         terms.append(bodies)

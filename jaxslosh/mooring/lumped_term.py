@@ -17,6 +17,7 @@ the scene's anchor (x, y from the COG at rest, z from the still-water level) by 
 """
 from __future__ import annotations
 
+import dataclasses
 import math
 from typing import Optional
 
@@ -104,19 +105,85 @@ class LumpedLineTerm(AbstractTerm):
                  f"of the step (symplectic Euler, stable sub-step {ln.substep_max:.3g} s)"),)
 
 
+class LumpedLines(AbstractTerm):
+    """Lumped lines of one shape (the same segments and sub-steps) as one term: each line's
+    LumpedLineTerm equations mapped over the lines (jax.vmap) on their arrays stacked, so that the
+    step's program holds one line's sub-steps whatever the number of lines (each line a term of
+    its own repeated them per line in every copy of the residual: the FLNG scene's eight lines
+    made two thirds of its program, docs/benchmarks.md). States: (lines, the line's states)."""
+    lines: tuple             # LumpedLineTerm, one per line, all of one shape (group_lines)
+
+    @property
+    def names(self) -> tuple:
+        return tuple(t.name for t in self.lines)
+
+    def stacked(self) -> LumpedLineTerm:
+        """The lines as one LumpedLineTerm whose arrays have a leading axis of lines."""
+        plain = [dataclasses.replace(t, name="") for t in self.lines]
+        return jax.tree_util.tree_map(lambda *x: jnp.stack(x), *plain)
+
+    def state_init(self):
+        return jnp.stack([t.state_init() for t in self.lines])
+
+    def state_coefficients(self, h):
+        return jnp.asarray(h)
+
+    def state_advance(self, z, v_old, v_new, coef):
+        raise TypeError("a lumped line's states follow the vessel's configuration: state_advance_config")
+
+    def state_advance_config(self, z, c_old, v_old, c_new, v_new, coef):
+        return jax.vmap(lambda t, zi: t.state_advance_config(zi, c_old, v_old, c_new, v_new, coef))(self.stacked(), z)
+
+    def rows(self, k: Kin) -> Rows:
+        rigid = jax.vmap(lambda t, zi: t.rows(k._replace(z=zi)).rigid)(self.stacked(), k.z)
+        return Rows(jnp.sum(rigid, axis=0))
+
+    def observe(self, z, c: Config, V0, omega) -> tuple:
+        """(fairlead tensions (n,), anchor tensions (n,), nodes (n, N + 1, 3), energies {part: (n,)}) of
+        the lines (the energies: lm.energies, the dissipated work and the fairlead's)."""
+        def one(t, zi):
+            p, u = _fairlead(t.fairlead, c, V0, omega)
+            s = t.split(zi)
+            parts = dict(lm.energies(t.line, s.r, s.v, p), dissipated=s.dissipated, fairlead_work=s.work)
+            return (jnp.linalg.norm(lm.fairlead_force(t.line, s.r, s.v, p, u)),
+                    jnp.linalg.norm(lm.anchor_force(t.line, s.r, s.v, p, u)), t.nodes(c, zi),
+                    {k: parts[k] for k in LINE_ENERGY})
+        return jax.vmap(one)(self.stacked(), z)
+
+    def describe(self) -> tuple:
+        return sum((t.describe() for t in self.lines), ())
+
+
+def group_lines(terms) -> tuple:
+    """The line terms as LumpedLines, one per shape (segments, sub-steps), in their first line's order."""
+    groups: dict = {}
+    for t in terms:
+        groups.setdefault((t.line.segments, t.line.substep_max, t.substeps), []).append(t)
+    return tuple(LumpedLines(tuple(g)) for g in groups.values())
+
+
+@jax.jit
+def _rest_shape(line, p_b, X0, q):
+    """(nodes, converged, the line's force on the fairlead) of its static shape with the vessel at
+    (X0, q): one program, compiled once for every line of the same segments (its steps run op by
+    op took a compilation of each operation, a third of the FLNG scene's build)."""
+    fair, _ = _fairlead(p_b, Config(X0, q, jnp.zeros(0)), jnp.zeros(3), jnp.zeros(3))
+    nodes, ok = lm.static_shape(line, fair)
+    return nodes, ok, lm.fairlead_force(line, nodes, jnp.zeros_like(nodes), fair, jnp.zeros(3))
+
+
 def _static(line, p_b, X0, q, name):
-    """The line's static shape with the vessel at (X0, q), solved in float64 whatever the caller's
-    precision (a description, `jaxslosh check`, may build the model in float32, where the energy's
-    round-off stops the solve short of its tolerance), in the caller's precision."""
+    """(nodes, the line's force on the fairlead) of the line's static shape with the vessel at (X0,
+    q), solved in float64 whatever the caller's precision (a description, `jaxslosh check`, may
+    build the model in float32, where the energy's round-off stops the solve short of its
+    tolerance), in the caller's precision."""
     with jax.enable_x64(True):
-        line64 = jax.tree_util.tree_map(lambda x: jnp.asarray(x, dtype=jnp.float64), line)
-        c = Config(jnp.asarray(X0, dtype=jnp.float64), jnp.asarray(q, dtype=jnp.float64), jnp.zeros(0))
-        fair, _ = _fairlead(jnp.asarray(p_b, dtype=jnp.float64), c, jnp.zeros(3), jnp.zeros(3))
-        nodes, ok = jax.jit(lm.static_shape)(line64, fair)
-        nodes, ok = np.asarray(nodes), bool(ok)
+        f64 = lambda x: jnp.asarray(x, dtype=jnp.float64)  # noqa: E731
+        nodes, ok, F = _rest_shape(jax.tree_util.tree_map(f64, line), f64(p_b), f64(X0), f64(q))
+        nodes, ok, F = np.asarray(nodes), bool(ok), np.asarray(F)
     if not ok:
         raise ValueError(f"mooring.{name}: the line's static shape did not converge")
-    return jnp.asarray(nodes, dtype=float)
+    return jnp.asarray(nodes, dtype=float), jnp.asarray(F, dtype=float)
 
 
 def lumped_line_term(c0: Config, dt: float, *, name: str, fairlead, anchor, length, weight, ea,
@@ -152,13 +219,10 @@ def lumped_line_term(c0: Config, dt: float, *, name: str, fairlead, anchor, leng
                           seabed_damping=kw["seabed_damping"], rho=water_density, gravity=gravity,
                           current=current)
     p_b = jnp.asarray(fairlead, dtype=float)
-    nodes0 = _static(line, p_b, c0.X0, c0.q, name)
+    nodes0, _ = _static(line, p_b, c0.X0, c0.q, name)
     carried = jnp.zeros(3)
     if balanced:       # the pull at the rest position (X0 = 0, level), where the springs are balanced
-        q_rest = jnp.array([1.0, 0.0, 0.0, 0.0])
-        nodes_r = _static(line, p_b, jnp.zeros(3), q_rest, name)
-        fair_r, _ = _fairlead(p_b, Config(jnp.zeros(3), q_rest, c0.d), jnp.zeros(3), jnp.zeros(3))
-        F = lm.fairlead_force(line, nodes_r, jnp.zeros_like(nodes_r), fair_r, jnp.zeros(3))
+        _, F = _static(line, p_b, np.zeros(3), np.array([1.0, 0.0, 0.0, 0.0]), name)
         carried = jnp.array([0.0, 0.0, -F[2]])
     return LumpedLineTerm(line, p_b, nodes0, carried, name, line.substeps(dt))
 
@@ -199,38 +263,37 @@ def lumped_observe(system, z: tuple, c: Config, V0, omega) -> dict:
     energies `energy/mooring/<line>/<part>` (J: lm.energies, the dissipated work and the fairlead's)."""
     out = {}
     for term, zi in zip(system.all_terms(), z, strict=True):
-        if isinstance(term, LumpedLineTerm):
-            p, u = _fairlead(term.fairlead, c, V0, omega)
-            s = term.split(zi)
-            out[f"mooring/{term.name}/fairlead_tension"] = jnp.linalg.norm(lm.fairlead_force(term.line, s.r, s.v, p, u))
-            out[f"mooring/{term.name}/anchor_tension"] = jnp.linalg.norm(lm.anchor_force(term.line, s.r, s.v, p, u))
-            out[f"mooring/{term.name}/nodes"] = term.nodes(c, zi)
-            parts = dict(lm.energies(term.line, s.r, s.v, p), dissipated=s.dissipated, fairlead_work=s.work)
-            out.update({f"energy/mooring/{term.name}/{k}": parts[k] for k in LINE_ENERGY})
+        if isinstance(term, LumpedLines):
+            fair, anchor, nodes, energy = term.observe(zi, c, V0, omega)
+            for i, name in enumerate(term.names):
+                out[f"mooring/{name}/fairlead_tension"] = fair[i]
+                out[f"mooring/{name}/anchor_tension"] = anchor[i]
+                out[f"mooring/{name}/nodes"] = nodes[i]
+                out.update({f"energy/mooring/{name}/{k}": energy[k][i] for k in LINE_ENERGY})
     return out
 
 
 def with_lines(stepper, terms):
-    """A Stepper (run/stepper.py) whose System has the given line terms added beside its own
-    (how a test or a user adds lumped lines before the scene's keys are wired)."""
-    return eqx.tree_at(lambda s: s.built.system.terms, stepper, stepper.built.system.terms + tuple(terms))
+    """A Stepper (run/stepper.py) whose System has the given line terms added beside its own, as
+    LumpedLines (how a test or a user adds lumped lines before the scene's keys are wired)."""
+    return eqx.tree_at(lambda s: s.built.system.terms, stepper, stepper.built.system.terms + group_lines(terms))
 
 
 def line_states(stepper, state, term_index: Optional[int] = None):
-    """The integrator states of the System's LumpedLineTerms in a Stepper's state, by term: a dict
-    name -> (term, z)."""
+    """The lumped lines in a Stepper's state, by line: a dict name -> (its LumpedLineTerm, its states z);
+    `term_index`: those of the System's term of that index alone."""
     system = stepper.built.system
     out = {}
     for i, (term, z) in enumerate(zip(system.all_terms(), state.s.z, strict=True)):
-        if isinstance(term, LumpedLineTerm) and (term_index is None or term_index == i):
-            out[term.name] = (term, z)
+        if isinstance(term, LumpedLines) and (term_index is None or term_index == i):
+            out.update({t.name: (t, z[j]) for j, t in enumerate(term.lines)})
     return out
 
 
 def lumped_terms(system) -> tuple:
-    """The system's lumped lines' terms, in its terms' order."""
-    return tuple(t for t in system.all_terms() if isinstance(t, LumpedLineTerm))
+    """The system's lumped lines, each line's LumpedLineTerm, in its terms' order."""
+    return tuple(t for g in system.all_terms() if isinstance(g, LumpedLines) for t in g.lines)
 
 
-__all__ = ["LumpedLineTerm", "lumped_line_term", "read_lumped", "build_lumped_lines", "lumped_observe",
+__all__ = ["LumpedLineTerm", "LumpedLines", "group_lines", "lumped_line_term", "read_lumped", "build_lumped_lines", "lumped_observe",
            "lumped_terms", "with_lines", "line_states", "LUMPED_KEYS"]

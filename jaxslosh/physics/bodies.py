@@ -41,6 +41,7 @@ hawser does not push, a fender does not pull).
 """
 from __future__ import annotations
 
+import dataclasses
 from typing import Any, Optional
 
 import equinox as eqx
@@ -98,7 +99,9 @@ class Link(eqx.Module):
     def curve(self, x):
         """(W(x), F(x)): the curve's energy and force at deflection x >= 0."""
         xs, fs = self.xs, self.fs
-        i = jnp.clip(jnp.searchsorted(xs, x, side="right") - 1, 0, xs.shape[0] - 2)
+        # a curve has a handful of points: compared with all of them at once (the default search's
+        # loop of bisections made a tenth of the FLNG scene's step program)
+        i = jnp.clip(jnp.searchsorted(xs, x, side="right", method="compare_all") - 1, 0, xs.shape[0] - 2)
         slope = (fs[1:] - fs[:-1]) / (xs[1:] - xs[:-1])
         W_nodes = jnp.concatenate([jnp.zeros(1), jnp.cumsum(0.5 * (fs[1:] + fs[:-1]) * (xs[1:] - xs[:-1]))])
         s = x - xs[i]
@@ -115,15 +118,17 @@ class Link(eqx.Module):
         return W, sign * F * slope, slope
 
     def state(self, poses):
-        """(tension T (> 0 pulls), extension e, U, the two points, their velocities, the unit vector a -> b)
-        of this link, `poses[end]` = (X, A, V, omega) (omega body frame)."""
+        """(tension T (> 0 pulls), extension e, U, the unit vector a -> b) of this link, `poses[end]`
+        = (X, A, V, omega) (omega body frame)."""
         def point(end, p):
             if end == FIXED:
                 return p, jnp.zeros(3)
             X, A, V, w = poses[end]
             return X + A @ p, V + A @ jnp.cross(w, p)
-        Pa, Va = point(self.ends[0], self.pa)
-        Pb, Vb = point(self.ends[1], self.pb)
+        return self.state_at(*point(self.ends[0], self.pa), *point(self.ends[1], self.pb))
+
+    def state_at(self, Pa, Va, Pb, Vb):
+        """`state` for its two points at Pa, Pb (inertial) moving at Va, Vb."""
         dv = Pb - Pa
         d = jnp.sqrt(dv @ dv + _D_EPS2)
         n = dv / d
@@ -137,15 +142,47 @@ class Link(eqx.Module):
             Td = jnp.minimum(Td, -dU)
         return dU + Td, e, U, n
 
-    def forces(self, poses, rows: dict):
-        """Add its generalized forces (translation inertial, rotation body) to rows[end] (6,)."""
-        T, _, _, n = self.state(poses)
-        for end, p, f in ((self.ends[0], self.pa, T * n), (self.ends[1], self.pb, -T * n)):
-            if end == FIXED:
-                continue
-            A = poses[end][1]
-            rows[end] = rows[end] + jnp.concatenate([f, jnp.cross(p, A.T @ f)])
-        return rows
+
+def links_state(links: tuple, poses: dict, S: int):
+    """(T (n,), e (n,), U (n,), rows (S + 1, 6)) of the connections `links` (Link), `poses[end]` =
+    (X, A, V, omega) of the vessel and the S bodies: their tensions, extensions, energies in the
+    links' order, and their generalized forces (translation inertial, rotation body) on the bodies
+    (rows 0..S-1) and the vessel (row S).
+
+    The links of one kind and curve size are evaluated as one, Link.state_at mapped over their
+    arrays stacked (jax.vmap), their ends' poses gathered by index (a fixed point's pose the
+    identity, which gives its point and a zero velocity exactly): the program holds one link's
+    law per group, not one per connection (twelve connections made a fifth of the FLNG scene's
+    program, docs/benchmarks.md)."""
+    n = len(links)
+    if not n:
+        return jnp.zeros(0), jnp.zeros(0), jnp.zeros(0), jnp.zeros((S + 1, 6))
+    z3 = jnp.zeros(3)
+    ends = [poses[s] for s in range(S)] + [poses[VESSEL], (z3, jnp.eye(3), z3, z3)]
+    X, A, V, W = (jnp.stack(x) for x in zip(*ends))
+    slot = {VESSEL: S, FIXED: S + 1}
+    groups: dict = {}
+    for i, link in enumerate(links):       # static: by kind and curve size, at most a few groups
+        groups.setdefault((link.kind, link.xs.shape[0]), []).append(i)
+    rows = jnp.zeros((S + 2, 6))
+    T, e, U = jnp.zeros(n), jnp.zeros(n), jnp.zeros(n)
+    for idx in groups.values():
+        stacked = jax.tree_util.tree_map(lambda *x: jnp.stack(x), *[dataclasses.replace(links[i], ends=(0, 0))
+                                                                    for i in idx])
+        ia = np.array([slot.get(links[i].ends[0], links[i].ends[0]) for i in idx])
+        ib = np.array([slot.get(links[i].ends[1], links[i].ends[1]) for i in idx])
+
+        def one(link, Xa, Aa, Va, Wa, Xb, Ab, Vb, Wb):
+            Ti, ei, Ui, ni = link.state_at(Xa + Aa @ link.pa, Va + Aa @ jnp.cross(Wa, link.pa),
+                                           Xb + Ab @ link.pb, Vb + Ab @ jnp.cross(Wb, link.pb))
+            fa = Ti * ni
+            fb = -Ti * ni
+            return (Ti, ei, Ui, jnp.concatenate([fa, jnp.cross(link.pa, Aa.T @ fa)]),
+                    jnp.concatenate([fb, jnp.cross(link.pb, Ab.T @ fb)]))
+        Ti, ei, Ui, ra, rb = jax.vmap(one)(stacked, X[ia], A[ia], V[ia], W[ia], X[ib], A[ib], V[ib], W[ib])
+        rows = rows.at[ia].add(ra).at[ib].add(rb)
+        T, e, U = T.at[np.array(idx)].set(Ti), e.at[np.array(idx)].set(ei), U.at[np.array(idx)].set(Ui)
+    return T, e, U, rows[:S + 1]
 
 
 class Floating(eqx.Module):
@@ -255,19 +292,15 @@ class Bodies(AbstractOwner):
 
     def link_forces(self, poses):
         """(6 + 6 S,) the connections' generalized forces on the vessel and the bodies."""
-        rows = {e: jnp.zeros(6) for e in poses}
-        for link in self.links:
-            rows = link.forces(poses, rows)
-        return jnp.concatenate([rows[VESSEL]] + [rows[s] for s in range(self.S)])
+        rows = links_state(self.links, poses, self.S)[3]
+        return jnp.concatenate([rows[self.S], rows[:self.S].reshape(-1)])
 
     def link_potential(self, poses):
-        return sum((link.state(poses)[2] for link in self.links), jnp.zeros(()))
+        return jnp.sum(links_state(self.links, poses, self.S)[2])
 
     def link_states(self, c: Config, vy):
         """(tensions (n,), extensions (n,)) of the connections."""
-        p = self.poses(c, vy)
-        st = [link.state(p) for link in self.links]
-        return jnp.stack([s[0] for s in st]) if st else jnp.zeros(0), jnp.stack([s[1] for s in st]) if st else jnp.zeros(0)
+        return links_state(self.links, self.poses(c, vy), self.S)[:2]
 
     # ------------------------------------------------------------ a plain term without bodies
     def rows(self, k: Kin) -> Rows:

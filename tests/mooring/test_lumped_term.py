@@ -167,8 +167,11 @@ def test_gradient_through_a_moored_run():
     st = eqx.tree_at(lambda s: s.solver, st, dataclasses.replace(st.solver, implicit=True))
     s0 = st.init()
 
+    def line(s):
+        return s.built.system.terms[-1].lines[-1].line     # the last line (the lines are one term)
+
     def surge(scale):
-        b = eqx.tree_at(lambda s: s.built.system.terms[-1].line.cd, st, st.built.system.terms[-1].line.cd * scale)
+        b = eqx.tree_at(lambda s: line(s).cd, st, line(st).cd * scale)
         return b.advance(s0, 30).s.c.X0[0]
 
     g = jax.grad(surge)(1.0)
