@@ -7,8 +7,9 @@ group) whose rows are the sum of the *same term classes* as the vessel's rigid p
 `LinearDamping`),
 evaluated with the body's own kinematics (`Floating.kin`): a body is built by the functions that
 build the vessel's rigid terms, its wave excitation among them (seakeeping.py's `WaveExcitation`,
-its forces at the body's place in the incident field). What the vessel has and a body has not
-yet: hull meshes, nonlinear hydrostatics, and elastic tank walls.
+its forces at the body's place in the incident field), and, where the body has a hull with
+nonlinear hydrostatics, the vessel's hull pressure and weight terms (assemble/hull.py). What the
+vessel has and a body has not yet: elastic tank walls.
 
 Tanks on a body (`[[tanks]] body = ...`): each body's tanks are a liquid of the vessel's kind
 (jaxslosh/liquid, built by the vessel's builder: finite elements, reduced or full, whose block
