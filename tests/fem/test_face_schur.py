@@ -17,7 +17,13 @@ from jaxslosh.assemble.liquid import build_liquid_block
 from jaxslosh.liquid.face.schur import face_schur
 from jaxslosh.liquid.face.element import build_face_liquid
 from jaxslosh.geometry import Baffle, Box, Prismatic
+from jaxslosh.scene.liquids import FaceForm
 from jaxslosh.liquid.face.inverse import FaceStepInverse, chebyshev_steps, face_solver_blocks
+
+
+def _tank(origin):
+    """What the face-normal block's builder reads of a tank: its place, rigid walls, full order."""
+    return SimpleNamespace(origin=origin, wall_spec=None, form=FaceForm())
 
 
 def _models():
@@ -34,7 +40,7 @@ def _models():
 def test_the_sparse_blocks_equal_the_dense_ones_to_round_off():
     models = _models()
     assert models[1].pools == 2
-    tanks = [SimpleNamespace(origin=(0.3, -1.0, -0.5), wall_spec=None), SimpleNamespace(origin=(-1.0, 0.5, -0.2), wall_spec=None)]
+    tanks = [_tank((0.3, -1.0, -0.5)), _tank((-1.0, 0.5, -0.2))]
     dense, (Kdt0, Ktt0), _ = face_full_liquid(tanks, models)
     sparse, (Kdt1, Ktt1), _ = face_full_liquid(tanks, models, sparse=True)
     n = dense.nf
@@ -63,7 +69,7 @@ def test_the_dense_step_block_is_the_operator_and_the_element_gathers_the_points
     scattered over the elements' slots, and FaceOps.scatter as a gather, equal the points' own
     slots and segment_sum to round-off."""
     models = _models()
-    tanks = [SimpleNamespace(origin=(0.3, -1.0, -0.5), wall_spec=None), SimpleNamespace(origin=(-1.0, 0.5, -0.2), wall_spec=None)]
+    tanks = [_tank((0.3, -1.0, -0.5)), _tank((-1.0, 0.5, -0.2))]
     dense, _, _ = face_full_liquid(tanks, models)
     sparse, _, _ = face_full_liquid(tanks, models, sparse=True)
     c = 4.0 / 0.01 ** 2
@@ -101,7 +107,7 @@ def test_chebyshev_steps_reach_the_bound():
 
 def test_the_operators_vmap_and_export():
     models = _models()
-    liquid, _, _ = face_full_liquid([SimpleNamespace(origin=(0.0, 0.0, 0.0), wall_spec=None)], models[:1], sparse=True)
+    liquid, _, _ = face_full_liquid([_tank((0.0, 0.0, 0.0))], models[:1], sparse=True)
     step, *_ = face_solver_blocks(liquid, 4.0 / 0.01 ** 2)
     X = jnp.asarray(np.random.default_rng(1).standard_normal((3, liquid.nf)))
 
@@ -172,7 +178,7 @@ def test_scaled_sparse_blocks_equal_the_dense_ones():
     equal the dense blocks at those values, the stiffness, row sums (a bound within the factors'
     spread), the static start and the Newton blocks' inverses; and traced (jit, grad) as well."""
     models = _models()
-    tanks = [SimpleNamespace(origin=(0.3, -1.0, -0.5), wall_spec=None), SimpleNamespace(origin=(-1.0, 0.5, -0.2), wall_spec=None)]
+    tanks = [_tank((0.3, -1.0, -0.5)), _tank((-1.0, 0.5, -0.2))]
     scales = [(1.1, 0.9, 1.2), (0.8, 1.3, 0.95)]
     dense, (Kdt0, Ktt0), _ = face_full_liquid(tanks, models, scales)
     sparse, (Kdt1, Ktt1), _ = face_full_liquid(tanks, models, scales, sparse=True)
