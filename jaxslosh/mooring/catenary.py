@@ -308,7 +308,8 @@ def _chord(residual, guess, inverse, r0=None):
     """(x, the residual before the last step) after CHORD_STEPS chord steps from `guess` with
     `inverse` (n, 2, 2), the inverse of the residual's Jacobian at the guess: one evaluation of the
     profile each, none after the last (within a step's motion each step gains some four digits; the
-    profile's evaluations are most of what the lines add to a step), a line held once below TOL.
+    evaluations are a small part of what the lines add to a step: docs/benchmarks.md, the moored
+    step's pieces), a line held once below TOL.
     Written out, no loop: a `lax.while_loop` inside the residual runs apart from the step's fused
     kernels. `r0`: the residual at the guess where the caller has it (`_start_residual`)."""
     x, r = guess, residual(guess) if r0 is None else r0
