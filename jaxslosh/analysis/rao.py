@@ -87,20 +87,18 @@ def _check(scene: Scene, tables, radiation, w, heads):
 
 
 def across_tank_warnings(scene: Scene, headings) -> list:
-    """One line per multimodal tank with `flow = "2d"` when some heading is not along the ship
-    (sin(heading) not zero): such a tank sloshes only along its length (the vessel's x), so the
-    sway, roll and yaw those seas drive leave its liquid turning with the tank, without the
-    transverse waves' free-surface effect; `flow = "3d"` (a box) holds waves across it too."""
+    """One line per tank whose liquid leaves out what seas not along the ship drive, when some heading
+    is not (sin(heading) not zero), as its form says it (scene/liquids.py `across_seas_warning`): a
+    multimodal tank with `flow = "2d"` sloshes only along its length (the vessel's x), so the sway,
+    roll and yaw those seas drive leave its liquid turning with the tank, without the transverse
+    waves' free-surface effect; `flow = "3d"` (a box) holds waves across it too."""
     heads = np.atleast_1d(np.asarray(headings, dtype=float))
     across = heads[np.abs(np.sin(heads)) > 1e-9]
     if across.size == 0:
         return []
     shown = ", ".join(f"{np.degrees(b):.0f}" for b in across[:4]) + (", ..." if across.size > 4 else "")
-    return [f"tanks[{i}] {t.name!r}: a multimodal tank with flow = \"2d\" sloshes only along its length (x); at "
-            f"heading {shown} deg the sway, roll and yaw leave its liquid frozen across the tank (no transverse "
-            f"sloshing, no free-surface effect in roll): set flow = \"3d\" in [[tanks]] for waves across it too"
-            for i, t in enumerate(scene.tanks)
-            if t.form.along_length_only]
+    return [f"tanks[{i}] {t.name!r}: {why}" for i, t in enumerate(scene.tanks)
+            if (why := t.form.across_seas_warning(shown))]
 
 
 def default_frequencies(scene: Scene, tables=None, radiation=None, count: int = DEFAULT_COUNT):

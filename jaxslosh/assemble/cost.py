@@ -1,21 +1,20 @@
 """What a scene will cost before anything is built: unknowns, memory, steps; and the refusal of a
 scene this machine cannot hold.
 
-The memory is an estimate of the largest phase, tank by tank, as assemble/ assembles them: the element
-arrays of the assembly, then the solver's blocks (dense inverses below `SPARSE_AUTO` unknowns; above
-it the sparse matrices and the fast-diagonalization blocks, the JAX factors of shaped tanks, or the
-sparse factor that the modal basis of a reduced tank needs), plus the result's frames. It is meant to tell 1 GB from 1 TB, not
-to predict the process's peak to a few per cent.
+The memory is an estimate of the largest phase, tank by tank, as the model that runs each tank's form
+counts it (liquid/cost.py: the element arrays of the assembly, then the solver's blocks, dense or on
+the sparse way that assemble/liquid.py `wants_sparse` chooses), plus the result's frames. It is meant
+to tell 1 GB from 1 TB, not to predict the process's peak to a few per cent.
 """
 from __future__ import annotations
 
 import os
 from typing import NamedTuple
 
+from ..liquid.forms import tank_liquid
 from ..scene.types import Scene, SceneError
-from ..solve.factored import DENSE_MAX
-from ..liquid.nodal.sparse import SPARSE_AUTO
-from .effects import count_unknowns, free_liquid_dofs
+from .effects import count_unknowns
+from .liquid import wants_sparse
 
 #: a scene is refused when its estimate exceeds this share of the machine's memory (unless forced)
 MEMORY_SHARE = 0.8
@@ -44,49 +43,16 @@ def machine_memory() -> float:
     return total
 
 
-def _factor_bytes(t, nf: int) -> float:
-    """The liquid block's JAX factors of a tank the fast diagonalization does not take (solve/
-    factored.py): the step's and the mass's, dense inverses or banded block factors, whose RCM
-    bandwidth is about twice the dofs of a cross-section across the two shortest node counts."""
-    if nf <= DENSE_MAX:
-        return 2 * 8.0 * nf * nf
-    a, b, _ = sorted(n + 1 for n in t.mesh)
-    return 2 * 8.0 * 2 * nf * min(nf, 2 * 3 * a * b)
-
-
-def _tank_bytes(t, sparse: bool, host_lu: bool = False, rt_dense: bool = False) -> float:
-    nx, ny, nz = t.mesh
-    E = nx * ny * nz
-    N = (nx + 1) * (ny + 1) * (nz + 1)
-    nf = free_liquid_dofs(t)
-    assembly = 8.0 * E * (24 * 24) * 3 + 8.0 * E * 64 * 3            # COO rows, columns and values
-    if t.form.face_normal and not t.form.reduced:
-        # face-normal at full order (liquid/face/build.py): dense M, K and inverses on the ~3E
-        # faces, or (sparse) dense blocks on the elements and top faces only, ~7 of them while the
-        # Schur complement's inverses are formed (liquid/face/schur.py)
-        return max(assembly, 8.0 * 6 * (3 * E) ** 2 if rt_dense else 8.0 * 7 * (E + nx * ny) ** 2)
-    if not sparse:
-        solver = 8.0 * (N * N + 4.0 * nf * nf)                      # mass, stiffness, two or three inverses
-    else:
-        solver = 8.0 * 81 * 3 * nf * 2 + 8.0 * nx * ny * (3 * (nz + 1)) ** 2   # sparse products, box blocks
-        if not t.geometry.plain_box and not host_lu and not t.form.reduced:
-            solver += _factor_bytes(t, nf)
-        if t.form.reduced:                                           # the basis: a sparse factor of the mesh
-            solver = max(solver, 8.0 * nf * 30 * max(nx * ny, ny * nz, nx * nz) ** 0.5)
-    return max(assembly, solver)
-
-
 def estimate(scene: Scene) -> Cost:
     sim = scene.simulation
     steps = sim.n_steps
     frames = steps // max(1, sim.save_every) + 1
-    liquid = sum(free_liquid_dofs(t) for t in scene.tanks) if scene.effects.liquid else 0
+    liquid = scene.effects.liquid and bool(scene.tanks)
     choice = sim.linear_solver
-    sparse = choice in ("sparse", "sparse-host") or (choice == "auto" and liquid > SPARSE_AUTO
-                                    and not any(t.form.elastic for t in scene.tanks))
+    sparse = wants_sparse(scene)
     worst, total = ("", 0.0), 0.0
     for i, t in enumerate(scene.tanks if scene.effects.liquid else ()):
-        b = _tank_bytes(t, sparse, choice == "sparse-host", choice == "dense")
+        b = tank_liquid(t).tank_bytes(t, sparse, choice == "sparse-host", choice == "dense")
         total += b
         if b > worst[1]:
             worst = (f"tanks[{i}].mesh", b)

@@ -27,15 +27,14 @@ def build_damping(scene: Scene, params: Optional[dict], block) -> tuple[Optional
         return block.damping
     if not any(t.damping is not None for t in tanks) or not block.liquid.nf or not block.tanks:
         return None, ()
-    if block.vstructs or any(t.form.elastic for t in tanks):
+    if block.vstructs or not all(t.form.dampable for t in tanks):
         i = next(i for i, t in enumerate(tanks) if t.damping is not None)
         raise SceneError(f"tanks[{i}].damping", "is not available with elastic tank walls or structures in the "
                                                 "vessel's frame (their modes are not the liquid's alone)")
     params = params or {}
-    reduced = tanks[0].form.reduced
     parts, cs, table, offset = [], [], [], 0
     for i, (t, tb) in enumerate(zip(tanks, block.tanks)):
-        model, n_t, omega, Phi, Bt, where = sloshing_basis(tb.model, t, reduced, scene.environment.gravity)
+        model, n_t, omega, Phi, Bt, where = sloshing_basis(tb.model, t, scene.environment.gravity)
         if t.damping is None:
             offset += n_t
             continue

@@ -39,8 +39,8 @@ def wants_sparse(scene) -> bool:
     choice = scene.simulation.linear_solver
     if choice != "auto":
         return choice in ("sparse", "sparse-host")
-    if any(t.form.elastic for t in scene.tanks):
-        return False             # elastic walls have dense blocks of their own
+    if any(t.form.dense_blocks for t in scene.tanks):
+        return False
     return liquid_unknowns(scene) > SPARSE_AUTO
 
 

@@ -164,6 +164,13 @@ class AbstractLiquid(AbstractTerm):
         """The n lowest natural modes of the tank's liquid (with its elastic walls, where it has them)
         at gravity g, the vessel held fixed: `liquid/modes.Modes` (or `liquid/walls.TankModes`)."""
 
+    @classmethod
+    @abc.abstractmethod
+    def tank_bytes(cls, tank, sparse: bool, host_lu: bool = False, rt_dense: bool = False) -> float:
+        """The memory the tank's liquid takes at its largest phase, an estimate (liquid/cost.py the
+        shared pieces): on the sparse way or not (`sparse`), the host's sparse LU (`host_lu`) or
+        `simulation.linear_solver = "dense"` (`rt_dense`)."""
+
     # The tank's liquid in `jaxslosh check`'s words and the run's validity watch (assemble/about.py,
     # effects.py, run/validity.py ask these of `tank_liquid(tank)`; liquid/words.py the shared pieces).
     @classmethod
@@ -305,6 +312,10 @@ class NoLiquid(AbstractLiquid):
     @classmethod
     def sloshing_modes(cls, tank, g: float, n: int = 10):
         raise ValueError("a vessel without tank liquid has no sloshing modes")
+
+    @classmethod
+    def tank_bytes(cls, tank, sparse: bool, host_lu: bool = False, rt_dense: bool = False) -> float:
+        return 0.0
 
     # no tank runs NoLiquid (liquid/forms.py tank_liquid): never asked of a tank
     @classmethod

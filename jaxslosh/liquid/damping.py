@@ -209,10 +209,12 @@ class SloshingBasis(NamedTuple):
     where: str             # what holds the modes, for the error where a table lists more
 
 
-def sloshing_basis(model, t, reduced: bool, gravity: float) -> SloshingBasis:
+def sloshing_basis(model, t, gravity: float) -> SloshingBasis:
     """The sloshing modes of tank `t` (its element model `model`): at full order on its free dofs
-    (or faces), or on its modal basis (`reduced`, [tanks.reduction]); from the scene's values
-    (`gravity` the scene's) where the model was built at traced ones."""
+    (or faces), or on its modal basis (a reduced tank's, [tanks.reduction]: the block reduces every
+    tank or none); from the scene's values (`gravity` the scene's) where the model was built at
+    traced ones."""
+    reduced = t.form.reduced
     if t.form.face_normal and not reduced:      # full order: its lowest modes, on the free faces
         fm = face_modes(model, SPARSE_SEARCH)
         slosh = np.array([k == "sloshing" for k in fm.kind], dtype=bool)

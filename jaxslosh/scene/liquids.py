@@ -1,8 +1,9 @@
 """The liquid form of a `[[tanks]]` table: an abstract `LiquidForm` and one final class per liquid
 model, made once from the tank's keys (`model`, `fluid.element`, `flow`, `expansion`, the
 `[tanks.reduction]` and `[tanks.walls]` tables) by `liquid_form`. The tank keeps it as `Tank.form`;
-code outside the loader asks it (its `multimodal`, `face_normal`, `reduced`, `elastic`, ...) instead
-of comparing the keys' strings, and jaxslosh/liquid maps it to the model that runs it
+jaxslosh/liquid asks its flags (`multimodal`, `face_normal`, `reduced`, `elastic`, ...) instead of
+comparing the keys' strings, code elsewhere its behaviour (`dense_blocks`, `dampable`, ...) or the
+liquid that runs it, and jaxslosh/liquid maps it to the model that runs it
 (liquid/forms.py `tank_liquid`). docs/design.md, "The liquid", lists the forms.
 """
 from __future__ import annotations
@@ -36,6 +37,29 @@ class LiquidForm(abc.ABC):
     def along_length_only(self) -> bool:
         """Its liquid sloshes along the tank's length (x) alone: a two-dimensional multimodal tank."""
         return self.multimodal and not self.three_dimensional
+
+    # What code outside the loader and jaxslosh/liquid asks of a form: behaviour, never which model
+    # (tests/docs/test_liquid_guards.py keeps the flags above to scene/ and liquid/).
+    @property
+    def dense_blocks(self) -> bool:
+        """Its blocks are dense whatever the mesh's size (elastic walls bring dense blocks of their
+        own): `simulation.linear_solver = "auto"` keeps the scene's liquid off the sparse way."""
+        return self.elastic
+
+    @property
+    def dampable(self) -> bool:
+        """`[tanks.damping]` can damp its sloshing modes: they are the liquid's alone (rigid walls),
+        not shared with elastic walls."""
+        return not self.elastic
+
+    def across_seas_warning(self, headings: str) -> str:
+        """What its liquid leaves out at the headings `headings` (degrees, in words) that are not
+        along the ship, in a warning's words; "" where it takes such seas whole."""
+        if not self.along_length_only:
+            return ""
+        return (f"a multimodal tank with flow = \"2d\" sloshes only along its length (x); at heading {headings} deg "
+                f"the sway, roll and yaw leave its liquid frozen across the tank (no transverse sloshing, no "
+                f"free-surface effect in roll): set flow = \"3d\" in [[tanks]] for waves across it too")
 
     @property
     @abc.abstractmethod

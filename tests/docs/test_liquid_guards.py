@@ -3,6 +3,7 @@ jaxslosh/liquid, code elsewhere asks the AbstractLiquid contract and the tank's 
 (`Tank.form`: its `multimodal`, `face_normal`, `reduced`, `elastic`, ...) instead of which class or
 string it holds, and the assembly's dispatch stays short. Read from the source with `ast`."""
 import ast
+import dataclasses
 import inspect
 import os
 
@@ -222,3 +223,42 @@ def test_every_final_liquid_states_every_hook():
     missing = [f"{c.__name__}.{h}" for c in sorted(finals, key=lambda c: c.__name__) for h in HOOKS
                if h not in vars(c)]
     assert not missing, missing
+
+
+#: the liquid form's flags: which model a tank takes and how it runs (scene/liquids.py), read by the
+#: loader and jaxslosh/liquid alone
+FORM_FLAGS = {"multimodal", "face_normal", "reduced", "elastic", "three_dimensional", "third_order",
+              "along_length_only", "element", "form", "name"}
+#: what code elsewhere may ask a form: behaviour, named by what it answers
+FORM_ASKS = {"dense_blocks", "dampable", "across_seas_warning"}
+
+
+def flag_reads(source: str) -> list:
+    """(line, text) of each read of a flag of a tank's liquid form (`t.form.elastic`)."""
+    return sorted({(node.lineno, ast.unparse(node)) for node in ast.walk(ast.parse(source))
+                   if isinstance(node, ast.Attribute) and node.attr in FORM_FLAGS
+                   and isinstance(node.value, ast.Attribute) and node.value.attr == "form"})
+
+
+def test_the_flag_finder_sees_the_flags():
+    src = ("a = t.form.elastic\nb = t.form.dense_blocks\nc = tanks[0].form.reduced\nd = self.form\n"
+           "e = t.form.along_length_only\nf = x.elastic\n")
+    assert [line for line, _ in flag_reads(src)] == [1, 3, 5]
+
+
+def test_every_form_answer_is_a_flag_or_a_behaviour():
+    """A new answer of the forms is sorted here: a flag (which model, kept to the loader and the
+    liquid) or a behaviour that code elsewhere may ask."""
+    names = {n for c in (LiquidForm, *LiquidForm.__subclasses__()) for n in vars(c)
+             if not n.startswith("_")} | {f.name for c in LiquidForm.__subclasses__() for f in dataclasses.fields(c)}
+    assert names - FORM_FLAGS - FORM_ASKS == set()
+    assert not FORM_FLAGS & FORM_ASKS
+
+
+def test_no_branch_on_the_forms_flags_outside_the_loader_and_the_liquid():
+    """Outside jaxslosh/scene and jaxslosh/liquid a tank's form is asked what it does (`dense_blocks`,
+    `dampable`, `across_seas_warning`) or the liquid that runs it (liquid/forms.py `tank_liquid(t)`:
+    `tank_unknowns`, `tank_bytes`, `sloshing_modes`, ...), never which model it is."""
+    bad = [f"{rel}:{line}: {text}" for rel, path in sorted(_sources()) if not rel.startswith(("scene/", "liquid/"))
+           for line, text in flag_reads(open(path).read())]
+    assert not bad, "\n".join(bad)

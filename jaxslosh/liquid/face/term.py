@@ -43,6 +43,7 @@ import jax.numpy as jnp
 from ...fem.linalg import solve
 from ...physics.about import About
 from ..words import TankWords, element_words
+from ..cost import face_bytes
 from ..base import AbstractLiquid, StepInverse, dense_step_inverse, inertial_lines, switch_inertial, particle_rows, point_mass_scale
 from .inverse import face_solver_blocks
 from .tank_modes import face_sloshing_modes, face_unknowns
@@ -207,6 +208,10 @@ class FaceLiquid(AbstractLiquid):
     @classmethod
     def sloshing_modes(cls, tank, g: float, n: int = 10):
         return face_sloshing_modes(tank, g, n)
+
+    @classmethod
+    def tank_bytes(cls, tank, sparse: bool, host_lu: bool = False, rt_dense: bool = False) -> float:
+        return face_bytes(tank, rt_dense)
 
     @classmethod
     def describe_tank(cls, tank) -> TankWords:

@@ -20,6 +20,7 @@ from ...fem.linalg import solve
 from ...physics.kinematics import mv3, tv3
 from ...physics.about import About
 from ..words import TankWords, element_words
+from ..cost import basis_bytes
 from ..base import AbstractLiquid, dense_step_inverse, inertial_lines, switch_inertial, point_mass_scale
 from ..face.tank_modes import face_sloshing_modes, face_unknowns
 from ..nodal.tank_modes import nodal_sloshing_modes, nodal_unknowns
@@ -168,6 +169,10 @@ class ModalLiquid(AbstractLiquid):
     @classmethod
     def sloshing_modes(cls, tank, g: float, n: int = 10):
         return (face_sloshing_modes if tank.form.face_normal else nodal_sloshing_modes)(tank, g, n)
+
+    @classmethod
+    def tank_bytes(cls, tank, sparse: bool, host_lu: bool = False, rt_dense: bool = False) -> float:
+        return basis_bytes(tank, cls.tank_unknowns(tank), sparse)
 
     @classmethod
     def describe_tank(cls, tank) -> TankWords:

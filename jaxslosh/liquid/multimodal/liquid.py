@@ -17,6 +17,7 @@ from ..base import AbstractLiquid, dense_step_inverse
 from .steep import roundoff_floor, steep_rows
 from .tank_modes import multimodal_sloshing_modes, multimodal_unknowns
 from ..words import TankWords
+from ..cost import nodal_bytes
 from .watch import SurfaceTable, multimodal_words, surface_table
 
 
@@ -51,6 +52,11 @@ class MultimodalLiquid(AbstractLiquid):
     @classmethod
     def sloshing_modes(cls, tank, g: float, n: int = 10):
         return multimodal_sloshing_modes(tank, g, n)
+
+    # counted as a nodal tank on its `mesh` would be: an upper bound of its few modal blocks
+    @classmethod
+    def tank_bytes(cls, tank, sparse: bool, host_lu: bool = False, rt_dense: bool = False) -> float:
+        return nodal_bytes(tank, cls.tank_unknowns(tank), sparse, host_lu)
 
     @classmethod
     def describe_tank(cls, tank) -> TankWords:

@@ -16,6 +16,7 @@ from ...fem.slip import rotate_matrix
 from ...physics.about import About
 from ...physics.terms import Kin, Rows
 from ..words import TankWords, element_words
+from ..cost import nodal_bytes
 from ..base import (AbstractLiquid, StepInverse, dense_step_inverse, inertial_lines, switch_inertial, nodal_product, particle_rows,
                     point_mass_scale)
 from .sparse import hydrostatic_start, sparse_solver_blocks
@@ -172,6 +173,10 @@ class NodalLiquid(AbstractLiquid):
     @classmethod
     def sloshing_modes(cls, tank, g: float, n: int = 10):
         return nodal_sloshing_modes(tank, g, n)
+
+    @classmethod
+    def tank_bytes(cls, tank, sparse: bool, host_lu: bool = False, rt_dense: bool = False) -> float:
+        return nodal_bytes(tank, cls.tank_unknowns(tank), sparse, host_lu)
 
     @classmethod
     def describe_tank(cls, tank) -> TankWords:
