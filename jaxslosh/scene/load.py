@@ -119,6 +119,7 @@ def parse_scene(mapping: Mapping[str, Any], text: str = "", path: str = "") -> S
     _locking_elements(tanks, warnings)
     _unique_names(structures, "structures", "structure")
     _attachments(structures)
+    _beside_vessel_multimodal(tanks, carriers, structures)
     _unique_names(probes, "probes", "probe")
     for i, probe in enumerate(probes):
         _place_probe(probe, f"probes[{i}]", tanks, structures)
@@ -381,6 +382,16 @@ def _structure(table, where: str) -> Structure:
         "stiffening": ("str", one_of(("none", "centrifugal"))), "material": ("table", None),
     }, required=("name", "origin", "size", "mesh", "attach", "material"))
     return Structure(material=_material(table["material"], f"{where}.material"), **v)
+
+
+def _beside_vessel_multimodal(tanks, carriers, structures) -> None:
+    """The vessel's multimodal liquid is a block of its modal coordinates alone (liquid/multimodal):
+    a structure in the vessel's frame has no place in it (it would be left out of the run)."""
+    i = next((i for i, s in enumerate(structures) if s.frame == "vessel"), None)
+    if i is not None and any(t.form.multimodal for t, c in zip(tanks, carriers) if c == "vessel"):
+        raise SceneError(f"structures[{i}].frame", 'a structure in the vessel\'s frame (frame = "vessel") is not '
+                                                   'available beside the vessel\'s multimodal tanks: give it frame = '
+                                                   '"own", or the tanks model = "fem"')
 
 
 def _attachments(structures) -> None:
