@@ -19,7 +19,7 @@ from .hull import read_hydrostatics
 from ..hull.surface import HullMeshError
 from ..hydro.database import DatabaseError
 from ..hydro.multibody import file_bodies, netcdf_centres, read_multibody
-from .types import Body, Connection, Hydrostatics, Initial, SceneError
+from .types import Body, Connection, FloatingBody, Hydrostatics, Initial, SceneError
 from .waves import FileContext, read_hull, read_hydrodynamics
 
 KINDS = ("hawser", "fender", "spring")
@@ -241,11 +241,9 @@ def _overlaps(bodies, vessel) -> None:
     """Two bodies whose waterplanes intersect at rest are refused: they would float through each other
     (no contact is modelled but by fenders). A waterplane is the rectangle of its `footprint` along its
     heading where given, else the circle of its area about its COG."""
-    outlines = []
-    if vessel.hydrostatics is not None:
-        outlines.append(("vessel", _outline((0.0, 0.0), 0.0, vessel.footprint,
-                                            vessel.hydrostatics.waterplane_area)))
-    outlines += [(b.name, _outline(b.position, b.heading, b.footprint, b.hydrostatics.waterplane_area)) for b in bodies]
+    outlines = [("vessel" if f is vessel else f.name, _outline(f.position, f.heading, f.footprint,
+                                                               f.hydrostatics.waterplane_area))
+                for f in (vessel, *bodies) if f.hydrostatics is not None]
     for j, (nb, ob) in enumerate(outlines):
         for na, oa in outlines[:j]:
             gap = _apart(oa, ob)
@@ -274,15 +272,14 @@ def _body_tank(table, where: str, body: str) -> None:
                                               f"body; {where}.{key})")
 
 
-def hull_extent(owner, key: str = "vessel.hull.file") -> Optional[tuple]:
+def hull_extent(owner: FloatingBody, key: str = "vessel.hull.file") -> Optional[tuple]:
     """((x_min, y_min, z_min or -inf), (x_max, y_max)) of a body's (or the vessel's) hull in its frame
     from its COG, what the connection points are checked against: its hull where it has one (its
     plan and its keel), else the rectangle of a `footprint` about the COG (its plan only: a
     footprint has no keel), else None (nothing to check against). `key`: the hull's file key."""
-    hull = getattr(owner, "hull", None)
-    if hull is not None:
+    if owner.hull is not None:
         try:
-            return hull.extent()
+            return owner.hull.extent()
         except HullMeshError as e:
             raise SceneError(key, str(e)) from None
     if owner.footprint is not None:
@@ -310,7 +307,7 @@ def _points_inside(connections, vessel, bodies) -> None:
                 out.append(f"z = {p[2]:.6g} m below the keel at {lo[2]:.6g} m")
             if out:
                 whose = (("the vessel's" if end == "vessel" else f"{end!r}'s")
-                         + (" hull" if getattr(owners[end], "hull", None) is not None else " footprint"))
+                         + (" hull" if owners[end].hull is not None else " footprint"))
                 raise SceneError(f"connections[{i}].points", (
                     f"point {k + 1} {list(p)} (in {end!r}'s frame, from its COG) lies outside {whose}: "
                     f"{'; '.join(out)}"))

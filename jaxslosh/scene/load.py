@@ -127,7 +127,7 @@ def parse_scene(mapping: Mapping[str, Any], text: str = "", path: str = "") -> S
     connections = read_connections(mapping.get("connections", []), vessel, bodies)
     bodies_scene(bodies, vessel, structures, mapping, warnings, files)
     tanks = tank_groups(tanks, carriers).get("vessel", ())      # the vessel's; a body's are in its Body
-    mooring = read_mooring(mapping.get("mooring", []), environment.depth, vessel.name, vessel.cog_height, warnings,
+    mooring = read_mooring(mapping.get("mooring", []), environment.depth, vessel, warnings,
                            tuple(bodies))
     _mass_balance(vessel, tanks, environment, warnings, structures,     # the vessel's own lines
                   tuple(m for m in mooring if m.body in ("vessel", vessel.name)))

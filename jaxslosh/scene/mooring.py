@@ -11,18 +11,19 @@ import math
 
 from .fields import non_negative, one_of, positive, read, show, valid_name
 from .lumped_keys import read_lumped
-from .types import MooringLine, SceneError
+from .types import FloatingBody, MooringLine, SceneError, Vessel
 
 MODELS = ("catenary", "lumped")
 #: m: how far below the seabed an anchor may be given (rounding of the depth in a scene file)
 SEABED_TOLERANCE = 1e-6
 
 
-def read_mooring(tables, depth, vessel_name: str, cog_z: float, warnings: list[str],
-                 bodies: tuple = ()) -> tuple[MooringLine, ...]:
-    """The lines of a scene; `depth` is `[environment] depth` (None when absent), `cog_z` the
-    vessel's COG height above the still-water level, `bodies` the scene's [[bodies]] (scene.types.Body)."""
+def read_mooring(tables, depth, vessel: Vessel, warnings: list[str], bodies: tuple = ()) -> tuple[MooringLine, ...]:
+    """The lines of a scene; `depth` is `[environment] depth` (None when absent), `vessel` the
+    scene's, `bodies` its [[bodies]] (scene.types.Body)."""
     held = {b.name: b for b in bodies}
+    vessel_name = vessel.name
+    owners: dict[str, FloatingBody] = {"vessel": vessel, vessel.name: vessel, **held}
     lines = []
     for i, table in enumerate(tables):
         where = f"mooring[{i}]"
@@ -45,7 +46,7 @@ def read_mooring(tables, depth, vessel_name: str, cog_z: float, warnings: list[s
             raise SceneError(f"{where}.body", f"{show(body)}: lumped-mass lines (line {show(v.get('name', f'line{i + 1}'))}, "
                                               "model = \"lumped\") hold the vessel only; a body of [[bodies]] "
                                               "takes catenary lines (the default model)")
-        if body not in ("vessel", vessel_name, *held):
+        if body not in owners:
             raise SceneError(f"{where}.body", f"{show(body)} is not a body of the scene (the vessel is "
                                               f"{show(vessel_name)}; \"vessel\" names it too"
                                               + (f"; the [[bodies]] are {', '.join(map(show, held))})" if held else ")"))
@@ -56,13 +57,7 @@ def read_mooring(tables, depth, vessel_name: str, cog_z: float, warnings: list[s
         if az > 0:
             raise SceneError(f"{where}.anchor", f"z = {show(az)} m is above the still-water level; anchors lie on "
                                                 f"or above the seabed at -{show(depth)} m, under water")
-        fx, fy, fz = v["fairlead"]
-        if body in held:      # the fairlead in the body's frame: its place at rest (the body's position and heading)
-            b = held[body]
-            c, s = math.cos(b.heading), math.sin(b.heading)
-            rest = (b.position[0] + c * fx - s * fy, b.position[1] + s * fx + c * fy, fz + b.cog_height)
-        else:
-            rest = (fx, fy, fz + cog_z)
+        rest = owners[body].rest_point(v["fairlead"])    # the fairlead, in its body's frame, at rest
         span = math.dist(rest, (ax, ay, az))
         if v["weight"] == 0 and span <= v["length"]:
             raise SceneError(f"{where}.weight", f"0 N/m with a slack line (the anchor is {span:.6g} m from the "

@@ -7,8 +7,10 @@ Values that `simulate(scene, params=...)` may override are looked up by their do
 """
 from __future__ import annotations
 
+import abc
+import math
 from dataclasses import dataclass, field
-from typing import Optional, Union
+from typing import Optional, Union, final
 
 from ..fem.mesh import ELEMENT_FORMS, FACE_FORMS  # noqa: F401  (the loader reads them here)
 from ..geometry import SHAPES, AbstractShape
@@ -114,8 +116,44 @@ class Forced:
     columns: tuple = ()              # record: ((dof, samples), ...) in the file's column order
 
 
+class FloatingBody(abc.ABC):
+    """A rigid floating body of the scene: the vessel (`Vessel`, one final) or one of the `[[bodies]]`
+    beside it (`Body`, the other), abstract-or-final (docs/design.md). The finals declare these
+    fields as their own dataclass fields (their constructors' orders differ); code that takes the
+    vessel or a body alike reads them here: its name, its rigid-body mass and inertia about its
+    COG, its hydrostatics, initial offsets, hull and hydrodynamic tables, its COG's height above the
+    still-water level, its waterplane's `footprint`, and its rest pose in the vessel-at-rest frame."""
+    name: str
+    mass: float
+    inertia: Mat3
+    hydrostatics: Optional[Hydrostatics]
+    initial: Initial
+    hull: Optional["Hull"]
+    hydrodynamics: Optional["Hydrodynamics"]
+    cog_height: float
+    footprint: Optional[tuple]
+
+    @property
+    @abc.abstractmethod
+    def position(self) -> tuple:
+        """(x, y) m of its COG at rest from the vessel's, inertial."""
+
+    @property
+    @abc.abstractmethod
+    def heading(self) -> float:
+        """Its x axis at rest, rad from the inertial X axis."""
+
+    def rest_point(self, point) -> Vec3:
+        """A point of its frame (from its COG) at rest: x, y from the vessel's COG at rest along the
+        inertial axes, z from the still-water level."""
+        c, s = math.cos(self.heading), math.sin(self.heading)
+        x, y, z = point
+        return (self.position[0] + c * x - s * y, self.position[1] + s * x + c * y, z + self.cog_height)
+
+
+@final
 @dataclass(frozen=True)
-class Vessel:
+class Vessel(FloatingBody):
     mass: float                      # kg, > 0 (everything except tank liquid)
     inertia: Mat3                    # kg m^2 about the COG, body axes, symmetric positive definite
     hydrostatics: Optional[Hydrostatics] = None   # None: no buoyancy (free body)
@@ -127,9 +165,19 @@ class Vessel:
     cog_height: float = 0.0          # m, the COG's height above the still-water level at rest
     footprint: Optional[tuple] = None   # (length, beam) m of the waterplane: the bodies' overlap check
 
+    # the vessel at rest is the frame the bodies' places are given in
+    @property
+    def position(self) -> tuple:
+        return (0.0, 0.0)
 
+    @property
+    def heading(self) -> float:
+        return 0.0
+
+
+@final
 @dataclass(frozen=True)
-class Body:
+class Body(FloatingBody):
     """A `[[bodies]]` rigid floating body beside the vessel (docs/guide/bodies-and-connections.md):
     its COG at rest `position` (x, y) horizontally from the vessel's, inertial, and `cog_height`
     above the still-water level; its x axis `heading` rad from the inertial X axis."""
