@@ -76,7 +76,9 @@ def body_liquid(scene, body, q0, g):
         damping, _ = multimodal_damping(own, {}, liquid)
         return liquid, () if damping is None else (damping,), surface_meshes(own)
     block = build_liquid_block(own, {}, g)
-    liquid = dataclasses.replace(block.liquid, coriolis=eff.coriolis, centrifugal=eff.centrifugal)
+    # the [effects] switches through the liquid's own interface, as the vessel's (assemble/system.py); its
+    # lines are the Bodies term's (assemble/bodies.py _about), so the liquid keeps its own
+    liquid = block.liquid.with_effects(eff.coriolis, eff.centrifugal, block.liquid.about)
     terms = () if block.penalty is None else (RotationPenalty(Kdt=block.penalty[0], Ktt=block.penalty[1], q_ref=q0),)
     damping, _ = build_damping(own, {}, block)        # [tanks.damping]: the vessel's modal damping
     return liquid, terms + (() if damping is None else (damping,)), block.tanks
@@ -95,23 +97,25 @@ def build_bodies(scene, params: dict, g, outline: bool = False) -> tuple[Optiona
     floating, hosts, offset = [], [], 0
     for s, b in enumerate(scene.bodies):
         rest = body_rest(b, cog)
-        ini = b.initial
-        roll, pitch, yaw = ini.roll_pitch_yaw
         key = f"bodies.{b.name}"
         traced = lambda k, v, key=key: P(f"{key}.hydrostatics.{k}", v)  # noqa: E731
-        q0 = quat_from_rpy(jnp.array([roll, pitch, yaw + b.heading]))
+        # its initial state as the vessel's (assemble/system.py), offsets from its rest pose, traced where params name them
+        ini = {k: jnp.asarray(P(f"{key}.initial.{k}", getattr(b.initial, k)), dtype=float)
+               for k in ("position", "velocity", "angular_velocity", "roll_pitch_yaw")}
+        q0 = quat_from_rpy(ini["roll_pitch_yaw"] + jnp.array([0.0, 0.0, b.heading]))
         tank, tank_terms, blocks = (None, (), ()) if outline else body_liquid(scene, b, q0, g)
         if blocks:
             hosts.append(BodyTanks(s, b.name, offset, blocks))
             offset += tank.nf
         floating.append(Floating(
-            terms=rigid_terms(P(f"{key}.mass", b.mass), b.inertia, b.hydrostatics, rho, g, b.viscous_damping,
+            terms=rigid_terms(P(f"{key}.mass", b.mass), P(f"{key}.inertia", b.inertia), b.hydrostatics, rho, g,
+                              b.viscous_damping,
                               traced, body_restoring(scene, b, params, g, tank)) + (
                 () if X is None or not np.abs(X[s]).max() > 0 else
                 (WaveExcitation(make_excitation(waves, X[s], P(waves.height_key,
                                                               waves.height))),)),
-            rest=jnp.asarray(rest), x0=jnp.asarray(rest + np.asarray(ini.position)),
-            q0=q0, v0=jnp.asarray(np.concatenate([ini.velocity, ini.angular_velocity]), dtype=float),
+            rest=jnp.asarray(rest), x0=jnp.asarray(rest) + ini["position"],
+            q0=q0, v0=jnp.concatenate([ini["velocity"], ini["angular_velocity"]]),
             tank=tank, tank_terms=tank_terms))
     index = end_index(b.name for b in scene.bodies)
     links = []
