@@ -5,6 +5,7 @@ nonlinear ones and its weight: assemble/hull.py) and its viscous damping."""
 from __future__ import annotations
 
 import dataclasses
+import re
 from typing import NamedTuple, Optional
 
 import jax
@@ -18,6 +19,7 @@ from ..physics.bodies import BAND, Bodies, Floating, Link, body_rest, end_index
 from ..physics.kinematics import quat_from_rpy
 from ..physics.seakeeping import LinearDamping, WaveExcitation
 from ..physics.vessel import RESTORING_FORMS, AbstractRestoring, RigidBody
+from ..scene.keys import toml_mapping
 from ..scene.types import SceneError
 from .about import damping_about, tank_line
 from .bodyhydro import time_terms
@@ -99,13 +101,27 @@ def body_liquid(scene, body, q0, g):
         liquid = build_multimodal(own, {}, g)
         damping, _ = multimodal_damping(own, {}, liquid)
         return liquid, () if damping is None else (damping,), surface_meshes(own), ()
-    block = build_liquid_block(own, {}, g)
+    try:
+        block = build_liquid_block(own, {}, g)
+    except SceneError as e:          # the builder names the body's tanks by their index among its own
+        raise SceneError(_scene_tank_key(scene, body, e.key), str(e)[len(e.key) + 2:]) from None
     # the [effects] switches through the liquid's own interface, as the vessel's (assemble/system.py); its
     # lines are the Bodies term's (assemble/bodies.py _about), so the liquid keeps its own
     liquid = block.liquid.with_effects(eff.coriolis, eff.centrifugal, block.liquid.about)
     terms = () if block.penalty is None else (RotationPenalty(Kdt=block.penalty[0], Ktt=block.penalty[1], q_ref=q0),)
     damping, _ = build_damping(own, {}, block)        # [tanks.damping]: the vessel's modal damping
     return liquid, terms + (() if damping is None else (damping,)), block.tanks, block.carried
+
+
+def _scene_tank_key(scene, body, key: str) -> str:
+    """`tanks[i]...` of the body's i-th tank as the scene file numbers its [[tanks]] (the name form
+    `tanks.<name>...` for a scene built without a file); other keys unchanged."""
+    m = re.match(r"tanks\[(\d+)\](.*)", key or "")
+    if m is None or int(m.group(1)) >= len(body.tanks):
+        return key
+    name = body.tanks[int(m.group(1))].name
+    names = [t.get("name") for t in toml_mapping(scene.text).get("tanks", [])] if scene.text else []
+    return f"tanks[{names.index(name)}]{m.group(2)}" if name in names else f"tanks.{name}{m.group(2)}"
 
 
 def build_bodies(scene, params: dict, g, outline: bool = False) -> tuple[Optional[Bodies], tuple]:

@@ -131,8 +131,10 @@ def _fitted_hulls(keys) -> list:
 
 def implied_keys(keys) -> tuple:
     """The scene values that follow from the fitted keys (the GM0s of a fitted KG or COG, the
-    vessel's or a body's): a record made with another KG differs in them too, and the fit reports them."""
-    return tuple(f"{prefix}.{k.partition('.')[2]}" for prefix, _ in _fitted_hulls(keys) for k in IMPLIED_BY_KG)
+    vessel's or a body's, and a body's `cog_height`, its hull's kg - draft unless given): a record
+    made with another KG differs in them too, and the fit reports the GM0s."""
+    return tuple(f"{prefix}.{k.partition('.')[2]}" for prefix, _ in _fitted_hulls(keys)
+                 for k in IMPLIED_BY_KG + (("vessel.cog_height",) if prefix != "vessel" else ()))
 
 
 def implied_values(scene: Scene, values: dict, errors: dict) -> tuple[dict, dict]:

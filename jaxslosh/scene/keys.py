@@ -307,7 +307,7 @@ def check_values(scene: Scene, values: dict) -> Scene:
     canon = check_param_keys(scene, values)
     if not scene.text:
         return scene
-    mapping = copy.deepcopy(_mapping(scene.text))
+    mapping = copy.deepcopy(toml_mapping(scene.text))
     sim = mapping.setdefault("simulation", {})
     sim["duration"], sim["dt"] = float(scene.simulation.duration), float(scene.simulation.dt)
     given = list(values)
@@ -327,8 +327,9 @@ def check_values(scene: Scene, values: dict) -> Scene:
 
 
 @functools.lru_cache(maxsize=4)
-def _mapping(text: str) -> dict:
-    """The scene's TOML mapping, parsed once for the many runs of a batch (check_values copies it)."""
+def toml_mapping(text: str) -> dict:
+    """The scene's TOML mapping, parsed once for the many runs of a batch (check_values copies it;
+    not to be changed in place)."""
     return tomllib.loads(text)
 
 

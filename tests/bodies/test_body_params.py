@@ -13,6 +13,7 @@ from jaxslosh.fit.params import fit_keys, implied_keys, implied_values, make_par
 from jaxslosh.physics.hull import HullPressure
 from jaxslosh.physics.kinematics import quat_from_rpy
 from jaxslosh.physics.vessel import RigidBody
+from jaxslosh.scene.compare import differences
 from jaxslosh.scene.keys import resolve_params, traceable_keys
 from jaxslosh.scene.types import SceneError
 
@@ -142,8 +143,13 @@ def test_a_bodys_keys_are_the_vessels(scene):
     (p,) = make_params(scene, ["bodies.barge.inertia"], None, None)
     np.testing.assert_array_equal(p.start, [4.0e5, 9.0e5, 1.1e6])
     np.testing.assert_array_equal(np.asarray(p.param_value(jnp.array([1.0, 2.0, 3.0]))), np.diag([1.0, 2.0, 3.0]))
+    # a record made with another KG differs in these too (its COG height is the box's kg - draft)
     assert implied_keys(["bodies.barge.hull.kg"]) == ("bodies.barge.hydrostatics.gm_t",
-                                                      "bodies.barge.hydrostatics.gm_l")
+                                                      "bodies.barge.hydrostatics.gm_l", "bodies.barge.cog_height")
+    other = js.load_scene(SCENE.replace(f"kg = {KG}", "kg = 2.1"))
+    assert {d[0] for d in differences(scene, other)} == {"bodies.barge.cog_height", "bodies.barge.hydrostatics.gm_t",
+                                                        "bodies.barge.hydrostatics.gm_l", "bodies.barge.hull.kg"}
+    assert differences(scene, other, ignore=("bodies.barge.hull.kg",) + implied_keys(["bodies.barge.hull.kg"])) == []
     h = scene.bodies[0].hydrostatics
     out, se = implied_values(scene, {"bodies.barge.hull.kg": KG + 0.1}, {"bodies.barge.hull.kg": 0.01})
     assert out == pytest.approx({"bodies.barge.hydrostatics.gm_t": h.gm_t - 0.1,

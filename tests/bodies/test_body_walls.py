@@ -91,3 +91,14 @@ def test_check_counts_a_body_tanks_wall_unknowns():
     (the vessel's frame) than the lone carrier's 788."""
     assert count_unknowns(walled(scene_alone())) == 788
     assert count_unknowns(walled(scene_on_body())) == 788 + 6
+
+
+def test_reduced_walls_on_a_body_are_refused_naming_the_scenes_tank():
+    """Elastic walls need the full-order liquid, on a body as on the vessel: the reduced walled tank is
+    refused naming it by its place among the scene's [[tanks]] (the second: a tank on the vessel comes first)."""
+    vessel_tank = ('[[tanks]]\nname = "other"\norigin = [-4.0, -2.0, 1.0]\nsize = [8.0, 4.0, 3.0]\nfill_depth = 1.0\n'
+                   'mesh = [2, 2, 2]\n')
+    text = scene_on_body(duration=0.02).text.replace("mesh = [2, 4, 3]\n", WALLS)
+    with pytest.raises(js.SceneError, match=r"tanks\[1\]\.walls: elastic walls, and structures in the vessel's frame, "
+                                            r"need the full-order dense liquid"):
+        js.simulate(js.load_scene(text.replace("[[tanks]]", vessel_tank + "[[tanks]]", 1)))
