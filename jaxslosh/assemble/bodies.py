@@ -5,8 +5,10 @@ nonlinear ones and its weight: assemble/hull.py) and its viscous damping."""
 from __future__ import annotations
 
 import dataclasses
+import re
 from typing import NamedTuple, Optional
 
+import jax
 import jax.numpy as jnp
 import numpy as np
 
@@ -17,6 +19,8 @@ from ..physics.bodies import BAND, Bodies, Floating, Link, body_rest, end_index
 from ..physics.kinematics import quat_from_rpy
 from ..physics.seakeeping import LinearDamping, WaveExcitation
 from ..physics.vessel import RESTORING_FORMS, AbstractRestoring, RigidBody
+from ..scene.keys import toml_mapping
+from ..scene.types import SceneError
 from .about import damping_about, tank_line
 from .bodyhydro import time_terms
 from .damping import build_damping
@@ -36,18 +40,39 @@ def linear_hydrostatics(h, rho_w, g, value=lambda key, v: v) -> AbstractRestorin
 
 
 def rigid_terms(mass, inertia, hydrostatics, rho_w, g, viscous=None, value=lambda key, v: v,
-                restoring=None) -> tuple:
+                restoring=None, S=None) -> tuple:
     """A floating body's rigid terms, as the vessel has them: inertia with its gyroscopic terms
     (RigidBody), linear hydrostatics about the rest pose (its weight balanced by the buoyancy at
     rest) or the `restoring` terms given instead (a hull's pressure and the weight:
     assemble/hull.py body_restoring), and linear viscous damping (6 x 6) where given; `value(name,
-    v)` may replace the hydrostatics' values (a body's traced params)."""
+    v)` may replace the hydrostatics' values (a body's traced params); `S` the hull's first moment
+    where parts carry their own mass (`hull_part`)."""
     I = jnp.asarray(inertia, dtype=float)
-    terms = [RigidBody(mass=jnp.asarray(mass, dtype=float), inertia=jnp.diag(I) if I.ndim == 1 else I),
+    terms = [RigidBody(mass=jnp.asarray(mass, dtype=float), inertia=jnp.diag(I) if I.ndim == 1 else I, S=S),
              *((linear_hydrostatics(hydrostatics, rho_w, g, value),) if restoring is None else restoring)]
     if viscous is not None:
         terms.append(LinearDamping(jnp.asarray(viscous, dtype=float)))
     return tuple(terms)
+
+
+def hull_part(mass, inertia, parts, key: str = "vessel", what: str = "ship", carriers: str = "structures and elastic walls"):
+    """The hull's own mass, inertia about the origin and first moment: the floating body's (`key`:
+    the vessel's or a body's table; mass, inertia about its COG at the origin) less the parts that
+    carry their own (structures, elastic walls: liquid/block.py rigid_part). SceneError naming its
+    mass or inertia where they are not more than those parts'."""
+    m = sum(p[0] for p in parts)
+    S = sum(p[1] for p in parts)
+    I = sum(p[2] for p in parts)
+    if not isinstance(mass, jax.core.Tracer):
+        if float(mass) <= m:
+            raise SceneError(f"{key}.mass", f"{float(mass):.6g} kg is the whole {what} without its liquid, {carriers} "
+                                            f"included, but those alone weigh {m:.6g} kg")
+    if not isinstance(inertia, jax.core.Tracer):
+        if np.min(np.linalg.eigvalsh(np.asarray(inertia) - I)) <= 0:
+            raise SceneError(f"{key}.inertia", f"is the whole {what}'s about its COG, {carriers} "
+                                               "included, but it is smaller than theirs alone (the hull's would not "
+                                               f"be positive definite; theirs: {np.round(np.diag(I), 1).tolist()} kg m^2)")
+    return mass - m, inertia - jnp.asarray(I), -jnp.asarray(S)
 
 
 class BodyTanks(NamedTuple):
@@ -61,25 +86,42 @@ class BodyTanks(NamedTuple):
 
 
 def body_liquid(scene, body, q0, g):
-    """(liquid, its terms, host blocks) of the tanks a body carries: the vessel's builder
-    (assemble/liquid.py) on the scene with the body's tanks as its tanks, so that a tank is the
-    same model on any body; the rotation penalty at the body's initial attitude, as the vessel's
-    at its own. (None, (), ()) without tanks or with the liquid switched off."""
+    """(liquid, its terms, host blocks, the rigid parts of its elastic walls) of the tanks a body
+    carries: the vessel's builder (assemble/liquid.py) on the scene with the body's tanks as its
+    tanks, so that a tank is the same model on any body, its elastic walls included; the rotation
+    penalty at the body's initial attitude, as the vessel's at its own. (None, (), (), ()) without
+    tanks or with the liquid switched off."""
     eff = scene.effects
     if not body.tanks or not eff.liquid:
-        return None, (), ()
+        return None, (), (), ()
     # dense: the body's liquid block is inverted whole as the Bodies term's deformable block
     own = dataclasses.replace(scene, tanks=body.tanks, structures=(),
                               simulation=dataclasses.replace(scene.simulation, linear_solver="dense"))
     if multimodal_scene(own):     # the vessel's multimodal liquid and damping; its fields on surface meshes
         liquid = build_multimodal(own, {}, g)
         damping, _ = multimodal_damping(own, {}, liquid)
-        return liquid, () if damping is None else (damping,), surface_meshes(own)
-    block = build_liquid_block(own, {}, g)
-    liquid = dataclasses.replace(block.liquid, coriolis=eff.coriolis, centrifugal=eff.centrifugal)
+        return liquid, () if damping is None else (damping,), surface_meshes(own), ()
+    try:
+        block = build_liquid_block(own, {}, g)
+    except SceneError as e:          # the builder names the body's tanks by their index among its own
+        raise SceneError(_scene_tank_key(scene, body, e.key), str(e)[len(e.key) + 2:]) from None
+    # the [effects] switches through the liquid's own interface, as the vessel's (assemble/system.py); its
+    # lines are the Bodies term's (assemble/bodies.py _about), so the liquid keeps its own
+    liquid = block.liquid.with_effects(eff.coriolis, eff.centrifugal, block.liquid.about)
     terms = () if block.penalty is None else (RotationPenalty(Kdt=block.penalty[0], Ktt=block.penalty[1], q_ref=q0),)
     damping, _ = build_damping(own, {}, block)        # [tanks.damping]: the vessel's modal damping
-    return liquid, terms + (() if damping is None else (damping,)), block.tanks
+    return liquid, terms + (() if damping is None else (damping,)), block.tanks, block.carried
+
+
+def _scene_tank_key(scene, body, key: str) -> str:
+    """`tanks[i]...` of the body's i-th tank as the scene file numbers its [[tanks]] (the name form
+    `tanks.<name>...` for a scene built without a file); other keys unchanged."""
+    m = re.match(r"tanks\[(\d+)\](.*)", key or "")
+    if m is None or int(m.group(1)) >= len(body.tanks):
+        return key
+    name = body.tanks[int(m.group(1))].name
+    names = [t.get("name") for t in toml_mapping(scene.text).get("tanks", [])] if scene.text else []
+    return f"tanks[{names.index(name)}]{m.group(2)}" if name in names else f"tanks.{name}{m.group(2)}"
 
 
 def build_bodies(scene, params: dict, g, outline: bool = False) -> tuple[Optional[Bodies], tuple]:
@@ -95,23 +137,29 @@ def build_bodies(scene, params: dict, g, outline: bool = False) -> tuple[Optiona
     floating, hosts, offset = [], [], 0
     for s, b in enumerate(scene.bodies):
         rest = body_rest(b, cog)
-        ini = b.initial
-        roll, pitch, yaw = ini.roll_pitch_yaw
         key = f"bodies.{b.name}"
         traced = lambda k, v, key=key: P(f"{key}.hydrostatics.{k}", v)  # noqa: E731
-        q0 = quat_from_rpy(jnp.array([roll, pitch, yaw + b.heading]))
-        tank, tank_terms, blocks = (None, (), ()) if outline else body_liquid(scene, b, q0, g)
+        # its initial state as the vessel's (assemble/system.py), offsets from its rest pose, traced where params name them
+        ini = {k: jnp.asarray(P(f"{key}.initial.{k}", getattr(b.initial, k)), dtype=float)
+               for k in ("position", "velocity", "angular_velocity", "roll_pitch_yaw")}
+        q0 = quat_from_rpy(ini["roll_pitch_yaw"] + jnp.array([0.0, 0.0, b.heading]))
+        tank, tank_terms, blocks, carried = (None, (), (), ()) if outline else body_liquid(scene, b, q0, g)
         if blocks:
             hosts.append(BodyTanks(s, b.name, offset, blocks))
             offset += tank.nf
+        mass, inertia, S = jnp.asarray(P(f"{key}.mass", b.mass), dtype=float), P(f"{key}.inertia", b.inertia), None
+        if carried:       # its elastic walls carry their own mass in its liquid: the hull is the rest, as the vessel's
+            inertia = jnp.asarray(inertia, dtype=float)
+            mass, inertia, S = hull_part(mass, jnp.diag(inertia) if inertia.ndim == 1 else inertia, carried,
+                                    f"bodies[{s}]", "body", "its tanks' elastic walls")
         floating.append(Floating(
-            terms=rigid_terms(P(f"{key}.mass", b.mass), b.inertia, b.hydrostatics, rho, g, b.viscous_damping,
-                              traced, body_restoring(scene, b, params, g, tank)) + (
+            terms=rigid_terms(mass, inertia, b.hydrostatics, rho, g, b.viscous_damping, traced,
+                              body_restoring(scene, b, params, g, tank, mass, S), S) + (
                 () if X is None or not np.abs(X[s]).max() > 0 else
                 (WaveExcitation(make_excitation(waves, X[s], P(waves.height_key,
                                                               waves.height))),)),
-            rest=jnp.asarray(rest), x0=jnp.asarray(rest + np.asarray(ini.position)),
-            q0=q0, v0=jnp.asarray(np.concatenate([ini.velocity, ini.angular_velocity]), dtype=float),
+            rest=jnp.asarray(rest), x0=jnp.asarray(rest) + ini["position"],
+            q0=q0, v0=jnp.concatenate([ini["velocity"], ini["angular_velocity"]]),
             tank=tank, tank_terms=tank_terms))
     index = end_index(b.name for b in scene.bodies)
     links = []

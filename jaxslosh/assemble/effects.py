@@ -106,5 +106,5 @@ def count_unknowns(scene: Scene) -> int:
     n = 6 + sum(structure_unknowns(s) for s in scene.structures) + 6 * len(scene.bodies)
     if not scene.effects.liquid:
         return n
-    # the bodies' tanks (reduced, rigid walls) counted as the vessel's are
-    return n + liquid_unknowns(scene) + sum(free_liquid_dofs(t) for b in scene.bodies for t in b.tanks)
+    # the bodies' tanks counted as the vessel's are, their elastic walls' unknowns included
+    return n + liquid_unknowns(scene) + sum(free_liquid_dofs(t) + wall_unknowns(t) for b in scene.bodies for t in b.tanks)

@@ -75,20 +75,22 @@ def hull_term(scene, hull, params: dict, g, key: str = "vessel.hull", place=None
                         about=hull_about(scene, waves is not None, hull), place=at)
 
 
-def body_restoring(scene, body, params: dict, g, liquid=None) -> Optional[tuple]:
+def body_restoring(scene, body, params: dict, g, liquid=None, mass=None, S=None) -> Optional[tuple]:
     """The restoring terms of a `[[bodies]]` body with nonlinear hydrostatics, as the vessel's
     (assemble/system.py): its hull's pressure (`hull_term`, the waves at its place) and its weight,
-    the liquid of its tanks (`liquid`) included; () with `[effects] buoyancy` off (nothing holds it
-    up nor pulls it down, as the vessel); None for linear hydrostatics (assemble/bodies.py's term)."""
+    the liquid of its tanks (`liquid`, elastic walls included) included; `mass` and `S` the hull's
+    own mass and first moment where elastic walls carry theirs (default: the body's mass, none);
+    () with `[effects] buoyancy` off (nothing holds it up nor pulls it down, as the vessel); None
+    for linear hydrostatics (assemble/bodies.py's term)."""
     if not body.hydrostatics.nonlinear:
         return None
     if not scene.effects.buoyancy:
         return ()
     key = f"bodies.{body.name}"
-    mass = jnp.asarray(params.get(f"{key}.mass", body.mass), dtype=float)
-    S = jnp.zeros(3)
+    mass = jnp.asarray(params.get(f"{key}.mass", body.mass) if mass is None else mass, dtype=float)
+    S = jnp.zeros(3) if S is None else S
     if liquid is not None:
-        mass, S = mass + liquid.total_mass(), liquid.rigid_first_moment()
+        mass, S = mass + liquid.total_mass(), S + liquid.rigid_first_moment()
     weight = About(("gravity", f"the weight of the body {body.name!r} and its liquid, borne by its hull's pressure"))
     return (hull_term(scene, body.hull, params, g, f"{key}.hull", body.position),
             Weight(mass=mass, S=S, gravity=g, about=weight))

@@ -10,7 +10,6 @@ from __future__ import annotations
 import dataclasses
 from typing import NamedTuple, Optional
 
-import jax
 import jax.numpy as jnp
 import numpy as np
 
@@ -27,9 +26,9 @@ from ..physics.vessel import (HarmonicMotion, RecordedMotion, RigidBody, SpinUpM
                               Weight, record_coefficients)
 from ..staging import staged
 from ..scene.keys import resolve_params
-from ..scene.types import DOFS, Scene, SceneError
+from ..scene.types import DOFS, Scene
 from .about import damping_about, flex_about, liquid_about, record_about, stiffening_about, weight_about
-from .bodies import build_bodies, linear_hydrostatics
+from .bodies import build_bodies, hull_part, linear_hydrostatics
 from .damping import build_damping
 from .hull import build_hull_pressure
 from .liquid import LiquidBlock, build_liquid_block, outline_liquid_block, rigid_part
@@ -145,7 +144,7 @@ def _model(scene: Scene, params: dict, outline: bool = False) -> _Model:
     carried = block.carried + tuple(rigid_part(b.model.mass, b.model.nodes + np.asarray(scene.structure(b.name).origin))
                                     for b in blocks)
     if carried:       # the ship's mass and inertia include these parts: the hull is the rest (docs/reference/scene.md)
-        mass, inertia, hull_S = _hull(mass, inertia, carried)
+        mass, inertia, hull_S = hull_part(mass, inertia, carried)
     body = RigidBody(mass=mass, inertia=inertia, S=hull_S)
     balanced = ves.hydrostatics is not None and not nonlinear
     if not balanced:           # nothing holds the vessel up, or the hull's pressure does: its weight, liquid included
@@ -195,23 +194,6 @@ def _prescribed(f, P):
     value = lambda key: jnp.asarray(P(f"vessel.forced.{key}", getattr(f, key)), dtype=float)  # noqa: E731
     return HarmonicMotion(dof=DOFS.index(f.dof), amplitude=value("amplitude"), frequency=value("frequency"),
                           ramp=float(f.ramp), phase=value("phase"))
-
-
-def _hull(mass, inertia, parts):
-    """The hull's own mass, inertia about the origin and first moment: the ship's (mass, inertia
-    about its COG at the origin) less the parts that carry their own (structures, elastic walls)."""
-    m = sum(p[0] for p in parts)
-    S = sum(p[1] for p in parts)
-    I = sum(p[2] for p in parts)
-    if not isinstance(mass, jax.core.Tracer):
-        if float(mass) <= m:
-            raise SceneError("vessel.mass", f"{float(mass):.6g} kg is the whole ship without its liquid, structures "
-                                            f"and elastic walls included, but those alone weigh {m:.6g} kg")
-        if np.min(np.linalg.eigvalsh(np.asarray(inertia) - I)) <= 0:
-            raise SceneError("vessel.inertia", "is the whole ship's about its COG, structures and elastic walls "
-                                               "included, but it is smaller than theirs alone (the hull's would not "
-                                               f"be positive definite; theirs: {np.round(np.diag(I), 1).tolist()} kg m^2)")
-    return mass - m, inertia - jnp.asarray(I), -jnp.asarray(S)
 
 
 def _hydrostatic_start(system: System, q0):

@@ -37,7 +37,7 @@ def parse_grid(items):
 
 def check_grid(scene, grid):
     """The keys: traceable values of this scene, each given once, each a single number per run (a
-    vector or `vessel.inertia` is refused: its runs are swept from Python, js.simulate_batch)."""
+    vector or an inertia (`vessel.inertia`, `bodies.<name>.inertia`) is refused: its runs are swept from Python, js.simulate_batch)."""
     try:
         traceable(scene, grid)
     except SceneError as e:
@@ -46,7 +46,7 @@ def check_grid(scene, grid):
     for key in grid:
         shape = np.shape(values[key])
         if shape != ():
-            what = "3 diagonal values or a 3 x 3 matrix" if key == "vessel.inertia" else f"{shape[0]} numbers"
+            what = "3 diagonal values or a 3 x 3 matrix" if len(shape) == 2 else f"{shape[0]} numbers"
             raise InputError(f"--param {key}: holds {what}, and a sweep gives each run one number; sweep it "
                              f"from Python: js.simulate_batch(scene, {{{key!r}: an array with a row per run}})")
 

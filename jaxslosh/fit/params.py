@@ -10,7 +10,7 @@ import jax.numpy as jnp
 import numpy as np
 
 from ..hull.hydrostatics import rest_hydrostatics
-from ..scene.keys import SPRING_KEYS, canonical_key, scene_values, traceable
+from ..scene.keys import canonical_key, owner_of, scene_values, spring_key, traceable
 from ..scene.types import Scene, SceneError
 
 
@@ -19,9 +19,14 @@ POSITIVE = ("environment.gravity", "environment.water_density", "vessel.mass", "
             "vessel.hydrostatics.waterplane_area", "vessel.hydrostatics.displaced_volume",
             "vessel.hydrostatics.gm_t", "vessel.hydrostatics.gm_l", "vessel.hull.kg")
 # ... and of every [[bodies]] body and [[connections]] connection (after the name)
-POSITIVE_OWN = {"bodies": ("mass", "hydrostatics.waterplane_area", "hydrostatics.displaced_volume",
-                           "hydrostatics.gm_t", "hydrostatics.gm_l"),
+POSITIVE_OWN = {"bodies": ("mass", "inertia", "hydrostatics.waterplane_area", "hydrostatics.displaced_volume",
+                           "hydrostatics.gm_t", "hydrostatics.gm_l", "hull.kg"),
                 "connections": ("length", "stiffness")}
+
+
+def inertia_key(key: str) -> bool:
+    """Whether a canonical key is the vessel's or a body's inertia (fitted by its diagonal)."""
+    return key == "vessel.inertia" or (key.startswith("bodies.") and key.count(".") == 2 and key.endswith(".inertia"))
 
 
 def positive(key: str) -> bool:
@@ -76,7 +81,7 @@ class Param:
 
     def param_value(self, p):
         """The value simulate(params=) takes for this key, from the fitted components p."""
-        if self.key == "vessel.inertia":
+        if inertia_key(self.key):
             i = np.arange(3)
             return jnp.asarray(self.base).at[i, i].set(p)
         return p[0] if self.scalar else p
@@ -104,45 +109,58 @@ def fit_keys(scene: Scene, fit: Sequence[str]) -> tuple:
     if not fit:
         raise SceneError("fit", "give at least one key to fit")
     keys = traceable(scene, fit)
-    h = scene.vessel.hydrostatics
-    if h is not None and h.nonlinear:
-        for given, key in zip(fit, keys):
-            if key in SPRING_KEYS:
-                raise SceneError(given, 'model = "nonlinear" takes its restoring from the hull, which this value '
-                                        "does not enter: fit vessel.hull.kg (a mesh: vessel.hull.cog); the fit reports "
-                                        "the implied GM0 = KM - KG")
+    for given, key in zip(fit, keys):
+        if spring_key(scene, key):
+            hull = key.rpartition(".hydrostatics.")[0] + ".hull"
+            raise SceneError(given, 'model = "nonlinear" takes its restoring from the hull, which this value '
+                                    f"does not enter: fit {hull}.kg (a mesh: {hull}.cog); the fit reports "
+                                    "the implied GM0 = KM - KG")
     return keys
 
 
 # GM0 = KM - KG of the hull at rest: what a fitted KG (a mesh's COG) implies for the small-angle
-# springs, reported beside it
+# springs, reported beside it (the vessel's keys; a body's after its `bodies.<name>.`)
 IMPLIED_BY_KG = ("vessel.hydrostatics.gm_t", "vessel.hydrostatics.gm_l")
 
 
+def _fitted_hulls(keys) -> list:
+    """(the prefix `vessel` or `bodies.<name>`, the hull key) of each fitted KG or COG."""
+    return [(k.rpartition(".hull.")[0], k) for k in keys if k.endswith((".hull.kg", ".hull.cog"))
+            and (k.startswith("vessel.") or k.startswith("bodies."))]
+
+
 def implied_keys(keys) -> tuple:
-    """The scene values that follow from the fitted keys (the GM0s of a fitted KG or COG): a record
-    made with another KG differs in them too, and the fit reports them."""
-    return IMPLIED_BY_KG if ("vessel.hull.kg" in keys or "vessel.hull.cog" in keys) else ()
+    """The scene values that follow from the fitted keys (the GM0s of a fitted KG or COG, the
+    vessel's or a body's, and a body's `cog_height`, its hull's kg - draft unless given): a record
+    made with another KG differs in them too, and the fit reports the GM0s."""
+    return tuple(f"{prefix}.{k.partition('.')[2]}" for prefix, _ in _fitted_hulls(keys)
+                 for k in IMPLIED_BY_KG + (("vessel.cog_height",) if prefix != "vessel" else ()))
 
 
 def implied_values(scene: Scene, values: dict, errors: dict) -> tuple[dict, dict]:
     """({key: value}, {key: standard error}) of the implied keys: GM0 = KM - KG with the hull's KM
     (the scene's GM0 plus its KG) for a fitted KG, whose standard error it shares (dGM0/dKG = -1);
     for a mesh's fitted COG the GM0s of its surface at rest about that COG, with the standard
-    error of the COG's height (exact for a COG on the centre plane of a symmetric hull)."""
-    h = scene.vessel.hydrostatics
-    if "vessel.hull.kg" in values:
-        kg0, kg = scene.vessel.hull.kg, values["vessel.hull.kg"]
-        out = {"vessel.hydrostatics.gm_t": h.gm_t + kg0 - kg, "vessel.hydrostatics.gm_l": h.gm_l + kg0 - kg}
-        return out, {k: errors["vessel.hull.kg"] for k in out}
-    if "vessel.hull.cog" in values:
-        hull, env = scene.vessel.hull, scene.environment
-        cog = np.asarray(values["vessel.hull.cog"], dtype=float)
-        tris = hull.triangles() + (np.asarray(hull.cog, dtype=float) - cog)
-        own = rest_hydrostatics(tris, -cog[2], env.water_density, env.gravity)
-        out = {k: own[k.split(".")[-1]] for k in IMPLIED_BY_KG}
-        return out, {k: errors["vessel.hull.cog"][2] for k in out}
-    return {}, {}
+    error of the COG's height (exact for a COG on the centre plane of a symmetric hull). For the
+    vessel and each body whose KG or COG is fitted."""
+    out, se = {}, {}
+    for prefix, key in _fitted_hulls(values):
+        owner = owner_of(scene, key)[0]
+        h, hull = owner.hydrostatics, owner.hull
+        names = [f"{prefix}.{k.partition('.')[2]}" for k in IMPLIED_BY_KG]
+        if key.endswith(".kg"):
+            kg0, kg = hull.kg, values[key]
+            own = {"gm_t": h.gm_t + kg0 - kg, "gm_l": h.gm_l + kg0 - kg}
+            err = errors[key]
+        else:
+            env = scene.environment
+            cog = np.asarray(values[key], dtype=float)
+            tris = hull.triangles() + (np.asarray(hull.cog, dtype=float) - cog)
+            own = rest_hydrostatics(tris, -cog[2], env.water_density, env.gravity)
+            err = errors[key][2]
+        for name in names:
+            out[name], se[name] = own[name.rpartition(".")[2]], err
+    return out, se
 
 
 def make_params(scene: Scene, keys, x0, bounds) -> list:
@@ -156,7 +174,7 @@ def make_params(scene: Scene, keys, x0, bounds) -> list:
     out = []
     for key in keys:
         base = np.asarray(values[key], dtype=float)
-        default = np.diag(base) if key == "vessel.inertia" else base
+        default = np.diag(base) if inertia_key(key) else base
         start = np.asarray(x0.get(key, default), dtype=float)
         if start.shape != default.shape:
             raise SceneError(f"x0.{key}", f"expected shape {default.shape}, got {start.shape}")
@@ -174,7 +192,7 @@ def make_params(scene: Scene, keys, x0, bounds) -> list:
 
 
 def param_value(scene: Scene, key: str, value):
-    if key == "vessel.inertia":
+    if inertia_key(key):
         base = np.array(scene_values(scene)[key], dtype=float)
         base[np.arange(3), np.arange(3)] = value
         return base

@@ -8,13 +8,15 @@ group) whose rows are the sum of the *same term classes* as the vessel's rigid p
 evaluated with the body's own kinematics (`Floating.kin`): a body is built by the functions that
 build the vessel's rigid terms, its wave excitation among them (seakeeping.py's `WaveExcitation`,
 its forces at the body's place in the incident field), and, where the body has a hull with
-nonlinear hydrostatics, the vessel's hull pressure and weight terms (assemble/hull.py). What the
-vessel has and a body has not yet: elastic tank walls.
+nonlinear hydrostatics, the vessel's hull pressure and weight terms (assemble/hull.py). Its values
+are params as the vessel's (`bodies.<name>.mass`, `.inertia`, `.hydrostatics.*`, `.initial.*`,
+`.hull.kg`): leaves of these terms and of its initial state.
 
 Tanks on a body (`[[tanks]] body = ...`): each body's tanks are a liquid of the vessel's kind
-(jaxslosh/liquid, built by the vessel's builder: finite elements, reduced or full, whose block
-is constant, or the multimodal one, whose coordinates join the exact block: `exact`), held by its
-`Floating` and evaluated with the body's kinematics: its rigid rows add to the
+(jaxslosh/liquid, built by the vessel's builder: finite elements, reduced or full, elastic walls
+included, whose block is constant, or the multimodal one, whose coordinates join the exact block:
+`exact`), held by its `Floating` and evaluated with the body's kinematics (the walls' mass is the
+liquid's, the body's hull the rest: assemble/bodies.py hull_part): its rigid rows add to the
 body's six, its own rows are this term's deformable unknowns (the layout's z after the vessel's
 liquid; the configuration's `eta`, every body's tanks' stacked in the bodies' order), with the
 liquid's constant blocks as their block of the Newton preconditioner (`deformable_block`). They

@@ -261,17 +261,6 @@ def _overlaps(bodies, vessel) -> None:
                 f"`footprint`, circles of their areas without one) overlap at rest by {-gap:.4g} m"))
 
 
-def _body_tank(table, where: str, body: str) -> None:
-    """What a tank on one of [[bodies]] may be yet: a multimodal tank, or a finite-element tank (full
-    or reduced to its modes) with rigid walls (docs/guide/bodies-and-connections.md)."""
-    refused = [("walls", table.get("walls", "rigid") != "rigid", "elastic tank walls")]
-    for key, bad, what in refused:
-        if bad:
-            raise SceneError(f"{where}.body", f"{body!r}: {what} are not available yet on [[bodies]] (a "
-                                              f"finite-element tank with rigid walls or a multimodal tank rides on a "
-                                              f"body; {where}.{key})")
-
-
 def hull_extent(owner: FloatingBody, key: str = "vessel.hull.file") -> Optional[tuple]:
     """((x_min, y_min, z_min or -inf), (x_max, y_max)) of a body's (or the vessel's) hull in its frame
     from its COG, what the connection points are checked against: its hull where it has one (its
@@ -382,8 +371,6 @@ def bodies_scene(bodies, vessel, structures, mapping, warnings: list[str], files
         body = t.get("body", "vessel") if isinstance(t, dict) else "vessel"
         if body not in ("vessel", vessel.name, *[b.name for b in bodies]):
             raise SceneError(f"tanks[{i}].body", f"{body!r} is not a body of the scene")
-        if body in [b.name for b in bodies]:
-            _body_tank(t, f"tanks[{i}]", body)
     if not bodies:
         return
     _beside_multimodal(bodies, vessel, structures, mapping.get("tanks", []))

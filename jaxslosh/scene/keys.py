@@ -56,9 +56,11 @@ TANK_TRACEABLE = ("fill_depth", "fluid.density", "fluid.sound_speed", "damping.r
 MOORING_TRACEABLE = ("length", "weight", "ea", "seabed_friction")
 # a connection's values, leaves of its link (physics/bodies.py)
 CONNECTION_TRACEABLE = ("length", "stiffness", "damping")
-# a [[bodies]] body's values, leaves of its rigid terms (assemble/bodies.py)
-BODY_TRACEABLE = ("mass", "hydrostatics.waterplane_area", "hydrostatics.displaced_volume", "hydrostatics.gm_t",
-                  "hydrostatics.gm_l")
+# a [[bodies]] body's values, the vessel's own (without a forced motion, which a body has not):
+# leaves of its rigid terms, its hull's pressure and its initial state (assemble/bodies.py)
+BODY_TRACEABLE = ("mass", "inertia", "hydrostatics.waterplane_area", "hydrostatics.displaced_volume",
+                  "hydrostatics.gm_t", "hydrostatics.gm_l", "initial.position", "initial.velocity",
+                  "initial.angular_velocity", "initial.roll_pitch_yaw", "hull.kg", "hull.cog")
 
 
 TRACEABLE = _Keys((
@@ -80,6 +82,32 @@ HULL_TRACEABLE = ("vessel.hull.kg", "vessel.hull.cog")
 # change nothing
 SPRING_KEYS = ("vessel.hydrostatics.waterplane_area", "vessel.hydrostatics.displaced_volume",
                "vessel.hydrostatics.gm_t", "vessel.hydrostatics.gm_l")
+
+
+def owner_of(scene: Scene, key: str):
+    """(the floating body a canonical key belongs to: the scene's Vessel or a Body, its key in the
+    vessel's form: `bodies.barge.hull.kg` -> "vessel.hull.kg"), or (None, key) for other keys: one
+    rule for the vessel's keys and every body's."""
+    if key.startswith("vessel."):
+        return scene.vessel, key
+    if key.startswith("bodies."):
+        name, _, rest = key[len("bodies."):].partition(".")
+        body = next((b for b in scene.bodies if b.name == name), None)
+        if body is not None:
+            return body, "vessel." + rest
+    return None, key
+
+
+def hull_key(scene: Scene, key: str) -> bool:
+    """Whether a canonical key is traced by its body's nonlinear hydrostatics alone (a hull's KG or COG)."""
+    return owner_of(scene, key)[1] in HULL_TRACEABLE
+
+
+def spring_key(scene: Scene, key: str) -> bool:
+    """Whether a canonical key is a GM spring of a body (or the vessel) whose restoring is its hull's
+    (the nonlinear hydrostatics): tracing it would change nothing."""
+    owner, own = owner_of(scene, key)
+    return own in SPRING_KEYS and owner is not None and owner.hydrostatics is not None and owner.hydrostatics.nonlinear
 
 
 def scene_values(scene: Scene) -> dict[str, Any]:
@@ -148,9 +176,14 @@ def scene_values(scene: Scene) -> dict[str, Any]:
             v.update({f"{prefix}.{k}": x for k, x in own.items()})
     for i, b in enumerate(scene.bodies):
         h = b.hydrostatics
-        own = {"mass": b.mass, "cog_height": b.cog_height, "heading": b.heading,
+        own = {"mass": b.mass, "inertia": b.inertia, "cog_height": b.cog_height, "heading": b.heading,
                "hydrostatics.waterplane_area": h.waterplane_area, "hydrostatics.displaced_volume": h.displaced_volume,
                "hydrostatics.gm_t": h.gm_t, "hydrostatics.gm_l": h.gm_l}
+        own |= {f"initial.{k}": getattr(b.initial, k) for k in ("position", "velocity", "angular_velocity",
+                                                                  "roll_pitch_yaw")}
+        if b.hull is not None:      # as the vessel's: a box's KG, a mesh's COG
+            key, value = b.hull.cog_key()
+            own[key.partition(".")[2]] = value
         for prefix in (f"bodies.{b.name}", f"bodies[{i}]"):
             v.update({f"{prefix}.{k}": x for k, x in own.items()})
     if scene.campaign is not None:   # a campaign's settings (never traced: they change no run)
@@ -212,23 +245,25 @@ def traceable(scene: Scene, keys: Iterable[str]) -> tuple[str, ...]:
         if key not in TRACEABLE:
             raise SceneError(given, "cannot be traced by params, a sweep or a fit (traceable: "
                                     + ", ".join(traceable_keys(scene)) + ")")
-        if key in HULL_TRACEABLE and not _hull_restoring(scene):
-            raise SceneError(given, 'is traced by the nonlinear hydrostatics only ([vessel.hydrostatics] model = '
+        if hull_key(scene, key) and not _hull_restoring(scene, key):
+            table = key.rpartition(".hull.")[0]
+            raise SceneError(given, f'is traced by the nonlinear hydrostatics only ([{table}.hydrostatics] model = '
                                     '"nonlinear", [effects] buoyancy on): the linear model\'s GM springs were fixed '
-                                    "when the scene was loaded (trace vessel.hydrostatics.gm_t there)")
+                                    f"when the scene was loaded (trace {table}.hydrostatics.gm_t there)")
     return canon
 
 
-def _hull_restoring(scene: Scene) -> bool:
-    """Whether the restoring is the hull's wetted surface (the nonlinear hydrostatics, switched on)."""
-    h = scene.vessel.hydrostatics
+def _hull_restoring(scene: Scene, key: str) -> bool:
+    """Whether the restoring of the key's body (or the vessel) is its hull's wetted surface (the
+    nonlinear hydrostatics, switched on)."""
+    h = owner_of(scene, key)[0].hydrostatics
     return h is not None and h.nonlinear and scene.effects.buoyancy
 
 
 def traceable_keys(scene: Scene) -> tuple[str, ...]:
     """The keys of this scene that params may trace."""
-    hull = _hull_restoring(scene)
-    return tuple(k for k in scene_values(scene) if "[" not in k and k in TRACEABLE and (hull or k not in HULL_TRACEABLE))
+    return tuple(k for k in scene_values(scene)
+                 if "[" not in k and k in TRACEABLE and (not hull_key(scene, k) or _hull_restoring(scene, k)))
 
 
 def _shaped(key: str, value, base):
@@ -272,7 +307,7 @@ def check_values(scene: Scene, values: dict) -> Scene:
     canon = check_param_keys(scene, values)
     if not scene.text:
         return scene
-    mapping = copy.deepcopy(_mapping(scene.text))
+    mapping = copy.deepcopy(toml_mapping(scene.text))
     sim = mapping.setdefault("simulation", {})
     sim["duration"], sim["dt"] = float(scene.simulation.duration), float(scene.simulation.dt)
     given = list(values)
@@ -292,8 +327,9 @@ def check_values(scene: Scene, values: dict) -> Scene:
 
 
 @functools.lru_cache(maxsize=4)
-def _mapping(text: str) -> dict:
-    """The scene's TOML mapping, parsed once for the many runs of a batch (check_values copies it)."""
+def toml_mapping(text: str) -> dict:
+    """The scene's TOML mapping, parsed once for the many runs of a batch (check_values copies it;
+    not to be changed in place)."""
     return tomllib.loads(text)
 
 

@@ -356,9 +356,6 @@ def test_bad_input_names_its_key(what, old, new, key):
 
 
 @pytest.mark.parametrize("extra,key", [
-    ('[[tanks]]\nname = "t"\nbody = "barge"\norigin = [-2.0, -1.5, -1.0]\nsize = [4.0, 3.0, 3.0]\nfill_depth = 2.0\n'
-     'mesh = [4, 3, 3]\n[tanks.walls]\nthickness = 0.02\n[tanks.walls.material]\nyoung = 2.0e11\npoisson = 0.3\n'
-     'density = 7850.0\n', "tanks[0].body"),
     ('[environment2]\n', "environment2"),
 ])
 def test_what_a_body_cannot_have_yet_exits_2_naming_the_key(tmp_path, capsys, extra, key):

@@ -145,3 +145,8 @@ def test_cli_identify_names_a_bad_body_key(tmp_path, capsys, record):
     assert "bodies.tug.hydrostatics.gm_t" in capsys.readouterr().err
     assert main(["identify", str(path), "--data", str(data), "--fit", "bodies.barge.heading"]) == 2
     assert "bodies.barge.heading: cannot be traced" in capsys.readouterr().err
+    assert main(["identify", str(path), "--data", str(data), "--fit", "bodies.nosuch.hull.kg"]) == 2
+    assert "bodies.nosuch.hull.kg: not a value of this scene" in capsys.readouterr().err
+    # the barge has no hull: its springs are what it has
+    assert main(["identify", str(path), "--data", str(data), "--fit", "bodies.barge.hull.kg"]) == 2
+    assert "bodies.barge.hull.kg: not a value of this scene" in capsys.readouterr().err

@@ -198,18 +198,6 @@ def test_a_body_with_a_tank_on_a_hawser_runs_from_the_command_line(tmp_path, cap
     assert reader.num_steps == 21 and len(points) == len(h5py.File(out_file)["tanks/cargo/nodes"])
 
 
-@pytest.mark.parametrize("old,new,what", [
-    ('mesh = [2, 4, 3]\n', 'mesh = [2, 4, 3]\n[tanks.walls]\nthickness = 0.02\n[tanks.walls.material]\n'
-     'young = 2.0e11\npoisson = 0.3\ndensity = 7850.0\n', "elastic tank walls"),
-], ids=["elastic"])
-def test_what_a_body_tank_cannot_be_yet_is_refused_naming_the_key(old, new, what):
-    text = scene_on_body().text
-    assert old in text
-    with pytest.raises(js.SceneError) as e:
-        js.load_scene(text.replace(old, new, 1))
-    assert e.value.key == "tanks[0].body" and what in str(e.value), str(e.value)
-
-
 def test_without_the_liquid_a_probe_in_a_body_tank_follows_the_body():
     """[effects] liquid = false: no liquid unknowns, the probe moves rigidly with the carrier."""
     r = js.simulate(js.load_scene(scene_on_body(duration=0.2).text + "[effects]\nliquid = false\n"))
