@@ -154,11 +154,16 @@ damping = {damping}
 """)
 
 
+# both fender runs this long: the damped one then runs the undamped one's compiled program (the
+# damping is a value); 24 contacts hold the energy as 102 do (measured: 2.45e-5 and 2.48e-5 of it)
+BOUNCING = 40.0
+
+
 def test_an_undamped_fender_contact_conserves_the_energy():
-    r = js.simulate(_bouncing())
+    r = js.simulate(_bouncing(duration=BOUNCING))
     f = np.asarray(r.connections["fender"].force)
     contacts = np.count_nonzero((f[:-1] > -1.0) & (f[1:] <= -1.0))
-    assert contacts >= 100
+    assert contacts >= 20
     assert np.all(f <= 0.0)                                               # a fender pushes only
     E = np.asarray(r.energy.kinetic) + np.asarray(r.energy.potential)
     assert np.max(np.abs(E - E[0])) / E[0] < 1e-4, np.max(np.abs(E - E[0])) / E[0]
@@ -167,7 +172,7 @@ def test_an_undamped_fender_contact_conserves_the_energy():
 def test_a_damped_fender_loses_energy_only_in_contact():
     """(Where its damping cancels its push, while the body leaves it faster than it expands, the
     energy it still holds is lost too: a fender does not pull.)"""
-    r = js.simulate(_bouncing(duration=3.0, damping=2.0e5))
+    r = js.simulate(_bouncing(duration=BOUNCING, damping=2.0e5))
     e = np.asarray(r.connections["fender"].extension)
     E = np.asarray(r.energy.kinetic) + np.asarray(r.energy.potential)
     dE = np.diff(E)
