@@ -1,5 +1,6 @@
 """The fast twin of a body's tank's run against the same tank on the lone vessel: the body's rows
 and its liquid's at one state away from rest against the lone vessel's residual there."""
+import jax
 import jax.numpy as jnp
 import numpy as np
 
@@ -14,13 +15,23 @@ def rows_and_residual(on_body: str, alone: str, seed: int, sizes=(0.05, 0.1, 0.2
     """(the body's six rows and its liquid's, the lone vessel's residual) of the scene texts `on_body`
     (the tank on the first body) and `alone` (the body as the vessel), at a tilted, moving state with
     the liquid's unknowns displaced, moving and accelerating by `sizes`."""
-    floating = bodies_term(build(js.load_scene(on_body)).system).bodies[0]
-    vessel = build(js.load_scene(alone)).system
-    assert floating.nf == vessel.nf
+    scenes = js.load_scene(on_body), js.load_scene(alone)
     rng = np.random.default_rng(seed)
-    x, q = jnp.asarray(rng.normal(size=3) * 0.1), quat_from_rpy(jnp.asarray([0.05, -0.08, 0.3]))
-    v, a = jnp.asarray(rng.normal(size=6) * 0.1), jnp.asarray(rng.normal(size=6) * 0.1)
-    d, d_dot, d_acc = (jnp.asarray(rng.normal(size=floating.nf) * s) for s in sizes)
-    rigid, rows_d = floating.rows(floating.kin(floating.rest + x, q, v, a, vessel.gravity, 0.0, d, d_dot, d_acc))
-    ref = vessel.residual(Config(x, q, d), v[:3], v[3:], d_dot, jnp.concatenate([a, d_acc]))
-    return np.concatenate([np.asarray(rigid), np.asarray(rows_d)]), np.asarray(ref)
+    x, v, a = rng.normal(size=3) * 0.1, rng.normal(size=6) * 0.1, rng.normal(size=6) * 0.1
+
+    # built and evaluated in one compiled program: built eagerly, the two models cost hundreds of
+    # one-operation programs (the same numbers, to round-off)
+    @jax.jit
+    def rows(x, v, a):
+        floating = bodies_term(build(scenes[0]).system).bodies[0]
+        vessel = build(scenes[1]).system
+        assert floating.nf == vessel.nf
+        q = quat_from_rpy(jnp.asarray([0.05, -0.08, 0.3]))
+        # drawn here, where the number of the liquid's unknowns is known (the same draws as outside)
+        d, d_dot, d_acc = (jnp.asarray(rng.normal(size=floating.nf) * s) for s in sizes)
+        rigid, rows_d = floating.rows(floating.kin(floating.rest + x, q, v, a, vessel.gravity, 0.0, d, d_dot, d_acc))
+        ref = vessel.residual(Config(x, q, d), v[:3], v[3:], d_dot, jnp.concatenate([a, d_acc]))
+        return jnp.concatenate([rigid, rows_d]), ref
+
+    ours, ref = rows(jnp.asarray(x), jnp.asarray(v), jnp.asarray(a))
+    return np.asarray(ours), np.asarray(ref)

@@ -154,11 +154,16 @@ damping = {damping}
 """)
 
 
+# both fender runs this long: the damped one then runs the undamped one's compiled program (the
+# damping is a value); 24 contacts hold the energy as 102 do (measured: 2.45e-5 and 2.48e-5 of it)
+BOUNCING = 40.0
+
+
 def test_an_undamped_fender_contact_conserves_the_energy():
-    r = js.simulate(_bouncing())
+    r = js.simulate(_bouncing(duration=BOUNCING))
     f = np.asarray(r.connections["fender"].force)
     contacts = np.count_nonzero((f[:-1] > -1.0) & (f[1:] <= -1.0))
-    assert contacts >= 100
+    assert contacts >= 20
     assert np.all(f <= 0.0)                                               # a fender pushes only
     E = np.asarray(r.energy.kinetic) + np.asarray(r.energy.potential)
     assert np.max(np.abs(E - E[0])) / E[0] < 1e-4, np.max(np.abs(E - E[0])) / E[0]
@@ -167,7 +172,7 @@ def test_an_undamped_fender_contact_conserves_the_energy():
 def test_a_damped_fender_loses_energy_only_in_contact():
     """(Where its damping cancels its push, while the body leaves it faster than it expands, the
     energy it still holds is lost too: a fender does not pull.)"""
-    r = js.simulate(_bouncing(duration=3.0, damping=2.0e5))
+    r = js.simulate(_bouncing(duration=BOUNCING, damping=2.0e5))
     e = np.asarray(r.connections["fender"].extension)
     E = np.asarray(r.energy.kinetic) + np.asarray(r.energy.potential)
     dE = np.diff(E)
@@ -219,8 +224,9 @@ def test_a_damped_contact_never_pushes_a_hawser_or_pulls_a_fender(kind):
 def test_the_contact_force_is_the_derivative_of_its_energy_and_continuous():
     link = _link("hawser")
     xs = jnp.linspace(-2 * BAND, 2 * BAND, 401)
-    T = jax.vmap(lambda x: _tension(link, -x)[0])(xs)
-    dU = jax.vmap(jax.grad(lambda x: _tension(link, -x)[2]))(xs)
+    # one compiled program for both (eagerly, each operation its own)
+    T, dU = jax.jit(lambda xs: (jax.vmap(lambda x: _tension(link, -x)[0])(xs),
+                                jax.vmap(jax.grad(lambda x: _tension(link, -x)[2]))(xs)))(xs)
     np.testing.assert_allclose(np.asarray(T), np.asarray(dU), rtol=1e-10, atol=1e-9)
     # no jump: within the band the slope k (rho'^2 + rho rho'') stays below 1.5 k
     assert np.max(np.abs(np.diff(np.asarray(T)))) < 1.5e5 * 4 * BAND / 400 * 1.01
@@ -304,19 +310,27 @@ def test_the_connections_forces_are_the_gradient_of_their_energy_along_the_incre
     from jaxslosh.assemble.bodies import build_bodies
     from jaxslosh.physics.kinematics import quat_exp, quat_from_rpy, quat_multiply
     from jaxslosh.physics.terms import Config
-    term, _ = build_bodies(_pair(), {}, jnp.asarray(G))
-    c = Config(jnp.array([0.1, 0.3, -0.05]), quat_from_rpy(jnp.array([0.02, -0.01, 0.05])), jnp.zeros(0),
-               Xs=jnp.array([[0.0, 29.6, 0.02]]), qs=quat_from_rpy(jnp.array([-0.03, 0.01, 0.02]))[None, :])
-    zero = jnp.zeros(12)
+    scene = _pair()
 
-    def energy(x):
-        moved = c._replace(X0=c.X0 + x[:3], q=quat_multiply(c.q, quat_exp(x[3:6])), Xs=c.Xs + x[None, 6:9],
-                           qs=quat_multiply(c.qs[0], quat_exp(x[9:12]))[None, :])
-        return term.link_potential(term.poses(moved, zero))
+    # the term built, its forces and the energy's gradient in one compiled program (eagerly, two
+    # hundred one-operation programs)
+    @jax.jit
+    def forces_and_gradient():
+        term, _ = build_bodies(scene, {}, jnp.asarray(G))
+        c = Config(jnp.array([0.1, 0.3, -0.05]), quat_from_rpy(jnp.array([0.02, -0.01, 0.05])), jnp.zeros(0),
+                   Xs=jnp.array([[0.0, 29.6, 0.02]]), qs=quat_from_rpy(jnp.array([-0.03, 0.01, 0.02]))[None, :])
+        zero = jnp.zeros(12)
 
-    F = np.asarray(term.link_forces(term.poses(c, zero)))
+        def energy(x):
+            moved = c._replace(X0=c.X0 + x[:3], q=quat_multiply(c.q, quat_exp(x[3:6])), Xs=c.Xs + x[None, 6:9],
+                               qs=quat_multiply(c.qs[0], quat_exp(x[9:12]))[None, :])
+            return term.link_potential(term.poses(moved, zero))
+
+        return term.link_forces(term.poses(c, zero)), jax.grad(energy)(zero)
+
+    F, grad = (np.asarray(x) for x in forces_and_gradient())
     assert np.max(np.abs(F)) > 1e4
-    np.testing.assert_allclose(F, -np.asarray(jax.grad(energy)(zero)), rtol=1e-9, atol=1e-6)
+    np.testing.assert_allclose(F, -grad, rtol=1e-9, atol=1e-6)
 
 
 BAD = [

@@ -3,6 +3,7 @@ the same hull on the same three catenary lines moves the same as the vessel and 
 lines' tensions the same in the result; bad input exits 2 naming its key."""
 import math
 
+import jax
 import jax.numpy as jnp
 import numpy as np
 import pytest
@@ -117,18 +118,26 @@ def test_a_turned_bodys_lines_act_in_its_own_frame():
         r_b = Rz.T @ np.array([6 * math.cos(a), 6 * math.sin(a), -5.0])
         text = text.replace(f"fairlead = [{6 * math.cos(a)!r}, {6 * math.sin(a)!r}, -5.0]",
                             f"fairlead = {[float(x) for x in r_b]}")
-    ves = mooring_term(build(js.load_scene(_vessel_moored())).system)
-    bod = mooring_term(build(js.load_scene(text)).system)
+    scenes = js.load_scene(_vessel_moored()), js.load_scene(text)
     A_v = np.asarray(rotation_matrix(jnp.array([0.99, 0.05, -0.03, 0.1]) / np.linalg.norm([0.99, 0.05, -0.03, 0.1])))
     dx = np.array([2.0, -1.5, 0.3])
-    F, M = ves.force_moment(jnp.asarray(dx), jnp.asarray(A_v))
-    ref = np.concatenate([np.asarray(F + ves.carried), A_v.T @ np.asarray(M)])
     X_b = np.array([BODY_AT[0], BODY_AT[1], 0.0]) + dx
-    got = np.asarray(bod.frame_rows(jnp.broadcast_to(X_b, (3, 3)), jnp.broadcast_to(A_v @ Rz, (3, 3, 3))))[1]
+
+    # both terms built and evaluated in one compiled program (eagerly: a hundred one-operation programs)
+    @jax.jit
+    def forces(dx, A_v, X_b):
+        ves = mooring_term(build(scenes[0]).system)
+        bod = mooring_term(build(scenes[1]).system)
+        F, M = ves.force_moment(dx, A_v)
+        got = bod.frame_rows(jnp.broadcast_to(X_b, (3, 3)), jnp.broadcast_to(A_v @ Rz, (3, 3, 3)))[1]
+        return F + ves.carried, M, got, bod.carried
+
+    F, M, got, carried = (np.asarray(x) for x in forces(jnp.asarray(dx), jnp.asarray(A_v), jnp.asarray(X_b)))
+    ref = np.concatenate([F, A_v.T @ M])
     assert np.linalg.norm(ref[:3]) > 5e4 and np.linalg.norm(ref[3:]) > 5e4      # the lines pull and turn
     np.testing.assert_allclose(got[:3], ref[:3], rtol=1e-10, atol=1e-6)
     np.testing.assert_allclose(got[3:], Rz.T @ ref[3:], rtol=1e-10, atol=1e-5)
-    assert np.asarray(bod.carried) == pytest.approx(0.0)     # the free vessel has no lines to carry
+    assert carried == pytest.approx(0.0)     # the free vessel has no lines to carry
 
 
 @pytest.mark.slow      # two linearisations (rao, modes --coupled): about 40 s on a loaded 2-core machine

@@ -64,13 +64,16 @@ def scene_text(duration=60.0, components=30):
     return SCENE.format(duration=duration, components=components)
 
 
+def _environment():
+    """Workers (and subprocesses) import this worktree's package, share one compilation cache."""
+    return {"PYTHONPATH": os.pathsep.join([str(ROOT), str(ROOT / "tests"), os.environ.get("PYTHONPATH", "")]),
+            "JAXSLOSH_CACHE_DIR": str(CACHE), "JAXSLOSH_PROGRESS": "0"}
+
+
 @pytest.fixture
 def env(tmp_path, monkeypatch):
-    """Workers (and subprocesses) import this worktree's package, share one compilation cache."""
-    path = os.pathsep.join([str(ROOT), str(ROOT / "tests"), os.environ.get("PYTHONPATH", "")])
-    monkeypatch.setenv("PYTHONPATH", path)
-    monkeypatch.setenv("JAXSLOSH_CACHE_DIR", str(CACHE))
-    monkeypatch.setenv("JAXSLOSH_PROGRESS", "0")
+    for k, v in _environment().items():
+        monkeypatch.setenv(k, v)
     return tmp_path
 
 
@@ -134,19 +137,32 @@ def _campaign(p, s, seeds=2, **kw):
                        batch=4, **kw)
 
 
-def test_one_or_two_workers_give_the_same_statistics_as_jaxslosh_run(env):
+@pytest.fixture(scope="module")
+def two_workers(tmp_path_factory):
+    """A local cluster of two worker processes and the campaign it ran (the two tests below share
+    both: the killed worker's campaign is compared with this one, on the same cluster)."""
+    folder = tmp_path_factory.mktemp("two")
+    with pytest.MonkeyPatch.context() as mp:
+        for k, v in _environment().items():
+            mp.setenv(k, v)
+        p, s = files(folder)
+        with LocalCluster(n_workers=2, threads_per_worker=1, processes=True, dashboard_address=None) as cl, \
+                Client(cl) as client:
+            two = _campaign(p, s, client=client, output=str(folder / "two.h5"))
+            pids = list(client.run(os.getpid).values())
+            yield client, two, pids, folder
+
+
+def test_one_or_two_workers_give_the_same_statistics_as_jaxslosh_run(env, two_workers):
+    _, two, pids, folder = two_workers
     p, s = files(env)
-    with LocalCluster(n_workers=2, threads_per_worker=1, processes=True, dashboard_address=None) as cl, \
-            Client(cl) as client:
-        two = _campaign(p, s, client=client, output=str(env / "two.h5"))
-        pids = set(client.run(os.getpid).values())
     one = _campaign(p, s, workers=1, output=str(env / "one.h5"))
-    assert two.status == ["ok"] * 12 and one.status == ["ok"] * 12 and len(pids) == 2
+    assert two.status == ["ok"] * 12 and one.status == ["ok"] * 12 and len(set(pids)) == 2
     for ch in ("roll", "pitch", "heave"):
         for st in ("std", "max", "mpm", "tz"):
             np.testing.assert_allclose(one.statistics[ch][st], two.statistics[ch][st], rtol=1e-12, atol=1e-300)
         np.testing.assert_allclose(one.spectra[ch], two.spectra[ch], rtol=1e-12, atol=1e-300)
-    f = load_campaign(str(env / "two.h5"))
+    f = load_campaign(str(folder / "two.h5"))
     assert f.attrs["format"] == "jaxslosh.campaign" and f.status == ["ok"] * 12
     np.testing.assert_array_equal(f.statistics["roll"]["std"], two.statistics["roll"]["std"])
     np.testing.assert_allclose(f.cases["weight"].sum(), 1.0, rtol=1e-12)
@@ -165,33 +181,30 @@ def test_one_or_two_workers_give_the_same_statistics_as_jaxslosh_run(env):
     np.testing.assert_allclose(np.abs(roll - roll.mean()).max(), two.statistics["roll"]["max"][7], rtol=1e-6)
 
 
-def test_a_killed_worker_has_its_cases_rerun(env):
+def test_a_killed_worker_has_its_cases_rerun(env, two_workers):
+    client, ref, pids, _ = two_workers
     p, s = files(env)
-    with LocalCluster(n_workers=2, threads_per_worker=1, processes=True, dashboard_address=None) as cl, \
-            Client(cl) as client:
-        ref = _campaign(p, s, client=client, output=str(env / "ref.h5"))
-        pids = list(client.run(os.getpid).values())
-        out = env / "killed.h5"
-        killed = []
+    out = env / "killed.h5"
+    killed = []
 
-        def kill_when_started():         # the first worker, once the campaign has finished a batch
-            deadline = time.time() + 300
-            n_ok = 0
-            while time.time() < deadline and n_ok == 0:
-                try:
-                    with h5py.File(out, "r") as f:
-                        n_ok = sum(x == b"ok" for x in f["cases/status"][()])
-                except (OSError, KeyError):
-                    pass
-                time.sleep(0.02)
-            os.kill(pids[0], signal.SIGKILL)
-            killed.append(n_ok)
+    def kill_when_started():         # the first worker, once the campaign has finished a batch
+        deadline = time.time() + 300
+        n_ok = 0
+        while time.time() < deadline and n_ok == 0:
+            try:
+                with h5py.File(out, "r") as f:
+                    n_ok = sum(x == b"ok" for x in f["cases/status"][()])
+            except (OSError, KeyError):
+                pass
+            time.sleep(0.02)
+        os.kill(pids[0], signal.SIGKILL)
+        killed.append(n_ok)
 
-        th = threading.Thread(target=kill_when_started)
-        th.start()
-        r = js.campaign(js.load_scene(str(p)), str(s), headings=[1.2, BEAM], seeds=2, cache_dir=str(CACHE), batch=1,
-                        client=client, output=str(out))
-        th.join()
+    th = threading.Thread(target=kill_when_started)
+    th.start()
+    r = js.campaign(js.load_scene(str(p)), str(s), headings=[1.2, BEAM], seeds=2, cache_dir=str(CACHE), batch=1,
+                    client=client, output=str(out))
+    th.join()
     assert killed and killed[0] < 12 and r.status == ["ok"] * 12       # killed mid-campaign, yet complete
     for ch in ("roll", "heave"):
         np.testing.assert_allclose(r.statistics[ch]["std"], ref.statistics[ch]["std"], rtol=1e-12)

@@ -20,10 +20,17 @@ F0 = jnp.array(OC3["fairlead"])
 ZERO = jnp.zeros(3)
 
 
-def static_force(line, fair):
+@jax.jit
+def _static_force(line, fair):
+    # compiled once per number of segments (eagerly, a few hundred one-operation programs)
     r, ok = lm.static_shape(line, fair)
+    return lm.fairlead_force(line, r, jnp.zeros_like(r), fair, ZERO), ok
+
+
+def static_force(line, fair):
+    F, ok = _static_force(line, fair)
     assert bool(ok)
-    return np.asarray(lm.fairlead_force(line, r, jnp.zeros_like(r), fair, ZERO))
+    return np.asarray(F)
 
 
 def test_reference_is_the_published_oc3_line():
@@ -164,7 +171,8 @@ def test_advance_gradient_matches_finite_differences():
         s1 = lm.advance(line, s, F0, ZERO, p1, v1, 0.1)
         return jnp.linalg.norm(lm.fairlead_force(line, s1.r, s1.v, p1, v1))
 
-    g = jax.grad(tension)(0.05)
+    g = jax.jit(jax.grad(tension))(0.05)
     e = 1e-4
-    fd = (tension(0.05 + e) - tension(0.05 - e)) / (2 * e)
+    jtension = jax.jit(tension)         # one compiled program for both ends (not operation by operation)
+    fd = (jtension(0.05 + e) - jtension(0.05 - e)) / (2 * e)
     assert float(g) == pytest.approx(float(fd), rel=1e-5)

@@ -5,6 +5,7 @@ force on the vessel in its equations of motion, and the lines restoring a surge 
 import os
 from types import SimpleNamespace
 
+import jax
 import jax.numpy as jnp
 import numpy as np
 import pytest
@@ -101,10 +102,16 @@ def test_balanced_vessel_at_rest_stays_at_rest():
 def test_observe_gives_tensions_and_nodes(run):
     st, terms, states = run
     b = states[-1].s
-    d = lumped_observe(st.built.system, b.z, b.c, b.v[:3], b.v[3:6])
-    for name, (term, z) in line_states(st, states[-1]).items():
-        assert float(d[f"mooring/{name}/fairlead_tension"]) == pytest.approx(
-            float(term.tension(b.c, b.v[:3], b.v[3:6], z)), rel=1e-12)
+    lines = line_states(st, states[-1])
+
+    @jax.jit        # one compiled program (eagerly, a hundred one-operation programs)
+    def observed(b, zs):
+        return (lumped_observe(st.built.system, b.z, b.c, b.v[:3], b.v[3:6]),
+                {name: lines[name][0].tension(b.c, b.v[:3], b.v[3:6], z) for name, z in zs.items()})
+
+    d, tension = observed(b, {name: z for name, (_, z) in lines.items()})
+    for name, (term, z) in lines.items():
+        assert float(d[f"mooring/{name}/fairlead_tension"]) == pytest.approx(float(tension[name]), rel=1e-12)
         nodes = np.asarray(d[f"mooring/{name}/nodes"])
         assert nodes.shape == (21, 3)
         np.testing.assert_allclose(nodes[0], np.asarray(term.line.anchor))
