@@ -74,7 +74,8 @@ def test_backbone_is_the_third_order_standing_wave(hL):
     k = np.pi
     T = {}
     for a in (1e-6, 0.01, 0.005):
-        T[a], miss = _standing_wave_period(t, a)
+        # the amplitude an array, not a static argument: one program for the three (and every depth)
+        T[a], miss = _standing_wave_period(t, jnp.asarray(a))
         assert miss < 1e-12                       # the orbit closes
     c = {a: (T[1e-6] / T[a] - 1.0) / (k * a) ** 2 for a in (0.01, 0.005)}
     c0 = (4 * c[0.005] - c[0.01]) / 3
