@@ -42,7 +42,8 @@ def test_integrals_against_scipy_quadrature_of_the_exact_modes():
     """A_n, dA_n/dbeta, A_nk, the flux integrals and the moments at a large surface deflection."""
     t = _tank(0.4, n=3)
     beta = jnp.array([0.08, -0.03, 0.02])
-    I = t.integrals(beta)
+    # the integrals and their derivative in one program (eager: each operation compiles on its own)
+    I, Jn = eqx.filter_jit(lambda t, b: (t.integrals(b), jax.jacfwd(lambda be: t.integrals(be).An)(b)))(t, beta)
     h, k = 0.4, np.arange(1, 4) * np.pi
     zeta = lambda x: float(np.cos(k * x) @ np.asarray(beta))  # noqa: E731
     phi = lambda n, x, u: np.cos(k[n] * x) * np.cosh(k[n] * u) / np.cosh(k[n] * h)  # noqa: E731
@@ -60,7 +61,7 @@ def test_integrals_against_scipy_quadrature_of_the_exact_modes():
         for m in range(3):
             ref = q(lambda x, u: px(n, x, u) * px(m, x, u) + pz(n, x, u) * pz(m, x, u))
             assert float(I.Ank[n, m]) == pytest.approx(ref, rel=1e-9, abs=1e-12)
-    np.testing.assert_allclose(I.Jn, jax.jacfwd(lambda be: t.integrals(be).An)(beta), rtol=1e-12, atol=1e-14)
+    np.testing.assert_allclose(I.Jn, Jn, rtol=1e-12, atol=1e-14)
     assert float(I.mxz) == pytest.approx(q(lambda x, u: x * u), rel=1e-10)
     assert float(I.area) == pytest.approx(h, rel=1e-13)        # the cosines conserve the volume
 

@@ -63,6 +63,17 @@ def test_resonant_surge_runs_its_12_s_with_one_warning(tmp_path):
     assert "tanks[0]" in msg and "steep-wave damping" in msg and "slope" in msg, msg
 
 
+def test_surface_past_the_roof_is_said(tmp_path):
+    """The same tank filled to 0.95 m of its 1 m, the same surge: the crest passes the roof and the run
+    says that the multimodal liquid is outside its validity, naming the tank. (As long a run as the
+    resonant one: it takes that run's compiled programs, the depth and the forcing being their inputs.)"""
+    text = RESONANT.format(duration=12.0, amplitude=0.01).replace("fill_depth = 0.5", "fill_depth = 0.95")
+    report = run_to_file(js.load_scene(text.replace("point = [0.0, 0.5, 0.5]", "point = [0.0, 0.5, 0.95]")),
+                         str(tmp_path / "r.h5"), progress=False)
+    roof = [w for w in report.warnings if "roof" in w]
+    assert len(roof) == 1 and "tanks[0]" in roof[0] and "multimodal" in roof[0], report.warnings
+
+
 def test_damping_is_zero_within_the_range_and_dissipates_past_it():
     """The force on the modal rows is exactly zero while the crest index is below STEEP_ON (a 0.1 m
     crest on 6 modes of a 1 m tank: index 1.4), grows past it, and always takes energy
