@@ -42,7 +42,8 @@ def test_integrals_against_scipy_quadrature_of_the_exact_modes():
     """A_n, dA_n/dbeta, A_nk, the flux integrals and the moments at a large surface deflection."""
     t = _tank(0.4, n=3)
     beta = jnp.array([0.08, -0.03, 0.02])
-    I = t.integrals(beta)
+    # the integrals and their derivative in one program (eager: each operation compiles on its own)
+    I, Jn = eqx.filter_jit(lambda t, b: (t.integrals(b), jax.jacfwd(lambda be: t.integrals(be).An)(b)))(t, beta)
     h, k = 0.4, np.arange(1, 4) * np.pi
     zeta = lambda x: float(np.cos(k * x) @ np.asarray(beta))  # noqa: E731
     phi = lambda n, x, u: np.cos(k[n] * x) * np.cosh(k[n] * u) / np.cosh(k[n] * h)  # noqa: E731
@@ -60,7 +61,7 @@ def test_integrals_against_scipy_quadrature_of_the_exact_modes():
         for m in range(3):
             ref = q(lambda x, u: px(n, x, u) * px(m, x, u) + pz(n, x, u) * pz(m, x, u))
             assert float(I.Ank[n, m]) == pytest.approx(ref, rel=1e-9, abs=1e-12)
-    np.testing.assert_allclose(I.Jn, jax.jacfwd(lambda be: t.integrals(be).An)(beta), rtol=1e-12, atol=1e-14)
+    np.testing.assert_allclose(I.Jn, Jn, rtol=1e-12, atol=1e-14)
     assert float(I.mxz) == pytest.approx(q(lambda x, u: x * u), rel=1e-10)
     assert float(I.area) == pytest.approx(h, rel=1e-13)        # the cosines conserve the volume
 
@@ -110,6 +111,10 @@ def test_surge_force_is_the_spring_mass_models():
         assert F == pytest.approx(mass + np.sum(mn * w ** 2 / (wn ** 2 - w ** 2)), rel=1e-9)
 
 
+#: RK4's stages: (the step's fraction to the stage's state, the stage's weight times 6)
+RK4_STAGES = jnp.array([[0.0, 1.0], [0.5, 2.0], [0.5, 2.0], [1.0, 1.0]])
+
+
 @eqx.filter_jit
 def _free_period(t, eps, periods: int = 8, per: int = 120):
     """Free oscillation from beta_1 = eps L at rest (RK4): the mean period of beta_1's down-crossings."""
@@ -124,11 +129,14 @@ def _free_period(t, eps, periods: int = 8, per: int = 120):
     dt = T / per
 
     def step(y, _):
-        k1 = acc(y)
-        k2 = acc(y + dt / 2 * k1)
-        k3 = acc(y + dt / 2 * k2)
-        k4 = acc(y + dt * k3)
-        y = y + dt / 6 * (k1 + 2 * k2 + 2 * k3 + k4)
+        # RK4's four stages as a loop: the program holds the rows (and their Jacobian) once, not four
+        # times (a quarter of the compile)
+        def stage(carry, c):
+            total, k = carry
+            k = acc(y + c[0] * dt * k)
+            return (total + c[1] * k, k), None
+        (total, _), _ = jax.lax.scan(stage, (jnp.zeros_like(y), jnp.zeros_like(y)), RK4_STAGES)
+        y = y + dt / 6 * total
         return y, y[0]
     _, b1 = jax.lax.scan(step, jnp.concatenate([z.at[0].set(eps * t.L), z]), None, length=periods * per)
     return jnp.concatenate([jnp.array([eps * t.L]), b1]), dt, T
@@ -182,8 +190,12 @@ def test_closed_form_integrals_are_the_quadrature_over_the_liquid():
     surface) against Gauss quadrature over the whole deflected liquid, pitch terms included."""
     t = modal_tank(1.0, 0.4, 0.5, 1000.0, (-0.5, -0.2, -0.3), 5, D=0.8)
     beta = jnp.array([0.09, -0.03, 0.02, 0.01, -0.005])
-    a, b = t.integrals(beta), t.integrals_quadrature(beta)
+
+    @eqx.filter_jit        # both sides and their derivatives, one program (eager: each operation its own)
+    def both(t, beta):
+        return (t.integrals(beta), t.integrals_quadrature(beta), jax.jacfwd(lambda be: t.integrals(be).W)(beta),
+                jax.jacfwd(lambda be: t.integrals_quadrature(be).W)(beta))
+    a, b, Ja, Jb = both(t, beta)
     for name in a._fields:
         np.testing.assert_allclose(getattr(a, name), getattr(b, name), rtol=1e-9, atol=1e-11, err_msg=name)
-    np.testing.assert_allclose(jax.jacfwd(lambda be: t.integrals(be).W)(beta),
-                               jax.jacfwd(lambda be: t.integrals_quadrature(be).W)(beta), rtol=1e-8, atol=1e-10)
+    np.testing.assert_allclose(Ja, Jb, rtol=1e-8, atol=1e-10)

@@ -15,6 +15,7 @@ from jaxslosh.liquid.multimodal.expansion import third_order
 from jaxslosh.liquid.multimodal.tank3d import cylinder_tank
 from test_multimodal3d_tank import BOX, _transfer
 from test_multimodal3d_tank import FORCED as FORCED_3D
+from test_multimodal import RK4_STAGES
 from test_multimodal_tank import FORCED, _amplitude
 
 G = 9.81
@@ -39,11 +40,13 @@ def _acc(t, y):
 
 def _rk4(t, y, dt, steps):
     def step(y, _):
-        k1 = _acc(t, y)
-        k2 = _acc(t, y + dt / 2 * k1)
-        k3 = _acc(t, y + dt / 2 * k2)
-        k4 = _acc(t, y + dt * k3)
-        y = y + dt / 6 * (k1 + 2 * k2 + 2 * k3 + k4)
+        # the four stages as a loop: the program holds the rows once, not four times
+        def stage(carry, c):
+            total, k = carry
+            k = _acc(t, y + c[0] * dt * k)
+            return (total + c[1] * k, k), None
+        (total, _), _ = jax.lax.scan(stage, (jnp.zeros_like(y), jnp.zeros_like(y)), RK4_STAGES)
+        y = y + dt / 6 * total
         return y, y
     return jax.lax.scan(step, y, None, length=steps)
 
@@ -74,7 +77,8 @@ def test_backbone_is_the_third_order_standing_wave(hL):
     k = np.pi
     T = {}
     for a in (1e-6, 0.01, 0.005):
-        T[a], miss = _standing_wave_period(t, a)
+        # the amplitude an array, not a static argument: one program for the three (and every depth)
+        T[a], miss = _standing_wave_period(t, jnp.asarray(a))
         assert miss < 1e-12                       # the orbit closes
     c = {a: (T[1e-6] / T[a] - 1.0) / (k * a) ** 2 for a in (0.01, 0.005)}
     c0 = (4 * c[0.005] - c[0.01]) / 3

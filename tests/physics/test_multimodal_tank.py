@@ -147,7 +147,10 @@ def test_gradient_through_a_run_matches_finite_differences(expansion):
     assert abs(g) > 1e-4
 
 
-def test_keys_and_warnings(tmp_path, capsys):
+def test_keys_and_warnings():
+    """The loader's keys and warnings for a multimodal tank (the run's warning of a surface past the
+    roof: test_multimodal_steep.py, on the programs of its resonant run; that the command line prints
+    a run's warnings: tests/io/test_files.py)."""
     base = FORCED.format(duration=1.0, amplitude=0.001, w=4.0, ratio=0.1)
     shallow = js.load_scene(base.replace("fill_depth = 0.5", "fill_depth = 0.05").replace(
         "point = [0.0, 0.2, 0.5]", "point = [0.0, 0.2, 0.05]"))
@@ -159,14 +162,6 @@ def test_keys_and_warnings(tmp_path, capsys):
     two = base + '[[tanks]]\nname = "b"\norigin = [2.0, 0.0, 0.0]\nsize = [1.0, 1.0, 1.0]\nfill_depth = 0.5\nmesh = [2, 2, 2]\n'
     with pytest.raises(js.SceneError, match=r"tanks\[1\]\.model"):
         js.load_scene(two)
-    p = tmp_path / "s.toml"
-    p.write_text(base.replace("fill_depth = 0.5", "fill_depth = 0.78").replace("point = [0.0, 0.2, 0.5]",
-                                                                               "point = [0.0, 0.2, 0.78]")
-                 .replace("amplitude = 0.001", "amplitude = 0.01").replace("frequency = 4.0", "frequency = 5.0")
-                 .replace("duration = 1.0", "duration = 8.0").replace("ratio = 0.1", "ratio = 0.05"))
-    assert main(["run", str(p), "-o", str(tmp_path / "o.h5")]) == 0
-    err = capsys.readouterr().err
-    assert "roof" in err and "multimodal" in err, err
 
 
 # slow, for the default suite's budget: it keeps a batch of multimodal tanks equal to its single runs
@@ -214,14 +209,16 @@ def test_modes_command_lists_the_linear_frequencies(tmp_path, capsys):
 
 def test_rao_of_a_multimodal_tank_is_the_finite_elements_along_its_length():
     """js.rao linearises the multimodal rows about rest: in head seas (the flow along the tank's
-    length the only sloshing) the paper ship's pitch and surge RAOs with its tank as 20 modes are the
-    20-mode finite elements' within 0.2 % below the sloshing resonance (2.43 rad/s) and 3 % near it
-    (the 5 x 5 x 5 mesh's own first mode is off linear theory there)."""
+    length the only sloshing) the paper ship's pitch and surge RAOs with its tank as 10 modes are the
+    10-mode finite elements' within 0.2 % below the sloshing resonance (2.43 rad/s) and 3 % near it
+    (the 5 x 5 x 5 mesh's own first mode is off linear theory there). Measured: 0.045 % and 1.8 %,
+    as with 20 modes each (the same to 4e-6), whose multimodal linearisation costs three times the
+    CPU."""
     from pathlib import Path
     from test_frequency import with_hull
     text = (Path(__file__).resolve().parents[2] / "scenes" / "paper_ship_tank.toml").read_text()
-    fem = text.replace('walls = "rigid"', 'walls = "rigid"\n[tanks.reduction]\nmodes = 20')
-    mm = text.replace('mesh = [5, 5, 5]\nwalls = "rigid"', 'model = "multimodal"\nmodes = 20')
+    fem = text.replace('walls = "rigid"', 'walls = "rigid"\n[tanks.reduction]\nmodes = 10')
+    mm = text.replace('mesh = [5, 5, 5]\nwalls = "rigid"', 'model = "multimodal"\nmodes = 10')
     w = np.array([0.6, 1.0, 1.5, 2.3])
     a, b = js.rao(with_hull(fem), w, [0.0]), js.rao(with_hull(mm), w, [0.0])
     for j in (0, 4):
