@@ -69,7 +69,9 @@ def test_a_flexible_wall_vibrates_lower_wet_than_dry():
     modes (held at the hull, no liquid): the liquid's added mass (measured 115.8 against 134.5 rad/s
     for the first pair, 145.1 against 187.5 for the next)."""
     E = 2.1e11
-    md = tank_modes(build_tank_with_walls(_tank(E), _liquid()), n=2000)
+    # the lowest 300 of the 1668 modes: the first wall modes are the 235th, 236th and 261st (below
+    # them the sloshing modes); all of them took 3.5 times as long
+    md = tank_modes(build_tank_with_walls(_tank(E), _liquid()), n=300)
     wet = md.omega[(md.wall_share > 0.9)][:3]
     w = build_walls(SIZE, FILL, MESH, 0.1, E, 0.3, 7850.0)
     f = np.flatnonzero(~np.repeat(w.held, 3))

@@ -35,9 +35,10 @@ def test_liquid_model_from_traced_values_and_its_derivatives(mesh, element):
     base = {"fill_depth": 3.0, "density": 1000.0, "sound_speed": 20.0, "gravity": 9.81}
     concrete = _model_arrays(base, mesh, element)
     p0 = jnp.asarray([base[k] for k in LIQUID])
-    # all four traced at once: one forward pass per direction (jacfwd), the values from the traced build
-    jac, traced = jax.jacfwd(lambda p: (lambda out: (out, out))(_model_arrays(dict(zip(LIQUID, p)), mesh, element)),
-                             has_aux=True)(p0)
+    # all four traced at once: one forward pass per direction (jacfwd), the values from the traced
+    # build; jitted, one program instead of the ~140 small ones of its operations run one by one
+    jac, traced = jax.jit(jax.jacfwd(lambda p: (lambda out: (out, out))(_model_arrays(dict(zip(LIQUID, p)), mesh, element)),
+                                     has_aux=True))(p0)
     for k, v in concrete.items():
         assert isinstance(v, np.ndarray) and not isinstance(traced[k], np.ndarray)
         assert np.max(np.abs(np.asarray(traced[k]) - v)) <= 1e-13 * np.max(np.abs(v)), k
@@ -233,7 +234,9 @@ def test_gradient_of_a_trajectory_loss_wrt_tank_parameters_matches_central_diffe
 def test_checkpointed_long_runs_give_the_same_frames_and_gradient(monkeypatch, steps=103):
     """Runs of run.REMAT_MIN_STEPS steps or more are checkpointed in blocks of ~sqrt(n) frames (103:
     10 blocks of 10 and a remainder of 3): the frames and the gradient equal the plain scan's."""
+    import equinox as eqx
     import jaxslosh.run.loop as run_mod
+    import jaxslosh.run.simulate as sim_mod
     from helpers import vessel_scene
     scene = vessel_scene(duration=steps * 0.01, omega=(0.03, 0.01, 0.0))
 
@@ -245,7 +248,10 @@ def test_checkpointed_long_runs_give_the_same_frames_and_gradient(monkeypatch, s
     monkeypatch.setattr(run_mod, "REMAT_MIN_STEPS", 50)
     calls, checkpoint = [], jax.checkpoint
     monkeypatch.setattr(run_mod.jax, "checkpoint", lambda f, *a, **k: calls.append(1) or checkpoint(f, *a, **k))
-    jax.clear_caches()        # the compiled loop of the first run would be taken again
+    # the compiled loop of the first run would be taken again: the run's loop through a jit of its
+    # own (a new function, so no trace of the first is reused), not jax.clear_caches(), which would
+    # also drop the many small programs of the model's build and compile them all again
+    monkeypatch.setattr(sim_mod, "advance", eqx.filter_jit(lambda *a: run_mod.traced_advance(*a)))
     (l1, q1), g1 = jax.value_and_grad(loss, has_aux=True)(1.5)
     assert calls              # the checkpointed form ran
     assert q1.shape == q0.shape == (steps + 1, 4)
