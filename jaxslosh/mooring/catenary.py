@@ -301,7 +301,8 @@ def _solve2(J, r):
 
 def _err(r):
     """Each line's largest scaled residual (inf where it is not finite)."""
-    return jnp.where(jnp.isfinite(r).all(axis=1), jnp.max(jnp.abs(r), axis=1), jnp.inf)
+    return jnp.where(jnp.isfinite(r[:, 0]) & jnp.isfinite(r[:, 1]), jnp.maximum(jnp.abs(r[:, 0]), jnp.abs(r[:, 1])),
+                     jnp.inf)
 
 
 def _chord(residual, guess, inverse, r0=None):
@@ -314,7 +315,7 @@ def _chord(residual, guess, inverse, r0=None):
     kernels. `r0`: the residual at the guess where the caller has it (`_start_residual`)."""
     x, r = guess, residual(guess) if r0 is None else r0
     for k in range(CHORD_STEPS):       # a fixed count, unrolled: not a loop over time steps
-        dx = jnp.einsum("nij,nj->ni", inverse, r)
+        dx = inverse[:, :, 0] * r[:, :1] + inverse[:, :, 1] * r[:, 1:]
         x = jnp.where((_err(r) <= TOL)[:, None], x, _descend(x, dx))
         if k < CHORD_STEPS - 1:
             r = residual(x)
