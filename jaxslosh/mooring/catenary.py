@@ -315,8 +315,7 @@ def _chord(residual, guess, inverse, r0=None):
     kernels. `r0`: the residual at the guess where the caller has it (`_start_residual`)."""
     x, r = guess, residual(guess) if r0 is None else r0
     for k in range(CHORD_STEPS):       # a fixed count, unrolled: not a loop over time steps
-        dx = inverse[:, :, 0] * r[:, :1] + inverse[:, :, 1] * r[:, 1:]
-        x = jnp.where((_err(r) <= TOL)[:, None], x, _descend(x, dx))
+        x = jnp.where((_err(r) <= TOL)[:, None], x, _descend(x, _times(inverse, r)))
         if k < CHORD_STEPS - 1:
             r = residual(x)
     return x, r
@@ -368,6 +367,13 @@ def _lines_warm(XF, ZF, L, w, EA, CB, hA, slack, H0, guess, inverse=None):
     return jax.lax.while_loop(lambda s: s[3], polish, (x, r, 0, jnp.any(_err(r) > TOL)))[0]
 
 
+def _times(inverse, r):
+    """(n, 2) the products of (n, 2, 2) blocks and (n, 2) vectors, written out: a batched dot is an
+    XLA kernel of its own (and so is a reduction over the pair, `_err`), where these products fuse
+    with the profile's arithmetic around them."""
+    return inverse[:, :, 0] * r[:, :1] + inverse[:, :, 1] * r[:, 1:]
+
+
 def _descend(x, dx):
     """x - dx with H kept positive (a step that would cross zero goes nine tenths of the way there)."""
     return jnp.stack([jnp.maximum(x[:, 0] - dx[:, 0], 0.1 * x[:, 0]), x[:, 1] - dx[:, 1]], axis=1)
@@ -395,22 +401,28 @@ def lines_inverse(XF, ZF, L, w, EA, CB, hA, x):
 
 def lines_settle(XF, ZF, L, w, EA, CB, hA, guess, inverse, at=None):
     """((n, 2) solutions, (n, 2, 2) the inverses of the Jacobians there, (n, 2) the profile's spans
-    there) from the chord steps of the
-    step's residual (`_lines_chord`, from the last step's `guess` and `inverse`) and one Newton step
-    after them: what a step's end keeps for the next (once a step, no loop). Where the step's
-    residual took the chord steps' solution (its residual before the last step below CHORD_TOL) the
-    Newton step brings it to round-off; where it did not, the step has failed (NaN) and its states
-    are not kept. The Jacobian is the one at the chord steps' solution (a chord step's, within
-    round-off of the solution's); `at` as `_lines_chord`'s."""
+    there) from the last step's `guess`, `inverse` and `at` (`_lines_chord`'s): what a step's end
+    keeps for the next (once a step, no loop). One chord step from the guess, which needs no
+    evaluation of the profile (its residual there comes from `at`), then one evaluation of the
+    profile with its Jacobian (a jvp in two directions) and a Newton step from there: the chord step
+    leaves the step's motion times the chord's rate (some four digits below the motion's), the
+    Newton step squares that, to round-off wherever the step's own chord steps converged (where
+    they did not, the step has failed, NaN, and its states are not kept). The Jacobian is the one
+    before the Newton step (within round-off of the solution's), and the spans at the solution are
+    the fairlead's own (XF, ZF), which the Newton step leaves within round-off (a slack line's
+    horizontal span is not read: its residual is its tension's). One evaluation of the profile,
+    where the step's chord steps, a Newton step and the spans took four: each is a chain of small
+    XLA kernels, and their count, not their arithmetic, was what the step's end cost
+    (docs/benchmarks.md, mooring lines)."""
+    XF, ZF, L, w = (jnp.asarray(v, dtype=float) for v in (XF, ZF, L, w))
     residual, slack, H0 = _prepared(XF, ZF, L, w, EA, CB, hA)
-    r0 = None if at is None else _start_residual(*(jnp.asarray(v, dtype=float) for v in (XF, ZF, L, w)), slack, H0,
-                                                 guess, at)
-    x, _ = _chord(residual, guess, inverse, r0)
+    r0 = residual(guess) if at is None else _start_residual(XF, ZF, L, w, slack, H0, guess, at)
+    x = jnp.where((_err(r0) <= TOL)[:, None], guess, _descend(guess, _times(inverse, r0)))
     r, cols = jax.vmap(lambda e: jax.jvp(residual, (x,), (jnp.broadcast_to(e, x.shape),)),
                        out_axes=(None, 0))(jnp.eye(2, dtype=x.dtype))
     J = jnp.moveaxis(cols, 0, -1)
     x = jnp.where((_err(r) <= TOL)[:, None], x, _descend(x, _solve2(J, r)))
-    return x, _inv2(J), lines_spans(L, w, EA, CB, hA, x)
+    return x, _inv2(J), jnp.stack([XF, ZF], axis=1)
 
 
 def lines_spans(L, w, EA, CB, hA, x):
