@@ -68,10 +68,14 @@ def _asinh_chord(a, b):
 
 
 def _suspended(H, V, L, w, EA):
-    a = V / H
-    b = (V - w * L) / H
-    xf = L * _asinh_chord(a, b) + H * L / EA
-    zf = L * (a + b) / (jnp.sqrt(1 + a * a) + jnp.sqrt(1 + b * b)) + (V * L - 0.5 * w * L * L) / EA
+    # products by reciprocals, not quotients: XLA fuses no divide that two expressions share into
+    # both, so each shared quotient was a kernel of its own (eight kernels an evaluation, three now;
+    # the step evaluates the profile in every residual: docs/benchmarks.md, mooring lines)
+    hi, ei = 1.0 / H, 1.0 / EA
+    a = V * hi
+    b = (V - w * L) * hi
+    xf = L * _asinh_chord(a, b) + H * L * ei
+    zf = L * (a + b) / (jnp.sqrt(1 + a * a) + jnp.sqrt(1 + b * b)) + (V * L - 0.5 * w * L * L) * ei
     return xf, zf
 
 
@@ -91,17 +95,19 @@ def _contact(H, V, L, w, EA, CB, hA):
     """The line on the seabed: (XF, ZF, L_B, the anchor's horizontal and vertical force), w > 0."""
     # the part between a raised anchor and the seabed
     u = _rise_slope(H, hA, w, EA)
-    s1 = H * u / w
-    s2 = V / w
+    wi, hi, ei = 1.0 / w, 1.0 / H, 1.0 / EA       # products by reciprocals (see _suspended)
+    s1 = H * u * wi
+    s2 = V * wi
     LB = L - s1 - s2
     # friction acts only where the seabed portion ends at the anchor (a raised anchor's U-shaped
     # line slides towards its middle from both sides: taken frictionless)
     cbw = jnp.where(hA > 0, 0.0, CB) * w
     cbw_safe = jnp.where(cbw > 0, cbw, 1.0)
     slack_part = jnp.maximum(cbw * LB - H, 0.0)
-    friction = (-cbw * LB * LB + jnp.where(cbw > 0, slack_part ** 2 / cbw_safe, 0.0)) / (2 * EA)
-    xf = (LB + H / w * jnp.arcsinh(u) + H / w * jnp.arcsinh(V / H) + H * L / EA + friction)
-    zf = H / w * (jnp.sqrt(1 + (V / H) ** 2) - 1) + V * V / (2 * EA * w) - hA
+    friction = (-cbw * LB * LB + jnp.where(cbw > 0, slack_part ** 2 / cbw_safe, 0.0)) * (0.5 * ei)
+    a = V * hi
+    xf = (LB + H * wi * jnp.arcsinh(u) + H * wi * jnp.arcsinh(a) + H * L * ei + friction)
+    zf = H * wi * (jnp.sqrt(1 + a * a) - 1) + V * V * (0.5 * ei * wi) - hA
     return xf, zf, LB, jnp.maximum(H - cbw * LB, 0.0), -w * s1
 
 
