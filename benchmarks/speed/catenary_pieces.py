@@ -6,8 +6,8 @@ The lines of benchmarks/speed/mooring_cost.py (420 m, 600 N/m, EA 3e8 N, spans 3
 three solved at once as the step's term solves them), the fairleads moved 1 mm from the guess:
 what each evaluation of the step's residual runs (the chord steps from the last step's solution,
 `solve_lines(..., fallback=False)`), its linearisation (one jvp: what the step's preconditioner
-and gradients take, through the implicit function theorem), the step's end (`lines_settle`: the
-chord steps, one Newton step and the Jacobian there, once a step) and one evaluation of the
+and gradients take, through the implicit function theorem), the step's end (`lines_settle`: one
+chord step, one evaluation with the Jacobian there and a Newton step, once a step) and one evaluation of the
 profile alone; then the lines' whole term in the moored paper example (its rows: the fairleads'
 spans, the solve, the force and moment; their linearisation in the six rigid directions; its
 step's end). Each in a compiled `fori_loop` of many calls (a call alone would time the dispatch),

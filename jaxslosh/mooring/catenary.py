@@ -68,10 +68,14 @@ def _asinh_chord(a, b):
 
 
 def _suspended(H, V, L, w, EA):
-    a = V / H
-    b = (V - w * L) / H
-    xf = L * _asinh_chord(a, b) + H * L / EA
-    zf = L * (a + b) / (jnp.sqrt(1 + a * a) + jnp.sqrt(1 + b * b)) + (V * L - 0.5 * w * L * L) / EA
+    # products by reciprocals, not quotients: XLA fuses no divide that two expressions share into
+    # both, so each shared quotient was a kernel of its own (eight kernels an evaluation, three now;
+    # the step evaluates the profile in every residual: docs/benchmarks.md, mooring lines)
+    hi, ei = 1.0 / H, 1.0 / EA
+    a = V * hi
+    b = (V - w * L) * hi
+    xf = L * _asinh_chord(a, b) + H * L * ei
+    zf = L * (a + b) / (jnp.sqrt(1 + a * a) + jnp.sqrt(1 + b * b)) + (V * L - 0.5 * w * L * L) * ei
     return xf, zf
 
 
@@ -91,17 +95,19 @@ def _contact(H, V, L, w, EA, CB, hA):
     """The line on the seabed: (XF, ZF, L_B, the anchor's horizontal and vertical force), w > 0."""
     # the part between a raised anchor and the seabed
     u = _rise_slope(H, hA, w, EA)
-    s1 = H * u / w
-    s2 = V / w
+    wi, hi, ei = 1.0 / w, 1.0 / H, 1.0 / EA       # products by reciprocals (see _suspended)
+    s1 = H * u * wi
+    s2 = V * wi
     LB = L - s1 - s2
     # friction acts only where the seabed portion ends at the anchor (a raised anchor's U-shaped
     # line slides towards its middle from both sides: taken frictionless)
     cbw = jnp.where(hA > 0, 0.0, CB) * w
     cbw_safe = jnp.where(cbw > 0, cbw, 1.0)
     slack_part = jnp.maximum(cbw * LB - H, 0.0)
-    friction = (-cbw * LB * LB + jnp.where(cbw > 0, slack_part ** 2 / cbw_safe, 0.0)) / (2 * EA)
-    xf = (LB + H / w * jnp.arcsinh(u) + H / w * jnp.arcsinh(V / H) + H * L / EA + friction)
-    zf = H / w * (jnp.sqrt(1 + (V / H) ** 2) - 1) + V * V / (2 * EA * w) - hA
+    friction = (-cbw * LB * LB + jnp.where(cbw > 0, slack_part ** 2 / cbw_safe, 0.0)) * (0.5 * ei)
+    a = V * hi
+    xf = (LB + H * wi * jnp.arcsinh(u) + H * wi * jnp.arcsinh(a) + H * L * ei + friction)
+    zf = H * wi * (jnp.sqrt(1 + a * a) - 1) + V * V * (0.5 * ei * wi) - hA
     return xf, zf, LB, jnp.maximum(H - cbw * LB, 0.0), -w * s1
 
 
@@ -301,7 +307,8 @@ def _solve2(J, r):
 
 def _err(r):
     """Each line's largest scaled residual (inf where it is not finite)."""
-    return jnp.where(jnp.isfinite(r).all(axis=1), jnp.max(jnp.abs(r), axis=1), jnp.inf)
+    return jnp.where(jnp.isfinite(r[:, 0]) & jnp.isfinite(r[:, 1]), jnp.maximum(jnp.abs(r[:, 0]), jnp.abs(r[:, 1])),
+                     jnp.inf)
 
 
 def _chord(residual, guess, inverse, r0=None):
@@ -314,8 +321,7 @@ def _chord(residual, guess, inverse, r0=None):
     kernels. `r0`: the residual at the guess where the caller has it (`_start_residual`)."""
     x, r = guess, residual(guess) if r0 is None else r0
     for k in range(CHORD_STEPS):       # a fixed count, unrolled: not a loop over time steps
-        dx = jnp.einsum("nij,nj->ni", inverse, r)
-        x = jnp.where((_err(r) <= TOL)[:, None], x, _descend(x, dx))
+        x = jnp.where((_err(r) <= TOL)[:, None], x, _descend(x, _times(inverse, r)))
         if k < CHORD_STEPS - 1:
             r = residual(x)
     return x, r
@@ -367,6 +373,13 @@ def _lines_warm(XF, ZF, L, w, EA, CB, hA, slack, H0, guess, inverse=None):
     return jax.lax.while_loop(lambda s: s[3], polish, (x, r, 0, jnp.any(_err(r) > TOL)))[0]
 
 
+def _times(inverse, r):
+    """(n, 2) the products of (n, 2, 2) blocks and (n, 2) vectors, written out: a batched dot is an
+    XLA kernel of its own (and so is a reduction over the pair, `_err`), where these products fuse
+    with the profile's arithmetic around them."""
+    return inverse[:, :, 0] * r[:, :1] + inverse[:, :, 1] * r[:, 1:]
+
+
 def _descend(x, dx):
     """x - dx with H kept positive (a step that would cross zero goes nine tenths of the way there)."""
     return jnp.stack([jnp.maximum(x[:, 0] - dx[:, 0], 0.1 * x[:, 0]), x[:, 1] - dx[:, 1]], axis=1)
@@ -394,22 +407,28 @@ def lines_inverse(XF, ZF, L, w, EA, CB, hA, x):
 
 def lines_settle(XF, ZF, L, w, EA, CB, hA, guess, inverse, at=None):
     """((n, 2) solutions, (n, 2, 2) the inverses of the Jacobians there, (n, 2) the profile's spans
-    there) from the chord steps of the
-    step's residual (`_lines_chord`, from the last step's `guess` and `inverse`) and one Newton step
-    after them: what a step's end keeps for the next (once a step, no loop). Where the step's
-    residual took the chord steps' solution (its residual before the last step below CHORD_TOL) the
-    Newton step brings it to round-off; where it did not, the step has failed (NaN) and its states
-    are not kept. The Jacobian is the one at the chord steps' solution (a chord step's, within
-    round-off of the solution's); `at` as `_lines_chord`'s."""
+    there) from the last step's `guess`, `inverse` and `at` (`_lines_chord`'s): what a step's end
+    keeps for the next (once a step, no loop). One chord step from the guess, which needs no
+    evaluation of the profile (its residual there comes from `at`), then one evaluation of the
+    profile with its Jacobian (a jvp in two directions) and a Newton step from there: the chord step
+    leaves the step's motion times the chord's rate (some four digits below the motion's), the
+    Newton step squares that, to round-off wherever the step's own chord steps converged (where
+    they did not, the step has failed, NaN, and its states are not kept). The Jacobian is the one
+    before the Newton step (within round-off of the solution's), and the spans at the solution are
+    the fairlead's own (XF, ZF), which the Newton step leaves within round-off (a slack line's
+    horizontal span is not read: its residual is its tension's). One evaluation of the profile,
+    where the step's chord steps, a Newton step and the spans took four: each is a chain of small
+    XLA kernels, and their count, not their arithmetic, was what the step's end cost
+    (docs/benchmarks.md, mooring lines)."""
+    XF, ZF, L, w = (jnp.asarray(v, dtype=float) for v in (XF, ZF, L, w))
     residual, slack, H0 = _prepared(XF, ZF, L, w, EA, CB, hA)
-    r0 = None if at is None else _start_residual(*(jnp.asarray(v, dtype=float) for v in (XF, ZF, L, w)), slack, H0,
-                                                 guess, at)
-    x, _ = _chord(residual, guess, inverse, r0)
+    r0 = residual(guess) if at is None else _start_residual(XF, ZF, L, w, slack, H0, guess, at)
+    x = jnp.where((_err(r0) <= TOL)[:, None], guess, _descend(guess, _times(inverse, r0)))
     r, cols = jax.vmap(lambda e: jax.jvp(residual, (x,), (jnp.broadcast_to(e, x.shape),)),
                        out_axes=(None, 0))(jnp.eye(2, dtype=x.dtype))
     J = jnp.moveaxis(cols, 0, -1)
     x = jnp.where((_err(r) <= TOL)[:, None], x, _descend(x, _solve2(J, r)))
-    return x, _inv2(J), lines_spans(L, w, EA, CB, hA, x)
+    return x, _inv2(J), jnp.stack([XF, ZF], axis=1)
 
 
 def lines_spans(L, w, EA, CB, hA, x):
