@@ -76,7 +76,8 @@ def test_a_full_disk_ends_the_run_with_one_line_and_a_readable_file(tmp_path):
 
     # a file-size limit stands for a full disk: past it writes fail with EFBIG (SIGXFSZ ignored; set by
     # the shell, not a preexec_fn, which forks a process that JAX's threads already run in)
-    cmd = f"ulimit -f 5860; trap '' XFSZ; exec '{sys.executable}' -m jaxslosh run '{PAPER}' -o '{out}' " \
+    # (faulthandler: a crash instead of the one line, seen once in a full suite, then shows its stack)
+    cmd = f"ulimit -f 5860; trap '' XFSZ; PYTHONFAULTHANDLER=1 exec '{sys.executable}' -m jaxslosh run '{PAPER}' -o '{out}' " \
           "--no-progress --duration 5"
     p = subprocess.run(["bash", "-c", cmd], capture_output=True, text=True, timeout=300)
     assert p.returncode == 1, p.stderr
