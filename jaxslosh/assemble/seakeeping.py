@@ -27,13 +27,17 @@ def memory_module(fit: RadiationFit) -> Optional[Memory]:
 
 def make_excitation(waves, X, height) -> Excitation:
     """From the components of `waves` and X (N, 6): the force of each component per unit `height`."""
-    c = components(waves)
-    h0 = waves.height
-    a = c.amplitude / h0
-    amp = (np.abs(X) * a[:, None]).T
-    phase = (np.angle(X) + c.phase[:, None]).T
-    return Excitation(jnp.asarray(c.omega), jnp.asarray(amp), jnp.asarray(phase), jnp.asarray(height, dtype=float),
+    omega, amp, phase = excitation_arrays(waves, components(waves), X)
+    return Excitation(jnp.asarray(omega), jnp.asarray(amp), jnp.asarray(phase), jnp.asarray(height, dtype=float),
                       ramp=float(waves.ramp))
+
+
+def excitation_arrays(waves, c, X) -> tuple:
+    """(omega (N,), amp (6, N) per unit height, phase (6, N)) of make_excitation, as NumPy arrays,
+    from the components `c` of `waves` (hydro/spectra.components) and X (N, 6): what a campaign's
+    batch of seas runs on (campaign/cases.sea_arrays), drawn on the host once per case."""
+    a = c.amplitude / waves.height
+    return c.omega, (np.abs(X) * a[:, None]).T, (np.angle(X) + c.phase[:, None]).T
 
 
 def linear_excitation_rao(scene, c) -> Optional[np.ndarray]:

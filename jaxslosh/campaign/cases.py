@@ -18,7 +18,7 @@ except ModuleNotFoundError:  # Python 3.10
     import tomli as tomllib  # type: ignore[no-redef]
 
 from ..assemble.hull import hull_waves, incident_waves
-from ..assemble.seakeeping import linear_excitation_rao, make_excitation
+from ..assemble.seakeeping import excitation_arrays, linear_excitation_rao
 from ..hydro.spectra import components
 from ..scene.load import parse_scene
 from ..scene.types import Scene, SceneError
@@ -199,9 +199,9 @@ def sea_arrays(scene: Scene) -> tuple:
     waves = scene.waves
     c = components(waves)
     X = linear_excitation_rao(scene, c)
-    e = make_excitation(waves, np.zeros((c.omega.size, 6)) if X is None else X, waves.hs)
+    omega, amp, phase = excitation_arrays(waves, c, np.zeros((c.omega.size, 6)) if X is None else X)
     incident = None
     if hull_waves(scene):
         w = incident_waves(scene, {})
         incident = tuple(np.asarray(x) for x in (w.k, w.amp, w.phase, w.cb, w.sb))
-    return np.asarray(e.omega), np.asarray(e.amp), np.asarray(e.phase), float(waves.hs), incident
+    return np.asarray(omega), np.asarray(amp), np.asarray(phase), float(waves.hs), incident

@@ -302,7 +302,7 @@ def _programs_dir(cache_dir):
     return programs.folder() or (os.path.join(cache_dir, "jaxslosh-programs") if cache_dir else None)
 
 
-def _in_process(template, duration, cases, batches, batch, caches):
+def _in_process(template, duration, cases, scenes, batches, batch, caches):
     """One worker and no client: the batches in this process, one after the other. A LocalCluster
     of one worker process cost its start (the processes, their imports, the model and the program
     read back) and a copy of every result, for the same single core's work (docs/benchmarks.md)."""
@@ -314,7 +314,7 @@ def _in_process(template, duration, cases, batches, batch, caches):
         for idx in batches:
             try:
                 outcomes = run_batch(template.text, template.path, duration, [case_values(cases, i) for i in idx],
-                                     batch, *caches)
+                                     batch, *caches, scenes=[scenes[i] for i in idx])
             except Exception as e:          # a batch that raised: its cases fail with the reason, as on Dask
                 outcomes = _raised(e, idx)
             yield idx, outcomes
@@ -381,7 +381,7 @@ def _run(template, duration, cases, scenes, todo, client, workers, batch, output
     batches = _batches(scenes, todo, batch)
     t_cases, writing = time.perf_counter(), 0.0
     try:
-        done = (_in_process(template, duration, cases, batches, batch, caches) if local else
+        done = (_in_process(template, duration, cases, scenes, batches, batch, caches) if local else
                 _on_dask(client, template, duration, cases, batches, batch, caches, futures))
         for idx, outcomes in done:
             if "first" not in phases:

@@ -6,7 +6,6 @@ from __future__ import annotations
 import math
 
 import numpy as np
-from scipy import signal
 
 STATISTICS = ("std", "significant", "max", "mpm", "tz")
 #: a channel whose standard deviation is below this (m or rad, plus 1e-12 of its largest value) has
@@ -43,6 +42,25 @@ def frequencies(n_frames: int, dt_frame: float) -> np.ndarray:
     return 2.0 * np.pi * np.fft.rfftfreq(segment_length(n_frames), dt_frame)
 
 
+def welch(y, dt: float, nperseg: int) -> np.ndarray:
+    """The one-sided power spectral density (per Hz) of y sampled every dt by Welch's method, as
+    SciPy's `signal.welch(y, fs=1 / dt, nperseg=nperseg, detrend="constant")` computes it: segments
+    of nperseg samples overlapping by half, each less its mean and windowed by the periodic Hann
+    window, their periodograms averaged. Written out here (the frequencies are
+    `frequencies(n, dt)`'s): importing scipy.signal, which imports scipy.stats, took a second of
+    every campaign process's start, a worker's too (docs/benchmarks.md, campaigns)."""
+    y = np.asarray(y, dtype=float)
+    nperseg = min(int(nperseg), y.size)
+    step = nperseg - nperseg // 2
+    starts = np.arange((y.size - nperseg // 2) // step) * step
+    seg = y[starts[:, None] + np.arange(nperseg)]
+    win = 0.5 - 0.5 * np.cos(2.0 * np.pi * np.arange(nperseg) / nperseg)
+    X = np.fft.rfft((seg - seg.mean(axis=1, keepdims=True)) * win, axis=1)
+    p = (X.real ** 2 + X.imag ** 2).mean(axis=0) * (dt / float(np.sum(win * win)))
+    p[1:nperseg - nperseg // 2] *= 2.0          # one-sided: every bin but 0 (and nperseg / 2 when even) twice
+    return p
+
+
 def statistics(t, x) -> dict:
     """std, significant (4 std), max |x - mean|, most probable maximum over the record (Rayleigh:
     std sqrt(2 ln N), N = duration / tz), the mean zero-upcrossing period tz, and the one-sided
@@ -63,7 +81,7 @@ def statistics(t, x) -> dict:
     # a single periodogram's scatter at each frequency does not fall as the record grows, the
     # average of segments' does, at the price of the segment's coarser resolution
     dt = float(t[1] - t[0])
-    f, p = signal.welch(y, fs=1.0 / dt, nperseg=segment_length(y.size), detrend="constant")
+    p = welch(y, dt, segment_length(y.size))
     return {"std": std, "significant": 4.0 * std, "max": float(np.abs(y).max()), "mpm": mpm, "tz": tz,
             "spectrum": p / (2.0 * np.pi)}
 

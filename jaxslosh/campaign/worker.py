@@ -74,13 +74,16 @@ def structure_scene(template: Scene, case: Scene) -> Scene:
 
 
 def run_batch(text: str, path: str, duration: Optional[float], values: list, batch: int,
-              cache_dir: Optional[str] = None, programs_dir: Optional[str] = None) -> list:
+              cache_dir: Optional[str] = None, programs_dir: Optional[str] = None, scenes: Optional[list] = None) -> list:
     """Run the cases `values` (their [waves] values, all of one sea structure) padded to `batch`
     runs; returns per case {"status": ..., "stats": {channel: {std, significant, max, mpm, tz,
-    spectrum}}, "pid": the worker's process id}."""
+    spectrum}}, "pid": the worker's process id}. `scenes`: the cases' scenes (case_scene's) where
+    the caller has them (the batches run in the campaign's own process, which built every case's
+    scene to check it: reading each again cost as much)."""
     configure_jax(cache_dir, programs_dir)
     template = template_scene(text, path, duration)
-    scenes = [case_scene(template, v, duration) for v in values]
+    if scenes is None:
+        scenes = [case_scene(template, v, duration) for v in values]
     seas = [sea_arrays(s) for s in scenes]
     seas += [seas[-1]] * (batch - len(seas))
     omega, amp, phase, hs = (np.stack([s[k] for s in seas]) for k in range(4))

@@ -62,14 +62,17 @@ def create_campaign(path, scene_text: str, cases: dict, channels, frequency, att
 
 def write_cases(path, indices, outcomes):
     """Store finished cases: `outcomes[i]` {"status", "stats": {channel: {std, ..., spectrum}}}."""
+    # each dataset written once for the batch's cases (HDF5's point selection, in increasing
+    # order), not once per case: a batch's writes were one per case, channel and statistic
+    done = sorted((int(i), o["stats"]) for i, o in zip(indices, outcomes) if o["stats"] is not None)
+    rows = [i for i, _ in done]
     with _open_for_writing(path) as f:
         status = f["cases/status"]
+        for ch in done[0][1] if done else ():
+            for s in STATS:
+                f[f"statistics/{ch}/{s}"][rows] = np.array([st[ch][s] for _, st in done], dtype=float)
+            f[f"spectra/{ch}"][rows] = np.stack([st[ch]["spectrum"] for _, st in done])
         for i, o in zip(indices, outcomes):
-            if o["stats"] is not None:
-                for ch, st in o["stats"].items():
-                    for s in STATS:
-                        f[f"statistics/{ch}/{s}"][i] = st[s]
-                    f[f"spectra/{ch}"][i] = st["spectrum"]
             status[i] = o["status"]
         f.flush()
 
