@@ -19,10 +19,11 @@ from ..physics.bodies import BAND, Bodies, Floating, Link, body_rest, end_index
 from ..physics.kinematics import quat_from_rpy
 from ..physics.seakeeping import LinearDamping, WaveExcitation
 from ..physics.vessel import RESTORING_FORMS, AbstractRestoring, RigidBody
+from ..scene.bodies import coupled_file
 from ..scene.keys import toml_mapping
 from ..scene.types import SceneError
 from .about import damping_about, tank_line
-from .bodyhydro import time_terms
+from .bodyhydro import box_waves, time_terms
 from .damping import build_damping
 from .hull import body_restoring, restoring_words
 from .liquid import build_liquid_block
@@ -183,13 +184,18 @@ def build_bodies(scene, params: dict, g, outline: bool = False) -> tuple[Optiona
 
 def _about(scene) -> About:
     lines = []
+    coupled = (coupled_file(scene.vessel, scene.bodies) or ((), ()))[1]     # the bodies of a multibody file
     for b in scene.bodies:
         h = b.hydrostatics
         damp = ", viscous damping" if b.viscous_damping is not None else ""
         hd = b.hydrodynamics
-        if hd is not None and (hd.file or hd.added_mass is not None or hd.excitation_amplitude is not None):
+        tabled = hd is not None and (hd.file or hd.added_mass is not None or hd.excitation_amplitude is not None)
+        if tabled:
             damp += (f"; radiation and wave excitation from {hd.file}" if hd.file else
                      "; radiation and wave excitation from its tables") + " (at its place in the waves)"
+        box = box_waves(b)
+        if scene.waves is not None and (box == "only" or (box == "unless tabled" and not tabled and b.name not in coupled)):
+            damp += "; the waves' Froude-Krylov force on its box hull (at its place in the waves)"
         statics = (f"linear hydrostatics (A_w {h.waterplane_area:g} m^2, GM_T {h.gm_t:g} m, GM_L {h.gm_l:g} m)"
                    if not h.nonlinear else restoring_words(scene, b))
         lines.append(("floating body", f"{b.name!r}: 6 unknowns of its own floating frame at "
