@@ -401,7 +401,8 @@ def bodies_scene(bodies, vessel, structures, mapping, warnings: list[str], files
            and not (_box_on_springs(b) and (b.hydrodynamics is None or b.hydrodynamics.excitation != "table"))]
     if "waves" in mapping and dry:
         warnings.append(f"waves: the [[bodies]] {', '.join(repr(n) for n in dry)} have no excitation tables "
-                        f"([bodies.hydrodynamics] file or excitation_amplitude): the waves exert no force on them")
+                        f"([bodies.hydrodynamics] file or excitation_amplitude) and no box hull on linear "
+                        "hydrostatics (Froude-Krylov): the waves exert no force on them")
 
 
 def _box_on_springs(body) -> bool:
