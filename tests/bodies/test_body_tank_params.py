@@ -12,6 +12,7 @@ import jaxslosh as js
 from jaxslosh.assemble.bodies import build_bodies
 from jaxslosh.cli import main
 from jaxslosh.liquid.modal_damping import ModalDamping
+from jaxslosh.fit.identify import identify
 from jaxslosh.fit.params import fit_keys
 from jaxslosh.scene.keys import canonical_key, resolve_params, scene_values, traceable_keys
 from jaxslosh.scene.types import SceneError
@@ -188,3 +189,15 @@ def test_a_bad_tank_key_is_refused_naming_it(scene, key, value, words, tmp_path,
     assert main(["run", str(path), "-o", str(data), "--no-progress"]) == 0
     assert main(["identify", str(path), "--data", str(data), "--fit", key]) == 2
     assert key in capsys.readouterr().err
+
+
+@pytest.mark.slow      # its Jacobian's compile: about a minute of CPU on a loaded 2-core machine
+def test_identify_recovers_a_bodys_tank_fill_depth():
+    """A noiseless record of 10 steps made with the carrier's tank 1.2 m deep: identify, started
+    from the scene's 1.5 m, returns 1.2 m within 1e-6 from the carrier's channels and its probe."""
+    made = js.simulate(_scene(fill=1.2))
+    fit = identify(_scene(), made, ["tanks.cargo.fill_depth"], weights={"roll": 0.0, "pitch": 0.0, "heave": 0.0},
+                   data_scene="ignore")
+    assert fit.converged, fit.message
+    assert fit.values["tanks.cargo.fill_depth"] == pytest.approx(1.2, abs=1e-6)
+    assert fit.channels["bodies.carrier.roll"] > 0
