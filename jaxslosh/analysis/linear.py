@@ -110,7 +110,9 @@ def linearise(scene: Scene, params=None) -> Linearisation:
         raise SceneError("tanks.reduction", f"the linearised model has {n} unknowns (dense matrices above "
                                             f"{MAX_UNKNOWNS}): reduce the liquid to its modes with [tanks.reduction]")
     c0, _, alg0, info = static_equilibrium(sysm, solver, b.c0, b.v0, b.alg0)
-    if sysm.owners() and not bool(info.ok):     # (no owners: nothing solved, nothing to check)
+    # (no owner that settles, as the bodies: nothing solved, nothing to check, and under tracing no
+    # concrete flag to read)
+    if any(o.settles() for o in sysm.owners()) and not bool(info.ok):
         raise SceneError("structures", "no static equilibrium of the structures under their weight was found")
     # the interface rows as forces per metre of gap (any scale solves the same equations; the
     # structure's mass keeps them near the other rows' size for the factorisations)

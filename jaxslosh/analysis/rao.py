@@ -171,13 +171,12 @@ def rao(scene: Scene, frequencies=None, headings=None, *, params=None,
     F = np.zeros((w.size, n, heads.size), dtype=complex)
     F[:, :6] = X.transpose(0, 2, 1)
     N = 6 + 6 * len(scene.bodies)
+    dA = dB = None
     if scene.bodies:           # the bodies' excitation and radiation (assemble/bodyhydro.py)
-        if is_traced((lin.M, lin.C, lin.K)):
-            raise SceneError("bodies", "gradients through the RAOs of [[bodies]] are not available yet")
         dA, dB, Fb = frequency_terms(scene, w, heads)
         F[:, 6:N] += Fb[:, :, 6:].transpose(0, 2, 1)
     if is_traced((lin.M, lin.C, lin.K)):
-        out, xp = _traced_solves(lin, tables, radiation, w, F), jnp
+        out, xp = _traced_solves(lin, tables, radiation, w, F, dA, dB), jnp
     else:
         out, xp = np.zeros((w.size, heads.size, n), dtype=complex), np
         for i, wi in enumerate(w):
@@ -191,19 +190,24 @@ def rao(scene: Scene, frequencies=None, headings=None, *, params=None,
     return RAO(w, heads, out[:, :, :6], probes, scene.text, bodies)
 
 
-def _traced_solves(lin: Linearisation, tables, radiation: bool, w, F):
+def _traced_solves(lin: Linearisation, tables, radiation: bool, w, F, bodies_A=None, bodies_B=None):
     """The RAOs (f, h, n) of a linearisation whose matrices are traced (a gradient through them):
     one solve per frequency in a lax.map, so that the compiled program does not grow with the
-    number of frequencies."""
-    dA, dB = np.zeros((w.size, 6, 6)), np.zeros((w.size, 6, 6))
+    number of frequencies. The frequency-dependent radiation is the concrete path's: the vessel's
+    tables on its rows and the bodies' (`bodies_A`, `bodies_B`: frequency_terms', (f, N, N) over
+    the N rigid dofs) added, from the scene's values."""
+    N = 6 if bodies_A is None else bodies_A.shape[1]
+    dA, dB = np.zeros((w.size, N, N)), np.zeros((w.size, N, N))
     if radiation:
         A, B = interpolate_radiation(tables, w)
-        dA, dB = np.asarray(A) - lin.added_mass_infinite[None], np.asarray(B)
+        dA[:, :6, :6], dB[:, :6, :6] = np.asarray(A) - lin.added_mass_infinite[None], np.asarray(B)
+    if bodies_A is not None:
+        dA, dB = dA + bodies_A, dB + bodies_B
 
     def one(args):
         wi, dAi, dBi, Fi = args
         Z = lin.K - wi * wi * lin.M + 1j * wi * lin.C
-        Z = Z.at[:6, :6].add(-wi * wi * dAi + 1j * wi * dBi)
+        Z = Z.at[:N, :N].add(-wi * wi * dAi + 1j * wi * dBi)
         return solve_equilibrated(Z, Fi).T
 
     return jax.lax.map(one, (jnp.asarray(w), jnp.asarray(dA), jnp.asarray(dB), jnp.asarray(F)))

@@ -19,10 +19,11 @@ from ..physics.bodies import BAND, Bodies, Floating, Link, body_rest, end_index
 from ..physics.kinematics import quat_from_rpy
 from ..physics.seakeeping import LinearDamping, WaveExcitation
 from ..physics.vessel import RESTORING_FORMS, AbstractRestoring, RigidBody
+from ..scene.bodies import coupled_file
 from ..scene.keys import toml_mapping
 from ..scene.types import SceneError
 from .about import damping_about, tank_line
-from .bodyhydro import time_terms
+from .bodyhydro import box_waves, time_terms
 from .damping import build_damping
 from .hull import body_restoring, restoring_words
 from .liquid import build_liquid_block
@@ -85,31 +86,33 @@ class BodyTanks(NamedTuple):
     tanks: tuple
 
 
-def body_liquid(scene, body, q0, g):
+def body_liquid(scene, body, q0, g, params=None):
     """(liquid, its terms, host blocks, the rigid parts of its elastic walls) of the tanks a body
     carries: the vessel's builder (assemble/liquid.py) on the scene with the body's tanks as its
-    tanks, so that a tank is the same model on any body, its elastic walls included; the rotation
-    penalty at the body's initial attitude, as the vessel's at its own. (None, (), (), ()) without
-    tanks or with the liquid switched off."""
+    tanks, so that a tank is the same model on any body, its elastic walls included, and takes the
+    same traced `params` (`tanks.<name>.fill_depth`, ...: canonical keys, by the tank's name); the
+    rotation penalty at the body's initial attitude, as the vessel's at its own. (None, (), (), ())
+    without tanks or with the liquid switched off."""
     eff = scene.effects
     if not body.tanks or not eff.liquid:
         return None, (), (), ()
     # dense: the body's liquid block is inverted whole as the Bodies term's deformable block
     own = dataclasses.replace(scene, tanks=body.tanks, structures=(),
                               simulation=dataclasses.replace(scene.simulation, linear_solver="dense"))
+    params = params or {}
     if multimodal_scene(own):     # the vessel's multimodal liquid and damping; its fields on surface meshes
-        liquid = build_multimodal(own, {}, g)
-        damping, _ = multimodal_damping(own, {}, liquid)
+        liquid = build_multimodal(own, params, g)
+        damping, _ = multimodal_damping(own, params, liquid)
         return liquid, () if damping is None else (damping,), surface_meshes(own), ()
     try:
-        block = build_liquid_block(own, {}, g)
+        block = build_liquid_block(own, params, g)
     except SceneError as e:          # the builder names the body's tanks by their index among its own
         raise SceneError(_scene_tank_key(scene, body, e.key), str(e)[len(e.key) + 2:]) from None
     # the [effects] switches through the liquid's own interface, as the vessel's (assemble/system.py); its
     # lines are the Bodies term's (assemble/bodies.py _about), so the liquid keeps its own
     liquid = block.liquid.with_effects(eff.coriolis, eff.centrifugal, block.liquid.about)
     terms = () if block.penalty is None else (RotationPenalty(Kdt=block.penalty[0], Ktt=block.penalty[1], q_ref=q0),)
-    damping, _ = build_damping(own, {}, block)        # [tanks.damping]: the vessel's modal damping
+    damping, _ = build_damping(own, params, block)        # [tanks.damping]: the vessel's modal damping
     return liquid, terms + (() if damping is None else (damping,)), block.tanks, block.carried
 
 
@@ -143,7 +146,7 @@ def build_bodies(scene, params: dict, g, outline: bool = False) -> tuple[Optiona
         ini = {k: jnp.asarray(P(f"{key}.initial.{k}", getattr(b.initial, k)), dtype=float)
                for k in ("position", "velocity", "angular_velocity", "roll_pitch_yaw")}
         q0 = quat_from_rpy(ini["roll_pitch_yaw"] + jnp.array([0.0, 0.0, b.heading]))
-        tank, tank_terms, blocks, carried = (None, (), (), ()) if outline else body_liquid(scene, b, q0, g)
+        tank, tank_terms, blocks, carried = (None, (), (), ()) if outline else body_liquid(scene, b, q0, g, params)
         if blocks:
             hosts.append(BodyTanks(s, b.name, offset, blocks))
             offset += tank.nf
@@ -181,13 +184,18 @@ def build_bodies(scene, params: dict, g, outline: bool = False) -> tuple[Optiona
 
 def _about(scene) -> About:
     lines = []
+    coupled = (coupled_file(scene.vessel, scene.bodies) or ((), ()))[1]     # the bodies of a multibody file
     for b in scene.bodies:
         h = b.hydrostatics
         damp = ", viscous damping" if b.viscous_damping is not None else ""
         hd = b.hydrodynamics
-        if hd is not None and (hd.file or hd.added_mass is not None or hd.excitation_amplitude is not None):
+        tabled = hd is not None and (hd.file or hd.added_mass is not None or hd.excitation_amplitude is not None)
+        if tabled:
             damp += (f"; radiation and wave excitation from {hd.file}" if hd.file else
                      "; radiation and wave excitation from its tables") + " (at its place in the waves)"
+        box = box_waves(b)
+        if scene.waves is not None and (box == "only" or (box == "unless tabled" and not tabled and b.name not in coupled)):
+            damp += "; the waves' Froude-Krylov force on its box hull (at its place in the waves)"
         statics = (f"linear hydrostatics (A_w {h.waterplane_area:g} m^2, GM_T {h.gm_t:g} m, GM_L {h.gm_l:g} m)"
                    if not h.nonlinear else restoring_words(scene, b))
         lines.append(("floating body", f"{b.name!r}: 6 unknowns of its own floating frame at "

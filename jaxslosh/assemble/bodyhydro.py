@@ -139,8 +139,14 @@ def hull_share(scene, body, omega, heads) -> np.ndarray:
     heads = np.broadcast_to(np.asarray(heads, dtype=float), np.shape(omega))
     Xb = froude_krylov_surface(hull.triangles(hull.divisions(waves)), hull.water_height(), omega,
                                heads - body.heading, env.water_density, env.gravity, depth)
+    return _placed(scene, body, Xb, omega, heads)
+
+
+def _placed(scene, body, Xb, omega, heads) -> np.ndarray:
+    """X (n, 6) of a body's own axes and COG -> the step's axes, phases from the vessel's COG at rest."""
     Xs = np.concatenate([Xb[:, :3] @ _rz(body.heading).T, Xb[:, 3:]], axis=1)    # forces in inertial axes
-    k = wavenumber(np.asarray(omega, dtype=float), env.gravity, depth)
+    k = wavenumber(np.asarray(omega, dtype=float), scene.environment.gravity,
+                   None if scene.waves is None else scene.waves.depth)
     x, y = body.position
     return Xs * np.exp(-1j * k * (x * np.cos(heads) + y * np.sin(heads)))[:, None]
 
@@ -148,6 +154,41 @@ def hull_share(scene, body, omega, heads) -> np.ndarray:
 def on_hull(scene, body) -> bool:
     """Whether the waves act on a body's wetted hull (its nonlinear hydrostatics, buoyancy and waves on)."""
     return body.hydrostatics.nonlinear and scene.effects.buoyancy and scene.effects.waves
+
+
+def box_waves(body) -> Optional[str]:
+    """How the closed-form Froude-Krylov force of a body's box hull makes its wave force, as the
+    vessel's does (hydro/source.py excitation_at): "only" where its `[bodies.hydrodynamics]
+    excitation` says "froude-krylov", "unless tabled" by default (where no table, its own or a
+    multibody file's, gives it an excitation); None where it does not: no box hull, `excitation =
+    "table"`, or its nonlinear hydrostatics, which integrate the incident pressure on the hull
+    themselves (hull_share)."""
+    if body.hull is None or not body.hull.closed_form or body.hydrostatics.nonlinear:
+        return None
+    source = "auto" if body.hydrodynamics is None else body.hydrodynamics.excitation
+    return {"froude-krylov": "only", "auto": "unless tabled"}.get(source)
+
+
+def box_share(scene, body, omega, heads) -> np.ndarray:
+    """X (n, 6) in the step's axes, phases from the vessel's COG at rest: the Froude-Krylov force of
+    the waves (frequencies `omega`, headings `heads`, (n,) each) on a body's box hull, in closed form
+    (hydro/box.py), the vessel's with a box hull and linear hydrostatics."""
+    env, depth = scene.environment, None if scene.waves is None else scene.waves.depth
+    w = np.atleast_1d(np.asarray(omega, dtype=float))
+    heads = np.broadcast_to(np.asarray(heads, dtype=float), w.shape)
+    Xb = np.zeros((w.size, 6), dtype=complex)
+    for beta in np.unique(heads):
+        m = heads == beta
+        Xb[m] = body.hull.froude_krylov(w[m], float(beta) - body.heading, env.water_density, env.gravity, depth)
+    return _placed(scene, body, Xb, w, heads)
+
+
+def _with_box(scene, body, X, omega, heads):
+    """A body's X (n, 6) from the sources, with its box hull's Froude-Krylov force where box_waves says so."""
+    how = box_waves(body)
+    if how == "only" or (how == "unless tabled" and not np.abs(X).max(initial=0.0) > 0):
+        return box_share(scene, body, omega, heads)
+    return X
 
 
 def excitation(src: Source, omega, beta, g, depth=None) -> np.ndarray:
@@ -213,6 +254,8 @@ def frequency_terms(scene, omega, headings):
         if on_hull(scene, b) and not np.abs(F[:, :, 6 + 6 * s:12 + 6 * s]).max(initial=0.0) > 0:
             for h, beta in enumerate(headings):
                 F[:, h, 6 + 6 * s:12 + 6 * s] = hull_share(scene, b, w, np.full(w.shape, float(beta)))
+        for h, beta in enumerate(headings):      # a box hull on linear springs: its Froude-Krylov force
+            F[:, h, 6 + 6 * s:12 + 6 * s] = _with_box(scene, b, F[:, h, 6 + 6 * s:12 + 6 * s], w, float(beta))
     return dA, B, F
 
 
@@ -246,8 +289,10 @@ def time_terms(scene, params: dict):
                         X[i // 6 - 1, m] += Xs[:, 6 * k:6 * k + 6]
     if X is not None:
         for s, b in enumerate(scene.bodies):
+            heads = waves.heading if c.headings is None else c.headings
             if np.abs(X[s]).max() > 0 and on_hull(scene, b):
-                X[s] -= hull_share(scene, b, c.omega, waves.heading if c.headings is None else c.headings)
+                X[s] -= hull_share(scene, b, c.omega, heads)
+            X[s] = _with_box(scene, b, X[s], c.omega, heads)     # a box hull on linear springs
     memory = None
     if poles and sum(p.size for p in poles):
         p = np.concatenate(poles)

@@ -390,11 +390,24 @@ def bodies_scene(bodies, vessel, structures, mapping, warnings: list[str], files
     # buoyancy on: without them no hull force acts, and the warning below stays true)
     eff = mapping.get("effects", {}) if isinstance(mapping.get("effects", {}), dict) else {}
     on_hull = eff.get("buoyancy", True) is not False and eff.get("waves", True) is not False
+    for i, b in enumerate(bodies):
+        if b.hydrodynamics is not None and b.hydrodynamics.excitation == "froude-krylov" and not _box_on_springs(b):
+            raise SceneError(f"bodies[{i}].hydrodynamics.excitation", '"froude-krylov" needs a box [bodies.hull] and '
+                                                                      "linear hydrostatics (a nonlinear body's hull "
+                                                                      "takes the waves' pressure itself)")
+    # a box hull on linear springs takes the Froude-Krylov force, as the vessel's (assemble/bodyhydro.py box_waves)
     dry = [b.name for b in bodies if (b.hydrodynamics is None or b.hydrodynamics.excitation_amplitude is None)
-           and not (b.hydrostatics.nonlinear and on_hull)]
+           and not (b.hydrostatics.nonlinear and on_hull)
+           and not (_box_on_springs(b) and (b.hydrodynamics is None or b.hydrodynamics.excitation != "table"))]
     if "waves" in mapping and dry:
         warnings.append(f"waves: the [[bodies]] {', '.join(repr(n) for n in dry)} have no excitation tables "
-                        f"([bodies.hydrodynamics] file or excitation_amplitude): the waves exert no force on them")
+                        f"([bodies.hydrodynamics] file or excitation_amplitude) and no box hull on linear "
+                        "hydrostatics (Froude-Krylov): the waves exert no force on them")
+
+
+def _box_on_springs(body) -> bool:
+    """Whether a body has a box hull and linear hydrostatics (its waves' Froude-Krylov force in closed form)."""
+    return body.hull is not None and body.hull.closed_form and not body.hydrostatics.nonlinear
 
 
 def _file_places(path: str, vessel, bodies) -> None:

@@ -22,6 +22,7 @@ try:
 except ModuleNotFoundError:  # Python 3.10
     import tomli as tomllib  # type: ignore[no-redef]
 
+from .bodies import tank_carriers
 from .fields import show
 from .keydocs import KEYS as KEY_DOCS, TABLES as KEY_TABLES  # noqa: F401  default, unit, meaning (docs)
 from .load import forced_span, parse_scene, step_warnings
@@ -50,7 +51,8 @@ class _Keys(tuple):
 # Scene values that simulate(params=...) may replace by traced values (the vessel is rebuilt per
 # call; the liquid matrices are assembled from traced fill depth, density, sound speed and gravity;
 # a traced damping ratio scales the modal damping, whose modes come from the scene's values; the
-# harmonic forced motion's amplitude, frequency and phase are leaves of its term).
+# harmonic forced motion's amplitude, frequency and phase are leaves of its term); a tank on a body
+# takes them alike (assemble/bodies.py body_liquid).
 TANK_TRACEABLE = ("fill_depth", "fluid.density", "fluid.sound_speed", "damping.ratio")
 # a mooring line's values, leaves of the lines' term (jaxslosh/mooring/term.py)
 MOORING_TRACEABLE = ("length", "weight", "ea", "seabed_friction")
@@ -146,7 +148,7 @@ def scene_values(scene: Scene) -> dict[str, Any]:
     def material(prefix: str, m: Material) -> dict[str, float]:
         return {f"{prefix}.young": m.young, f"{prefix}.poisson": m.poisson, f"{prefix}.density": m.density}
 
-    for i, t in enumerate(scene.tanks):
+    for i, t in enumerate(file_tanks(scene)):     # the vessel's and the bodies' alike (`tanks.body`)
         own = {"origin": t.origin, "size": t.size, "fill_depth": t.fill_depth,
                "fluid.density": t.fluid.density, "fluid.sound_speed": t.fluid.sound_speed}
         if t.damping is not None:
@@ -194,9 +196,23 @@ def scene_values(scene: Scene) -> dict[str, Any]:
     return v
 
 
+def file_tanks(scene: Scene) -> tuple:
+    """Every tank of the scene, the vessel's and each body's, in the order of the scene file's
+    [[tanks]] (the `i` of `tanks[i]` keys); a scene built without a file: the vessel's, then each
+    body's. The vessel's alone (`scene.tanks`) without [[bodies]]."""
+    if not scene.bodies:
+        return tuple(scene.tanks)
+    groups = {"vessel": list(scene.tanks)} | {b.name: list(b.tanks) for b in scene.bodies}
+    tables = toml_mapping(scene.text).get("tanks", []) if scene.text else []
+    carriers = tank_carriers(tables, scene.vessel.name)
+    if sorted(carriers) != sorted(c for c, ts in groups.items() for _ in ts):   # not this scene's file
+        return tuple(t for ts in groups.values() for t in ts)
+    return tuple(groups[c].pop(0) for c in carriers)
+
+
 def canonical_key(scene: Scene, key: str) -> str:
     """The name form of a dotted key: `tanks[0].fill_depth` -> `tanks.tank.fill_depth` (others unchanged)."""
-    for group, items in (("tanks", scene.tanks), ("structures", scene.structures), ("probes", scene.probes),
+    for group, items in (("tanks", file_tanks(scene)), ("structures", scene.structures), ("probes", scene.probes),
                          ("mooring", scene.mooring), ("connections", scene.connections),
                          ("bodies", scene.bodies)):
         if key.startswith(group + "["):
@@ -340,7 +356,7 @@ def _plain(value):
 
 def _toml_path(scene: Scene, key: str) -> list:
     """The path of a canonical key in the TOML mapping: `tanks.tank.fill_depth` -> ["tanks", 0, "fill_depth"]."""
-    for group, items in (("tanks", scene.tanks), ("structures", scene.structures), ("probes", scene.probes),
+    for group, items in (("tanks", file_tanks(scene)), ("structures", scene.structures), ("probes", scene.probes),
                          ("mooring", scene.mooring), ("connections", scene.connections),
                          ("bodies", scene.bodies)):
         for i, item in enumerate(items):
