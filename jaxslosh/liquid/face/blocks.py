@@ -32,6 +32,9 @@ class FaceOps(eqx.Module):
     # none), so that `scatter` is a gather and a sum (XLA's CPU scatter, a serial loop, took three
     # times as long); None: by segment_sum (`owners` builds it)
     places: Optional[jax.Array] = None
+    # (n,) int32: each unknown's place among the top faces (T: not a top face), so that adding the top
+    # faces' values is a gather of them padded with a zero, not XLA's CPU scatter; None: `.at[].add`
+    top_of: Optional[jax.Array] = None
 
     def gather(self, d):
         """(n, ...) -> (E, 6, ...)"""
@@ -61,7 +64,20 @@ class FaceOps(eqx.Module):
         div = jnp.concatenate([y[:b - a] for y, (a, b) in zip(ys, self.elements)])
         tp = jnp.concatenate([y[b - a:] for y, (a, b) in zip(ys, self.elements)])
         out = self.scatter(self.signs.reshape(self.signs.shape + (1,) * (div.ndim - 1)) * div[:, None])
-        return out.at[self.top].add(tp)
+        return self.add_top(out, tp)
+
+    def add_top(self, out, tp):
+        """out (n, ...) plus tp (T, ...) on the top faces' unknowns."""
+        if self.top_of is None:
+            return out.at[self.top].add(tp)
+        return out + jnp.concatenate([tp, jnp.zeros((1,) + tp.shape[1:], tp.dtype)])[self.top_of]
+
+
+def top_places(top, n: int):
+    """`FaceOps.top_of` of the top faces' unknowns `top` (T,) (host)."""
+    out = np.full(n, len(top), dtype=np.int32)
+    out[np.asarray(top)] = np.arange(len(top), dtype=np.int32)
+    return out
 
 
 def owners(slots, n: int):

@@ -19,7 +19,7 @@ from .schur import face_schur, mass_bounds, project_pools
 from .element import ROTATION_PENALTY_RATIO, FaceModel, _gauss, _loads, _Mixed, face_modes
 from ...fem.mesh import box_gauss_points
 from .walls import build_face_tank_with_walls, wall_points
-from .blocks import FaceOps, FaceStiffness, owners
+from .blocks import FaceOps, FaceStiffness, owners, top_places
 from .term import FaceLiquid
 from ...scene.types import RT_FULL_FACES, SceneError
 from .inverse import mass_inverse
@@ -133,9 +133,9 @@ def stack_sparse(parts: list, scales=None) -> tuple:
         top_ranges.append((t0, t0 + T))
         off, e0, t0 = off + p["nf"], e0 + E, t0 + T
     slots = np.concatenate(slots).astype(np.int32)
-    ops = FaceOps(jnp.asarray(slots), jnp.asarray(np.concatenate([p["signs"] for p in parts])),
-                  jnp.asarray(np.concatenate(tops).astype(np.int32)), n, tuple(elements), tuple(top_ranges),
-                  jnp.asarray(owners(slots, n)))
+    top = np.concatenate(tops).astype(np.int32)
+    ops = FaceOps(jnp.asarray(slots), jnp.asarray(np.concatenate([p["signs"] for p in parts])), jnp.asarray(top), n,
+                  tuple(elements), tuple(top_ranges), jnp.asarray(owners(slots, n)), jnp.asarray(top_places(top, n)))
     kappa_n = np.concatenate([np.full(p["nf"], p["kappa"]) for p in parts])
     lo = min(p["bounds"][0] for p in parts)
     hi = max(p["bounds"][1] for p in parts)
@@ -353,7 +353,11 @@ def face_full_liquid(tanks, models, scales=None, depths=None, sparse=False, stru
     slot = fix(np.concatenate(slots))
     if sparse:
         K, Minv, start = stack_sparse(parts, scales)
-        blocks = dict(K=K, Mff=None, Minv=Minv, start=jnp.asarray(start), sparse=True)
+        phi = np.concatenate(phis)
+        E = phi.shape[0] // P          # every tank's points element by element, P = 8 each (_gauss)
+        blocks = dict(K=K, Mff=None, Minv=Minv, start=jnp.asarray(start), sparse=True,
+                      phi_e=None if wall_parts else jnp.asarray(phi.reshape(E, P, 6, 3).transpose(0, 2, 1, 3)
+                                                                .reshape(E, 6, P * 3)))
     else:
         stack = jax_block_diag if xp is jnp else block_diag
         blocks = dict(K=jnp.asarray(stack(*Ks)), Mff=jnp.asarray(stack(*Ms)))

@@ -68,6 +68,12 @@ class FaceLiquid(AbstractLiquid):
     Minv: Any = None
     start: Any = None
     sparse: bool = eqx.field(static=True, default=False)
+    # the sparse blocks' `phi` element by element, (E, 6, P * 3): each element's six face fields at its P
+    # points, faces before points, the layout XLA's CPU products over the elements read without a copy.
+    # From `phi` (G, 6, 3) as a parameter of the step, each residual copied it to this layout twice (the
+    # field and the forces), 0.5 MB each on the horizontal cylinder 6x12x6, most of the residual's time
+    # (docs/benchmarks.md, the shaped tanks against their floor); None: the points' own slots
+    phi_e: Optional[jax.Array] = None
     # elastic walls and structures in the vessel's frame (None without): the wall faces' fluxes
     # qw = segment_sum(coef * d[cols], rows), held in slots nf + 1 + j of the liquid points' gathers;
     # the wall (and structure) points' shape values (Gw, 8) and their corners' unknowns (Gw, 8, 3);
@@ -99,7 +105,7 @@ class FaceLiquid(AbstractLiquid):
         without dense matrices on the faces have them (no walls or structures; the points element
         by element, assemble/face_liquid.py): the gathers and scatters then run over the elements'
         slots (FaceOps), a P-th of the points' (0: the points' own slots)."""
-        if not self.sparse or self.wall_N is not None:
+        if self.phi_e is None or self.wall_N is not None:
             return 0
         return self.r.shape[0] // self.K.ops.slots.shape[0]
 
@@ -108,8 +114,7 @@ class FaceLiquid(AbstractLiquid):
         walls')."""
         P = self._by_element()
         if P:                   # (a batched product over the elements: XLA's CPU fuses it as a loop)
-            E = self.K.ops.slots.shape[0]
-            return jnp.einsum("epfi,ef->epi", self.phi.reshape(E, P, 6, 3), self.K.ops.gather(d)).reshape(E * P, 3)
+            return jnp.einsum("efx,ef->ex", self.phi_e, self.K.ops.gather(d)).reshape(-1, 3)
         dz = jnp.concatenate([d, jnp.zeros(1, d.dtype)])
         if self.wall_N is None:
             return jnp.einsum("gfi,gf->gi", self.phi, dz[self.slots])
@@ -122,8 +127,7 @@ class FaceLiquid(AbstractLiquid):
         nf = self.nf
         P = self._by_element()
         if P:                   # each element's six unknowns summed over its points, then scattered
-            E = self.K.ops.slots.shape[0]
-            return self.K.ops.scatter(jnp.einsum("epfi,epi->ef", self.phi.reshape(E, P, 6, 3), F.reshape(E, P, 3)))
+            return self.K.ops.scatter(jnp.einsum("efx,ex->ef", self.phi_e, F.reshape(self.phi_e.shape[0], -1)))
         if self.wall_N is None:
             local = jnp.einsum("gfi,gi->gf", self.phi, F)
             return jax.ops.segment_sum(local.reshape(-1), self.slots.reshape(-1), nf + 1)[:nf]
