@@ -13,7 +13,7 @@ import jax.numpy as jnp
 import numpy as np
 
 from ..liquid.base import RotationPenalty
-from ..liquid.multimodal.build import build_multimodal, multimodal_damping, multimodal_scene, surface_meshes
+from ..liquid.block import LiquidBlock
 from ..physics.about import About
 from ..physics.bodies import BAND, Bodies, Floating, Link, body_rest, end_index
 from ..physics.kinematics import quat_from_rpy
@@ -76,31 +76,32 @@ def hull_part(mass, inertia, parts, key: str = "vessel", what: str = "ship", car
 
 
 class BodyTanks(NamedTuple):
-    """The host-side blocks of the tanks one body carries (liquid/block.TankBlock: meshes for the
-    result's fields and the probes), its index among the bodies and the offset of its liquid
-    unknowns among the bodies' tanks' (physics/bodies.py Bodies.tank_slices)."""
+    """The host-side blocks of the tanks one body carries (the tanks a result keeps the fields of:
+    liquid/block.py LiquidBlock.result_tanks), its index among the bodies, the offset of its liquid
+    unknowns among the bodies' tanks' (physics/bodies.py Bodies.tank_slices) and the block its
+    liquid's builder made (`block`: what the probes and the validity watch ask, as of the vessel's)."""
     body: int
     name: str
     offset: int
     tanks: tuple
+    block: Optional[LiquidBlock] = None
 
 
 def body_liquid(scene, body, q0, g):
-    """(liquid, its terms, host blocks, the rigid parts of its elastic walls) of the tanks a body
+    """(liquid, its terms, its block, the rigid parts of its elastic walls) of the tanks a body
     carries: the vessel's builder (assemble/liquid.py) on the scene with the body's tanks as its
-    tanks, so that a tank is the same model on any body, its elastic walls included; the rotation
-    penalty at the body's initial attitude, as the vessel's at its own. (None, (), (), ()) without
-    tanks or with the liquid switched off."""
+    tanks and the probes in them as its probes, so that a tank is the same model on any body
+    (whichever model its form takes: liquid/forms.py block_form), its elastic walls included; the
+    rotation penalty at the body's initial attitude, as the vessel's at its own. (None, (), None,
+    ()) without tanks or with the liquid switched off."""
     eff = scene.effects
     if not body.tanks or not eff.liquid:
-        return None, (), (), ()
+        return None, (), None, ()
     # dense: the body's liquid block is inverted whole as the Bodies term's deformable block
+    names = {t.name for t in body.tanks}
     own = dataclasses.replace(scene, tanks=body.tanks, structures=(),
+                              probes=tuple(p for p in scene.probes if p.tank in names),
                               simulation=dataclasses.replace(scene.simulation, linear_solver="dense"))
-    if multimodal_scene(own):     # the vessel's multimodal liquid and damping; its fields on surface meshes
-        liquid = build_multimodal(own, {}, g)
-        damping, _ = multimodal_damping(own, {}, liquid)
-        return liquid, () if damping is None else (damping,), surface_meshes(own), ()
     try:
         block = build_liquid_block(own, {}, g)
     except SceneError as e:          # the builder names the body's tanks by their index among its own
@@ -110,7 +111,7 @@ def body_liquid(scene, body, q0, g):
     liquid = block.liquid.with_effects(eff.coriolis, eff.centrifugal, block.liquid.about)
     terms = () if block.penalty is None else (RotationPenalty(Kdt=block.penalty[0], Ktt=block.penalty[1], q_ref=q0),)
     damping, _ = build_damping(own, {}, block)        # [tanks.damping]: the vessel's modal damping
-    return liquid, terms + (() if damping is None else (damping,)), block.tanks, block.carried
+    return liquid, terms + (() if damping is None else (damping,)), block, block.carried
 
 
 def _scene_tank_key(scene, body, key: str) -> str:
@@ -143,9 +144,9 @@ def build_bodies(scene, params: dict, g, outline: bool = False) -> tuple[Optiona
         ini = {k: jnp.asarray(P(f"{key}.initial.{k}", getattr(b.initial, k)), dtype=float)
                for k in ("position", "velocity", "angular_velocity", "roll_pitch_yaw")}
         q0 = quat_from_rpy(ini["roll_pitch_yaw"] + jnp.array([0.0, 0.0, b.heading]))
-        tank, tank_terms, blocks, carried = (None, (), (), ()) if outline else body_liquid(scene, b, q0, g)
-        if blocks:
-            hosts.append(BodyTanks(s, b.name, offset, blocks))
+        tank, tank_terms, block, carried = (None, (), None, ()) if outline else body_liquid(scene, b, q0, g)
+        if block is not None and block.result_tanks():
+            hosts.append(BodyTanks(s, b.name, offset, block.result_tanks(), block))
             offset += tank.nf
         mass, inertia, S = jnp.asarray(P(f"{key}.mass", b.mass), dtype=float), P(f"{key}.inertia", b.inertia), None
         if carried:       # its elastic walls carry their own mass in its liquid: the hull is the rest, as the vessel's
@@ -200,10 +201,7 @@ def _about(scene) -> About:
             eff = scene.effects
             loads = ", ".join(["its element's rotation penalty"] + ["Coriolis"] * eff.coriolis
                               + ["centrifugal"] * eff.centrifugal + ["gravity turning with the body"])
-            if t.multimodal:        # its loads are its modal Lagrangian's (tank_line says so)
-                text, loads = text.split("; its inertial loads")[0], "the modal Lagrangian's, gravity turning with it"
-            elif t.reduction is not None:
-                text += f", on {t.reduction.modes} modes"
+            text, loads = t.form.carried_words(t, text, loads)     # the liquid's own loads, in its words
             lines.append((what, f"{text}; carried by the body {b.name!r} (in its frame from its COG, its liquid's "
                                 f"unknowns its own, its loads on the body's six rows: {loads})"))
             if f"liquid damping in tank {t.name!r}" in damped:
