@@ -39,6 +39,13 @@ def linear_hydrostatics(h, rho_w, g, value=lambda key, v: v) -> AbstractRestorin
                 gm_l=f("gm_l", h.gm_l))
 
 
+def inertia_matrix(value):
+    """(3, 3) inertia of a floating body's `inertia` key (the vessel's or a body's): its principal
+    moments (3,) on the diagonal, or the matrix itself."""
+    a = jnp.asarray(value, dtype=float)
+    return jnp.diag(a) if a.ndim == 1 else a
+
+
 def rigid_terms(mass, inertia, hydrostatics, rho_w, g, viscous=None, value=lambda key, v: v,
                 restoring=None, S=None) -> tuple:
     """A floating body's rigid terms, as the vessel has them: inertia with its gyroscopic terms
@@ -47,8 +54,7 @@ def rigid_terms(mass, inertia, hydrostatics, rho_w, g, viscous=None, value=lambd
     assemble/hull.py body_restoring), and linear viscous damping (6 x 6) where given; `value(name,
     v)` may replace the hydrostatics' values (a body's traced params); `S` the hull's first moment
     where parts carry their own mass (`hull_part`)."""
-    I = jnp.asarray(inertia, dtype=float)
-    terms = [RigidBody(mass=jnp.asarray(mass, dtype=float), inertia=jnp.diag(I) if I.ndim == 1 else I, S=S),
+    terms = [RigidBody(mass=jnp.asarray(mass, dtype=float), inertia=inertia_matrix(inertia), S=S),
              *((linear_hydrostatics(hydrostatics, rho_w, g, value),) if restoring is None else restoring)]
     if viscous is not None:
         terms.append(LinearDamping(jnp.asarray(viscous, dtype=float)))
@@ -150,9 +156,8 @@ def build_bodies(scene, params: dict, g, outline: bool = False) -> tuple[Optiona
             offset += tank.nf
         mass, inertia, S = jnp.asarray(P(f"{key}.mass", b.mass), dtype=float), P(f"{key}.inertia", b.inertia), None
         if carried:       # its elastic walls carry their own mass in its liquid: the hull is the rest, as the vessel's
-            inertia = jnp.asarray(inertia, dtype=float)
-            mass, inertia, S = hull_part(mass, jnp.diag(inertia) if inertia.ndim == 1 else inertia, carried,
-                                    f"bodies[{s}]", "body", "its tanks' elastic walls")
+            mass, inertia, S = hull_part(mass, inertia_matrix(inertia), carried, f"bodies[{s}]", "body",
+                                         "its tanks' elastic walls")
         floating.append(Floating(
             terms=rigid_terms(mass, inertia, b.hydrostatics, rho, g, b.viscous_damping, traced,
                               body_restoring(scene, b, params, g, tank, mass, S), S) + (

@@ -28,9 +28,9 @@ from ..staging import staged
 from ..scene.keys import resolve_params
 from ..scene.types import DOFS, Scene
 from .about import damping_about, flex_about, liquid_about, record_about, stiffening_about, weight_about
-from .bodies import build_bodies, hull_part, linear_hydrostatics
+from .bodies import build_bodies, hull_part, inertia_matrix, linear_hydrostatics
 from .damping import build_damping
-from .hull import build_hull_pressure
+from .hull import build_hull_pressure, weight_term
 from .liquid import LiquidBlock, build_liquid_block, outline_liquid_block, rigid_part
 from .probes import Probes, build_probes
 from .seakeeping import build_seakeeping, outline_seakeeping
@@ -58,11 +58,6 @@ def _owners_start(system: System, c0: Config, v0):
 
 
 _start = staged(_owners_start)
-
-
-def _inertia(value):
-    a = jnp.asarray(value, dtype=float)
-    return jnp.diag(a) if a.ndim == 1 else a
 
 
 class _Model(NamedTuple):
@@ -139,7 +134,7 @@ def _model(scene: Scene, params: dict, outline: bool = False) -> _Model:
     if own:
         structures, blocks = (Structures(bodies=(), interfaces=()), ()) if outline else build_structures(scene)
         structures = dataclasses.replace(structures, about=flex_about(scene))
-    mass, inertia = jnp.asarray(P("vessel.mass", ves.mass), dtype=float), _inertia(P("vessel.inertia", ves.inertia))
+    mass, inertia = jnp.asarray(P("vessel.mass", ves.mass), dtype=float), inertia_matrix(P("vessel.inertia", ves.inertia))
     hull_S = None
     carried = block.carried + tuple(rigid_part(b.model.mass, b.model.nodes + np.asarray(scene.structure(b.name).origin))
                                     for b in blocks)
@@ -152,8 +147,7 @@ def _model(scene: Scene, params: dict, outline: bool = False) -> _Model:
         if outline:
             terms.append(Weight(mass=None, S=None, gravity=g, about=weight))
         else:
-            S = liquid.rigid_first_moment() if hull_S is None else hull_S + liquid.rigid_first_moment()
-            terms.append(Weight(mass=mass + liquid.total_mass(), S=S, gravity=g, about=weight))
+            terms.append(weight_term(mass, hull_S, liquid, g, weight))     # a body's too (assemble/hull.py)
     if any(m.model == "catenary" for m in scene.mooring):   # quasi-static catenary lines (jaxslosh/mooring/term.py)
         terms.append(build_mooring(scene, balanced, outline, params))
     terms.extend(group_lines(build_lumped_lines(scene, balanced, q0)))    # dynamic lumped-mass lines (mooring/lumped_term.py)
