@@ -46,6 +46,13 @@ def inertia_matrix(value):
     return jnp.diag(a) if a.ndim == 1 else a
 
 
+def initial_values(P, key: str, initial) -> dict:
+    """A floating body's initial state (`<key>.initial`: the vessel's or a body's), each value traced
+    where `P` (the params' get) names it: position, velocity, angular_velocity, roll_pitch_yaw."""
+    return {k: jnp.asarray(P(f"{key}.initial.{k}", getattr(initial, k)), dtype=float)
+            for k in ("position", "velocity", "angular_velocity", "roll_pitch_yaw")}
+
+
 def rigid_terms(mass, inertia, hydrostatics, rho_w, g, viscous=None, value=lambda key, v: v,
                 restoring=None, S=None) -> tuple:
     """A floating body's rigid terms, as the vessel has them: inertia with its gyroscopic terms
@@ -147,8 +154,7 @@ def build_bodies(scene, params: dict, g, outline: bool = False) -> tuple[Optiona
         key = f"bodies.{b.name}"
         traced = lambda k, v, key=key: P(f"{key}.hydrostatics.{k}", v)  # noqa: E731
         # its initial state as the vessel's (assemble/system.py), offsets from its rest pose, traced where params name them
-        ini = {k: jnp.asarray(P(f"{key}.initial.{k}", getattr(b.initial, k)), dtype=float)
-               for k in ("position", "velocity", "angular_velocity", "roll_pitch_yaw")}
+        ini = initial_values(P, key, b.initial)
         q0 = quat_from_rpy(ini["roll_pitch_yaw"] + jnp.array([0.0, 0.0, b.heading]))
         tank, tank_terms, block, carried = (None, (), None, ()) if outline else body_liquid(scene, b, q0, g)
         if block is not None and block.result_tanks():

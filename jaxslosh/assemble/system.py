@@ -28,7 +28,7 @@ from ..staging import staged
 from ..scene.keys import resolve_params
 from ..scene.types import DOFS, Scene
 from .about import damping_about, flex_about, liquid_about, record_about, stiffening_about, weight_about
-from .bodies import build_bodies, hull_part, inertia_matrix, linear_hydrostatics
+from .bodies import build_bodies, hull_part, inertia_matrix, initial_values, linear_hydrostatics
 from .damping import build_damping
 from .hull import build_hull_pressure, weight_term
 from .liquid import LiquidBlock, build_liquid_block, outline_liquid_block, rigid_part
@@ -74,15 +74,13 @@ def build(scene: Scene, params: Optional[dict] = None) -> Built:
     ves = scene.vessel
     system, block, blocks, body_tanks = _model(scene, params)
     liquid, q0 = system.liquid, system.q_ref
-    ini = ves.initial
+    ini = initial_values(P, "vessel", ves.initial)      # a body's the same way (assemble/bodies.py)
     nf = system.nf
     d_init = jnp.zeros(nf)
     if nf:
         d_init = _hydrostatic_start(system, q0)
-    c0 = Config(jnp.asarray(P("vessel.initial.position", ini.position), dtype=float), q0, d_init)
-    v0 = jnp.concatenate([jnp.asarray(P("vessel.initial.velocity", ini.velocity), dtype=float),
-                          jnp.asarray(P("vessel.initial.angular_velocity", ini.angular_velocity), dtype=float),
-                          jnp.zeros(nf)])
+    c0 = Config(ini["position"], q0, d_init)
+    v0 = jnp.concatenate([ini["velocity"], ini["angular_velocity"], jnp.zeros(nf)])
     for motion in system.prescribing():     # a prescribed motion sets the rigid state at t = 0
         c0, v0 = motion.start(c0, v0)
     # the terms that own unknowns (the structures) start them; nothing to compile without
@@ -123,8 +121,7 @@ def _model(scene: Scene, params: dict, outline: bool = False) -> _Model:
     motion = None if ves.forced is None else _prescribed(ves.forced, P)
     q0 = None
     if not outline:
-        ini = ves.initial
-        q0 = _quat_from_rpy(jnp.asarray(P("vessel.initial.roll_pitch_yaw", ini.roll_pitch_yaw), dtype=float))
+        q0 = _quat_from_rpy(initial_values(P, "vessel", ves.initial)["roll_pitch_yaw"])
         if motion is not None:     # the prescribed attitude at t = 0 (upright unless a phase or a record tilts it)
             q0 = _quat_from_rpy(motion.coordinates(jnp.zeros(()))[3:])
     if scene.waves is not None or ves.hydrodynamics is not None:
