@@ -13,7 +13,7 @@ import jax.numpy as jnp
 import numpy as np
 
 from ..liquid.base import RotationPenalty
-from ..liquid.multimodal.build import build_multimodal, multimodal_damping, multimodal_scene, surface_meshes
+from ..liquid.block import LiquidBlock
 from ..physics.about import About
 from ..physics.bodies import BAND, Bodies, Floating, Link, body_rest, end_index
 from ..physics.kinematics import quat_from_rpy
@@ -40,6 +40,20 @@ def linear_hydrostatics(h, rho_w, g, value=lambda key, v: v) -> AbstractRestorin
                 gm_l=f("gm_l", h.gm_l))
 
 
+def inertia_matrix(value):
+    """(3, 3) inertia of a floating body's `inertia` key (the vessel's or a body's): its principal
+    moments (3,) on the diagonal, or the matrix itself."""
+    a = jnp.asarray(value, dtype=float)
+    return jnp.diag(a) if a.ndim == 1 else a
+
+
+def initial_values(P, key: str, initial) -> dict:
+    """A floating body's initial state (`<key>.initial`: the vessel's or a body's), each value traced
+    where `P` (the params' get) names it: position, velocity, angular_velocity, roll_pitch_yaw."""
+    return {k: jnp.asarray(P(f"{key}.initial.{k}", getattr(initial, k)), dtype=float)
+            for k in ("position", "velocity", "angular_velocity", "roll_pitch_yaw")}
+
+
 def rigid_terms(mass, inertia, hydrostatics, rho_w, g, viscous=None, value=lambda key, v: v,
                 restoring=None, S=None) -> tuple:
     """A floating body's rigid terms, as the vessel has them: inertia with its gyroscopic terms
@@ -48,8 +62,7 @@ def rigid_terms(mass, inertia, hydrostatics, rho_w, g, viscous=None, value=lambd
     assemble/hull.py body_restoring), and linear viscous damping (6 x 6) where given; `value(name,
     v)` may replace the hydrostatics' values (a body's traced params); `S` the hull's first moment
     where parts carry their own mass (`hull_part`)."""
-    I = jnp.asarray(inertia, dtype=float)
-    terms = [RigidBody(mass=jnp.asarray(mass, dtype=float), inertia=jnp.diag(I) if I.ndim == 1 else I, S=S),
+    terms = [RigidBody(mass=jnp.asarray(mass, dtype=float), inertia=inertia_matrix(inertia), S=S),
              *((linear_hydrostatics(hydrostatics, rho_w, g, value),) if restoring is None else restoring)]
     if viscous is not None:
         terms.append(LinearDamping(jnp.asarray(viscous, dtype=float)))
@@ -77,33 +90,34 @@ def hull_part(mass, inertia, parts, key: str = "vessel", what: str = "ship", car
 
 
 class BodyTanks(NamedTuple):
-    """The host-side blocks of the tanks one body carries (liquid/block.TankBlock: meshes for the
-    result's fields and the probes), its index among the bodies and the offset of its liquid
-    unknowns among the bodies' tanks' (physics/bodies.py Bodies.tank_slices)."""
+    """The host-side blocks of the tanks one body carries (the tanks a result keeps the fields of:
+    liquid/block.py LiquidBlock.result_tanks), its index among the bodies, the offset of its liquid
+    unknowns among the bodies' tanks' (physics/bodies.py Bodies.tank_slices) and the block its
+    liquid's builder made (`block`: what the probes and the validity watch ask, as of the vessel's)."""
     body: int
     name: str
     offset: int
     tanks: tuple
+    block: Optional[LiquidBlock] = None
 
 
 def body_liquid(scene, body, q0, g, params=None):
-    """(liquid, its terms, host blocks, the rigid parts of its elastic walls) of the tanks a body
+    """(liquid, its terms, its block, the rigid parts of its elastic walls) of the tanks a body
     carries: the vessel's builder (assemble/liquid.py) on the scene with the body's tanks as its
-    tanks, so that a tank is the same model on any body, its elastic walls included, and takes the
-    same traced `params` (`tanks.<name>.fill_depth`, ...: canonical keys, by the tank's name); the
-    rotation penalty at the body's initial attitude, as the vessel's at its own. (None, (), (), ())
-    without tanks or with the liquid switched off."""
+    tanks and the probes in them as its probes, so that a tank is the same model on any body
+    (whichever model its form takes: liquid/forms.py block_form), its elastic walls included, and
+    takes the same traced `params` (`tanks.<name>.fill_depth`, ...: canonical keys, by the tank's
+    name); the rotation penalty at the body's initial attitude, as the vessel's at its own. (None,
+    (), None, ()) without tanks or with the liquid switched off."""
     eff = scene.effects
     if not body.tanks or not eff.liquid:
-        return None, (), (), ()
+        return None, (), None, ()
     # dense: the body's liquid block is inverted whole as the Bodies term's deformable block
+    names = {t.name for t in body.tanks}
     own = dataclasses.replace(scene, tanks=body.tanks, structures=(),
+                              probes=tuple(p for p in scene.probes if p.tank in names),
                               simulation=dataclasses.replace(scene.simulation, linear_solver="dense"))
     params = params or {}
-    if multimodal_scene(own):     # the vessel's multimodal liquid and damping; its fields on surface meshes
-        liquid = build_multimodal(own, params, g)
-        damping, _ = multimodal_damping(own, params, liquid)
-        return liquid, () if damping is None else (damping,), surface_meshes(own), ()
     try:
         block = build_liquid_block(own, params, g)
     except SceneError as e:          # the builder names the body's tanks by their index among its own
@@ -113,7 +127,7 @@ def body_liquid(scene, body, q0, g, params=None):
     liquid = block.liquid.with_effects(eff.coriolis, eff.centrifugal, block.liquid.about)
     terms = () if block.penalty is None else (RotationPenalty(Kdt=block.penalty[0], Ktt=block.penalty[1], q_ref=q0),)
     damping, _ = build_damping(own, params, block)        # [tanks.damping]: the vessel's modal damping
-    return liquid, terms + (() if damping is None else (damping,)), block.tanks, block.carried
+    return liquid, terms + (() if damping is None else (damping,)), block, block.carried
 
 
 def _scene_tank_key(scene, body, key: str) -> str:
@@ -143,18 +157,16 @@ def build_bodies(scene, params: dict, g, outline: bool = False) -> tuple[Optiona
         key = f"bodies.{b.name}"
         traced = lambda k, v, key=key: P(f"{key}.hydrostatics.{k}", v)  # noqa: E731
         # its initial state as the vessel's (assemble/system.py), offsets from its rest pose, traced where params name them
-        ini = {k: jnp.asarray(P(f"{key}.initial.{k}", getattr(b.initial, k)), dtype=float)
-               for k in ("position", "velocity", "angular_velocity", "roll_pitch_yaw")}
+        ini = initial_values(P, key, b.initial)
         q0 = quat_from_rpy(ini["roll_pitch_yaw"] + jnp.array([0.0, 0.0, b.heading]))
-        tank, tank_terms, blocks, carried = (None, (), (), ()) if outline else body_liquid(scene, b, q0, g, params)
-        if blocks:
-            hosts.append(BodyTanks(s, b.name, offset, blocks))
+        tank, tank_terms, block, carried = (None, (), None, ()) if outline else body_liquid(scene, b, q0, g, params)
+        if block is not None and block.result_tanks():
+            hosts.append(BodyTanks(s, b.name, offset, block.result_tanks(), block))
             offset += tank.nf
         mass, inertia, S = jnp.asarray(P(f"{key}.mass", b.mass), dtype=float), P(f"{key}.inertia", b.inertia), None
         if carried:       # its elastic walls carry their own mass in its liquid: the hull is the rest, as the vessel's
-            inertia = jnp.asarray(inertia, dtype=float)
-            mass, inertia, S = hull_part(mass, jnp.diag(inertia) if inertia.ndim == 1 else inertia, carried,
-                                    f"bodies[{s}]", "body", "its tanks' elastic walls")
+            mass, inertia, S = hull_part(mass, inertia_matrix(inertia), carried, f"bodies[{s}]", "body",
+                                         "its tanks' elastic walls")
         floating.append(Floating(
             terms=rigid_terms(mass, inertia, b.hydrostatics, rho, g, b.viscous_damping, traced,
                               body_restoring(scene, b, params, g, tank, mass, S), S) + (
@@ -208,10 +220,7 @@ def _about(scene) -> About:
             eff = scene.effects
             loads = ", ".join(["its element's rotation penalty"] + ["Coriolis"] * eff.coriolis
                               + ["centrifugal"] * eff.centrifugal + ["gravity turning with the body"])
-            if t.multimodal:        # its loads are its modal Lagrangian's (tank_line says so)
-                text, loads = text.split("; its inertial loads")[0], "the modal Lagrangian's, gravity turning with it"
-            elif t.reduction is not None:
-                text += f", on {t.reduction.modes} modes"
+            text, loads = t.form.carried_words(t, text, loads)     # the liquid's own loads, in its words
             lines.append((what, f"{text}; carried by the body {b.name!r} (in its frame from its COG, its liquid's "
                                 f"unknowns its own, its loads on the body's six rows: {loads})"))
             if f"liquid damping in tank {t.name!r}" in damped:

@@ -88,12 +88,18 @@ def body_restoring(scene, body, params: dict, g, liquid=None, mass=None, S=None)
         return ()
     key = f"bodies.{body.name}"
     mass = jnp.asarray(params.get(f"{key}.mass", body.mass) if mass is None else mass, dtype=float)
-    S = jnp.zeros(3) if S is None else S
-    if liquid is not None:
-        mass, S = mass + liquid.total_mass(), S + liquid.rigid_first_moment()
     weight = About(("gravity", f"the weight of the body {body.name!r} and its liquid, borne by its hull's pressure"))
     return (hull_term(scene, body.hull, params, g, f"{key}.hull", body.position),
-            Weight(mass=mass, S=S, gravity=g, about=weight))
+            weight_term(mass, S, liquid, g, weight))
+
+
+def weight_term(mass, S, liquid, g, about: About) -> Weight:
+    """A floating body's weight with the liquid it carries (`liquid`, None: none), the vessel's and a
+    body's alike: `mass` and `S` its hull's own (S None: its COG at the frame origin)."""
+    if liquid is not None:
+        S = liquid.rigid_first_moment() if S is None else S + liquid.rigid_first_moment()
+        mass = mass + liquid.total_mass()
+    return Weight(mass=mass, S=jnp.zeros(3) if S is None else S, gravity=g, about=about)
 
 
 def restoring_words(scene, body) -> str:

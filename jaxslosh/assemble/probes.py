@@ -2,7 +2,6 @@
 the liquid's nodes (or a structure's), computed once."""
 from __future__ import annotations
 
-import dataclasses
 from typing import NamedTuple, Optional
 
 import jax
@@ -10,7 +9,6 @@ import jax.numpy as jnp
 import numpy as np
 
 from ..fem.mesh import HEX_CORNERS
-from ..liquid.multimodal.build import probe_modal
 from ..scene.types import Scene
 
 
@@ -44,24 +42,32 @@ class BodyProbes(NamedTuple):
     n: int
 
 
-def _body_probe(scene, p, t, bt, tank):
-    """(point in the body's frame, its weights (m, 3) on the body's tank liquid's coordinates) of a
-    probe in tank t (TankBlock `bt.tanks`' one) carried by a body whose liquid is `tank`: the
-    vessel's rule (probe_weights) on the body's mesh."""
-    b = next(x for x in bt.tanks if x.name == t.name)
-    if t.multimodal:              # the free surface's elevation at the probe: the vessel's rule (probe_modal)
-        body = next(x for x in scene.bodies if t in x.tanks)
-        own = dataclasses.replace(scene, tanks=body.tanks, probes=(p,))
-        return np.asarray(t.origin) + np.asarray(p.point), probe_modal(own, tank)[0]
-    local = (mapped_weights(np.asarray(p.point), t.fill_depth, b.nodes, b.elements)
-             if getattr(b.model, "geometry", None) is not None else
-             probe_weights(np.asarray(p.point), t.size, t.fill_depth, b.nodes, b.elements))
-    w = np.zeros((1, tank.n_nodes))
-    w[0, b.node_offset:b.node_offset + b.nodes.shape[0]] = local
-    modal = tank.probe_modal(jnp.asarray(w))
-    if modal is None:             # a full-order liquid: its probe displacement is linear in d, (3, nf) -> (nf, 3)
-        modal = jax.jacfwd(lambda d: tank.probe_displacements(jnp.asarray(w), None, d)[0])(jnp.zeros(tank.nf)).T[None]
-    return np.asarray(t.origin) + np.asarray(p.point), modal[0]
+def tank_weights(p, t, b) -> np.ndarray:
+    """The trilinear weights (N_t,) of probe `p` in tank `t` over its tank block `b`'s nodes (liquid/block.py
+    TankBlock): a box's rule (probe_weights) or a shaped tank's (mapped_weights)."""
+    if getattr(b.model, "geometry", None) is not None:
+        return mapped_weights(np.asarray(p.point), t.fill_depth, b.nodes, b.elements)
+    return probe_weights(np.asarray(p.point), t.size, t.fill_depth, b.nodes, b.elements)
+
+
+def body_modal(bt, tank, found) -> jnp.ndarray:
+    """(k, m, 3): the weights of the probes `found` ((t, p) per probe, in the scene's order) in the
+    tanks of one body on its liquid `tank`'s coordinates, by the vessel's rule: their nodal
+    interpolation over the tank blocks the liquid's builder made (`bt.block`, none for a liquid
+    without a mesh), turned into modal weights by the block (LiquidBlock.probe_modal: a reduced
+    liquid's basis, or the rows a model's builder made from the probes itself); where the liquid
+    reads the nodal field (full order), its probe displacement, linear in d."""
+    W = np.zeros((len(found), tank.n_nodes))
+    meshes = {b.name: b for b in bt.block.tanks}
+    for k, (t, p) in enumerate(found):
+        b = meshes.get(t.name)
+        if b is not None:
+            W[k, b.node_offset:b.node_offset + b.nodes.shape[0]] = tank_weights(p, t, b)
+    modal = bt.block.probe_modal(jnp.asarray(W))
+    if modal is None:        # (k, 3, nf) -> (k, nf, 3)
+        modal = jax.jacfwd(lambda d: tank.probe_displacements(jnp.asarray(W), None, d))(jnp.zeros(tank.nf))
+        modal = jnp.swapaxes(modal, 1, 2)
+    return modal
 
 
 def build_probes(scene: Scene, tanks, liquid, structures=(), vstructs=(), body_tanks=(), bodies=None) -> Probes:
@@ -76,24 +82,15 @@ def build_probes(scene: Scene, tanks, liquid, structures=(), vstructs=(), body_t
         w = np.zeros(N)
         if p.tank is not None and p.tank in carried:      # in a body's tank: it follows that body
             s, t = carried[p.tank]
-            bt = next((x for x in body_tanks if x.body == s), None)
-            if bt is None:                # no liquid built ([effects] liquid = false): it follows the body
-                r, modal, at = np.asarray(t.origin) + np.asarray(p.point), jnp.zeros((0, 3)), (0, 0)
-            else:
-                r, modal = _body_probe(scene, p, t, bt, bodies.bodies[s].tank)
-                at = (bt.offset, bodies.bodies[s].nf)
+            r = np.asarray(t.origin) + np.asarray(p.point)
             pts.append(r)
-            on_body.setdefault(s, (*at, []))[2].append((i, r, modal))
+            on_body.setdefault(s, []).append((i, r, t, p))
         elif p.tank is not None:
             t = scene.tank(p.tank)
             pts.append(np.asarray(t.origin) + np.asarray(p.point))
             b = by_name.get(t.name)
-            if b is not None and getattr(b.model, "geometry", None) is not None:
-                local = mapped_weights(np.asarray(p.point), t.fill_depth, b.nodes, b.elements)
-                w[b.node_offset:b.node_offset + b.nodes.shape[0]] = local
-            elif b is not None:
-                local = probe_weights(np.asarray(p.point), t.size, t.fill_depth, b.nodes, b.elements)
-                w[b.node_offset:b.node_offset + b.nodes.shape[0]] = local
+            if b is not None:
+                w[b.node_offset:b.node_offset + b.nodes.shape[0]] = tank_weights(p, t, b)
         elif scene.structure(p.structure).frame == "vessel":     # in the vessel-frame block, like a liquid point
             st = scene.structure(p.structure)
             pts.append(np.asarray(st.origin) + np.asarray(p.point))
@@ -111,10 +108,20 @@ def build_probes(scene: Scene, tanks, liquid, structures=(), vstructs=(), body_t
         W.append(w)
     sp = tuple(StructureProbes(k, np.array([e[0] for e in v]), jnp.asarray(np.array([e[1] for e in v])),
                                jnp.asarray(np.array([e[2] for e in v]))) for k, v in sorted(on_struct.items()))
-    bp = tuple(BodyProbes(s, np.array([e[0] for e in v]), jnp.asarray(np.array([e[1] for e in v])),
-                          jnp.stack([e[2] for e in v]), off, n) for s, (off, n, v) in sorted(on_body.items()))
+    bp = tuple(_body_probes(s, v, body_tanks, bodies) for s, v in sorted(on_body.items()))
     return Probes(tuple(names), jnp.asarray(np.array(pts).reshape(-1, 3)),
                   jnp.asarray(np.array(W, dtype=float).reshape(len(W), N)), sp, on_bodies=bp)
+
+
+def _body_probes(s, found, body_tanks, bodies) -> BodyProbes:
+    """The probes `found` ((row, point, tank, probe) each) in the tanks of body `s`; without its
+    liquid built ([effects] liquid = false) they follow the body."""
+    bt = next((x for x in body_tanks if x.body == s), None)
+    rows, r = np.array([e[0] for e in found]), jnp.asarray(np.array([e[1] for e in found]))
+    if bt is None:
+        return BodyProbes(s, rows, r, jnp.zeros((len(found), 0, 3)), 0, 0)
+    tank = bodies.bodies[s].tank
+    return BodyProbes(s, rows, r, body_modal(bt, tank, [(e[2], e[3]) for e in found]), bt.offset, tank.nf)
 
 
 def block_weights(point, nodes, elements, tol=1e-9):

@@ -28,9 +28,9 @@ from ..staging import staged
 from ..scene.keys import resolve_params
 from ..scene.types import DOFS, Scene
 from .about import damping_about, flex_about, liquid_about, record_about, stiffening_about, weight_about
-from .bodies import build_bodies, hull_part, linear_hydrostatics
+from .bodies import build_bodies, hull_part, inertia_matrix, initial_values, linear_hydrostatics
 from .damping import build_damping
-from .hull import build_hull_pressure
+from .hull import build_hull_pressure, weight_term
 from .liquid import LiquidBlock, build_liquid_block, outline_liquid_block, rigid_part
 from .probes import Probes, build_probes
 from .seakeeping import build_seakeeping, outline_seakeeping
@@ -60,11 +60,6 @@ def _owners_start(system: System, c0: Config, v0):
 _start = staged(_owners_start)
 
 
-def _inertia(value):
-    a = jnp.asarray(value, dtype=float)
-    return jnp.diag(a) if a.ndim == 1 else a
-
-
 class _Model(NamedTuple):
     """The static model of a scene and what the build's initial state and probes need of it."""
     system: System
@@ -79,15 +74,13 @@ def build(scene: Scene, params: Optional[dict] = None) -> Built:
     ves = scene.vessel
     system, block, blocks, body_tanks = _model(scene, params)
     liquid, q0 = system.liquid, system.q_ref
-    ini = ves.initial
+    ini = initial_values(P, "vessel", ves.initial)      # a body's the same way (assemble/bodies.py)
     nf = system.nf
     d_init = jnp.zeros(nf)
     if nf:
         d_init = _hydrostatic_start(system, q0)
-    c0 = Config(jnp.asarray(P("vessel.initial.position", ini.position), dtype=float), q0, d_init)
-    v0 = jnp.concatenate([jnp.asarray(P("vessel.initial.velocity", ini.velocity), dtype=float),
-                          jnp.asarray(P("vessel.initial.angular_velocity", ini.angular_velocity), dtype=float),
-                          jnp.zeros(nf)])
+    c0 = Config(ini["position"], q0, d_init)
+    v0 = jnp.concatenate([ini["velocity"], ini["angular_velocity"], jnp.zeros(nf)])
     for motion in system.prescribing():     # a prescribed motion sets the rigid state at t = 0
         c0, v0 = motion.start(c0, v0)
     # the terms that own unknowns (the structures) start them; nothing to compile without
@@ -128,8 +121,7 @@ def _model(scene: Scene, params: dict, outline: bool = False) -> _Model:
     motion = None if ves.forced is None else _prescribed(ves.forced, P)
     q0 = None
     if not outline:
-        ini = ves.initial
-        q0 = _quat_from_rpy(jnp.asarray(P("vessel.initial.roll_pitch_yaw", ini.roll_pitch_yaw), dtype=float))
+        q0 = _quat_from_rpy(initial_values(P, "vessel", ves.initial)["roll_pitch_yaw"])
         if motion is not None:     # the prescribed attitude at t = 0 (upright unless a phase or a record tilts it)
             q0 = _quat_from_rpy(motion.coordinates(jnp.zeros(()))[3:])
     if scene.waves is not None or ves.hydrodynamics is not None:
@@ -139,7 +131,7 @@ def _model(scene: Scene, params: dict, outline: bool = False) -> _Model:
     if own:
         structures, blocks = (Structures(bodies=(), interfaces=()), ()) if outline else build_structures(scene)
         structures = dataclasses.replace(structures, about=flex_about(scene))
-    mass, inertia = jnp.asarray(P("vessel.mass", ves.mass), dtype=float), _inertia(P("vessel.inertia", ves.inertia))
+    mass, inertia = jnp.asarray(P("vessel.mass", ves.mass), dtype=float), inertia_matrix(P("vessel.inertia", ves.inertia))
     hull_S = None
     carried = block.carried + tuple(rigid_part(b.model.mass, b.model.nodes + np.asarray(scene.structure(b.name).origin))
                                     for b in blocks)
@@ -152,8 +144,7 @@ def _model(scene: Scene, params: dict, outline: bool = False) -> _Model:
         if outline:
             terms.append(Weight(mass=None, S=None, gravity=g, about=weight))
         else:
-            S = liquid.rigid_first_moment() if hull_S is None else hull_S + liquid.rigid_first_moment()
-            terms.append(Weight(mass=mass + liquid.total_mass(), S=S, gravity=g, about=weight))
+            terms.append(weight_term(mass, hull_S, liquid, g, weight))     # a body's too (assemble/hull.py)
     if any(m.model == "catenary" for m in scene.mooring):   # quasi-static catenary lines (jaxslosh/mooring/term.py)
         terms.append(build_mooring(scene, balanced, outline, params))
     terms.extend(group_lines(build_lumped_lines(scene, balanced, q0)))    # dynamic lumped-mass lines (mooring/lumped_term.py)

@@ -54,6 +54,7 @@ from jax.scipy.linalg import block_diag
 import numpy as np
 
 from .about import About
+from .floating import AbstractFloating, frame_kin
 from .kinematics import quat_exp, quat_multiply, rotation_matrix
 from .seakeeping import Memory
 from .terms import Config, Kin, Rows, Unknowns
@@ -188,11 +189,12 @@ def links_state(links: tuple, poses: dict, S: int):
     return T, e, U, rows[:S + 1]
 
 
-class Floating(eqx.Module):
-    """One body's floating frame: its rigid terms (the vessel's classes, evaluated with its own
-    kinematics), its rest pose and its initial state; and the liquid of the tanks it carries
-    (`tank`: a liquid of the vessel's kind, jaxslosh/liquid, built by the vessel's builder; None
-    without tanks) with the terms that act on that liquid (`tank_terms`: its rotation penalty)."""
+class Floating(AbstractFloating):
+    """One body's floating frame (a floating body as the vessel is one: floating.AbstractFloating
+    sums its terms): its rigid terms (the vessel's classes, evaluated with its own kinematics), its
+    rest pose and its initial state; and the liquid of the tanks it carries (`tank`: a liquid of the
+    vessel's kind, jaxslosh/liquid, built by the vessel's builder; None without tanks) with the
+    terms that act on that liquid (`tank_terms`: its rotation penalty)."""
     terms: tuple
     rest: jax.Array        # (3,) its COG at rest, in the vessel-at-rest frame
     x0: jax.Array          # (3,) its COG at t = 0, same frame
@@ -209,33 +211,31 @@ class Floating(eqx.Module):
     def kin(self, X, q, v, a, gravity, t, d=None, d_dot=None, d_acc=None) -> Kin:
         """The body's Kin: its offset from rest as the configuration's X0 (what the hydrostatics read)
         and its tanks' liquid unknowns as the deformable ones (d, their rates d_dot and d_acc)."""
-        A = rotation_matrix(q)
-        g_b = A.T @ jnp.array([0.0, 0.0, -gravity])
         e = jnp.zeros(0)
-        return Kin(Config(X - self.rest, q, e if d is None else d), v[:3], v[3:], e if d_dot is None else d_dot, a,
-                   None if a is None else (e if d_acc is None else d_acc), jnp.asarray(t), jnp.zeros((0,)), A, g_b)
+        return frame_kin(Config(X - self.rest, q, e if d is None else d), v[:3], v[3:], e if d_dot is None else d_dot,
+                         a, None if a is None else (e if d_acc is None else d_acc), t, gravity)
 
     def carried(self):
         """Its terms on its tanks' liquid: the liquid's own, then the others'."""
         return () if self.tank is None else (self.tank, *self.tank_terms)
 
+    def frame_terms(self) -> tuple:
+        """Its rigid terms, then its liquid and the terms on it."""
+        return self.terms + self.carried()
+
     def rows(self, k: Kin):
         """(its six rows, its liquid's rows)."""
-        rigid = sum((t.rows(k).rigid for t in self.terms), jnp.zeros(6))
-        d = jnp.zeros(0)
-        for t in self.carried():
-            r = t.rows(k)
-            rigid, d = rigid + r.rigid, r.d if not d.size else d + r.d
-        return rigid, d
+        rigid, d, _ = self.frame_rows(k)
+        return rigid, jnp.zeros(0) if d is None else d
 
     def kinetic(self, k: Kin):
-        return sum((t.kinetic(k) for t in self.terms + self.carried()), jnp.zeros(()))
+        return self.frame_kinetic(k)
 
     def potential(self, k: Kin):
-        return sum((t.potential(k) for t in self.terms + self.carried()), jnp.zeros(()))
+        return self.frame_potential(k)
 
     def mass_scale(self):
-        return sum((t.mass_scale() for t in self.terms + self.carried()), jnp.zeros(6))
+        return self.frame_mass_scale()
 
 
 class Bodies(AbstractOwner):

@@ -23,13 +23,14 @@ import equinox as eqx
 import jax
 import jax.numpy as jnp
 
-from .kinematics import G_matrix, quat_exp, quat_multiply, rotation_matrix, tv3
+from .floating import AbstractFloating, frame_kin, gravity_in
+from .kinematics import G_matrix, quat_exp, quat_multiply, rotation_matrix
 from .terms import Config, Kin, Unknowns
 from .unknowns import Layout
 from .vessel import RigidBody
 
 
-class System(eqx.Module):
+class System(AbstractFloating):
     body: RigidBody                  # the hull's inertia (always a term)
     terms: tuple                     # the other terms the scene has (buoyancy, weight, waves, penalties, ...)
     # the owner of the deformable unknowns: a jaxslosh/liquid AbstractLiquid (NoLiquid without tanks);
@@ -60,6 +61,10 @@ class System(eqx.Module):
 
     def all_terms(self) -> tuple:
         return (self.body, *self.terms, self.liquid, *self.tail)
+
+    def frame_terms(self) -> tuple:
+        """The vessel's terms (a floating body's, floating.AbstractFloating): all of them."""
+        return self.all_terms()
 
     # ---------------------------------------------------------------- the terms' own unknowns
     def owners(self) -> tuple:
@@ -215,12 +220,12 @@ class System(eqx.Module):
 
     def gravity_body(self, A):
         """Gravity in the body frame: turning with the body (the load of eq. 32), or frozen at the start."""
-        g_vec = jnp.array([0.0, 0.0, -self.gravity])
-        return tv3(A if self.gravity_turning else rotation_matrix(self.q_ref), g_vec)
+        return gravity_in(A if self.gravity_turning else rotation_matrix(self.q_ref), self.gravity)
 
     def kin(self, c: Config, V0, omega, d_dot, a6=None, d_acc=None, t=0.0) -> Kin:
-        A = rotation_matrix(c.q)
-        return Kin(c, V0, omega, d_dot, a6, d_acc, jnp.asarray(t), jnp.zeros((0,)), A, self.gravity_body(A))
+        """The vessel's Kin (floating.frame_kin), its gravity frozen at the start where it does not turn."""
+        return frame_kin(c, V0, omega, d_dot, a6, d_acc, t, self.gravity,
+                         None if self.gravity_turning else rotation_matrix(self.q_ref))
 
     def at_time(self, t) -> "System":
         """The System for the evaluations of one step at time t: each term's `at_time` (what
@@ -271,32 +276,20 @@ class System(eqx.Module):
     def terms_rows(self, c: Config, V0, omega, d_dot, a6, d_acc, t=0.0, z=None):
         """`residual_parts` before `hold`: the sum of the terms' rows (vessel, deformable, the bodies'
         frames: None where no term has rows there)."""
-        k = self.kin(c, V0, omega, d_dot, a6, d_acc, t)
-        rigid, d, frames = None, None, None
-        for term, zi in zip(self.all_terms(), self.states_init() if z is None else z, strict=True):
-            with jax.named_scope(type(term).__name__):
-                r = term.rows(k._replace(z=zi))
-            rigid = r.rigid if rigid is None else rigid + r.rigid
-            if r.d is not None:
-                d = r.d if d is None else d + r.d
-            if r.frames is not None:
-                frames = r.frames if frames is None else frames + r.frames
-        return rigid, d, frames
+        return self.frame_rows(self.kin(c, V0, omega, d_dot, a6, d_acc, t), z)
 
     # ---------------------------------------------------------------- energies
     def kinetic_energy(self, c: Config, v):
         """The kinetic energy for the velocity vector v (vessel, [structures,] liquid, [modal])."""
         ves, _, d_dot, _ = self.layout().split(v)
-        k = self.kin(c, ves[:3], ves[3:6], d_dot)
-        T = sum((term.kinetic(k) for term in self.all_terms()), jnp.zeros(()))
+        T = self.frame_kinetic(self.kin(c, ves[:3], ves[3:6], d_dot))
         for o in self.owners():
             T = T + o.extra_kinetic(self, c, v)
         return T
 
     def potential_energy(self, c: Config):
         z = jnp.zeros(3)
-        k = self.kin(c, z, z, jnp.zeros(self.nf))
-        V = sum((term.potential(k) for term in self.all_terms()), jnp.zeros(()))
+        V = self.frame_potential(self.kin(c, z, z, jnp.zeros(self.nf)))
         for o in self.owners():
             V = V + o.extra_potential(self, c)
         return V
@@ -308,8 +301,7 @@ class System(eqx.Module):
     # ---------------------------------------------------------------- scales
     def scales(self):
         """Characteristic mass (kg or kg m^2) of each unknown, to scale residual rows to O(1)."""
-        rigid = sum((term.mass_scale() for term in self.all_terms()), jnp.zeros(6))
-        return jnp.concatenate([rigid, self.liquid.d_scale()])
+        return jnp.concatenate([self.frame_mass_scale(), self.liquid.d_scale()])
 
 
 def advance_config(c: Config, delta) -> Config:

@@ -18,7 +18,6 @@ import jax
 import numpy as np
 
 from ..liquid.forms import tank_liquid
-from ..liquid.multimodal.build import multimodal_scene, surfaces
 from ..liquid.multimodal.build3d import three_dimensional
 from ..liquid.multimodal.watch import omega2
 from ..physics.bodies import bodies_term
@@ -115,9 +114,7 @@ class Watch:
         for bt in getattr(built, "body_tanks", ()):
             floating, body = term.bodies[bt.body], self.scene.bodies[bt.body]
             own = dataclasses.replace(self.scene, tanks=body.tanks)
-            tops = (surfaces(own) if multimodal_scene(own) else
-                    tuple(t.node_offset + np.flatnonzero(np.isclose(t.nodes[:, 2], t.nodes[:, 2].max()))
-                          for t in bt.tanks))
+            tops = bt.block.surfaces()        # the rows its liquid's surface_heave reads, as the vessel's
             sub = Watch(own, label=lambda i, t, b=body.name: f"tank {t.name!r} on the body {b!r}")
             sub.watch_liquid(floating.tank)
             self.on_bodies.append((sub, floating.tank, slice(bt.offset, bt.offset + floating.nf), tops))

@@ -61,6 +61,12 @@ class LiquidForm(abc.ABC):
                 f"the sway, roll and yaw leave its liquid frozen across the tank (no transverse sloshing, no "
                 f"free-surface effect in roll): set flow = \"3d\" in [[tanks]] for waves across it too")
 
+    def carried_words(self, tank, text: str, loads: str) -> tuple[str, str]:
+        """(the tank's line `text`, its loads on a body that carries it) in the words of the body's
+        line (assemble/bodies.py): a finite element's loads are `loads` (its rotation penalty, the
+        inertial loads [effects] switches, gravity), and a reduced liquid's line says its modes."""
+        return (f"{text}, on {tank.reduction.modes} modes" if self.reduced else text), loads
+
     @property
     @abc.abstractmethod
     def element(self) -> str:
@@ -104,6 +110,10 @@ class MultimodalForm(LiquidForm):
     @property
     def element(self) -> str:
         return ""
+
+    def carried_words(self, tank, text: str, loads: str) -> tuple[str, str]:
+        # its inertial loads are the modal Lagrangian's, not switched by [effects] (its line says so)
+        return text.split("; its inertial loads")[0], "the modal Lagrangian's, gravity turning with it"
 
 
 def liquid_form(tank) -> LiquidForm:

@@ -230,7 +230,7 @@ def test_every_final_liquid_states_every_hook():
 FORM_FLAGS = {"multimodal", "face_normal", "reduced", "elastic", "three_dimensional", "third_order",
               "along_length_only", "element", "form", "name"}
 #: what code elsewhere may ask a form: behaviour, named by what it answers
-FORM_ASKS = {"dense_blocks", "dampable", "across_seas_warning"}
+FORM_ASKS = {"dense_blocks", "dampable", "across_seas_warning", "carried_words"}
 
 
 def flag_reads(source: str) -> list:
@@ -261,4 +261,47 @@ def test_no_branch_on_the_forms_flags_outside_the_loader_and_the_liquid():
     `tank_unknowns`, `tank_bytes`, `sloshing_modes`, ...), never which model it is."""
     bad = [f"{rel}:{line}: {text}" for rel, path in sorted(_sources()) if not rel.startswith(("scene/", "liquid/"))
            for line, text in flag_reads(open(path).read())]
+    assert not bad, "\n".join(bad)
+
+
+#: the tank's own properties that read a flag of its form (scene/types.py Tank: `t.multimodal` is
+#: `t.form.multimodal`), and the key tables whose presence makes a flag (`reduced`, `elastic`)
+TANK_FLAGS = {"multimodal", "face_normal", "three_dimensional", "third_order", "along_length_only"}
+FLAG_TABLES = {"reduction", "wall_spec"}
+#: the multimodal package's own test of a scene's form (`multimodal_scene(scene)`)
+FLAG_CALLS = {"multimodal_scene"}
+
+
+def tank_flag_reads(source: str) -> list:
+    """(line, text) of each read of a tank's form flag through the tank (`t.multimodal`,
+    `tank.three_dimensional`), each test of a flag's key table (`t.reduction is not None`,
+    `t.wall_spec is None`) and each call of a scene's form test (`multimodal_scene(own)`)."""
+    out = set()
+    for node in ast.walk(ast.parse(source)):
+        if isinstance(node, ast.Attribute) and node.attr in TANK_FLAGS and isinstance(node.ctx, ast.Load):
+            out.add((node.lineno, ast.unparse(node)))
+        if isinstance(node, ast.Compare) and any(isinstance(op, (ast.Is, ast.IsNot)) for op in node.ops):
+            sides = [node.left] + node.comparators
+            if any(isinstance(s, ast.Attribute) and s.attr in FLAG_TABLES for s in sides) and \
+                    any(isinstance(s, ast.Constant) and s.value is None for s in sides):
+                out.add((node.lineno, ast.unparse(node)))
+        if isinstance(node, ast.Call) and _named(node.func) & FLAG_CALLS:
+            out.add((node.lineno, ast.unparse(node)))
+    return sorted(out)
+
+
+def test_the_tank_flag_finder_sees_the_reads():
+    src = ("a = t.multimodal\nb = scene.tanks[0].three_dimensional\nc = t.reduction is not None\n"
+           "d = t.wall_spec is None\ne = multimodal_scene(own)\nf = t.reduction.modes\ng = t.name\n"
+           "h = build.multimodal_scene(s)\ni = t.fill_depth is None\n")
+    assert [line for line, _ in tank_flag_reads(src)] == [1, 2, 3, 4, 5, 8]
+
+
+def test_no_tank_flag_reads_outside_the_loader_and_the_liquid():
+    """A tank is asked what its liquid does (its form's behaviour, the liquid that runs it, the
+    block its builder makes), never which model it takes: outside jaxslosh/scene and jaxslosh/liquid
+    no `t.multimodal` (or another flag the tank reads from its form), no test of the key tables that
+    make the `reduced` and `elastic` flags, and no `multimodal_scene`."""
+    bad = [f"{rel}:{line}: {text}" for rel, path in sorted(_sources()) if not rel.startswith(("scene/", "liquid/"))
+           for line, text in tank_flag_reads(open(path).read())]
     assert not bad, "\n".join(bad)
