@@ -175,6 +175,19 @@ def test_connection_points_outside_a_bodys_hull_exit_2(tmp_path, capsys):
         and "below the keel at -3 m" in out.err, out.err
 
 
+@pytest.mark.parametrize("y,status", [(9.5, 0), (8.5, 2)])
+def test_hulls_side_by_side_overlap_by_their_plans(tmp_path, capsys, y, status):
+    """Two box hulls without `footprint` are compared by their plans (beams 10 and 8 m: 9 m between
+    their COGs at least), not by circles of their waterplane areas (15.1 m): 9.5 m apart they float,
+    8.5 m apart they overlap by 0.5 m, named at the body's position."""
+    text = (HEAD.format(duration=1.0) + VESSEL + f'[[bodies]]\nname = "barge"\nposition = [0.0, {y}]\n'
+            + BOX.format(t="bodies"))
+    got, out = _check(tmp_path, capsys, text)
+    assert got == status, out.err
+    if status:
+        assert "bodies[0].position" in out.err and "hull's plan" in out.err and "overlap at rest by 0.5 m" in out.err
+
+
 def test_a_bodys_box_hull_gives_its_large_angle_gz_curve(tmp_path, capsys):
     """`stability` on a body with a box hull: its curve from its hull (free to sink and trim), the
     wall-sided box's GZ = sin(phi) (GM + BM tan^2(phi) / 2) while the bilge stays wet (26.6 deg)
