@@ -65,7 +65,7 @@ def cmd_stability(a):
     for b in s.bodies.values():
         if b["model"] == "hull":        # a body with its own hull: the vessel's table of its curves
             print(f"body {b.name}:")
-            print_vessel(b, a.axis)
+            print_vessel(b, a.axis, "body")
         else:
             print_body(b)
     if a.output:
@@ -73,9 +73,9 @@ def cmd_stability(a):
     return EXIT_OK
 
 
-def print_vessel(s, axis: str):
-    """The vessel's curves from its hull and the criteria."""
-    print(f"GZ about the {axis} axis (m), the vessel free to sink and trim at its displacement:")
+def print_vessel(s, axis: str, who: str = "vessel"):
+    """The vessel's (or a body's: `who`) curves from its hull and the criteria."""
+    print(f"GZ about the {axis} axis (m), the {who} free to sink and trim at its displacement:")
     print(f"{'heel deg':>9} {'GZ level':>10} {'GZ frozen':>10}")
     for ang, g, gf in zip(s.angle, s.gz, s.gz_frozen):
         print(f"{np.degrees(ang):9.3f} {g:10.5f} {gf:10.5f}")

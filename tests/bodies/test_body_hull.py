@@ -206,7 +206,8 @@ def test_a_bodys_box_hull_gives_its_large_angle_gz_curve(tmp_path, capsys):
     from jaxslosh.cli import main
     assert main(["stability", str(p), "--angles", "0:40:5"]) == 0
     out = capsys.readouterr().out
-    assert "body barge:" in out and "IS Code 2008 Part A 2.2 (liquids level):" in out.split("body barge:")[1]
+    after = out.split("body barge:")[1]
+    assert "the body free to sink and trim" in after and "IS Code 2008 Part A 2.2 (liquids level):" in after
 
 
 def test_a_bodys_hull_takes_the_waves_in_its_rao():
@@ -254,3 +255,30 @@ def test_a_bodys_mesh_hull_rows_are_the_lone_vessels(tmp_path):
     ours, ref = rows_and_residual(text, alone(ramp=0.0).replace(box, mesh), seed=7)
     assert np.abs(ours).max() > 1e4
     np.testing.assert_allclose(ours, ref, rtol=0, atol=1e-12 * np.abs(ours).max())
+
+
+def test_a_bodys_hull_is_watched_for_capsize_as_the_lone_vessels():
+    """The run's capsize watch takes each body on its own hull: its angles of vanishing stability are
+    the same box's as the only vessel of a scene, and frames whose roll passes them are said naming
+    the body (the vessel, upright, is not)."""
+    from jaxslosh.run.capsize import body_vanishing_angles, vanishing_angles
+    from jaxslosh.run.validity import Watch
+    scene = js.load_scene(on_body())
+    got = body_vanishing_angles(build(scene).system)
+    want = vanishing_angles(build(js.load_scene(alone())).system)
+    assert set(got) == {"barge"} and want[0] is not None and np.radians(30.0) < want[0] < np.radians(90.0)
+    np.testing.assert_allclose([a for a in got["barge"] if a is not None], [a for a in want if a is not None],
+                               rtol=1e-12)
+    watch = Watch(scene)
+    watch.watch_capsize(vanishing_angles(build(scene).system), got, ("barge",))
+    t = np.linspace(0.0, 1.0, 11)
+    rolls = np.linspace(0.0, want[0] + 0.1, 11)
+    frames = np.zeros((11, 1, 10))
+    frames[:, 0, 3], frames[:, 0, 4] = np.cos(rolls / 2), np.sin(rolls / 2)     # pure rolls
+    upright = np.tile([1.0, 0.0, 0.0, 0.0], (11, 1))
+    watch.update(t, np.zeros((11, 0, 2)), np.zeros(11), None, upright, None, frames[:6])
+    assert not [w for w in watch.warnings() if "capsized" in w]
+    watch.update(t, np.zeros((11, 0, 2)), np.zeros(11), None, upright, None, frames)
+    said = [w for w in watch.warnings() if "capsized" in w]
+    assert len(said) == 1 and said[0].startswith("capsized: the body 'barge''s roll reached") \
+        and f"{np.degrees(rolls[-1]):.1f} deg at t = 1 s" in said[0], said
