@@ -282,3 +282,37 @@ def test_a_bodys_hull_is_watched_for_capsize_as_the_lone_vessels():
     said = [w for w in watch.warnings() if "capsized" in w]
     assert len(said) == 1 and said[0].startswith("capsized: the body 'barge''s roll reached") \
         and f"{np.degrees(rolls[-1]):.1f} deg at t = 1 s" in said[0], said
+
+
+LINE = """
+[[mooring]]
+name = "{name}"
+body = "{body}"
+fairlead = [9.0, 0.0, -1.0]
+anchor = [{x}, {y}, -60.0]
+length = 330.0
+weight = 800.0
+ea = 5.0e8
+"""
+
+
+def test_a_body_on_its_hull_bears_its_lines_pull_as_the_vessel_on_its_hull():
+    """Lines on a body with linear hydrostatics: its buoyancy carries their vertical pull at rest (the
+    rows vanish there, as the vessel's on linear springs). On a body with its own hull the hull's
+    pressure bears only the weight, so at rest the lines' pull is the whole of its mooring rows (it
+    sinks under it, as the vessel on its hull does: its own carried force is zero too)."""
+    from jaxslosh.mooring.term import mooring_term
+    spring = ('[[bodies]]\nname = "buoy"\nposition = [0.0, -300.0]\nmass = 4.0e5\ninertia = [5.0e6, 1.5e7, 1.7e7]\n'
+              '[bodies.hydrostatics]\nwaterplane_area = 200.0\ndisplaced_volume = 390.0\ngm_t = 1.5\ngm_l = 15.0\n')
+    text = (HEAD.format(duration=1.0).replace("water_density = 1025.0\n", "water_density = 1025.0\ndepth = 60.0\n")
+            + VESSEL
+            + f'[[bodies]]\nname = "barge"\nposition = [{X0}, 200.0]\n' + BOX.format(t="bodies") + spring
+            + LINE.format(name="a", body="barge", x=X0 + 300.0, y=200.0)
+            + LINE.format(name="b", body="buoy", x=300.0, y=-300.0))
+    term = mooring_term(build(js.load_scene(text)).system)
+    per = np.asarray(term.frame_rows(term.rest_X, term.rest_A))       # vessel, barge, buoy
+    pull = np.asarray(term.state(term.rest_X, term.rest_A).force)      # each line's force on its fairlead
+    assert pull[0, 2] < -1e4 and pull[1, 2] < -1e4                     # both lines pull down
+    np.testing.assert_allclose(np.asarray(term.carried_bodies)[0], 0.0, atol=0)
+    np.testing.assert_allclose(per[1, :3], pull[0], rtol=1e-12)        # the barge: the line's pull itself
+    assert abs(per[2, 2]) < 1e-9 * abs(pull[1, 2])                     # the buoy's buoyancy carries it
