@@ -1,6 +1,7 @@
 """Mooring lines on a body of [[bodies]] (docs/guide/moorings.md, docs/guide/bodies-and-connections.md):
 the same hull on the same three catenary lines moves the same as the vessel and as a body, its
 lines' tensions the same in the result; bad input exits 2 naming its key."""
+import json
 import math
 
 import jax
@@ -140,6 +141,23 @@ def test_a_moored_bodys_statics_are_the_moored_vessels():
     for a, b in zip(got.lines, ref.lines):
         assert a["fairlead_tension"] == pytest.approx(b["fairlead_tension"], rel=1e-9)
     assert set(got.as_dict()["bodies"]) == {"buoy"}
+
+
+@pytest.mark.slow      # the several frames' analysis compiled (half a minute); its rows' twin above is fast
+def test_the_mooring_command_prints_each_bodys_equilibrium(tmp_path, capsys):
+    """`jaxslosh mooring` of the moored body beside the free vessel: a line per frame, the body's own
+    stiffness table, and its JSON's "bodies" (the same program as js.mooring's: nothing compiled anew
+    for a second scene of the same structure)."""
+    from jaxslosh.cli import main
+    p = tmp_path / "scene.toml"
+    p.write_text(_at_rest(_body_moored()))
+    assert main(["mooring", str(p), "--offsets", "0,5"]) == 0
+    out = capsys.readouterr().out
+    assert "  vessel: surge" in out and "  buoy: surge" in out and "buoy's lines' stiffness about its COG:" in out
+    assert main(["mooring", str(p), "--offsets", "0,5", "--json"]) == 0
+    d = json.loads(capsys.readouterr().out)
+    assert len(d["bodies"]["buoy"]["equilibrium"]) == 6 and np.asarray(d["bodies"]["buoy"]["stiffness"]).shape == (6, 6)
+    assert d["bodies"]["buoy"]["stiffness"][0][0] > 1e3 and d["stiffness"][0][0] == 0.0     # its lines, not the vessel's
 
 
 def test_a_turned_bodys_lines_act_in_its_own_frame():
