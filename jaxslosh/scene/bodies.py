@@ -221,13 +221,11 @@ def _outline(centre, heading, footprint, area, shift=(0.0, 0.0)):
 
 
 def _plan(f, key: str):
-    """(footprint, its centre from the COG) of a body as the overlap check takes it: its `footprint`
-    where given, else its hull's plan (a hull's plan bounds its waterplane: two hulls whose plans
-    are apart do not meet), else (None, 0): the circle of its waterplane's area."""
+    """(footprint, its centre from the COG) for the overlap check: its `footprint`, else its hull's
+    plan (which bounds its waterplane), else (None, 0): the circle of its waterplane's area."""
     if f.footprint is not None or f.hull is None:
         return f.footprint, (0.0, 0.0)
-    lo, hi = hull_extent(f, key)
-    lo, hi = np.asarray(lo[:2]), np.asarray(hi)
+    lo, hi = (np.asarray(v[:2]) for v in hull_extent(f, key))
     return tuple(hi - lo), tuple(0.5 * (hi + lo))
 
 
