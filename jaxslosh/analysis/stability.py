@@ -333,6 +333,8 @@ def stability(scene, angles=None, axis: str = "roll", *, criteria: bool = True) 
     for i, b in enumerate(scene.bodies):      # a body's own hull gives its large-angle curves
         if b.hull is not None and (not b.hull.closed_form or b.hull.depth is not None):
             bodies[b.name] = _body_hull(scene, i, angles, axis, criteria)
+        elif b.tanks and b.hydrostatics is not None:     # its linear curve, its liquids frozen and level
+            bodies[b.name] = dataclasses.replace(_linear_vessel(_alone(scene, i), angles, axis, {}), name=b.name)
     if bodies and scene.vessel.hull is None and scene.vessel.hydrostatics is not None:
         return _linear_vessel(scene, angles, axis, bodies)
     model = build_model(scene)
@@ -373,16 +375,20 @@ def stability(scene, angles=None, axis: str = "roll", *, criteria: bool = True) 
 def _body_hull(scene, i: int, angles, axis: str, criteria: bool) -> Stability:
     """The Stability of the body `scene.bodies[i]` from its hull, the vessel's analysis on the body as
     the only vessel of the scene with its own tanks (docs/guide/stability.md#bodies)."""
-    b = scene.bodies[i]
-    own = dataclasses.replace(scene, vessel=Vessel(mass=b.mass, inertia=b.inertia, hydrostatics=b.hydrostatics,
-                                                   hull=b.hull, name=b.name, cog_height=b.cog_height),
-                              tanks=b.tanks, bodies=(), connections=(), mooring=())
     try:
-        s = stability(own, angles, axis, criteria=criteria)
+        s = stability(_alone(scene, i), angles, axis, criteria=criteria)
     except SceneError as e:      # its keys are the body's
         key = e.key.replace("vessel", f"bodies[{i}]", 1)
         raise SceneError(key, str(e)[len(e.key) + 2:].replace("vessel", "body")) from None
-    return dataclasses.replace(s, name=b.name)
+    return dataclasses.replace(s, name=scene.bodies[i].name)
+
+
+def _alone(scene, i: int):
+    """The body `scene.bodies[i]` as the only vessel of the scene, with its own tanks."""
+    b = scene.bodies[i]
+    return dataclasses.replace(scene, vessel=Vessel(mass=b.mass, inertia=b.inertia, hydrostatics=b.hydrostatics,
+                                                    hull=b.hull, name=b.name, cog_height=b.cog_height),
+                               tanks=b.tanks, bodies=(), connections=(), mooring=())
 
 
 def _linear_vessel(scene, angles, axis: str, bodies: dict) -> Stability:

@@ -71,6 +71,9 @@ def cmd_stability(a):
         if b["model"] == "hull":        # a body with its own hull: the vessel's table of its curves
             print(f"body {b.name}:")
             print_vessel(b, a.axis, "body")
+        elif "gz_frozen" in b.as_dict():       # linear hydrostatics and tanks: both curves, no criteria
+            print(f"body {b.name} (its linear hydrostatics with the liquids frozen; neither sinking nor trimming):")
+            print_vessel(b, a.axis, "body", judged=False)
         else:
             print_body(b)
     if a.output:
