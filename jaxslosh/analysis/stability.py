@@ -151,6 +151,14 @@ def build_model(scene) -> _Model:
     if mass / rho >= total:
         raise SceneError("vessel.mass", f"the ship and its liquid ({mass:.6g} kg) need {mass / rho:.6g} m^3 "
                                         f"displaced, more than the whole hull to its deck ({total:.6g} m^3)")
+    tanks, vol, cen = _tanks(scene)
+    return _Model(hull=hull, volume=mass / rho, mass=mass, tanks=tanks, tank_volume=vol, tank_mass=mass_l,
+                  rest_centroid=cen, size=float(np.ptp(hull.reshape(-1, 3), axis=0).max()))
+
+
+def _tanks(scene):
+    """(surfaces (k, m, 3, 3) in the vessel frame, padded with repeated vertices; the liquid's volume
+    in each at rest (k,); its centroid there (k, 3)) of the scene's tanks."""
     surfaces = [tank_surface(t) + np.asarray(t.origin) for t in scene.tanks]
     m = max((len(s) for s in surfaces), default=1)
     tanks = np.zeros((len(surfaces), m, 3, 3))
@@ -162,8 +170,19 @@ def build_model(scene) -> _Model:
         fill = np.array([t.origin[2] + t.fill_depth for t in scene.tanks])
         v, mom = _rest_state(jnp.asarray(tanks), jnp.array([0.0, 0.0, 1.0]), jnp.asarray(fill))
         vol, cen = np.asarray(v), np.asarray(mom) / np.asarray(v)[:, None]
-    return _Model(hull=hull, volume=mass / rho, mass=mass, tanks=tanks, tank_volume=vol, tank_mass=mass_l,
-                  rest_centroid=cen, size=float(np.ptp(hull.reshape(-1, 3), axis=0).max()))
+    return tanks, vol, cen
+
+
+@functools.partial(jax.jit, static_argnames=("axis",))
+def _level_levers(tanks, v_l, m_l, rest, heels, *, axis):
+    """(heels,) the change of GZ times the displacement (kg m) when the tanks' liquids turn level at
+    each heel (no sinkage nor trim: a vessel on linear springs), their rest state the frozen one."""
+    def one(heel):
+        R = _rotation(heel, 0.0) if axis == "roll" else _rotation(0.0, heel)
+        _, V, S = jax.vmap(level, in_axes=(0, None, 0))(tanks, R[2], v_l)
+        shift = R @ (m_l @ (S / V[:, None] - rest))       # the liquids' first moment moved, world axes
+        return shift[1] if axis == "roll" else -shift[0]  # the COG moved by it: gz = -d[1] (roll), d[0] (pitch)
+    return jax.vmap(one)(heels)
 
 
 def _rotation(roll, pitch):
@@ -314,7 +333,9 @@ def stability(scene, angles=None, axis: str = "roll", *, criteria: bool = True) 
     for i, b in enumerate(scene.bodies):      # a body's own hull gives its large-angle curves
         if b.hull is not None and (not b.hull.closed_form or b.hull.depth is not None):
             bodies[b.name] = _body_hull(scene, i, angles, axis, criteria)
-    if bodies and scene.vessel.hull is None and not scene.tanks and scene.vessel.hydrostatics is not None:
+        elif b.tanks and b.hydrostatics is not None:     # its linear curve, its liquids frozen and level
+            bodies[b.name] = dataclasses.replace(_linear_vessel(_alone(scene, i), angles, axis, {}), name=b.name)
+    if bodies and scene.vessel.hull is None and scene.vessel.hydrostatics is not None:
         return _linear_vessel(scene, angles, axis, bodies)
     model = build_model(scene)
     grid = np.radians(np.linspace(*DEFAULT_DEGREES))
@@ -354,25 +375,41 @@ def stability(scene, angles=None, axis: str = "roll", *, criteria: bool = True) 
 def _body_hull(scene, i: int, angles, axis: str, criteria: bool) -> Stability:
     """The Stability of the body `scene.bodies[i]` from its hull, the vessel's analysis on the body as
     the only vessel of the scene with its own tanks (docs/guide/stability.md#bodies)."""
-    b = scene.bodies[i]
-    own = dataclasses.replace(scene, vessel=Vessel(mass=b.mass, inertia=b.inertia, hydrostatics=b.hydrostatics,
-                                                   hull=b.hull, name=b.name, cog_height=b.cog_height),
-                              tanks=b.tanks, bodies=(), connections=(), mooring=())
     try:
-        s = stability(own, angles, axis, criteria=criteria)
+        s = stability(_alone(scene, i), angles, axis, criteria=criteria)
     except SceneError as e:      # its keys are the body's
         key = e.key.replace("vessel", f"bodies[{i}]", 1)
         raise SceneError(key, str(e)[len(e.key) + 2:].replace("vessel", "body")) from None
-    return dataclasses.replace(s, name=b.name)
+    return dataclasses.replace(s, name=scene.bodies[i].name)
+
+
+def _alone(scene, i: int):
+    """The body `scene.bodies[i]` as the only vessel of the scene, with its own tanks."""
+    b = scene.bodies[i]
+    return dataclasses.replace(scene, vessel=Vessel(mass=b.mass, inertia=b.inertia, hydrostatics=b.hydrostatics,
+                                                    hull=b.hull, name=b.name, cog_height=b.cog_height),
+                               tanks=b.tanks, bodies=(), connections=(), mooring=())
 
 
 def _linear_vessel(scene, angles, axis: str, bodies: dict) -> Stability:
-    """The Stability of a vessel without a hull (nor tanks) beside bodies: its linear hydrostatics'
-    curve, as the bodies' (it neither sinks nor trims at a heel; no criteria: they judge a hull's
-    curve, which linear springs only approximate near upright)."""
+    """The Stability of a vessel without a hull beside bodies: its linear hydrostatics' curve, as the
+    bodies' (it neither sinks nor trims at a heel; no criteria: they judge a hull's curve, which
+    linear springs only approximate near upright). Its GM is the ship's with the tank liquids
+    frozen (as its run's springs hold it): that is the frozen curve, and the level one adds each
+    tank's liquid turned level in its own shape (the free-surface effect)."""
     env = scene.environment
-    v = linear_stability(scene.vessel.name, scene.vessel.hydrostatics, env.water_density, env.gravity, angles, axis)
+    h = scene.vessel.hydrostatics
+    v = linear_stability(scene.vessel.name, h, env.water_density, env.gravity, angles, axis)
+    gz, gm0 = v.gz, v.gm0
+    if scene.tanks:
+        tanks, vol, cen = _tanks(scene)
+        mass_l = np.array([t.liquid_mass for t in scene.tanks])
+        heels = np.concatenate([angles, [-GM0_STEP, GM0_STEP]])
+        lever = np.asarray(_level_levers(jnp.asarray(tanks), jnp.asarray(vol), jnp.asarray(mass_l), jnp.asarray(cen),
+                                         jnp.asarray(heels), axis=axis)) / (env.water_density * h.displaced_volume)
+        gz = v.gz + lever[:-2] + 0.0
+        gm0 = v.gm0 + float((lever[-1] - lever[-2]) / (2 * GM0_STEP))
     zero = np.zeros_like(v.gz)
-    return Stability(angle=angles, gz=v.gz, gz_frozen=v.gz, gm0=v.gm0, gm0_frozen=v.gm0,
-                     vanishing_angle=v.vanishing_angle, axis=axis, sinkage=zero, trim=zero, bodies=bodies,
+    return Stability(angle=angles, gz=gz, gz_frozen=v.gz, gm0=gm0, gm0_frozen=v.gm0,
+                     vanishing_angle=first_vanishing(angles, gz), axis=axis, sinkage=zero, trim=zero, bodies=bodies,
                      model="linear")

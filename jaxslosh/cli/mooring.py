@@ -26,6 +26,12 @@ def add_parsers(sub):
     s.add_argument("-o", "--output", help="a figure of the lines' shapes and of the offset curve")
 
 
+def _pose(eq) -> str:
+    """x, y, z (m) and roll, pitch, yaw (deg) of an equilibrium (rad)."""
+    return ", ".join(f"{n} {v:.6g} {'m' if i < 3 else 'deg'}"
+                     for i, (n, v) in enumerate(zip(DOF_NAMES, np.r_[eq[:3], np.degrees(eq[3:])])))
+
+
 def parse_offsets(text):
     if text is None:
         return None
@@ -57,17 +63,23 @@ def cmd_mooring(a):
     if a.json:
         print(json.dumps(r.as_dict()))
         return EXIT_OK
-    eq = r.equilibrium
     print("static equilibrium in still water (COG from its rest position):")
-    print("  " + ", ".join(f"{n} {v:.6g} {'m' if i < 3 else 'deg'}"
-                           for i, (n, v) in enumerate(zip(DOF_NAMES, np.r_[eq[:3], np.degrees(eq[3:])]))))
+    print(("  vessel: " if r.bodies else "  ") + _pose(r.equilibrium))
+    for name, b in r.bodies.items():     # each body's angles about its own axes
+        print(f"  {name}: {_pose(b['equilibrium'])}")
     print(f"{'line':>12} {'fairlead N':>13} {'anchor N':>13} {'H N':>13} {'V N':>13} {'on seabed m':>12}")
     for line in r.lines:
         print(f"{line['name']:>12} {line['fairlead_tension']:13.6g} {line['anchor_tension']:13.6g} "
               f"{line['horizontal']:13.6g} {line['vertical']:13.6g} {line['seabed_length']:12.5g}")
-    print("the lines' stiffness about the COG, K = -dF/dx (N/m, N/rad, N m/m, N m/rad):")
+    print(f"the {'vessel' + chr(39) + 's ' if r.bodies else ''}lines' stiffness about the COG, K = -dF/dx "
+          "(N/m, N/rad, N m/m, N m/rad):")
     for row in r.stiffness:
         print("  " + " ".join(f"{v:11.4g}" for v in row))
+    for name, b in r.bodies.items():
+        if np.any(b["stiffness"]):
+            print(f"{name}'s lines' stiffness about its COG:")
+            for row in b["stiffness"]:
+                print("  " + " ".join(f"{v:11.4g}" for v in row))
     print(f"offset curve along {a.direction:g} deg: offset m, restoring N, most loaded line's fairlead tension N")
     for o, f, t in zip(r.offsets, r.restoring, r.max_tension):
         print(f"  {o:10.4g} {f:13.6g} {t:13.6g}")

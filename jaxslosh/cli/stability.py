@@ -57,15 +57,23 @@ def cmd_stability(a):
         return EXIT_OK
     if s.model == "linear":      # a vessel without a hull beside bodies: its curve as theirs
         h = scene.vessel.hydrostatics
-        print_body(LinearStability(scene.vessel.name, s.angle, s.gz, s.gm0, h.gm_t, h.gm_l, s.vanishing_angle,
-                                   s.axis), "vessel")
+        if scene.tanks:          # its liquids frozen (its GM's) and level
+            print(f"vessel {scene.vessel.name} (its linear hydrostatics, GM_T {h.gm_t:.5f} m, GM_L {h.gm_l:.5f} m "
+                  "with the liquids frozen; neither sinking nor trimming):")
+            print_vessel(s, a.axis, "vessel", judged=False)
+        else:
+            print_body(LinearStability(scene.vessel.name, s.angle, s.gz, s.gm0, h.gm_t, h.gm_l, s.vanishing_angle,
+                                       s.axis), "vessel")
         print("IS Code 2008 Part A 2.2: not judged on linear hydrostatics (the criteria are for a hull's curve)")
     else:
         print_vessel(s, a.axis)
     for b in s.bodies.values():
         if b["model"] == "hull":        # a body with its own hull: the vessel's table of its curves
             print(f"body {b.name}:")
-            print_vessel(b, a.axis)
+            print_vessel(b, a.axis, "body")
+        elif "gz_frozen" in b.as_dict():       # linear hydrostatics and tanks: both curves, no criteria
+            print(f"body {b.name} (its linear hydrostatics with the liquids frozen; neither sinking nor trimming):")
+            print_vessel(b, a.axis, "body", judged=False)
         else:
             print_body(b)
     if a.output:
@@ -73,9 +81,10 @@ def cmd_stability(a):
     return EXIT_OK
 
 
-def print_vessel(s, axis: str):
-    """The vessel's curves from its hull and the criteria."""
-    print(f"GZ about the {axis} axis (m), the vessel free to sink and trim at its displacement:")
+def print_vessel(s, axis: str, who: str = "vessel", judged: bool = True):
+    """The vessel's (or a body's: `who`) curves from its hull and the criteria (`judged`)."""
+    print(f"GZ about the {axis} axis (m), the {who} " + ("free to sink and trim at its displacement:" if judged
+                                                        else "at its displacement:"))
     print(f"{'heel deg':>9} {'GZ level':>10} {'GZ frozen':>10}")
     for ang, g, gf in zip(s.angle, s.gz, s.gz_frozen):
         print(f"{np.degrees(ang):9.3f} {g:10.5f} {gf:10.5f}")
@@ -83,6 +92,8 @@ def print_vessel(s, axis: str):
           f"(free-surface correction {s.gm0_frozen - s.gm0:.5f} m)")
     va = s.vanishing_angle
     print("angle of vanishing stability: " + ("none in the range" if va is None else f"{np.degrees(va):.3f} deg"))
+    if not judged:
+        return
     if s.criteria:
         print("IS Code 2008 Part A 2.2 (liquids level):")
         for c in s.criteria:

@@ -13,8 +13,9 @@ every one; ParaView opens them together), all over one HDF5 file `STEM_paraview.
   the vessel's frame as three lines along its axes from the COG;
 * `STEM_structures.xdmf`: flexible structures as their undeformed blocks carried by the vessel
   (a result file keeps no structure fields: their probes carry their deformation);
-* `STEM_body_<name>.xdmf`: each [[bodies]] body as its frame (three lines along its axes from its
-  COG, half the side of a square of its waterplane area long: a body has no hull), and
+* `STEM_body_<name>.xdmf`: each [[bodies]] body as its wetted box (a `[bodies.hull]` box), else its
+  frame (three lines along its axes from its COG, half the side of a square of its waterplane
+  area long), and
   `STEM_<name>_liquid.xdmf`, `STEM_<name>_surface.xdmf` the tanks it carries;
 * `STEM_probes.xdmf`: the probes' material points, `displacement` (the result's, inertial).
 
@@ -106,14 +107,8 @@ def series_of(r: Result, every: int = 1) -> list:
     mine = ("vessel", vessel.get("name", "vessel"))
     on_bodies = {t.get("name") for t in scene.get("tanks", []) if t.get("body", "vessel") not in mine}
     out += _liquid(r, [n for n in r.tanks if n not in on_bodies], X0, A, origins, sl, "")
-    hull = vessel.get("hull")
-    if hull and hull.get("type", "box") == "box":
-        L, B, T, kg = (float(hull[k]) for k in ("length", "beam", "draft", "kg"))
-        pts, el = box_mesh((L, B, T), (1, 1, 1))
-        out.append(Series("vessel", "hexahedron", el, carried(X0, A, pts + np.array([-L / 2, -B / 2, -kg])), {}))
-    else:
-        size = max([max(t.get("size", (1.0,))) for t in scene.get("tanks", [])] + [1.0])
-        out.append(_axes("vessel", X0, A, size))
+    size = max([max(t.get("size", (1.0,))) for t in scene.get("tanks", [])] + [1.0])
+    out.append(_hull("vessel", vessel, X0, A, size))
     blocks = []
     for st in scene.get("structures", []):
         pts, el = box_mesh(st["size"], st["mesh"])
@@ -164,6 +159,17 @@ def _axes(name: str, X, A, size: float) -> Series:
     return Series(name, "line", np.array([[0, 1], [0, 2], [0, 3]]), carried(X, A, pts), {})
 
 
+def _hull(name: str, table: dict, X, A, size: float) -> Series:
+    """The vessel's or a body's hull (its `table`) carried by its frame: a box hull as its wetted box
+    (keel to waterline), else its frame's axes `size` long."""
+    hull = table.get("hull") or {}
+    if hull.get("type", "box") == "box" and all(k in hull for k in ("length", "beam", "draft", "kg")):
+        L, B, T, kg = (float(hull[k]) for k in ("length", "beam", "draft", "kg"))
+        pts, el = box_mesh((L, B, T), (1, 1, 1))
+        return Series(name, "hexahedron", el, carried(X, A, pts + np.array([-L / 2, -B / 2, -kg])), {})
+    return _axes(name, X, A, size)
+
+
 def _cog_height(vessel: dict) -> float:
     """The vessel's COG height above the still water at rest, as the loader gives it: its
     `cog_height`, else kg - draft for a box hull, else 0."""
@@ -176,20 +182,20 @@ def _cog_height(vessel: dict) -> float:
 
 
 def _bodies(r: Result, scene: dict, origins: dict, sl) -> list:
-    """Each [[bodies]] body's meshes, carried by its own frame: its axes (a body has no hull), sized
-    by its waterplane (half the side of a square of its area), and the liquid of the tanks it
-    carries; `body_<name>` and `<name>_liquid`, `<name>_surface`."""
+    """Each [[bodies]] body's meshes, carried by its own frame: its box hull as the vessel's, else its
+    axes, sized by its waterplane (half the side of a square of its area), and the liquid of the
+    tanks it carries; `body_<name>` and `<name>_liquid`, `<name>_surface`."""
     out = []
     cog = _cog_height(scene.get("vessel", {}))
     tables = {b.get("name"): b for b in scene.get("bodies", [])}
     for name, b in (r.bodies or {}).items():
         table = tables.get(name, {})
         px, py = (list(table.get("position", (0.0, 0.0))) + [0.0, 0.0])[:2]
-        rest = np.array([px, py, float(table.get("cog_height", 0.0)) - cog])
+        rest = np.array([px, py, _cog_height(table) - cog])      # its height as the loader gives it
         X = rest + np.asarray(b.position, dtype=float)[sl]      # the result keeps its offset from rest
         A = rotation_matrices(np.asarray(b.quaternion)[sl])
         area = float(table.get("hydrostatics", {}).get("waterplane_area", 4.0))
-        out.append(_axes(f"body_{name}", X, A, 0.5 * np.sqrt(max(area, 1e-12))))
+        out.append(_hull(f"body_{name}", table, X, A, 0.5 * np.sqrt(max(area, 1e-12))))
         out += _liquid(r, [t.get("name") for t in scene.get("tanks", []) if t.get("body") == name], X, A, origins,
                        sl, f"{name}_")
     return out

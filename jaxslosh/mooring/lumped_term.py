@@ -219,10 +219,13 @@ def lumped_line_term(c0: Config, dt: float, *, name: str, fairlead, anchor, leng
                           seabed_damping=kw["seabed_damping"], rho=water_density, gravity=gravity,
                           current=current)
     p_b = jnp.asarray(fairlead, dtype=float)
-    nodes0, _ = _static(line, p_b, c0.X0, c0.q, name)
+    nodes0, F0 = _static(line, p_b, c0.X0, c0.q, name)
     carried = jnp.zeros(3)
     if balanced:       # the pull at the rest position (X0 = 0, level), where the springs are balanced
-        _, F = _static(line, p_b, np.zeros(3), np.array([1.0, 0.0, 0.0, 0.0]), name)
+        rest = np.zeros(3), np.array([1.0, 0.0, 0.0, 0.0])
+        # a vessel starting at rest: the same solve as its start's (half the lines' build)
+        at_rest = all(np.array_equal(np.asarray(a, dtype=float), b) for a, b in zip((c0.X0, c0.q), rest))
+        _, F = (None, F0) if at_rest else _static(line, p_b, *rest, name)
         carried = jnp.array([0.0, 0.0, -F[2]])
     return LumpedLineTerm(line, p_b, nodes0, carried, name, line.substeps(dt))
 

@@ -12,8 +12,9 @@ import jax.numpy as jnp
 import numpy as np
 
 from ..assemble.system import build
+from ..physics.bodies import VESSEL, bodies_term
 from ..physics.hull import HullPressure
-from ..physics.kinematics import quat_exp, rotation_matrix, rpy_from_quat
+from ..physics.kinematics import quat_exp, quat_from_rpy, quat_multiply, rotation_matrix, rpy_from_quat
 from ..physics.terms import Config
 from ..physics.vessel import AbstractRestoring, Weight
 from ..scene.types import Scene, SceneError
@@ -47,12 +48,20 @@ class MooringAnalysis:
     max_tension: np.ndarray
     direction: float = 0.0
     shapes: tuple = ()        # per line, (horizontal distance from the anchor, z) points at the equilibrium (m)
+    #: a scene with [[bodies]]: {name: {"equilibrium": [x, y, z, roll, pitch, yaw] of its COG from its
+    #: rest pose (angles about its own axes), "stiffness": (6, 6) its lines' about its COG}}
+    bodies: dict = dataclasses.field(default_factory=dict)
 
     def as_dict(self) -> dict:
-        return {"equilibrium": [float(x) for x in self.equilibrium], "lines": self.lines,
-                "stiffness": np.asarray(self.stiffness, dtype=float).tolist(),
-                "offsets": [float(x) for x in self.offsets], "restoring": [float(x) for x in self.restoring],
-                "max_tension": [float(x) for x in self.max_tension], "direction": float(self.direction)}
+        out = {"equilibrium": [float(x) for x in self.equilibrium], "lines": self.lines,
+               "stiffness": np.asarray(self.stiffness, dtype=float).tolist(),
+               "offsets": [float(x) for x in self.offsets], "restoring": [float(x) for x in self.restoring],
+               "max_tension": [float(x) for x in self.max_tension], "direction": float(self.direction)}
+        if self.bodies:
+            out["bodies"] = {n: {"equilibrium": [float(x) for x in b["equilibrium"]],
+                                 "stiffness": np.asarray(b["stiffness"], dtype=float).tolist()}
+                             for n, b in self.bodies.items()}
+        return out
 
 
 def _rotate(theta, A):
@@ -77,21 +86,77 @@ def static_residual(system, x):
     return total
 
 
-def equilibrium(system, scale):
-    """(the pose [X0, theta] where the still-water rows vanish, Newton's scaled residual at the
-    iterate before the last), by Newton from rest. The residual and its Jacobian come from one
-    forward-mode pass and the test is made on that residual: the rows (the lines' cold solve
-    among them) appear once in the loop's body, which is what its compilation costs."""
-    f = lambda x: static_residual(system, x) / scale  # noqa: E731
+def _still_rows(terms, k):
+    """The still-water rows of a floating frame's restoring terms (the hull's pressure, the linear
+    springs, the weight) at its Kin k."""
+    total = jnp.zeros(6)
+    for term in terms:
+        if isinstance(term, HullPressure):
+            F, M = term.still_force_moment(k.c.X0, k.A)
+            total = total - jnp.concatenate([F, M])
+        elif isinstance(term, (AbstractRestoring, Weight)):
+            total = total + term.rows(k).rigid
+    return total
+
+
+def _frames_config(system, x, heads):
+    """The configuration of the poses x = [vessel's X0, theta; each body's offset from rest, theta]
+    (theta: inertial rotation vectors from upright, a body's from its heading `heads` (S, 4))."""
+    bodies = bodies_term(system)
+    y = x.reshape(-1, 6)
+    rest = jnp.stack([b.rest for b in bodies.bodies])
+    qs = jax.vmap(lambda th, h: quat_multiply(quat_exp(th), h))(y[1:, 3:], heads)
+    return Config(y[0, :3], quat_exp(y[0, 3:]), jnp.zeros(system.nf), rest + y[1:, :3], qs)
+
+
+def frames_residual(system, x, heads):
+    """The still-water rows of the vessel and of every [[bodies]] body (6 each, the frames' order) at
+    the poses x (`_frames_config`): each frame's restoring terms, the lines on it and the
+    connections between them. The liquids are held as built at rest."""
+    c = _frames_config(system, x, heads)
+    bodies = bodies_term(system)
+    k = system.kin(c, jnp.zeros(3), jnp.zeros(3), jnp.zeros(system.nf), jnp.zeros(6), jnp.zeros(system.nf), 0.0)
+    zero = jnp.zeros(6)
+    rows = [_still_rows(system.terms, k)]
+    for b, X, q in zip(bodies.bodies, c.Xs, c.qs):
+        rows.append(_still_rows(b.terms, b.kin(X, q, zero, zero, system.gravity, 0.0)))
+    rows = jnp.concatenate(rows)
+    term = mooring_term(system)
+    if term is not None:
+        per = term.frame_rows(*term.frames(c, k.A)) if term.on_bodies else \
+            jnp.zeros((bodies.S + 1, 6)).at[0].set(-term.rows(k).rigid)
+        rows = rows - per.reshape(-1)
+    poses = {VESSEL: (c.X0, k.A, jnp.zeros(3), jnp.zeros(3))}
+    poses |= {s: (c.Xs[s], rotation_matrix(c.qs[s]), jnp.zeros(3), jnp.zeros(3)) for s in range(bodies.S)}
+    return rows - bodies.link_forces(poses)
+
+
+#: the several frames' Newton step: least squares, singular values below this fraction of the
+#: largest cut, so that a dof nothing holds (a free vessel's surge beside a moored body) stays at rest
+RCOND = 1e-12
+
+
+def _least_squares(J, r):
+    return jnp.linalg.lstsq(J, r, rcond=RCOND)[0]
+
+
+def equilibrium(system, scale, residual=static_residual, solve=jnp.linalg.solve):
+    """(the poses where the still-water rows vanish, Newton's scaled residual at the iterate before
+    the last), by Newton from rest: [X0, theta] of the vessel alone (`static_residual`), or of
+    every frame (`frames_residual` with its bodies' headings bound; `solve` its steps: RCOND). The
+    residual and its Jacobian come from one forward-mode pass and the test is made on that
+    residual: the rows (the lines' cold solve among them) appear once in the loop's body, which is
+    what its compilation costs."""
+    f = lambda x: residual(system, x) / scale  # noqa: E731
     jac = jax.jacfwd(lambda x: (lambda r: (r, r))(f(x)), has_aux=True)
 
     def step(state):
         x, _, it = state
         J, r = jac(x)
-        return x - jnp.linalg.solve(J, r), jnp.max(jnp.abs(r)), it + 1
+        return x - solve(J, r), jnp.max(jnp.abs(r)), it + 1
 
     cond = lambda s: (s[1] > TOL) & (s[2] < MAX_ITER)  # noqa: E731
-    x, err, _ = jax.lax.while_loop(cond, step, (jnp.zeros(6), jnp.asarray(jnp.inf), 0))
+    x, err, _ = jax.lax.while_loop(cond, step, (jnp.zeros(scale.shape), jnp.asarray(jnp.inf), 0))
     return x, err
 
 
@@ -133,6 +198,46 @@ def _analysis(system, scale, offsets, e):
     return x, err, rpy_from_quat(quat_exp(x[3:])), K[0], s
 
 
+def _frame_stiffness(term: MooringLines, X, A, mask, P):
+    """(6, 6) K = -d(F, M)/d(x, theta) of the lines `mask` (n,) whose frame's COG is P, the lines'
+    frames X (n, 3), A (n, 3, 3) (`MooringLines.frames`): translations and small inertial rotations
+    of that frame about P, moments about it too."""
+    m = jnp.asarray(mask, dtype=float)
+
+    def loads(x):
+        R = rotation_matrix(quat_exp(x[3:]))
+        s = term.state(jnp.where(mask[:, None], P + x[:3], X), jnp.where(mask[:, None, None], R @ A, A))
+        F = s.force * m[:, None]
+        return jnp.concatenate([F.sum(axis=0), jnp.cross(s.fairlead - P - x[:3], F).sum(axis=0)])
+    return -jax.jacfwd(loads)(jnp.zeros(6))
+
+
+@eqx.filter_jit
+def _frames_analysis(system, scale, heads, offsets, e):
+    """`_analysis` of a scene with [[bodies]]: the equilibrium of every frame; each frame's lines'
+    stiffness there and its angles about its own axes; the lines' state at the equilibrium and with
+    the vessel moved by each offset along e (the bodies held)."""
+    term = mooring_term(system)
+    x, err = equilibrium(system, scale, lambda sysm, x: frames_residual(sysm, x, heads), _least_squares)
+    c = _frames_config(system, x, heads)
+    A = rotation_matrix(c.q)
+    y = x.reshape(-1, 6)
+    own = jax.vmap(lambda th, h: quat_multiply(h * jnp.array([1.0, -1.0, -1.0, -1.0]),
+                                               quat_multiply(quat_exp(th), h)))(y[1:, 3:], heads)
+    rpy = jnp.concatenate([rpy_from_quat(c.q)[None], jax.vmap(rpy_from_quat)(own)])
+    if term.on_bodies:
+        X, As = term.frames(c, A)
+        ends = np.array([0 if end == VESSEL else 1 + end for end in term.ends])
+        centres = jnp.concatenate([c.X0[None], c.Xs])
+        K = jnp.stack([_frame_stiffness(term, X, As, ends == f, centres[f]) for f in range(centres.shape[0])])
+        states = jax.vmap(lambda o: term.state(jnp.where((ends == 0)[:, None], X + o * e, X), As))(
+            jnp.concatenate([jnp.zeros(1), offsets]))
+    else:
+        K = jnp.zeros((y.shape[0], 6, 6)).at[0].set(stiffness(term, c.X0, A))
+        states = jax.vmap(lambda o: term.state(c.X0 + o * e, A))(jnp.concatenate([jnp.zeros(1), offsets]))
+    return x, err, rpy, K, states
+
+
 def line_shape(H, V, L, w, EA, LB, hA, n=200):
     """Points (horizontal distance from the anchor, height above the anchor) along a line (NumPy,
     for the figure): its stretched tangent integrated along the unstretched arc length, the part on
@@ -165,11 +270,6 @@ def mooring(scene: Scene, offsets: Optional[Sequence[float]] = None, direction: 
     """
     if not scene.mooring:
         raise SceneError("mooring", "the scene has no [[mooring]] lines")
-    for i, line in enumerate(scene.mooring):
-        if line.body not in ("vessel", scene.vessel.name):
-            raise SceneError(f"mooring[{i}].body", f"{line.body!r}: the static analysis (js.mooring, `jaxslosh "
-                                                   "mooring`) takes the vessel's lines only; this line holds a body of "
-                                                   "[[bodies]] (run the scene to see it moored)")
     scene = quasi_static_lines(scene)        # lumped lines at rest: their catenary
     if offsets is None:
         offsets = np.linspace(0.0, 0.1 * scene.environment.depth, 11)
@@ -182,11 +282,25 @@ def mooring(scene: Scene, offsets: Optional[Sequence[float]] = None, direction: 
     size = max(float(np.max(np.abs(np.asarray(term.fairlead)))), 1.0)
     scale = jnp.array([m * g] * 3 + [m * g * size] * 3)
     e = jnp.array([np.cos(direction), np.sin(direction), 0.0])
-    x, err, rpy, K, states = _analysis(system, scale, jnp.asarray(offsets), e)
+    bodies = bodies_term(system)
+    several = bodies is not None and bodies.S > 0
+    if several:        # every frame at once: the vessel, the bodies, the lines on each, the connections
+        for b in scene.bodies:
+            scale = jnp.concatenate([scale, jnp.array([b.mass * g] * 3 + [b.mass * g * size] * 3)])
+        heads = jnp.stack([quat_from_rpy(jnp.array([0.0, 0.0, b.heading])) for b in scene.bodies])
+        x, err, rpys, Ks, states = _frames_analysis(system, scale, heads, jnp.asarray(offsets), e)
+        x, rpy, K = np.asarray(x).reshape(-1, 6), np.asarray(rpys[0]), Ks[0]
+    else:
+        x, err, rpy, K, states = _analysis(system, scale, jnp.asarray(offsets), e)
     if not (np.isfinite(float(err)) and float(err) <= 1e3 * TOL):
         raise StaticFailure(f"no static equilibrium found (Newton's scaled residual {float(err):.3g} after "
-                            f"{MAX_ITER} iterations): do the lines and the hydrostatics hold every dof?")
-    eq = np.concatenate([np.asarray(x[:3]), np.asarray(rpy)])
+                            f"{MAX_ITER} iterations): do the lines{', the connections' if several else ''} and the "
+                            f"hydrostatics hold every dof{' of every body' if several else ''}?")
+    eq = np.concatenate([np.asarray(x[0, :3] if several else x[:3]), np.asarray(rpy)])
+    on_bodies = {}
+    if several:
+        on_bodies = {b.name: {"equilibrium": np.concatenate([x[s + 1, :3], np.asarray(rpys[s + 1])]),
+                              "stiffness": np.asarray(Ks[s + 1])} for s, b in enumerate(scene.bodies)}
     states = jax.tree_util.tree_map(np.asarray, states)      # NumPy from here: no more programs to compile
     s = jax.tree_util.tree_map(lambda v: v[0], states)       # at the equilibrium
     tension = np.hypot(states.horizontal, states.vertical)
@@ -198,7 +312,9 @@ def mooring(scene: Scene, offsets: Optional[Sequence[float]] = None, direction: 
                       "vertical": float(s.vertical[i]), "seabed_length": float(s.seabed_length[i])})
         shapes.append(line_shape(float(s.horizontal[i]), float(s.vertical[i]), line.length, line.weight, line.ea,
                                  float(s.seabed_length[i]), line.anchor_height))
-    restoring = -(states.force[1:].sum(axis=1) @ np.array([np.cos(direction), np.sin(direction), 0.0]))
+    vessel = np.array([line.body in ("vessel", scene.vessel.name) for line in scene.mooring], dtype=float)
+    restoring = -((states.force[1:] * vessel[:, None]).sum(axis=1) @ np.array([np.cos(direction), np.sin(direction),
+                                                                               0.0]))
     tmax = np.max(tension[1:], axis=1)
     return MooringAnalysis(eq, lines, np.asarray(K), offsets, restoring, tmax, float(direction),
-                           tuple(shapes))
+                           tuple(shapes), on_bodies)

@@ -10,9 +10,10 @@ derivative, not its iterations.
 
 A line may hold a body of `[[bodies]]` instead of the vessel (its `ends` entry: the body's slot, as
 a connection's ends, physics/bodies.py): its fairlead is then in that body's frame, from its COG,
-and its force and moment go to that body's rows (`Rows.frames`). A body's hydrostatics are linear
-springs about its rest pose, so its buoyancy carries its lines' vertical pull at rest
-(`carried_bodies`), as the vessel's does with linear hydrostatics.
+and its force and moment go to that body's rows (`Rows.frames`). Where a body's hydrostatics are
+linear springs about its rest pose its buoyancy carries its lines' vertical pull at rest
+(`carried_bodies`), as the vessel's does with linear hydrostatics; a body on its own hull
+(nonlinear hydrostatics) sinks under that pull, as the vessel on its hull does.
 """
 from __future__ import annotations
 
@@ -208,6 +209,10 @@ def build_mooring(scene, balanced: bool, outline: bool = False, params: Optional
                                           for b in scene.bodies])
         held = dict(ends=ends, n_bodies=len(scene.bodies), carried_bodies=jnp.zeros((len(scene.bodies), 3)),
                     rest_X=jnp.asarray(rest[slot]), rest_A=turn[slot])
+        # the bodies whose buoyancy carries their lines' pull at rest: those on linear springs about
+        # their rest pose; a body on its own hull sinks under it, as the vessel on its hull does
+        springs = jnp.asarray([float(b.hydrostatics is not None and not b.hydrostatics.nonlinear)
+                               for b in scene.bodies])
     term = MooringLines(fairlead=jnp.asarray([m.fairlead for m in lines], dtype=float), anchor=jnp.asarray(anchor),
                         length=col("length"), weight=col("weight"), ea=col("ea"), friction=col("seabed_friction"),
                         anchor_height=col("anchor_height"), carried=jnp.zeros(3), names=tuple(m.name for m in lines),
@@ -215,20 +220,20 @@ def build_mooring(scene, balanced: bool, outline: bool = False, params: Optional
     if outline:
         return term
     if on_bodies or balanced:
-        return _carry_rest(term, balanced)
+        return _carry_rest(term, balanced, springs if on_bodies else None)
     return term
 
 
 @eqx.filter_jit
-def _carry_rest(term: MooringLines, balanced: bool) -> MooringLines:
-    """The term with the lines' vertical pull at rest carried by the buoyancy (`build_mooring`): one
-    program, cached by the term's structure (run eagerly, the cold solve's loops were compiled anew
-    for every build)."""
-    if term.on_bodies:       # a body's hydrostatics are always linear springs about its rest pose
+def _carry_rest(term: MooringLines, balanced: bool, springs=None) -> MooringLines:
+    """The term with the lines' vertical pull at rest carried by the buoyancy (`build_mooring`) of the
+    vessel where `balanced` and of the bodies where `springs` (S,) is 1: one program, cached by the
+    term's structure (run eagerly, the cold solve's loops were compiled anew for every build)."""
+    if term.on_bodies:
         per = term.frame_rows(term.rest_X, term.rest_A)
         up = jnp.zeros_like(per[:, :3]).at[:, 2].set(-per[:, 2])
         return eqx.tree_at(lambda t: (t.carried, t.carried_bodies), term,
-                           (up[0] if balanced else jnp.zeros(3), up[1:]))
+                           (up[0] if balanced else jnp.zeros(3), up[1:] * springs[:, None]))
     F, _ = term.force_moment(jnp.zeros(3), jnp.eye(3))
     return eqx.tree_at(lambda t: t.carried, term, jnp.array([0.0, 0.0, -F[2]]))
 

@@ -13,6 +13,7 @@ import jax.numpy as jnp
 import numpy as np
 
 from ..hull.hydrostatics import first_vanishing, gz_curve
+from ..physics.bodies import bodies_term
 from ..physics.hull import HullPressure
 from ..physics.vessel import Weight
 
@@ -23,8 +24,23 @@ HEELS = 91
 def vanishing_angles(system) -> Optional[tuple]:
     """(roll, pitch) angles of vanishing stability (rad; None where GZ stays positive) of a built
     System with the nonlinear hydrostatics; None for other systems."""
-    hull = [t for t in system.terms if isinstance(t, HullPressure)]
-    weight = [t for t in system.terms if isinstance(t, Weight)]
+    return _angles(system.terms)
+
+
+def body_vanishing_angles(system) -> dict:
+    """{name: (roll, pitch) angles of vanishing stability} of the [[bodies]] of a built System that
+    float on their own hull with the nonlinear hydrostatics (the same hull and weight terms as the
+    vessel's, its tanks' liquid in its weight); the other bodies are left out."""
+    term = bodies_term(system)
+    if term is None:
+        return {}
+    angles = {name: _angles(f.terms) for name, f in zip(term.names, term.bodies)}
+    return {name: a for name, a in angles.items() if a is not None}
+
+
+def _angles(terms) -> Optional[tuple]:
+    hull = [t for t in terms if isinstance(t, HullPressure)]
+    weight = [t for t in terms if isinstance(t, Weight)]
     if not hull or not weight:
         return None
     h, w = hull[0], weight[0]

@@ -20,7 +20,7 @@ from ..io.result import ResultWriter
 from ..io.status import Status
 from ..scene.types import Scene
 from .guard import Interrupted, interrupts
-from .capsize import vanishing_angles
+from .capsize import body_vanishing_angles, vanishing_angles
 from ..staging import cached
 from .compiled import compile_run
 from ..mooring.lumped_term import lumped_terms
@@ -61,7 +61,8 @@ def run_to_file(scene: Scene, out: str, *, progress: bool = True,
             setup = prepare(scene) if key is None else cached("model", key, lambda: prepare(scene))
             b, solver = setup.built, setup.solver
             watch = Watch(scene, np.asarray(solver.noise))
-            watch.watch_capsize(vanishing_angles(b.system))
+            watch.watch_capsize(vanishing_angles(b.system), body_vanishing_angles(b.system),
+                                getattr(bodies_term(b.system), "names", ()))
             watch.watch_liquid(b.system.liquid)
             watch.watch_bodies(b)
             se = setup.save_every
@@ -91,7 +92,7 @@ def run_to_file(scene: Scene, out: str, *, progress: bool = True,
                 ok = ~np.asarray(pending.failed)
                 n_ok = int(ok.sum()) if ok.all() else int(np.argmin(ok))
                 rows = jax.tree_util.tree_map(lambda x: x[:n_ok], pending)
-                watch.update(rows.t, rows.surface, rows.residual, rows.D, rows.q, rows.body_d)
+                watch.update(rows.t, rows.surface, rows.residual, rows.D, rows.q, rows.body_d, rows.bodies)
                 steps = min(int(carry.k), setup.n_steps)
                 writer.append({k: np.asarray(v) for k, v in frame_datasets(b, rows, p0, save_fields).items()}, steps)
                 steps_written = steps

@@ -62,6 +62,17 @@ def _tank_label(i, t) -> str:
     return f"tanks[{i}] ({t.name!r})"
 
 
+def _passed(q, angles, time, heel, t_heel, capsized) -> None:
+    """Mark in place (heel, t_heel, capsized: per axis) the first frame whose |roll| or |pitch| of the
+    attitudes q (k, 4) passes its angle of vanishing stability (None: never)."""
+    rp = np.abs(np.asarray(rpy_from_quat(np.asarray(q)))[:, :2])
+    for axis, limit in enumerate(angles):
+        j = int(np.argmax(rp[:, axis]))
+        if limit is not None and rp[j, axis] > limit and not capsized[axis]:
+            capsized[axis] = True
+            heel[axis], t_heel[axis] = rp[j, axis], time[j]
+
+
 class Watch:
     """Extremes seen over the frames of a run, chunk by chunk. The tanks of [[bodies]] are watched
     by a Watch of their own per body (`watch_bodies`), fed from the frames' bodies' liquid unknowns."""
@@ -81,6 +92,8 @@ class Watch:
         self.heel = np.zeros(2)                  # largest |roll|, |pitch| seen past them, and when
         self.t_heel = np.zeros(2)
         self.capsized = [False, False]
+        # [[bodies]] on their own hulls: {name: [index among the bodies, angles, heel (2,), t_heel (2,), capsized (2,)]}
+        self.body_capsize = {}
         self.tables = _surface_tables(scene) if n else []
         self.slope = np.zeros(len(self.tables))     # steepest free surface of each multimodal tank, and when
         self.t_slope = np.zeros(len(self.tables))
@@ -119,30 +132,32 @@ class Watch:
             sub.watch_liquid(floating.tank)
             self.on_bodies.append((sub, floating.tank, slice(bt.offset, bt.offset + floating.nf), tops))
 
-    def watch_capsize(self, angles) -> None:
+    def watch_capsize(self, angles, bodies=None, names=()) -> None:
         """Check the frames' roll and pitch against these angles of vanishing stability (rad; None
-        where the hull has none)."""
+        where the hull has none); `bodies` {name: angles} the same for [[bodies]] on their own hulls
+        (capsize.body_vanishing_angles), `names` all the bodies' names in their order (the frames')."""
         self.vanishing = angles
+        self.body_capsize = {n: [list(names).index(n), a, np.zeros(2), np.zeros(2), [False, False]]
+                             for n, a in (bodies or {}).items()}
 
-    def update(self, time, surface, residual, field=None, q=None, body_d=None):
+    def update(self, time, surface, residual, field=None, q=None, body_d=None, bodies=None):
         """time (k,), surface (k, tanks, 2), residual (k,) of the frames just computed; `field`
         (k, ...): their liquid unknowns (Frame.D), whose size sets each frame's round-off floor;
-        `q` (k, 4): their attitudes; `body_d` (k, m): the bodies' tanks' liquid unknowns (Frame.body_d)."""
+        `q` (k, 4): their attitudes; `body_d` (k, m): the bodies' tanks' liquid unknowns (Frame.body_d);
+        `bodies` (k, S, 10): the bodies' poses (Frame.bodies, their quaternions at 3:7)."""
         time = np.asarray(time)
         if time.size == 0:
             return
+        if bodies is not None:
+            for i, angles, heel, t_heel, capsized in self.body_capsize.values():
+                _passed(np.asarray(bodies)[:, i, 3:7], angles, time, heel, t_heel, capsized)
         for sub, liquid, sl, tops in self.on_bodies if body_d is not None else ():
             d = np.asarray(body_d, float).reshape(time.size, -1)[:, sl]
             heave = [np.asarray(jax.vmap(lambda x, i=i: liquid.surface_heave(x, i))(d)) for i in tops]
             sub.update(time, np.stack([np.stack([h.min(axis=1), h.max(axis=1)], -1) for h in heave], 1),
                        np.zeros(time.size), d)
         if self.vanishing is not None and q is not None:
-            rp = np.abs(np.asarray(rpy_from_quat(np.asarray(q)))[:, :2])
-            for axis, limit in enumerate(self.vanishing):
-                j = int(np.argmax(rp[:, axis]))
-                if limit is not None and rp[j, axis] > limit and not self.capsized[axis]:
-                    self.capsized[axis] = True
-                    self.heel[axis], self.t_heel[axis] = rp[j, axis], time[j]
+            _passed(q, self.vanishing, time, self.heel, self.t_heel, self.capsized)
         surface = np.asarray(surface).reshape(time.size, -1, 2)
         for i in range(self.low.size):
             j, k = int(np.argmin(surface[:, i, 0])), int(np.argmax(surface[:, i, 1]))
@@ -201,6 +216,13 @@ class Watch:
                            f"{self.t_heel[axis]:.4g} s, past the hull's angle of vanishing stability "
                            f"{np.degrees(self.vanishing[axis]):.1f} deg (its GZ at the ship's displacement, free to "
                            f"sink, tank liquid frozen): the vessel capsized")
+        for name, (_, angles, heel, t_heel, capsized) in self.body_capsize.items():
+            for axis, what in enumerate(("roll", "pitch")):
+                if capsized[axis]:
+                    out.append(f"capsized: the body {name!r}'s {what} reached {np.degrees(heel[axis]):.1f} deg at "
+                               f"t = {t_heel[axis]:.4g} s, past its hull's angle of vanishing stability "
+                               f"{np.degrees(angles[axis]):.1f} deg (its GZ at its displacement, free to sink, tank "
+                               f"liquid frozen): the body capsized")
         for i, t in enumerate(self.scene.tanks[:self.low.size]):
             if not np.isfinite(self.low[i]):
                 continue

@@ -208,13 +208,25 @@ def footprint_radius(area: float) -> float:
     return math.sqrt(area / math.pi)
 
 
-def _outline(centre, heading, footprint, area):
-    """A waterplane at rest as the overlap check sees it: ("rect", centre, its axes (2, 2), half sizes)
-    for a footprint, else ("circle", centre, radius) of its area."""
+def _outline(centre, heading, footprint, area, shift=(0.0, 0.0)):
+    """A waterplane at rest as the overlap check sees it: ("rect", its centre, its axes (2, 2), half
+    sizes) for a footprint (its centre `shift` from the COG along the body's axes), else ("circle",
+    centre, radius) of its area."""
     if footprint is None:
         return ("circle", np.asarray(centre, dtype=float), footprint_radius(area))
     c, s = math.cos(heading), math.sin(heading)
-    return ("rect", np.asarray(centre, dtype=float), np.array([[c, s], [-s, c]]), 0.5 * np.asarray(footprint))
+    axes = np.array([[c, s], [-s, c]])
+    return ("rect", np.asarray(centre, dtype=float) + axes.T @ np.asarray(shift, dtype=float), axes,
+            0.5 * np.asarray(footprint))
+
+
+def _plan(f, key: str):
+    """(footprint, its centre from the COG) for the overlap check: its `footprint`, else its hull's
+    plan (which bounds its waterplane), else (None, 0): the circle of its waterplane's area."""
+    if f.footprint is not None or f.hull is None:
+        return f.footprint, (0.0, 0.0)
+    lo, hi = (np.asarray(v[:2]) for v in hull_extent(f, key))
+    return tuple(hi - lo), tuple(0.5 * (hi + lo))
 
 
 def _apart(a, b) -> float:
@@ -240,25 +252,30 @@ def _apart(a, b) -> float:
 def _overlaps(bodies, vessel) -> None:
     """Two bodies whose waterplanes intersect at rest are refused: they would float through each other
     (no contact is modelled but by fenders). A waterplane is the rectangle of its `footprint` along its
-    heading where given, else the circle of its area about its COG."""
-    outlines = [("vessel" if f is vessel else f.name, _outline(f.position, f.heading, f.footprint,
-                                                               f.hydrostatics.waterplane_area))
-                for f in (vessel, *bodies) if f.hydrostatics is not None]
-    for j, (nb, ob) in enumerate(outlines):
-        for na, oa in outlines[:j]:
+    heading where given, else its hull's plan, else the circle of its area about its COG."""
+    keys = ["vessel.hull.file"] + [f"bodies[{i}].hull.file" for i in range(len(bodies))]
+    outlines = []
+    for f, key in zip((vessel, *bodies), keys):
+        if f.hydrostatics is not None:
+            footprint, shift = _plan(f, key)
+            outlines.append(("vessel" if f is vessel else f.name, np.asarray(f.position, dtype=float),
+                             _outline(f.position, f.heading, footprint, f.hydrostatics.waterplane_area, shift)))
+    for j, (nb, pb, ob) in enumerate(outlines):
+        for na, pa, oa in outlines[:j]:
             gap = _apart(oa, ob)
             if gap >= 0:
                 continue
             i = [b.name for b in bodies].index(nb)
-            dist = float(np.linalg.norm(oa[1] - ob[1]))
+            dist = float(np.linalg.norm(pa - pb))
             if oa[0] == ob[0] == "circle":
                 raise SceneError(f"bodies[{i}].position", (
-                    f"{show(list(ob[1]))} puts {nb!r} {dist:.6g} m from {na!r}: their waterplanes (as circles of their "
+                    f"{show(list(pb))} puts {nb!r} {dist:.6g} m from {na!r}: their waterplanes (as circles of their "
                     f"areas, radii {ob[2]:.4g} and {oa[2]:.4g} m) overlap at rest; place the bodies at least "
                     f"{oa[2] + ob[2]:.6g} m apart, or give their `footprint` (length, beam)"))
             raise SceneError(f"bodies[{i}].position", (
-                f"{show(list(ob[1]))} puts {nb!r} {dist:.6g} m from {na!r}: their waterplanes (rectangles of their "
-                f"`footprint`, circles of their areas without one) overlap at rest by {-gap:.4g} m"))
+                f"{show(list(pb))} puts {nb!r} {dist:.6g} m from {na!r}: their waterplanes (rectangles of their "
+                f"`footprint` or their hull's plan, circles of their areas without either) overlap at rest by "
+                f"{-gap:.4g} m"))
 
 
 def hull_extent(owner: FloatingBody, key: str = "vessel.hull.file") -> Optional[tuple]:

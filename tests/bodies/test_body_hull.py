@@ -175,6 +175,19 @@ def test_connection_points_outside_a_bodys_hull_exit_2(tmp_path, capsys):
         and "below the keel at -3 m" in out.err, out.err
 
 
+@pytest.mark.parametrize("y,status", [(9.5, 0), (8.5, 2)])
+def test_hulls_side_by_side_overlap_by_their_plans(tmp_path, capsys, y, status):
+    """Two box hulls without `footprint` are compared by their plans (beams 10 and 8 m: 9 m between
+    their COGs at least), not by circles of their waterplane areas (15.1 m): 9.5 m apart they float,
+    8.5 m apart they overlap by 0.5 m, named at the body's position."""
+    text = (HEAD.format(duration=1.0) + VESSEL + f'[[bodies]]\nname = "barge"\nposition = [0.0, {y}]\n'
+            + BOX.format(t="bodies"))
+    got, out = _check(tmp_path, capsys, text)
+    assert got == status, out.err
+    if status:
+        assert "bodies[0].position" in out.err and "hull's plan" in out.err and "overlap at rest by 0.5 m" in out.err
+
+
 def test_a_bodys_box_hull_gives_its_large_angle_gz_curve(tmp_path, capsys):
     """`stability` on a body with a box hull: its curve from its hull (free to sink and trim), the
     wall-sided box's GZ = sin(phi) (GM + BM tan^2(phi) / 2) while the bilge stays wet (26.6 deg)
@@ -193,7 +206,8 @@ def test_a_bodys_box_hull_gives_its_large_angle_gz_curve(tmp_path, capsys):
     from jaxslosh.cli import main
     assert main(["stability", str(p), "--angles", "0:40:5"]) == 0
     out = capsys.readouterr().out
-    assert "body barge:" in out and "IS Code 2008 Part A 2.2 (liquids level):" in out.split("body barge:")[1]
+    after = out.split("body barge:")[1]
+    assert "the body free to sink and trim" in after and "IS Code 2008 Part A 2.2 (liquids level):" in after
 
 
 def test_a_bodys_hull_takes_the_waves_in_its_rao():
@@ -241,3 +255,64 @@ def test_a_bodys_mesh_hull_rows_are_the_lone_vessels(tmp_path):
     ours, ref = rows_and_residual(text, alone(ramp=0.0).replace(box, mesh), seed=7)
     assert np.abs(ours).max() > 1e4
     np.testing.assert_allclose(ours, ref, rtol=0, atol=1e-12 * np.abs(ours).max())
+
+
+def test_a_bodys_hull_is_watched_for_capsize_as_the_lone_vessels():
+    """The run's capsize watch takes each body on its own hull: its angles of vanishing stability are
+    the same box's as the only vessel of a scene, and frames whose roll passes them are said naming
+    the body (the vessel, upright, is not)."""
+    from jaxslosh.run.capsize import body_vanishing_angles, vanishing_angles
+    from jaxslosh.run.validity import Watch
+    scene = js.load_scene(on_body())
+    got = body_vanishing_angles(build(scene).system)
+    want = vanishing_angles(build(js.load_scene(alone())).system)
+    assert set(got) == {"barge"} and want[0] is not None and np.radians(30.0) < want[0] < np.radians(90.0)
+    np.testing.assert_allclose([a for a in got["barge"] if a is not None], [a for a in want if a is not None],
+                               rtol=1e-12)
+    watch = Watch(scene)
+    watch.watch_capsize(vanishing_angles(build(scene).system), got, ("barge",))
+    t = np.linspace(0.0, 1.0, 11)
+    rolls = np.linspace(0.0, want[0] + 0.1, 11)
+    frames = np.zeros((11, 1, 10))
+    frames[:, 0, 3], frames[:, 0, 4] = np.cos(rolls / 2), np.sin(rolls / 2)     # pure rolls
+    upright = np.tile([1.0, 0.0, 0.0, 0.0], (11, 1))
+    watch.update(t, np.zeros((11, 0, 2)), np.zeros(11), None, upright, None, frames[:6])
+    assert not [w for w in watch.warnings() if "capsized" in w]
+    watch.update(t, np.zeros((11, 0, 2)), np.zeros(11), None, upright, None, frames)
+    said = [w for w in watch.warnings() if "capsized" in w]
+    assert len(said) == 1 and said[0].startswith("capsized: the body 'barge''s roll reached") \
+        and f"{np.degrees(rolls[-1]):.1f} deg at t = 1 s" in said[0], said
+
+
+LINE = """
+[[mooring]]
+name = "{name}"
+body = "{body}"
+fairlead = [9.0, 0.0, -1.0]
+anchor = [{x}, {y}, -60.0]
+length = 330.0
+weight = 800.0
+ea = 5.0e8
+"""
+
+
+def test_a_body_on_its_hull_bears_its_lines_pull_as_the_vessel_on_its_hull():
+    """Lines on a body with linear hydrostatics: its buoyancy carries their vertical pull at rest (the
+    rows vanish there, as the vessel's on linear springs). On a body with its own hull the hull's
+    pressure bears only the weight, so at rest the lines' pull is the whole of its mooring rows (it
+    sinks under it, as the vessel on its hull does: its own carried force is zero too)."""
+    from jaxslosh.mooring.term import mooring_term
+    spring = ('[[bodies]]\nname = "buoy"\nposition = [0.0, -300.0]\nmass = 4.0e5\ninertia = [5.0e6, 1.5e7, 1.7e7]\n'
+              '[bodies.hydrostatics]\nwaterplane_area = 200.0\ndisplaced_volume = 390.0\ngm_t = 1.5\ngm_l = 15.0\n')
+    text = (HEAD.format(duration=1.0).replace("water_density = 1025.0\n", "water_density = 1025.0\ndepth = 60.0\n")
+            + VESSEL
+            + f'[[bodies]]\nname = "barge"\nposition = [{X0}, 200.0]\n' + BOX.format(t="bodies") + spring
+            + LINE.format(name="a", body="barge", x=X0 + 300.0, y=200.0)
+            + LINE.format(name="b", body="buoy", x=300.0, y=-300.0))
+    term = mooring_term(build(js.load_scene(text)).system)
+    per = np.asarray(term.frame_rows(term.rest_X, term.rest_A))       # vessel, barge, buoy
+    pull = np.asarray(term.state(term.rest_X, term.rest_A).force)      # each line's force on its fairlead
+    assert pull[0, 2] < -1e4 and pull[1, 2] < -1e4                     # both lines pull down
+    np.testing.assert_allclose(np.asarray(term.carried_bodies)[0], 0.0, atol=0)
+    np.testing.assert_allclose(per[1, :3], pull[0], rtol=1e-12)        # the barge: the line's pull itself
+    assert abs(per[2, 2]) < 1e-9 * abs(pull[1, 2])                     # the buoy's buoyancy carries it

@@ -1,6 +1,7 @@
 """Mooring lines on a body of [[bodies]] (docs/guide/moorings.md, docs/guide/bodies-and-connections.md):
 the same hull on the same three catenary lines moves the same as the vessel and as a body, its
 lines' tensions the same in the result; bad input exits 2 naming its key."""
+import json
 import math
 
 import jax
@@ -95,14 +96,68 @@ def test_a_moored_body_moves_as_the_same_moored_vessel():
 
 
 def test_lines_on_bodies_are_refused_where_not_available():
-    """A lumped line on a body, a line on a body that does not exist, and js.mooring on a scene whose
-    lines hold a body: refused naming the key."""
+    """A lumped line on a body and a line on a body that does not exist: refused naming the key."""
     with pytest.raises(SceneError, match=r"mooring\[0\]\.body.*lumped"):
         js.load_scene(_body_moored('model = "lumped"\nsegments = 4\n'))
     with pytest.raises(SceneError, match=r"mooring\[0\]\.body.*not a body.*buoy"):
         js.load_scene(_body_moored().replace('body = "buoy"', 'body = "boy"', 1))
-    with pytest.raises(SceneError, match=r"mooring\[0\]\.body.*vessel's lines only"):
-        js.mooring(js.load_scene(_body_moored()))
+
+
+def _at_rest(text: str) -> str:
+    return text.replace(f"position = {OFFSET}", "position = [0, 0, 0]").replace(f"angular_velocity = {SPIN}",
+                                                                              "angular_velocity = [0, 0, 0]")
+
+
+def test_the_still_water_rows_of_a_moored_body_are_the_moored_vessels():
+    """The fast twin of the statics: at one pose away from rest, the body's six rows of the several
+    frames' residual (its hydrostatics and its lines) equal the moored vessel's static residual at
+    that pose to round-off; the free vessel's rows beside it vanish (it is at rest, upright)."""
+    from jaxslosh.mooring.statics import frames_residual, static_residual
+    scenes = js.load_scene(_at_rest(_vessel_moored())), js.load_scene(_at_rest(_body_moored()))
+    x = jnp.array([3.0, -1.0, 0.2, 0.01, -0.02, 0.05])
+
+    @jax.jit
+    def rows(x):
+        ref = static_residual(build(scenes[0]).system, x)
+        got = frames_residual(build(scenes[1]).system, jnp.concatenate([jnp.zeros(6), x]), jnp.eye(4)[:1])
+        return ref, got
+    ref, got = (np.asarray(r) for r in rows(x))
+    assert np.abs(ref[:3]).max() > 1e4                          # the lines and the springs pull back
+    np.testing.assert_allclose(got[6:], ref, rtol=0, atol=1e-9 * np.abs(ref).max())
+    np.testing.assert_allclose(got[:6], 0.0, atol=1e-9 * np.abs(ref).max())
+
+
+@pytest.mark.slow      # two static analyses compiled (about a minute); the rows' twin above is the fast check
+def test_a_moored_bodys_statics_are_the_moored_vessels():
+    """`js.mooring` of the body on its lines beside a free vessel: the body's equilibrium and its lines'
+    stiffness equal those of the same hull moored as the vessel (the free vessel, which nothing
+    holds in surge, sway and yaw, stays at rest), and the lines' tensions are the same."""
+    ref = js.mooring(js.load_scene(_at_rest(_vessel_moored())), offsets=[0.0])
+    got = js.mooring(js.load_scene(_at_rest(_body_moored())), offsets=[0.0])
+    body = got.bodies["buoy"]
+    np.testing.assert_allclose(got.equilibrium, 0.0, atol=1e-12)
+    np.testing.assert_allclose(body["equilibrium"], ref.equilibrium, rtol=1e-8, atol=1e-10)
+    np.testing.assert_allclose(body["stiffness"], ref.stiffness, rtol=1e-8, atol=1e-8 * np.abs(ref.stiffness).max())
+    for a, b in zip(got.lines, ref.lines):
+        assert a["fairlead_tension"] == pytest.approx(b["fairlead_tension"], rel=1e-9)
+    assert set(got.as_dict()["bodies"]) == {"buoy"}
+
+
+@pytest.mark.slow      # the several frames' analysis compiled (half a minute); its rows' twin above is fast
+def test_the_mooring_command_prints_each_bodys_equilibrium(tmp_path, capsys):
+    """`jaxslosh mooring` of the moored body beside the free vessel: a line per frame, the body's own
+    stiffness table, and its JSON's "bodies" (the same program as js.mooring's: nothing compiled anew
+    for a second scene of the same structure)."""
+    from jaxslosh.cli import main
+    p = tmp_path / "scene.toml"
+    p.write_text(_at_rest(_body_moored()))
+    assert main(["mooring", str(p), "--offsets", "0,5"]) == 0
+    out = capsys.readouterr().out
+    assert "  vessel: surge" in out and "  buoy: surge" in out and "buoy's lines' stiffness about its COG:" in out
+    assert main(["mooring", str(p), "--offsets", "0,5", "--json"]) == 0
+    d = json.loads(capsys.readouterr().out)
+    assert len(d["bodies"]["buoy"]["equilibrium"]) == 6 and np.asarray(d["bodies"]["buoy"]["stiffness"]).shape == (6, 6)
+    assert d["bodies"]["buoy"]["stiffness"][0][0] > 1e3 and d["stiffness"][0][0] == 0.0     # its lines, not the vessel's
 
 
 def test_a_turned_bodys_lines_act_in_its_own_frame():

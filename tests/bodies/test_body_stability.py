@@ -96,3 +96,45 @@ def test_a_vessel_without_a_hull_alone_still_exits_2(tmp_path, capsys):
                  "displaced_volume = 400.0\ngm_t = 1.67\ngm_l = 14.2\n")
     assert main(["stability", str(p)]) == 2
     assert "vessel.hull" in capsys.readouterr().err
+
+
+def test_a_vessel_without_a_hull_but_with_a_tank_beside_bodies_levels_its_liquid(tmp_path, capsys):
+    """A vessel on linear springs carrying a box tank, beside a body: its frozen curve is GM sin(phi),
+    its level curve the wall-sided tank's free-surface effect taken off, FSC sin(phi) (1 + tan^2(phi) / 2)
+    with FSC = rho_l (l b^3 / 12) / (rho V), within 1e-9 m while the surface stays between floor and roof;
+    GM0 level is GM - FSC. The command prints both columns and judges no criteria."""
+    tank = ('[[tanks]]\nname = "t"\norigin = [-2.0, -3.0, -1.0]\nsize = [4.0, 6.0, 3.0]\nfill_depth = 1.0\n'
+            'mesh = [2, 3, 2]\n')
+    text = (BOX.split("[vessel.hull]")[0].replace("410000.0", "386000.0") + "[vessel.hydrostatics]\n"
+            "waterplane_area = 160.0\ndisplaced_volume = 400.0\ngm_t = 1.67\ngm_l = 14.2\n" + BODY + tank)
+    phi = np.radians([0.0, 5.0, 10.0, 15.0])
+    s = js.stability(js.load_scene(text), phi)
+    fsc = 1000.0 * (4.0 * 6.0 ** 3 / 12.0) / (1025.0 * 400.0)
+    assert s.model == "linear" and s.criteria == ()
+    np.testing.assert_allclose(s.gz_frozen, 1.67 * np.sin(phi), rtol=0, atol=1e-12)
+    np.testing.assert_allclose(s.gz, np.sin(phi) * (1.67 - fsc * (1 + np.tan(phi) ** 2 / 2)), rtol=0, atol=1e-9)
+    assert s.gm0 == pytest.approx(1.67 - fsc, abs=1e-8) and s.gm0_frozen == pytest.approx(1.67, abs=1e-8)
+    p = tmp_path / "s.toml"
+    p.write_text(text)
+    assert main(["stability", str(p), "--angles", "0:15:4"]) == 0
+    out = capsys.readouterr().out
+    assert "GZ level  GZ frozen" in out and "not judged on linear hydrostatics" in out and "body tug:" in out
+
+
+def test_a_body_with_a_tank_levels_its_liquid_as_the_vessel_does(tmp_path, capsys):
+    """The same box tank on a body of linear hydrostatics: its entry has both curves, the level one
+    with the tank's free-surface effect (the closed form above, of the body's own V)."""
+    tank = ('[[tanks]]\nname = "t"\nbody = "tug"\norigin = [-2.0, -3.0, -1.0]\nsize = [4.0, 6.0, 3.0]\n'
+            'fill_depth = 1.0\nmesh = [2, 3, 2]\n')
+    text = BOX + BODY.replace("mass = 1.025e5", "mass = 78500.0") + tank
+    phi = np.radians([0.0, 5.0, 10.0, 15.0])
+    b = js.stability(js.load_scene(text), phi, criteria=False).bodies["tug"]
+    fsc = 1000.0 * (4.0 * 6.0 ** 3 / 12.0) / (1025.0 * 100.0)
+    assert b["model"] == "linear"
+    np.testing.assert_allclose(b.gz_frozen, 0.8 * np.sin(phi), rtol=0, atol=1e-12)
+    np.testing.assert_allclose(b.gz, np.sin(phi) * (0.8 - fsc * (1 + np.tan(phi) ** 2 / 2)), rtol=0, atol=1e-9)
+    p = tmp_path / "s.toml"
+    p.write_text(text)
+    assert main(["stability", str(p), "--angles", "0:15:4"]) == 0
+    out = capsys.readouterr().out.split("body tug (its linear hydrostatics")[1]
+    assert "GZ level  GZ frozen" in out and f"(free-surface correction {fsc:.5f} m)" in out
