@@ -29,9 +29,10 @@ from ..geometry import AXES, SHAPES
 from .campaign import read_campaign
 from .fields import (at_least, counts, flat_list, non_negative, one_of, poisson_ratio, positive, read, show, sizes,
                      valid_name)
-from .bodies import (bodies_scene, multimodal_scene, read_bodies, read_connections, read_footprint, tank_carriers,
+from .bodies import (bodies_scene, multimodal_scene, read_bodies, read_connections, tank_carriers,
                      tank_groups)
 from .mooring import read_mooring
+from .placement import read_footprint
 from .record import forced_span, read_forced
 from .rules import conservative as _conservative, locking_elements as _locking_elements
 from .hull import read_hydrostatics

@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 
 import jaxslosh as js
-from jaxslosh.scene.bodies import _apart, _outline
+from jaxslosh.scene.placement import apart as _apart, outline as _outline
 from jaxslosh.scene.types import SceneError
 
 ROOT = Path(__file__).resolve().parents[2]
