@@ -40,6 +40,7 @@ liquid's momentum: they are the rigid rows.
 """
 from __future__ import annotations
 
+import functools
 from typing import NamedTuple
 
 import equinox as eqx
@@ -47,6 +48,7 @@ import jax
 import jax.numpy as jnp
 import numpy as np
 
+from ...staging import no_eager_folding
 from .columns import spd_inverse
 from .modes import odd_powers
 
@@ -352,7 +354,32 @@ class ModalTank(eqx.Module):
 
 def modal_tank(L, b, h, rho, origin, n_modes: int, D=None) -> ModalTank:
     """The tank, with its rest values (the vortical integrals less their surface terms, the first
-    moment) formed once here by quadrature over the liquid at rest (`integrals_quadrature`)."""
+    moment) formed once here by quadrature over the liquid at rest (`integrals_quadrature`).
+
+    The build is one compiled program per mode count (`_modal_tank`), where op by op its tables and
+    quadrature compiled some 150 tiny XLA programs. Built from concrete values it is evaluated now,
+    even inside an outer trace (its arrays concrete, as the build's own eager operations left them);
+    traced values (a fill depth under differentiation) stage it into the caller's program."""
+    args = (*(_value(a) for a in (L, b, h, rho, origin)), n_modes, None if D is None else _value(D))
+    if any(isinstance(a, jax.core.Tracer) for a in args):
+        return _modal_tank(*args)
+    with no_eager_folding():      # its operations on constants staged too, not each compiled on its own
+        program = _modal_tank.lower(*args).compile()
+    return program(*args[:5], args[6])
+
+
+def _value(a):
+    """An argument of the compiled build: a JAX array (a tracer among them) as it is, anything else as
+    a float64 NumPy array (an argument of the program, not a constant compiled into it)."""
+    return a if isinstance(a, jax.Array) else np.asarray(a, dtype=float)
+
+
+@functools.partial(jax.jit, static_argnums=5)
+def _modal_tank(L, b, h, rho, origin, n_modes: int, D) -> ModalTank:
+    return _build(L, b, h, rho, origin, n_modes, D)
+
+
+def _build(L, b, h, rho, origin, n_modes: int, D) -> ModalTank:
     nx = max(NX, 8 * n_modes)
     xg, wg = np.polynomial.legendre.leggauss(nx)
     L = jnp.asarray(L, dtype=float)
