@@ -361,11 +361,11 @@ def modal_tank(L, b, h, rho, origin, n_modes: int, D=None) -> ModalTank:
     even inside an outer trace (its arrays concrete, as the build's own eager operations left them);
     traced values (a fill depth under differentiation) stage it into the caller's program."""
     args = (*(_value(a) for a in (L, b, h, rho, origin)), n_modes, None if D is None else _value(D))
-    if any(isinstance(a, jax.core.Tracer) for a in args):
-        return _modal_tank(*args)
     with no_eager_folding():      # its operations on constants staged too, not each compiled on its own
-        program = _modal_tank.lower(*args).compile()
-    return program(*args[:5], args[6])
+        if any(isinstance(a, jax.core.Tracer) for a in args):
+            return _modal_tank(*args)
+        program = _modal_tank.lower(*args).compile()     # cached by JAX: compiled once per signature
+    return program(*args[:5], args[6])                   # the program's arguments: all but n_modes
 
 
 def _value(a):
