@@ -40,7 +40,6 @@ liquid's momentum: they are the rigid rows.
 """
 from __future__ import annotations
 
-import functools
 from typing import NamedTuple
 
 import equinox as eqx
@@ -48,7 +47,7 @@ import jax
 import jax.numpy as jnp
 import numpy as np
 
-from ...staging import no_eager_folding
+from ...staging import evaluated
 from .columns import spd_inverse
 from .modes import odd_powers
 
@@ -356,16 +355,11 @@ def modal_tank(L, b, h, rho, origin, n_modes: int, D=None) -> ModalTank:
     """The tank, with its rest values (the vortical integrals less their surface terms, the first
     moment) formed once here by quadrature over the liquid at rest (`integrals_quadrature`).
 
-    The build is one compiled program per mode count (`_modal_tank`), where op by op its tables and
-    quadrature compiled some 150 tiny XLA programs. Built from concrete values it is evaluated now,
-    even inside an outer trace (its arrays concrete, as the build's own eager operations left them);
-    traced values (a fill depth under differentiation) stage it into the caller's program."""
-    args = (*(_value(a) for a in (L, b, h, rho, origin)), n_modes, None if D is None else _value(D))
-    with no_eager_folding():      # its operations on constants staged too, not each compiled on its own
-        if any(isinstance(a, jax.core.Tracer) for a in args):
-            return _modal_tank(*args)
-        program = _modal_tank.lower(*args).compile()     # cached by JAX: compiled once per signature
-    return program(*args[:5], args[6])                   # the program's arguments: all but n_modes
+    The build is one compiled program per mode count (`_build`, staging.py `evaluated`), where op by
+    op its tables and quadrature compiled some 150 tiny XLA programs. Built from concrete values it
+    is evaluated now, even inside an outer trace; traced values (a fill depth under differentiation)
+    stage it into the caller's program."""
+    return _modal_tank(*(_value(a) for a in (L, b, h, rho, origin)), n_modes, None if D is None else _value(D))
 
 
 def _value(a):
@@ -374,12 +368,8 @@ def _value(a):
     return a if isinstance(a, jax.Array) else np.asarray(a, dtype=float)
 
 
-@functools.partial(jax.jit, static_argnums=5)
-def _modal_tank(L, b, h, rho, origin, n_modes: int, D) -> ModalTank:
-    return _build(L, b, h, rho, origin, n_modes, D)
-
-
 def _build(L, b, h, rho, origin, n_modes: int, D) -> ModalTank:
+    """`modal_tank`'s program (staging.py `evaluated`: one per mode count)."""
     nx = max(NX, 8 * n_modes)
     xg, wg = np.polynomial.legendre.leggauss(nx)
     L = jnp.asarray(L, dtype=float)
@@ -400,3 +390,6 @@ def _build(L, b, h, rho, origin, n_modes: int, D) -> ModalTank:
     vort0 = (I.Bw - (w * flux) @ phis, I.W - w @ (chi * flux + (x - 0.5 * L) * 2.0 * Gz),
              I.wint - jnp.stack([w @ Gx, w @ Gz]), I.Zwx - w @ Gux, I.Xwz - (w * x) @ Gz)
     return eqx.tree_at(lambda m: (m.vort0, m.S0), t, (vort0, t.moments(I)[0]))
+
+
+_modal_tank = evaluated(_build, static_argnums=5)
