@@ -136,3 +136,22 @@ def staged(fn):
         with no_eager_folding():
             return jitted(*args, **kwargs)
     return call
+
+
+def evaluated(fn, static_argnums=()):
+    """`fn` (a build step written with jax.numpy) as one compiled program, where op by op every line
+    compiled a tiny XLA program of its own. With concrete arguments it is evaluated now, even inside
+    an outer trace (vmap, jit: its arrays stay concrete, as its eager operations left them); with
+    traced ones it is staged into the caller's program. Its operations on constants are staged in
+    either case (`no_eager_folding`), not evaluated one by one."""
+    static = (static_argnums,) if isinstance(static_argnums, int) else tuple(static_argnums)
+    jitted = jax.jit(fn, static_argnums=static)
+
+    @functools.wraps(fn)
+    def call(*args):
+        with no_eager_folding():
+            if any(isinstance(a, jax.core.Tracer) for a in jax.tree_util.tree_leaves(args)):
+                return jitted(*args)
+            program = jitted.lower(*args).compile()      # cached by JAX: compiled once per signature
+        return program(*(a for i, a in enumerate(args) if i not in static))
+    return call

@@ -22,6 +22,8 @@ import numpy as np
 from jax.scipy.special import i0e, i1e
 from scipy import special
 
+from ...staging import evaluated
+
 #: terms of the vortical flows' series
 SJ_TERMS = 24
 #: relative tolerance of two modes' wavenumbers that makes them one degenerate group
@@ -173,8 +175,9 @@ class DiskBase:
 
     def vortical_columns(self, D, x, y):
         """The flows' radial factors at the points (x, y) (`cylinder_columns`: Bessel functions, formed
-        once at a tank's quadrature points, never in a step)."""
-        return cylinder_columns(self.R, D, x, y)
+        once at a tank's quadrature points, never in a step; one compiled program, staging.py
+        `evaluated`, where op by op they compiled some 30)."""
+        return _columns_program(self.R, D, x, y)
 
     def vortical_at(self, columns, D, z):
         """The vortical flows at heights z over the points of `vortical_columns`."""
@@ -260,6 +263,9 @@ def cylinder_columns(R, D, x, y):
     mrs = jnp.where(mr > 0, mr, 1.0)
     I1r = jnp.where(mr > 0, i1e(mrs) / mrs, 0.5) * scale      # I_1(mu r) / (mu r), scaled
     return (xc, yc, c, s, b * jnp.where(mr > 0, i1pe(mrs), 0.5) * scale, b * I1r, b * I1r * mr)
+
+
+_columns_program = evaluated(cylinder_columns)
 
 
 def _odd_series(B, alpha, sign):

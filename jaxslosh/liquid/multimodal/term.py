@@ -47,6 +47,7 @@ import jax
 import jax.numpy as jnp
 import numpy as np
 
+from ...staging import evaluated
 from .columns import spd_inverse
 from .modes import odd_powers
 
@@ -352,7 +353,23 @@ class ModalTank(eqx.Module):
 
 def modal_tank(L, b, h, rho, origin, n_modes: int, D=None) -> ModalTank:
     """The tank, with its rest values (the vortical integrals less their surface terms, the first
-    moment) formed once here by quadrature over the liquid at rest (`integrals_quadrature`)."""
+    moment) formed once here by quadrature over the liquid at rest (`integrals_quadrature`).
+
+    The build is one compiled program per mode count (`_build`, staging.py `evaluated`), where op by
+    op its tables and quadrature compiled some 150 tiny XLA programs. Built from concrete values it
+    is evaluated now, even inside an outer trace; traced values (a fill depth under differentiation)
+    stage it into the caller's program."""
+    return _modal_tank(*(_value(a) for a in (L, b, h, rho, origin)), n_modes, None if D is None else _value(D))
+
+
+def _value(a):
+    """An argument of the compiled build: a JAX array (a tracer among them) as it is, anything else as
+    a float64 NumPy array (an argument of the program, not a constant compiled into it)."""
+    return a if isinstance(a, jax.Array) else np.asarray(a, dtype=float)
+
+
+def _build(L, b, h, rho, origin, n_modes: int, D) -> ModalTank:
+    """`modal_tank`'s program (staging.py `evaluated`: one per mode count)."""
     nx = max(NX, 8 * n_modes)
     xg, wg = np.polynomial.legendre.leggauss(nx)
     L = jnp.asarray(L, dtype=float)
@@ -373,3 +390,6 @@ def modal_tank(L, b, h, rho, origin, n_modes: int, D=None) -> ModalTank:
     vort0 = (I.Bw - (w * flux) @ phis, I.W - w @ (chi * flux + (x - 0.5 * L) * 2.0 * Gz),
              I.wint - jnp.stack([w @ Gx, w @ Gz]), I.Zwx - w @ Gux, I.Xwz - (w * x) @ Gz)
     return eqx.tree_at(lambda m: (m.vort0, m.S0), t, (vort0, t.moments(I)[0]))
+
+
+_modal_tank = evaluated(_build, static_argnums=5)
