@@ -9,6 +9,7 @@ from typing import NamedTuple
 import equinox as eqx
 import jax
 import jax.numpy as jnp
+import numpy as np
 
 from ..assemble.system import Built
 from ..io.status import Status
@@ -260,8 +261,28 @@ def _block_size(n: int) -> int:
     return r
 
 
+def _traced(tree) -> bool:
+    return any(isinstance(x, jax.core.Tracer) for x in jax.tree_util.tree_leaves(tree))
+
+
 def concat_frames(frames):
+    """Frames joined along their frame axis. Concrete frames are fetched once and joined on the host
+    (NumPy copies the same values; an eager jnp op per field compiled a program each); traced ones
+    stay jnp, in the caller's (differentiable) program."""
+    if not _traced(frames):
+        return jax.tree_util.tree_map(lambda *xs: np.concatenate(xs), *jax.device_get(frames))
     return jax.tree_util.tree_map(lambda *xs: jnp.concatenate(xs), *frames)
+
+
+def with_first(f0, frames):
+    """The frames after the first frame `f0` (concat_frames: on the host where concrete)."""
+    lift = (lambda x: np.asarray(x)[None]) if not _traced(f0) else (lambda x: x[None])
+    return concat_frames([jax.tree_util.tree_map(lift, f0), frames])
+
+
+# Concrete frames: one program, not one per eager op. At LLVM's optimisation level 0 its numbers are
+# the eager ops' to the bit (optimised, the fused program contracts multiply-adds: last-bit changes).
+_rpy_jit = jax.jit(rpy_from_quat, compiler_options={"xla_backend_optimization_level": 0})
 
 
 def nodal(b: Built, D):
@@ -274,8 +295,9 @@ def frame_datasets(b: Built, fr: Frame, p0=None, fields: bool = True) -> dict:
     """Frames (leading axes [batch,] frame) as the result file's datasets (io/result.py `schema`).
     `p0`: the probes' initial positions (default: the first frame's); `fields`: the tanks' nodal
     displacement fields too (b.tanks: the host-side blocks)."""
+    rpy = rpy_from_quat if _traced(fr.q) else _rpy_jit
     d = {"time": fr.t, "vessel/position": fr.X0, "vessel/quaternion": fr.q, "vessel/angular_velocity": fr.omega,
-         "vessel/roll_pitch_yaw": rpy_from_quat(fr.q), "energy/kinetic": fr.ke, "energy/potential": fr.pe,
+         "vessel/roll_pitch_yaw": rpy(fr.q), "energy/kinetic": fr.ke, "energy/potential": fr.pe,
          "solver/iterations": fr.iterations, "solver/residual": fr.residual, "solver/constraint": fr.gmax}
     P = fr.probes                                                   # (..., n, P, 3)
     p0 = P[..., :1, :, :] if p0 is None else p0
@@ -293,7 +315,7 @@ def frame_datasets(b: Built, fr: Frame, p0=None, fields: bool = True) -> dict:
             d[f"bodies/{name}/position"] = B[..., :3]
             d[f"bodies/{name}/quaternion"] = B[..., 3:7]
             d[f"bodies/{name}/angular_velocity"] = B[..., 7:]
-            d[f"bodies/{name}/roll_pitch_yaw"] = rpy_from_quat(B[..., 3:7])
+            d[f"bodies/{name}/roll_pitch_yaw"] = rpy(B[..., 3:7])
         for i, name in enumerate(term.link_names):
             d[f"connections/{name}/force"] = fr.links[..., i, 0]
             d[f"connections/{name}/extension"] = fr.links[..., i, 1]

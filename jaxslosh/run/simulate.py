@@ -23,7 +23,7 @@ from ..scene.keys import check_values, with_overrides
 from ..scene.types import Scene
 from ..solve.linear import Solver, make_solver
 from .compiled import compile_run
-from .loop import Carry, Frame, advance, concat_frames, core, frame_datasets, start, tank_blocks
+from .loop import Carry, Frame, advance, core, frame_datasets, start, tank_blocks, with_first
 
 
 class NumericalFailure(RuntimeError):
@@ -97,7 +97,10 @@ def to_result(b: Built, fr: Frame, scene_text: str, status: str, carry: Carry, s
     carry is traced: the result reads its outcome once computed)."""
     tanks = {t.name: (t.nodes, t.elements) for t in tank_blocks(b)}
     failure = Failure(carry.fail_step, carry.fail_err, carry.fail_it)
-    return result_from(frame_datasets(b, fr), b.probes.names, tanks, status=status, steps_done=carry.k,
+    d = frame_datasets(b, fr)
+    if not isinstance(fr.t, jax.core.Tracer):       # host-joined frames: the result holds jax arrays as before
+        d = jax.device_put(d)                         # (a transfer, no compiled program)
+    return result_from(d, b.probes.names, tanks, status=status, steps_done=carry.k,
                        scene_text=scene_text, status_code=carry.code, failure=failure, dt=float(solver.h),
                        tolerance=float(solver.tol))
 
@@ -159,7 +162,7 @@ def simulate(scene: Scene, params: Optional[dict] = None, *, duration: Optional[
     else:    # compiled as `jaxslosh run` compiles (XLA options, both programs at once), then run
         carry, f0, run = compile_run(bc, solver, n_frames, setup.save_every)
         carry, frames = run(bc, solver, carry, n_frames, setup.save_every)
-    fr = concat_frames([jax.tree_util.tree_map(lambda x: x[None], f0), frames])
+    fr = with_first(f0, frames)
     if isinstance(carry.failed, jax.core.Tracer):
         res = to_result(b, fr, scene.text, "", carry, solver)
         if throw:
