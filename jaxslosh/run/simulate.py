@@ -23,7 +23,7 @@ from ..scene.keys import check_values, with_overrides
 from ..scene.types import Scene
 from ..solve.linear import Solver, make_solver
 from .compiled import compile_run
-from .loop import Carry, Frame, advance, core, frame_datasets, start, tank_blocks, with_first
+from .loop import Carry, Frame, advance, core, frame_datasets, start, tank_blocks, traced, with_first
 
 
 class NumericalFailure(RuntimeError):
@@ -98,8 +98,8 @@ def to_result(b: Built, fr: Frame, scene_text: str, status: str, carry: Carry, s
     tanks = {t.name: (t.nodes, t.elements) for t in tank_blocks(b)}
     failure = Failure(carry.fail_step, carry.fail_err, carry.fail_it)
     d = frame_datasets(b, fr)
-    if not isinstance(fr.t, jax.core.Tracer):       # host-joined frames: the result holds jax arrays as before
-        d = jax.device_put(d)                         # (a transfer, no compiled program)
+    if not traced(fr):      # host-joined frames (under jax.grad a field may be concrete while others are traced)
+        d = jax.device_put(d)       # the result holds jax arrays as before (a transfer, no compiled program)
     return result_from(d, b.probes.names, tanks, status=status, steps_done=carry.k,
                        scene_text=scene_text, status_code=carry.code, failure=failure, dt=float(solver.h),
                        tolerance=float(solver.tol))
