@@ -74,6 +74,7 @@ class Failure(eqx.Module):
 
 
 def is_traced(x) -> bool:
+    """Whether a value (or a pytree of them) holds a JAX tracer: no value to check or to convert."""
     return any(isinstance(v, jax.core.Tracer) for v in jax.tree_util.tree_leaves(x))
 
 

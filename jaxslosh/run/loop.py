@@ -12,7 +12,7 @@ import jax.numpy as jnp
 import numpy as np
 
 from ..assemble.system import Built
-from ..io.status import Status
+from ..io.status import Status, is_traced
 from ..mooring.lumped_term import lumped_observe
 from ..mooring.term import mooring_datasets
 from ..physics.bodies import bodies_term
@@ -261,23 +261,18 @@ def _block_size(n: int) -> int:
     return r
 
 
-def traced(tree) -> bool:
-    """Whether any leaf is a tracer (under jax.grad, fields that do not depend on the inputs stay concrete)."""
-    return any(isinstance(x, jax.core.Tracer) for x in jax.tree_util.tree_leaves(tree))
-
-
 def concat_frames(frames):
     """Frames joined along their frame axis. Concrete frames are fetched once and joined on the host
     (NumPy copies the same values; an eager jnp op per field compiled a program each); traced ones
     stay jnp, in the caller's (differentiable) program."""
-    if not traced(frames):
+    if not is_traced(frames):
         return jax.tree_util.tree_map(lambda *xs: np.concatenate(xs), *jax.device_get(frames))
     return jax.tree_util.tree_map(lambda *xs: jnp.concatenate(xs), *frames)
 
 
 def with_first(f0, frames):
     """The frames after the first frame `f0` (concat_frames: on the host where concrete)."""
-    lift = (lambda x: np.asarray(x)[None]) if not traced(f0) else (lambda x: x[None])
+    lift = (lambda x: np.asarray(x)[None]) if not is_traced(f0) else (lambda x: x[None])
     return concat_frames([jax.tree_util.tree_map(lift, f0), frames])
 
 
@@ -296,7 +291,7 @@ def frame_datasets(b: Built, fr: Frame, p0=None, fields: bool = True) -> dict:
     """Frames (leading axes [batch,] frame) as the result file's datasets (io/result.py `schema`).
     `p0`: the probes' initial positions (default: the first frame's); `fields`: the tanks' nodal
     displacement fields too (b.tanks: the host-side blocks)."""
-    rpy = rpy_from_quat if traced(fr.q) else _rpy_jit
+    rpy = rpy_from_quat if is_traced(fr.q) else _rpy_jit
     d = {"time": fr.t, "vessel/position": fr.X0, "vessel/quaternion": fr.q, "vessel/angular_velocity": fr.omega,
          "vessel/roll_pitch_yaw": rpy(fr.q), "energy/kinetic": fr.ke, "energy/potential": fr.pe,
          "solver/iterations": fr.iterations, "solver/residual": fr.residual, "solver/constraint": fr.gmax}

@@ -17,13 +17,13 @@ import jax.numpy as jnp
 import numpy as np
 
 from ..assemble.system import Built, build
-from ..io.status import failure_text, outcome_of
+from ..io.status import failure_text, is_traced, outcome_of
 from ..io.result import Failure, Result, result_from, truncated
 from ..scene.keys import check_values, with_overrides
 from ..scene.types import Scene
 from ..solve.linear import Solver, make_solver
 from .compiled import compile_run
-from .loop import Carry, Frame, advance, core, frame_datasets, start, tank_blocks, traced, with_first
+from .loop import Carry, Frame, advance, core, frame_datasets, start, tank_blocks, with_first
 
 
 class NumericalFailure(RuntimeError):
@@ -86,11 +86,6 @@ def _trace_clean() -> bool:
     return bool(clean()) if clean is not None else False
 
 
-def is_traced(value) -> bool:
-    """Whether a value (or a pytree of them) holds a JAX tracer: no value to check or to convert."""
-    return any(isinstance(x, jax.core.Tracer) for x in jax.tree_util.tree_leaves(value))
-
-
 def to_result(b: Built, fr: Frame, scene_text: str, status: str, carry: Carry, solver: Solver) -> Result:
     """The result of a run's frames and its final carry: the outcome, steps done and first failure
     are the carry's (leaves, traced inside a transformation); `status` the host's text ("" where the
@@ -98,7 +93,7 @@ def to_result(b: Built, fr: Frame, scene_text: str, status: str, carry: Carry, s
     tanks = {t.name: (t.nodes, t.elements) for t in tank_blocks(b)}
     failure = Failure(carry.fail_step, carry.fail_err, carry.fail_it)
     d = frame_datasets(b, fr)
-    if not traced(fr):      # host-joined frames (under jax.grad a field may be concrete while others are traced)
+    if not is_traced(fr):      # host-joined frames (under jax.grad a field may be concrete while others are traced)
         d = jax.device_put(d)       # the result holds jax arrays as before (a transfer, no compiled program)
     return result_from(d, b.probes.names, tanks, status=status, steps_done=carry.k,
                        scene_text=scene_text, status_code=carry.code, failure=failure, dt=float(solver.h),
