@@ -14,6 +14,12 @@ motion within the step.
 Frames: `fairlead` is in the body frame from the COG; the line's anchor and seabed in the frame of
 the vessel's COG position X0 (its origin the COG's rest position, z up): `lumped_line_term` shifts
 the scene's anchor (x, y from the COG at rest, z from the still-water level) by the COG's height.
+
+A line may hold a body of `[[bodies]]` instead of the vessel (`end`: the body's slot, as a
+connection's ends, physics/bodies.py): its fairlead is then in that body's frame and moves with that
+body's pose and velocities (the configuration's `Xs`, `qs` and the step's rigid velocities of every
+frame: `Kin.vs` in the rows, the frames' velocities in the states' advance), and its force and
+moment go to that body's rows (`Rows.frames`), as the catenary lines' do (mooring/term.py).
 """
 from __future__ import annotations
 
@@ -27,17 +33,24 @@ import jax.numpy as jnp
 import numpy as np
 
 from ..io.line_energy import LINE_ENERGY
-from ..physics.kinematics import rotation_matrix
+from ..physics.bodies import VESSEL, bodies_term, body_rest, end_index
+from ..physics.kinematics import quat_from_rpy, rotation_matrix
 from ..physics.terms import AbstractTerm, Config, Kin, Rows
 from . import lumped as lm
 from ..scene.types import SceneError
 from .lumped_keys import LUMPED_KEYS, read_lumped  # noqa: F401  (the loader's reader, JAX-free)
 
 
+def _point(p_b, pose):
+    """The inertial position and velocity of the point p_b of a body at `pose` = (X, A, V, W): its COG,
+    rotation matrix, COG velocity (inertial) and angular velocity (body frame)."""
+    X, A, V, W = pose
+    return X + A @ p_b, V + A @ jnp.cross(W, p_b)
+
+
 def _fairlead(p_b, c: Config, V0, omega):
-    """The fairlead's inertial position and velocity for the body point p_b."""
-    A = rotation_matrix(c.q)
-    return c.X0 + A @ p_b, V0 + A @ jnp.cross(omega, p_b)
+    """The fairlead's inertial position and velocity for the vessel's point p_b."""
+    return _point(p_b, (c.X0, rotation_matrix(c.q), V0, omega))
 
 
 class LumpedLineTerm(AbstractTerm):
@@ -53,6 +66,7 @@ class LumpedLineTerm(AbstractTerm):
     carried: jax.Array = eqx.field(default_factory=lambda: jnp.zeros(3))
     name: str = eqx.field(static=True, default="line")
     substeps: int = eqx.field(static=True, default=1)
+    end: int = eqx.field(static=True, default=VESSEL)    # the body it holds: VESSEL or a body's slot
 
     # ------------------------------------------------------------ states
     def state_init(self):
@@ -70,8 +84,13 @@ class LumpedLineTerm(AbstractTerm):
         raise TypeError("a lumped line's states follow the vessel's configuration: state_advance_config")
 
     def state_advance_config(self, z, c_old, v_old, c_new, v_new, coef):
-        p0, u0 = _fairlead(self.fairlead, c_old, v_old[:3], v_old[3:6])
-        p1, u1 = _fairlead(self.fairlead, c_new, v_new[:3], v_new[3:6])
+        return self.advance_at(z, (c_old.X0, rotation_matrix(c_old.q), v_old[:3], v_old[3:6]),
+                               (c_new.X0, rotation_matrix(c_new.q), v_new[:3], v_new[3:6]), coef)
+
+    def advance_at(self, z, pose_old, pose_new, coef):
+        """The states at t_{n+1}, its body at `pose_old` at t_n and `pose_new` at t_{n+1} (_point's poses)."""
+        p0, u0 = _point(self.fairlead, pose_old)
+        p1, u1 = _point(self.fairlead, pose_new)
         s = lm.advance(self.line, self.split(z), p0, u0, p1, u1, coef, self.substeps)
         return jnp.concatenate([s.r.reshape(-1), s.v.reshape(-1), jnp.stack([s.dissipated, s.work])])
 
@@ -79,14 +98,22 @@ class LumpedLineTerm(AbstractTerm):
     def force(self, c: Config, V0, omega, z):
         """The line's force on the fairlead (3,), inertial, for the vessel at (c, V0, omega) and the
         line's states z."""
-        p, u = _fairlead(self.fairlead, c, V0, omega)
+        return self.force_at((c.X0, rotation_matrix(c.q), V0, omega), z)
+
+    def force_at(self, pose, z):
+        """`force` with its body at `pose` (_point's)."""
+        p, u = _point(self.fairlead, pose)
         s = self.split(z)
         return lm.fairlead_force(self.line, s.r, s.v, p, u)
 
+    def rows_at(self, pose, z):
+        """(6,) its rows on its body at `pose`: minus the force (inertial, the carried one added) and
+        its moment about the COG in the body's frame."""
+        F = self.force_at(pose, z)
+        return -jnp.concatenate([F + self.carried, jnp.cross(self.fairlead, pose[1].T @ F)])
+
     def rows(self, k: Kin) -> Rows:
-        F = self.force(k.c, k.V0, k.omega, k.z)
-        M_b = jnp.cross(self.fairlead, k.A.T @ F)
-        return Rows(-jnp.concatenate([F + self.carried, M_b]))
+        return Rows(self.rows_at((k.c.X0, k.A, k.V0, k.omega), k.z))
 
     def tension(self, c: Config, V0, omega, z):
         """|force on the fairlead| (N)."""
@@ -95,9 +122,12 @@ class LumpedLineTerm(AbstractTerm):
     def nodes(self, c: Config, z):
         """Every node (N + 1, 3) in the X0 frame: anchor, moving nodes, fairlead (the result file's
         `/mooring/<line>/nodes`)."""
-        A = rotation_matrix(c.q)
+        return self.nodes_at(c.X0, rotation_matrix(c.q), z)
+
+    def nodes_at(self, X, A, z):
+        """`nodes` with its body's COG at X, its rotation A."""
         s = self.split(z)
-        return jnp.concatenate([self.line.anchor[None], s.r, (c.X0 + A @ self.fairlead)[None]], axis=0)
+        return jnp.concatenate([self.line.anchor[None], s.r, (X + A @ self.fairlead)[None]], axis=0)
 
     def describe(self) -> tuple:
         ln = self.line
@@ -110,17 +140,43 @@ class LumpedLines(AbstractTerm):
     LumpedLineTerm equations mapped over the lines (jax.vmap) on their arrays stacked, so that the
     step's program holds one line's sub-steps whatever the number of lines (each line a term of
     its own repeated them per line in every copy of the residual: the FLNG scene's eight lines
-    made two thirds of its program, docs/benchmarks.md). States: (lines, the line's states)."""
+    made two thirds of its program, docs/benchmarks.md). States: (lines, the line's states).
+    Lines on bodies of [[bodies]] (`ends`, static: each line's VESSEL or body slot; `n_bodies` the
+    scene's bodies) take their body's pose, gathered per line, and put their rows on its frame."""
     lines: tuple             # LumpedLineTerm, one per line, all of one shape (group_lines)
+    ends: tuple = eqx.field(static=True, default=())    # per line: VESSEL or a body's slot; () all on the vessel
+    n_bodies: int = eqx.field(static=True, default=0)
 
     @property
     def names(self) -> tuple:
         return tuple(t.name for t in self.lines)
 
+    @property
+    def on_bodies(self) -> bool:
+        """Whether some line holds a body of [[bodies]] (then the poses are per line)."""
+        return any(e != VESSEL for e in self.ends)
+
     def stacked(self) -> LumpedLineTerm:
         """The lines as one LumpedLineTerm whose arrays have a leading axis of lines."""
-        plain = [dataclasses.replace(t, name="") for t in self.lines]
+        plain = [dataclasses.replace(t, name="", end=VESSEL) for t in self.lines]
         return jax.tree_util.tree_map(lambda *x: jnp.stack(x), *plain)
+
+    def poses(self, c: Config, v, A=None):
+        """(pose, its vmap axis): the vessel's (X0, A, V0, omega) for every line (axis None) where all
+        hold the vessel, else each line's body's, stacked (axis 0); `v` the rigid velocities of every
+        frame (the vessel's six, then six per body), `A` the vessel's rotation where known."""
+        A = rotation_matrix(c.q) if A is None else A
+        vessel = (c.X0, A, v[:3], v[3:6])
+        if not self.on_bodies:
+            return vessel, None
+        S = self.n_bodies
+        if c.Xs is None or v.shape[0] < 6 + 6 * S:
+            raise ValueError("lumped lines on bodies need the bodies' poses and velocities (the step's)")
+        vs = v[6:6 + 6 * S].reshape(S, 6)
+        idx = np.array([0 if e == VESSEL else 1 + e for e in self.ends])
+        every = (jnp.concatenate([c.X0[None], c.Xs]), jnp.concatenate([A[None], jax.vmap(rotation_matrix)(c.qs)]),
+                 jnp.concatenate([v[None, :3], vs[:, :3]]), jnp.concatenate([v[None, 3:6], vs[:, 3:]]))
+        return tuple(x[idx] for x in every), 0
 
     def state_init(self):
         return jnp.stack([t.state_init() for t in self.lines])
@@ -132,34 +188,46 @@ class LumpedLines(AbstractTerm):
         raise TypeError("a lumped line's states follow the vessel's configuration: state_advance_config")
 
     def state_advance_config(self, z, c_old, v_old, c_new, v_new, coef):
-        return jax.vmap(lambda t, zi: t.state_advance_config(zi, c_old, v_old, c_new, v_new, coef))(self.stacked(), z)
+        (p0, ax), (p1, _) = self.poses(c_old, v_old), self.poses(c_new, v_new)
+        return jax.vmap(lambda t, zi, a, b: t.advance_at(zi, a, b, coef), in_axes=(0, 0, ax, ax))(
+            self.stacked(), z, p0, p1)
 
     def rows(self, k: Kin) -> Rows:
-        rigid = jax.vmap(lambda t, zi: t.rows(k._replace(z=zi)).rigid)(self.stacked(), k.z)
-        return Rows(jnp.sum(rigid, axis=0))
+        v = k.v6 if k.vs is None else jnp.concatenate([k.v6, k.vs])
+        pose, ax = self.poses(k.c, v, k.A)
+        rigid = jax.vmap(lambda t, zi, p: t.rows_at(p, zi), in_axes=(0, 0, ax))(self.stacked(), k.z, pose)
+        if not self.on_bodies:
+            return Rows(jnp.sum(rigid, axis=0))
+        slot = np.array([0 if e == VESSEL else 1 + e for e in self.ends])
+        per = jax.ops.segment_sum(rigid, slot, num_segments=self.n_bodies + 1)
+        return Rows(per[0], frames=per[1:].reshape(-1))
 
-    def observe(self, z, c: Config, V0, omega) -> tuple:
+    def observe(self, z, c: Config, v) -> tuple:
         """(fairlead tensions (n,), anchor tensions (n,), nodes (n, N + 1, 3), energies {part: (n,)}) of
-        the lines (the energies: lm.energies, the dissipated work and the fairlead's)."""
-        def one(t, zi):
-            p, u = _fairlead(t.fairlead, c, V0, omega)
+        the lines (the energies: lm.energies, the dissipated work and the fairlead's); `v` the rigid
+        velocities of every frame (`poses`)."""
+        def one(t, zi, pose):
+            p, u = _point(t.fairlead, pose)
             s = t.split(zi)
             parts = dict(lm.energies(t.line, s.r, s.v, p), dissipated=s.dissipated, fairlead_work=s.work)
             return (jnp.linalg.norm(lm.fairlead_force(t.line, s.r, s.v, p, u)),
-                    jnp.linalg.norm(lm.anchor_force(t.line, s.r, s.v, p, u)), t.nodes(c, zi),
+                    jnp.linalg.norm(lm.anchor_force(t.line, s.r, s.v, p, u)), t.nodes_at(pose[0], pose[1], zi),
                     {k: parts[k] for k in LINE_ENERGY})
-        return jax.vmap(one)(self.stacked(), z)
+        pose, ax = self.poses(c, v)
+        return jax.vmap(one, in_axes=(0, 0, ax))(self.stacked(), z, pose)
 
     def describe(self) -> tuple:
         return sum((t.describe() for t in self.lines), ())
 
 
-def group_lines(terms) -> tuple:
-    """The line terms as LumpedLines, one per shape (segments, sub-steps), in their first line's order."""
+def group_lines(terms, n_bodies: int = 0) -> tuple:
+    """The line terms as LumpedLines, one per shape (segments, sub-steps), in their first line's
+    order; `n_bodies`: the scene's [[bodies]] (where lines hold some)."""
     groups: dict = {}
     for t in terms:
         groups.setdefault((t.line.segments, t.line.substep_max, t.substeps), []).append(t)
-    return tuple(LumpedLines(tuple(g)) for g in groups.values())
+    return tuple(LumpedLines(tuple(g), tuple(t.end for t in g) if any(t.end != VESSEL for t in g) else (),
+                             n_bodies) for g in groups.values())
 
 
 @jax.jit
@@ -189,15 +257,17 @@ def _static(line, p_b, X0, q, name):
 def lumped_line_term(c0: Config, dt: float, *, name: str, fairlead, anchor, length, weight, ea,
                      depth: Optional[float] = None, cog_height: float = 0.0, gravity: float = 9.81,
                      water_density: float = 1025.0, current=(0.0, 0.0, 0.0), balanced: bool = False,
-                     **lumped) -> LumpedLineTerm:
+                     end: int = VESSEL, rest=None, **lumped) -> LumpedLineTerm:
     """The term of one `[[mooring]]` table with `model = "lumped"`: the scene's values (fairlead in
     the body frame from the COG; anchor x, y from the COG at rest and z from the still-water level;
     `depth` the water depth, None without a seabed; `cog_height` the COG's height above the
     still-water level at rest) and the lumped-only keys (LUMPED_KEYS), for the vessel starting at
     c0 (its lines start in their static shape there) and stepped at dt. `balanced`: the vessel's
     hydrostatics are linear springs about the rest position (X0 = 0, level), whose buoyancy then
-    carries the line's vertical pull there (`carried`, as the catenary lines' term does). Bad values raise ValueError naming the key
-    (`mooring.<name>.<key>`)."""
+    carries the line's vertical pull there (`carried`, as the catenary lines' term does). `end`: the
+    body it holds (VESSEL, or a [[bodies]] body's slot: then c0 is that body's initial pose and
+    `rest` = (X, q) its rest pose, where its springs are balanced). Bad values raise ValueError
+    naming the key (`mooring.<name>.<key>`)."""
     unknown = set(lumped) - set(LUMPED_KEYS)
     if unknown:
         raise ValueError(f"mooring.{name}.{sorted(unknown)[0]}: not a key of a lumped line")
@@ -221,21 +291,23 @@ def lumped_line_term(c0: Config, dt: float, *, name: str, fairlead, anchor, leng
     p_b = jnp.asarray(fairlead, dtype=float)
     nodes0, F0 = _static(line, p_b, c0.X0, c0.q, name)
     carried = jnp.zeros(3)
-    if balanced:       # the pull at the rest position (X0 = 0, level), where the springs are balanced
-        rest = np.zeros(3), np.array([1.0, 0.0, 0.0, 0.0])
-        # a vessel starting at rest: the same solve as its start's (half the lines' build)
+    if balanced:       # the pull at the rest pose (the vessel's: X0 = 0, level), where the springs are balanced
+        rest = (np.zeros(3), np.array([1.0, 0.0, 0.0, 0.0])) if rest is None else \
+            tuple(np.asarray(x, dtype=float) for x in rest)
+        # a body starting at rest: the same solve as its start's (half the lines' build)
         at_rest = all(np.array_equal(np.asarray(a, dtype=float), b) for a, b in zip((c0.X0, c0.q), rest))
         _, F = (None, F0) if at_rest else _static(line, p_b, *rest, name)
         carried = jnp.array([0.0, 0.0, -F[2]])
-    return LumpedLineTerm(line, p_b, nodes0, carried, name, line.substeps(dt))
+    return LumpedLineTerm(line, p_b, nodes0, carried, name, line.substeps(dt), end)
 
 
 # ---------------------------------------------------------------------------- the scene's tables
 def build_lumped_lines(scene, balanced: bool, q0=None) -> tuple:
     """The terms of the scene's `[[mooring]]` lines with `model = "lumped"` (each line's lumped
     values in its `lumped` attribute, read_lumped's pairs; absent: the defaults), each in its static
-    shape with the vessel at its initial position and attitude q0 (identity when None), sub-stepped
-    for the scene's dt."""
+    shape with the vessel at its initial position and attitude q0 (identity when None), or the body
+    of [[bodies]] it holds at that body's initial pose, sub-stepped for the scene's dt. `balanced`:
+    the vessel's hydrostatics are linear springs; a body's lines are carried where its own are."""
     lines = [m for m in scene.mooring if getattr(m, "model", "catenary") == "lumped"]
     if not lines:
         return ()
@@ -246,28 +318,46 @@ def build_lumped_lines(scene, balanced: bool, q0=None) -> tuple:
     X0 = jnp.asarray(scene.vessel.initial.position, dtype=float)
     q = jnp.array([1.0, 0.0, 0.0, 0.0]) if q0 is None else jnp.asarray(q0, dtype=float)
     c0 = Config(X0, q, jnp.zeros(0))
+    index = end_index(b.name for b in getattr(scene, "bodies", ())) | {getattr(scene.vessel, "name", "vessel"): VESSEL}
     terms = []
     for m in lines:
+        end = index[getattr(m, "body", "vessel")]
+        held = dict(balanced=balanced) if end == VESSEL else _body_pose(scene, end)
+        start = held.pop("c0", c0)
         try:
             terms.append(lumped_line_term(
-                c0, scene.simulation.dt, name=m.name, fairlead=m.fairlead, anchor=m.anchor, length=m.length,
+                start, scene.simulation.dt, name=m.name, fairlead=m.fairlead, anchor=m.anchor, length=m.length,
                 weight=m.weight, ea=m.ea, depth=env.depth, cog_height=getattr(scene.vessel, "cog_height", 0.0),
-                gravity=env.gravity, water_density=env.water_density, balanced=balanced,
+                gravity=env.gravity, water_density=env.water_density, **held,
                 **dict(getattr(m, "lumped", ()))))
         except ValueError as e:
             raise SceneError(f"mooring.{m.name}", str(e)) from e
     return tuple(terms)
 
 
-def lumped_observe(system, z: tuple, c: Config, V0, omega) -> dict:
-    """For the result file, at one frame (the integrator state's configuration c, velocities and the
-    terms' states z, as State.z): `mooring/<line>/fairlead_tension`, `anchor_tension` (N) and
-    `nodes` ((N + 1, 3), in the frame of the vessel's position X0) of each lumped line, and its
-    energies `energy/mooring/<line>/<part>` (J: lm.energies, the dissipated work and the fairlead's)."""
+def _body_pose(scene, s: int) -> dict:
+    """lumped_line_term's arguments for a line on the body of slot s: its initial pose c0 (as
+    assemble/bodies.py starts it: its rest pose offset by its initial values), its rest pose and
+    whether its buoyancy carries the line's pull at rest (linear springs about that pose)."""
+    b = scene.bodies[s]
+    X = jnp.asarray(body_rest(b, scene.vessel.cog_height))
+    turn = jnp.array([0.0, 0.0, b.heading])
+    q0 = quat_from_rpy(jnp.asarray(b.initial.roll_pitch_yaw, dtype=float) + turn)
+    c0 = Config(X + jnp.asarray(b.initial.position, dtype=float), q0, jnp.zeros(0))
+    springs = b.hydrostatics is not None and not b.hydrostatics.nonlinear
+    return dict(c0=c0, end=s, rest=(X, quat_from_rpy(turn)), balanced=springs)
+
+
+def lumped_observe(system, z: tuple, c: Config, v) -> dict:
+    """For the result file, at one frame (the integrator state's configuration c, velocities v (the
+    vessel's six, then six per [[bodies]] body, as the state's) and the terms' states z, as
+    State.z): `mooring/<line>/fairlead_tension`, `anchor_tension` (N) and `nodes` ((N + 1, 3), in
+    the frame of the vessel's position X0) of each lumped line, and its energies
+    `energy/mooring/<line>/<part>` (J: lm.energies, the dissipated work and the fairlead's)."""
     out = {}
     for term, zi in zip(system.all_terms(), z, strict=True):
         if isinstance(term, LumpedLines):
-            fair, anchor, nodes, energy = term.observe(zi, c, V0, omega)
+            fair, anchor, nodes, energy = term.observe(zi, c, v)
             for i, name in enumerate(term.names):
                 out[f"mooring/{name}/fairlead_tension"] = fair[i]
                 out[f"mooring/{name}/anchor_tension"] = anchor[i]
@@ -279,7 +369,10 @@ def lumped_observe(system, z: tuple, c: Config, V0, omega) -> dict:
 def with_lines(stepper, terms):
     """A Stepper (run/stepper.py) whose System has the given line terms added beside its own, as
     LumpedLines (how a test or a user adds lumped lines before the scene's keys are wired)."""
-    return eqx.tree_at(lambda s: s.built.system.terms, stepper, stepper.built.system.terms + group_lines(terms))
+    system = stepper.built.system
+    term = bodies_term(system)
+    S = 0 if term is None else term.S
+    return eqx.tree_at(lambda s: s.built.system.terms, stepper, system.terms + group_lines(terms, S))
 
 
 def line_states(stepper, state, term_index: Optional[int] = None):

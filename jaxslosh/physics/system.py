@@ -145,7 +145,8 @@ class System(AbstractFloating):
         vessel's)."""
         nf = self.nf
         if core:
-            ry, rz, frames = self.terms_rows(c, vy[:3], vy[3:6], vz[:nf], ay[:6], az[:nf], t, z)
+            ry, rz, frames = self.terms_rows(c, vy[:3], vy[3:6], vz[:nf], ay[:6], az[:nf], t, z,
+                                             vy[6:] if vy.shape[0] > 6 else None)
         else:
             ry, rz, frames = jnp.zeros(6), jnp.zeros(nf), None
         states = self.states_init() if z is None else z
@@ -222,10 +223,11 @@ class System(AbstractFloating):
         """Gravity in the body frame: turning with the body (the load of eq. 32), or frozen at the start."""
         return gravity_in(A if self.gravity_turning else rotation_matrix(self.q_ref), self.gravity)
 
-    def kin(self, c: Config, V0, omega, d_dot, a6=None, d_acc=None, t=0.0) -> Kin:
-        """The vessel's Kin (floating.frame_kin), its gravity frozen at the start where it does not turn."""
+    def kin(self, c: Config, V0, omega, d_dot, a6=None, d_acc=None, t=0.0, vs=None) -> Kin:
+        """The vessel's Kin (floating.frame_kin), its gravity frozen at the start where it does not turn;
+        `vs` the other frames' rigid velocities (Kin.vs)."""
         return frame_kin(c, V0, omega, d_dot, a6, d_acc, t, self.gravity,
-                         None if self.gravity_turning else rotation_matrix(self.q_ref))
+                         None if self.gravity_turning else rotation_matrix(self.q_ref))._replace(vs=vs)
 
     def at_time(self, t) -> "System":
         """The System for the evaluations of one step at time t: each term's `at_time` (what
@@ -273,10 +275,10 @@ class System(AbstractFloating):
         rigid, d, _ = self.terms_rows(c, V0, omega, d_dot, a6, d_acc, t, z)
         return self.hold(rigid, a6, t), d
 
-    def terms_rows(self, c: Config, V0, omega, d_dot, a6, d_acc, t=0.0, z=None):
+    def terms_rows(self, c: Config, V0, omega, d_dot, a6, d_acc, t=0.0, z=None, vs=None):
         """`residual_parts` before `hold`: the sum of the terms' rows (vessel, deformable, the bodies'
-        frames: None where no term has rows there)."""
-        return self.frame_rows(self.kin(c, V0, omega, d_dot, a6, d_acc, t), z)
+        frames: None where no term has rows there); `vs` the other frames' rigid velocities (Kin.vs)."""
+        return self.frame_rows(self.kin(c, V0, omega, d_dot, a6, d_acc, t, vs), z)
 
     # ---------------------------------------------------------------- energies
     def kinetic_energy(self, c: Config, v):

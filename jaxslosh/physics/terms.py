@@ -74,6 +74,9 @@ class Kin(NamedTuple):
     z: jax.Array            # this term's integrator states at t (zero-size for a term without)
     A: jax.Array            # (3, 3) rotation matrix of q
     g_b: jax.Array          # (3,) gravity acceleration in the body frame
+    # (6 S,) the other floating frames' rigid velocities (V inertial, omega body; the [[bodies]]'), for
+    # a term with rows on them that reads their rates (a lumped mooring line on a body); None without
+    vs: Optional[jax.Array] = None
 
     @property
     def acc(self):

@@ -94,7 +94,7 @@ def _frame(b: Built, s: State, it, err, failed) -> Frame:
     heave = [sysm.liquid.surface_heave(s.c.d, idx) for idx in b.surfaces]
     surface = jnp.array([[h.min(), h.max()] for h in heave]).reshape(len(heave), 2)
     bodies, links = body_frames(sysm, s.c, s.v)
-    lines = lumped_observe(sysm, s.z, s.c, s.v[:3], s.v[3:6])
+    lines = lumped_observe(sysm, s.z, s.c, s.v)
     term = bodies_term(sysm)
     body_d = s.c.eta if term is not None and term.M else jnp.zeros(0)
     return Frame(s.t, s.c.X0, s.c.q, s.v[3:6], probes, ke, pe, it, err, sysm.liquid.frame_field(s.c.d), failed, gmax,

@@ -42,10 +42,6 @@ def read_mooring(tables, depth, vessel: Vessel, warnings: list[str], bodies: tup
             raise SceneError("environment.depth", f"is required by the mooring lines ({where}): the water depth "
                                                   "in m, which places the seabed")
         body = v.get("body", "vessel")
-        if body in held and lumped:
-            raise SceneError(f"{where}.body", f"{show(body)}: lumped-mass lines (line {show(v.get('name', f'line{i + 1}'))}, "
-                                              "model = \"lumped\") hold the vessel only; a body of [[bodies]] "
-                                              "takes catenary lines (the default model)")
         if body not in owners:
             raise SceneError(f"{where}.body", f"{show(body)} is not a body of the scene (the vessel is "
                                               f"{show(vessel_name)}; \"vessel\" names it too"

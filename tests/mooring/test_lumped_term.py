@@ -106,7 +106,7 @@ def test_observe_gives_tensions_and_nodes(run):
 
     @jax.jit        # one compiled program (eagerly, a hundred one-operation programs)
     def observed(b, zs):
-        return (lumped_observe(st.built.system, b.z, b.c, b.v[:3], b.v[3:6]),
+        return (lumped_observe(st.built.system, b.z, b.c, b.v),
                 {name: lines[name][0].tension(b.c, b.v[:3], b.v[3:6], z) for name, z in zs.items()})
 
     d, tension = observed(b, {name: z for name, (_, z) in lines.items()})
