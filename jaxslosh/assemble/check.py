@@ -6,6 +6,7 @@ from __future__ import annotations
 
 import dataclasses
 
+from ..physics.about import holder
 from ..physics.system import System
 from ..physics.terms import AbstractTerm
 from ..scene.types import Scene
@@ -42,10 +43,27 @@ def model_effects(system: System) -> list[tuple[str, str, object]]:
     return out
 
 
+def _body_named(text: str, names) -> str:
+    """Which of `names` a "floating body" line (assemble/bodies.py: "'<name>': ...") is about; "" if none."""
+    return next((n for n in names if text.startswith(f"{n!r}:")), "")
+
+
 def effects_summary(scene: Scene) -> str:
     """`check`'s effects: the model's own lines, what `[effects]` switched off, and the unknowns."""
     lines = ["effects simulated:"]
-    lines += [f"  - {name}: {why}" for name, why, _ in model_effects(outline(scene))]
+    effects = model_effects(outline(scene))
+    # a line a term adds for a [[bodies]] body (a mooring line it holds) goes under that body's own line
+    held: dict = {}
+    for name, why, _ in effects:
+        body, text = holder(why)
+        if body is not None:
+            held.setdefault(body, []).append(f"      - {name}: {text}")
+    for name, why, _ in effects:
+        if holder(why)[0] is None:
+            lines.append(f"  - {name}: {why}")
+            if name == "floating body":
+                lines += held.pop(_body_named(why, held), [])
+    lines += [line for rest in held.values() for line in rest]      # a body check did not list (none expected)
     off = switched_off(scene)
     if off:
         lines.append("switched off in [effects]: " + ", ".join(off))

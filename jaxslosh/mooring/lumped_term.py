@@ -33,6 +33,7 @@ import jax.numpy as jnp
 import numpy as np
 
 from ..io.line_energy import LINE_ENERGY
+from ..physics.about import held_by
 from ..physics.bodies import VESSEL, bodies_term, body_rest, end_index
 from ..physics.kinematics import quat_from_rpy, rotation_matrix
 from ..physics.terms import AbstractTerm, Config, Kin, Rows
@@ -67,6 +68,7 @@ class LumpedLineTerm(AbstractTerm):
     name: str = eqx.field(static=True, default="line")
     substeps: int = eqx.field(static=True, default=1)
     end: int = eqx.field(static=True, default=VESSEL)    # the body it holds: VESSEL or a body's slot
+    holder: str = eqx.field(static=True, default="")     # that body's name ("" for the vessel): check's words
 
     # ------------------------------------------------------------ states
     def state_init(self):
@@ -131,8 +133,9 @@ class LumpedLineTerm(AbstractTerm):
 
     def describe(self) -> tuple:
         ln = self.line
-        return (("mooring", f"lumped line {self.name}: {ln.segments} segments, {self.substeps} sub-steps "
-                 f"of the step (symplectic Euler, stable sub-step {ln.substep_max:.3g} s)"),)
+        text = (f"lumped line {self.name}: {ln.segments} segments, {self.substeps} sub-steps "
+                f"of the step (symplectic Euler, stable sub-step {ln.substep_max:.3g} s)")
+        return (("mooring", held_by(self.holder, text) if self.holder else text),)
 
 
 class LumpedLines(AbstractTerm):
@@ -158,7 +161,7 @@ class LumpedLines(AbstractTerm):
 
     def stacked(self) -> LumpedLineTerm:
         """The lines as one LumpedLineTerm whose arrays have a leading axis of lines."""
-        plain = [dataclasses.replace(t, name="", end=VESSEL) for t in self.lines]
+        plain = [dataclasses.replace(t, name="", end=VESSEL, holder="") for t in self.lines]
         return jax.tree_util.tree_map(lambda *x: jnp.stack(x), *plain)
 
     def poses(self, c: Config, v, A=None):
@@ -257,7 +260,7 @@ def _static(line, p_b, X0, q, name):
 def lumped_line_term(c0: Config, dt: float, *, name: str, fairlead, anchor, length, weight, ea,
                      depth: Optional[float] = None, cog_height: float = 0.0, gravity: float = 9.81,
                      water_density: float = 1025.0, current=(0.0, 0.0, 0.0), balanced: bool = False,
-                     end: int = VESSEL, rest=None, **lumped) -> LumpedLineTerm:
+                     end: int = VESSEL, rest=None, holder: str = "", **lumped) -> LumpedLineTerm:
     """The term of one `[[mooring]]` table with `model = "lumped"`: the scene's values (fairlead in
     the body frame from the COG; anchor x, y from the COG at rest and z from the still-water level;
     `depth` the water depth, None without a seabed; `cog_height` the COG's height above the
@@ -266,7 +269,7 @@ def lumped_line_term(c0: Config, dt: float, *, name: str, fairlead, anchor, leng
     hydrostatics are linear springs about the rest position (X0 = 0, level), whose buoyancy then
     carries the line's vertical pull there (`carried`, as the catenary lines' term does). `end`: the
     body it holds (VESSEL, or a [[bodies]] body's slot: then c0 is that body's initial pose and
-    `rest` = (X, q) its rest pose, where its springs are balanced). Bad values raise ValueError
+    `rest` = (X, q) its rest pose, where its springs are balanced; `holder` its name). Bad values raise ValueError
     naming the key (`mooring.<name>.<key>`)."""
     unknown = set(lumped) - set(LUMPED_KEYS)
     if unknown:
@@ -298,7 +301,7 @@ def lumped_line_term(c0: Config, dt: float, *, name: str, fairlead, anchor, leng
         at_rest = all(np.array_equal(np.asarray(a, dtype=float), b) for a, b in zip((c0.X0, c0.q), rest))
         _, F = (None, F0) if at_rest else _static(line, p_b, *rest, name)
         carried = jnp.array([0.0, 0.0, -F[2]])
-    return LumpedLineTerm(line, p_b, nodes0, carried, name, line.substeps(dt), end)
+    return LumpedLineTerm(line, p_b, nodes0, carried, name, line.substeps(dt), end, holder)
 
 
 # ---------------------------------------------------------------------------- the scene's tables
@@ -345,7 +348,7 @@ def _body_pose(scene, s: int) -> dict:
     q0 = quat_from_rpy(jnp.asarray(b.initial.roll_pitch_yaw, dtype=float) + turn)
     c0 = Config(X + jnp.asarray(b.initial.position, dtype=float), q0, jnp.zeros(0))
     springs = b.hydrostatics is not None and not b.hydrostatics.nonlinear
-    return dict(c0=c0, end=s, rest=(X, quat_from_rpy(turn)), balanced=springs)
+    return dict(c0=c0, end=s, rest=(X, quat_from_rpy(turn)), balanced=springs, holder=b.name)
 
 
 def lumped_observe(system, z: tuple, c: Config, v) -> dict:

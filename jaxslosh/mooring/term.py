@@ -24,7 +24,7 @@ import jax
 import jax.numpy as jnp
 import numpy as np
 
-from ..physics.about import About
+from ..physics.about import About, held_by
 from ..physics.bodies import VESSEL, body_rest, end_index
 from ..physics.kinematics import quat_from_rpy, rotation_matrix
 from ..physics.terms import AbstractTerm, Config, Kin, Rows
@@ -194,12 +194,9 @@ def build_mooring(scene, balanced: bool, outline: bool = False, params: Optional
     col = lambda key: jnp.stack([jnp.asarray(P(f"mooring.{m.name}.{key}", getattr(m, key)), dtype=float)  # noqa: E731
                                  for m in lines])
     anchor = np.array([m.anchor for m in lines], dtype=float) - np.array([0.0, 0.0, cog])
-    carried_words = (" (the buoyancy carries their vertical pull at rest: linear hydrostatics)" if balanced else "")
-    about = About(("mooring", f"{len(lines)} quasi-static elastic catenary line(s) "
-                              f"{', '.join(repr(m.name) for m in lines)}, depth {scene.environment.depth:g} m"
-                              + carried_words))
     index = end_index(b.name for b in scene.bodies) | {scene.vessel.name: VESSEL}
     ends = tuple(index[m.body] for m in lines)
+    about = _about(scene, lines, ends, balanced)
     on_bodies = any(e != VESSEL for e in ends)
     held = {}
     if on_bodies:
@@ -222,6 +219,25 @@ def build_mooring(scene, balanced: bool, outline: bool = False, params: Optional
     if on_bodies or balanced:
         return _carry_rest(term, balanced, springs if on_bodies else None)
     return term
+
+
+def _about(scene, lines, ends, balanced: bool) -> About:
+    """`check`'s lines of the catenary lines: those on the vessel, then each body's under its name
+    (physics/about.py held_by), each group saying whether its buoyancy carries their pull at rest."""
+    def words(group, carried: bool, whose: str) -> str:
+        return (f"{len(group)} quasi-static elastic catenary line(s) {', '.join(repr(m.name) for m in group)}, "
+                f"depth {scene.environment.depth:g} m"
+                + (f" ({whose} buoyancy carries their vertical pull at rest: linear hydrostatics)" if carried else ""))
+    out = []
+    mine = [m for m, e in zip(lines, ends) if e == VESSEL]
+    if mine:
+        out.append(("mooring", words(mine, balanced, "the")))
+    for s, b in enumerate(scene.bodies):
+        group = [m for m, e in zip(lines, ends) if e == s]
+        if group:
+            springs = b.hydrostatics is not None and not b.hydrostatics.nonlinear
+            out.append(("mooring", held_by(b.name, words(group, springs, "its"))))
+    return About(*out)
 
 
 @eqx.filter_jit

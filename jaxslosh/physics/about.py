@@ -33,3 +33,22 @@ class About:
 
     def __repr__(self):
         return f"About({len(self.lines)} lines)"
+
+
+#: how the text of a line that a term adds for a [[bodies]] body begins (a mooring line on that body):
+#: `jaxslosh check` lists it under that body's own line (assemble/check.py)
+HELD = "on the body {!r}: "
+
+
+def held_by(name: str, text: str) -> str:
+    """`text` of a line that belongs to the body `name`, as `check` finds it (HELD)."""
+    return HELD.format(name) + text
+
+
+def holder(text: str):
+    """(the body's name, the text without HELD) of a line that held_by wrote; (None, text) otherwise."""
+    head = HELD.split("{")[0]
+    if text.startswith(head) and "': " in text:
+        name, rest = text[len(head) + 1:].split("': ", 1)
+        return name, rest
+    return None, text
