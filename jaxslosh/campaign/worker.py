@@ -22,8 +22,8 @@ except ModuleNotFoundError:  # Python 3.10
 from ..assemble.hull import hull_waves
 from ..cache.programs import install as install_cache
 from ..cache import programs
-from ..run.batch import capsize_angles, simulate_seas
-from ..run.capsize import capsize_reason
+from ..run.batch import body_capsize_angles, capsize_angles, simulate_seas
+from ..run.capsize import case_capsize
 from ..scene.load import parse_scene
 from ..scene.types import Scene
 from .cases import case_scene, sea_arrays
@@ -91,12 +91,12 @@ def run_batch(text: str, path: str, duration: Optional[float], values: list, bat
     structure = structure_scene(template, scenes[0])
     result, statuses = simulate_seas(structure, omega, amp, phase, hs, incident)
     t = np.asarray(result.time)
-    angles = capsize_angles(structure)
+    angles, body_angles = capsize_angles(structure), body_capsize_angles(structure)
     out = []
     for i, s in enumerate(scenes):
-        if statuses[i] == "ok" and angles is not None:
-            rpy = np.asarray(result.vessel.roll_pitch_yaw[i])
-            statuses[i] = capsize_reason(rpy[:, 0], rpy[:, 1], angles) or "ok"
+        if statuses[i] == "ok" and (angles is not None or body_angles):     # the vessel's hull, then each body's
+            bodies = {n: (np.asarray(result.bodies[n].roll_pitch_yaw[i]), a) for n, a in body_angles.items()}
+            statuses[i] = case_capsize(result.vessel.roll_pitch_yaw[i], angles, bodies) or "ok"
         st = case_statistics(t[i], channels(result, i), s.waves.ramp) if statuses[i] == "ok" else None
         out.append({"status": statuses[i], "stats": st, "pid": os.getpid()})
     return out

@@ -19,7 +19,7 @@ from ..physics.seakeeping import Excitation, WaveExcitation
 from ..scene.keys import check_values, resolve_params, with_overrides
 from ..scene.types import Scene, SceneError
 from ..staging import XLA_OPTIONS, cached, compile_program, folder
-from .capsize import vanishing_angles
+from .capsize import body_vanishing_angles, vanishing_angles
 from .loop import advance, concat_frames, core, frame_datasets, start
 from .simulate import BATCH_AXIS, failure_message, is_traced, prepare
 from .tofile import model_key
@@ -251,12 +251,28 @@ def capsize_angles(scene: Scene):
     """The (roll, pitch) angles of vanishing stability of a scene with the nonlinear hydrostatics
     (run/capsize.py), None for other scenes; from the model its batches are built on. Kept per
     scene, as that model is: a campaign asks once per batch, and the GZ curves do not change."""
+    return _capsize_angles(scene)[0]
+
+
+def body_capsize_angles(scene: Scene) -> dict:
+    """{name: (roll, pitch) angles of vanishing stability} of the scene's [[bodies]] that float on
+    their own hull with the nonlinear hydrostatics (run/capsize.py body_vanishing_angles), kept as
+    capsize_angles' are; {} without such bodies."""
+    return _capsize_angles(scene)[1]
+
+
+def _capsize_angles(scene: Scene) -> tuple:
     try:
         return _kept_angles(scene)
     except TypeError:                 # an unhashable scene: computed each time
-        return vanishing_angles(_setup0(scene).built.system)
+        return _all_angles(scene)
 
 
 @functools.lru_cache(maxsize=8)
 def _kept_angles(scene: Scene):
-    return vanishing_angles(_setup0(scene).built.system)
+    return _all_angles(scene)
+
+
+def _all_angles(scene: Scene) -> tuple:
+    system = _setup0(scene).built.system
+    return vanishing_angles(system), body_vanishing_angles(system)

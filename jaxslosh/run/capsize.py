@@ -49,16 +49,32 @@ def _angles(terms) -> Optional[tuple]:
                                                   jnp.asarray(angles), axis)) for axis in (0, 1))
 
 
-def capsize_reason(roll, pitch, angles) -> Optional[str]:
+def capsize_reason(roll, pitch, angles, body: Optional[str] = None) -> Optional[str]:
     """Why a run's record (roll and pitch series, rad) counts as capsized against its angles of
     vanishing stability (vanishing_angles), or None: the first axis whose largest |angle| passes
     its angle. A campaign gives this as the case's status, so the case counts as not operable and
-    as exceeding every limit."""
+    as exceeding every limit. `body`: the record is that [[bodies]] body's (body_vanishing_angles),
+    named in the reason as the run's capsize watch names it."""
     if angles is None:
         return None
     for name, x, limit in (("roll", roll, angles[0]), ("pitch", pitch, angles[1])):
         peak = float(np.max(np.abs(np.asarray(x)))) if np.size(x) else 0.0
         if limit is not None and peak > limit:
-            return (f"capsized: the {name} reached {np.degrees(peak):.1f} deg, past the hull's angle of vanishing "
-                    f"stability {np.degrees(limit):.1f} deg")
+            what = f"the {name}" if body is None else f"the body {body!r}'s {name}"
+            return (f"capsized: {what} reached {np.degrees(peak):.1f} deg, past {'the' if body is None else 'its'} "
+                    f"hull's angle of vanishing stability {np.degrees(limit):.1f} deg")
     return None
+
+
+def case_capsize(roll_pitch_yaw, angles, bodies: dict) -> Optional[str]:
+    """Why a campaign case capsized, or None: the vessel's record (roll_pitch_yaw (n, 3)) against its
+    `angles`, then each body's, `bodies` = {name: (its roll_pitch_yaw (n, 3), its angles)} in the
+    bodies' order (capsize_reason): the first that passed its angle."""
+    rpy = np.asarray(roll_pitch_yaw)
+    why = capsize_reason(rpy[:, 0], rpy[:, 1], angles)
+    for name, (r, a) in bodies.items():
+        if why is not None:
+            break
+        r = np.asarray(r)
+        why = capsize_reason(r[:, 0], r[:, 1], a, name)
+    return why

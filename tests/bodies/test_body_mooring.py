@@ -95,10 +95,10 @@ def test_a_moored_body_moves_as_the_same_moored_vessel():
             np.testing.assert_allclose(np.asarray(getattr(r.mooring[name], what)), want, rtol=1e-8)
 
 
-def test_lines_on_bodies_are_refused_where_not_available():
-    """A lumped line on a body and a line on a body that does not exist: refused naming the key."""
-    with pytest.raises(SceneError, match=r"mooring\[0\]\.body.*lumped"):
-        js.load_scene(_body_moored('model = "lumped"\nsegments = 4\n'))
+def test_a_line_on_a_body_that_does_not_exist_is_refused():
+    """A line on a body that does not exist: refused naming the key (lumped lines on bodies are
+    taken: tests/bodies/test_body_lumped.py)."""
+    assert js.load_scene(_body_moored('model = "lumped"\nsegments = 4\n')).mooring[0].body == "buoy"
     with pytest.raises(SceneError, match=r"mooring\[0\]\.body.*not a body.*buoy"):
         js.load_scene(_body_moored().replace('body = "buoy"', 'body = "boy"', 1))
 

@@ -1,8 +1,8 @@
 """A body's traced initial state with mooring lines on that body (docs/guide/bodies-and-connections.md,
 a body's values in params): the lines start from the traced pose (their state settled there), so
 that a concrete `bodies.<name>.initial.position` runs as the scene file that says it and the
-gradient of a run in it equals central differences. (Lumped lines hold the vessel only: a lumped
-line on a body is refused at load, tests/bodies/test_body_mooring.py.)"""
+gradient of a run in it equals central differences. (A lumped line on a body starts in its static
+shape at the body's initial pose of the scene file, as the vessel's do: tests/bodies/test_body_lumped.py.)"""
 import jax
 import jax.numpy as jnp
 import numpy as np

@@ -32,3 +32,19 @@ def test_a_capsized_case_is_not_operable_and_exceeds_every_limit():
     assert math.isclose(out["operability"], 50.0, rel_tol=1e-12)
     assert math.isclose(out["failed"], 50.0, rel_tol=1e-12)
     assert 0.5 <= out["exceedance"]["roll"] < 0.5 + 1e-6
+
+
+def test_a_case_whose_body_capsized_is_marked_naming_the_body():
+    """A campaign case (campaign/worker.py) is capsized when a [[bodies]] body on its own hull passes
+    its angle of vanishing stability, the vessel upright: its status names the body and its axis;
+    within every angle it is not, and the vessel's own capsize is said first."""
+    from jaxslosh.run.capsize import case_capsize
+    t = np.linspace(0.0, 10.0, 201)
+    upright = np.zeros((t.size, 3))
+    heeled = np.stack([np.radians(80.0) * np.sin(t), np.radians(2.0) * np.sin(t), 0 * t], axis=1)
+    angles = (np.radians(75.0), np.radians(60.0))
+    why = case_capsize(upright, angles, {"tug": (0.5 * heeled, angles), "barge": (heeled, angles)})
+    assert why is not None and why.startswith("capsized: the body 'barge''s roll reached 80.0 deg") and "75.0 deg" in why
+    assert case_capsize(upright, angles, {"barge": (0.5 * heeled, angles)}) is None
+    assert case_capsize(upright, None, {"barge": (heeled, (None, None))}) is None
+    assert case_capsize(heeled, angles, {"barge": (heeled, angles)}).startswith("capsized: the roll")
