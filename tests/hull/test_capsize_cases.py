@@ -48,3 +48,27 @@ def test_a_case_whose_body_capsized_is_marked_naming_the_body():
     assert case_capsize(upright, angles, {"barge": (0.5 * heeled, angles)}) is None
     assert case_capsize(upright, None, {"barge": (heeled, (None, None))}) is None
     assert case_capsize(heeled, angles, {"barge": (heeled, angles)}).startswith("capsized: the roll")
+
+
+def test_a_campaign_batch_marks_the_case_whose_body_capsized(monkeypatch):
+    """The worker's wiring (campaign/worker.py run_batch), the batch's runs replaced by their records:
+    of two cases, the one whose barge rolled past the barge's angle is capsized naming the barge and
+    has no statistics; the other, upright, is ok."""
+    from types import SimpleNamespace
+    from jaxslosh.campaign import worker
+    from test_body_campaign import SCENE
+    t = np.linspace(0.0, 30.0, 151)
+    rpy = np.zeros((2, t.size, 3))
+    barge = np.zeros((2, t.size, 3))
+    barge[1, :, 0] = np.radians(70.0) * np.sin(t)
+    track = lambda r: SimpleNamespace(roll_pitch_yaw=r, position=np.zeros_like(r))  # noqa: E731
+    result = SimpleNamespace(time=np.stack([t, t]), vessel=track(rpy), probes={}, mooring=None,
+                             bodies={"barge": track(barge)},
+                             connections={n: SimpleNamespace(force=np.ones((2, t.size))) for n in ("bow", "stern")})
+    monkeypatch.setattr(worker, "simulate_seas", lambda *a: (result, ["ok", "ok"]))
+    monkeypatch.setattr(worker, "capsize_angles", lambda s: None)        # the ship has no hull of its own here
+    monkeypatch.setattr(worker, "body_capsize_angles", lambda s: {"barge": (np.radians(60.0), None)})
+    cases = [{"hs": 0.6, "tp": 7.0, "heading": 1.2, "seed": k} for k in (1, 2)]
+    out = worker.run_batch(SCENE, "", None, cases, 2)
+    assert out[0]["status"] == "ok" and out[0]["stats"] is not None
+    assert out[1]["status"].startswith("capsized: the body 'barge''s roll reached 70.0 deg") and out[1]["stats"] is None
