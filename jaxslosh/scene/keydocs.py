@@ -270,7 +270,7 @@ KEYS = (
     # mooring
     ("mooring.name", '"line<i>"', "", "The line's name (result datasets `/mooring/<name>/...`)."),
     ("mooring.body", '"vessel"', "", 'The body the fairlead is on: "vessel", the vessel\'s `name`, or a body of '
-                                     '`[[bodies]]` (catenary lines only; guide: Moorings, Lines on a body).'),
+                                     '`[[bodies]]` (catenary and lumped lines; guide: Moorings, Lines on a body).'),
     ("mooring.fairlead", _REQ, "m", "The fairlead in the body's frame, from its COG."),
     ("mooring.anchor", _REQ, "m", "The anchor: x, y inertial from the vessel's COG at rest, z from the still-water "
                                   "level (on the seabed at z = -depth, or above it)."),
