@@ -34,7 +34,7 @@ from ..hydro.source import tables_of
 from ..hydro.spectra import components, wavenumber
 from ..hydro.tables import Tables, interpolate_excitation, interpolate_radiation
 from ..physics.seakeeping import Memory
-from .hull import froude_krylov_surface
+from .hull import froude_krylov_surface, hull_pressure
 from ..scene.types import SceneError
 
 
@@ -152,8 +152,9 @@ def _placed(scene, body, Xb, omega, heads) -> np.ndarray:
 
 
 def on_hull(scene, body) -> bool:
-    """Whether the waves act on a body's wetted hull (its nonlinear hydrostatics, buoyancy and waves on)."""
-    return body.hydrostatics.nonlinear and scene.effects.buoyancy and scene.effects.waves
+    """Whether the waves act on a body's wetted hull (its restoring the pressure there, the vessel's
+    rule: assemble/hull.py hull_pressure; and the waves effect on)."""
+    return hull_pressure(scene, body) and scene.effects.waves
 
 
 def box_waves(body) -> Optional[str]:
