@@ -38,6 +38,13 @@ def inertia_matrix(value):
     return jnp.diag(a) if a.ndim == 1 else a
 
 
+def gravity_turns(scene, carries_liquid: bool) -> bool:
+    """Whether a floating body's gravity turns with it (the vessel's and a body's alike:
+    physics/floating.py gravity_attitude): `[effects] gravity_turning`, a load on the liquid it
+    carries; without liquid it has nothing to load, and turns."""
+    return scene.effects.gravity_turning or not carries_liquid
+
+
 def initial_values(P, key: str, initial) -> dict:
     """A floating body's initial state (`<key>.initial`: the vessel's or a body's), each value traced
     where `P` (the params' get) names it: position, velocity, angular_velocity, roll_pitch_yaw."""
@@ -160,7 +167,7 @@ def build_bodies(scene, params: dict, g, outline: bool = False) -> tuple[Optiona
                                                               waves.height))),)),
             rest=jnp.asarray(rest), x0=jnp.asarray(rest) + ini["position"],
             q0=q0, v0=jnp.concatenate([ini["velocity"], ini["angular_velocity"]]),
-            tank=tank, tank_terms=tank_terms))
+            tank=tank, tank_terms=tank_terms, gravity_turning=gravity_turns(scene, tank is not None)))
     index = end_index(b.name for b in scene.bodies)
     links = []
     for c in scene.connections:
@@ -202,8 +209,10 @@ def _about(scene) -> About:
             what, text = tank_line(t)
             eff = scene.effects
             loads = ", ".join(["its element's rotation penalty"] + ["Coriolis"] * eff.coriolis
-                              + ["centrifugal"] * eff.centrifugal + ["gravity turning with the body"])
+                              + ["centrifugal"] * eff.centrifugal)
             text, loads = t.form.carried_words(t, text, loads)     # the liquid's own loads, in its words
+            loads += ", gravity " + ("turning with the body" if gravity_turns(scene, True) else
+                                     "frozen at its initial attitude ([effects] gravity_turning off)")
             lines.append((what, f"{text}; carried by the body {b.name!r} (in its frame from its COG, its liquid's "
                                 f"unknowns its own, its loads on the body's six rows: {loads})"))
             if f"liquid damping in tank {t.name!r}" in damped:

@@ -28,7 +28,7 @@ from ..staging import staged
 from ..scene.keys import resolve_params
 from ..scene.types import DOFS, Scene
 from .about import damping_about, flex_about, liquid_about, record_about, stiffening_about, weight_about
-from .bodies import build_bodies, hull_part, inertia_matrix, initial_values
+from .bodies import build_bodies, gravity_turns, hull_part, inertia_matrix, initial_values
 from .damping import build_damping
 from .hull import restoring, weight_term
 from .liquid import LiquidBlock, build_liquid_block, outline_liquid_block, rigid_part
@@ -165,7 +165,7 @@ def _model(scene: Scene, params: dict, outline: bool = False) -> _Model:
     if motion is not None:     # listed (and summed, with no share) first, after the hull's inertia
         terms.insert(0, motion)
     system = System(body=body, terms=tuple(terms), liquid=liquid, gravity=g, q_ref=q0,
-                    gravity_turning=eff.gravity_turning or not has_liquid, balanced=balanced,
+                    gravity_turning=gravity_turns(scene, has_liquid), balanced=balanced,
                     tail=() if damping is None else (damping,))
     return _Model(system, block, blocks, body_tanks)
 

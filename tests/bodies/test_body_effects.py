@@ -4,6 +4,7 @@ restoring, as the vessel (its weight balanced: it drifts and turns freely, close
 `gravity_turning = false` its tank's liquid sees gravity frozen at its initial attitude, as the
 vessel's: the same body and tank as a body far from the vessel and as the only vessel move alike."""
 import numpy as np
+import pytest
 
 import jaxslosh as js
 from jaxslosh.cli import main
@@ -94,3 +95,21 @@ def test_check_says_a_body_has_no_hydrostatics_with_buoyancy_off(tmp_path, capsy
     out = capsys.readouterr().out
     line = next(x for x in out.splitlines() if "'carrier'" in x)
     assert "no hydrostatics ([effects] buoyancy off)" in line and "linear hydrostatics" not in line
+
+
+@pytest.mark.parametrize("turning", [False, True])
+def test_a_bodys_gravity_turns_as_the_vessels(turning):
+    """`gravity_turning` on a body's tank as on the vessel's: the carrier with its tank rolling as
+    a body and as the only vessel, over 100 steps, equal within 1e-10 (rad, m) with the switch off
+    and on; and switched off, gravity frozen at the start changes the roll (it is not the turning
+    one's)."""
+    on_body, alone = scenes(f"gravity_turning = {str(turning).lower()}", tank=True)
+    a, b = js.simulate(on_body), js.simulate(alone)
+    body = a.bodies["carrier"]
+    assert np.ptp(body.roll_pitch_yaw[:, 0]) > 0.02                # it rolls
+    np.testing.assert_allclose(body.roll_pitch_yaw, b.vessel.roll_pitch_yaw, rtol=0, atol=1e-10)
+    np.testing.assert_allclose(body.position, b.vessel.position, rtol=0, atol=1e-10)
+    np.testing.assert_allclose(a.tanks["cargo"].displacement, b.tanks["cargo"].displacement, rtol=0, atol=1e-10)
+    if not turning:
+        other = js.simulate(scenes("gravity_turning = true", tank=True)[1])
+        assert np.abs(np.asarray(other.vessel.roll_pitch_yaw[:, 0]) - np.asarray(body.roll_pitch_yaw[:, 0])).max() > 1e-4
