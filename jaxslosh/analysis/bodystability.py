@@ -1,6 +1,6 @@
 """The righting levers of rigid bodies with linear hydrostatics (docs/guide/stability.md#bodies):
 each `[[bodies]]` body's, and the vessel's where it has no hull to heel. A body's restoring is its
-linear hydrostatic term (the one its run uses: assemble/bodies.py `linear_hydrostatics`), so its
+linear hydrostatic term (the one its run uses: assemble/hull.py `linear_hydrostatics`), so its
 GZ at a heel phi is the term's moment about the heel axis over its weight rho g V: GM sin(phi)
 for the conservative form (GM_T about roll, GM_L about pitch). The heave force of the linear
 term does not depend on the attitude, so a body free to sink does not sink at a heel, and a pure
@@ -14,7 +14,7 @@ import jax
 import jax.numpy as jnp
 import numpy as np
 
-from ..assemble.bodies import linear_hydrostatics
+from ..assemble.hull import linear_hydrostatics
 from ..hull.hydrostatics import first_vanishing
 
 #: rad: the half step of GM0's central difference of the linear GZ

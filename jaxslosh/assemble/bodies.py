@@ -1,7 +1,8 @@
 """The `[[bodies]]` and `[[connections]]` of a scene as the term physics/bodies.py defines
 (docs/guide/bodies-and-connections.md). A body's rigid terms come from the functions that make the
-vessel's (`rigid_terms`): its inertia, its linear hydrostatics (or, on its hull, the vessel's
-nonlinear ones and its weight: assemble/hull.py) and its viscous damping."""
+vessel's (`rigid_terms`): its inertia, its restoring by the vessel's rule (assemble/hull.py
+`restoring`: linear springs, or on its hull the pressure there and its weight, or none with
+`[effects] buoyancy` off) and its viscous damping."""
 from __future__ import annotations
 
 import dataclasses
@@ -18,7 +19,7 @@ from ..physics.about import About
 from ..physics.bodies import BAND, Bodies, Floating, Link, body_rest, end_index
 from ..physics.kinematics import quat_from_rpy
 from ..physics.seakeeping import LinearDamping, WaveExcitation
-from ..physics.vessel import RESTORING_FORMS, AbstractRestoring, RigidBody
+from ..physics.vessel import RigidBody
 from ..scene.bodies import coupled_file
 from ..scene.keys import toml_mapping
 from ..scene.types import SceneError
@@ -30,21 +31,18 @@ from .liquid import build_liquid_block
 from .seakeeping import make_excitation
 
 
-def linear_hydrostatics(h, rho_w, g, value=lambda key, v: v) -> AbstractRestoring:
-    """The linear restoring term of a `hydrostatics` table (the vessel's or a body's); `value(name,
-    v)` may replace a value (the vessel's traced params)."""
-    f = lambda k, v: jnp.asarray(value(k, v), dtype=float)  # noqa: E731
-    return RESTORING_FORMS[h.moment](rho_w=jnp.asarray(rho_w, dtype=float), gravity=g,
-                waterplane_area=f("waterplane_area", h.waterplane_area),
-                displaced_volume=f("displaced_volume", h.displaced_volume), gm_t=f("gm_t", h.gm_t),
-                gm_l=f("gm_l", h.gm_l))
-
-
 def inertia_matrix(value):
     """(3, 3) inertia of a floating body's `inertia` key (the vessel's or a body's): its principal
     moments (3,) on the diagonal, or the matrix itself."""
     a = jnp.asarray(value, dtype=float)
     return jnp.diag(a) if a.ndim == 1 else a
+
+
+def gravity_turns(scene, carries_liquid: bool) -> bool:
+    """Whether a floating body's gravity turns with it (the vessel's and a body's alike:
+    physics/floating.py gravity_attitude): `[effects] gravity_turning`, a load on the liquid it
+    carries; without liquid it has nothing to load, and turns."""
+    return scene.effects.gravity_turning or not carries_liquid
 
 
 def initial_values(P, key: str, initial) -> dict:
@@ -54,16 +52,12 @@ def initial_values(P, key: str, initial) -> dict:
             for k in ("position", "velocity", "angular_velocity", "roll_pitch_yaw")}
 
 
-def rigid_terms(mass, inertia, hydrostatics, rho_w, g, viscous=None, value=lambda key, v: v,
-                restoring=None, S=None) -> tuple:
+def rigid_terms(mass, inertia, restoring: tuple, viscous=None, S=None) -> tuple:
     """A floating body's rigid terms, as the vessel has them: inertia with its gyroscopic terms
-    (RigidBody), linear hydrostatics about the rest pose (its weight balanced by the buoyancy at
-    rest) or the `restoring` terms given instead (a hull's pressure and the weight:
-    assemble/hull.py body_restoring), and linear viscous damping (6 x 6) where given; `value(name,
-    v)` may replace the hydrostatics' values (a body's traced params); `S` the hull's first moment
-    where parts carry their own mass (`hull_part`)."""
-    terms = [RigidBody(mass=jnp.asarray(mass, dtype=float), inertia=inertia_matrix(inertia), S=S),
-             *((linear_hydrostatics(hydrostatics, rho_w, g, value),) if restoring is None else restoring)]
+    (RigidBody), its `restoring` terms (assemble/hull.py body_restoring: the vessel's rule) and
+    linear viscous damping (6 x 6) where given; `S` the hull's first moment where parts carry their
+    own mass (`hull_part`)."""
+    terms = [RigidBody(mass=jnp.asarray(mass, dtype=float), inertia=inertia_matrix(inertia), S=S), *restoring]
     if viscous is not None:
         terms.append(LinearDamping(jnp.asarray(viscous, dtype=float)))
     return tuple(terms)
@@ -147,7 +141,6 @@ def build_bodies(scene, params: dict, g, outline: bool = False) -> tuple[Optiona
     if not scene.bodies and not scene.connections:
         return None, ()
     P = params.get
-    rho = P("environment.water_density", scene.environment.water_density)
     cog = scene.vessel.cog_height
     Ainf, memory, X = time_terms(scene, params)
     waves = scene.waves
@@ -155,7 +148,6 @@ def build_bodies(scene, params: dict, g, outline: bool = False) -> tuple[Optiona
     for s, b in enumerate(scene.bodies):
         rest = body_rest(b, cog)
         key = f"bodies.{b.name}"
-        traced = lambda k, v, key=key: P(f"{key}.hydrostatics.{k}", v)  # noqa: E731
         # its initial state as the vessel's (assemble/system.py), offsets from its rest pose, traced where params name them
         ini = initial_values(P, key, b.initial)
         q0 = quat_from_rpy(ini["roll_pitch_yaw"] + jnp.array([0.0, 0.0, b.heading]))
@@ -168,14 +160,14 @@ def build_bodies(scene, params: dict, g, outline: bool = False) -> tuple[Optiona
             mass, inertia, S = hull_part(mass, inertia_matrix(inertia), carried, f"bodies[{s}]", "body",
                                          "its tanks' elastic walls")
         floating.append(Floating(
-            terms=rigid_terms(mass, inertia, b.hydrostatics, rho, g, b.viscous_damping, traced,
-                              body_restoring(scene, b, params, g, tank, mass, S), S) + (
+            terms=rigid_terms(mass, inertia, body_restoring(scene, b, params, g, tank, mass, S),
+                              b.viscous_damping, S) + (
                 () if X is None or not np.abs(X[s]).max() > 0 else
                 (WaveExcitation(make_excitation(waves, X[s], P(waves.height_key,
                                                               waves.height))),)),
             rest=jnp.asarray(rest), x0=jnp.asarray(rest) + ini["position"],
             q0=q0, v0=jnp.concatenate([ini["velocity"], ini["angular_velocity"]]),
-            tank=tank, tank_terms=tank_terms))
+            tank=tank, tank_terms=tank_terms, gravity_turning=gravity_turns(scene, tank is not None)))
     index = end_index(b.name for b in scene.bodies)
     links = []
     for c in scene.connections:
@@ -198,7 +190,6 @@ def _about(scene) -> About:
     lines = []
     coupled = (coupled_file(scene.vessel, scene.bodies) or ((), ()))[1]     # the bodies of a multibody file
     for b in scene.bodies:
-        h = b.hydrostatics
         damp = ", viscous damping" if b.viscous_damping is not None else ""
         hd = b.hydrodynamics
         tabled = hd is not None and (hd.file or hd.added_mass is not None or hd.excitation_amplitude is not None)
@@ -208,8 +199,7 @@ def _about(scene) -> About:
         box = box_waves(b)
         if scene.waves is not None and (box == "only" or (box == "unless tabled" and not tabled and b.name not in coupled)):
             damp += "; the waves' Froude-Krylov force on its box hull (at its place in the waves)"
-        statics = (f"linear hydrostatics (A_w {h.waterplane_area:g} m^2, GM_T {h.gm_t:g} m, GM_L {h.gm_l:g} m)"
-                   if not h.nonlinear else restoring_words(scene, b))
+        statics = restoring_words(scene, b)
         lines.append(("floating body", f"{b.name!r}: 6 unknowns of its own floating frame at "
                                        f"({b.position[0]:g}, {b.position[1]:g}) m from the vessel, heading "
                                        f"{b.heading:g} rad, mass {b.mass:g} kg; rigid-body inertia and "
@@ -219,8 +209,10 @@ def _about(scene) -> About:
             what, text = tank_line(t)
             eff = scene.effects
             loads = ", ".join(["its element's rotation penalty"] + ["Coriolis"] * eff.coriolis
-                              + ["centrifugal"] * eff.centrifugal + ["gravity turning with the body"])
+                              + ["centrifugal"] * eff.centrifugal)
             text, loads = t.form.carried_words(t, text, loads)     # the liquid's own loads, in its words
+            loads += ", gravity " + ("turning with the body" if gravity_turns(scene, True) else
+                                     "frozen at its initial attitude ([effects] gravity_turning off)")
             lines.append((what, f"{text}; carried by the body {b.name!r} (in its frame from its COG, its liquid's "
                                 f"unknowns its own, its loads on the body's six rows: {loads})"))
             if f"liquid damping in tank {t.name!r}" in damped:

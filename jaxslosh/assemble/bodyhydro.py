@@ -24,17 +24,16 @@ from __future__ import annotations
 import os
 from typing import NamedTuple, Optional
 
-import jax.numpy as jnp
 import numpy as np
 
 from ..hydro.multibody import read_multibody
 from ..scene.bodies import coupled_file, resolve
-from ..hydro.radiation import fit_radiation
+from ..hydro.radiation import fit_tables
 from ..hydro.source import tables_of
 from ..hydro.spectra import components, wavenumber
 from ..hydro.tables import Tables, interpolate_excitation, interpolate_radiation
-from ..physics.seakeeping import Memory
-from .hull import froude_krylov_surface
+from .hull import froude_krylov_surface, hull_pressure
+from .seakeeping import memory_of
 from ..scene.types import SceneError
 
 
@@ -48,6 +47,7 @@ class Source(NamedTuple):
     skip: np.ndarray        # (d, d) bool: entries the vessel's own terms carry
     key: tuple              # hashable: what the fit's cache is keyed on
     warnings: tuple = ()
+    order: int = 0          # the memory fit's pole pairs per entry (`memory_order`; 0: automatic)
 
 
 def _rz(psi):
@@ -91,8 +91,11 @@ def sources(scene) -> list:
             v = 6 * inside.index(scene.vessel.name)
             skip[v:v + 6, v:v + 6] = True
         heads = tuple(heading[names.index(n)] for n in inside)
+        # the memory_order of the table that names the file (the vessel's first), as the vessel's own fit of it
+        order = (scene.vessel.hydrodynamics if key.startswith("vessel") else
+                 scene.bodies[int(key.split("[")[1].split("]")[0])].hydrodynamics).memory_order
         out.append(Source(index, mb.tables, transform(heads, "global"), (0.0, 0.0), heads, "global", skip,
-                          (path, inside, heads, bool(skip.any())), mb.warnings))
+                          (path, inside, heads, bool(skip.any()), order), mb.warnings, order))
         members = set(inside)
     for s, b in enumerate(scene.bodies):
         hd = b.hydrodynamics
@@ -100,7 +103,7 @@ def sources(scene) -> list:
             continue
         t = tables_of(hd, None, env.water_density, env.gravity)
         out.append(Source(tuple(range(6 + 6 * s, 12 + 6 * s)), t, transform((b.heading,), "body"), b.position,
-                          (b.heading,), "body", np.zeros((6, 6), dtype=bool), (hd, b.heading)))
+                          (b.heading,), "body", np.zeros((6, 6), dtype=bool), (hd, b.heading), order=hd.memory_order))
     return out
 
 
@@ -114,17 +117,14 @@ _FITS: dict = {}
 
 
 def source_fit(src: Source):
-    """The source's radiation memory fit in the step's dofs (cached per source), or None without
-    radiation tables."""
-    t = src.tables
-    if t.added_mass is None:
+    """The source's radiation memory fit in the step's dofs (cached per source; the vessel's own
+    tables' path: hydro/radiation.py fit_tables), or None without radiation tables."""
+    if src.tables.added_mass is None:
         return None
     if src.key not in _FITS:
         if len(_FITS) > 32:
             _FITS.clear()
-        _FITS[src.key] = fit_radiation(t.omega, _rotate(src.T, t.added_mass), _rotate(src.T, t.damping),
-                                       None if t.added_mass_infinite is None else _rotate(src.T, t.added_mass_infinite),
-                                       skip=src.skip)
+        _FITS[src.key] = fit_tables(src.tables, src.T, src.skip, src.order)
     return _FITS[src.key]
 
 
@@ -152,8 +152,9 @@ def _placed(scene, body, Xb, omega, heads) -> np.ndarray:
 
 
 def on_hull(scene, body) -> bool:
-    """Whether the waves act on a body's wetted hull (its nonlinear hydrostatics, buoyancy and waves on)."""
-    return body.hydrostatics.nonlinear and scene.effects.buoyancy and scene.effects.waves
+    """Whether the waves act on a body's wetted hull (its restoring the pressure there, the vessel's
+    rule: assemble/hull.py hull_pressure; and the waves effect on)."""
+    return hull_pressure(scene, body) and scene.effects.waves
 
 
 def box_waves(body) -> Optional[str]:
@@ -264,7 +265,7 @@ def time_terms(scene, params: dict):
     (S, n_c, 6) or None) of the bodies' sources, for physics/bodies.py."""
     N, S = rigid_size(scene), len(scene.bodies)
     Ainf = np.zeros((N, N))
-    poles, sel, cs = [], [], []
+    fits = []
     waves, eff = scene.waves, scene.effects
     X = None
     if waves is not None and eff.waves:
@@ -275,10 +276,7 @@ def time_terms(scene, params: dict):
         fit = source_fit(src) if eff.radiation else None
         if fit is not None:
             Ainf[ix[:, None], ix[None, :]] += fit.added_mass_infinite
-            poles.append(fit.p)
-            sel.append(ix[fit.inp])
-            cs.append(np.zeros((N, fit.p.size), dtype=complex))
-            cs[-1][ix] = fit.c
+            fits.append((fit, ix))
         if X is not None:
             heads = np.full(c.omega.shape, waves.heading) if c.headings is None else np.asarray(c.headings)
             for beta in np.unique(heads):
@@ -293,12 +291,5 @@ def time_terms(scene, params: dict):
             if np.abs(X[s]).max() > 0 and on_hull(scene, b):
                 X[s] -= hull_share(scene, b, c.omega, heads)
             X[s] = _with_box(scene, b, X[s], c.omega, heads)     # a box hull on linear springs
-    memory = None
-    if poles and sum(p.size for p in poles):
-        p = np.concatenate(poles)
-        s = np.zeros((p.size, N))
-        s[np.arange(p.size), np.concatenate(sel)] = 1.0
-        c_all = np.concatenate(cs, axis=1)
-        memory = Memory(jnp.asarray(p.real), jnp.asarray(p.imag), jnp.asarray(s), jnp.asarray(c_all.real),
-                        jnp.asarray(c_all.imag))
+    memory = memory_of(fits, N)     # the vessel's own memory's builder (assemble/seakeeping.py)
     return Ainf, memory, X

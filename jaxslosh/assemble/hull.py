@@ -2,7 +2,7 @@
 closed surface, its still water plane and, with `[waves]`, the incident components."""
 from __future__ import annotations
 
-from typing import Optional
+from typing import NamedTuple, Optional
 
 import jax.numpy as jnp
 import numpy as np
@@ -11,14 +11,51 @@ from ..hull.clip import MIDPOINT_RULE, area_vectors, clip_below
 from ..hydro.spectra import components, wavenumber
 from ..physics.about import About
 from ..physics.hull import HullPressure, IncidentWaves
-from ..physics.vessel import Weight
+from ..physics.vessel import RESTORING_FORMS, AbstractRestoring, Weight
 from .about import hull_about
 
-def hull_pressure(scene) -> bool:
-    """Whether the scene's restoring is the pressure on its wetted hull: the nonlinear
-    hydrostatics with the buoyancy effect on."""
-    hs = scene.vessel.hydrostatics
+
+def hull_pressure(scene, floating=None) -> bool:
+    """Whether a floating body's restoring is the pressure on its wetted hull (`floating`: the
+    vessel where None, or a body): its nonlinear hydrostatics with the buoyancy effect on."""
+    hs = (scene.vessel if floating is None else floating).hydrostatics
     return hs is not None and hs.nonlinear and scene.effects.buoyancy
+
+
+class Restoring(NamedTuple):
+    """A floating body's restoring as its scene chooses it (`restoring`)."""
+    terms: tuple          # its hull's pressure, its linear springs, or nothing
+    weighs: bool          # its weight is a term (its hull's pressure carries it, or nothing does): not balanced at rest
+
+
+def restoring(scene, floating, params: dict, g, key: str, place=None) -> Restoring:
+    """The restoring of a floating body, the vessel's and every `[[bodies]]` body's by the same rule
+    (`key`: its params' prefix, "vessel" or "bodies.<name>"; `place`: a body's rest (x, y), where
+    the waves reach its hull): the pressure on its wetted hull with its nonlinear hydrostatics
+    (`hull_term`; its weight then a term, `weighs`), the linear springs about its rest pose with
+    linear ones (its weight balanced by the buoyancy at rest); with `[effects] buoyancy` off, none,
+    its weight balanced as at rest (nothing holds it up nor pulls it down); without a hydrostatics
+    table (the vessel only) none, and it falls under its weight."""
+    hs = floating.hydrostatics
+    if hs is None:
+        return Restoring((), True)
+    if not scene.effects.buoyancy:
+        return Restoring((), False)
+    if hull_pressure(scene, floating):
+        return Restoring((hull_term(scene, floating.hull, params, g, f"{key}.hull", place),), True)
+    P = params.get
+    return Restoring((linear_hydrostatics(hs, P("environment.water_density", scene.environment.water_density), g,
+                                          lambda k, v: P(f"{key}.hydrostatics.{k}", v)),), False)
+
+
+def linear_hydrostatics(h, rho_w, g, value=lambda key, v: v) -> AbstractRestoring:
+    """The linear restoring term of a `hydrostatics` table (the vessel's or a body's); `value(name,
+    v)` may replace a value (traced params)."""
+    f = lambda k, v: jnp.asarray(value(k, v), dtype=float)  # noqa: E731
+    return RESTORING_FORMS[h.moment](rho_w=jnp.asarray(rho_w, dtype=float), gravity=g,
+                waterplane_area=f("waterplane_area", h.waterplane_area),
+                displaced_volume=f("displaced_volume", h.displaced_volume), gm_t=f("gm_t", h.gm_t),
+                gm_l=f("gm_l", h.gm_l))
 
 
 def hull_waves(scene) -> bool:
@@ -75,22 +112,18 @@ def hull_term(scene, hull, params: dict, g, key: str = "vessel.hull", place=None
                         about=hull_about(scene, waves is not None, hull), place=at)
 
 
-def body_restoring(scene, body, params: dict, g, liquid=None, mass=None, S=None) -> Optional[tuple]:
-    """The restoring terms of a `[[bodies]]` body with nonlinear hydrostatics, as the vessel's
-    (assemble/system.py): its hull's pressure (`hull_term`, the waves at its place) and its weight,
-    the liquid of its tanks (`liquid`, elastic walls included) included; `mass` and `S` the hull's
-    own mass and first moment where elastic walls carry theirs (default: the body's mass, none);
-    () with `[effects] buoyancy` off (nothing holds it up nor pulls it down, as the vessel); None
-    for linear hydrostatics (assemble/bodies.py's term)."""
-    if not body.hydrostatics.nonlinear:
-        return None
-    if not scene.effects.buoyancy:
-        return ()
+def body_restoring(scene, body, params: dict, g, liquid=None, mass=None, S=None) -> tuple:
+    """A `[[bodies]]` body's restoring terms (`restoring`, the vessel's rule) with its weight where
+    it weighs: the liquid of its tanks (`liquid`, elastic walls included) included; `mass` and `S`
+    the hull's own mass and first moment where elastic walls carry theirs (default: the body's
+    mass, none)."""
     key = f"bodies.{body.name}"
+    r = restoring(scene, body, params, g, key, body.position)
+    if not r.weighs:
+        return r.terms
     mass = jnp.asarray(params.get(f"{key}.mass", body.mass) if mass is None else mass, dtype=float)
     weight = About(("gravity", f"the weight of the body {body.name!r} and its liquid, borne by its hull's pressure"))
-    return (hull_term(scene, body.hull, params, g, f"{key}.hull", body.position),
-            weight_term(mass, S, liquid, g, weight))
+    return r.terms + (weight_term(mass, S, liquid, g, weight),)
 
 
 def weight_term(mass, S, liquid, g, about: About) -> Weight:
@@ -103,9 +136,12 @@ def weight_term(mass, S, liquid, g, about: About) -> Weight:
 
 
 def restoring_words(scene, body) -> str:
-    """A body's nonlinear restoring in words (its line in `jaxslosh check`)."""
+    """A body's restoring in words (its line in `jaxslosh check`), as `restoring` chooses it."""
+    h = body.hydrostatics
     if not scene.effects.buoyancy:
         return "no hydrostatics ([effects] buoyancy off)"
+    if not h.nonlinear:
+        return f"linear hydrostatics (A_w {h.waterplane_area:g} m^2, GM_T {h.gm_t:g} m, GM_L {h.gm_l:g} m)"
     waves = scene.waves is not None and scene.effects.waves
     return (f"nonlinear hydrostatics: the still-water pressure on the instantaneous wetted surface of its "
             f"{body.hull.describe()}" + (" and the waves' Froude-Krylov pressure there, at its place" if waves else "")

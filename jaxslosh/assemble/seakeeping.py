@@ -17,12 +17,25 @@ from ..physics.seakeeping import AddedMass, Excitation, LinearDamping, Memory, R
 
 
 def memory_module(fit: RadiationFit) -> Optional[Memory]:
-    if fit.p.size == 0:
+    """The vessel's own radiation memory, over its six dofs (`memory_of`)."""
+    return memory_of([(fit, np.arange(6))], 6)
+
+
+def memory_of(fits, N: int) -> Optional[Memory]:
+    """The radiation memory over N rigid dofs of fits, each (RadiationFit, the dofs (d,) of the N its
+    tables are over): one builder for the vessel's own fit (over its six) and the bodies' sources
+    (over the 6 + 6 S dofs of the vessel and the bodies, assemble/bodyhydro.py); None without poles."""
+    if not sum(f.p.size for f, _ in fits):
         return None
-    sel = np.zeros((fit.p.size, 6))
-    sel[np.arange(fit.p.size), fit.inp] = 1.0
-    return Memory(jnp.asarray(fit.p.real), jnp.asarray(fit.p.imag), jnp.asarray(sel),
-                  jnp.asarray(fit.c.real), jnp.asarray(fit.c.imag))
+    p = np.concatenate([f.p for f, _ in fits])
+    sel = np.zeros((p.size, N))
+    sel[np.arange(p.size), np.concatenate([np.asarray(ix)[f.inp] for f, ix in fits])] = 1.0
+    c = np.zeros((N, p.size), dtype=complex)
+    k = 0
+    for f, ix in fits:
+        c[np.asarray(ix), k:k + f.p.size] = f.c
+        k += f.p.size
+    return Memory(jnp.asarray(p.real), jnp.asarray(p.imag), jnp.asarray(sel), jnp.asarray(c.real), jnp.asarray(c.imag))
 
 
 def make_excitation(waves, X, height) -> Excitation:

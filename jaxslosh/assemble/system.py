@@ -28,9 +28,9 @@ from ..staging import staged
 from ..scene.keys import resolve_params
 from ..scene.types import DOFS, Scene
 from .about import damping_about, flex_about, liquid_about, record_about, stiffening_about, weight_about
-from .bodies import build_bodies, hull_part, inertia_matrix, initial_values, linear_hydrostatics
+from .bodies import build_bodies, gravity_turns, hull_part, inertia_matrix, initial_values
 from .damping import build_damping
-from .hull import build_hull_pressure, weight_term
+from .hull import restoring, weight_term
 from .liquid import LiquidBlock, build_liquid_block, outline_liquid_block, rigid_part
 from .probes import Probes, build_probes
 from .seakeeping import build_seakeeping, outline_seakeeping
@@ -104,14 +104,10 @@ def _model(scene: Scene, params: dict, outline: bool = False) -> _Model:
     P = params.get
     env, ves, eff = scene.environment, scene.vessel, scene.effects
     g = jnp.asarray(P("environment.gravity", env.gravity), dtype=float)
-    terms = []
-    nonlinear = ves.hydrostatics is not None and ves.hydrostatics.nonlinear and eff.buoyancy
-    if nonlinear:              # the hull's wetted surface (assemble/hull.py); the weight below
-        terms.append(build_hull_pressure(scene, params, g))
-    elif ves.hydrostatics is not None and eff.buoyancy:
-        # the one function that makes every floating body's restoring (assemble/bodies.py)
-        terms.append(linear_hydrostatics(ves.hydrostatics, P("environment.water_density", env.water_density), g,
-                                         lambda k, v: P(f"vessel.hydrostatics.{k}", v)))
+    # the one rule of every floating body's restoring (assemble/hull.py): its hull's pressure (the
+    # weight below), its linear springs, or none
+    held = restoring(scene, ves, params, g, "vessel")
+    terms = list(held.terms)
     # every liquid model's block from the one dispatch (liquid/forms.py block_form)
     block = outline_liquid_block(scene, g, include_liquid=eff.liquid) if outline else \
         build_liquid_block(scene, params, g, include_liquid=eff.liquid)
@@ -138,9 +134,9 @@ def _model(scene: Scene, params: dict, outline: bool = False) -> _Model:
     if carried:       # the ship's mass and inertia include these parts: the hull is the rest (docs/reference/scene.md)
         mass, inertia, hull_S = hull_part(mass, inertia, carried)
     body = RigidBody(mass=mass, inertia=inertia, S=hull_S)
-    balanced = ves.hydrostatics is not None and not nonlinear
+    balanced = not held.weighs
     if not balanced:           # nothing holds the vessel up, or the hull's pressure does: its weight, liquid included
-        weight = weight_about(scene, nonlinear)
+        weight = weight_about(scene, bool(held.terms))
         if outline:
             terms.append(Weight(mass=None, S=None, gravity=g, about=weight))
         else:
@@ -169,7 +165,7 @@ def _model(scene: Scene, params: dict, outline: bool = False) -> _Model:
     if motion is not None:     # listed (and summed, with no share) first, after the hull's inertia
         terms.insert(0, motion)
     system = System(body=body, terms=tuple(terms), liquid=liquid, gravity=g, q_ref=q0,
-                    gravity_turning=eff.gravity_turning or not has_liquid, balanced=balanced,
+                    gravity_turning=gravity_turns(scene, has_liquid), balanced=balanced,
                     tail=() if damping is None else (damping,))
     return _Model(system, block, blocks, body_tanks)
 

@@ -147,6 +147,20 @@ def vector_fit(omega, F, n_pairs, with_e=False, iterations=15, weight=None):
     return poles, res * scale[:, None], e * scale, err
 
 
+def fit_tables(tables, T=None, skip=None, order: int = 0):
+    """The memory fit (`fit_radiation`) of hydrodynamic tables (hydro/tables.py Tables) over their
+    dofs: the one path of the vessel's own tables (hydro/source.py radiation_fit) and of the bodies'
+    sources (assemble/bodyhydro.py source_fit). `T` (d, d): the step's dofs -> the tables' (A in the
+    step's dofs is T^T A T; None: the tables' own axes, as given); `skip`: entries left out; `order`:
+    pole pairs per entry (0: automatic, the scene's `memory_order`). None without radiation tables."""
+    if tables.added_mass is None:
+        return None
+    turn = (lambda A: A) if T is None else (lambda A: np.einsum("ki,...kl,lj->...ij", T, A, T))  # noqa: E731
+    Ainf = tables.added_mass_infinite
+    return fit_radiation(tables.omega, turn(tables.added_mass), turn(tables.damping),
+                         None if Ainf is None else turn(Ainf), order=order, skip=skip)
+
+
 def fit_radiation(omega, added_mass, damping, added_mass_infinite=None, order: int = 0, tol: float = 0.005,
                   max_pairs: int = 12, threshold: float = 1e-2, skip=None):
     """Fit the memory to tables A(w), B(w) (n, d, d) about the COG (d = 6, or 6 per body of a

@@ -9,7 +9,7 @@ from typing import Optional
 import numpy as np
 
 from .capytaine import capytaine_tables
-from .radiation import RadiationFit, fit_radiation
+from .radiation import RadiationFit, fit_tables
 from .tables import Tables, interpolate_excitation, scene_tables
 
 
@@ -41,8 +41,7 @@ def scene_hydro_tables(scene) -> Tables:
 
 @functools.lru_cache(maxsize=32)
 def _radiation_fit_cached(hd, hull, rho, g, depth, heading):
-    t = tables_of(hd, hull, rho, g, depth, () if heading is None else (heading,))
-    return fit_radiation(t.omega, t.added_mass, t.damping, t.added_mass_infinite, order=hd.memory_order)
+    return fit_tables(tables_of(hd, hull, rho, g, depth, () if heading is None else (heading,)), order=hd.memory_order)
 
 
 def radiation_fit(scene) -> Optional[RadiationFit]:

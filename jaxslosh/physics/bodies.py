@@ -202,6 +202,10 @@ class Floating(AbstractFloating):
     v0: jax.Array          # (6,) V (inertial), omega (body) at t = 0
     tank: Any = None
     tank_terms: tuple = ()
+    gravity_turning: bool = eqx.field(static=True, default=True)   # off: its gravity stays as at the start
+
+    def start_attitude(self):
+        return self.q0
 
     @property
     def nf(self) -> int:
@@ -209,11 +213,13 @@ class Floating(AbstractFloating):
         return 0 if self.tank is None else self.tank.nf
 
     def kin(self, X, q, v, a, gravity, t, d=None, d_dot=None, d_acc=None) -> Kin:
-        """The body's Kin: its offset from rest as the configuration's X0 (what the hydrostatics read)
-        and its tanks' liquid unknowns as the deformable ones (d, their rates d_dot and d_acc)."""
+        """The body's Kin: its offset from rest as the configuration's X0 (what the hydrostatics read),
+        its tanks' liquid unknowns as the deformable ones (d, their rates d_dot and d_acc), its
+        gravity frozen at the start where it does not turn (the vessel's rule)."""
         e = jnp.zeros(0)
         return frame_kin(Config(X - self.rest, q, e if d is None else d), v[:3], v[3:], e if d_dot is None else d_dot,
-                         a, None if a is None else (e if d_acc is None else d_acc), t, gravity)
+                         a, None if a is None else (e if d_acc is None else d_acc), t, gravity,
+                         self.gravity_attitude())
 
     def carried(self):
         """Its terms on its tanks' liquid: the liquid's own, then the others'."""

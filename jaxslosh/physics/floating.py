@@ -30,7 +30,7 @@ def gravity_in(A, gravity):
 
 def frame_kin(c: Config, V0, omega, d_dot, a6, d_acc, t, gravity, attitude: Optional[jax.Array] = None) -> Kin:
     """A body's Kin at configuration c: its rotation A(c.q), and gravity in its axes (in those of
-    `attitude` instead where given: gravity frozen at the start, System.gravity_turning)."""
+    `attitude` instead where given: gravity frozen at the start, AbstractFloating.gravity_attitude)."""
     A = rotation_matrix(c.q)
     return Kin(c, V0, omega, d_dot, a6, d_acc, jnp.asarray(t), jnp.zeros((0,)), A,
                gravity_in(A if attitude is None else attitude, gravity))
@@ -38,7 +38,21 @@ def frame_kin(c: Config, V0, omega, d_dot, a6, d_acc, t, gravity, attitude: Opti
 
 class AbstractFloating(eqx.Module):
     """A floating rigid body (the vessel, or one of the `[[bodies]]`): the sums of its terms'
-    rows, energies and mass scales. Each final body gives its terms (`frame_terms`)."""
+    rows, energies and mass scales, and the gravity in its axes. Each final body gives its terms
+    (`frame_terms`), its attitude at the start (`start_attitude`) and whether its gravity turns with
+    it (`gravity_turning`: off, the liquid it carries sees gravity frozen at the start, eq. 32
+    without its turning; the scene's `[effects] gravity_turning` for every body alike: a static
+    field of each final, not declared here, since a field declared on the abstract class would
+    come before the finals' fields without defaults)."""
+
+    @abc.abstractmethod
+    def start_attitude(self) -> jax.Array:
+        """(4,) its attitude at t = 0 (Euler parameters)."""
+
+    def gravity_attitude(self) -> Optional[jax.Array]:
+        """None where its gravity turns with it; else its rotation at the start, where gravity
+        stays in its axes (`frame_kin`'s `attitude`)."""
+        return None if self.gravity_turning else rotation_matrix(self.start_attitude())
 
     @abc.abstractmethod
     def frame_terms(self) -> tuple:

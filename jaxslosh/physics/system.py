@@ -24,7 +24,7 @@ import jax
 import jax.numpy as jnp
 
 from .floating import AbstractFloating, frame_kin, gravity_in
-from .kinematics import G_matrix, quat_exp, quat_multiply, rotation_matrix
+from .kinematics import G_matrix, quat_exp, quat_multiply
 from .terms import Config, Kin, Unknowns
 from .unknowns import Layout
 from .vessel import RigidBody
@@ -219,15 +219,18 @@ class System(AbstractFloating):
     def total_mass(self):
         return self.body.mass + self.liquid.total_mass()
 
+    def start_attitude(self):
+        return self.q_ref
+
     def gravity_body(self, A):
-        """Gravity in the body frame: turning with the body (the load of eq. 32), or frozen at the start."""
-        return gravity_in(A if self.gravity_turning else rotation_matrix(self.q_ref), self.gravity)
+        """Gravity in the body frame at rotation A: turning with the body (the load of eq. 32), or frozen at the start."""
+        frozen = self.gravity_attitude()
+        return gravity_in(A if frozen is None else frozen, self.gravity)
 
     def kin(self, c: Config, V0, omega, d_dot, a6=None, d_acc=None, t=0.0, vs=None) -> Kin:
         """The vessel's Kin (floating.frame_kin), its gravity frozen at the start where it does not turn;
         `vs` the other frames' rigid velocities (Kin.vs)."""
-        return frame_kin(c, V0, omega, d_dot, a6, d_acc, t, self.gravity,
-                         None if self.gravity_turning else rotation_matrix(self.q_ref))._replace(vs=vs)
+        return frame_kin(c, V0, omega, d_dot, a6, d_acc, t, self.gravity, self.gravity_attitude())._replace(vs=vs)
 
     def at_time(self, t) -> "System":
         """The System for the evaluations of one step at time t: each term's `at_time` (what

@@ -18,11 +18,9 @@ import jax
 import numpy as np
 
 from ..liquid.forms import tank_liquid
-from ..liquid.multimodal.build3d import three_dimensional
-from ..liquid.multimodal.watch import omega2
 from ..physics.bodies import bodies_term
 from ..physics.kinematics import rpy_from_quat
-from ..liquid.multimodal.steep import DEFINITE_ON, DEFINITE_SOFT, STEEP_FULL, STEEP_MODES, STEEP_ON
+from ..liquid.multimodal.steep import DEFINITE_ON, DEFINITE_SOFT, STEEP_FULL, STEEP_ON
 from ..scene.types import Scene
 
 #: a frame residual this many times its level, max(tolerance, round-off floor), is reported (the
@@ -39,16 +37,20 @@ def _surface_tables(scene: Scene):
     slope's rows (P, modes) or its x and y rows for a three-dimensional tank, the elevation's rows at
     the liquid's quadrature points (Q, modes), their weights (Q,), k_N, omega_N^2): what the slope,
     the crest index and the round-off floor (liquid/multimodal/steep.py) are read from, as the model
-    that runs the tank's form gives them (AbstractLiquid.surface_table); none where a tank has none."""
+    that runs the tank's form gives them (AbstractLiquid.surface_table); none where a tank has none.
+    And {offset: (modes, k, omega^2)} of the tanks whose rows keep fewer modes past their range (the
+    table's steepness cut: their round-off floor is then that mode's)."""
     g = scene.environment.gravity
     tables = [tank_liquid(t).surface_table(t, g) for t in scene.tanks]
     if any(s is None for s in tables):
-        return []
-    out, off = [], 0
+        return [], {}
+    out, cuts, off = [], {}, 0
     for s in tables:
-        out.append((off, *s))
+        out.append((off, s.slope, s.Z, s.w, s.kN, s.omega2))
+        if s.cut is not None:
+            cuts[off] = s.cut
         off += s.Z.shape[1]
-    return out
+    return out, cuts
 
 
 def _crest_index(Z, w, kN, d):
@@ -94,18 +96,13 @@ class Watch:
         self.capsized = [False, False]
         # [[bodies]] on their own hulls: {name: [index among the bodies, angles, heel (2,), t_heel (2,), capsized (2,)]}
         self.body_capsize = {}
-        self.tables = _surface_tables(scene) if n else []
+        # a two-dimensional tank on more modes than its rows keep past its range: (modes, k, omega^2) of
+        # its highest kept mode, whose floor its rows have past STEEP_FULL, by offset (the liquid's answer)
+        self.tables, self.cut = _surface_tables(scene) if n else ([], {})
         self.slope = np.zeros(len(self.tables))     # steepest free surface of each multimodal tank, and when
         self.t_slope = np.zeros(len(self.tables))
         self.crest = np.zeros(len(self.tables))     # largest crest index of each, and when it first passed STEEP_ON
         self.t_crest = np.full(len(self.tables), np.nan)
-        # a two-dimensional tank on more than STEEP_MODES modes: (k, omega^2) of its STEEP_MODES-th mode,
-        # whose floor its rows have past STEEP_FULL (liquid/multimodal/steep.steep_rows), by offset
-        self.cut = {}
-        for (off, _, Z, _, _, _), t in zip(self.tables, scene.tanks):
-            if not three_dimensional(t) and t.modes > STEEP_MODES:
-                kc = STEEP_MODES * np.pi / t.size[0]
-                self.cut[off] = (kc, omega2(scene.environment.gravity, t, kc))
         self.third = {}          # by tank: the third-order system's modal mass polynomial (`watch_liquid`)
         self.margin = np.ones(len(self.tables))        # its smallest margin, and when it first fell below DEFINITE_ON
         self.t_margin = np.full(len(self.tables), np.nan)
@@ -199,9 +196,9 @@ class Watch:
                 b = raw[:, off:off + Z.shape[1]]
                 k, o2 = np.full(time.size, kN), np.full(time.size, om2)
                 cut = self.cut.get(off)
-                if cut is not None:      # past STEEP_FULL its rows are the first STEEP_MODES modes'
+                if cut is not None:      # past STEEP_FULL its rows are its first modes' (the cut's)
                     past = _crest_index(Z, w, kN, b) >= STEEP_FULL
-                    k, o2 = np.where(past, cut[0], k), np.where(past, cut[1], o2)
+                    k, o2 = np.where(past, cut[1], k), np.where(past, cut[2], o2)
                 level = np.maximum(level, np.finfo(float).eps * o2 * np.abs(b).max(axis=1)
                                    * np.exp(2.0 * k * (b @ Z.T).max(axis=1)))
         r = int(np.argmax(residual / level))
@@ -246,11 +243,11 @@ class Watch:
                             f"singularity (its smallest eigenvalue over the modal masses down to {self.margin[i]:.3g}, "
                             f"below {DEFINITE_ON:.3g}): its rows were blended into the exact integrals' where it did")
             if not np.isnan(self.t_crest[i]):
-                cut = i < len(self.tables) and self.tables[i][0] in self.cut
+                cut = self.cut.get(self.tables[i][0]) if i < len(self.tables) else None
                 said.append(f"from t = {self.t_crest[i]:.4g} s its crests were higher than its modes resolve (crest "
                             f"index up to {self.crest[i]:.3g}, past {STEEP_ON:.3g}): the steep-wave damping of its "
                             f"higher modes acted from then on"
-                            + (f", its modes above the {STEEP_MODES}th as damped linear oscillators" if cut else "")
+                            + (f", its modes above the {cut[0]}th as damped linear oscillators" if cut else "")
                             + ", and the results are that model's "
                             "(docs/guide/nonlinear-sloshing.md, \"Past the method's range\")")
             if said and np.isnan(self.t_crest[i]) and np.isnan(self.t_margin[i]):

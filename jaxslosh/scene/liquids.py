@@ -64,7 +64,8 @@ class LiquidForm(abc.ABC):
     def carried_words(self, tank, text: str, loads: str) -> tuple[str, str]:
         """(the tank's line `text`, its loads on a body that carries it) in the words of the body's
         line (assemble/bodies.py): a finite element's loads are `loads` (its rotation penalty, the
-        inertial loads [effects] switches, gravity), and a reduced liquid's line says its modes."""
+        inertial loads [effects] switches; gravity's the body's, added after), and a reduced
+        liquid's line says its modes."""
         return (f"{text}, on {tank.reduction.modes} modes" if self.reduced else text), loads
 
     @property
@@ -113,7 +114,7 @@ class MultimodalForm(LiquidForm):
 
     def carried_words(self, tank, text: str, loads: str) -> tuple[str, str]:
         # its inertial loads are the modal Lagrangian's, not switched by [effects] (its line says so)
-        return text.split("; its inertial loads")[0], "the modal Lagrangian's, gravity turning with it"
+        return text.split("; its inertial loads")[0], "the modal Lagrangian's"
 
 
 def liquid_form(tank) -> LiquidForm:

@@ -210,6 +210,27 @@ def test_the_check_words_and_the_assembly_ask_the_liquid_not_its_form():
     assert not bad, "\n".join(bad)
 
 
+#: what the modules that ask the liquid (ASK_THE_LIQUID) still import of a model's package (its
+#: thresholds): the watch's tables, its steepness cut included, are the liquid's answer
+#: (AbstractLiquid.surface_table)
+MODEL_IMPORTS = {("run/validity.py", "liquid.multimodal.steep"): {"DEFINITE_ON", "DEFINITE_SOFT", "STEEP_FULL",
+                                                                 "STEEP_ON"}}
+
+
+def test_the_modules_that_ask_the_liquid_import_no_model_but_its_thresholds():
+    """The check words, the validity watch and the assembly import nothing of a model's package
+    (liquid/<model>/...) but the thresholds listed in MODEL_IMPORTS (the list only shrinks)."""
+    bad = []
+    for rel in ASK_THE_LIQUID:
+        for node in ast.walk(ast.parse(open(os.path.join(ROOT, rel)).read())):
+            if isinstance(node, ast.ImportFrom) and node.level and (node.module or "").count(".") >= 2 \
+                    and (node.module or "").startswith("liquid."):
+                names = {a.name for a in node.names} - MODEL_IMPORTS.get((rel, node.module), set())
+                if names:
+                    bad.append(f"{rel}:{node.lineno}: {sorted(names)} from {node.module}")
+    assert not bad, "\n".join(bad)
+
+
 #: the contract's hooks that most models answer neutrally: each final liquid states its own
 HOOKS = ("roundoff", "probe_modal", "surface_heave", "rigid_first_moment", "for_batch", "with_effects",
          "describe_tank", "surface_table")

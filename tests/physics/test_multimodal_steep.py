@@ -120,7 +120,8 @@ def test_watch_reads_the_crest_index_as_the_liquid():
     from jaxslosh.liquid.multimodal.steep import crest_index
     from jaxslosh.run.validity import Watch, _crest_index, _surface_tables
     scene = js.load_scene(RESONANT.format(duration=1.0, amplitude=0.001))
-    (off, _, Z, w, kN, _), = _surface_tables(scene)
+    ((off, _, Z, w, kN, _),), cuts = _surface_tables(scene)
+    assert cuts == {}                  # 6 modes: its rows keep them all
     t = _tank()
     betas = np.array([[0.05, 0.0, 0.0, 0.0, 0.0, 0.0], [0.25, 0.06, 0.03, 0.015, 0.007, 0.003]])
     np.testing.assert_allclose(_crest_index(Z, w, kN, betas), [float(crest_index(t, jnp.asarray(b))) for b in betas],
@@ -133,6 +134,20 @@ def test_watch_reads_the_crest_index_as_the_liquid():
     watch.update(np.array([0.9]), z, np.zeros(1), betas[1:])
     msg = watch.warnings()
     assert len(msg) == 1 and "from t = 0.7 s" in msg[0] and "steep-wave damping" in msg[0], msg
+
+
+def test_the_watchs_steepness_cut_is_the_liquids():
+    """A two-dimensional tank on 16 modes: the watch's cut (whose round-off floor it takes past
+    STEEP_FULL) is the liquid's answer, the 10th mode's k = 10 pi / L and omega^2 = g k tanh(k h),
+    the highest its rows keep (liquid/multimodal/steep.py); a three-dimensional one has none."""
+    from jaxslosh.liquid.multimodal.steep import STEEP_MODES
+    from jaxslosh.run.validity import Watch
+    text = RESONANT.format(duration=1.0, amplitude=0.001)
+    cut = Watch(js.load_scene(text.replace('model = "multimodal"', 'model = "multimodal"\nmodes = 16'))).cut
+    k = STEEP_MODES * np.pi / L
+    assert STEEP_MODES == 10 and cut == {0: (10, k, G * k * np.tanh(k * H))}
+    flat = Watch(js.load_scene(text.replace('model = "multimodal"', 'model = "multimodal"\nflow = "3d"\nmodes = 12')))
+    assert flat.cut == {}
 
 
 def _hos_record(modes, order, dt, amplitude=0.01):

@@ -3,13 +3,14 @@ slope, its crest index and its round-off floor (steep.py), at the points and wei
 uses; and the tank in `jaxslosh check`'s words (liquid.py MultimodalLiquid's lines)."""
 from __future__ import annotations
 
-from typing import NamedTuple
+from typing import NamedTuple, Optional
 
 import numpy as np
 
 from ..words import TankWords, shape_words
 from .build3d import tank_3d, three_dimensional
 from .modes import modal_modes
+from .steep import STEEP_MODES
 from .term import NX
 
 #: points per two-dimensional tank where the slope is read (walls included)
@@ -23,6 +24,10 @@ class SurfaceTable(NamedTuple):
     w: np.ndarray         # (Q,) their weights
     kN: float             # the highest mode's wavenumber
     omega2: float         # its omega^2 = g k tanh(k h)
+    # the steepness cut: (modes, k, omega^2) of the highest mode whose rows a two-dimensional tank on
+    # more than STEEP_MODES modes keeps past STEEP_FULL (steep.steep_rows; its round-off floor is then
+    # that mode's, steep.roundoff_floor); None where its rows keep every mode
+    cut: Optional[tuple] = None
 
 
 def omega2(g: float, t, k) -> float:
@@ -40,8 +45,10 @@ def surface_table(t, g: float) -> SurfaceTable:
     k = np.arange(1, t.modes + 1) * np.pi / t.size[0]
     xg, wg = np.polynomial.legendre.leggauss(max(NX, 8 * t.modes))
     xq = 0.5 * t.size[0] * (xg + 1.0)
+    kc = STEEP_MODES * np.pi / t.size[0]
+    cut = (STEEP_MODES, kc, omega2(g, t, kc)) if t.modes > STEEP_MODES else None
     return SurfaceTable((-k * np.sin(np.outer(np.linspace(0.0, t.size[0], SLOPE_SAMPLES), k)),),
-                        np.cos(np.outer(xq, k)), 0.5 * t.size[0] * wg, float(k[-1]), omega2(g, t, k[-1]))
+                        np.cos(np.outer(xq, k)), 0.5 * t.size[0] * wg, float(k[-1]), omega2(g, t, k[-1]), cut)
 
 
 def modal_words(t) -> str:
