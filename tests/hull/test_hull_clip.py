@@ -130,8 +130,9 @@ def test_pressure_force_is_archimedes():
     n /= np.linalg.norm(n)
     t = 0.5 * (box_surface([0, 0, 0], SIZE).reshape(-1, 3) @ n).mean()
     point = jnp.array([0.2, 0.4, 0.9])
-    F, Mo = pressure_force_moment(tris, jnp.asarray(n), t, point, rho=1000.0, g=9.81)
-    V, S = submerged(tris, jnp.asarray(n), t)
+    # both in one program (eager, each operation of the clipping would compile on its own)
+    (F, Mo), (V, S) = jax.jit(lambda n, t: (pressure_force_moment(tris, n, t, point, rho=1000.0, g=9.81),
+                                            submerged(tris, n, t)))(jnp.asarray(n), t)
     np.testing.assert_allclose(F, 1000 * 9.81 * V * n, rtol=1e-12, atol=1e-9)
     np.testing.assert_allclose(Mo, np.cross(S / V - point, 1000 * 9.81 * V * n), rtol=1e-12, atol=1e-8)
 
