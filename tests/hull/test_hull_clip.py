@@ -130,8 +130,9 @@ def test_pressure_force_is_archimedes():
     n /= np.linalg.norm(n)
     t = 0.5 * (box_surface([0, 0, 0], SIZE).reshape(-1, 3) @ n).mean()
     point = jnp.array([0.2, 0.4, 0.9])
-    F, Mo = pressure_force_moment(tris, jnp.asarray(n), t, point, rho=1000.0, g=9.81)
-    V, S = submerged(tris, jnp.asarray(n), t)
+    # both in one program (eager, each operation of the clipping would compile on its own)
+    (F, Mo), (V, S) = jax.jit(lambda n, t: (pressure_force_moment(tris, n, t, point, rho=1000.0, g=9.81),
+                                            submerged(tris, n, t)))(jnp.asarray(n), t)
     np.testing.assert_allclose(F, 1000 * 9.81 * V * n, rtol=1e-12, atol=1e-9)
     np.testing.assert_allclose(Mo, np.cross(S / V - point, 1000 * 9.81 * V * n), rtol=1e-12, atol=1e-8)
 
@@ -171,9 +172,10 @@ def test_gradients_agree_with_finite_differences_and_are_finite_on_the_plane():
     np.testing.assert_allclose(g, fd, rtol=1e-6, atol=1e-8)
     # a vertex (and a whole face) exactly on the plane: finite gradients
     flat = jnp.asarray(box_surface([0, 0, 0], SIZE))
-    g = jax.grad(lambda t: submerged(flat, jnp.array([0.0, 0.0, 1.0]), t)[0] + 0.0)(jnp.asarray(SIZE[2]))
+    # (jitted: eager, each operation of the clipping's gradient would compile on its own)
+    g = jax.jit(jax.grad(lambda t: submerged(flat, jnp.array([0.0, 0.0, 1.0]), t)[0] + 0.0))(jnp.asarray(SIZE[2]))
     assert np.isfinite(g)
-    gt = jax.grad(lambda tr: submerged(tr, jnp.array([0.0, 0.0, 1.0]), 0.0)[1].sum())(flat)
+    gt = jax.jit(jax.grad(lambda tr: submerged(tr, jnp.array([0.0, 0.0, 1.0]), 0.0)[1].sum()))(flat)
     assert np.all(np.isfinite(np.asarray(gt)))
 
 

@@ -170,10 +170,13 @@ def test_gradient_through_a_run_agrees_with_finite_differences():
         r = js.simulate(scene, params=p)
         return jnp.sum(r.vessel.roll_pitch_yaw[:, 0] ** 2) + jnp.sum(r.vessel.position[:, 2] ** 2)
 
+    # one program for the gradient and the four values of the differences (each f called alone
+    # would compile its run again): the values are the same run's, jax.grad its reverse pass
+    value_and_grad = jax.jit(jax.value_and_grad(f))
     p0 = {"vessel.mass": jnp.asarray(MASS * 1.02), "vessel.initial.roll_pitch_yaw": jnp.array([0.3, 0.0, 0.0])}
-    g = jax.grad(f)(p0)
+    _, g = value_and_grad(p0)
     for key, d in (("vessel.mass", jnp.asarray(MASS * 1e-5)), ("vessel.initial.roll_pitch_yaw", jnp.array([1e-5, 0, 0]))):
-        fd = (f(p0 | {key: p0[key] + d}) - f(p0 | {key: p0[key] - d})) / (2.0 * jnp.linalg.norm(d))
+        fd = (value_and_grad(p0 | {key: p0[key] + d})[0] - value_and_grad(p0 | {key: p0[key] - d})[0]) / (2.0 * jnp.linalg.norm(d))
         got = g[key] if g[key].ndim == 0 else g[key][0]
         assert abs(float(got) - float(fd)) < 1e-5 * abs(float(fd)) + 1e-12, (key, got, fd)
 
@@ -392,9 +395,11 @@ roll_pitch_yaw = [0.05, 0.0, 0.0]
 def test_parametric_roll_grows_to_a_steady_amplitude_only_with_the_nonlinear_model():
     """scenes/parametric_roll.toml, 100 s: the 3-degree roll grows more than fourfold and settles
     (the last 20 s of peaks within 5 % of each other); with the linear model of the same hull in
-    the same waves it never exceeds the disturbance."""
+    the same waves it never exceeds the disturbance. At dt = 0.1 s (25 steps a wave period, as
+    test_parametric_roll_art.py; half the steps of the scene's 0.05 s): measured growth 5.7-fold,
+    last peaks within 3.3 % (over 60-80 s, still settling, they are 11 % apart: the test can fail)."""
     from jaxslosh.scene.keys import with_overrides
-    scene = with_overrides(js.load_scene("scenes/parametric_roll.toml"), duration=100.0)
+    scene = with_overrides(js.load_scene("scenes/parametric_roll.toml"), duration=100.0, dt=0.1)
     r = js.simulate(scene)
     assert r.status == "ok"
     t, roll = np.asarray(r.time), np.degrees(np.asarray(r.vessel.roll_pitch_yaw)[:, 0])

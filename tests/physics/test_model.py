@@ -1,5 +1,6 @@
 """The residual is the virtual work of one Lagrangian: forces are gradients of the potential energy,
 the mass matrix is the Hessian of the kinetic energy (STYLE.md: write energies once)."""
+import equinox as eqx
 import jax
 import jax.numpy as jnp
 import numpy as np
@@ -25,24 +26,38 @@ def _state(system, seed):
     return c, v
 
 
-@pytest.mark.parametrize("seed", [0, 1])
-def test_static_residual_is_the_gradient_of_the_potential(system, seed):
-    c, _ = _state(system, seed)
+# Each side one program, the system and the state its inputs (run eagerly, their operations
+# compiled one by one: ~9 s of the file's CPU); the seeds and the tests of a system share it.
+
+@eqx.filter_jit
+def _rows_and_potential_gradient(system, c):
+    """The residual at rest in the state c, and the gradient of the potential energy there."""
     z = jnp.zeros(system.n)
-    r = system.residual(c, z[:3], z[3:6], z[6:], z)
 
     def V(x):
         return system.potential_energy(Config(c.X0 + x[:3], quat_multiply(c.q, quat_exp(x[3:6])), c.d + x[6:]))
 
-    g = jax.grad(V)(jnp.zeros(system.n))
+    return system.residual(c, z[:3], z[3:6], z[6:], z), jax.grad(V)(z)
+
+
+@eqx.filter_jit
+def _mass_matrices(system, c, v):
+    """The residual's Jacobian in the accelerations, and the Hessian of the kinetic energy."""
+    Mr = jax.jacfwd(lambda a: system.residual(c, v[:3], v[3:6], v[6:], a))(jnp.zeros(system.n))
+    return Mr, jax.hessian(lambda w: system.kinetic_energy(c, w))(v)
+
+
+@pytest.mark.parametrize("seed", [0, 1])
+def test_static_residual_is_the_gradient_of_the_potential(system, seed):
+    c, _ = _state(system, seed)
+    r, g = _rows_and_potential_gradient(system, c)
     np.testing.assert_allclose(r, g, rtol=1e-9, atol=1e-9 * float(jnp.max(jnp.abs(g))))
 
 
 @pytest.mark.parametrize("seed", [0, 1])
 def test_mass_matrix_is_the_hessian_of_the_kinetic_energy(system, seed):
     c, v = _state(system, seed)
-    Mr = jax.jacfwd(lambda a: system.residual(c, v[:3], v[3:6], v[6:], a))(jnp.zeros(system.n))
-    Mt = jax.hessian(lambda w: system.kinetic_energy(c, w))(v)
+    Mr, Mt = _mass_matrices(system, c, v)
     np.testing.assert_allclose(Mr, Mt, rtol=1e-10, atol=1e-10 * float(jnp.max(jnp.abs(Mt))))
 
 
@@ -62,11 +77,5 @@ def falling():
 def test_weight_rows_of_a_free_vessel_are_the_gradient_of_the_potential(falling, seed):
     assert "Weight" in {type(t).__name__ for t in falling.terms}
     c, _ = _state(falling, seed)
-    z = jnp.zeros(falling.n)
-    r = falling.residual(c, z[:3], z[3:6], z[6:], z)
-
-    def V(x):
-        return falling.potential_energy(Config(c.X0 + x[:3], quat_multiply(c.q, quat_exp(x[3:6])), c.d + x[6:]))
-
-    g = jax.grad(V)(jnp.zeros(falling.n))
+    r, g = _rows_and_potential_gradient(falling, c)
     np.testing.assert_allclose(r, g, rtol=1e-9, atol=1e-9 * float(jnp.max(jnp.abs(g))))

@@ -5,6 +5,7 @@ with the stabilized element in the same walls."""
 import functools
 import os
 
+import equinox as eqx
 import jax
 import jax.numpy as jnp
 import numpy as np
@@ -31,6 +32,16 @@ def _run(text):
     return js.simulate(js.load_scene(text))
 
 
+@eqx.filter_jit
+def points_products(liquid, F, d):
+    """One program (eager, each operation would compile on its own): the points' mass
+    sum_g m_g J_g^T J_g from the Jacobian J of `field`, `free_part` of F beside J^T F, and the
+    nodal fields of d."""
+    J = jax.jacfwd(liquid.field)(jnp.zeros(liquid.nf))                              # (G, 3, nf)
+    return (jnp.einsum("gin,g,gim->nm", J, liquid.m, J), liquid.free_part(F), jnp.einsum("gin,gi->n", J, F),
+            liquid.nodal_fields(d))
+
+
 def test_the_points_carry_the_coupled_mass():
     """The liquid's Gauss points and the walls' (each moving with its element's field) give, as
     sum_g m_g J_g^T J_g, the Newton block's mass, which is T^T M T plus the walls' consistent mass
@@ -38,19 +49,17 @@ def test_the_points_carry_the_coupled_mass():
     scene = js.load_scene(_text())
     liquid = build(scene).system.liquid
     nf = liquid.nf
-    J = jax.jacfwd(liquid.field)(jnp.zeros(nf))                                    # (G, 3, nf)
-    Mp = np.asarray(jnp.einsum("gin,g,gim->nm", J, liquid.m, J))
+    F = jax.random.normal(jax.random.PRNGKey(0), (liquid.r.shape[0], 3), dtype=jnp.float64)
+    d = jax.random.normal(jax.random.PRNGKey(1), (nf,), dtype=jnp.float64)
+    Mp, FJ, JF, U = (np.asarray(x) for x in points_products(liquid, F, d))
     t = scene.tanks[0]
     tm = t.geometry.mesh(t.fill_depth, t.mesh)
     tw = build_face_tank_with_walls(t, build_face_liquid(tm.nodes, tm.elements, tm.depth, 1000.0, 1500.0, 9.81))
     scale = np.abs(tw.mass).max()
     assert np.abs(Mp - np.asarray(liquid.Mff)).max() < 1e-12 * scale
     assert np.abs(tw.mass - np.asarray(liquid.Mff)).max() < 1e-12 * scale
-    F = jax.random.normal(jax.random.PRNGKey(0), (liquid.r.shape[0], 3), dtype=jnp.float64)
-    np.testing.assert_allclose(liquid.free_part(F), jnp.einsum("gin,gi->n", J, F), rtol=1e-12, atol=1e-12)
+    np.testing.assert_allclose(FJ, JF, rtol=1e-12, atol=1e-12)
     # the walls' nodes follow the liquid's in the nodal fields
-    d = jax.random.normal(jax.random.PRNGKey(1), (nf,), dtype=jnp.float64)
-    U = np.asarray(liquid.nodal_fields(d))
     n_liquid = tw.model.n_nodes
     np.testing.assert_allclose(U[n_liquid:].reshape(-1)[tw.wall_dofs], np.asarray(d)[tw.nq:], rtol=1e-14)
 

@@ -23,10 +23,10 @@ from jaxslosh.physics.terms import Kin
 
 try:
     from helpers import mast, multibody_vessel
-    from test_rt_elastic_walls import _text as walls_text
+    from test_rt_elastic_walls import _text as walls_text, points_products
 except ImportError:     # imported as tests.physics.test_rt_vessel_structures from the repository root (benchmarks/)
     from tests.helpers import mast, multibody_vessel
-    from tests.physics.test_rt_elastic_walls import _text as walls_text
+    from tests.physics.test_rt_elastic_walls import _text as walls_text, points_products
 
 BAFFLED = ('[[tanks]]\nname = "tank"\norigin = [-1.5, -1.0, -2.0]\nsize = [3.0, 2.0, 2.0]\nfill_depth = 1.2\n'
            'mesh = [4, 2, 3]\n[[tanks.baffles]]\nnormal = "x"\nposition = 1.5\nfrom = "bottom"\nheight = 0.6\n'
@@ -59,18 +59,17 @@ def test_the_points_carry_the_structure_block():
     hs = held_structure(scene.structures[0])
     n = hs.free.size
     nq = liquid.nf - n
-    J = jax.jacfwd(liquid.field)(jnp.zeros(liquid.nf))                               # (G, 3, nf)
-    Mp = np.asarray(jnp.einsum("gin,g,gim->nm", J, liquid.m, J))
+    F = jax.random.normal(jax.random.PRNGKey(0), (liquid.r.shape[0], 3), dtype=jnp.float64)
+    d = jax.random.normal(jax.random.PRNGKey(1), (liquid.nf,), dtype=jnp.float64)
+    Mp, FJ, JF, U = (np.asarray(x) for x in points_products(liquid, F, d))
     M, K = np.asarray(liquid.Mff), np.asarray(liquid.K)
     assert np.abs(Mp - M).max() < 1e-12 * np.abs(M).max()
     Ms3 = np.kron(hs.mass, np.eye(3))[np.ix_(hs.free, hs.free)]
     assert np.abs(M[nq:, nq:] - Ms3).max() < 1e-12 * np.abs(Ms3).max()
     assert np.all(M[:nq, nq:] == 0) and np.all(K[:nq, nq:] == 0)
     assert np.abs(K[nq:, nq:] - hs.stiffness).max() < 1e-12 * np.abs(hs.stiffness).max()
-    F = jax.random.normal(jax.random.PRNGKey(0), (liquid.r.shape[0], 3), dtype=jnp.float64)
-    np.testing.assert_allclose(liquid.free_part(F), jnp.einsum("gin,gi->n", J, F), rtol=1e-12, atol=1e-9)
-    d = jax.random.normal(jax.random.PRNGKey(1), (liquid.nf,), dtype=jnp.float64)
-    U = np.asarray(liquid.nodal_fields(d))[-len(hs.nodes):].reshape(-1)
+    np.testing.assert_allclose(FJ, JF, rtol=1e-12, atol=1e-9)
+    U = U[-len(hs.nodes):].reshape(-1)
     np.testing.assert_allclose(U[hs.free], np.asarray(d)[nq:], rtol=1e-14)
     held = np.setdiff1d(np.arange(U.size), hs.free)
     assert np.all(U[held] == 0)

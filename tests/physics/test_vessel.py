@@ -113,9 +113,11 @@ def _random_states(n, seed=0):
 def test_buoyancy_moment_derivative_is_eq_38():
     h = _hydro()
     k = RHO * G * V
+    jac = jax.jit(jax.jacfwd(h.moment_paper))       # one program (eager: each operation its own)
     for _, q in _random_states(10):
-        J = jax.jacfwd(h.moment_paper)(q)
-        eq38 = -2 * k * (jnp.outer(jnp.array([GMT, 0, 0]), q @ A_PHI) + jnp.outer(jnp.array([0, GML, 0]), q @ A_THETA))
+        J = jac(q)
+        q = np.asarray(q)
+        eq38 = -2 * k * (np.outer([GMT, 0, 0], q @ np.asarray(A_PHI)) + np.outer([0, GML, 0], q @ np.asarray(A_THETA)))
         np.testing.assert_allclose(J, eq38, rtol=1e-12, atol=1e-12 * k)
 
 
@@ -130,15 +132,16 @@ def test_buoyancy_force_derivative_is_eq_37():
     def f_body(X0, q):
         return rotation_matrix(q).T @ h.force(X0)
 
+    # the derivatives and the rotation in one program (eager, each operation compiles on its own)
+    parts = jax.jit(lambda X0, q: (jax.jacfwd(f_body, 0)(X0, q), jax.jacfwd(f_body, 1)(X0, q), f_body(X0, q),
+                                   rotation_matrix(q), G_matrix(q)))
     rng = np.random.default_rng(1)
     for X0, q in _random_states(10):
-        JX = jax.jacfwd(f_body, 0)(X0, q)
-        Jq = jax.jacfwd(f_body, 1)(X0, q)
-        f = f_body(X0, q)
-        np.testing.assert_allclose(JX, -RHO * G * AW * rotation_matrix(q).T @ AZ, rtol=1e-12, atol=1e-6)
+        JX, Jq, f, A, Gq = (np.asarray(x) for x in parts(X0, q))
+        np.testing.assert_allclose(JX, -RHO * G * AW * A.T @ np.asarray(AZ), rtol=1e-12, atol=1e-6)
         dq = rng.normal(size=4)
-        dq = jnp.asarray(dq - (dq @ np.asarray(q)) * np.asarray(q))   # tangent to |q| = 1
-        np.testing.assert_allclose(Jq @ dq, 2 * skew(f) @ G_matrix(q) @ dq, rtol=1e-10, atol=1e-6)
+        dq = dq - (dq @ np.asarray(q)) * np.asarray(q)                 # tangent to |q| = 1
+        np.testing.assert_allclose(Jq @ dq, 2 * np.asarray(skew(f)) @ Gq @ dq, rtol=1e-10, atol=1e-6)
 
 
 def test_paper_moment_is_the_restoring_moment_for_pure_roll_and_pitch():
@@ -173,10 +176,11 @@ def test_conservative_hydrostatic_rows_are_the_gradient_of_the_restoring_potenti
     its potential along the step's increments (translations, body-frame rotations on the group)."""
     from jaxslosh.physics.terms import Config, potential_rows
     h = _hydro()
+    # the rows and their reference in one program (eager, each operation compiles on its own)
+    both = jax.jit(lambda c: (jnp.concatenate([-h.force(c.X0), -h.moment(c.q)]),
+                              potential_rows(lambda cc: h.restoring_potential(cc.X0, cc.q), c)))
     for X0, q in _random_states(6, seed=5):
         if rotation_matrix(q)[2, 2] < -0.5:
             continue
-        c = Config(X0, q, jnp.zeros(0))
-        rows = jnp.concatenate([-h.force(X0), -h.moment(q)])
-        ref = potential_rows(lambda cc: h.restoring_potential(cc.X0, cc.q), c)
+        rows, ref = both(Config(X0, q, jnp.zeros(0)))
         np.testing.assert_allclose(rows, ref, rtol=1e-10, atol=1e-9 * float(jnp.max(jnp.abs(ref))))

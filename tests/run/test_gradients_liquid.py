@@ -188,7 +188,7 @@ P0 = np.array([3.0, 1000.0, 50.0, 9.81, 1.2, 120.0])
 
 
 def test_gradient_of_a_trajectory_loss_wrt_tank_parameters_matches_central_differences():
-    """1 s of roll, pitch and heave of a light hull carrying 75 t of liquid (3 x 3 x 2 mesh): the
+    """0.5 s (50 steps) of roll, pitch and heave of a light hull carrying 75 t of liquid (3 x 3 x 2 mesh): the
     loss sums the squared roll and pitch, the free-surface elevation at a wall relative to the tank
     bottom (probes B - A) and the heave. jax.grad (reverse mode) against central differences at
     relative steps 1e-4 and 1e-5, which must agree with each other first. The sound speed is 50 m/s
@@ -197,7 +197,7 @@ def test_gradient_of_a_trajectory_loss_wrt_tank_parameters_matches_central_diffe
     The differences are taken with the same program (its values), jitted as a whole, so that the 24
     evaluations neither compile again nor build the traced model op by op (63 -> 36 s); that the
     traced model equals the NumPy one is tested above."""
-    scene = _scene()
+    scene = _scene(duration=0.5)
 
     def loss(p):
         r = js.simulate(scene, params=dict(zip(KEYS, p)))
