@@ -61,7 +61,7 @@ def test_rest_pull_gradient_matches_central_differences(key, h):
     g = float(jax.grad(pull)(jnp.asarray(BASE[key])))
     fd = (float(pull(BASE[key] + h)) - float(pull(BASE[key] - h))) / (2 * h)
     assert abs(g) > 0
-    assert g == pytest.approx(fd, rel=1e-6)   # measured: within 2e-7 (the seabed band is 1 mm)
+    assert g == pytest.approx(fd, rel=1e-6)   # measured: within 4e-7 (the seabed band is 1 mm)
 
 
 def test_lumped_lines_refuse_seabed_friction_naming_the_key():
