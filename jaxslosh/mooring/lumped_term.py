@@ -299,19 +299,15 @@ def lumped_line_term(c0: Config, dt: float, *, name: str, fairlead, anchor, leng
             raise ValueError(f"mooring.{name}.{key}: out of range ({kw.get(key, locals().get(key))!r})")
     shift = jnp.array([0.0, 0.0, -cog_height])
     seabed = -math.inf if depth is None else -float(depth) - cog_height
-    line = lm.lumped_line(jnp.asarray(anchor, dtype=float) + shift, length, weight, ea,
-                          segments=int(kw["segments"]), diameter=kw["diameter"], mass=kw["mass"],
-                          cd=tuple(kw["cd"]), ca=tuple(kw["ca"]), internal_damping=kw["internal_damping"],
-                          seabed_z=seabed, seabed_stiffness=kw["seabed_stiffness"],
-                          seabed_damping=kw["seabed_damping"], rho=water_density, gravity=gravity,
-                          current=current)
-    if traced:
+    common = dict(segments=int(kw["segments"]), diameter=kw["diameter"], mass=kw["mass"], cd=tuple(kw["cd"]),
+                  ca=tuple(kw["ca"]), internal_damping=kw["internal_damping"], seabed_z=seabed,
+                  seabed_stiffness=kw["seabed_stiffness"], seabed_damping=kw["seabed_damping"],
+                  rho=water_density, gravity=gravity, current=current)
+    anchor = jnp.asarray(anchor, dtype=float) + shift
+    line = lm.lumped_line(anchor, length, weight, ea, **common)
+    if traced:        # the traced values, on the sub-step of the scene's (static)
         own = dict(length=length, weight=weight, ea=ea) | dict(traced)
-        line = lm.lumped_line(line.anchor, own["length"], own["weight"], own["ea"], segments=line.segments,
-                              diameter=kw["diameter"], mass=kw["mass"], cd=tuple(kw["cd"]), ca=tuple(kw["ca"]),
-                              internal_damping=kw["internal_damping"], seabed_z=seabed,
-                              seabed_stiffness=kw["seabed_stiffness"], seabed_damping=kw["seabed_damping"],
-                              rho=water_density, gravity=gravity, current=current, substep=line.substep_max)
+        line = lm.lumped_line(anchor, own["length"], own["weight"], own["ea"], substep=line.substep_max, **common)
     p_b = jnp.asarray(fairlead, dtype=float)
     nodes0, F0 = _static(line, p_b, c0.X0, c0.q, name)
     carried = jnp.zeros(3)
