@@ -143,7 +143,8 @@ def _model(scene: Scene, params: dict, outline: bool = False) -> _Model:
             terms.append(weight_term(mass, hull_S, liquid, g, weight))     # a body's too (assemble/hull.py)
     if any(m.model == "catenary" for m in scene.mooring):   # quasi-static catenary lines (jaxslosh/mooring/term.py)
         terms.append(build_mooring(scene, balanced, outline, params))
-    terms.extend(group_lines(build_lumped_lines(scene, balanced, q0), len(scene.bodies)))    # dynamic lumped-mass lines (mooring/lumped_term.py)
+    # dynamic lumped-mass lines (mooring/lumped_term.py)
+    terms.extend(group_lines(build_lumped_lines(scene, balanced, q0, params), len(scene.bodies)))
     bodies, body_tanks = build_bodies(scene, params, g, outline)   # [[bodies]] and [[connections]] (physics/bodies.py)
     if bodies is not None:
         terms.append(bodies)

@@ -105,19 +105,28 @@ class LumpedLine(eqx.Module):
 
 def lumped_line(anchor, length, weight, ea, *, segments=20, diameter=0.09, mass=None, cd=(1.6, 0.1),
                 ca=(1.0, 0.0), internal_damping=-0.8, seabed_z=-jnp.inf, seabed_stiffness=3.0e6,
-                seabed_damping=3.0e5, rho=1025.0, gravity=9.81, current=(0.0, 0.0, 0.0)) -> LumpedLine:
+                seabed_damping=3.0e5, rho=1025.0, gravity=9.81, current=(0.0, 0.0, 0.0),
+                substep=None) -> LumpedLine:
     """A line's constants from the scene's values (concrete numbers: the sub-step is chosen here).
     `mass` (kg/m in air) defaults to weight / g plus the displaced water rho pi d^2 / 4;
     `internal_damping` < 0 is that fraction of a segment's critical axial damping l sqrt(EA m)
-    (MoorDyn's BA / -zeta convention); `seabed_z` = -depth (no seabed: -inf)."""
+    (MoorDyn's BA / -zeta convention); `seabed_z` = -depth (no seabed: -inf). `substep` given (the
+    largest stable sub-step of the line with the scene's values): `length`, `weight` and `ea` may be
+    traced (params, a sweep's runs), the sub-step being static."""
     area = math.pi * diameter ** 2 / 4.0
     m = weight / gravity + rho * area if mass is None else mass
     if segments < 2:
         raise ValueError("a lumped line needs at least 2 segments")
-    if m <= 0.0:
+    if substep is None and m <= 0.0:
         raise ValueError(f"a lumped line's mass per metre must be positive, got {m}")
     seg = length / segments
-    ba = -internal_damping * seg * math.sqrt(ea * m) if internal_damping < 0 else internal_damping
+    ba = -internal_damping * seg * jnp.sqrt(ea * m) if internal_damping < 0 else internal_damping
+    f = lambda x: jnp.asarray(x, dtype=float)  # noqa: E731
+    if substep is not None:
+        return LumpedLine(f(anchor), f(length), f(weight), f(ea), f(diameter), f(m), f(cd), f(ca), f(ba),
+                          f(seabed_z), f(seabed_stiffness), f(seabed_damping), f(rho), f(current),
+                          int(segments), float(substep))
+    ba = float(ba)
     # the fastest modes: the axial one (adjacent nodes out of phase, node mass m l without the
     # tangential added mass, which is 0 by default) and the seabed's vertical spring (with its added
     # mass); their damping ratios from BA and c_b
@@ -134,7 +143,6 @@ def lumped_line(anchor, length, weight, ea, *, segments=20, diameter=0.09, mass=
         return math.inf if w == 0.0 else 2.0 / w * (math.sqrt(1.0 + z * z) - z)
 
     dt = SAFETY * min(limit(w_ax, z_ax), limit(w_sb, z_sb))
-    f = lambda x: jnp.asarray(x, dtype=float)  # noqa: E731
     return LumpedLine(f(anchor), f(length), f(weight), f(ea), f(diameter), f(m), f(cd), f(ca), f(ba),
                       f(seabed_z), f(seabed_stiffness), f(seabed_damping), f(rho), f(current),
                       int(segments), float(dt))
@@ -399,3 +407,18 @@ def static_shape(line: LumpedLine, fair, tol=1e-8, max_iter=200):
 
     x, mu, it, gmax = jax.lax.while_loop(cond, body, (x0, jnp.asarray(1.0), 0, jnp.asarray(jnp.inf)))
     return x.reshape(-1, 3), gmax <= tol * fscale
+
+
+def static_shape_traced(line: LumpedLine, fair, tol=1e-8, max_iter=200):
+    """`static_shape` for a line whose values (length, weight, EA) or fairlead are traced: the solve
+    runs on their values with no derivative through its loop (reverse mode cannot pass a while
+    loop), and the derivative comes from the equilibrium instead (implicit function theorem: grad
+    V(x*, p) = 0 gives dx*/dp = -H^-1 d(grad V)/dp), added as a term whose value is zero so that the
+    nodes are the solve's to the last bit. Returns (nodes, converged)."""
+    held = jax.tree_util.tree_map(jax.lax.stop_gradient, (line, fair))
+    x, ok = static_shape(*held, tol=tol, max_iter=max_iter)
+    x = jax.lax.stop_gradient(x.reshape(-1))
+    g = jax.grad(lambda y: potential(line, y.reshape(-1, 3), fair))(x)
+    H = jax.hessian(lambda y: potential(held[0], y.reshape(-1, 3), held[1]))(x)
+    dx = jnp.linalg.solve(H, g)
+    return (x - (dx - jax.lax.stop_gradient(dx))).reshape(-1, 3), ok

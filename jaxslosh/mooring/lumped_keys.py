@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import dataclasses
 
-from ..scene.lumped_keys import LUMPED_KEYS, read_lumped  # noqa: F401
+from ..scene.lumped_keys import LUMPED_KEYS, LUMPED_TRACEABLE, read_lumped  # noqa: F401
 
 def quasi_static_lines(scene):
     """The scene with its lumped lines as catenary lines, their quasi-static limit (within 0.13 % at

@@ -33,13 +33,14 @@ import jax.numpy as jnp
 import numpy as np
 
 from ..io.line_energy import LINE_ENERGY
+from ..io.status import is_traced
 from ..physics.about import held_by
 from ..physics.bodies import VESSEL, bodies_term, body_rest, end_index
 from ..physics.kinematics import quat_from_rpy, rotation_matrix
 from ..physics.terms import AbstractTerm, Config, Kin, Rows
 from . import lumped as lm
 from ..scene.types import SceneError
-from .lumped_keys import LUMPED_KEYS, read_lumped  # noqa: F401  (the loader's reader, JAX-free)
+from .lumped_keys import LUMPED_KEYS, LUMPED_TRACEABLE, read_lumped  # noqa: F401  (the loader's reader, JAX-free)
 
 
 def _point(p_b, pose):
@@ -243,11 +244,23 @@ def _rest_shape(line, p_b, X0, q):
     return nodes, ok, lm.fairlead_force(line, nodes, jnp.zeros_like(nodes), fair, jnp.zeros(3))
 
 
+def _traced_rest(line, p_b, X0, q):
+    """_rest_shape for traced values (params, a sweep's runs): solved in the trace, differentiable
+    (lm.static_shape_traced); a shape that did not converge gives NaN nodes, which the run's first
+    step reports (a traced flag cannot raise here)."""
+    fair, _ = _fairlead(p_b, Config(X0, q, jnp.zeros(0)), jnp.zeros(3), jnp.zeros(3))
+    nodes, ok = lm.static_shape_traced(line, fair)
+    nodes = jnp.where(ok, nodes, jnp.nan)
+    return nodes, lm.fairlead_force(line, nodes, jnp.zeros_like(nodes), fair, jnp.zeros(3))
+
+
 def _static(line, p_b, X0, q, name):
     """(nodes, the line's force on the fairlead) of the line's static shape with the vessel at (X0,
     q), solved in float64 whatever the caller's precision (a description, `jaxslosh check`, may
     build the model in float32, where the energy's round-off stops the solve short of its
-    tolerance), in the caller's precision."""
+    tolerance), in the caller's precision. Traced values: _traced_rest."""
+    if is_traced((line, p_b, X0, q)):
+        return _traced_rest(line, p_b, X0, q)
     with jax.enable_x64(True):
         f64 = lambda x: jnp.asarray(x, dtype=jnp.float64)  # noqa: E731
         nodes, ok, F = _rest_shape(jax.tree_util.tree_map(f64, line), f64(p_b), f64(X0), f64(q))
@@ -260,7 +273,7 @@ def _static(line, p_b, X0, q, name):
 def lumped_line_term(c0: Config, dt: float, *, name: str, fairlead, anchor, length, weight, ea,
                      depth: Optional[float] = None, cog_height: float = 0.0, gravity: float = 9.81,
                      water_density: float = 1025.0, current=(0.0, 0.0, 0.0), balanced: bool = False,
-                     end: int = VESSEL, rest=None, holder: str = "", **lumped) -> LumpedLineTerm:
+                     end: int = VESSEL, rest=None, holder: str = "", traced=None, **lumped) -> LumpedLineTerm:
     """The term of one `[[mooring]]` table with `model = "lumped"`: the scene's values (fairlead in
     the body frame from the COG; anchor x, y from the COG at rest and z from the still-water level;
     `depth` the water depth, None without a seabed; `cog_height` the COG's height above the
@@ -270,7 +283,8 @@ def lumped_line_term(c0: Config, dt: float, *, name: str, fairlead, anchor, leng
     carries the line's vertical pull there (`carried`, as the catenary lines' term does). `end`: the
     body it holds (VESSEL, or a [[bodies]] body's slot: then c0 is that body's initial pose and
     `rest` = (X, q) its rest pose, where its springs are balanced; `holder` its name). Bad values raise ValueError
-    naming the key (`mooring.<name>.<key>`)."""
+    naming the key (`mooring.<name>.<key>`). `traced`: {"length" | "weight" | "ea": value} that replace
+    the scene's (tracers too: params, a sweep's runs); the sub-step stays the scene values' (static)."""
     unknown = set(lumped) - set(LUMPED_KEYS)
     if unknown:
         raise ValueError(f"mooring.{name}.{sorted(unknown)[0]}: not a key of a lumped line")
@@ -285,12 +299,15 @@ def lumped_line_term(c0: Config, dt: float, *, name: str, fairlead, anchor, leng
             raise ValueError(f"mooring.{name}.{key}: out of range ({kw.get(key, locals().get(key))!r})")
     shift = jnp.array([0.0, 0.0, -cog_height])
     seabed = -math.inf if depth is None else -float(depth) - cog_height
-    line = lm.lumped_line(jnp.asarray(anchor, dtype=float) + shift, length, weight, ea,
-                          segments=int(kw["segments"]), diameter=kw["diameter"], mass=kw["mass"],
-                          cd=tuple(kw["cd"]), ca=tuple(kw["ca"]), internal_damping=kw["internal_damping"],
-                          seabed_z=seabed, seabed_stiffness=kw["seabed_stiffness"],
-                          seabed_damping=kw["seabed_damping"], rho=water_density, gravity=gravity,
-                          current=current)
+    common = dict(segments=int(kw["segments"]), diameter=kw["diameter"], mass=kw["mass"], cd=tuple(kw["cd"]),
+                  ca=tuple(kw["ca"]), internal_damping=kw["internal_damping"], seabed_z=seabed,
+                  seabed_stiffness=kw["seabed_stiffness"], seabed_damping=kw["seabed_damping"],
+                  rho=water_density, gravity=gravity, current=current)
+    anchor = jnp.asarray(anchor, dtype=float) + shift
+    line = lm.lumped_line(anchor, length, weight, ea, **common)
+    if traced:        # the traced values, on the sub-step of the scene's (static)
+        own = dict(length=length, weight=weight, ea=ea) | dict(traced)
+        line = lm.lumped_line(anchor, own["length"], own["weight"], own["ea"], substep=line.substep_max, **common)
     p_b = jnp.asarray(fairlead, dtype=float)
     nodes0, F0 = _static(line, p_b, c0.X0, c0.q, name)
     carried = jnp.zeros(3)
@@ -300,17 +317,19 @@ def lumped_line_term(c0: Config, dt: float, *, name: str, fairlead, anchor, leng
         # a body starting at rest: the same solve as its start's (half the lines' build)
         at_rest = all(np.array_equal(np.asarray(a, dtype=float), b) for a, b in zip((c0.X0, c0.q), rest))
         _, F = (None, F0) if at_rest else _static(line, p_b, *rest, name)
-        carried = jnp.array([0.0, 0.0, -F[2]])
+        carried = jnp.zeros(3).at[2].set(-F[2])
     return LumpedLineTerm(line, p_b, nodes0, carried, name, line.substeps(dt), end, holder)
 
 
 # ---------------------------------------------------------------------------- the scene's tables
-def build_lumped_lines(scene, balanced: bool, q0=None) -> tuple:
+def build_lumped_lines(scene, balanced: bool, q0=None, params=None) -> tuple:
     """The terms of the scene's `[[mooring]]` lines with `model = "lumped"` (each line's lumped
     values in its `lumped` attribute, read_lumped's pairs; absent: the defaults), each in its static
     shape with the vessel at its initial position and attitude q0 (identity when None), or the body
     of [[bodies]] it holds at that body's initial pose, sub-stepped for the scene's dt. `balanced`:
-    the vessel's hydrostatics are linear springs; a body's lines are carried where its own are."""
+    the vessel's hydrostatics are linear springs; a body's lines are carried where its own are.
+    `params`: canonical keys `mooring.<name>.length | weight | ea` that replace the scene's values
+    (tracers too; the loader's keys refuse the others on a lumped line: scene/keys.py)."""
     lines = [m for m in scene.mooring if getattr(m, "model", "catenary") == "lumped"]
     if not lines:
         return ()
@@ -332,6 +351,8 @@ def build_lumped_lines(scene, balanced: bool, q0=None) -> tuple:
                 start, scene.simulation.dt, name=m.name, fairlead=m.fairlead, anchor=m.anchor, length=m.length,
                 weight=m.weight, ea=m.ea, depth=env.depth, cog_height=getattr(scene.vessel, "cog_height", 0.0),
                 gravity=env.gravity, water_density=env.water_density, **held,
+                traced={k: params[f"mooring.{m.name}.{k}"] for k in LUMPED_TRACEABLE
+                        if f"mooring.{m.name}.{k}" in (params or {})},
                 **dict(getattr(m, "lumped", ()))))
         except ValueError as e:
             raise SceneError(f"mooring.{m.name}", str(e)) from e

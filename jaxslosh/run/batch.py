@@ -234,7 +234,7 @@ def _batch_lines(scene: Scene, res: Result, fr, params: dict) -> Result:
     """A batch that varies the mooring lines' values: each run's line tensions from its own lines
     (_batch_result's come from the scene's)."""
     runs = [resolve_params(scene, {k: np.asarray(v)[i] for k, v in params.items()}) for i in range(len(res.time))]
-    if not res.mooring or not any(k.startswith("mooring.") for k in runs[0]):
+    if not any(m.model == "catenary" for m in scene.mooring) or not any(k.startswith("mooring.") for k in runs[0]):
         return res
     rest = jnp.asarray(np.array([body_rest(b, scene.vessel.cog_height) for b in scene.bodies]).reshape(-1, 3))
     poses = (lambda i: ()) if not scene.bodies else (      # the bodies' poses, for lines that hold them
@@ -242,8 +242,9 @@ def _batch_lines(scene: Scene, res: Result, fr, params: dict) -> Result:
     per_run = [line_datasets(build_mooring(scene, False, True, run), fr.X0[i], fr.q[i], *poses(i))
                for i, run in enumerate(runs)]
     d = {k: jnp.stack([p[k] for p in per_run]) for k in per_run[0]}
+    # a lumped line's tensions are its own run's already (its nodes are states of the vmapped run)
     lines = {n: type(m)(d[f"mooring/{n}/fairlead_tension"], d[f"mooring/{n}/anchor_tension"])
-             for n, m in res.mooring.items()}
+             if f"mooring/{n}/fairlead_tension" in d else m for n, m in res.mooring.items()}
     return dataclasses.replace(res, mooring=lines)
 
 

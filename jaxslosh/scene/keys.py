@@ -26,6 +26,7 @@ from .bodies import tank_carriers
 from .fields import show
 from .keydocs import KEYS as KEY_DOCS, TABLES as KEY_TABLES  # noqa: F401  default, unit, meaning (docs)
 from .load import forced_span, parse_scene, step_warnings
+from .lumped_keys import LUMPED_TRACEABLE
 from .types import Material, Scene, SceneError
 
 
@@ -261,12 +262,21 @@ def traceable(scene: Scene, keys: Iterable[str]) -> tuple[str, ...]:
         if key not in TRACEABLE:
             raise SceneError(given, "cannot be traced by params, a sweep or a fit (traceable: "
                                     + ", ".join(traceable_keys(scene)) + ")")
+        if _lumped_refused(scene, key):
+            raise SceneError(given, "cannot be traced on a lumped line (its seabed has no friction); a lumped "
+                                    "line traces " + ", ".join(LUMPED_TRACEABLE) + " (docs/guide/moorings-lumped.md)")
         if hull_key(scene, key) and not _hull_restoring(scene, key):
             table = key.rpartition(".hull.")[0]
             raise SceneError(given, f'is traced by the nonlinear hydrostatics only ([{table}.hydrostatics] model = '
                                     '"nonlinear", [effects] buoyancy on): the linear model\'s GM springs were fixed '
                                     f"when the scene was loaded (trace {table}.hydrostatics.gm_t there)")
     return canon
+
+
+def _lumped_refused(scene: Scene, key: str) -> bool:
+    """Whether a canonical key is a mooring value that a lumped line does not trace (LUMPED_TRACEABLE)."""
+    return any(m.model == "lumped" and key.startswith(f"mooring.{m.name}.")
+               and key[len(f"mooring.{m.name}."):] not in LUMPED_TRACEABLE for m in scene.mooring)
 
 
 def _hull_restoring(scene: Scene, key: str) -> bool:
@@ -279,7 +289,8 @@ def _hull_restoring(scene: Scene, key: str) -> bool:
 def traceable_keys(scene: Scene) -> tuple[str, ...]:
     """The keys of this scene that params may trace."""
     return tuple(k for k in scene_values(scene)
-                 if "[" not in k and k in TRACEABLE and (not hull_key(scene, k) or _hull_restoring(scene, k)))
+                 if "[" not in k and k in TRACEABLE and (not hull_key(scene, k) or _hull_restoring(scene, k))
+                 and not _lumped_refused(scene, k))
 
 
 def _shaped(key: str, value, base):

@@ -8,6 +8,9 @@ from .types import SceneError
 #: the lumped-only keys of a `[[mooring]]` table and their defaults (mass: from weight and diameter)
 LUMPED_KEYS = {"segments": 20, "diameter": 0.09, "mass": None, "cd": (1.6, 0.1), "ca": (1.0, 0.0),
                "internal_damping": -0.8, "seabed_stiffness": 3.0e6, "seabed_damping": 3.0e5}
+#: the values of a lumped line that params, a sweep or a fit may trace (its rest shape is solved from
+#: them in the trace; the sub-step stays the scene's); a lumped line's seabed has no friction to trace
+LUMPED_TRACEABLE = ("length", "weight", "ea")
 
 
 def read_lumped(table: dict, where: str) -> tuple[dict, tuple]:
