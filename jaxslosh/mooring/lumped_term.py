@@ -35,7 +35,7 @@ import numpy as np
 from ..io.line_energy import LINE_ENERGY
 from ..io.status import is_traced
 from ..physics.about import held_by
-from ..physics.bodies import VESSEL, bodies_term, body_rest, end_index
+from ..physics.bodies import VESSEL, bodies_term, body_rest, end_index, weight_balanced
 from ..physics.kinematics import quat_from_rpy, rotation_matrix
 from ..physics.terms import AbstractTerm, Config, Kin, Rows
 from . import lumped as lm
@@ -362,14 +362,13 @@ def build_lumped_lines(scene, balanced: bool, q0=None, params=None) -> tuple:
 def _body_pose(scene, s: int) -> dict:
     """lumped_line_term's arguments for a line on the body of slot s: its initial pose c0 (as
     assemble/bodies.py starts it: its rest pose offset by its initial values), its rest pose and
-    whether its buoyancy carries the line's pull at rest (linear springs about that pose)."""
+    whether its buoyancy carries the line's pull at rest (physics/bodies.py weight_balanced)."""
     b = scene.bodies[s]
     X = jnp.asarray(body_rest(b, scene.vessel.cog_height))
     turn = jnp.array([0.0, 0.0, b.heading])
     q0 = quat_from_rpy(jnp.asarray(b.initial.roll_pitch_yaw, dtype=float) + turn)
     c0 = Config(X + jnp.asarray(b.initial.position, dtype=float), q0, jnp.zeros(0))
-    springs = b.hydrostatics is not None and not b.hydrostatics.nonlinear
-    return dict(c0=c0, end=s, rest=(X, quat_from_rpy(turn)), balanced=springs, holder=b.name)
+    return dict(c0=c0, end=s, rest=(X, quat_from_rpy(turn)), balanced=weight_balanced(scene, b), holder=b.name)
 
 
 def lumped_observe(system, z: tuple, c: Config, v) -> dict:

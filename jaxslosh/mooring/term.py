@@ -25,7 +25,7 @@ import jax.numpy as jnp
 import numpy as np
 
 from ..physics.about import About, held_by
-from ..physics.bodies import VESSEL, body_rest, end_index
+from ..physics.bodies import VESSEL, body_rest, end_index, weight_balanced
 from ..physics.kinematics import quat_from_rpy, rotation_matrix
 from ..physics.terms import AbstractTerm, Config, Kin, Rows
 from .catenary import lines_inverse, lines_settle, lines_spans, profile, solve_lines
@@ -206,10 +206,9 @@ def build_mooring(scene, balanced: bool, outline: bool = False, params: Optional
                                           for b in scene.bodies])
         held = dict(ends=ends, n_bodies=len(scene.bodies), carried_bodies=jnp.zeros((len(scene.bodies), 3)),
                     rest_X=jnp.asarray(rest[slot]), rest_A=turn[slot])
-        # the bodies whose buoyancy carries their lines' pull at rest: those on linear springs about
-        # their rest pose; a body on its own hull sinks under it, as the vessel on its hull does
-        springs = jnp.asarray([float(b.hydrostatics is not None and not b.hydrostatics.nonlinear)
-                               for b in scene.bodies])
+        # the bodies whose buoyancy carries their lines' pull at rest: those whose weight it balances there
+        # (linear springs, or buoyancy off); a body on its own hull sinks under it, as the vessel does
+        springs = jnp.asarray([float(weight_balanced(scene, b)) for b in scene.bodies])
     term = MooringLines(fairlead=jnp.asarray([m.fairlead for m in lines], dtype=float), anchor=jnp.asarray(anchor),
                         length=col("length"), weight=col("weight"), ea=col("ea"), friction=col("seabed_friction"),
                         anchor_height=col("anchor_height"), carried=jnp.zeros(3), names=tuple(m.name for m in lines),
@@ -227,7 +226,7 @@ def _about(scene, lines, ends, balanced: bool) -> About:
     def words(group, carried: bool, whose: str) -> str:
         return (f"{len(group)} quasi-static elastic catenary line(s) {', '.join(repr(m.name) for m in group)}, "
                 f"depth {scene.environment.depth:g} m"
-                + (f" ({whose} buoyancy carries their vertical pull at rest: linear hydrostatics)" if carried else ""))
+                + (f" ({whose} buoyancy carries their vertical pull at rest)" if carried else ""))
     out = []
     mine = [m for m, e in zip(lines, ends) if e == VESSEL]
     if mine:
@@ -235,8 +234,7 @@ def _about(scene, lines, ends, balanced: bool) -> About:
     for s, b in enumerate(scene.bodies):
         group = [m for m, e in zip(lines, ends) if e == s]
         if group:
-            springs = b.hydrostatics is not None and not b.hydrostatics.nonlinear
-            out.append(("mooring", held_by(b.name, words(group, springs, "its"))))
+            out.append(("mooring", held_by(b.name, words(group, weight_balanced(scene, b), "its"))))
     return About(*out)
 
 

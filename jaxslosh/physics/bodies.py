@@ -78,6 +78,15 @@ def body_rest(b, vessel_cog: float) -> np.ndarray:
     return np.array([b.position[0], b.position[1], b.cog_height - vessel_cog], dtype=float)
 
 
+def weight_balanced(scene, b) -> bool:
+    """Whether a scene body's weight is balanced at rest, so that its buoyancy also carries its lines'
+    vertical pull there: linear hydrostatics (springs about its rest pose), or `[effects] buoyancy`
+    off; not where its hull's pressure carries it (it then sinks under the pull). The rule of
+    assemble/hull.py `restoring`, which the vessel follows too."""
+    hs = b.hydrostatics
+    return hs is not None and not (hs.nonlinear and scene.effects.buoyancy)
+
+
 def ramp(x, band=BAND):
     """(rho, rho'): max(x, 0) with its corner replaced by (x + band/2)^2 / (2 band) on |x| < band/2."""
     h = 0.5 * band

@@ -113,3 +113,17 @@ def test_a_bodys_gravity_turns_as_the_vessels(turning):
     if not turning:
         other = js.simulate(scenes("gravity_turning = true", tank=True)[1])
         assert np.abs(np.asarray(other.vessel.roll_pitch_yaw[:, 0]) - np.asarray(body.roll_pitch_yaw[:, 0])).max() > 1e-4
+
+
+@pytest.mark.parametrize("name", ["paper_ship_tank.toml", "parametric_roll.toml"])
+@pytest.mark.parametrize("buoyancy", [True, False])
+def test_the_lines_rule_of_a_balanced_weight_is_the_restorings(name, buoyancy):
+    """The moorings carry a floating body's lines' pull at rest where its weight is balanced there
+    (physics/bodies.py weight_balanced); that must be the restoring's own choice (assemble/hull.py
+    restoring: no weight term), on linear springs and on a hull's pressure, buoyancy on and off."""
+    from jaxslosh.assemble.hull import restoring
+    from jaxslosh.physics.bodies import weight_balanced
+    scene = js.scene_with(js.load_scene(f"scenes/{name}"), {"effects.buoyancy": buoyancy})
+    held = restoring(scene, scene.vessel, {}, 9.81, "vessel")
+    assert weight_balanced(scene, scene.vessel) == (not held.weighs)
+    assert weight_balanced(scene, scene.vessel) == (not (scene.vessel.hydrostatics.nonlinear and buoyancy))
