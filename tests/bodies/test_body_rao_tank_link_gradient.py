@@ -1,8 +1,9 @@
-"""The RAOs of a scene with [[bodies]] are differentiable in a body's tank and in a connection
-(docs/guide/rao-gradients.md): the two boxes of tests/data/bodies, a tank of water on the tender and
-a spring between them; the derivatives of `js.rao` in the tank's fill depth
-(`tanks.<name>.fill_depth`) and the spring's stiffness (`connections.<name>.stiffness`) equal
-central differences (the keys of test_body_rao_gradient.py are the bodies' own)."""
+"""The RAOs of a scene with [[bodies]] are differentiable in a body's tank (docs/guide/rao-gradients.md):
+the two boxes of tests/data/bodies, a tank of water on the tender and a spring between them; the
+derivative of `js.rao` in the tank's fill depth (`tanks.<name>.fill_depth`, traced through the
+liquid's matrices) equals central differences (the keys of test_body_rao_gradient.py are the
+bodies' own). A connection's stiffness (`connections.<name>.stiffness`) is a traced key too, but
+the RAOs do not move with it (a hundred times stiffer: the same RAOs): the expected failure below."""
 import jax
 import jax.numpy as jnp
 import numpy as np
@@ -52,21 +53,32 @@ def _responses(scene, w, p):
 
 
 @pytest.mark.slow      # about 2 minutes on a loaded machine: three compiles of the RAOs with a liquid
-def test_the_rao_gradient_in_a_body_tanks_fill_and_a_connections_stiffness(case):
+def test_the_rao_gradient_in_a_body_tanks_fill_depth(case):
     scene, w, p0 = case
     f = lambda p: _responses(scene, w, p)   # noqa: E731
     traced, J = jax.jit(lambda p: (f(p), jax.jacfwd(f)(p)))(jnp.asarray(p0))
     concrete = np.asarray(f(p0))
     np.testing.assert_allclose(np.asarray(traced), concrete, rtol=1e-10)
     values = jax.jit(f)
-    J = np.asarray(J)
-    for i, key in enumerate(KEYS):
-        fds = []
-        for rel in (1e-5, 3e-6):
-            e = np.zeros(2)
-            e[i] = rel * p0[i]
-            fds.append((np.asarray(values(p0 + e)) - np.asarray(values(p0 - e))) / (2 * e[i]))
-        scale = np.max(np.abs(fds[1]))
-        assert scale * p0[i] > 1e-3 * np.max(concrete), key          # the value moves the RAOs
-        assert np.max(np.abs(fds[0] - fds[1])) <= 1e-5 * scale, (key, "central differences not converged")
-        assert np.max(np.abs(J[:, i] - fds[1])) <= 1e-5 * scale, (key, J[:, i], fds[1])
+    J = np.asarray(J)[:, 0]
+    # steps of 1e-3 and 5e-4 of the depth: the RAOs' round-off (about 1e-10 of them: the liquid's
+    # compression is stiff) makes smaller steps' differences noisier than these' truncation
+    fds = []
+    for rel in (1e-3, 5e-4):
+        e = np.array([rel * p0[0], 0.0])
+        fds.append((np.asarray(values(p0 + e)) - np.asarray(values(p0 - e))) / (2 * e[0]))
+    scale = np.max(np.abs(fds[1]))
+    assert scale * p0[0] > 1e-3 * np.max(concrete)          # the fill depth moves the RAOs
+    assert np.max(np.abs(fds[0] - fds[1])) <= 1e-5 * scale, "central differences not converged"
+    assert np.max(np.abs(J - fds[1])) <= 1e-5 * scale, (J, fds[1])
+
+
+@pytest.mark.slow
+@pytest.mark.xfail(strict=True, reason="js.rao leaves a connection's stiffness out: the RAOs are the same at "
+                                       "2e5 and 2e7 N/m (issue 46, item 4)")
+def test_a_connections_stiffness_moves_the_rao(case):
+    scene, _, _ = case
+    w = np.array([0.6, 1.0, 1.4])
+    sway = [np.abs(js.rao(js.scene_with(scene, {KEYS[1]: k}), w, [np.pi / 2]).bodies["tender"][:, 0, 1])
+            for k in (2.0e5, 2.0e7)]
+    assert np.max(np.abs(sway[0] - sway[1])) > 1e-3 * np.max(sway[0])
