@@ -2,14 +2,15 @@
 the two boxes of tests/data/bodies, a tank of water on the tender and a spring between them; the
 derivative of `js.rao` in the tank's fill depth (`tanks.<name>.fill_depth`, traced through the
 liquid's matrices) equals central differences (the keys of test_body_rao_gradient.py are the
-bodies' own). A connection's stiffness (`connections.<name>.stiffness`) is a traced key too, but
-the RAOs do not move with it (a hundred times stiffer: the same RAOs): the expected failure below."""
+bodies' own), and so does its derivative in a connection's stiffness (`connections.<name>.stiffness`),
+which needs the spring's force differentiated right at its unstretched length (the rest state)."""
 import jax
 import jax.numpy as jnp
 import numpy as np
 import pytest
 
 import jaxslosh as js
+from jaxslosh.physics.bodies import Link
 
 from two_boxes_scene import reference, two_boxes
 
@@ -73,12 +74,29 @@ def test_the_rao_gradient_in_a_body_tanks_fill_depth(case):
     assert np.max(np.abs(J - fds[1])) <= 1e-5 * scale, (J, fds[1])
 
 
+def test_a_springs_force_has_its_stiffness_at_its_length():
+    """A spring at its unstretched length (the RAOs' rest state): dF/de is its stiffness, on both sides
+    (through sign(e) F(|e|) the derivative at e = 0 was 0, and js.rao left the spring out)."""
+    k = 2.0e5
+    link = Link(ends=(-1, 0), kind="spring", xs=jnp.array([0.0, 1.0]), fs=jnp.array([0.0, k]))
+    dF = jax.grad(lambda e: link.law(e)[1])
+    for e in (0.0, 0.3, -0.3):
+        np.testing.assert_allclose(float(dF(jnp.asarray(e))), k, rtol=1e-14)
+    np.testing.assert_allclose(float(link.law(jnp.asarray(-0.3))[1]), -0.3 * k, rtol=1e-14)
+    np.testing.assert_allclose(float(link.law(jnp.asarray(-0.3))[0]), 0.5 * k * 0.09, rtol=1e-14)
+
+
 @pytest.mark.slow
-@pytest.mark.xfail(strict=True, reason="js.rao leaves a connection's stiffness out: the RAOs are the same at "
-                                       "2e5 and 2e7 N/m (issue 46, item 4)")
-def test_a_connections_stiffness_moves_the_rao(case):
+def test_a_connections_stiffness_moves_the_rao_and_its_gradient_is_the_differences(case):
     scene, _, _ = case
     w = np.array([0.6, 1.0, 1.4])
-    sway = [np.abs(js.rao(js.scene_with(scene, {KEYS[1]: k}), w, [np.pi / 2]).bodies["tender"][:, 0, 1])
-            for k in (2.0e5, 2.0e7)]
-    assert np.max(np.abs(sway[0] - sway[1])) > 1e-3 * np.max(sway[0])
+    sway = lambda k: jnp.abs(js.rao(scene, w, [np.pi / 2], params={KEYS[1]: k}).bodies["tender"][:, 0, 1])  # noqa: E731
+    values = jax.jit(sway)
+    k0 = 2.0e5
+    J = np.asarray(jax.jit(jax.jacfwd(sway))(k0))
+    assert np.max(np.abs(np.asarray(values(100 * k0)) - np.asarray(values(k0)))) > 1e-3 * np.max(np.asarray(values(k0)))
+    fds = [(np.asarray(values(k0 * (1 + rel))) - np.asarray(values(k0 * (1 - rel)))) / (2 * rel * k0)
+           for rel in (1e-3, 5e-4)]
+    scale = np.max(np.abs(fds[1]))
+    assert np.max(np.abs(fds[0] - fds[1])) <= 1e-5 * scale, "central differences not converged"
+    assert np.max(np.abs(J - fds[1])) <= 1e-5 * scale, (J, fds[1])
