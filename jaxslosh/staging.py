@@ -17,6 +17,7 @@ import functools
 
 import equinox as eqx
 import jax
+from threadpoolctl import threadpool_limits
 
 _JAXLIB = tuple(int(p) for p in jax.lib.__version__.split(".")[:2] if p.isdigit())
 
@@ -155,3 +156,13 @@ def evaluated(fn, static_argnums=()):
             program = jitted.lower(*args).compile()      # cached by JAX: compiled once per signature
         return program(*(a for i, a in enumerate(args) if i not in static))
     return call
+
+
+def one_blas_thread():
+    """A context in which NumPy's and SciPy's BLAS (OpenBLAS, which jaxlib's LAPACK calls use too)
+    run on one thread: the build's host-side algebra (modal bases, factors of a few hundred to a few
+    thousand rows, many small multi-column solves) gains nothing from a second thread, and on a busy
+    machine its threads' waits for each other cost several times the work (scenes/flng_side_by_side.toml:
+    the face-normal tanks' bases 5 s of CPU against 0.4 s; docs/benchmarks.md). XLA's own threads are
+    not BLAS's: the run's compiled programs are unaffected."""
+    return threadpool_limits(limits=1, user_api="blas")

@@ -24,7 +24,7 @@ from ..physics.system import System
 from ..physics.terms import Config
 from ..physics.vessel import (HarmonicMotion, RecordedMotion, RigidBody, SpinUpMotion,
                               Weight, record_coefficients)
-from ..staging import staged
+from ..staging import one_blas_thread, staged
 from ..scene.keys import resolve_params
 from ..scene.types import DOFS, Scene
 from .about import damping_about, flex_about, liquid_about, record_about, stiffening_about, weight_about
@@ -69,6 +69,11 @@ class _Model(NamedTuple):
 
 
 def build(scene: Scene, params: Optional[dict] = None) -> Built:
+    with one_blas_thread():          # host algebra of small matrices (staging.one_blas_thread)
+        return _build(scene, params)
+
+
+def _build(scene: Scene, params: Optional[dict]) -> Built:
     params = resolve_params(scene, params)
     P = params.get
     ves = scene.vessel

@@ -123,8 +123,10 @@ class Link(eqx.Module):
     def law(self, e):
         """(U(e), dU/de, the contact factor of the damping) at extension e."""
         if self.kind == "spring":       # W(|e|) is C1: F(0) = 0
-            W, F = self.curve(jnp.abs(e))
-            return W, jnp.sign(e) * F, jnp.ones_like(e)
+            # each side's curve on its own branch: through sign(e) F(|e|) the derivative at e = 0 (a
+            # spring at its length: the RAOs' rest state) would be sign'(0) F(0) + sign(0) F' = 0, not k
+            (Wp, Fp), (Wm, Fm) = self.curve(e), self.curve(-e)
+            return jnp.where(e >= 0, Wp, Wm), jnp.where(e >= 0, Fp, -Fm), jnp.ones_like(e)
         sign = 1.0 if self.kind == "hawser" else -1.0
         rho, slope = ramp(sign * e)
         W, F = self.curve(rho)

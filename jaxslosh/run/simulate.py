@@ -22,6 +22,7 @@ from ..io.result import Failure, Result, result_from, truncated
 from ..scene.keys import check_values, with_overrides
 from ..scene.types import Scene
 from ..solve.linear import Solver, make_solver
+from ..staging import one_blas_thread
 from .compiled import compile_run
 from .loop import Carry, Frame, advance, core, frame_datasets, start, tank_blocks, with_first
 
@@ -61,7 +62,7 @@ def prepare(scene: Scene, params=None, batch: bool = False, check: bool = True) 
     # Under an outer jax.jit (a user's jitted loss) every jnp operation is staged, even on
     # constants; the build relies on the scene's own values being concrete (NumPy meshes, host
     # factors), so what does not depend on traced `params` is evaluated now, as outside jit.
-    with jax.ensure_compile_time_eval():
+    with jax.ensure_compile_time_eval(), one_blas_thread():     # the solver's host factors too
         b = build(scene, params)
         scheme = sim.time_scheme()
         solver = make_solver(b.system, h, scheme, sim.tolerance, sim.max_iterations, sim.substeps,
