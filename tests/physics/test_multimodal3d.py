@@ -10,6 +10,7 @@ import numpy as np
 import pytest
 from scipy import integrate, special
 
+from jaxslosh.liquid.multimodal.modes import DiskBase
 from jaxslosh.liquid.multimodal.term import modal_tank
 from jaxslosh.liquid.multimodal.tank3d import box_tank3d, cylinder_tank
 
@@ -232,3 +233,19 @@ def test_cylinder_turning_about_its_axis_keeps_its_waves_still():
     expect = np.sort([wn + (0.0 if m == 0 else (-m if c == 0 else m) * 0.7) for wn, (m, _, c) in zip(w, t.modes)])
     got = np.sort(np.abs(ev.imag))[::2]
     np.testing.assert_allclose(got, expect, rtol=1e-8)
+
+
+@pytest.mark.parametrize("n", [6, 16])
+def test_cylinder_quadrature_holds_the_modes_norms_and_orthogonality(n):
+    """The disk's base quadrature (Gauss-Jacobi in r by the trapezoidal rule in theta) gives the area
+    pi R^2, the modes' norms in closed form, pi_m R^2 / 2 (1 - m^2 / (k R)^2) with pi_m = 2 pi for m = 0
+    and pi otherwise (J_m'(k R) = 0), and their orthogonality."""
+    R = 0.6
+    base = DiskBase(R)
+    modes = base.lowest(n)
+    x, y, w = base.quadrature(modes)
+    F = base.values(modes, x, y)[0]
+    k, m = base.wavenumbers(modes), np.array([md[0] for md in modes])
+    norms = np.where(m == 0, 2.0 * np.pi, np.pi) * 0.5 * R * R * (1.0 - (m / (k * R)) ** 2)
+    np.testing.assert_allclose(w.sum(), np.pi * R * R, rtol=1e-13)
+    np.testing.assert_allclose((F * w[:, None]).T @ F, np.diag(norms), rtol=0, atol=1e-9 * norms.max())
