@@ -17,6 +17,8 @@ import functools
 
 import equinox as eqx
 import jax
+import jax.numpy as jnp
+import numpy as np
 
 _JAXLIB = tuple(int(p) for p in jax.lib.__version__.split(".")[:2] if p.isdigit())
 
@@ -155,3 +157,13 @@ def evaluated(fn, static_argnums=()):
             program = jitted.lower(*args).compile()      # cached by JAX: compiled once per signature
         return program(*(a for i, a in enumerate(args) if i not in static))
     return call
+
+
+def on_device(x):
+    """`jnp.asarray(x)` without a compile: JAX lifts a NumPy array or scalar through a primitive that,
+    outside a trace, compiles a tiny XLA program for every new shape and dtype; `jax.device_put`
+    copies it (same dtype, same weak type; inside a trace the same constant). Anything else (JAX
+    arrays, tracers, Python lists) goes to `jnp.asarray`."""
+    if isinstance(x, (np.ndarray, np.generic)) and not isinstance(x, np.ma.MaskedArray):
+        return jax.device_put(x)
+    return jnp.asarray(x)
