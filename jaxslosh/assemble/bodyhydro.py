@@ -24,7 +24,6 @@ from __future__ import annotations
 import os
 from typing import NamedTuple, Optional
 
-import jax.numpy as jnp
 import numpy as np
 
 from ..hydro.multibody import read_multibody
@@ -36,6 +35,7 @@ from ..hydro.tables import Tables, interpolate_excitation, interpolate_radiation
 from ..physics.seakeeping import Memory
 from .hull import froude_krylov_surface
 from ..scene.types import SceneError
+from ..staging import on_device
 
 
 class Source(NamedTuple):
@@ -299,6 +299,6 @@ def time_terms(scene, params: dict):
         s = np.zeros((p.size, N))
         s[np.arange(p.size), np.concatenate(sel)] = 1.0
         c_all = np.concatenate(cs, axis=1)
-        memory = Memory(jnp.asarray(p.real), jnp.asarray(p.imag), jnp.asarray(s), jnp.asarray(c_all.real),
-                        jnp.asarray(c_all.imag))
+        memory = Memory(on_device(p.real), on_device(p.imag), on_device(s), on_device(c_all.real),
+                        on_device(c_all.imag))
     return Ainf, memory, X

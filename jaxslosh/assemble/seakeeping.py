@@ -14,6 +14,7 @@ from .hull import froude_krylov_hull, hull_pressure
 from ..hydro.spectra import components
 from ..hydro.tables import matrix6
 from ..physics.seakeeping import AddedMass, Excitation, LinearDamping, Memory, RadiationMemory, WaveExcitation
+from ..staging import on_device
 
 
 def memory_module(fit: RadiationFit) -> Optional[Memory]:
@@ -28,7 +29,7 @@ def memory_module(fit: RadiationFit) -> Optional[Memory]:
 def make_excitation(waves, X, height) -> Excitation:
     """From the components of `waves` and X (N, 6): the force of each component per unit `height`."""
     omega, amp, phase = excitation_arrays(waves, components(waves), X)
-    return Excitation(jnp.asarray(omega), jnp.asarray(amp), jnp.asarray(phase), jnp.asarray(height, dtype=float),
+    return Excitation(on_device(omega), on_device(amp), on_device(phase), jnp.asarray(height, dtype=float),
                       ramp=float(waves.ramp))
 
 
