@@ -17,6 +17,8 @@ import functools
 
 import equinox as eqx
 import jax
+import jax.numpy as jnp
+import numpy as np
 from threadpoolctl import threadpool_limits
 
 _JAXLIB = tuple(int(p) for p in jax.lib.__version__.split(".")[:2] if p.isdigit())
@@ -166,3 +168,13 @@ def one_blas_thread():
     the face-normal tanks' bases 5 s of CPU against 0.4 s; docs/benchmarks.md). XLA's own threads are
     not BLAS's: the run's compiled programs are unaffected."""
     return threadpool_limits(limits=1, user_api="blas")
+
+
+def on_device(x):
+    """`jnp.asarray(x)` without a compile: JAX lifts a NumPy array or scalar through a primitive that,
+    outside a trace, compiles a tiny XLA program for every new shape and dtype; `jax.device_put`
+    copies it (same dtype, same weak type; inside a trace the same constant). Anything else (JAX
+    arrays, tracers, Python lists) goes to `jnp.asarray`."""
+    if isinstance(x, (np.ndarray, np.generic)) and not isinstance(x, np.ma.MaskedArray):
+        return jax.device_put(x)
+    return jnp.asarray(x)

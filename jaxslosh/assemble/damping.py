@@ -9,6 +9,7 @@ from __future__ import annotations
 
 from typing import Optional
 
+import jax
 import jax.numpy as jnp
 import numpy as np
 
@@ -16,6 +17,7 @@ from ..liquid.damping import boundary_layer_ratios, sloshing_basis
 from ..liquid.modal_damping import ModalDamping, TankDamping
 from ..scene.fields import show
 from ..scene.types import Scene, SceneError
+from ..staging import on_device
 from .liquid import build_liquid_block
 
 
@@ -45,12 +47,14 @@ def build_damping(scene: Scene, params: Optional[dict], block) -> tuple[Optional
             raise SceneError(f"tanks[{i}].damping.ratio", f"gives {L} damping ratios, but {where} sloshing modes")
         k = L if listed and t.damping.viscosity == 0.0 else omega.size
         omega, Phi, Bt = omega[:k], Phi[:, :k], Bt[:, :k]
-        zeta = jnp.concatenate([jnp.asarray(ratio, dtype=float), jnp.zeros(k - L)]) if listed \
-            else jnp.full(k, 1.0) * jnp.asarray(ratio, dtype=float)
+        # NumPy for the scene's own ratios (op by op in JAX each line compiled a tiny program)
+        xp = jnp if any(isinstance(v, jax.core.Tracer) for v in jax.tree_util.tree_leaves(ratio)) else np
+        zeta = xp.concatenate([xp.asarray(ratio, dtype=float), xp.zeros(k - L)]) if listed \
+            else xp.full(k, 1.0) * xp.asarray(ratio, dtype=float)
         zeta = zeta + boundary_layer_ratios(model, omega, Phi, t.damping.viscosity)
         parts.append((offset, Bt))
         cs.append(2.0 * zeta * omega)
-        table.append(TankDamping(t.name, omega, zeta))
+        table.append(TankDamping(t.name, omega, on_device(zeta)))
         offset += n_t
     B = np.zeros((offset, sum(b.shape[1] for _, b in parts)))
     col = 0
@@ -59,7 +63,8 @@ def build_damping(scene: Scene, params: Optional[dict], block) -> tuple[Optional
         col += Bt.shape[1]
     if B.shape[0] != block.liquid.nf:
         raise AssertionError(f"damping rows {B.shape[0]} != liquid unknowns {block.liquid.nf}")
-    return ModalDamping(B=jnp.asarray(B), c=jnp.concatenate(cs)), tuple(table)
+    c = jnp.concatenate(cs) if any(isinstance(x, jax.core.Tracer) for x in cs) else on_device(np.concatenate(cs))
+    return ModalDamping(B=on_device(B), c=c), tuple(table)
 
 
 def describe_damping(scene: Scene) -> list[str]:

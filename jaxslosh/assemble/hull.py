@@ -12,6 +12,7 @@ from ..hydro.spectra import components, wavenumber
 from ..physics.about import About
 from ..physics.hull import HullPressure, IncidentWaves
 from ..physics.vessel import RESTORING_FORMS, AbstractRestoring, Weight
+from ..staging import on_device
 from .about import hull_about
 
 
@@ -69,9 +70,9 @@ def incident_waves(scene, params: dict) -> IncidentWaves:
     c = components(w)
     b = c.each_heading()
     key = w.height_key
-    return IncidentWaves(jnp.asarray(c.omega), jnp.asarray(wavenumber(c.omega, g, w.depth)),
-                         jnp.asarray(c.amplitude / w.height), jnp.asarray(c.phase), jnp.asarray(np.cos(b)),
-                         jnp.asarray(np.sin(b)), jnp.asarray(params.get(key, w.height), dtype=float),
+    return IncidentWaves(on_device(c.omega), on_device(wavenumber(c.omega, g, w.depth)),
+                         on_device(c.amplitude / w.height), on_device(c.phase), on_device(np.cos(b)),
+                         on_device(np.sin(b)), jnp.asarray(params.get(key, w.height), dtype=float),
                          depth=None if w.depth is None else float(w.depth), ramp=float(w.ramp))
 
 
@@ -108,7 +109,7 @@ def hull_term(scene, hull, params: dict, g, key: str = "vessel.hull", place=None
         z_water = -cog[2]
         shift = jnp.asarray(hull.cog, dtype=float) - cog
     at = None if place is None else jnp.asarray([place[0], place[1], 0.0], dtype=float)
-    return HullPressure(jnp.asarray(tris), rho, g, z_water, inc, shift,
+    return HullPressure(on_device(tris), rho, g, z_water, inc, shift,
                         about=hull_about(scene, waves is not None, hull), place=at)
 
 

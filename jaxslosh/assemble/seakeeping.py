@@ -14,6 +14,7 @@ from .hull import froude_krylov_hull, hull_pressure
 from ..hydro.spectra import components
 from ..hydro.tables import matrix6
 from ..physics.seakeeping import AddedMass, Excitation, LinearDamping, Memory, RadiationMemory, WaveExcitation
+from ..staging import on_device
 
 
 def memory_module(fit: RadiationFit) -> Optional[Memory]:
@@ -35,13 +36,13 @@ def memory_of(fits, N: int) -> Optional[Memory]:
     for f, ix in fits:
         c[np.asarray(ix), k:k + f.p.size] = f.c
         k += f.p.size
-    return Memory(jnp.asarray(p.real), jnp.asarray(p.imag), jnp.asarray(sel), jnp.asarray(c.real), jnp.asarray(c.imag))
+    return Memory(on_device(p.real), on_device(p.imag), on_device(sel), on_device(c.real), on_device(c.imag))
 
 
 def make_excitation(waves, X, height) -> Excitation:
     """From the components of `waves` and X (N, 6): the force of each component per unit `height`."""
     omega, amp, phase = excitation_arrays(waves, components(waves), X)
-    return Excitation(jnp.asarray(omega), jnp.asarray(amp), jnp.asarray(phase), jnp.asarray(height, dtype=float),
+    return Excitation(on_device(omega), on_device(amp), on_device(phase), jnp.asarray(height, dtype=float),
                       ramp=float(waves.ramp))
 
 

@@ -69,12 +69,12 @@ def _dot(x, u):
     return x[..., 0, :] * u[0] + x[..., 1, :] * u[1] + x[..., 2, :] * u[2]
 
 
-def cross3(a, b):
+def cross3(a, b, xp=jnp):
     """a x b for coordinate-major vectors (3, ...)."""
-    return jnp.stack([a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]])
+    return xp.stack([a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]])
 
 
-def _split(P, d):
+def _split(P, d, xp=jnp):
     """The cut of each triangle of P (3, 3, n) with signed heights d (3, n): its vertices rotated so
     that v0 is the odd one (below when one is, above when two are; orientation kept), their
     heights, the fractions t1, t2 of the edges v0 v1 and v0 v2 where the plane cuts them (0 when it
@@ -82,19 +82,19 @@ def _split(P, d):
     below = d <= 0.0
     count = below.sum(axis=0)
     one, two = count == 1, count == 2
-    odd = jnp.where(one, below, ~below)
+    odd = xp.where(one, below, ~below)
     s0, s1 = odd[0], odd[1]
 
     def rotate(x):
         x0, x1, x2 = x[0], x[1], x[2]
-        return (jnp.where(s0, x0, jnp.where(s1, x1, x2)), jnp.where(s0, x1, jnp.where(s1, x2, x0)),
-                jnp.where(s0, x2, jnp.where(s1, x0, x1)))
+        return (xp.where(s0, x0, xp.where(s1, x1, x2)), xp.where(s0, x1, xp.where(s1, x2, x0)),
+                xp.where(s0, x2, xp.where(s1, x0, x1)))
     v, dd = rotate(P), rotate(d)
     cut = one | two
     # in the cut cases d0 lies strictly on the other side of d1 and d2 (or on the plane with them
     # above), so d0 - d1 and d0 - d2 do not vanish; elsewhere the safe 1 keeps gradients finite
-    t1 = jnp.where(cut, dd[0] / jnp.where(cut, dd[0] - dd[1], 1.0), 0.0)
-    t2 = jnp.where(cut, dd[0] / jnp.where(cut, dd[0] - dd[2], 1.0), 0.0)
+    t1 = xp.where(cut, dd[0] / xp.where(cut, dd[0] - dd[1], 1.0), 0.0)
+    t2 = xp.where(cut, dd[0] / xp.where(cut, dd[0] - dd[2], 1.0), 0.0)
     return v, t1, t2, (one, two, count == 3)
 
 
@@ -113,24 +113,25 @@ def cut_pieces(P, u, off):
     return a, (i01, v2, i02), (one | two | three).astype(dtype), two.astype(dtype)
 
 
-def lid_integrals(P, u, off, second=True):
+def lid_integrals(P, u, off, second=True, xp=jnp):
     """(V, m, A, s, J) of the closed surface P (3, 3, n) (`panels`) cut by the plane u . x = off (u
     of unit length): the volume below and its first moment int x dV, the area, first moment and
     second moment int x x^T dA of the lid; J is None when `second` is False. See the module's
-    docstring."""
-    v, t1, t2, (one, two, three) = _split(P, _dot(P, u) - off)
+    docstring. `xp=np` evaluates it in NumPy (concrete inputs: a build step's hull at rest, which
+    op by op in JAX compiled some sixty tiny programs)."""
+    v, t1, t2, (one, two, three) = _split(P, _dot(P, u) - off, xp)
     v0, v1, v2 = v
     p0, p1, p2 = P[0], P[1], P[2]
-    k = _dot(p0, cross3(p1 - p0, p2 - p0)) / 6.0           # 1/3 (x . N) dS over the whole panel
+    k = _dot(p0, cross3(p1 - p0, p2 - p0, xp)) / 6.0           # 1/3 (x . N) dS over the whole panel
     # the small triangle at v0 has the fraction t1 t2 of the panel's area; two below: the panel less it
-    small = jnp.where(one, t1 * t2, jnp.where(two, -t1 * t2, 0.0))
+    small = xp.where(one, t1 * t2, xp.where(two, -t1 * t2, 0.0))
     whole = (two | three).astype(P.dtype)
     i01 = v0 + t1 * (v1 - v0)
     i02 = v0 + t2 * (v2 - v0)
     # the lid's boundary runs i02 -> i01 where one vertex is below, i01 -> i02 where two are; the
     # fan triangle (o, start, end) from o = off u has the area u . (start x end) / 2
-    half = jnp.where(one, 0.5, jnp.where(two, -0.5, 0.0))
-    a = half * _dot(cross3(i02, i01), u)
+    half = xp.where(one, 0.5, xp.where(two, -0.5, 0.0))
+    a = half * _dot(cross3(i02, i01, xp), u)
     o = off * u
     ends = i01 + i02
     rows = [((whole + small) * k)[None], (whole * (p0 + p1 + p2) + small * (v0 + i01 + i02)) * (0.25 * k),
@@ -138,11 +139,11 @@ def lid_integrals(P, u, off, second=True):
     if second:
         pairs = ((0, 0), (1, 1), (2, 2), (0, 1), (0, 2), (1, 2))
         f = o[:, None] + ends
-        rows.append(jnp.stack([a * (i01[i] * i01[j] + i02[i] * i02[j] + f[i] * f[j]) for i, j in pairs]))
+        rows.append(xp.stack([a * (i01[i] * i01[j] + i02[i] * i02[j] + f[i] * f[j]) for i, j in pairs]))
     # the sums over the triangles as one product with ones: XLA's CPU reduction of the stacked rows
     # along n cost as much as the clipping before it (a quarter of the call with the second moments)
-    rows = jnp.concatenate(rows)
-    tot = rows @ jnp.ones(rows.shape[-1], rows.dtype)
+    rows = xp.concatenate(rows)
+    tot = rows @ xp.ones(rows.shape[-1], rows.dtype)
     A = tot[4]
     s = (A * o + tot[5:8]) / 3.0
     V = tot[0] + off * A / 3.0
@@ -150,8 +151,8 @@ def lid_integrals(P, u, off, second=True):
     if not second:
         return V, m, A, s, None
     j = tot[8:14]
-    J = (jnp.stack([jnp.stack([j[0], j[3], j[4]]), jnp.stack([j[3], j[1], j[5]]), jnp.stack([j[4], j[5], j[2]])])
-         + A * jnp.outer(o, o)) / 12.0
+    J = (xp.stack([xp.stack([j[0], j[3], j[4]]), xp.stack([j[3], j[1], j[5]]), xp.stack([j[4], j[5], j[2]])])
+         + A * xp.outer(o, o)) / 12.0
     return V, m, A, s, J
 
 

@@ -78,11 +78,10 @@ def rest_hydrostatics(tris, z_water, rho=1025.0, g=9.81) -> dict:
     with the lid's (waterplane's) integrals: K33 = rho g A_w, K44 = rho g (int y^2 dA + V z_B) =
     rho g V GM_T, K55 = rho g (int x^2 dA + V z_B) = rho g V GM_L (the frame at the COG), and the
     centre of buoyancy (body frame). Host-side floats, in float64 whatever the session's setting:
-    the loader calls it before the command line switches JAX to float64, so it uses no program
-    that the run traces again (a constant cached in float32 would then meet float64 indices)."""
-    with jax.enable_x64(True):
-        V, m, area, s, J = (np.asarray(x) for x in lid_integrals(
-            panels(np.asarray(tris, dtype=np.float64)), jnp.array([0.0, 0.0, 1.0]), jnp.asarray(float(z_water))))
+    evaluated in NumPy (the loader calls it before the command line switches JAX to float64, and op
+    by op in JAX the clipping compiled some sixty tiny programs)."""
+    P = np.moveaxis(np.asarray(tris, dtype=np.float64), 0, -1)         # panels(), in NumPy
+    V, m, area, s, J = lid_integrals(P, np.array([0.0, 0.0, 1.0]), np.float64(z_water), xp=np)
     V = float(V)
     safe = V if V > 0 else 1.0
     return {"waterplane_area": float(area), "displaced_volume": V,

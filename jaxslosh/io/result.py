@@ -18,6 +18,7 @@ import jax
 import numpy as np
 
 from .._version import __version__
+from ..staging import on_device
 from .line_energy import LINE_ENERGY, line_energy_of
 from .output import OutputLock, ensure_room
 from .status import TEXT, Failure, RunResult, Status, code_of, failure_text, is_traced as _is_traced, outcome_of
@@ -487,8 +488,8 @@ def load_result(path: str) -> Result:
 
 
 def truncated(r: Result, n: int) -> Result:
-    """The first n frames of a result."""
-    cut = lambda x: x[:n]  # noqa: E731
+    """The first n frames of a result (concrete arrays cut in NumPy: eagerly each leaf compiled a program)."""
+    cut = lambda x: x[:n] if _is_traced(x) or not isinstance(x, jax.Array) else on_device(np.asarray(x)[:n])  # noqa: E731
     return dataclasses.replace(
         r, time=cut(r.time), vessel=jax.tree_util.tree_map(cut, r.vessel),
         probes={k: jax.tree_util.tree_map(cut, p) for k, p in r.probes.items()},
@@ -496,5 +497,4 @@ def truncated(r: Result, n: int) -> Result:
         tanks={k: TankField(t.nodes, t.elements, cut(t.displacement)) for k, t in r.tanks.items()},
         mooring=None if r.mooring is None else {k: jax.tree_util.tree_map(cut, m) for k, m in r.mooring.items()},
         bodies=None if r.bodies is None else {k: jax.tree_util.tree_map(cut, m) for k, m in r.bodies.items()},
-        connections=None if r.connections is None else {k: jax.tree_util.tree_map(cut, m)
-                                                        for k, m in r.connections.items()})
+        connections=None if r.connections is None else {k: jax.tree_util.tree_map(cut, m) for k, m in r.connections.items()})

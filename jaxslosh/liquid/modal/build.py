@@ -12,6 +12,7 @@ from jax.scipy.linalg import block_diag as jax_block_diag
 from scipy.linalg import block_diag
 
 from ...scene.types import SceneError
+from ...staging import on_device
 from ..block import LiquidBlock, host_block
 from ..face.element import FaceModel, face_basis, face_invariants
 from ..face.stack import face_scales
@@ -130,12 +131,13 @@ def reduce_liquid(models, concrete_models, origins, offsets, reductions, scales=
             Q2[k:k + mt, k:k + mt] = Q2t
         k += mt
     block_diag_ = jax_block_diag if traced else block_diag
+    dev = on_device          # NumPy results onto the device without a compile per shape (jnp.asarray's)
     liquid = ModalLiquid(
-        r=jnp.asarray(xp.concatenate(rs)), m_nodes=jnp.asarray(xp.concatenate(ms)), U=jnp.asarray(U),
-        mass=jnp.asarray(mass), S0=jnp.asarray(S0), U1=jnp.asarray(xp.concatenate(U1s)), Q0=jnp.asarray(Q0),
-        Q1=jnp.asarray(xp.concatenate(Q1s)), Q2=jnp.asarray(Q2), Mr=jnp.asarray(block_diag_(*Mr_blocks)),
-        Kr=jnp.asarray(block_diag_(*Kr_blocks)), row_scale=jnp.asarray(np.concatenate(row_scales)), n_nodes=N)
-    penalty = (jnp.asarray(xp.concatenate(Kdt_rows)), jnp.asarray(Ktt)) if coupled else None
+        r=dev(xp.concatenate(rs)), m_nodes=dev(xp.concatenate(ms)), U=dev(U),
+        mass=dev(mass), S0=dev(S0), U1=dev(xp.concatenate(U1s)), Q0=dev(Q0),
+        Q1=dev(xp.concatenate(Q1s)), Q2=dev(Q2), Mr=dev(block_diag_(*Mr_blocks)),
+        Kr=dev(block_diag_(*Kr_blocks)), row_scale=dev(np.concatenate(row_scales)), n_nodes=N)
+    penalty = (dev(xp.concatenate(Kdt_rows)), dev(Ktt)) if coupled else None
     return liquid, penalty
 
 

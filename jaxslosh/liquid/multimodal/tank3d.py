@@ -134,8 +134,9 @@ class ModalTank3D(eqx.Module):
         J = I.m2 + jnp.outer(o, m1) + jnp.outer(m1, o) + I.vol * jnp.outer(o, o)
         return self.rho * (m1 + I.vol * o), self.rho * J
 
-    def rates(self, I: Integrals3, beta_dot, omega=jnp.zeros(3)):
-        """The potential's amplitudes R from the projected kinematic condition."""
+    def rates(self, I: Integrals3, beta_dot, omega=np.zeros(3)):
+        """The potential's amplitudes R from the projected kinematic condition. (The default is a
+        NumPy constant: a jnp one compiled two programs at every import of the package.)"""
         return jnp.linalg.solve(I.Ank, I.Jn @ beta_dot - I.Bw @ omega)
 
     def mass_matrix(self, beta):
