@@ -23,6 +23,7 @@ from ..assemble.bodyhydro import frequency_terms
 from ..assemble.hull import froude_krylov_hull, hull_pressure
 from ..hydro.source import excitation_at, tables_of
 from ..hydro.tables import interpolate_radiation
+from ..physics.bodies import BAND, body_rest
 from ..scene.types import Scene, SceneError
 from ..run.simulate import is_traced
 from .linear import Linearisation, linearise
@@ -99,6 +100,33 @@ def across_tank_warnings(scene: Scene, headings) -> list:
     shown = ", ".join(f"{np.degrees(b):.0f}" for b in across[:4]) + (", ..." if across.size > 4 else "")
     return [f"tanks[{i}] {t.name!r}: {why}" for i, t in enumerate(scene.tanks)
             if (why := t.form.across_seas_warning(shown))]
+
+
+def contact_warnings(scene: Scene) -> list:
+    """One line per hawser or fender that sits at rest within its contact's smoothing band
+    (physics/bodies.py BAND, docs/guide/bodies-and-connections.md): the RAOs, linear about rest,
+    see there the smoothing's stiffness, between none and the connection's own (3/8 of it at its
+    length), where the rope is neither slack nor taut; a pretension or a gap beyond the band decides."""
+    cog = scene.vessel.cog_height
+    rest = {b.name: (body_rest(b, cog), b.heading) for b in scene.bodies}
+
+    def at_rest(end, p):           # the vessel at rest: its COG the origin, level; a fixed point as given
+        if end not in rest:
+            return np.asarray(p, dtype=float)
+        X, psi = rest[end]
+        c, s = np.cos(psi), np.sin(psi)
+        return X + np.array([[c, -s, 0.0], [s, c, 0.0], [0.0, 0.0, 1.0]]) @ np.asarray(p, dtype=float)
+    inside = []
+    for i, c in enumerate(scene.connections):
+        e = np.linalg.norm(at_rest(c.ends[1], c.points[1]) - at_rest(c.ends[0], c.points[0])) - c.length
+        if c.kind != "spring" and abs(e) < 0.5 * BAND:
+            inside.append(f"{c.name!r} ({c.kind}, {1e3 * e:+.3f} mm)")
+    if not inside:
+        return []
+    return [f"{len(inside)} connection(s) at rest within their contact's smoothing band (+-{500 * BAND:g} mm from "
+            f"their length): {', '.join(inside)}; the RAOs, linear about rest, see the smoothing's stiffness "
+            "there (3/8 of their own at their length); a pretension or a gap beyond the band gives them their own "
+            "stiffness or none"]
 
 
 def default_frequencies(scene: Scene, tables=None, radiation=None, count: int = DEFAULT_COUNT):

@@ -7,7 +7,7 @@ import time
 
 import numpy as np
 
-from ..analysis.rao import across_tank_warnings, rao
+from ..analysis.rao import across_tank_warnings, contact_warnings, rao
 from ..io.output import OutputError, check_output
 from ..io.rao import RAO_FORMAT, write_rao
 from ..plot.rao import plot_rao
@@ -85,7 +85,7 @@ def cmd_rao(a):
     write_rao(out, r.frequency, r.heading, r.vessel, r.probes, scene.text, r.bodies)
     if replaced:
         print(f"note: replaced {out}", file=sys.stderr)
-    for line in across_tank_warnings(scene, r.heading):
+    for line in across_tank_warnings(scene, r.heading) + contact_warnings(scene):
         print(f"warning: {line}", file=sys.stderr)
     print(f"{'heading deg':>11} {'channel':>14} {'peak amplitude':>15} {'at rad/s':>9}")
     for h, beta in enumerate(r.heading):
