@@ -35,7 +35,7 @@ import numpy as np
 from ..io.line_energy import LINE_ENERGY
 from ..io.status import is_traced
 from ..physics.about import held_by
-from ..physics.bodies import VESSEL, bodies_term, body_rest, end_index, weight_balanced
+from ..physics.bodies import VESSEL, bodies_term, body_rest, end_index, frame_slots, point_motion, weight_balanced
 from ..physics.kinematics import quat_from_rpy, rotation_matrix
 from ..physics.terms import AbstractTerm, Config, Kin, Rows
 from . import lumped as lm
@@ -43,16 +43,9 @@ from ..scene.types import SceneError
 from .lumped_keys import LUMPED_KEYS, LUMPED_TRACEABLE, read_lumped  # noqa: F401  (the loader's reader, JAX-free)
 
 
-def _point(p_b, pose):
-    """The inertial position and velocity of the point p_b of a body at `pose` = (X, A, V, W): its COG,
-    rotation matrix, COG velocity (inertial) and angular velocity (body frame)."""
-    X, A, V, W = pose
-    return X + A @ p_b, V + A @ jnp.cross(W, p_b)
-
-
 def _fairlead(p_b, c: Config, V0, omega):
     """The fairlead's inertial position and velocity for the vessel's point p_b."""
-    return _point(p_b, (c.X0, rotation_matrix(c.q), V0, omega))
+    return point_motion(p_b, (c.X0, rotation_matrix(c.q), V0, omega))
 
 
 class LumpedLineTerm(AbstractTerm):
@@ -91,9 +84,9 @@ class LumpedLineTerm(AbstractTerm):
                                (c_new.X0, rotation_matrix(c_new.q), v_new[:3], v_new[3:6]), coef)
 
     def advance_at(self, z, pose_old, pose_new, coef):
-        """The states at t_{n+1}, its body at `pose_old` at t_n and `pose_new` at t_{n+1} (_point's poses)."""
-        p0, u0 = _point(self.fairlead, pose_old)
-        p1, u1 = _point(self.fairlead, pose_new)
+        """The states at t_{n+1}, its body at `pose_old` at t_n and `pose_new` at t_{n+1} (physics/bodies.py point_motion's poses)."""
+        p0, u0 = point_motion(self.fairlead, pose_old)
+        p1, u1 = point_motion(self.fairlead, pose_new)
         s = lm.advance(self.line, self.split(z), p0, u0, p1, u1, coef, self.substeps)
         return jnp.concatenate([s.r.reshape(-1), s.v.reshape(-1), jnp.stack([s.dissipated, s.work])])
 
@@ -104,8 +97,8 @@ class LumpedLineTerm(AbstractTerm):
         return self.force_at((c.X0, rotation_matrix(c.q), V0, omega), z)
 
     def force_at(self, pose, z):
-        """`force` with its body at `pose` (_point's)."""
-        p, u = _point(self.fairlead, pose)
+        """`force` with its body at `pose` (point_motion's)."""
+        p, u = point_motion(self.fairlead, pose)
         s = self.split(z)
         return lm.fairlead_force(self.line, s.r, s.v, p, u)
 
@@ -177,7 +170,7 @@ class LumpedLines(AbstractTerm):
         if c.Xs is None or v.shape[0] < 6 + 6 * S:
             raise ValueError("lumped lines on bodies need the bodies' poses and velocities (the step's)")
         vs = v[6:6 + 6 * S].reshape(S, 6)
-        idx = np.array([0 if e == VESSEL else 1 + e for e in self.ends])
+        idx = frame_slots(self.ends)
         every = (jnp.concatenate([c.X0[None], c.Xs]), jnp.concatenate([A[None], jax.vmap(rotation_matrix)(c.qs)]),
                  jnp.concatenate([v[None, :3], vs[:, :3]]), jnp.concatenate([v[None, 3:6], vs[:, 3:]]))
         return tuple(x[idx] for x in every), 0
@@ -202,7 +195,7 @@ class LumpedLines(AbstractTerm):
         rigid = jax.vmap(lambda t, zi, p: t.rows_at(p, zi), in_axes=(0, 0, ax))(self.stacked(), k.z, pose)
         if not self.on_bodies:
             return Rows(jnp.sum(rigid, axis=0))
-        slot = np.array([0 if e == VESSEL else 1 + e for e in self.ends])
+        slot = frame_slots(self.ends)
         per = jax.ops.segment_sum(rigid, slot, num_segments=self.n_bodies + 1)
         return Rows(per[0], frames=per[1:].reshape(-1))
 
@@ -211,7 +204,7 @@ class LumpedLines(AbstractTerm):
         the lines (the energies: lm.energies, the dissipated work and the fairlead's); `v` the rigid
         velocities of every frame (`poses`)."""
         def one(t, zi, pose):
-            p, u = _point(t.fairlead, pose)
+            p, u = point_motion(t.fairlead, pose)
             s = t.split(zi)
             parts = dict(lm.energies(t.line, s.r, s.v, p), dissipated=s.dissipated, fairlead_work=s.work)
             return (jnp.linalg.norm(lm.fairlead_force(t.line, s.r, s.v, p, u)),

@@ -25,7 +25,7 @@ import jax.numpy as jnp
 import numpy as np
 
 from ..physics.about import About, held_by
-from ..physics.bodies import VESSEL, body_rest, end_index, weight_balanced
+from ..physics.bodies import VESSEL, body_rest, end_index, frame_slots, weight_balanced
 from ..physics.kinematics import quat_from_rpy, rotation_matrix
 from ..physics.terms import AbstractTerm, Config, Kin, Rows
 from .catenary import lines_inverse, lines_settle, lines_spans, profile, solve_lines
@@ -85,7 +85,7 @@ class MooringLines(AbstractTerm):
         if c.Xs is None:
             vessel = np.array([e == VESSEL for e in self.ends])
             return jnp.where(vessel[:, None], c.X0, self.rest_X), jnp.where(vessel[:, None, None], A, self.rest_A)
-        idx = np.array([0 if e == VESSEL else 1 + e for e in self.ends])
+        idx = frame_slots(self.ends)
         As = jax.vmap(rotation_matrix)(c.qs)
         return jnp.concatenate([c.X0[None], c.Xs])[idx], jnp.concatenate([A[None], As])[idx]
 
@@ -124,7 +124,7 @@ class MooringLines(AbstractTerm):
         the vessel (first) and on each body, carried forces included; X, A per line (`frames`)."""
         s = self.state(X, A, guess, inverse, fallback, at)
         moment = jnp.einsum("nji,nj->ni", A, jnp.cross(s.fairlead - X, s.force))
-        slot = np.array([0 if e == VESSEL else 1 + e for e in self.ends])
+        slot = frame_slots(self.ends)
         per = jax.ops.segment_sum(jnp.concatenate([s.force, moment], axis=1), slot, num_segments=self.n_bodies + 1)
         carried = jnp.concatenate([self.carried[None], self.carried_bodies])
         return per.at[:, :3].add(carried)
@@ -200,7 +200,7 @@ def build_mooring(scene, balanced: bool, outline: bool = False, params: Optional
     on_bodies = any(e != VESSEL for e in ends)
     held = {}
     if on_bodies:
-        slot = np.array([0 if e == VESSEL else 1 + e for e in ends])
+        slot = frame_slots(ends)
         rest = np.concatenate([np.zeros((1, 3))] + [body_rest(b, cog)[None] for b in scene.bodies])
         turn = jnp.stack([jnp.eye(3)] + [rotation_matrix(quat_from_rpy(jnp.array([0.0, 0.0, b.heading])))
                                           for b in scene.bodies])

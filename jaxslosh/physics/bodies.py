@@ -73,6 +73,19 @@ def end_index(names) -> dict:
     return {n: s for s, n in enumerate(names)} | {"vessel": VESSEL, "fixed": FIXED}
 
 
+def point_motion(p, pose):
+    """The inertial position and velocity of a body's point p (its frame, from the COG) at `pose` =
+    (X, A, V, omega): COG, rotation matrix, COG velocity (inertial), angular velocity (body frame)."""
+    X, A, V, w = pose
+    return X + A @ p, V + A @ jnp.cross(w, p)
+
+
+def frame_slots(ends) -> np.ndarray:
+    """Each end's frame among the vessel's (0) and the bodies' (1 + slot), as a line's or a term's
+    rows are stacked per frame (the vessel's first)."""
+    return np.array([0 if e == VESSEL else 1 + e for e in ends], dtype=int)
+
+
 def body_rest(b, vessel_cog: float) -> np.ndarray:
     """(3,) a scene body's COG at rest in the vessel-at-rest frame (`vessel_cog`: the vessel's COG height)."""
     return np.array([b.position[0], b.position[1], b.cog_height - vessel_cog], dtype=float)
@@ -136,10 +149,7 @@ class Link(eqx.Module):
         """(tension T (> 0 pulls), extension e, U, the unit vector a -> b) of this link, `poses[end]`
         = (X, A, V, omega) (omega body frame)."""
         def point(end, p):
-            if end == FIXED:
-                return p, jnp.zeros(3)
-            X, A, V, w = poses[end]
-            return X + A @ p, V + A @ jnp.cross(w, p)
+            return (p, jnp.zeros(3)) if end == FIXED else point_motion(p, poses[end])
         return self.state_at(*point(self.ends[0], self.pa), *point(self.ends[1], self.pb))
 
     def state_at(self, Pa, Va, Pb, Vb):
